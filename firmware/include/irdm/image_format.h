@@ -1,0 +1,153 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * On-disk layout of an IRDM flash image.  Shared by the offline tools that
+ * write images and the firmware that maps them; it holds no code.
+ *
+ * An image is: a 64-byte header at offset 0, a section table, and payloads.
+ * Everything is little-endian, position independent (offsets from the file
+ * start, never pointers) and every payload starts on an IRDM_IMAGE_ALIGN
+ * boundary so it can be used in place from a read-only mapping.
+ * See docs/image-format.md for the full description.
+ */
+#ifndef IRDM_IMAGE_FORMAT_H
+#define IRDM_IMAGE_FORMAT_H
+
+#include <stdint.h>
+
+#define IRDM_IMAGE_MAGIC "IRDMIMG"          /* 7 chars + NUL = 8 bytes */
+#define IRDM_IMAGE_VERSION_MAJOR 1u         /* incompatible layout change */
+#define IRDM_IMAGE_VERSION_MINOR 0u         /* compatible additions */
+#define IRDM_IMAGE_ALIGN 64u                /* payload alignment, bytes */
+#define IRDM_IMAGE_MAX_SECTIONS 32u
+
+struct irdm_image_header {                  /* 64 bytes at offset 0 */
+	uint8_t  magic[8];                  /* IRDM_IMAGE_MAGIC incl. NUL */
+	uint16_t version_major;
+	uint16_t version_minor;
+	uint32_t header_size;               /* sizeof(struct irdm_image_header) */
+	uint64_t file_size;                 /* whole file, bytes */
+	uint32_t section_count;             /* 1..IRDM_IMAGE_MAX_SECTIONS */
+	uint32_t section_table_offset;      /* bytes, multiple of IRDM_IMAGE_ALIGN */
+	uint32_t flags;                     /* reserved, 0 */
+	uint32_t table_crc32c;              /* CRC-32C of the section table */
+	uint8_t  reserved[20];              /* 0 */
+	uint32_t header_crc32c;             /* CRC-32C of bytes [0, 60) */
+};
+
+/* Element type of a section's payload (also the storage precision of
+ * response data). */
+enum irdm_elem {
+	IRDM_ELEM_BYTES = 0,                /* structs or text */
+	IRDM_ELEM_F16 = 1,                  /* IEEE 754 binary16 */
+	IRDM_ELEM_F32 = 2,
+	IRDM_ELEM_F64 = 3,
+	IRDM_ELEM_U32 = 4,
+};
+
+struct irdm_image_section {                 /* 32 bytes each */
+	uint32_t kind;                      /* enum irdm_section_kind */
+	uint32_t elem;                      /* enum irdm_elem */
+	uint64_t offset;                    /* from file start, aligned */
+	uint64_t size;                      /* payload bytes */
+	uint32_t crc32c;                    /* CRC-32C of the payload */
+	uint32_t reserved;                  /* 0 */
+};
+
+enum irdm_section_kind {
+	IRDM_SEC_META = 1,         /* struct irdm_meta, always present */
+	IRDM_SEC_PROVENANCE = 2,   /* UTF-8 "key=value\n" lines, always present */
+	IRDM_SEC_NODES = 3,        /* n_nodes x struct irdm_node (the rows) */
+	IRDM_SEC_COLUMNS = 4,      /* n_cols x u32: node index of each touchable node */
+	IRDM_SEC_SURFACE = 5,      /* n_tris x 3 u32 node indices, outward (CCW seen from outside) */
+	IRDM_SEC_FIR = 6,          /* FIR only: R[s] blocks [col][row][s][3][3], elem = precision */
+	IRDM_SEC_MODES = 7,        /* modal only: n_modes x struct irdm_mode */
+	IRDM_SEC_MODE_SHAPES = 8,  /* modal only: [row][3][mode], elem = precision */
+	IRDM_SEC_STATIC_CORR = 9,  /* modal, optional: residual compliance [col][row][3][3] */
+	IRDM_SEC_RIGID = 10,       /* floating only: struct irdm_rigid */
+	IRDM_SEC_STABILITY = 11,   /* n_cols x struct irdm_stability */
+	IRDM_SEC_CONTACT_BVH = 12, /* reserved for the contact acceleration structure */
+};
+
+enum irdm_repr {
+	IRDM_REPR_FIR = 1,
+	IRDM_REPR_MODAL = 2,
+};
+
+enum irdm_meta_flags {
+	IRDM_META_FLOATING = 1u << 0,       /* non-grounded: RIGID present */
+	IRDM_META_STATIC_CORR = 1u << 1,    /* STATIC_CORR present */
+	IRDM_META_CONSISTENT_MASS = 1u << 2,
+	IRDM_META_TIME_DOMAIN = 1u << 3,    /* FIR computed by time integration */
+};
+
+struct irdm_meta {                          /* 256 bytes */
+	uint32_t representation;            /* enum irdm_repr */
+	uint32_t precision;                 /* enum irdm_elem of FIR/MODE_SHAPES/STATIC_CORR */
+	uint32_t n_nodes;                   /* rows: nodes the image holds */
+	uint32_t n_cols;                    /* touchable nodes (columns) */
+	uint32_t n_tris;                    /* surface triangles */
+	uint32_t fir_length;                /* T, FIR only (else 0) */
+	uint32_t n_modes;                   /* modal only: modes stored (else 0) */
+	uint32_t flags;                     /* enum irdm_meta_flags */
+	double   dt_s;                      /* sample period */
+	double   young_pa;
+	double   poisson;
+	double   density_kg_m3;
+	double   rayleigh_a_per_s;          /* C = a M + b K */
+	double   rayleigh_b_s;
+	double   damping_ratio[2];          /* as requested; 0 when a, b given */
+	double   damping_freq_hz[2];
+	double   max_spectral_radius;       /* max over STABILITY entries */
+	double   first_elastic_hz;          /* lowest elastic natural frequency */
+	uint32_t mesh_nodes;                /* of the whole source mesh */
+	uint32_t mesh_tets;
+	uint32_t n_modes_total;             /* elastic modes of the whole model */
+	uint32_t reserved0;
+	uint64_t mesh_hash;                 /* FNV-1a 64 of positions and tets */
+	char     tool_version[32];          /* NUL-terminated */
+	char     mesh_name[64];             /* NUL-terminated */
+	uint8_t  reserved[8];               /* 0 */
+};
+
+struct irdm_node {                          /* 16 bytes */
+	float    pos_m[3];                  /* rest position, object frame */
+	uint32_t mesh_node;                 /* index in the source mesh (0-based) */
+};
+
+/*
+ * One mode q'' + 2 zeta omega q' + omega^2 q = phi^T f, discretised exactly
+ * under zero-order hold: x[t+1] = A x[t] + b g[t], x = (q, q'), g = phi^T f.
+ * The displacement response of the mode is u[t] = phi x_q[t+1].
+ */
+struct irdm_mode {                          /* 64 bytes */
+	double omega_rad_s;
+	double zeta;
+	double a[4];                        /* row-major 2x2 */
+	double b[2];
+};
+
+struct irdm_rigid {                         /* floating objects only */
+	double mass_kg;
+	double com_m[3];                    /* rest centre of mass, object frame */
+	double inertia_kg_m2[9];            /* about the COM, row-major */
+	double reserved[3];
+};
+
+enum irdm_stability_flags {
+	IRDM_STAB_STABLE = 1u << 0,         /* spectral radius < 1 */
+};
+
+struct irdm_stability {                     /* 8 bytes, one per column */
+	float    spectral_radius;           /* of the single-contact force recursion */
+	uint32_t flags;                     /* enum irdm_stability_flags */
+};
+
+_Static_assert(sizeof(struct irdm_image_header) == 64, "header size");
+_Static_assert(sizeof(struct irdm_image_section) == 32, "section size");
+_Static_assert(sizeof(struct irdm_meta) == 256, "meta size");
+_Static_assert(sizeof(struct irdm_node) == 16, "node size");
+_Static_assert(sizeof(struct irdm_mode) == 64, "mode size");
+_Static_assert(sizeof(struct irdm_rigid) == 128, "rigid size");
+_Static_assert(sizeof(struct irdm_stability) == 8, "stability size");
+
+#endif /* IRDM_IMAGE_FORMAT_H */
