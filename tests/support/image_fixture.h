@@ -1,0 +1,74 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * Small, valid IRDM images for tests: a grid of nodes with deterministic
+ * response values that are exact in every precision (k/1024, |k| <= 500),
+ * so a test can compare what it maps with img_fixture_value() bit for bit.
+ *
+ *   struct img_fixture fx;
+ *   img_fixture_fir(&fx, IRDM_ELEM_F32, 6, 2, 4);   (nodes, cols, T)
+ *   fx.meta.dt_s = 0;                             (tamper if you like)
+ *   img_fixture_write(&fx, path, err, sizeof(err));
+ *   img_fixture_free(&fx);
+ *
+ * Every array is owned by the fixture and may be changed before writing;
+ * changing a count in meta does not change what is written for the arrays.
+ */
+#ifndef IRDM_TESTS_IMAGE_FIXTURE_H
+#define IRDM_TESTS_IMAGE_FIXTURE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "irdm/image.h"
+#include "image/image_writer.h"
+
+struct img_fixture {
+	struct irdm_meta meta;
+	char provenance[256];
+	size_t provenance_len;
+	struct irdm_node *nodes;            /* n_nodes */
+	uint32_t *columns;                  /* n_cols */
+	uint32_t *tris;                     /* 3 * n_tris */
+	void *fir;                          /* FIR: fir_bytes */
+	struct irdm_mode *modes;            /* modal: n_modes */
+	void *mode_shapes;                  /* modal: shapes_bytes */
+	void *static_corr;                  /* modal + STATIC_CORR: corr_bytes */
+	struct irdm_rigid rigid;            /* written iff FLOATING */
+	struct irdm_stability *stability;   /* n_cols */
+	/* Sizes of the arrays as built: what img_fixture_add() writes, so
+	 * tampering with meta counts never makes it read past an array. */
+	uint64_t nodes_bytes, columns_bytes, tris_bytes, stability_bytes;
+	uint64_t fir_bytes, modes_bytes, shapes_bytes, corr_bytes;
+};
+
+/* Grounded FIR image.  Returns 0, -1 when out of memory. */
+int img_fixture_fir(struct img_fixture *fx, uint32_t precision,
+		    uint32_t n_nodes, uint32_t n_cols, uint32_t fir_length);
+
+/* Modal image; meta_flags may hold IRDM_META_FLOATING and
+ * IRDM_META_STATIC_CORR.  Modes are exact ZOH discretisations. */
+int img_fixture_modal(struct img_fixture *fx, uint32_t precision,
+		      uint32_t n_nodes, uint32_t n_cols, uint32_t n_modes,
+		      uint32_t meta_flags);
+
+void img_fixture_free(struct img_fixture *fx);
+
+/* Value stored at element i of section kind (FIR, MODE_SHAPES, STATIC_CORR). */
+double img_fixture_value(uint32_t kind, uint64_t i);
+
+/* Add every section the fixture holds (by meta) to w. */
+void img_fixture_add(const struct img_fixture *fx, struct irdm_image_writer *w);
+
+int img_fixture_buffer(const struct img_fixture *fx, void **buf, size_t *size);
+int img_fixture_write(const struct img_fixture *fx, const char *path,
+		      char *err, size_t errlen);
+
+/* Recompute every checksum of an image in memory after tampering, so that a
+ * test reaches the check it means to trigger.  Entries that point outside
+ * the buffer are left alone. */
+void img_fixture_reseal(void *buf, size_t size);
+
+/* An 8-aligned malloc'd copy of len bytes (ASan sees any overread). */
+void *img_fixture_copy(const void *buf, size_t len);
+
+#endif /* IRDM_TESTS_IMAGE_FIXTURE_H */

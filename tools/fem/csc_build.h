@@ -1,0 +1,18 @@
+/* SPDX-License-Identifier: MIT */
+/* Building CSC matrices from (row, col, value) triplets. */
+#ifndef IRDM_TOOLS_CSC_BUILD_H
+#define IRDM_TOOLS_CSC_BUILD_H
+
+#include "fem/fem.h"
+
+struct irdm_triplet {
+	int64_t row;
+	int64_t col;
+	double val;
+};
+
+/* Consumes (sorts) t.  Returns 0 or -1 on allocation failure. */
+int irdm_csc_from_triplets(size_t n, struct irdm_triplet *t, size_t nt,
+			   struct irdm_csc *a);
+
+#endif

@@ -1,0 +1,63 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * Modal analysis: K phi = w^2 M phi over the free DoFs, rigid modes
+ * separated, eigenvectors M-orthonormal.  Two independent solvers: dense
+ * LAPACK (all modes) and shift-invert Lanczos (ARPACK on a CHOLMOD factor)
+ * for the lowest modes of large models.
+ */
+#ifndef IRDM_TOOLS_MODAL_H
+#define IRDM_TOOLS_MODAL_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+#include "fem/fem.h"
+#include "irdm/image_format.h"
+
+enum irdm_eig_method {
+	IRDM_EIG_AUTO = 0,      /* dense when small or all modes wanted, else Lanczos */
+	IRDM_EIG_DENSE = 1,
+	IRDM_EIG_LANCZOS = 2,
+};
+
+struct irdm_modes {
+	size_t  n;              /* vector length (free DoFs) */
+	size_t  n_modes;        /* elastic modes stored, ascending */
+	size_t  n_rigid;        /* rigid modes found and excluded */
+	size_t  n_elastic_total;/* elastic modes of the model: n - n_rigid */
+	double *omega2;         /* n_modes eigenvalues w^2 (rad^2/s^2) */
+	double *phi;            /* n x n_modes, column-major, Phi^T M Phi = I */
+	double *rigid_phi;      /* n x n_rigid (floating only) */
+};
+
+typedef void (*irdm_progress_fn)(void *ctx, const char *stage, double fraction);
+
+/*
+ * Solve for the lowest n_wanted elastic modes (0: all).  floating: expect 6
+ * rigid modes (eigenvalues below rigid_tol * w_max^2) and drop them.
+ * A grounded model that shows a zero eigenvalue is an error (a mechanism:
+ * not enough fixed nodes).
+ */
+int irdm_modes_solve(const struct irdm_fem *fem, size_t n_wanted, bool floating,
+		     enum irdm_eig_method method, irdm_progress_fn progress, void *ctx,
+		     struct irdm_modes *out, char *err, size_t errlen);
+void irdm_modes_free(struct irdm_modes *m);
+
+/* Internal solvers (exposed for tests: a second method to compare with). */
+int irdm_eig_dense(const struct irdm_fem *fem, size_t n_lowest, double *w2, double *phi,
+		   char *err, size_t errlen);
+int irdm_eig_lanczos(const struct irdm_fem *fem, size_t n_lowest, double sigma,
+		     irdm_progress_fn progress, void *ctx, double *w2, double *phi,
+		     char *err, size_t errlen);
+
+/*
+ * Exact zero-order-hold discretisation of q'' + 2 z w q' + w^2 q = g:
+ * x[t+1] = A x[t] + b g[t], x = (q, q').  Any z >= 0 (under-, critically,
+ * over-damped), any w >= 0 (w = 0: a free mass).
+ */
+void irdm_zoh_mode(double omega_rad_s, double zeta, double dt_s, struct irdm_mode *out);
+
+/* Scalar response h[s] = e1^T A^s b of one discretised mode, s < n. */
+void irdm_zoh_response(const struct irdm_mode *m, size_t n, double *h);
+
+#endif /* IRDM_TOOLS_MODAL_H */

@@ -1,0 +1,44 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * Impulse responses from modes.  A selection of DoFs is a list of free-DoF
+ * indices (or -1 for a fixed DoF, whose response is zero).
+ */
+#ifndef IRDM_TOOLS_RESPONSE_H
+#define IRDM_TOOLS_RESPONSE_H
+
+#include "modal/modal.h"
+
+/* Discretise every mode with its Rayleigh damping ratio. */
+int irdm_modes_discretise(const struct irdm_modes *m, const struct irdm_rayleigh *damp,
+			  double dt_s, struct irdm_mode *out);
+
+/*
+ * FIR blocks R[c][r][s] (3x3, [i][j] = row axis i, column axis j) for column
+ * nodes cols (3 DoFs each, free indices or -1) and row nodes rows, s < T:
+ *   R = sum_k phi_r,k phi_c,k^T h_k[s]  (+ D[c][r] at s = 0 when D != NULL).
+ * out has n_cols*n_rows*T*9 doubles, layout of the FIR section.
+ */
+int irdm_fir_from_modes(const struct irdm_modes *m, const struct irdm_mode *zoh,
+			const int64_t *col_dofs, size_t n_cols, const int64_t *row_dofs,
+			size_t n_rows, size_t T, const double *D, double *out,
+			irdm_progress_fn progress, void *ctx);
+
+/*
+ * Static correction: the compliance of the modes NOT kept,
+ *   D[c][r] = G[r][c] - sum_{kept k} phi_r,k phi_c,k^T / w_k^2,
+ * G = K^-1 (grounded) or the elastic compliance (floating: the compliance
+ * that ignores rigid motion, found by shifted solves with iterative
+ * refinement).  out: n_cols*n_rows*9, layout [c][r][i][j].
+ */
+int irdm_static_correction(const struct irdm_fem *fem, const struct irdm_modes *m,
+			   bool floating, const int64_t *col_dofs, size_t n_cols,
+			   const int64_t *row_dofs, size_t n_rows, double *out,
+			   char *err, size_t errlen);
+
+/* Full static compliance columns X (n x n_in) for free DoFs in[] (same
+ * meaning of G as above); exposed for tests and the static correction. */
+int irdm_compliance_solve(const struct irdm_fem *fem, const struct irdm_modes *m,
+			  bool floating, const int64_t *in, size_t n_in, double *X,
+			  char *err, size_t errlen);
+
+#endif

@@ -1,0 +1,42 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * Stability of the single-contact force recursion
+ *   R[0] F[t] = U[t] - sum_{s>=1} R[s] F[t-s]
+ * at one node: its spectral radius is the largest |z| with
+ * det(sum_s R[s] z^-s) = 0.  Below 1 the recursion is stable.
+ */
+#ifndef IRDM_TOOLS_STABILITY_H
+#define IRDM_TOOLS_STABILITY_H
+
+#include <stddef.h>
+
+#include "irdm/image_format.h"
+
+/* Bounds of the search; a radius outside is reported as the bound. */
+#define IRDM_STAB_RHO_MIN 0.5
+#define IRDM_STAB_RHO_MAX 2.0
+
+/*
+ * FIR, by the argument principle: the number of zeros of det Q(w),
+ * Q(w) = sum_s R[s] w^s, inside |w| < r is the winding number of det Q on
+ * that circle (FFT-evaluated, refined until no phase step exceeds pi/2);
+ * bisection on r gives rho = 1 / min |w|.  R: T blocks of 9 (row-major
+ * 3x3).  Returns a certified upper bound of rho (accurate to ~1e-6 unless a
+ * zero sits too close to the circle to resolve, then a looser bound).
+ */
+double irdm_stability_fir(const double *R, size_t T);
+
+/* The same by the eigenvalues of the 3(T-1) block companion matrix (dense
+ * LAPACK, O(T^3)); the reference for tests and small T.  -1 on failure. */
+double irdm_stability_fir_companion(const double *R, size_t T);
+
+/*
+ * Modal: eigenvalues of the closed-loop matrix (I - B R0^-1 C) A of the
+ * modal state recursion at one node (dimension 2K).  phi_c: 3 x K
+ * row-major (phi_c[i*K + k]); D: 3x3 static correction or NULL.  -1 on
+ * failure.
+ */
+double irdm_stability_modal(const struct irdm_mode *zoh, size_t K, const double *phi_c,
+			    const double *D);
+
+#endif

@@ -1,0 +1,198 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * Static compliance and the static correction of a truncated modal basis.
+ *
+ * Grounded: G = K^-1 by one sparse Cholesky factorisation.
+ * Floating: K is singular (rigid motion).  The elastic compliance G solves
+ * K x = P f with P = I - M Phi_r Phi_r^T removing the rigid part of the load
+ * and x M-orthogonal to the rigid modes.  We factor the definite K + eps M
+ * and refine: x <- (K + eps M)^-1 (P f + eps M x), which converges by
+ * eps / (w1^2 + eps) per step on elastic modes; eps = 1e-2 w1^2 keeps the
+ * factor well conditioned and reaches double precision in 8 steps.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cholmod.h>
+
+#include "modal/response.h"
+
+#define REFINE_STEPS 8
+
+static cholmod_sparse *upper_shifted(const struct irdm_fem *fem, double eps, cholmod_common *cc)
+{
+	size_t n = fem->K.n;
+	cholmod_triplet *t = cholmod_l_allocate_triplet(n, n, fem->K.nnz + fem->M.nnz, 1,
+							 CHOLMOD_REAL, cc);
+	const struct irdm_csc *mats[2] = { &fem->K, &fem->M };
+	double scale[2] = { 1.0, eps };
+	size_t k = 0;
+
+	if (!t)
+		return NULL;
+	for (int q = 0; q < 2; q++)
+		for (size_t j = 0; j < n && scale[q] != 0.0; j++)
+			for (int64_t p = mats[q]->colptr[j]; p < mats[q]->colptr[j + 1]; p++) {
+				if (mats[q]->rowind[p] > (int64_t)j)
+					continue;
+				((int64_t *)t->i)[k] = mats[q]->rowind[p];
+				((int64_t *)t->j)[k] = (int64_t)j;
+				((double *)t->x)[k++] = scale[q] * mats[q]->val[p];
+			}
+	t->nnz = k;
+	cholmod_sparse *a = cholmod_l_triplet_to_sparse(t, k, cc);
+	cholmod_l_free_triplet(&t, cc);
+	return a;
+}
+
+/* x <- x - Phi_r Phi_r^T M x for each of the n_in columns. */
+static void remove_rigid(const struct irdm_fem *fem, const struct irdm_modes *m,
+			 double *x, size_t n_in, double *tmp)
+{
+	size_t n = m->n;
+
+	for (size_t c = 0; c < n_in; c++) {
+		double *xc = &x[c * n];
+		irdm_csc_matvec(&fem->M, xc, tmp);
+		for (size_t r = 0; r < m->n_rigid; r++) {
+			const double *phi = &m->rigid_phi[r * n];
+			double a = 0;
+			for (size_t i = 0; i < n; i++)
+				a += phi[i] * tmp[i];
+			for (size_t i = 0; i < n; i++)
+				xc[i] -= a * phi[i];
+		}
+	}
+}
+
+/* P e_j: the load e_j without its rigid part, M Phi_r Phi_r^T e_j removed. */
+static void elastic_load(const struct irdm_fem *fem, const struct irdm_modes *m, int64_t j,
+			 double *f, double *tmp)
+{
+	size_t n = m->n;
+
+	memset(f, 0, n * sizeof(double));
+	f[j] = 1.0;
+	if (!m->n_rigid)
+		return;
+	memset(tmp, 0, n * sizeof(double));
+	for (size_t r = 0; r < m->n_rigid; r++)
+		for (size_t i = 0; i < n; i++)
+			tmp[i] += m->rigid_phi[r * n + i] * m->rigid_phi[r * n + (size_t)j];
+	double *mt = malloc(n * sizeof(double));
+	if (!mt)
+		return;
+	irdm_csc_matvec(&fem->M, tmp, mt);
+	for (size_t i = 0; i < n; i++)
+		f[i] -= mt[i];
+	free(mt);
+}
+
+int irdm_compliance_solve(const struct irdm_fem *fem, const struct irdm_modes *m,
+			  bool floating, const int64_t *in, size_t n_in, double *X,
+			  char *err, size_t errlen)
+{
+	size_t n = fem->K.n;
+	double eps = floating ? 1e-2 * m->omega2[0] : 0.0;
+	cholmod_common cc;
+	cholmod_sparse *a = NULL;
+	cholmod_factor *f = NULL;
+	cholmod_dense *rhs = NULL, *sol = NULL;
+	double *tmp = malloc(n * sizeof(double)), *load = NULL;
+	int ret = -1;
+
+	cholmod_l_start(&cc);
+	cc.print = 0;
+	a = upper_shifted(fem, eps, &cc);
+	rhs = cholmod_l_allocate_dense(n, n_in, n, CHOLMOD_REAL, &cc);
+	load = malloc(n * n_in * sizeof(double));
+	if (!a || !rhs || !tmp || !load) {
+		snprintf(err, errlen, "static compliance: out of memory");
+		goto out_free;
+	}
+	f = cholmod_l_analyze(a, &cc);
+	if (!f || !cholmod_l_factorize(a, f, &cc) || cc.status != CHOLMOD_OK) {
+		snprintf(err, errlen, "static compliance: stiffness is not positive definite (grounded object with too few fixed nodes?)");
+		goto out_free;
+	}
+	for (size_t c = 0; c < n_in; c++)
+		elastic_load(fem, m, in[c], &load[c * n], tmp);
+	memset(X, 0, n * n_in * sizeof(double));
+	for (int step = 0; step < (floating ? REFINE_STEPS : 1); step++) {
+		double *b = rhs->x;
+		for (size_t c = 0; c < n_in; c++) {
+			irdm_csc_matvec(&fem->M, &X[c * n], tmp);
+			for (size_t i = 0; i < n; i++)
+				b[c * n + i] = load[c * n + i] + eps * tmp[i];
+		}
+		cholmod_l_free_dense(&sol, &cc);
+		sol = cholmod_l_solve(CHOLMOD_A, f, rhs, &cc);
+		if (!sol) {
+			snprintf(err, errlen, "static compliance: sparse solve failed");
+			goto out_free;
+		}
+		memcpy(X, sol->x, n * n_in * sizeof(double));
+		if (floating)
+			remove_rigid(fem, m, X, n_in, tmp);
+	}
+	ret = 0;
+out_free:
+	free(tmp);
+	free(load);
+	cholmod_l_free_dense(&sol, &cc);
+	cholmod_l_free_dense(&rhs, &cc);
+	cholmod_l_free_factor(&f, &cc);
+	cholmod_l_free_sparse(&a, &cc);
+	cholmod_l_finish(&cc);
+	return ret;
+}
+
+int irdm_static_correction(const struct irdm_fem *fem, const struct irdm_modes *m,
+			   bool floating, const int64_t *col_dofs, size_t n_cols,
+			   const int64_t *row_dofs, size_t n_rows, double *out,
+			   char *err, size_t errlen)
+{
+	size_t n = m->n, n_in = 0;
+	int64_t *in = malloc(3 * n_cols * sizeof(int64_t));
+	size_t *slot = malloc(3 * n_cols * sizeof(size_t));
+	double *X = NULL;
+	int ret = -1;
+
+	if (!in || !slot)
+		goto out_nomem;
+	for (size_t c = 0; c < 3 * n_cols; c++)
+		if (col_dofs[c] >= 0) {
+			slot[c] = n_in;
+			in[n_in++] = col_dofs[c];
+		}
+	X = malloc(n * (n_in ? n_in : 1) * sizeof(double));
+	if (!X)
+		goto out_nomem;
+	if (n_in && irdm_compliance_solve(fem, m, floating, in, n_in, X, err, errlen))
+		goto out_free;
+	for (size_t c = 0; c < n_cols; c++)
+		for (size_t r = 0; r < n_rows; r++)
+			for (int i = 0; i < 3; i++)
+				for (int j = 0; j < 3; j++) {
+					int64_t ri = row_dofs[3 * r + i], cj = col_dofs[3 * c + j];
+					double v = 0;
+					if (ri >= 0 && cj >= 0) {
+						v = X[slot[3 * c + j] * n + (size_t)ri];
+						for (size_t k = 0; k < m->n_modes; k++)
+							v -= m->phi[k * n + (size_t)ri] * m->phi[k * n + (size_t)cj]
+							     / m->omega2[k];
+					}
+					out[((c * n_rows + r) * 3 + i) * 3 + j] = v;
+				}
+	ret = 0;
+	goto out_free;
+out_nomem:
+	snprintf(err, errlen, "static correction: out of memory");
+out_free:
+	free(in);
+	free(slot);
+	free(X);
+	return ret;
+}

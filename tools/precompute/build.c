@@ -1,0 +1,611 @@
+/* SPDX-License-Identifier: MIT */
+/* Scene -> model -> responses -> stability -> image. */
+#include <math.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "image/image_writer.h"
+#include "irdm/image.h"
+#include "modal/lapack.h"
+#include "modal/response.h"
+#include "modal/stability.h"
+#include "precompute/precompute.h"
+#include "precompute/td_part.h"
+#include "timedomain/timedomain.h"
+
+struct build {
+	const struct irdm_scene *sc;
+	const struct irdm_precompute_opts *o;
+	struct irdm_model m;
+	struct irdm_mode *zoh;          /* modal */
+	size_t n_modes;                 /* modes in the image (modal) */
+	double *fir;                    /* FIR, double, section layout */
+	double *shapes;                 /* modal: [row][3][mode] */
+	double *corr;                   /* static correction [c][r][3][3] or NULL */
+	void *stored[3];                /* converted to the scene's precision */
+	size_t stored_bytes[3];
+	struct irdm_stability *stab;
+	struct irdm_meta meta;
+	struct irdm_rigid rigid;
+	struct irdm_node *nodes;
+	char *prov;
+	uint64_t scene_hash;
+};
+
+static double now_s(void)
+{
+	struct timespec ts;
+
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static uint64_t fnv1a(uint64_t h, const void *p, size_t n)
+{
+	const unsigned char *b = p;
+
+	for (size_t i = 0; i < n; i++) {
+		h ^= b[i];
+		h *= 1099511628211ull;
+	}
+	return h;
+}
+
+/* Modes the scene needs solved (0: all). */
+static size_t modes_needed(const struct irdm_scene *sc)
+{
+	if (sc->representation == IRDM_REPR_MODAL)
+		return sc->modes;
+	if (sc->method == IRDM_METHOD_TIME_DOMAIN)
+		return 1;       /* only the first mode, for the default damping */
+	return sc->modes;       /* FIR synthesised from modes */
+}
+
+static bool truncated(const struct build *b)
+{
+	return b->m.modes.n_modes < b->m.modes.n_elastic_total;
+}
+
+static int modal_data(struct build *b, char *err, size_t errlen)
+{
+	struct irdm_model *m = &b->m;
+	size_t K = m->modes.n_modes, n = m->modes.n;
+
+	b->n_modes = K;
+	b->zoh = malloc(K * sizeof(*b->zoh));
+	b->shapes = malloc(m->n_rows * 3 * K * sizeof(double));
+	if (!b->zoh || !b->shapes)
+		goto out_nomem;
+	irdm_modes_discretise(&m->modes, &m->damping, b->sc->dt_s, b->zoh);
+	for (size_t r = 0; r < 3 * m->n_rows; r++)
+		for (size_t k = 0; k < K; k++) {
+			int64_t d = m->row_dofs[r];
+			b->shapes[r * K + k] = d < 0 ? 0.0 : m->modes.phi[k * n + (size_t)d];
+		}
+	if (b->sc->static_correction && truncated(b)) {
+		b->corr = malloc(m->n_cols * m->n_rows * 9 * sizeof(double));
+		if (!b->corr)
+			goto out_nomem;
+		if (irdm_static_correction(&m->fem, &m->modes, b->sc->floating, m->col_dofs,
+					   m->n_cols, m->row_dofs, m->n_rows, b->corr, err, errlen))
+			return -1;
+	}
+	return 0;
+out_nomem:
+	snprintf(err, errlen, "precompute: out of memory for the modal data");
+	return -1;
+}
+
+static int fir_from_modes(struct build *b, char *err, size_t errlen)
+{
+	struct irdm_model *m = &b->m;
+	size_t T = b->sc->fir_length;
+
+	if (modal_data(b, err, errlen))
+		return -1;
+	b->fir = malloc(m->n_cols * m->n_rows * T * 9 * sizeof(double));
+	if (!b->fir) {
+		snprintf(err, errlen, "precompute: FIR of %zu x %zu nodes x %zu samples does not fit in memory (%.1f GiB); use a modal image or a smaller touch/display region",
+			 m->n_cols, m->n_rows, T, (double)m->n_cols * m->n_rows * T * 72 / (1 << 30));
+		return -1;
+	}
+	irdm_fir_from_modes(&m->modes, b->zoh, m->col_dofs, m->n_cols, m->row_dofs, m->n_rows,
+			    T, b->corr, b->fir, b->o->progress, b->o->ctx);
+	return 0;
+}
+
+/* Input i of the time-domain work: column c = i / n_free_axes ... we list
+ * the free column DoFs in order. */
+static size_t list_inputs(const struct irdm_model *m, int64_t *global, size_t *slot)
+{
+	size_t n = 0;
+
+	for (size_t c = 0; c < 3 * m->n_cols; c++)
+		if (m->col_dofs[c] >= 0) {
+			if (global)
+				global[n] = m->fem.map.global_of[m->col_dofs[c]];
+			if (slot)
+				slot[n] = c;
+			n++;
+		}
+	return n;
+}
+
+struct td_progress {
+	irdm_progress_fn fn;
+	void *ctx;
+};
+
+static void td_progress(void *ctx, size_t done, size_t total)
+{
+	struct td_progress *p = ctx;
+
+	if (p->fn)
+		p->fn(p->ctx, "time-domain responses", (double)done / (double)total);
+}
+
+static int td_run(struct build *b, size_t begin, size_t end, double *R, char *err, size_t errlen)
+{
+	struct irdm_model *m = &b->m;
+	size_t n_in = list_inputs(m, NULL, NULL);
+	int64_t *global = malloc(n_in * sizeof(int64_t));
+	struct td_progress tp = { b->o->progress, b->o->ctx };
+	struct irdm_td_opts o = {
+		.dt_s = b->sc->dt_s, .n_samples = b->sc->fir_length, .substeps = b->sc->substeps,
+		.damping = m->damping, .floating = b->sc->floating, .threads = b->sc->threads,
+		.progress = td_progress, .progress_ctx = &tp,
+	};
+	int ret;
+
+	if (!global) {
+		snprintf(err, errlen, "precompute: out of memory");
+		return -1;
+	}
+	list_inputs(m, global, NULL);
+	ret = irdm_td_responses(&m->mesh, &m->fem, &o, global + begin, end - begin, m->rows,
+				m->n_rows, R, err, errlen);
+	free(global);
+	return ret;
+}
+
+/* Scatter time-domain input columns into the FIR layout. */
+static void td_scatter(struct build *b, const double *R, size_t begin, size_t end)
+{
+	struct irdm_model *m = &b->m;
+	size_t T = b->sc->fir_length, n_out = 3 * m->n_rows;
+	size_t *slot = malloc(3 * m->n_cols * sizeof(size_t));
+
+	if (!slot)
+		return;
+	list_inputs(m, NULL, slot);
+	for (size_t i = begin; i < end; i++) {
+		size_t c = slot[i] / 3, j = slot[i] % 3;
+		for (size_t s = 0; s < T; s++)
+			for (size_t r = 0; r < m->n_rows; r++)
+				for (size_t a = 0; a < 3; a++)
+					b->fir[(((c * m->n_rows + r) * T + s) * 3 + a) * 3 + j] =
+						R[((i - begin) * T + s) * n_out + 3 * r + a];
+	}
+	free(slot);
+}
+
+static int fir_time_domain(struct build *b, char *err, size_t errlen)
+{
+	struct irdm_model *m = &b->m;
+	size_t T = b->sc->fir_length, n_out = 3 * m->n_rows, n_in = list_inputs(m, NULL, NULL);
+	size_t fir_n = m->n_cols * m->n_rows * T * 9;
+	const struct irdm_precompute_opts *o = b->o;
+	double *R = NULL;
+	int ret = -1;
+
+	if (o->part_out) {
+		size_t e = o->part_end < n_in ? o->part_end : n_in;
+		if (o->part_begin >= e) {
+			snprintf(err, errlen, "precompute: part range %zu:%zu is empty (the scene has %zu inputs)",
+				 o->part_begin, o->part_end, n_in);
+			return -1;
+		}
+		struct irdm_td_part p = { b->scene_hash, n_in, o->part_begin, e, T, n_out, NULL };
+		p.data = malloc((e - o->part_begin) * T * n_out * sizeof(double));
+		if (!p.data) {
+			snprintf(err, errlen, "precompute: out of memory for the part");
+			return -1;
+		}
+		ret = td_run(b, o->part_begin, e, p.data, err, errlen);
+		if (!ret)
+			ret = irdm_td_part_write(o->part_out, &p, err, errlen);
+		free(p.data);
+		return ret;
+	}
+	b->fir = calloc(fir_n, sizeof(double));
+	if (!b->fir) {
+		snprintf(err, errlen, "precompute: FIR does not fit in memory");
+		return -1;
+	}
+	if (!o->n_merge) {
+		R = malloc(n_in * T * n_out * sizeof(double));
+		if (!R) {
+			snprintf(err, errlen, "precompute: out of memory for time-domain responses");
+			return -1;
+		}
+		ret = td_run(b, 0, n_in, R, err, errlen);
+		if (!ret)
+			td_scatter(b, R, 0, n_in);
+		free(R);
+		return ret;
+	}
+	/* merge: every input covered exactly once, same scene */
+	unsigned char *seen = calloc(n_in ? n_in : 1, 1);
+	if (!seen)
+		return -1;
+	for (size_t k = 0; k < o->n_merge; k++) {
+		struct irdm_td_part p;
+		if (irdm_td_part_read(o->merge[k], &p, err, errlen))
+			goto out_seen;
+		if (p.scene_hash != b->scene_hash || p.n_inputs != n_in || p.T != T || p.n_out != n_out) {
+			snprintf(err, errlen, "%s: part was made from a different scene", o->merge[k]);
+			free(p.data);
+			goto out_seen;
+		}
+		for (size_t i = p.begin; i < p.end; i++) {
+			if (seen[i]++) {
+				snprintf(err, errlen, "%s: input %zu is also in an earlier part", o->merge[k], i);
+				free(p.data);
+				goto out_seen;
+			}
+		}
+		td_scatter(b, p.data, p.begin, p.end);
+		free(p.data);
+	}
+	for (size_t i = 0; i < n_in; i++)
+		if (!seen[i]) {
+			snprintf(err, errlen, "merge: input %zu of %zu is in no part", i, n_in);
+			goto out_seen;
+		}
+	ret = 0;
+out_seen:
+	free(seen);
+	return ret;
+}
+
+/* Store as the scene's precision; replace the doubles by what was stored
+ * so stability is judged on the data the firmware will use. */
+static void *store(double *x, size_t n, uint32_t elem, size_t *bytes)
+{
+	size_t es = irdm_elem_size(elem);
+	void *out = malloc(n * es > 0 ? n * es : 1);
+
+	*bytes = n * es;
+	if (!out)
+		return NULL;
+	for (size_t i = 0; i < n; i++) {
+		if (elem == IRDM_ELEM_F64) {
+			((double *)out)[i] = x[i];
+		} else if (elem == IRDM_ELEM_F32) {
+			((float *)out)[i] = (float)x[i];
+			x[i] = ((float *)out)[i];
+		} else {
+			((uint16_t *)out)[i] = irdm_f32_to_f16((float)x[i]);
+			x[i] = irdm_f16_to_f32(((uint16_t *)out)[i]);
+		}
+	}
+	return out;
+}
+
+struct stab_job {
+	struct build *b;
+	size_t begin, end;
+};
+
+static void stab_one(struct build *b, size_t c)
+{
+	struct irdm_model *m = &b->m;
+	size_t row = m->cols[c];
+	double rho;
+
+	if (b->sc->representation == IRDM_REPR_FIR) {
+		size_t T = b->sc->fir_length;
+		rho = irdm_stability_fir(&b->fir[(c * m->n_rows + row) * T * 9], T);
+	} else {
+		size_t K = b->n_modes;
+		double D[9];
+		if (b->corr)
+			memcpy(D, &b->corr[(c * m->n_rows + row) * 9], sizeof(D));
+		rho = irdm_stability_modal(b->zoh, K, &b->shapes[3 * row * K], b->corr ? D : NULL);
+	}
+	b->stab[c].spectral_radius = (float)rho;
+	b->stab[c].flags = (rho >= 0 && rho < 1.0) ? IRDM_STAB_STABLE : 0;
+}
+
+static void *stab_worker(void *arg)
+{
+	struct stab_job *j = arg;
+
+	for (size_t c = j->begin; c < j->end; c++) {
+		stab_one(j->b, c);
+		if (j->begin == 0 && j->b->o->progress && (c % 8 == 0))
+			j->b->o->progress(j->b->o->ctx, "stability", (double)(c + 1) / (double)j->end);
+	}
+	return NULL;
+}
+
+static int stability(struct build *b, char *err, size_t errlen)
+{
+	size_t n = b->m.n_cols;
+	long cpus = sysconf(_SC_NPROCESSORS_ONLN);
+	unsigned nt = b->sc->threads ? b->sc->threads : (unsigned)(cpus > 0 ? cpus : 1);
+	pthread_t th[64];
+	struct stab_job jobs[64];
+
+	b->stab = calloc(n, sizeof(*b->stab));
+	if (!b->stab) {
+		snprintf(err, errlen, "precompute: out of memory");
+		return -1;
+	}
+	if (nt > 64)
+		nt = 64;
+	if (nt > n)
+		nt = (unsigned)n;
+	/* one LAPACK call per thread: OpenBLAS's own threads would oversubscribe */
+	openblas_set_num_threads(1);
+	for (unsigned t = 0; t < nt; t++) {
+		jobs[t] = (struct stab_job){ b, n * t / nt, n * (t + 1) / nt };
+		if (pthread_create(&th[t], NULL, stab_worker, &jobs[t])) {
+			stab_worker(&jobs[t]);
+			th[t] = 0;
+		}
+	}
+	for (unsigned t = 0; t < nt; t++)
+		if (th[t])
+			pthread_join(th[t], NULL);
+	openblas_set_num_threads(cpus > 0 ? (int)cpus : 1);
+	b->meta.max_spectral_radius = 0;
+	for (size_t c = 0; c < n; c++) {
+		if (b->stab[c].spectral_radius < 0) {
+			snprintf(err, errlen, "stability: could not compute the force recursion at column %zu (mesh node %u): R[0] singular?",
+				 c, b->m.rows[b->m.cols[c]]);
+			return -1;
+		}
+		b->meta.max_spectral_radius = fmax(b->meta.max_spectral_radius, b->stab[c].spectral_radius);
+	}
+	return 0;
+}
+
+static void fill_meta(struct build *b)
+{
+	const struct irdm_scene *sc = b->sc;
+	struct irdm_model *m = &b->m;
+	struct irdm_meta *mt = &b->meta;
+
+	mt->representation = sc->representation;
+	mt->precision = sc->precision;
+	mt->n_nodes = (uint32_t)m->n_rows;
+	mt->n_cols = (uint32_t)m->n_cols;
+	mt->n_tris = (uint32_t)m->n_tris;
+	mt->fir_length = sc->representation == IRDM_REPR_FIR ? sc->fir_length : 0;
+	mt->n_modes = sc->representation == IRDM_REPR_MODAL ? (uint32_t)b->n_modes : 0;
+	mt->flags = (sc->floating ? IRDM_META_FLOATING : 0) |
+		    (b->corr && sc->representation == IRDM_REPR_MODAL ? IRDM_META_STATIC_CORR : 0) |
+		    (sc->mass == IRDM_MASS_CONSISTENT ? IRDM_META_CONSISTENT_MASS : 0) |
+		    (sc->method == IRDM_METHOD_TIME_DOMAIN ? IRDM_META_TIME_DOMAIN : 0);
+	mt->dt_s = sc->dt_s;
+	mt->young_pa = sc->mat.young_pa;
+	mt->poisson = sc->mat.poisson;
+	mt->density_kg_m3 = sc->mat.density_kg_m3;
+	mt->rayleigh_a_per_s = m->damping.a_per_s;
+	mt->rayleigh_b_s = m->damping.b_s;
+	if (sc->damping == IRDM_DAMP_RATIOS) {
+		mt->damping_ratio[0] = sc->damp_ratio[0];
+		mt->damping_ratio[1] = sc->damp_ratio[1];
+		mt->damping_freq_hz[0] = sc->damp_hz[0] > 0 ? sc->damp_hz[0]
+				       : sqrt(m->modes.omega2[0]) / (2 * M_PI);
+		mt->damping_freq_hz[1] = sc->damp_hz[1];
+	}
+	mt->first_elastic_hz = sqrt(m->modes.omega2[0]) / (2 * M_PI);
+	mt->mesh_nodes = (uint32_t)m->mesh.n_nodes;
+	mt->mesh_tets = (uint32_t)m->mesh.n_tets;
+	mt->n_modes_total = (uint32_t)m->modes.n_elastic_total;
+	mt->mesh_hash = irdm_mesh_hash(&m->mesh);
+	snprintf(mt->tool_version, sizeof(mt->tool_version), "%s", IRDM_TOOL_VERSION);
+	snprintf(mt->mesh_name, sizeof(mt->mesh_name), "%s", m->mesh.name);
+}
+
+static int fill_nodes_rigid(struct build *b)
+{
+	struct irdm_model *m = &b->m;
+
+	b->nodes = calloc(m->n_rows, sizeof(*b->nodes));
+	if (!b->nodes)
+		return -1;
+	for (size_t r = 0; r < m->n_rows; r++) {
+		for (int a = 0; a < 3; a++)
+			b->nodes[r].pos_m[a] = (float)m->mesh.pos_m[3 * (size_t)m->rows[r] + (size_t)a];
+		b->nodes[r].mesh_node = m->rows[r];
+	}
+	irdm_mass_properties(&m->mesh, m->fem.lumped_mass_kg, &b->rigid.mass_kg, b->rigid.com_m,
+			     b->rigid.inertia_kg_m2);
+	return 0;
+}
+
+static int provenance(struct build *b)
+{
+	char scene[4096];
+	size_t len = 8192;
+
+	b->prov = malloc(len);
+	if (!b->prov || irdm_scene_format(b->sc, scene, sizeof(scene)))
+		return -1;
+	snprintf(b->prov, len,
+		 "tool=%s\nmesh_name=%s\nmesh_nodes=%zu\nmesh_tets=%zu\nmesh_hash=%016llx\n"
+		 "free_dofs=%zu\nrayleigh_a_per_s=%.17g\nrayleigh_b_s=%.17g\n"
+		 "modes_solved=%zu\nmodes_total=%zu\nfirst_elastic_hz=%.9g\n%s",
+		 IRDM_TOOL_VERSION, b->m.mesh.name, b->m.mesh.n_nodes, b->m.mesh.n_tets,
+		 (unsigned long long)b->meta.mesh_hash, b->m.fem.map.n_free,
+		 b->m.damping.a_per_s, b->m.damping.b_s, b->m.modes.n_modes,
+		 b->m.modes.n_elastic_total, b->meta.first_elastic_hz, scene);
+	return 0;
+}
+
+static int write_image(struct build *b, size_t *bytes, char *err, size_t errlen)
+{
+	struct irdm_model *m = &b->m;
+	struct irdm_image_writer w;
+	uint32_t p = b->sc->precision;
+	FILE *f;
+
+	irdm_iw_init(&w);
+	irdm_iw_add(&w, IRDM_SEC_META, IRDM_ELEM_BYTES, &b->meta, sizeof(b->meta));
+	irdm_iw_add(&w, IRDM_SEC_PROVENANCE, IRDM_ELEM_BYTES, b->prov, strlen(b->prov));
+	irdm_iw_add(&w, IRDM_SEC_NODES, IRDM_ELEM_BYTES, b->nodes, m->n_rows * sizeof(*b->nodes));
+	irdm_iw_add(&w, IRDM_SEC_COLUMNS, IRDM_ELEM_U32, m->cols, m->n_cols * sizeof(uint32_t));
+	irdm_iw_add(&w, IRDM_SEC_SURFACE, IRDM_ELEM_U32, m->tris, m->n_tris * 3 * sizeof(uint32_t));
+	if (b->sc->representation == IRDM_REPR_FIR) {
+		irdm_iw_add(&w, IRDM_SEC_FIR, p, b->stored[0], b->stored_bytes[0]);
+	} else {
+		irdm_iw_add(&w, IRDM_SEC_MODES, IRDM_ELEM_BYTES, b->zoh, b->n_modes * sizeof(*b->zoh));
+		irdm_iw_add(&w, IRDM_SEC_MODE_SHAPES, p, b->stored[1], b->stored_bytes[1]);
+		if (b->corr)
+			irdm_iw_add(&w, IRDM_SEC_STATIC_CORR, p, b->stored[2], b->stored_bytes[2]);
+	}
+	if (b->sc->floating)
+		irdm_iw_add(&w, IRDM_SEC_RIGID, IRDM_ELEM_BYTES, &b->rigid, sizeof(b->rigid));
+	irdm_iw_add(&w, IRDM_SEC_STABILITY, IRDM_ELEM_BYTES, b->stab, m->n_cols * sizeof(*b->stab));
+	if (irdm_iw_write(&w, b->o->out_path, err, errlen))
+		return -1;
+	f = fopen(b->o->out_path, "rb");
+	if (f) {
+		fseek(f, 0, SEEK_END);
+		*bytes = (size_t)ftell(f);
+		fclose(f);
+	}
+	return 0;
+}
+
+static int responses(struct build *b, char *err, size_t errlen)
+{
+	struct irdm_model *m = &b->m;
+	int ret;
+
+	if (b->sc->representation == IRDM_REPR_MODAL)
+		ret = modal_data(b, err, errlen);
+	else if (b->sc->method == IRDM_METHOD_TIME_DOMAIN)
+		ret = fir_time_domain(b, err, errlen);
+	else
+		ret = fir_from_modes(b, err, errlen);
+	if (ret || b->o->part_out)
+		return ret;
+	if (b->fir)
+		b->stored[0] = store(b->fir, m->n_cols * m->n_rows * b->sc->fir_length * 9,
+				     b->sc->precision, &b->stored_bytes[0]);
+	if (b->shapes)
+		b->stored[1] = store(b->shapes, m->n_rows * 3 * b->n_modes, b->sc->precision,
+				     &b->stored_bytes[1]);
+	if (b->corr)
+		b->stored[2] = store(b->corr, m->n_cols * m->n_rows * 9, b->sc->precision,
+				     &b->stored_bytes[2]);
+	if ((b->fir && !b->stored[0]) || (b->shapes && !b->stored[1]) || (b->corr && !b->stored[2])) {
+		snprintf(err, errlen, "precompute: out of memory converting to the storage precision");
+		return -1;
+	}
+	return 0;
+}
+
+static void build_free(struct build *b)
+{
+	irdm_model_free(&b->m);
+	free(b->zoh);
+	free(b->fir);
+	free(b->shapes);
+	free(b->corr);
+	for (int i = 0; i < 3; i++)
+		free(b->stored[i]);
+	free(b->stab);
+	free(b->nodes);
+	free(b->prov);
+}
+
+static void report(const struct build *b, struct irdm_precompute_report *rep)
+{
+	const struct irdm_model *m = &b->m;
+
+	rep->seconds_mesh = m->seconds_mesh;
+	rep->seconds_fem = m->seconds_fem;
+	rep->seconds_eig = m->seconds_eig;
+	rep->mesh_nodes = m->mesh.n_nodes;
+	rep->mesh_tets = m->mesh.n_tets;
+	rep->free_dofs = m->fem.map.n_free;
+	rep->rows = m->n_rows;
+	rep->cols = m->n_cols;
+	rep->tris = m->n_tris;
+	rep->modes = m->modes.n_modes;
+	rep->modes_total = m->modes.n_elastic_total;
+	rep->first_elastic_hz = b->meta.first_elastic_hz;
+	rep->max_spectral_radius = b->meta.max_spectral_radius;
+	for (size_t c = 0; b->stab && c < m->n_cols; c++)
+		rep->unstable_cols += !(b->stab[c].flags & IRDM_STAB_STABLE);
+}
+
+static uint64_t scene_hash(const struct irdm_scene *sc)
+{
+	char text[4096];
+
+	if (irdm_scene_format(sc, text, sizeof(text)))
+		return 0;
+	return fnv1a(14695981039346656037ull, text, strlen(text));
+}
+
+int irdm_precompute(const struct irdm_scene *sc, const struct irdm_precompute_opts *o,
+		    struct irdm_precompute_report *rep, char *err, size_t errlen)
+{
+	struct build b = { .sc = sc, .o = o };
+	double t0 = now_s(), t1;
+	int ret = -1;
+
+	memset(rep, 0, sizeof(*rep));
+	b.scene_hash = scene_hash(sc);
+	if (irdm_model_build(sc, modes_needed(sc), o->progress, o->ctx, &b.m, err, errlen))
+		return -1;
+	b.scene_hash = fnv1a(b.scene_hash, &b.m.damping, sizeof(b.m.damping));
+	t1 = now_s();
+	if (responses(&b, err, errlen))
+		goto out_free;
+	rep->seconds_responses = now_s() - t1;
+	if (o->part_out) {
+		ret = 0;
+		goto out_report;
+	}
+	fill_meta(&b);
+	t1 = now_s();
+	if (stability(&b, err, errlen))
+		goto out_free;
+	rep->seconds_stability = now_s() - t1;
+	if (fill_nodes_rigid(&b) || provenance(&b)) {
+		snprintf(err, errlen, "precompute: out of memory");
+		goto out_free;
+	}
+	if (write_image(&b, &rep->image_bytes, err, errlen))
+		goto out_free;
+	ret = 0;
+out_report:
+	report(&b, rep);
+	rep->seconds_total = now_s() - t0;
+out_free:
+	build_free(&b);
+	return ret;
+}
+
+int irdm_precompute_count_inputs(const struct irdm_scene *sc, size_t *n_inputs,
+				 char *err, size_t errlen)
+{
+	struct irdm_model m;
+
+	if (irdm_model_build(sc, 1, NULL, NULL, &m, err, errlen))
+		return -1;
+	*n_inputs = list_inputs(&m, NULL, NULL);
+	irdm_model_free(&m);
+	return 0;
+}

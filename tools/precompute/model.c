@@ -1,0 +1,147 @@
+/* SPDX-License-Identifier: MIT */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "precompute/model.h"
+
+static double now_s(void)
+{
+	struct timespec ts;
+
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+int irdm_model_mesh(const struct irdm_scene *sc, struct irdm_mesh *mesh, char *err, size_t errlen)
+{
+	unsigned r[3] = { sc->res[0], sc->res[1], sc->res[2] };
+	double l[3];
+	int ret;
+
+	if (!strcmp(sc->mesh, "cuboid")) {
+		/* the paper's cuboid: 10 x 10 x 20 cm, 11 x 11 x 22 hexes of 5 tets */
+		l[0] = l[1] = 0.1;
+		l[2] = 0.2;
+		if (!r[0])
+			r[0] = 11, r[1] = 11, r[2] = 22;
+	} else if (!strcmp(sc->mesh, "cube")) {
+		l[0] = l[1] = l[2] = 0.12;   /* the paper's 12 cm cube */
+		if (!r[0])
+			r[0] = r[1] = r[2] = 10;
+	} else if (!strncmp(sc->mesh, "box:", 4)) {
+		if (sscanf(sc->mesh + 4, "%lf,%lf,%lf", &l[0], &l[1], &l[2]) != 3 ||
+		    !(l[0] > 0 && l[1] > 0 && l[2] > 0 && isfinite(l[0] + l[1] + l[2]))) {
+			snprintf(err, errlen, "scene: mesh '%s': expected box:LX,LY,LZ in metres", sc->mesh);
+			return -1;
+		}
+		if (!r[0])
+			r[0] = r[1] = r[2] = 4;
+	} else {
+		return irdm_mesh_read(sc->mesh, sc->mesh_scale, sc->tetgen, mesh, err, errlen);
+	}
+	ret = irdm_mesh_gen_box(l[0], l[1], l[2], r[0], r[1], r[2], sc->tets_per_hex, mesh,
+				err, errlen);
+	if (!ret)
+		snprintf(mesh->name, sizeof(mesh->name), "%.8s-%ux%ux%u-%ut",
+			 sc->mesh[0] == 'b' ? "box" : sc->mesh, r[0], r[1], r[2], sc->tets_per_hex);
+	return ret;
+}
+
+static int mark_nodes(const struct irdm_scene *sc, struct irdm_model *m, char *err, size_t errlen)
+{
+	size_t n = m->mesh.n_nodes, n_fixed = 0;
+
+	m->fixed = calloc(n, sizeof(bool));
+	m->on_surface = calloc(n, sizeof(bool));
+	if (!m->fixed || !m->on_surface) {
+		snprintf(err, errlen, "model: out of memory");
+		return -1;
+	}
+	for (size_t t = 0; t < 3 * m->mesh.n_tris; t++)
+		m->on_surface[m->mesh.tris[t]] = true;
+	for (size_t i = 0; i < n; i++) {
+		m->fixed[i] = irdm_region_contains(&sc->fixed, (uint32_t)i, &m->mesh.pos_m[3 * i],
+						   m->on_surface[i]);
+		n_fixed += m->fixed[i];
+	}
+	if (sc->fixed.kind == IRDM_REGION_NODES)
+		for (size_t k = 0; k < sc->fixed.n_nodes; k++)
+			if (sc->fixed.nodes[k] >= n) {
+				snprintf(err, errlen, "scene: fixed node %u does not exist (mesh has %zu nodes)",
+					 sc->fixed.nodes[k], n);
+				return -1;
+			}
+	if (!sc->floating && n_fixed == 0) {
+		snprintf(err, errlen,
+			 "scene: grounded object but 'fixed = %s' selects no node of mesh '%s'",
+			 sc->fixed.text, m->mesh.name);
+		return -1;
+	}
+	return 0;
+}
+
+static int pick_damping(const struct irdm_scene *sc, struct irdm_model *m, char *err, size_t errlen)
+{
+	if (sc->damping == IRDM_DAMP_RAYLEIGH) {
+		m->damping = sc->rayleigh;
+		return 0;
+	}
+	double w1 = sc->damp_hz[0] > 0 ? 2 * M_PI * sc->damp_hz[0] : sqrt(m->modes.omega2[0]);
+	return irdm_rayleigh_from_ratios(sc->damp_ratio[0], w1, sc->damp_ratio[1],
+					 2 * M_PI * sc->damp_hz[1], &m->damping, err, errlen);
+}
+
+int irdm_model_select(const struct irdm_scene *sc, struct irdm_model *m, char *err, size_t errlen);
+
+int irdm_model_build(const struct irdm_scene *sc, size_t n_modes_needed,
+		     irdm_progress_fn progress, void *ctx, struct irdm_model *m,
+		     char *err, size_t errlen)
+{
+	double t0 = now_s();
+
+	memset(m, 0, sizeof(*m));
+	if (irdm_scene_check(sc, err, errlen))
+		return -1;
+	if (progress)
+		progress(ctx, "mesh", 0.0);
+	if (irdm_model_mesh(sc, &m->mesh, err, errlen))
+		goto out_fail;
+	if (mark_nodes(sc, m, err, errlen))
+		goto out_fail;
+	m->seconds_mesh = now_s() - t0;
+	t0 = now_s();
+	if (irdm_fem_assemble(&m->mesh, &sc->mat, sc->mass, m->fixed, &m->fem, err, errlen))
+		goto out_fail;
+	m->seconds_fem = now_s() - t0;
+	t0 = now_s();
+	if (irdm_modes_solve(&m->fem, n_modes_needed, sc->floating, sc->eigensolver, progress,
+			     ctx, &m->modes, err, errlen))
+		goto out_fail;
+	m->seconds_eig = now_s() - t0;
+	if (pick_damping(sc, m, err, errlen))
+		goto out_fail;
+	if (irdm_model_select(sc, m, err, errlen))
+		goto out_fail;
+	return 0;
+out_fail:
+	irdm_model_free(m);
+	return -1;
+}
+
+void irdm_model_free(struct irdm_model *m)
+{
+	irdm_mesh_free(&m->mesh);
+	free(m->fixed);
+	free(m->on_surface);
+	irdm_fem_free(&m->fem);
+	irdm_modes_free(&m->modes);
+	free(m->rows);
+	free(m->cols);
+	free(m->row_dofs);
+	free(m->col_dofs);
+	free(m->tris);
+	memset(m, 0, sizeof(*m));
+}

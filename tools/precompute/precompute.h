@@ -1,0 +1,39 @@
+/* SPDX-License-Identifier: MIT */
+/* From a scene to a flash image. */
+#ifndef IRDM_TOOLS_PRECOMPUTE_H
+#define IRDM_TOOLS_PRECOMPUTE_H
+
+#include "precompute/model.h"
+
+#define IRDM_TOOL_VERSION "irdm 0.1.0"
+
+struct irdm_precompute_opts {
+	const char *out_path;        /* image to write (NULL with part_out) */
+	/* time-domain split: compute input DoFs [part_begin, part_end) of the
+	 * scene's column DoFs into part_out instead of an image */
+	const char *part_out;
+	size_t part_begin, part_end;
+	/* time-domain merge: take the responses from these part files */
+	const char *const *merge;
+	size_t n_merge;
+	irdm_progress_fn progress;
+	void *ctx;
+};
+
+struct irdm_precompute_report {
+	double seconds_total, seconds_mesh, seconds_fem, seconds_eig;
+	double seconds_responses, seconds_stability;
+	size_t image_bytes;
+	size_t mesh_nodes, mesh_tets, free_dofs, rows, cols, tris, modes, modes_total;
+	double first_elastic_hz, max_spectral_radius;
+	size_t unstable_cols;
+};
+
+int irdm_precompute(const struct irdm_scene *sc, const struct irdm_precompute_opts *o,
+		    struct irdm_precompute_report *rep, char *err, size_t errlen);
+
+/* Number of column DoFs the scene has (for splitting time-domain work). */
+int irdm_precompute_count_inputs(const struct irdm_scene *sc, size_t *n_inputs,
+				 char *err, size_t errlen);
+
+#endif

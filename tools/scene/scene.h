@@ -1,0 +1,98 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * A scene says what an image must hold: the object (mesh, material,
+ * damping, constraints), the sample period, the representation, and which
+ * nodes can be touched (columns) or are displayed (rows).  It is given as a
+ * small "key = value" file, as --key value options, or both (options win).
+ * docs/scenes.md lists the keys.
+ */
+#ifndef IRDM_TOOLS_SCENE_H
+#define IRDM_TOOLS_SCENE_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "fem/fem.h"
+#include "modal/modal.h"
+
+enum irdm_region_kind {
+	IRDM_REGION_NONE = 0,
+	IRDM_REGION_SURFACE,    /* every boundary node */
+	IRDM_REGION_PLANE,      /* coordinate <= or >= value */
+	IRDM_REGION_BOX,        /* axis-aligned box, inclusive */
+	IRDM_REGION_NODES,      /* explicit 0-based mesh node list */
+};
+
+#define IRDM_REGION_MAX_NODES 4096
+
+struct irdm_region {
+	enum irdm_region_kind kind;
+	int axis;               /* PLANE: 0, 1, 2 */
+	bool below;             /* PLANE: <= (true) or >= */
+	double value_m;         /* PLANE */
+	double box_m[6];        /* BOX: x0 y0 z0 x1 y1 z1 */
+	size_t n_nodes;         /* NODES */
+	uint32_t nodes[IRDM_REGION_MAX_NODES];
+	char text[128];         /* as written, for messages and provenance */
+};
+
+enum irdm_damping_kind { IRDM_DAMP_RATIOS = 0, IRDM_DAMP_RAYLEIGH = 1 };
+enum irdm_method { IRDM_METHOD_MODAL = 0, IRDM_METHOD_TIME_DOMAIN = 1 };
+
+struct irdm_scene {
+	char name[64];
+	char mesh[512];          /* "cuboid", "cube", "box:LX,LY,LZ" or a file path */
+	unsigned res[3];         /* builtin resolution (hexes per axis) */
+	unsigned tets_per_hex;   /* 5 or 6 */
+	double mesh_scale;       /* multiplies file coordinates */
+	char tetgen[32];         /* tetgen switches for surface meshes */
+	struct irdm_material mat;
+	enum irdm_mass_kind mass;
+	enum irdm_damping_kind damping;
+	double damp_ratio[2];
+	double damp_hz[2];       /* 0 for the first: "the first elastic mode" */
+	struct irdm_rayleigh rayleigh;
+	bool floating;
+	struct irdm_region fixed;
+	double dt_s;
+	uint32_t representation; /* enum irdm_repr */
+	unsigned fir_length;
+	unsigned modes;          /* modes kept (0 = all) */
+	bool static_correction;
+	uint32_t precision;      /* enum irdm_elem */
+	struct irdm_region touch;
+	struct irdm_region display;
+	enum irdm_method method;
+	unsigned substeps;
+	enum irdm_eig_method eigensolver;
+	unsigned threads;
+};
+
+/* The defaults: the paper's cuboid at its resolution, modal 300 + static
+ * correction, 1 ms, float32, top face touchable, whole surface displayed. */
+void irdm_scene_defaults(struct irdm_scene *sc);
+
+/* Set one key.  `where` names the source for messages ("cube.scene:7" or
+ * "--dt"). */
+int irdm_scene_set(struct irdm_scene *sc, const char *key, const char *value,
+		   const char *where, char *err, size_t errlen);
+
+/* Read a scene file on top of *sc. */
+int irdm_scene_load(struct irdm_scene *sc, const char *path, char *err, size_t errlen);
+
+/* Cross-field checks (after all keys are set). */
+int irdm_scene_check(const struct irdm_scene *sc, char *err, size_t errlen);
+
+/* Canonical text of every key (provenance, scene hash). */
+int irdm_scene_format(const struct irdm_scene *sc, char *buf, size_t len);
+
+/* Whether mesh node i (position p) is in region r; on_surface: i is a
+ * boundary node. */
+bool irdm_region_contains(const struct irdm_region *r, uint32_t node, const double p[3],
+			  bool on_surface);
+
+/* The list of keys with one-line help (for --help). */
+extern const char *const irdm_scene_help;
+
+#endif

@@ -1,0 +1,469 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * Time-domain responses R[s] by Newmark average-acceleration integration,
+ * parallel over input DoFs.  See timedomain.h for the convention.
+ *
+ * The step.  Newmark with beta = 1/4, gamma = 1/2 is the trapezoidal rule on
+ * the state (u, v):
+ *     u+ - u = h/2 (v + v+)
+ *     M (v+ - v) = h/2 (f_l + f_r) - h/2 C (v + v+) - h/2 K (u + u+)
+ * where f_l, f_r are the force at the step's left and right ends.  Writing
+ * D = u+ - u and eliminating v+ = 2 D / h - v gives
+ *     S D = h M v - h^2/2 K u + h^2/4 (f_l + f_r),   S = M + h/2 C + h^2/4 K
+ *     u+ = u + D,   v+ = 2 D / h - v.
+ * This is algebraically the textbook acceleration form with a_0 = M^-1 f_0,
+ * but it never needs a_0 (so no second factor of a consistent M) and it
+ * takes the force's jump at t = dt as it comes: every step inside [0, dt]
+ * has f = 1 at both ends (the left limit at dt), every later step f = 0 at
+ * both ends.  The acceleration form would have to re-solve M a = f - C v -
+ * K u at the jump instead.
+ *
+ * Determinism.  Inputs are integrated in fixed blocks of TD_BLOCK columns
+ * (several right-hand sides per CHOLMOD solve use BLAS-3 kernels); blocks
+ * are handed to threads dynamically, but a block's arithmetic does not
+ * depend on which thread runs it or how many there are, and OpenBLAS runs
+ * single-threaded meanwhile, so the output is the same bit for bit for any
+ * thread count.
+ */
+#include <math.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "timedomain/rigid_fit.h"
+#include "timedomain/td_priv.h"
+#include "timedomain/timedomain.h"
+
+/*
+ * OpenBLAS thread control (declared here: no OpenBLAS header is needed for
+ * two calls).  During the parallel phase OpenBLAS must run single-threaded:
+ * our workers already occupy the CPUs, nested BLAS threads would
+ * oversubscribe them, and a BLAS thread count that differs between runs
+ * could change reduction order and so break bitwise reproducibility.  The
+ * setting is process-wide; it is restored afterwards.
+ */
+void openblas_set_num_threads(int n);
+int openblas_get_num_threads(void);
+
+/* Input columns integrated together (a fixed number: see "Determinism"). */
+#define TD_BLOCK 4
+
+struct td_job {
+	/* read-only while the workers run */
+	const struct irdm_mesh *mesh;
+	const struct irdm_fem *fem;
+	const struct irdm_td_opts *o;
+	const int64_t *in_dofs;
+	size_t n_in;
+	const uint32_t *out_nodes;
+	size_t n_out;
+	double *R;             /* a worker writes only its own inputs' slices */
+	cholmod_factor *L;     /* shared; CHOLMOD's solve only reads it */
+	double h;
+	double rel_eps;
+	/* shared, under lock */
+	pthread_mutex_t lock;
+	size_t next_block;
+	size_t done;
+	bool failed;
+	char *err;
+	size_t errlen;
+};
+
+/* Everything one thread touches: CHOLMOD's common is not thread-safe, so
+ * each worker has its own, plus its own solve workspaces (y, e). */
+struct td_worker {
+	struct td_job *job;
+	pthread_t tid;
+	bool started;
+	cholmod_common cc;
+	cholmod_dense *b, *x, *y, *e;
+	double *u, *v, *ku, *mv;    /* n_free x TD_BLOCK, column-major */
+	double *full, *def;         /* 3 * n_nodes, floating only */
+	char err[200];
+};
+
+/* ---- validation --------------------------------------------------------- */
+
+static int check_opts(const struct irdm_td_opts *o, char *err, size_t errlen)
+{
+	if (!isfinite(o->dt_s) || o->dt_s <= 0) {
+		snprintf(err, errlen, "time-domain: dt must be finite and > 0 s (got %g)",
+			 o->dt_s);
+		return -1;
+	}
+	if (o->n_samples < 1 || o->substeps < 1) {
+		snprintf(err, errlen,
+			 "time-domain: need n_samples >= 1 and substeps >= 1 (got %u, %u)",
+			 o->n_samples, o->substeps);
+		return -1;
+	}
+	if (!isfinite(o->damping.a_per_s) || !isfinite(o->damping.b_s) ||
+	    o->damping.a_per_s < 0 || o->damping.b_s < 0) {
+		snprintf(err, errlen,
+			 "time-domain: Rayleigh damping must be finite and >= 0 (got a=%g /s, b=%g s)",
+			 o->damping.a_per_s, o->damping.b_s);
+		return -1;
+	}
+	if (o->rigid != IRDM_TD_RIGID_KABSCH && o->rigid != IRDM_TD_RIGID_LINEAR) {
+		snprintf(err, errlen, "time-domain: unknown rigid-removal method %d",
+			 (int)o->rigid);
+		return -1;
+	}
+	if (!(o->kabsch_rel_eps >= 0 && o->kabsch_rel_eps <= 1e-2)) {
+		snprintf(err, errlen,
+			 "time-domain: kabsch_rel_eps must be in [0, 1e-2] (0: default; got %g)",
+			 o->kabsch_rel_eps);
+		return -1;
+	}
+	return 0;
+}
+
+static int check_model(const struct irdm_mesh *mesh, const struct irdm_fem *fem,
+		       bool floating, char *err, size_t errlen)
+{
+	if (fem->map.n_dof != 3 * mesh->n_nodes || fem->K.n != fem->map.n_free ||
+	    fem->M.n != fem->map.n_free) {
+		snprintf(err, errlen,
+			 "time-domain: FEM (%zu DoFs, %zu free) does not belong to the mesh (%zu nodes)",
+			 fem->map.n_dof, fem->map.n_free, mesh->n_nodes);
+		return -1;
+	}
+	if (floating && fem->map.n_free != fem->map.n_dof) {
+		snprintf(err, errlen,
+			 "time-domain: a floating object must have no fixed node (%zu of %zu DoFs fixed)",
+			 fem->map.n_dof - fem->map.n_free, fem->map.n_dof);
+		return -1;
+	}
+	return 0;
+}
+
+static int check_io(const struct irdm_mesh *mesh, const struct irdm_fem *fem,
+		    const struct irdm_td_opts *o, const int64_t *in_dofs, size_t n_in,
+		    const uint32_t *out_nodes, size_t n_out, const double *R,
+		    char *err, size_t errlen)
+{
+	size_t per_in = (size_t)o->n_samples * 3;
+
+	if ((n_in && !in_dofs) || (n_out && !out_nodes) || (n_in && n_out && !R)) {
+		snprintf(err, errlen, "time-domain: NULL input, output or result array");
+		return -1;
+	}
+	if (n_out > SIZE_MAX / per_in / sizeof(double) ||
+	    (n_in && n_out * per_in > SIZE_MAX / sizeof(double) / n_in)) {
+		snprintf(err, errlen, "time-domain: %zu x %u x %zu responses do not fit in memory",
+			 n_in, o->n_samples, n_out);
+		return -1;
+	}
+	for (size_t i = 0; i < n_in; i++) {
+		int64_t g = in_dofs[i];
+
+		if (g < 0 || (uint64_t)g >= fem->map.n_dof) {
+			snprintf(err, errlen,
+				 "time-domain: input DoF %lld (entry %zu) out of range (mesh has %zu DoFs)",
+				 (long long)g, i, fem->map.n_dof);
+			return -1;
+		}
+		if (fem->map.free_of[g] < 0) {
+			snprintf(err, errlen,
+				 "time-domain: input DoF %lld (node %lld axis %c) is fixed; responses exist only for free DoFs",
+				 (long long)g, (long long)(g / 3), "xyz"[g % 3]);
+			return -1;
+		}
+	}
+	for (size_t i = 0; i < n_out; i++) {
+		if (out_nodes[i] >= mesh->n_nodes) {
+			snprintf(err, errlen,
+				 "time-domain: output node %u (entry %zu) out of range (mesh has %zu nodes)",
+				 out_nodes[i], i, mesh->n_nodes);
+			return -1;
+		}
+	}
+	return 0;
+}
+
+/* ---- one worker ---------------------------------------------------------- */
+
+static void worker_fini(struct td_worker *w)
+{
+	cholmod_l_free_dense(&w->b, &w->cc);
+	cholmod_l_free_dense(&w->x, &w->cc);
+	cholmod_l_free_dense(&w->y, &w->cc);
+	cholmod_l_free_dense(&w->e, &w->cc);
+	cholmod_l_finish(&w->cc);
+	free(w->u);
+	free(w->v);
+	free(w->ku);
+	free(w->mv);
+	free(w->full);
+	free(w->def);
+}
+
+static int worker_init(struct td_worker *w, struct td_job *job)
+{
+	size_t nb = job->fem->K.n * TD_BLOCK, nf = 3 * job->mesh->n_nodes;
+
+	memset(w, 0, sizeof(*w));
+	w->job = job;
+	cholmod_l_start(&w->cc);
+	w->cc.print = 0;	/* errors come back through err, not stdout */
+	w->u = malloc(nb * sizeof(double));
+	w->v = malloc(nb * sizeof(double));
+	w->ku = malloc(nb * sizeof(double));
+	w->mv = malloc(nb * sizeof(double));
+	if (job->o->floating) {
+		w->full = malloc(nf * sizeof(double));
+		w->def = malloc(nf * sizeof(double));
+	}
+	if (!w->u || !w->v || !w->ku || !w->mv ||
+	    (job->o->floating && (!w->full || !w->def)))
+		return -1;
+	return 0;
+}
+
+/* Right-hand side holder with k columns (the last block may be short). */
+static int worker_rhs(struct td_worker *w, size_t k)
+{
+	if (w->b && w->b->ncol == k)
+		return 0;
+	cholmod_l_free_dense(&w->b, &w->cc);
+	w->b = cholmod_l_allocate_dense(w->job->fem->K.n, k, w->job->fem->K.n,
+					CHOLMOD_REAL, &w->cc);
+	if (!w->b) {
+		snprintf(w->err, sizeof(w->err), "time-domain: out of memory (right-hand side)");
+		return -1;
+	}
+	return 0;
+}
+
+/* Rigid motion out of one full-length response column: w->def. */
+static int worker_rigid(struct td_worker *w, const double *col)
+{
+	const struct td_job *job = w->job;
+	const struct irdm_dofmap *map = &job->fem->map;
+	const struct irdm_mesh *mesh = job->mesh;
+	int rc;
+
+	/* floating: every DoF is free */
+	for (size_t g = 0; g < map->n_dof; g++)
+		w->full[g] = col[map->free_of[g]];
+	if (job->o->rigid == IRDM_TD_RIGID_LINEAR)
+		rc = irdm_rigid_project_linear(mesh->n_nodes, mesh->pos_m,
+					       job->fem->lumped_mass_kg, w->full, w->def);
+	else
+		rc = irdm_rigid_remove_kabsch(mesh->n_nodes, mesh->pos_m,
+					      job->fem->lumped_mass_kg, w->full,
+					      job->rel_eps, w->def);
+	if (rc)
+		snprintf(w->err, sizeof(w->err),
+			 "time-domain: rigid-motion fit failed (collinear mesh or non-finite response)");
+	return rc;
+}
+
+/* Store sample s of the k columns starting at input i0. */
+static int worker_record(struct td_worker *w, size_t i0, size_t k, size_t s)
+{
+	const struct td_job *job = w->job;
+	const int64_t *free_of = job->fem->map.free_of;
+	size_t n = job->fem->K.n, no = job->n_out;
+
+	for (size_t c = 0; c < k; c++) {
+		const double *col = w->u + c * n;
+		double *dst = job->R + ((i0 + c) * job->o->n_samples + s) * 3 * no;
+
+		if (job->o->floating && worker_rigid(w, col))
+			return -1;
+		for (size_t o = 0; o < no; o++) {
+			for (size_t a = 0; a < 3; a++) {
+				size_t g = 3 * (size_t)job->out_nodes[o] + a;
+
+				if (job->o->floating)
+					dst[3 * o + a] = w->def[g];
+				else
+					dst[3 * o + a] = free_of[g] < 0 ? 0.0 : col[free_of[g]];
+			}
+		}
+	}
+	return 0;
+}
+
+/* b = h M v - h^2/2 K u + h^2/4 (f_l + f_r) e_in, for the k columns. */
+static void worker_load(struct td_worker *w, size_t i0, size_t k, double fsum)
+{
+	const struct td_job *job = w->job;
+	const struct irdm_fem *fem = job->fem;
+	size_t n = fem->K.n;
+	double h = job->h, *b = w->b->x;
+
+	irdm_td_matvec_block(&fem->K, w->u, w->ku, k);
+	irdm_td_matvec_block(&fem->M, w->v, w->mv, k);
+	for (size_t i = 0; i < n * k; i++)
+		b[i] = h * w->mv[i] - 0.5 * h * h * w->ku[i];
+	if (fsum == 0.0)
+		return;
+	for (size_t c = 0; c < k; c++)
+		b[c * n + (size_t)fem->map.free_of[job->in_dofs[i0 + c]]] += 0.25 * h * h * fsum;
+}
+
+/* Integrate k inputs from rest over T samples. */
+static int worker_block(struct td_worker *w, size_t i0, size_t k)
+{
+	const struct td_job *job = w->job;
+	size_t n = job->fem->K.n;
+	uint64_t m = job->o->substeps, steps = m * job->o->n_samples;
+	double h = job->h;
+
+	if (worker_rhs(w, k))
+		return -1;
+	memset(w->u, 0, n * k * sizeof(double));
+	memset(w->v, 0, n * k * sizeof(double));
+	for (uint64_t st = 0; st < steps; st++) {
+		/* steps 0..m-1 lie inside [0, dt]: force 1 at both ends */
+		worker_load(w, i0, k, st < m ? 2.0 : 0.0);
+		if (!cholmod_l_solve2(CHOLMOD_A, job->L, w->b, NULL, &w->x, NULL, &w->y, &w->e,
+				      &w->cc)) {
+			snprintf(w->err, sizeof(w->err),
+				 "time-domain: CHOLMOD solve failed (status %d)", w->cc.status);
+			return -1;
+		}
+		const double *d = w->x->x;
+
+		for (size_t i = 0; i < n * k; i++) {
+			w->v[i] = 2.0 * d[i] / h - w->v[i];
+			w->u[i] += d[i];
+		}
+		if ((st + 1) % m == 0 && worker_record(w, i0, k, (size_t)((st + 1) / m - 1)))
+			return -1;
+	}
+	return 0;
+}
+
+/* Take blocks until none is left or someone failed. */
+static void *worker_main(void *arg)
+{
+	struct td_worker *w = arg;
+	struct td_job *job = w->job;
+
+	for (;;) {
+		size_t i0, k;
+
+		pthread_mutex_lock(&job->lock);
+		i0 = job->next_block * TD_BLOCK;
+		if (job->failed || i0 >= job->n_in) {
+			pthread_mutex_unlock(&job->lock);
+			return NULL;
+		}
+		job->next_block++;
+		pthread_mutex_unlock(&job->lock);
+
+		k = job->n_in - i0 < TD_BLOCK ? job->n_in - i0 : TD_BLOCK;
+		int rc = worker_block(w, i0, k);
+
+		pthread_mutex_lock(&job->lock);
+		if (rc && !job->failed)
+			snprintf(job->err, job->errlen, "%s", w->err);
+		job->failed |= rc != 0;
+		job->done += rc ? 0 : k;
+		/* under the lock: the callback is never entered concurrently */
+		if (!rc && job->o->progress)
+			job->o->progress(job->o->progress_ctx, job->done, job->n_in);
+		pthread_mutex_unlock(&job->lock);
+		if (rc)
+			return NULL;
+	}
+}
+
+/* ---- the job ------------------------------------------------------------- */
+
+static unsigned thread_count(unsigned asked, size_t n_blocks)
+{
+	long online = sysconf(_SC_NPROCESSORS_ONLN);
+	size_t t = asked ? asked : (online > 0 ? (size_t)online : 1);
+
+	return (unsigned)(t < n_blocks ? t : n_blocks);
+}
+
+/* Run the workers: w[0] in the calling thread, the rest in new threads.  A
+ * thread that cannot be created is not an error: the others take its
+ * blocks from the shared queue. */
+static void run_workers(struct td_worker *w, unsigned nt)
+{
+	int blas_threads = openblas_get_num_threads();
+
+	openblas_set_num_threads(1);
+	for (unsigned t = 1; t < nt; t++)
+		w[t].started = !pthread_create(&w[t].tid, NULL, worker_main, &w[t]);
+	worker_main(&w[0]);
+	for (unsigned t = 1; t < nt; t++)
+		if (w[t].started)
+			pthread_join(w[t].tid, NULL);
+	openblas_set_num_threads(blas_threads);
+}
+
+int irdm_td_responses(const struct irdm_mesh *mesh, const struct irdm_fem *fem,
+		      const struct irdm_td_opts *o, const int64_t *in_dofs, size_t n_in,
+		      const uint32_t *out_nodes, size_t n_out, double *R,
+		      char *err, size_t errlen)
+{
+	struct td_job job = {
+		.mesh = mesh, .fem = fem, .o = o, .in_dofs = in_dofs, .n_in = n_in,
+		.out_nodes = out_nodes, .n_out = n_out, .R = R, .err = err, .errlen = errlen,
+	};
+	struct td_worker *w = NULL;
+	cholmod_common cc;
+	unsigned nt, n_init = 0;
+	int rc = -1;
+
+	if (!mesh || !fem || !o) {
+		snprintf(err, errlen, "time-domain: NULL mesh, FEM or options");
+		return -1;
+	}
+	if (check_opts(o, err, errlen) || check_model(mesh, fem, o->floating, err, errlen) ||
+	    check_io(mesh, fem, o, in_dofs, n_in, out_nodes, n_out, R, err, errlen))
+		return -1;
+	if (n_in == 0)
+		return 0;
+	job.h = o->dt_s / o->substeps;
+	job.rel_eps = o->kabsch_rel_eps > 0 ? o->kabsch_rel_eps : IRDM_TD_KABSCH_REL_EPS;
+
+	cholmod_l_start(&cc);
+	cc.print = 0;
+	/* S = M + h/2 (a M + b K) + h^2/4 K */
+	if (irdm_td_factor(fem, 1.0 + 0.5 * job.h * o->damping.a_per_s,
+			   0.5 * job.h * o->damping.b_s + 0.25 * job.h * job.h, &cc, &job.L,
+			   err, errlen))
+		goto out_finish;
+	nt = thread_count(o->threads, (n_in + TD_BLOCK - 1) / TD_BLOCK);
+	w = calloc(nt, sizeof(*w));
+	if (!w) {
+		snprintf(err, errlen, "time-domain: out of memory (%u workers)", nt);
+		goto out_free_factor;
+	}
+	for (n_init = 0; n_init < nt; n_init++) {
+		if (worker_init(&w[n_init], &job)) {
+			n_init++;
+			snprintf(err, errlen, "time-domain: out of memory (worker %u, %zu DoFs)",
+				 n_init - 1, fem->K.n);
+			goto out_free_workers;
+		}
+	}
+	if (pthread_mutex_init(&job.lock, NULL)) {
+		snprintf(err, errlen, "time-domain: cannot create a mutex");
+		goto out_free_workers;
+	}
+	run_workers(w, nt);
+	pthread_mutex_destroy(&job.lock);
+	rc = job.failed ? -1 : 0;
+
+out_free_workers:
+	for (unsigned t = 0; t < n_init; t++)
+		worker_fini(&w[t]);
+	free(w);
+out_free_factor:
+	cholmod_l_free_factor(&job.L, &cc);
+out_finish:
+	cholmod_l_finish(&cc);
+	return rc;
+}
