@@ -40,15 +40,24 @@ void irdm_surface_free(struct irdm_surface *s);
  * Read any supported mesh, chosen by extension: .node or .ele (TetGen pair,
  * 0- or 1-based), .msh (Gmsh ASCII 2.2 or 4.1), .obj/.off/.stl (surface,
  * tetrahedralised by running `tetgen`).  scale multiplies coordinates (e.g.
- * 0.001 for a mesh in mm).  tetgen_switches: extra quality switches for
- * surface meshes (NULL for the default "pq1.414a").  The result is validated
- * and has its boundary computed.
+ * 0.001 for a mesh in mm).  tetgen_switches: tetgen switches for surface
+ * meshes, replacing the default "pq1.414" (NULL or "" for the default; 'p'
+ * and 'Q' are added when missing).  Surfaces are tetrahedralised in their
+ * file's units, so a volume bound such as "pq1.414a0.5" is in those units;
+ * scale is applied afterwards.  The result is validated and has its
+ * boundary computed.  Messages name nodes and elements as the file numbers
+ * them (TetGen index, Gmsh tag).
  */
 int irdm_mesh_read(const char *path, double scale, const char *tetgen_switches,
 		   struct irdm_mesh *m, char *err, size_t errlen);
 
-/* In-memory parsers (also the fuzz targets).  `what` names the input in
- * messages.  They do not validate geometry; irdm_mesh_finish() does. */
+/*
+ * In-memory parsers (also the fuzz targets).  `what` names the input in
+ * messages.  They do not validate geometry; irdm_mesh_finish() does (the
+ * surface parsers do check indices, finiteness and degenerate triangles).
+ * Inputs need no terminating NUL; only len bytes are read.  The output
+ * struct is overwritten, not freed first.
+ */
 int irdm_mesh_parse_tetgen(const char *node_txt, size_t node_len,
 			   const char *ele_txt, size_t ele_len, const char *what,
 			   struct irdm_mesh *m, char *err, size_t errlen);
@@ -62,18 +71,24 @@ int irdm_surface_parse_off(const char *txt, size_t len, const char *what,
 int irdm_surface_parse_stl(const void *buf, size_t len, const char *what,
 			   struct irdm_surface *s, char *err, size_t errlen);
 
-/* Run Debian's `tetgen` on a closed surface in a private temp directory. */
+/*
+ * Run Debian's `tetgen` on a closed surface in a private temp directory
+ * (under $TMPDIR, always removed); $IRDM_TETGEN overrides the program.
+ * switches as for irdm_mesh_read().
+ */
 int irdm_surface_tetrahedralize(const struct irdm_surface *s, const char *switches,
 				const char *what, struct irdm_mesh *m,
 				char *err, size_t errlen);
 
 /*
  * Validate and finish a parsed mesh: finite coordinates, indices in range,
- * no repeated node in a tet, no zero-volume or inverted tet (the message
- * names the element, 1-based as most mesh files count), no unreferenced
- * node; then compute the outward boundary triangles.  Inverted tets are an
- * error, not silently flipped: a reader that knows its convention orders
- * nodes itself.
+ * no repeated node in a tet, no zero-volume or inverted tet, no
+ * unreferenced node; then compute the outward boundary triangles (a face
+ * shared by more than two tets, or by two on the same side, is an error).
+ * Messages name nodes and elements by 1-based position, as most mesh files
+ * count; irdm_mesh_read() uses the file's own numbers instead.  Inverted
+ * tets are an error, not silently flipped: a reader that knows its
+ * convention orders nodes itself.  On failure the mesh is freed.
  */
 int irdm_mesh_finish(struct irdm_mesh *m, const char *what, char *err, size_t errlen);
 

@@ -50,7 +50,8 @@ static int merge_corners(struct corner *c, size_t n, struct irdm_surface *s,
 		mesh_err(err, errlen, what, "out of memory");
 		return -1;
 	}
-	qsort(c, n, sizeof(*c), corner_cmp);
+	if (n)
+		qsort(c, n, sizeof(*c), corner_cmp);
 	for (i = 0; i < n; i++) {
 		if (!i || memcmp(c[i].x, c[i - 1].x, sizeof(c[i].x))) {
 			memcpy(s->pos_m + 3 * nv, c[i].x, sizeof(c[i].x));

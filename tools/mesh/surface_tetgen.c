@@ -168,7 +168,10 @@ static int write_smesh(const struct tg_run *r, const struct irdm_surface *s,
 	return 0;
 }
 
-/* The last line tetgen wrote that says more than the C++ runtime's. */
+/*
+ * The last line tetgen wrote that says more than "Opening <file>." or the
+ * C++ runtime's "terminate called ...".
+ */
 static void last_log_line(const char *log, char *out, size_t outlen)
 {
 	char scratch[8];
@@ -182,7 +185,7 @@ static void last_log_line(const char *log, char *out, size_t outlen)
 		return;
 	mtext_init(&t, txt, len, -1);
 	while (mtext_next_line(&t, &l))
-		if (!mline_is(&l, "terminate"))
+		if (!mline_is(&l, "terminate") && !mline_is(&l, "Opening"))
 			last = l;
 	if (last.p) {
 		size_t n = last.len - last.pos, i;

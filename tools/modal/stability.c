@@ -1,5 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 #include <complex.h>
+#include <limits.h>
 #include <math.h>
 #include <stdbool.h>
 #include <stdlib.h>
@@ -17,45 +18,57 @@ static double complex det3(const double complex a[9])
 	       + a[2] * (a[3] * a[7] - a[4] * a[6]);
 }
 
+/* Winding number of det Q on |w| = r sampled at n points, or INT_MIN if det
+ * vanishes at a sample; *worst: the largest phase step seen. */
+static int winding(const double *R, size_t T, double r, size_t n, double complex *q,
+		   double *worst)
+{
+	/* Normalise by the largest power of r so nothing overflows. */
+	double lr = log(r), top = r > 1 ? lr * (double)(T - 1) : 0.0, total = 0;
+	double complex prev = 0;
+
+	*worst = 0;
+	for (int e = 0; e < 9; e++) {
+		double complex *x = &q[(size_t)e * n];
+		memset(x, 0, n * sizeof(*x));
+		for (size_t s = 0; s < T; s++)
+			x[s % n] += R[9 * s + (size_t)e] * exp(lr * (double)s - top);
+		irdm_fft_inverse_sign(x, n);
+	}
+	for (size_t m = 0; m <= n; m++) {
+		double complex a[9];
+		for (int e = 0; e < 9; e++)
+			a[e] = q[(size_t)e * n + m % n];
+		double complex d = det3(a);
+		if (cabs(d) == 0.0)
+			return INT_MIN;
+		if (m > 0) {
+			double step = carg(d / prev);
+			total += step;
+			*worst = fmax(*worst, fabs(step));
+		}
+		prev = d;
+	}
+	return (int)lround(total / (2 * M_PI));
+}
+
 /*
- * Zeros of det Q inside |w| < r.  Returns the count, or -1 when the circle
- * passes too close to a zero to resolve with MAX_FFT points.
+ * Zeros of det Q inside |w| < r.  The sampled winding number is exact when
+ * no true phase step between samples exceeds pi; we accept a count only when
+ * every sampled step is below pi/2, doubling the sampling until it is.
+ * -1 when that needs more than MAX_FFT points (a zero too close to the
+ * circle, or rounding noise in det Q near it): the caller stays on the
+ * side it has already certified.
  */
 static int zeros_inside(const double *R, size_t T, double r, double complex *buf,
 			size_t *n_fft)
 {
-	/* Normalise by the largest power of r so nothing overflows. */
-	double lr = log(r), top = r > 1 ? lr * (double)(T - 1) : 0.0;
-
 	for (size_t n = *n_fft; n <= MAX_FFT; n *= 2) {
-		double complex *q = buf;     /* 9 arrays of n */
-		for (int e = 0; e < 9; e++) {
-			double complex *x = &q[(size_t)e * n];
-			memset(x, 0, n * sizeof(*x));
-			for (size_t s = 0; s < T; s++)
-				x[s % n] += R[9 * s + (size_t)e] * exp(lr * (double)s - top);
-			irdm_fft_inverse_sign(x, n);
-		}
-		double total = 0, worst = 0;
-		double complex prev = 0;
-		bool ok = true;
-		for (size_t m = 0; m <= n && ok; m++) {
-			double complex a[9];
-			for (int e = 0; e < 9; e++)
-				a[e] = q[(size_t)e * n + m % n];
-			double complex d = det3(a);
-			if (cabs(d) == 0.0)
-				ok = false;
-			if (m > 0) {
-				double step = carg(d / prev);
-				total += step;
-				worst = fmax(worst, fabs(step));
-			}
-			prev = d;
-		}
-		if (ok && worst < M_PI / 2) {
+		double worst;
+		int c = winding(R, T, r, n, buf, &worst);
+		if (c != INT_MIN && worst < M_PI / 2) {
 			*n_fft = n;
-			return (int)lround(total / (2 * M_PI));
+			return c;
 		}
 	}
 	return -1;

@@ -158,6 +158,8 @@ static int td_run(struct build *b, size_t begin, size_t end, double *R, char *er
 		.dt_s = b->sc->dt_s, .n_samples = b->sc->fir_length, .substeps = b->sc->substeps,
 		.damping = m->damping, .floating = b->sc->floating, .threads = b->sc->threads,
 		.progress = td_progress, .progress_ctx = &tp,
+		/* SPEC: rigid motion removed by a mass-weighted best fit (Kabsch) */
+		.rigid = IRDM_TD_RIGID_KABSCH,
 	};
 	int ret;
 
@@ -309,7 +311,10 @@ static void stab_one(struct build *b, size_t c)
 
 	if (b->sc->representation == IRDM_REPR_FIR) {
 		size_t T = b->sc->fir_length;
-		rho = irdm_stability_fir(&b->fir[(c * m->n_rows + row) * T * 9], T);
+		const double *R = &b->fir[(c * m->n_rows + row) * T * 9];
+		/* exact eigenvalues while the companion matrix is cheap (3(T-1)
+		 * <= 480), the argument-principle upper bound beyond */
+		rho = T <= 161 ? irdm_stability_fir_companion(R, T) : irdm_stability_fir(R, T);
 	} else {
 		size_t K = b->n_modes;
 		double D[9];

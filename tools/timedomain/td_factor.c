@@ -73,6 +73,13 @@ int irdm_td_factor(const struct irdm_fem *fem, double cm, double ck, cholmod_com
 			 fem->K.n);
 		return -1;
 	}
+	/*
+	 * Every step of every input solves with this factor, so its fill is
+	 * worth a second ordering: try AMD and METIS (CHOLMOD's default tries
+	 * METIS only for very dense factors) and keep the sparser.  On 3D
+	 * meshes METIS typically wins by ~40 %.  Both are deterministic.
+	 */
+	cc->nmethods = 3;	/* given ordering (none: skipped), AMD, METIS */
 	*L = cholmod_l_analyze(s, cc);
 	if (!*L) {
 		snprintf(err, errlen, "time-domain: CHOLMOD analysis failed (status %d)",

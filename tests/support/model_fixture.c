@@ -1,0 +1,81 @@
+/* SPDX-License-Identifier: MIT */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "model_fixture.h"
+
+void dpotrf_(const char *uplo, const int *n, double *a, const int *lda, int *info);
+void dpotrs_(const char *uplo, const int *n, const int *nrhs, const double *a, const int *lda,
+	     double *b, const int *ldb, int *info);
+
+void fixture_model(struct irdm_model *m, double lx, double ly, double lz, unsigned nx,
+		   unsigned ny, unsigned nz, unsigned tph, double poisson, bool floating,
+		   size_t n_modes, enum irdm_eig_method eig, double dt_s)
+{
+	struct irdm_scene sc;
+	char err[512], mesh[128];
+
+	irdm_scene_defaults(&sc);
+	snprintf(mesh, sizeof(mesh), "box:%.17g,%.17g,%.17g", lx, ly, lz);
+	assert_int_equal(irdm_scene_set(&sc, "mesh", mesh, "test", err, sizeof(err)), 0);
+	sc.res[0] = nx;
+	sc.res[1] = ny;
+	sc.res[2] = nz;
+	sc.tets_per_hex = tph;
+	sc.mat.poisson = poisson;
+	sc.dt_s = dt_s;
+	sc.eigensolver = eig;
+	if (floating)
+		assert_int_equal(irdm_scene_set(&sc, "floating", "yes", "test", err, sizeof(err)), 0);
+	int rc = irdm_model_build(&sc, n_modes, NULL, NULL, m, err, sizeof(err));
+	if (rc)
+		fail_msg("model build failed: %s", err);
+}
+
+int64_t fixture_free_dof(const struct irdm_model *m, uint32_t node, int axis)
+{
+	int64_t d = m->fem.map.free_of[3 * (size_t)node + (size_t)axis];
+
+	assert_true(d >= 0);
+	return d;
+}
+
+uint32_t fixture_nearest_node(const struct irdm_mesh *mesh, const double p[3])
+{
+	double best = 1e300;
+	uint32_t bi = 0;
+
+	for (size_t i = 0; i < mesh->n_nodes; i++) {
+		double d = 0;
+		for (int a = 0; a < 3; a++) {
+			double t = mesh->pos_m[3 * i + (size_t)a] - p[a];
+			d += t * t;
+		}
+		if (d < best) {
+			best = d;
+			bi = (uint32_t)i;
+		}
+	}
+	return bi;
+}
+
+void fixture_dense_compliance(const struct irdm_fem *fem, int64_t j, double *x)
+{
+	int n = (int)fem->K.n, one = 1, info = 0;
+	double *a = irdm_csc_to_dense(&fem->K);
+
+	assert_non_null(a);
+	memset(x, 0, (size_t)n * sizeof(double));
+	x[j] = 1.0;
+	dpotrf_("L", &n, a, &n, &info);
+	assert_int_equal(info, 0);
+	dpotrs_("L", &n, &one, a, &n, x, &n, &info);
+	assert_int_equal(info, 0);
+	free(a);
+}

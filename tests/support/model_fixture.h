@@ -1,0 +1,23 @@
+/* SPDX-License-Identifier: MIT */
+/* Small models for the numerical tests. */
+#ifndef IRDM_TESTS_MODEL_FIXTURE_H
+#define IRDM_TESTS_MODEL_FIXTURE_H
+
+#include "precompute/model.h"
+
+/* Box lx*ly*lz (m) with nx*ny*nz hexes of tph tets; grounded at z = 0
+ * unless floating.  Aborts the test on failure. */
+void fixture_model(struct irdm_model *m, double lx, double ly, double lz, unsigned nx,
+		   unsigned ny, unsigned nz, unsigned tph, double poisson, bool floating,
+		   size_t n_modes, enum irdm_eig_method eig, double dt_s);
+
+/* Free DoF index of (node, axis), asserting it is free. */
+int64_t fixture_free_dof(const struct irdm_model *m, uint32_t node, int axis);
+
+/* Mesh node nearest to p. */
+uint32_t fixture_nearest_node(const struct irdm_mesh *mesh, const double p[3]);
+
+/* Dense K^-1 column j by LAPACK (dpotrf/dpotrs): an independent solve. */
+void fixture_dense_compliance(const struct irdm_fem *fem, int64_t j, double *x);
+
+#endif

@@ -1,0 +1,240 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * Modal analysis against independent references: closed-form oscillator
+ * step responses (ZOH), a second eigensolver, Euler-Bernoulli beam theory,
+ * and the rigid-body null space of a free body.
+ */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "modal/modal.h"
+#include "support/model_fixture.h"
+
+/* Unit step response of q'' + 2 z w q' + w^2 q = 1 from rest, closed form. */
+static double step_response(double w, double z, double t)
+{
+	if (w == 0)
+		return 0.5 * t * t;
+	if (z < 1) {
+		double wd = w * sqrt(1 - z * z);
+		return (1 - exp(-z * w * t) * (cos(wd * t) + z * w / wd * sin(wd * t))) / (w * w);
+	}
+	if (z == 1)
+		return (1 - exp(-w * t) * (1 + w * t)) / (w * w);
+	double s = sqrt(z * z - 1), r1 = -w * (z - s), r2 = -w * (z + s);
+	return (1 + (r2 * exp(r1 * t) - r1 * exp(r2 * t)) / (r1 - r2)) / (w * w);
+}
+
+static void check_zoh(double w, double z, double dt)
+{
+	struct irdm_mode m;
+	double h[400], worst = 0, scale = 0;
+
+	irdm_zoh_mode(w, z, dt, &m);
+	irdm_zoh_response(&m, 400, h);
+	for (int s = 0; s < 400; s++) {
+		/* a pulse of width dt is a step minus a step delayed by dt */
+		double ref = step_response(w, z, (s + 1) * dt) - step_response(w, z, s * dt);
+		worst = fmax(worst, fabs(h[s] - ref));
+		scale = fmax(scale, fabs(ref));
+	}
+	if (worst > 1e-11 * scale)
+		fail_msg("ZOH w=%g z=%g dt=%g: error %.3g of %.3g", w, z, dt, worst, scale);
+}
+
+static void test_zoh_matches_closed_form(void **state)
+{
+	(void)state;
+	check_zoh(10.0, 0.05, 0.002);     /* the cuboid's first mode */
+	check_zoh(628.0, 0.05, 0.001);    /* 100 Hz */
+	check_zoh(3000.0, 0.3, 0.002);    /* w dt = 6: far past Nyquist/2 */
+	check_zoh(50.0, 1.0, 0.001);      /* critically damped */
+	check_zoh(50.0, 4.0, 0.001);      /* overdamped */
+	check_zoh(20.0, 0.0, 0.001);      /* undamped */
+	check_zoh(0.0, 0.0, 0.001);       /* free mass: h[s] = (2s+1) dt^2 / 2 */
+}
+
+/* Eigenpairs satisfy K phi = w^2 M phi and Phi^T M Phi = I. */
+static void check_eigenpairs(const struct irdm_fem *fem, const double *w2, const double *phi,
+			     size_t k)
+{
+	size_t n = fem->K.n;
+	double *kp = malloc(n * sizeof(double)), *mp = malloc(n * sizeof(double));
+
+	for (size_t a = 0; a < k; a++) {
+		irdm_csc_matvec(&fem->K, &phi[a * n], kp);
+		irdm_csc_matvec(&fem->M, &phi[a * n], mp);
+		double res = 0, norm = 0;
+		for (size_t i = 0; i < n; i++) {
+			res = fmax(res, fabs(kp[i] - w2[a] * mp[i]));
+			norm = fmax(norm, fabs(kp[i]));
+		}
+		assert_true(res <= 1e-8 * norm);
+		for (size_t b = 0; b <= a; b++) {
+			double dot = 0;
+			for (size_t i = 0; i < n; i++)
+				dot += phi[b * n + i] * mp[i];
+			assert_true(fabs(dot - (a == b)) < 1e-9);
+		}
+	}
+	free(kp);
+	free(mp);
+}
+
+static void test_dense_and_lanczos_agree(void **state)
+{
+	struct irdm_model m;
+	const size_t k = 24;
+	char err[256];
+
+	(void)state;
+	fixture_model(&m, 0.1, 0.1, 0.2, 3, 3, 6, 6, 0.49, false, 1, IRDM_EIG_DENSE, 0.002);
+	size_t n = m.fem.K.n;
+	double *wd = malloc(k * sizeof(double)), *pd = malloc(n * k * sizeof(double));
+	double *wl = malloc(k * sizeof(double)), *pl = malloc(n * k * sizeof(double));
+	assert_int_equal(irdm_eig_dense(&m.fem, k, wd, pd, err, sizeof(err)), 0);
+	assert_int_equal(irdm_eig_lanczos(&m.fem, k, 0.0, NULL, NULL, wl, pl, err, sizeof(err)), 0);
+	for (size_t a = 0; a < k; a++)
+		assert_true(fabs(wd[a] - wl[a]) <= 1e-9 * wd[a]);
+	check_eigenpairs(&m.fem, wd, pd, k);
+	check_eigenpairs(&m.fem, wl, pl, k);
+	/* each Lanczos vector lies in the dense eigenspace of its eigenvalue */
+	double *mp = malloc(n * sizeof(double));
+	for (size_t a = 0; a < k; a++) {
+		irdm_csc_matvec(&m.fem.M, &pl[a * n], mp);
+		double proj = 0;
+		for (size_t b = 0; b < k; b++) {
+			if (fabs(wd[b] - wl[a]) > 1e-7 * wl[a])
+				continue;
+			double dot = 0;
+			for (size_t i = 0; i < n; i++)
+				dot += pd[b * n + i] * mp[i];
+			proj += dot * dot;
+		}
+		assert_true(fabs(proj - 1) < 1e-8);
+	}
+	free(mp);
+	free(wd);
+	free(pd);
+	free(wl);
+	free(pl);
+	irdm_model_free(&m);
+}
+
+/*
+ * Euler-Bernoulli cantilever: f_i = (beta_i L)^2 / (2 pi L^2) sqrt(EI / rho A),
+ * beta_1 L = 1.87510, beta_2 L = 4.69409.  nu = 0 (the theory has no Poisson
+ * effect), slenderness 20.
+ */
+static void test_cantilever_matches_euler_bernoulli(void **state)
+{
+	struct irdm_model m;
+	const double w = 0.01, L = 0.2, E = 2000, rho = 110;
+	const double bl[2] = { 1.87510407, 4.69409113 };
+
+	(void)state;
+	/* linear tets lock in bending: 8 cells across are needed for < 3 % */
+	fixture_model(&m, w, w, L, 8, 8, 160, 5, 0.0, false, 4, IRDM_EIG_LANCZOS, 0.001);
+	double EI = E * pow(w, 4) / 12, rhoA = rho * w * w;
+	/* bending modes come in degenerate x/y pairs: modes 0,1 and the second pair */
+	for (int i = 0; i < 2; i++) {
+		double f_eb = bl[i] * bl[i] / (2 * M_PI * L * L) * sqrt(EI / rhoA);
+		double f = 0;
+		/* the i-th distinct bending pair; torsion/axial modes lie far above */
+		size_t idx = 2 * (size_t)i;
+		f = sqrt(m.modes.omega2[idx]) / (2 * M_PI);
+		double rel = fabs(f - f_eb) / f_eb;
+		print_message("cantilever bending %d: FEM %.5f Hz, Euler-Bernoulli %.5f Hz (%.2f %%)\n",
+			      i + 1, f, f_eb, 100 * rel);
+		assert_true(rel <= 0.03);
+		/* the pair is degenerate by symmetry */
+		assert_true(fabs(m.modes.omega2[idx + 1] - m.modes.omega2[idx]) <= 1e-6 * m.modes.omega2[idx]);
+	}
+	irdm_model_free(&m);
+}
+
+/* A free body has exactly six zero modes spanning translations and rotations. */
+static void test_free_body_has_six_rigid_modes(void **state)
+{
+	struct irdm_model m;
+
+	(void)state;
+	for (int method = IRDM_EIG_DENSE; method <= IRDM_EIG_LANCZOS; method++) {
+		fixture_model(&m, 0.12, 0.12, 0.12, 3, 3, 3, 5, 0.49, true, 10,
+			      (enum irdm_eig_method)method, 0.001);
+		assert_int_equal(m.modes.n_rigid, 6);
+		assert_true(m.modes.omega2[0] > 1.0);  /* first elastic mode well clear of 0 */
+		size_t n = m.modes.n, nn = m.mesh.n_nodes;
+		double *v = malloc(n * sizeof(double)), *mv = malloc(n * sizeof(double));
+		/* six rigid fields: 3 translations, 3 infinitesimal rotations */
+		for (int f = 0; f < 6; f++) {
+			for (size_t i = 0; i < nn; i++) {
+				const double *p = &m.mesh.pos_m[3 * i];
+				double r[3] = { p[0] - 0.06, p[1] - 0.06, p[2] - 0.06 }, u[3] = { 0, 0, 0 };
+				if (f < 3) {
+					u[f] = 1;
+				} else {
+					int a = f - 3;   /* e_a x r */
+					u[(a + 1) % 3] = -r[(a + 2) % 3];
+					u[(a + 2) % 3] = r[(a + 1) % 3];
+				}
+				for (int ax = 0; ax < 3; ax++)
+					v[3 * i + (size_t)ax] = u[ax];
+			}
+			/* |P v|_M == |v|_M where P projects on the rigid modes */
+			irdm_csc_matvec(&m.fem.M, v, mv);
+			double vv = 0, proj = 0;
+			for (size_t i = 0; i < n; i++)
+				vv += v[i] * mv[i];
+			for (size_t r = 0; r < 6; r++) {
+				double d = 0;
+				for (size_t i = 0; i < n; i++)
+					d += m.modes.rigid_phi[r * n + i] * mv[i];
+				proj += d * d;
+			}
+			assert_true(fabs(proj - vv) <= 1e-8 * vv);
+		}
+		free(v);
+		free(mv);
+		irdm_model_free(&m);
+	}
+}
+
+static void test_grounded_mechanism_is_an_error(void **state)
+{
+	struct irdm_fem fem;
+	struct irdm_mesh mesh;
+	struct irdm_modes modes;
+	struct irdm_material mat = { 2000, 0.3, 110 };
+	char err[256];
+
+	(void)state;
+	assert_int_equal(irdm_mesh_gen_box(0.1, 0.1, 0.1, 2, 2, 2, 6, &mesh, err, sizeof(err)), 0);
+	/* nothing fixed, but declared grounded */
+	assert_int_equal(irdm_fem_assemble(&mesh, &mat, IRDM_MASS_LUMPED, NULL, &fem, err, sizeof(err)), 0);
+	assert_int_equal(irdm_modes_solve(&fem, 0, false, IRDM_EIG_DENSE, NULL, NULL, &modes, err,
+					  sizeof(err)), -1);
+	assert_non_null(strstr(err, "zero-stiffness"));
+	irdm_fem_free(&fem);
+	irdm_mesh_free(&mesh);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_zoh_matches_closed_form),
+		cmocka_unit_test(test_dense_and_lanczos_agree),
+		cmocka_unit_test(test_cantilever_matches_euler_bernoulli),
+		cmocka_unit_test(test_free_body_has_six_rigid_modes),
+		cmocka_unit_test(test_grounded_mechanism_is_an_error),
+	};
+
+	return cmocka_run_group_tests(tests, NULL, NULL);
+}
