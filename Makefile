@@ -45,6 +45,7 @@ TESTS    := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 BENCHES  := $(patsubst tests/bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC))
 
 .PHONY: all test san fuzz bench run clean
+.SECONDARY:
 all: $(IRDM) $(FW_LIB)
 
 $(BUILD)/obj/%.o: %.c

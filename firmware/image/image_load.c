@@ -255,7 +255,8 @@ static int check_header(struct parse *p)
 		return fail(p, IRDM_IMAGE_ERANGE,
 			    "header_size is %u, version 1 headers are %zu bytes",
 			    h->header_size, HEADER_SIZE);
-	if (!crc_matches(p->base, HEADER_CRC_LEN, h->header_crc32c, &crc))
+	/* Checksum the copies: what is checked is exactly what was summed. */
+	if (!crc_matches(&p->hdr, HEADER_CRC_LEN, h->header_crc32c, &crc))
 		return fail(p, IRDM_IMAGE_ECRC,
 			    "header checksum mismatch: stored 0x%08x, computed 0x%08x",
 			    h->header_crc32c, crc);
@@ -303,7 +304,7 @@ static int check_table(struct parse *p)
 			    (unsigned long long)(off + len),
 			    (unsigned long long)p->size);
 	memcpy(p->tab, p->base + off, (size_t)len);
-	if (!crc_matches(p->base + off, len, h->table_crc32c, &crc))
+	if (!crc_matches(p->tab, len, h->table_crc32c, &crc))
 		return fail(p, IRDM_IMAGE_ECRC,
 			    "section table checksum mismatch: stored 0x%08x, computed 0x%08x",
 			    h->table_crc32c, crc);
@@ -900,7 +901,7 @@ static int check_modal(struct parse *p)
 	const struct irdm_meta *m = &p->meta;
 	bool corr = m->flags & IRDM_META_STATIC_CORR;
 	const uint64_t shapes[] = { m->n_nodes, 3, m->n_modes };
-	const uint64_t sc[] = { m->n_cols, m->n_nodes, 9 };
+	const uint64_t sc[] = { m->n_cols, m->n_cols, 9 };
 	int ret;
 
 	ret = check_presence(p, IRDM_SEC_FIR, false, "modal image");
@@ -922,7 +923,7 @@ static int check_modal(struct parse *p)
 				   p->by_kind[IRDM_SEC_MODE_SHAPES]->size / p->es);
 	if (!ret && corr)
 		ret = check_shape(p, IRDM_SEC_STATIC_CORR, sc, 3,
-				  "n_cols x n_nodes x 9");
+				  "n_cols x n_cols x 9");
 	if (!ret && corr)
 		ret = check_finite(p, IRDM_SEC_STATIC_CORR,
 				   p->by_kind[IRDM_SEC_STATIC_CORR]->size / p->es);

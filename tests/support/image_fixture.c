@@ -200,7 +200,7 @@ int img_fixture_modal(struct img_fixture *fx, uint32_t precision,
 		goto fail;
 	if (meta_flags & IRDM_META_STATIC_CORR) {
 		fx->static_corr = fill_values(IRDM_SEC_STATIC_CORR, precision,
-					      (uint64_t)n_cols * n_nodes * 9,
+					      (uint64_t)n_cols * n_cols * 9,
 					      &fx->corr_bytes);
 		if (!fx->static_corr)
 			goto fail;

@@ -87,11 +87,15 @@ static int modal_data(struct build *b, char *err, size_t errlen)
 			b->shapes[r * K + k] = d < 0 ? 0.0 : m->modes.phi[k * n + (size_t)d];
 		}
 	if (b->sc->static_correction && truncated(b)) {
-		b->corr = malloc(m->n_cols * m->n_rows * 9 * sizeof(double));
+		/* modal images keep it between columns; FIR adds it to R[0] of every row */
+		bool fir = b->sc->representation == IRDM_REPR_FIR;
+		size_t n_out = fir ? m->n_rows : m->n_cols;
+		b->corr = malloc(m->n_cols * n_out * 9 * sizeof(double));
 		if (!b->corr)
 			goto out_nomem;
 		if (irdm_static_correction(&m->fem, &m->modes, b->sc->floating, m->col_dofs,
-					   m->n_cols, m->row_dofs, m->n_rows, b->corr, err, errlen))
+					   m->n_cols, fir ? m->row_dofs : m->col_dofs, n_out,
+					   b->corr, err, errlen))
 			return -1;
 	}
 	return 0;
@@ -319,11 +323,12 @@ static void stab_one(struct build *b, size_t c)
 		size_t K = b->n_modes;
 		double D[9];
 		if (b->corr)
-			memcpy(D, &b->corr[(c * m->n_rows + row) * 9], sizeof(D));
+			memcpy(D, &b->corr[(c * m->n_cols + c) * 9], sizeof(D));
 		rho = irdm_stability_modal(b->zoh, K, &b->shapes[3 * row * K], b->corr ? D : NULL);
 	}
+	/* judge the stored float: a radius within 3e-8 below 1 rounds to 1.0f */
 	b->stab[c].spectral_radius = (float)rho;
-	b->stab[c].flags = (rho >= 0 && rho < 1.0) ? IRDM_STAB_STABLE : 0;
+	b->stab[c].flags = (rho >= 0 && b->stab[c].spectral_radius < 1.0f) ? IRDM_STAB_STABLE : 0;
 }
 
 static void *stab_worker(void *arg)
@@ -473,7 +478,7 @@ static int write_image(struct build *b, size_t *bytes, char *err, size_t errlen)
 	} else {
 		irdm_iw_add(&w, IRDM_SEC_MODES, IRDM_ELEM_BYTES, b->zoh, b->n_modes * sizeof(*b->zoh));
 		irdm_iw_add(&w, IRDM_SEC_MODE_SHAPES, p, b->stored[1], b->stored_bytes[1]);
-		if (b->corr)
+		if (b->stored[2])
 			irdm_iw_add(&w, IRDM_SEC_STATIC_CORR, p, b->stored[2], b->stored_bytes[2]);
 	}
 	if (b->sc->floating)
@@ -506,13 +511,15 @@ static int responses(struct build *b, char *err, size_t errlen)
 	if (b->fir)
 		b->stored[0] = store(b->fir, m->n_cols * m->n_rows * b->sc->fir_length * 9,
 				     b->sc->precision, &b->stored_bytes[0]);
-	if (b->shapes)
+	if (b->shapes && b->sc->representation == IRDM_REPR_MODAL)
 		b->stored[1] = store(b->shapes, m->n_rows * 3 * b->n_modes, b->sc->precision,
 				     &b->stored_bytes[1]);
-	if (b->corr)
-		b->stored[2] = store(b->corr, m->n_cols * m->n_rows * 9, b->sc->precision,
+	if (b->corr && b->sc->representation == IRDM_REPR_MODAL)
+		b->stored[2] = store(b->corr, m->n_cols * m->n_cols * 9, b->sc->precision,
 				     &b->stored_bytes[2]);
-	if ((b->fir && !b->stored[0]) || (b->shapes && !b->stored[1]) || (b->corr && !b->stored[2])) {
+	if ((b->fir && !b->stored[0]) ||
+	    (b->shapes && b->sc->representation == IRDM_REPR_MODAL && !b->stored[1]) ||
+	    (b->corr && b->sc->representation == IRDM_REPR_MODAL && !b->stored[2])) {
 		snprintf(err, errlen, "precompute: out of memory converting to the storage precision");
 		return -1;
 	}

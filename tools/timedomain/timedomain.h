@@ -72,8 +72,11 @@ struct irdm_td_opts {
  * in the body frame with the rigid part (mass-weighted fit about the centre
  * of mass) removed at every sample.
  *
- * The result does not depend on `threads` (bit for bit).  Returns 0, or -1
- * with a one-line message in err.
+ * The result does not depend on `threads` (bit for bit).  While it runs,
+ * OpenBLAS is switched to one thread process-wide (restored on return), so
+ * do not run it concurrently with itself or with other OpenBLAS work that
+ * relies on its thread setting.  Returns 0, or -1 with a one-line message
+ * in err.
  */
 int irdm_td_responses(const struct irdm_mesh *mesh, const struct irdm_fem *fem,
 		      const struct irdm_td_opts *o, const int64_t *in_dofs, size_t n_in,

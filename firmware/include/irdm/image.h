@@ -45,7 +45,7 @@ struct irdm_image {
 	const void *fir;                    /* FIR: n_cols*n_nodes*T*9 of precision */
 	const struct irdm_mode *modes;      /* modal: n_modes */
 	const void *mode_shapes;            /* modal: n_nodes*3*n_modes of precision */
-	const void *static_corr;            /* modal, optional: n_cols*n_nodes*9 */
+	const void *static_corr;            /* modal, optional: n_cols*n_cols*9 */
 	const struct irdm_rigid *rigid;     /* floating only, else NULL */
 	const struct irdm_stability *stability; /* n_cols */
 };

@@ -62,7 +62,7 @@ enum irdm_section_kind {
 	IRDM_SEC_FIR = 6,          /* FIR only: R[s] blocks [col][row][s][3][3], elem = precision */
 	IRDM_SEC_MODES = 7,        /* modal only: n_modes x struct irdm_mode */
 	IRDM_SEC_MODE_SHAPES = 8,  /* modal only: [row][3][mode], elem = precision */
-	IRDM_SEC_STATIC_CORR = 9,  /* modal, optional: residual compliance [col][row][3][3] */
+	IRDM_SEC_STATIC_CORR = 9,  /* modal, optional: residual compliance [col][col'][3][3] */
 	IRDM_SEC_RIGID = 10,       /* floating only: struct irdm_rigid */
 	IRDM_SEC_STABILITY = 11,   /* n_cols x struct irdm_stability */
 	IRDM_SEC_CONTACT_BVH = 12, /* reserved for the contact acceleration structure */

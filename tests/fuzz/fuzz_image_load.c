@@ -1,0 +1,87 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * libFuzzer target: irdm_image_parse() on arbitrary bytes.  The input is
+ * copied into an exactly sized heap buffer (8-aligned, as the loader
+ * requires) so that AddressSanitizer catches any read outside the image.
+ * When an input is accepted, every view is read end to end by the meta
+ * counts: a view that the parser validated must lie inside the buffer.
+ *
+ * Checksums stop almost every mutation at the header; fuzz_image_semantic.c
+ * builds the same target with the checksum comparisons compiled out.
+ */
+#include <stddef.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "irdm/image.h"
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
+
+static volatile uint64_t fuzz_sink;
+
+static void read_bytes(const void *p, uint64_t len)
+{
+	const uint8_t *b = p;
+	uint64_t acc = 0;
+
+	for (uint64_t i = 0; i < len; i++)
+		acc += b[i];
+	fuzz_sink += acc;
+}
+
+static void read_values(const void *p, uint32_t elem, uint64_t count)
+{
+	double acc = 0;
+
+	for (uint64_t i = 0; i < count; i++)
+		acc += irdm_elem_get(p, elem, i);
+	fuzz_sink += (uint64_t)(acc != acc);
+}
+
+static void walk_views(const struct irdm_image *img)
+{
+	const struct irdm_meta *m = img->meta;
+	uint64_t nodes = m->n_nodes, cols = m->n_cols;
+
+	read_bytes(img->provenance, img->provenance_len);
+	read_bytes(img->nodes, nodes * sizeof(*img->nodes));
+	read_bytes(img->columns, cols * 4);
+	read_bytes(img->tris, (uint64_t)m->n_tris * 12);
+	read_bytes(img->stability, cols * sizeof(*img->stability));
+	if (img->fir)
+		read_values(img->fir, m->precision,
+			    cols * nodes * m->fir_length * 9);
+	if (img->modes)
+		read_bytes(img->modes, (uint64_t)m->n_modes * sizeof(*img->modes));
+	if (img->mode_shapes)
+		read_values(img->mode_shapes, m->precision,
+			    nodes * 3 * m->n_modes);
+	if (img->static_corr)
+		read_values(img->static_corr, m->precision, cols * nodes * 9);
+	if (img->rigid)
+		read_bytes(img->rigid, sizeof(*img->rigid));
+	for (uint32_t k = 0; k <= IRDM_SEC_CONTACT_BVH + 1; k++) {
+		const struct irdm_image_section *s = irdm_image_find(img, k);
+
+		if (s)
+			read_bytes(img->base + s->offset, s->size);
+	}
+}
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
+	struct irdm_image img;
+	char err[256];
+	void *buf = malloc(size ? size : 1);    /* malloc: 16-aligned */
+
+	if (!buf)
+		return 0;
+	memcpy(buf, data, size);
+	if (irdm_image_parse(buf, size, &img, err, sizeof(err)) == IRDM_IMAGE_OK)
+		walk_views(&img);
+	else if (!err[0] || img.base)
+		abort();        /* every rejection has a reason and no views */
+	free(buf);
+	return 0;
+}

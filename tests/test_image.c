@@ -1,0 +1,1518 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * Flash image: CRC-32C, binary16, writer layout and atomicity, loader round
+ * trips, and the loader's rejection of every kind of damaged image.
+ */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <dirent.h>
+#include <errno.h>
+#include <limits.h>
+#include <math.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "irdm/image.h"
+#include "image/image_writer.h"
+#include "support/image_fixture.h"
+
+static char tmpdir[512];
+static const char *current_case = "";      /* named when a check fails */
+
+/* ------------------------------------------------------------- helpers */
+
+static void path_in(char *buf, size_t len, const char *name)
+{
+	snprintf(buf, len, "%s/%s", tmpdir, name);
+}
+
+static int rm_tree(const char *path)
+{
+	struct dirent *de;
+	struct stat st;
+	char sub[PATH_MAX];
+	DIR *d;
+
+	if (lstat(path, &st))
+		return -1;
+	if (!S_ISDIR(st.st_mode))
+		return unlink(path);
+	d = opendir(path);
+	if (!d)
+		return -1;
+	while ((de = readdir(d))) {
+		if (!strcmp(de->d_name, ".") || !strcmp(de->d_name, ".."))
+			continue;
+		snprintf(sub, sizeof(sub), "%s/%s", path, de->d_name);
+		rm_tree(sub);
+	}
+	closedir(d);
+	return rmdir(path);
+}
+
+/* Entries of dir whose name contains ".tmp." (writer leftovers). */
+static int count_tmp_files(const char *dir)
+{
+	struct dirent *de;
+	int n = 0;
+	DIR *d = opendir(dir);
+
+	assert_non_null(d);
+	while ((de = readdir(d)))
+		if (strstr(de->d_name, ".tmp."))
+			n++;
+	closedir(d);
+	return n;
+}
+
+static void *read_file(const char *path, size_t *len)
+{
+	FILE *f = fopen(path, "rb");
+	void *buf;
+	long n;
+
+	assert_non_null(f);
+	assert_int_equal(fseek(f, 0, SEEK_END), 0);
+	n = ftell(f);
+	assert_true(n >= 0);
+	rewind(f);
+	buf = malloc((size_t)n + 1);
+	assert_non_null(buf);
+	assert_int_equal(fread(buf, 1, (size_t)n, f), (size_t)n);
+	fclose(f);
+	*len = (size_t)n;
+	return buf;
+}
+
+static void write_file(const char *path, const void *buf, size_t len)
+{
+	FILE *f = fopen(path, "wb");
+
+	assert_non_null(f);
+	assert_int_equal(fwrite(buf, 1, len, f), len);
+	assert_int_equal(fclose(f), 0);
+}
+
+/* Parse a private, exactly sized copy of buf (so ASan sees any overread)
+ * and expect code; on failure the message must be set and contain needle,
+ * and img must be left zeroed. */
+static void expect_parse(const void *buf, size_t size, int code,
+			 const char *needle)
+{
+	struct irdm_image img, zero;
+	char err[512];
+	void *copy = img_fixture_copy(buf, size);
+	int ret;
+
+	assert_non_null(copy);
+	memset(&img, 0xa5, sizeof(img));
+	memset(&zero, 0, sizeof(zero));
+	ret = irdm_image_parse(copy, size, &img, err, sizeof(err));
+	if (ret != code || (needle && ret && !strstr(err, needle)))
+		print_message("%s: parse got %d \"%s\", expected %d with \"%s\"\n",
+			      current_case, ret, err, code, needle ? needle : "");
+	assert_int_equal(ret, code);
+	if (code) {
+		assert_true(strlen(err) > 10);
+		assert_null(strchr(err, '\n'));
+		if (needle)
+			assert_non_null(strstr(err, needle));
+		assert_memory_equal(&img, &zero, sizeof(img));
+	}
+	free(copy);
+}
+
+static void fixture_buffer(const struct img_fixture *fx, void **buf,
+			   size_t *size)
+{
+	assert_int_equal(img_fixture_buffer(fx, buf, size), 0);
+}
+
+static void small_fir(struct img_fixture *fx)
+{
+	assert_int_equal(img_fixture_fir(fx, IRDM_ELEM_F32, 6, 2, 4), 0);
+}
+
+static void small_modal(struct img_fixture *fx)
+{
+	assert_int_equal(img_fixture_modal(fx, IRDM_ELEM_F64, 5, 2, 3,
+					   IRDM_META_FLOATING |
+					   IRDM_META_STATIC_CORR), 0);
+}
+
+static struct irdm_image_section get_entry(const void *buf, unsigned i)
+{
+	struct irdm_image_header h;
+	struct irdm_image_section s;
+
+	memcpy(&h, buf, sizeof(h));
+	memcpy(&s, (const uint8_t *)buf + h.section_table_offset + i * sizeof(s),
+	       sizeof(s));
+	return s;
+}
+
+static void put_entry(void *buf, unsigned i, const struct irdm_image_section *s)
+{
+	struct irdm_image_header h;
+
+	memcpy(&h, buf, sizeof(h));
+	memcpy((uint8_t *)buf + h.section_table_offset + i * sizeof(*s), s,
+	       sizeof(*s));
+}
+
+static unsigned entry_of(const void *buf, uint32_t kind)
+{
+	struct irdm_image_header h;
+
+	memcpy(&h, buf, sizeof(h));
+	for (unsigned i = 0; i < h.section_count; i++)
+		if (get_entry(buf, i).kind == kind)
+			return i;
+	fail_msg("kind %u not in image", kind);
+	return 0;
+}
+
+static struct irdm_image_header get_header(const void *buf)
+{
+	struct irdm_image_header h;
+
+	memcpy(&h, buf, sizeof(h));
+	return h;
+}
+
+static void put_header(void *buf, const struct irdm_image_header *h)
+{
+	memcpy(buf, h, sizeof(*h));
+}
+
+/* ---------------------------------------------------------------- CRC */
+
+/* Bit-at-a-time reference, independent of the table code. */
+static uint32_t crc32c_bitwise(const uint8_t *p, size_t n)
+{
+	uint32_t c = 0xffffffffu;
+
+	while (n--) {
+		c ^= *p++;
+		for (int k = 0; k < 8; k++)
+			c = (c >> 1) ^ (0x82f63b78u & (0u - (c & 1)));
+	}
+	return ~c;
+}
+
+static void test_crc32c_check_value(void **state)
+{
+	(void)state;
+	assert_int_equal(irdm_crc32c("123456789", 9), 0xE3069283u);
+	assert_int_equal(irdm_crc32c("", 0), 0);
+	/* RFC 3720 B.4: 32 bytes of zeros, of 0xff. */
+	uint8_t z[32] = { 0 }, f[32];
+
+	memset(f, 0xff, sizeof(f));
+	assert_int_equal(irdm_crc32c(z, 32), 0x8A9136AAu);
+	assert_int_equal(irdm_crc32c(f, 32), 0x62A8AB43u);
+}
+
+static void test_crc32c_all_lengths_and_alignments(void **state)
+{
+	uint8_t buf[300];
+
+	(void)state;
+	for (size_t i = 0; i < sizeof(buf); i++)
+		buf[i] = (uint8_t)(i * 167 + 13);
+	for (size_t off = 0; off < 8; off++)
+		for (size_t n = 0; n + off <= sizeof(buf); n++)
+			assert_int_equal(irdm_crc32c(buf + off, n),
+					 crc32c_bitwise(buf + off, n));
+}
+
+/* --------------------------------------------------------------- binary16 */
+
+static uint32_t f32bits(float f)
+{
+	uint32_t x;
+
+	memcpy(&x, &f, sizeof(x));
+	return x;
+}
+
+static void test_f16_known_patterns(void **state)
+{
+	static const struct {
+		float f;
+		uint16_t h;
+	} t[] = {
+		{ 1.0f, 0x3c00 }, { -2.0f, 0xc000 }, { 65504.0f, 0x7bff },
+		{ 0x1p-24f, 0x0001 }, { 0x1p-14f, 0x0400 }, { 0.1f, 0x2e66 },
+		{ 0.0f, 0x0000 }, { -0.0f, 0x8000 }, { 0.5f, 0x3800 },
+		{ 65520.0f, 0x7c00 }, { 1e6f, 0x7c00 }, { -1e6f, 0xfc00 },
+		{ INFINITY, 0x7c00 }, { -INFINITY, 0xfc00 },
+		{ 0x1p-25f, 0x0000 },           /* tie: to even (0) */
+		{ 0x1.8p-24f, 0x0002 },         /* tie 1.5 units: to even (2) */
+		{ 0x1.0p-26f, 0x0000 }, { 0x1.000002p-25f, 0x0001 },
+		{ 65519.0f, 0x7bff }, { 0x1.ff8p-15f, 0x03ff },
+		{ 0x1.ffcp-15f, 0x0400 },        /* tie: to even (normal) */
+		{ 1.0f + 0x1p-11f, 0x3c00 },    /* tie: to even */
+		{ 1.0f + 0x1.8p-10f, 0x3c02 },  /* tie: to even (up) */
+	};
+
+	(void)state;
+	for (size_t i = 0; i < sizeof(t) / sizeof(t[0]); i++) {
+		uint16_t h = irdm_f32_to_f16(t[i].f);
+
+		if (h != t[i].h)
+			print_message("%a -> 0x%04x, expected 0x%04x\n",
+				      (double)t[i].f, h, t[i].h);
+		assert_int_equal(h, t[i].h);
+	}
+	assert_true(irdm_f16_to_f32(0x3c00) == 1.0f);
+	assert_true(irdm_f16_to_f32(0xc000) == -2.0f);
+	assert_true(irdm_f16_to_f32(0x7bff) == 65504.0f);
+	assert_true(irdm_f16_to_f32(0x0001) == 0x1p-24f);
+	assert_true(irdm_f16_to_f32(0x03ff) == 0x1.ff8p-15f);
+	assert_true(irdm_f16_to_f32(0x7c00) == INFINITY);
+	assert_true(irdm_f16_to_f32(0xfc00) == -INFINITY);
+	assert_int_equal(f32bits(irdm_f16_to_f32(0x8000)), 0x80000000u);
+	assert_true(isnan(irdm_f16_to_f32(0x7e00)));
+	assert_true(isnan(irdm_f16_to_f32(0x7c01)));
+	assert_true((irdm_f32_to_f16(NAN) & 0x7fff) > 0x7c00);
+}
+
+static void test_f16_roundtrip_all(void **state)
+{
+	(void)state;
+	for (uint32_t i = 0; i < 65536; i++) {
+		uint16_t h = (uint16_t)i;
+		float f = irdm_f16_to_f32(h);
+		bool nan = (h & 0x7c00) == 0x7c00 && (h & 0x3ff);
+
+		assert_int_equal(isnan(f) != 0, nan);
+		if (nan) {
+			uint16_t back = irdm_f32_to_f16(f);
+
+			assert_true((back & 0x7c00) == 0x7c00 && (back & 0x3ff));
+			assert_int_equal(back & 0x8000, h & 0x8000);
+			continue;
+		}
+		assert_int_equal(irdm_f32_to_f16(f), h);
+	}
+}
+
+/* Every rounding boundary: just below, at and above the midpoint between
+ * each pair of neighbouring halves (both signs). */
+static void test_f16_rounding_all_midpoints(void **state)
+{
+	(void)state;
+	for (uint16_t h = 0; h < 0x7c00; h++) {
+		float lo = irdm_f16_to_f32(h);
+		float hi = irdm_f16_to_f32((uint16_t)(h + 1));
+		float mid = lo + (hi - lo) / 2;     /* exact in binary32 */
+		uint16_t even = (h & 1) ? (uint16_t)(h + 1) : h;
+
+		if (h == 0x7bff)
+			hi = 65536.0f, mid = 65520.0f;
+		assert_int_equal(irdm_f32_to_f16(nextafterf(mid, 0)), h);
+		assert_int_equal(irdm_f32_to_f16(mid), even);
+		assert_int_equal(irdm_f32_to_f16(nextafterf(mid, hi)), h + 1);
+		assert_int_equal(irdm_f32_to_f16(-nextafterf(mid, 0)), h | 0x8000);
+		assert_int_equal(irdm_f32_to_f16(-mid), even | 0x8000);
+	}
+}
+
+static void test_elem_size_and_get(void **state)
+{
+	const uint16_t h[2] = { 0x3c00, 0xc000 };
+	const float f[2] = { 1.5f, -3.25f };
+	const double d[2] = { 1e300, -2.5 };
+	const uint32_t u[2] = { 7, 4000000000u };
+	const uint8_t b[2] = { 9, 250 };
+
+	(void)state;
+	assert_int_equal(irdm_elem_size(IRDM_ELEM_BYTES), 1);
+	assert_int_equal(irdm_elem_size(IRDM_ELEM_F16), 2);
+	assert_int_equal(irdm_elem_size(IRDM_ELEM_F32), 4);
+	assert_int_equal(irdm_elem_size(IRDM_ELEM_F64), 8);
+	assert_int_equal(irdm_elem_size(IRDM_ELEM_U32), 4);
+	assert_int_equal(irdm_elem_size(5), 0);
+	assert_true(irdm_elem_get(h, IRDM_ELEM_F16, 1) == -2.0);
+	assert_true(irdm_elem_get(f, IRDM_ELEM_F32, 1) == -3.25);
+	assert_true(irdm_elem_get(d, IRDM_ELEM_F64, 0) == 1e300);
+	assert_true(irdm_elem_get(u, IRDM_ELEM_U32, 1) == 4000000000.0);
+	assert_true(irdm_elem_get(b, IRDM_ELEM_BYTES, 1) == 250.0);
+	assert_true(isnan(irdm_elem_get(b, 77, 0)));
+}
+
+/* ---------------------------------------------------------- writer layout */
+
+static void test_writer_layout(void **state)
+{
+	struct img_fixture fx;
+	struct irdm_image_header h;
+	uint64_t end = 0;
+	size_t size;
+	void *buf;
+
+	(void)state;
+	small_modal(&fx);
+	fixture_buffer(&fx, &buf, &size);
+	h = get_header(buf);
+	assert_memory_equal(h.magic, "IRDMIMG", 8);
+	assert_int_equal(h.version_major, 1);
+	assert_int_equal(h.version_minor, 0);
+	assert_int_equal(h.header_size, 64);
+	assert_int_equal(h.file_size, size);
+	assert_int_equal(h.section_count, 10);
+	assert_int_equal(h.section_table_offset, 64);
+	assert_int_equal(h.header_crc32c, irdm_crc32c(buf, 60));
+	assert_int_equal(h.table_crc32c,
+			 irdm_crc32c((uint8_t *)buf + 64, 10 * 32));
+	end = 64 + 10 * 32;
+	for (unsigned i = 0; i < h.section_count; i++) {
+		struct irdm_image_section s = get_entry(buf, i);
+
+		assert_int_equal(s.offset % 64, 0);
+		assert_true(s.offset >= end && s.offset - end < 64);
+		for (uint64_t o = end; o < s.offset; o++)
+			assert_int_equal(((uint8_t *)buf)[o], 0);
+		assert_int_equal(s.crc32c,
+				 irdm_crc32c((uint8_t *)buf + s.offset, s.size));
+		assert_int_equal(s.reserved, 0);
+		end = s.offset + s.size;
+	}
+	assert_int_equal(end, size);            /* no trailing bytes */
+	free(buf);
+	img_fixture_free(&fx);
+}
+
+static void test_writer_add_rejects(void **state)
+{
+	struct irdm_image_writer w;
+	uint8_t x[4] = { 0 };
+	char err[256] = "";
+	char path[PATH_MAX];
+	void *buf;
+	size_t size;
+
+	(void)state;
+	irdm_iw_init(&w);
+	assert_int_equal(irdm_iw_add(&w, 1, IRDM_ELEM_BYTES, x, 4), 0);
+	assert_int_equal(irdm_iw_add(&w, 1, IRDM_ELEM_BYTES, x, 4), -1);
+	assert_int_equal(irdm_iw_add(&w, 2, IRDM_ELEM_BYTES, NULL, 4), -1);
+	assert_int_equal(irdm_iw_add(&w, 2, 9, x, 4), -1);
+	for (uint32_t k = 2; k <= IRDM_IMAGE_MAX_SECTIONS; k++)
+		assert_int_equal(irdm_iw_add(&w, k, IRDM_ELEM_BYTES, x, 4), 0);
+	assert_int_equal(irdm_iw_add(&w, 99, IRDM_ELEM_BYTES, x, 4), -1);
+	assert_int_equal(w.n, IRDM_IMAGE_MAX_SECTIONS);
+
+	irdm_iw_init(&w);
+	assert_int_equal(irdm_iw_to_buffer(&w, &buf, &size), -1);
+	assert_null(buf);
+	path_in(path, sizeof(path), "empty.img");
+	assert_int_equal(irdm_iw_write(&w, path, err, sizeof(err)), -1);
+	assert_non_null(strstr(err, path));
+	assert_int_equal(access(path, F_OK), -1);
+	assert_int_equal(count_tmp_files(tmpdir), 0);
+}
+
+/* ------------------------------------------------------------ round trips */
+
+static void check_common_views(const struct irdm_image *img,
+			       const struct img_fixture *fx)
+{
+	const struct irdm_meta *m = &fx->meta;
+
+	assert_non_null(img->meta);
+	assert_memory_equal(img->meta, m, sizeof(*m));
+	assert_int_equal(img->provenance_len, fx->provenance_len);
+	assert_memory_equal(img->provenance, fx->provenance, fx->provenance_len);
+	assert_memory_equal(img->nodes, fx->nodes, m->n_nodes * sizeof(*fx->nodes));
+	assert_memory_equal(img->columns, fx->columns, m->n_cols * 4);
+	assert_memory_equal(img->tris, fx->tris, m->n_tris * 12);
+	assert_memory_equal(img->stability, fx->stability,
+			    m->n_cols * sizeof(*fx->stability));
+	for (uint32_t k = 1; k <= IRDM_SEC_STABILITY; k++) {
+		const struct irdm_image_section *s = irdm_image_find(img, k);
+
+		if (!s)
+			continue;
+		assert_int_equal(s->kind, k);
+		assert_int_equal(s->offset % 64, 0);
+		assert_true(s->offset + s->size <= img->size);
+	}
+	assert_null(irdm_image_find(img, IRDM_SEC_CONTACT_BVH));
+	assert_null(irdm_image_find(img, 1000));
+	assert_ptr_equal(irdm_image_find(img, IRDM_SEC_META)->offset +
+			 img->base, (const uint8_t *)img->meta);
+}
+
+static void check_fir_values(const struct irdm_image *img, uint32_t prec)
+{
+	const struct irdm_meta *m = img->meta;
+	uint64_t T = m->fir_length;
+
+	/* Block (col c, row r, sample s) element (i, j). */
+	for (uint64_t c = 0; c < m->n_cols; c++)
+		for (uint64_t r = 0; r < m->n_nodes; r++)
+			for (uint64_t s = 0; s < T; s++)
+				for (uint64_t i = 0; i < 3; i++)
+					for (uint64_t j = 0; j < 3; j++) {
+						uint64_t k = ((((c * m->n_nodes + r) * T + s) * 3 + i) * 3 + j);
+
+						assert_true(irdm_elem_get(img->fir, prec, k) ==
+							    img_fixture_value(IRDM_SEC_FIR, k));
+					}
+}
+
+static void test_fir_roundtrip(void **state)
+{
+	static const uint32_t precs[] = { IRDM_ELEM_F16, IRDM_ELEM_F32,
+					  IRDM_ELEM_F64 };
+	struct img_fixture fx;
+	struct irdm_image img;
+	char path[PATH_MAX], err[512];
+	struct stat st;
+
+	(void)state;
+	path_in(path, sizeof(path), "fir.img");
+	for (size_t p = 0; p < 3; p++) {
+		assert_int_equal(img_fixture_fir(&fx, precs[p], 7, 3, 5), 0);
+		assert_int_equal(img_fixture_write(&fx, path, err, sizeof(err)), 0);
+		assert_int_equal(irdm_image_map(path, 0, &img, err, sizeof(err)),
+				 IRDM_IMAGE_OK);
+		assert_int_equal(stat(path, &st), 0);
+		assert_int_equal(img.size, (size_t)st.st_size);
+		assert_true(img.mapped);
+		assert_false(img.locked);
+		assert_int_equal((uintptr_t)img.base % 4096, 0);
+		check_common_views(&img, &fx);
+		check_fir_values(&img, precs[p]);
+		assert_memory_equal(img.fir, fx.fir, fx.fir_bytes);
+		assert_null(img.modes);
+		assert_null(img.mode_shapes);
+		assert_null(img.static_corr);
+		assert_null(img.rigid);
+		irdm_image_unmap(&img);
+		assert_null(img.base);
+		assert_false(img.mapped);
+		img_fixture_free(&fx);
+	}
+	assert_int_equal(count_tmp_files(tmpdir), 0);
+}
+
+static void test_modal_floating_roundtrip(void **state)
+{
+	struct img_fixture fx;
+	struct irdm_image img;
+	char path[PATH_MAX], err[512];
+	uint64_t n;
+
+	(void)state;
+	small_modal(&fx);
+	path_in(path, sizeof(path), "modal.img");
+	assert_int_equal(img_fixture_write(&fx, path, err, sizeof(err)), 0);
+	assert_int_equal(irdm_image_map(path, 0, &img, err, sizeof(err)),
+			 IRDM_IMAGE_OK);
+	check_common_views(&img, &fx);
+	assert_null(img.fir);
+	assert_memory_equal(img.modes, fx.modes, 3 * sizeof(*fx.modes));
+	assert_memory_equal(img.rigid, &fx.rigid, sizeof(fx.rigid));
+	n = (uint64_t)5 * 3 * 3;        /* [row][3][mode] */
+	for (uint64_t k = 0; k < n; k++)
+		assert_true(irdm_elem_get(img.mode_shapes, IRDM_ELEM_F64, k) ==
+			    img_fixture_value(IRDM_SEC_MODE_SHAPES, k));
+	n = (uint64_t)2 * 2 * 9;        /* [col][col][3][3] */
+	for (uint64_t k = 0; k < n; k++)
+		assert_true(irdm_elem_get(img.static_corr, IRDM_ELEM_F64, k) ==
+			    img_fixture_value(IRDM_SEC_STATIC_CORR, k));
+	/* The fixture's modes are exact ZOH discretisations: |eig(A)| < 1. */
+	assert_true(img.modes[0].a[0] * img.modes[0].a[3] -
+		    img.modes[0].a[1] * img.modes[0].a[2] < 1);
+	irdm_image_unmap(&img);
+	img_fixture_free(&fx);
+}
+
+/* Grounded modal image without static correction, f16. */
+static void test_modal_grounded_f16_roundtrip(void **state)
+{
+	struct img_fixture fx;
+	size_t size;
+	void *buf;
+
+	(void)state;
+	assert_int_equal(img_fixture_modal(&fx, IRDM_ELEM_F16, 4, 4, 2, 0), 0);
+	fixture_buffer(&fx, &buf, &size);
+	expect_parse(buf, size, IRDM_IMAGE_OK, NULL);
+	free(buf);
+	img_fixture_free(&fx);
+}
+
+static void test_map_lock(void **state)
+{
+	struct img_fixture fx;
+	struct irdm_image img;
+	char path[PATH_MAX], err[512] = "";
+	int ret;
+
+	(void)state;
+	small_fir(&fx);
+	path_in(path, sizeof(path), "lock.img");
+	assert_int_equal(img_fixture_write(&fx, path, err, sizeof(err)), 0);
+	ret = irdm_image_map(path, IRDM_IMAGE_MAP_LOCK, &img, err, sizeof(err));
+	if (ret == IRDM_IMAGE_OK) {
+		assert_true(img.locked);
+		irdm_image_unmap(&img);
+	} else {
+		/* Not allowed to lock here: the reason must say how to fix it. */
+		assert_int_equal(ret, IRDM_IMAGE_EIO);
+		assert_non_null(strstr(err, "cannot lock"));
+		assert_non_null(strstr(err, "RLIMIT_MEMLOCK"));
+		assert_null(img.base);
+	}
+	assert_int_equal(irdm_image_map(path, 0x80, &img, err, sizeof(err)),
+			 IRDM_IMAGE_EINVAL);
+	img_fixture_free(&fx);
+}
+
+static void test_map_errors(void **state)
+{
+	struct irdm_image img;
+	char path[PATH_MAX], err[512];
+	struct img_fixture fx;
+	uint8_t *buf;
+	size_t size;
+
+	(void)state;
+	path_in(path, sizeof(path), "does-not-exist.img");
+	assert_int_equal(irdm_image_map(path, 0, &img, err, sizeof(err)),
+			 IRDM_IMAGE_EIO);
+	assert_non_null(strstr(err, path));
+	assert_non_null(strstr(err, strerror(ENOENT)));
+	assert_null(img.base);
+
+	assert_int_equal(irdm_image_map(tmpdir, 0, &img, err, sizeof(err)),
+			 IRDM_IMAGE_EIO);
+	assert_non_null(strstr(err, "regular file"));
+
+	path_in(path, sizeof(path), "tiny.img");
+	write_file(path, "IRDMIMG", 8);
+	assert_int_equal(irdm_image_map(path, 0, &img, err, sizeof(err)),
+			 IRDM_IMAGE_ETRUNC);
+	assert_non_null(strstr(err, "truncated"));
+	write_file(path, "", 0);
+	assert_int_equal(irdm_image_map(path, 0, &img, err, sizeof(err)),
+			 IRDM_IMAGE_ETRUNC);
+
+	/* A parse error through map names the path and the problem, and the
+	 * file is unmapped again. */
+	small_fir(&fx);
+	assert_int_equal(img_fixture_buffer(&fx, (void **)&buf, &size), 0);
+	buf[size - 1] ^= 1;
+	path_in(path, sizeof(path), "bad.img");
+	write_file(path, buf, size);
+	assert_int_equal(irdm_image_map(path, 0, &img, err, sizeof(err)),
+			 IRDM_IMAGE_ECRC);
+	assert_non_null(strstr(err, path));
+	assert_non_null(strstr(err, "STABILITY"));
+	assert_null(img.base);
+	free(buf);
+	img_fixture_free(&fx);
+}
+
+/* ------------------------------------------------------------- corruption */
+
+static void test_truncated_every_length(void **state)
+{
+	struct img_fixture fx;
+	size_t size;
+	void *buf;
+
+	(void)state;
+	small_modal(&fx);
+	fixture_buffer(&fx, &buf, &size);
+	/* Every length: covers 0 .. header + table and everything beyond. */
+	for (size_t len = 0; len < size; len++)
+		expect_parse(buf, len, IRDM_IMAGE_ETRUNC, "truncated");
+	expect_parse(buf, size, IRDM_IMAGE_OK, NULL);
+	free(buf);
+	img_fixture_free(&fx);
+}
+
+static void test_every_byte_flip_detected(void **state)
+{
+	static const uint8_t masks[] = { 0x01, 0x80, 0xff };
+	struct img_fixture fx;
+	int hist[9] = { 0 };
+	size_t size;
+	uint8_t *buf;
+
+	(void)state;
+	small_modal(&fx);
+	fixture_buffer(&fx, (void **)&buf, &size);
+	for (size_t pos = 0; pos < size; pos++) {
+		for (size_t m = 0; m < sizeof(masks); m++) {
+			struct irdm_image img;
+			char err[512] = "";
+			uint8_t *copy = img_fixture_copy(buf, size);
+			int ret;
+
+			copy[pos] ^= masks[m];
+			ret = irdm_image_parse(copy, size, &img, err, sizeof(err));
+			if (ret == IRDM_IMAGE_OK)
+				print_message("flip 0x%02x at %zu accepted\n",
+					      masks[m], pos);
+			assert_true(ret < 0 && ret >= IRDM_IMAGE_EINVAL);
+			assert_true(err[0] != '\0');
+			assert_null(img.base);
+			hist[-ret]++;
+			free(copy);
+		}
+	}
+	print_message("%zu bytes x 3 flips: trunc %d magic %d version %d crc %d "
+		      "range %d missing %d inval %d\n", size, hist[2], hist[3],
+		      hist[4], hist[5], hist[6], hist[7], hist[8]);
+	free(buf);
+	img_fixture_free(&fx);
+}
+
+static void test_bad_magic_and_version(void **state)
+{
+	struct img_fixture fx;
+	struct irdm_image_header h;
+	size_t size;
+	uint8_t *buf;
+
+	(void)state;
+	small_fir(&fx);
+	fixture_buffer(&fx, (void **)&buf, &size);
+
+	buf[0] = 'X';
+	expect_parse(buf, size, IRDM_IMAGE_EMAGIC, "not an IRDM image");
+	buf[0] = 'I';
+	buf[7] = ' ';                   /* the NUL is part of the magic */
+	expect_parse(buf, size, IRDM_IMAGE_EMAGIC, "magic");
+	buf[7] = 0;
+
+	h = get_header(buf);
+	h.version_major = 2;
+	put_header(buf, &h);
+	img_fixture_reseal(buf, size);
+	expect_parse(buf, size, IRDM_IMAGE_EVERSION, "version 2.0");
+	h.version_major = 0;
+	put_header(buf, &h);
+	img_fixture_reseal(buf, size);
+	expect_parse(buf, size, IRDM_IMAGE_EVERSION, "not supported");
+
+	/* A newer minor is compatible, and may use reserved header fields. */
+	h.version_major = 1;
+	h.version_minor = 3;
+	h.flags = 0x10;
+	h.reserved[5] = 7;
+	put_header(buf, &h);
+	img_fixture_reseal(buf, size);
+	expect_parse(buf, size, IRDM_IMAGE_OK, NULL);
+	/* ... but version 1.0 may not. */
+	h.version_minor = 0;
+	put_header(buf, &h);
+	img_fixture_reseal(buf, size);
+	expect_parse(buf, size, IRDM_IMAGE_EINVAL, "reserved");
+
+	h.flags = 0;
+	h.reserved[5] = 0;
+	h.header_size = 72;
+	put_header(buf, &h);
+	img_fixture_reseal(buf, size);
+	expect_parse(buf, size, IRDM_IMAGE_ERANGE, "header_size is 72");
+	free(buf);
+	img_fixture_free(&fx);
+}
+
+static void test_bad_checksums(void **state)
+{
+	struct img_fixture fx;
+	struct irdm_image_section s;
+	size_t size;
+	uint8_t *buf;
+	unsigned i;
+
+	(void)state;
+	small_fir(&fx);
+	fixture_buffer(&fx, (void **)&buf, &size);
+
+	buf[20] ^= 0x40;                /* file_size, covered by header crc */
+	expect_parse(buf, size, IRDM_IMAGE_ECRC, "header checksum mismatch");
+	buf[20] ^= 0x40;
+
+	buf[64 + 3 * 32 + 8] ^= 0x40;   /* an offset in the table */
+	expect_parse(buf, size, IRDM_IMAGE_ECRC, "section table checksum mismatch");
+	buf[64 + 3 * 32 + 8] ^= 0x40;
+
+	i = entry_of(buf, IRDM_SEC_NODES);
+	s = get_entry(buf, i);
+	buf[s.offset + 5] ^= 1;
+	expect_parse(buf, size, IRDM_IMAGE_ECRC, "(NODES) checksum mismatch");
+	buf[s.offset + 5] ^= 1;
+
+	s.crc32c ^= 1;                  /* the stored crc is in the table */
+	put_entry(buf, i, &s);
+	expect_parse(buf, size, IRDM_IMAGE_ECRC, "section table checksum");
+	free(buf);
+	img_fixture_free(&fx);
+}
+
+static void test_file_size_mismatch(void **state)
+{
+	struct img_fixture fx;
+	struct irdm_image_header h;
+	size_t size;
+	uint8_t *buf, *big;
+
+	(void)state;
+	small_fir(&fx);
+	fixture_buffer(&fx, (void **)&buf, &size);
+	h = get_header(buf);
+
+	h.file_size = size + 64;
+	put_header(buf, &h);
+	img_fixture_reseal(buf, size);
+	expect_parse(buf, size, IRDM_IMAGE_ETRUNC, "header says");
+
+	h.file_size = size;
+	put_header(buf, &h);
+	img_fixture_reseal(buf, size);
+	big = calloc(size + 64, 1);
+	assert_non_null(big);
+	memcpy(big, buf, size);
+	expect_parse(big, size + 64, IRDM_IMAGE_ERANGE, "trailing");
+	expect_parse(big, size + 1, IRDM_IMAGE_ERANGE, "trailing");
+	free(big);
+	free(buf);
+	img_fixture_free(&fx);
+}
+
+static void test_table_out_of_range(void **state)
+{
+	struct img_fixture fx;
+	struct irdm_image_header h, orig;
+	size_t size;
+	uint8_t *buf;
+
+	(void)state;
+	small_fir(&fx);
+	fixture_buffer(&fx, (void **)&buf, &size);
+	orig = get_header(buf);
+
+	h = orig;
+	h.section_count = 0;
+	put_header(buf, &h);
+	img_fixture_reseal(buf, size);
+	expect_parse(buf, size, IRDM_IMAGE_EINVAL, "section_count is 0");
+	h.section_count = 33;
+	put_header(buf, &h);
+	img_fixture_reseal(buf, size);
+	expect_parse(buf, size, IRDM_IMAGE_EINVAL, "section_count is 33");
+
+	h = orig;
+	h.section_table_offset = 96;
+	put_header(buf, &h);
+	img_fixture_reseal(buf, size);
+	expect_parse(buf, size, IRDM_IMAGE_ERANGE, "section table offset 96");
+	h.section_table_offset = 0;
+	put_header(buf, &h);
+	img_fixture_reseal(buf, size);
+	expect_parse(buf, size, IRDM_IMAGE_ERANGE, "section table offset 0");
+	h.section_table_offset = (uint32_t)(size / 64 * 64);
+	put_header(buf, &h);
+	img_fixture_reseal(buf, size);
+	expect_parse(buf, size, IRDM_IMAGE_ERANGE, "outside");
+	h.section_table_offset = 0xffffffc0u;
+	put_header(buf, &h);
+	img_fixture_reseal(buf, size);
+	expect_parse(buf, size, IRDM_IMAGE_ERANGE, "outside");
+	free(buf);
+	img_fixture_free(&fx);
+}
+
+/* Tamper with one table entry, reseal, and expect code. */
+static void expect_entry(const uint8_t *orig, size_t size, uint32_t kind,
+			 void (*edit)(struct irdm_image_section *, size_t),
+			 int code, const char *needle)
+{
+	uint8_t *buf = img_fixture_copy(orig, size);
+	unsigned i = entry_of(buf, kind);
+	struct irdm_image_section s = get_entry(buf, i);
+
+	edit(&s, size);
+	put_entry(buf, i, &s);
+	img_fixture_reseal(buf, size);
+	expect_parse(buf, size, code, needle);
+	free(buf);
+}
+
+static void e_past_end(struct irdm_image_section *s, size_t size)
+{
+	s->offset = (size + 64) / 64 * 64;
+}
+
+static void e_runs_past(struct irdm_image_section *s, size_t size)
+{
+	s->size = size - s->offset + 1;
+}
+
+static void e_wraps(struct irdm_image_section *s, size_t size)
+{
+	(void)size;
+	s->size = UINT64_MAX - s->offset + 2;   /* offset + size wraps to 1 */
+}
+
+static void e_misaligned(struct irdm_image_section *s, size_t size)
+{
+	(void)size;
+	s->offset += 8;
+}
+
+static void e_in_table(struct irdm_image_section *s, size_t size)
+{
+	(void)size;
+	s->offset = 64;
+}
+
+static void e_in_header(struct irdm_image_section *s, size_t size)
+{
+	(void)size;
+	s->offset = 0;
+}
+
+static void e_elem(struct irdm_image_section *s, size_t size)
+{
+	(void)size;
+	s->elem = 9;
+}
+
+static void e_reserved(struct irdm_image_section *s, size_t size)
+{
+	(void)size;
+	s->reserved = 1;
+}
+
+static void e_dup_nodes(struct irdm_image_section *s, size_t size)
+{
+	(void)size;
+	s->kind = IRDM_SEC_NODES;
+}
+
+static void e_shrink(struct irdm_image_section *s, size_t size)
+{
+	(void)size;
+	s->size -= 4;
+}
+
+static void test_section_out_of_range(void **state)
+{
+	struct img_fixture fx;
+	struct irdm_image_section a, b;
+	size_t size;
+	uint8_t *buf;
+
+	(void)state;
+	small_fir(&fx);
+	fixture_buffer(&fx, (void **)&buf, &size);
+	expect_entry(buf, size, IRDM_SEC_FIR, e_past_end, IRDM_IMAGE_ERANGE,
+		     "(FIR): payload at");
+	expect_entry(buf, size, IRDM_SEC_STABILITY, e_runs_past,
+		     IRDM_IMAGE_ERANGE, "runs past the end");
+	expect_entry(buf, size, IRDM_SEC_NODES, e_wraps, IRDM_IMAGE_ERANGE,
+		     "runs past the end");
+	expect_entry(buf, size, IRDM_SEC_COLUMNS, e_misaligned,
+		     IRDM_IMAGE_ERANGE, "is not a multiple of 64");
+	expect_entry(buf, size, IRDM_SEC_META, e_in_table, IRDM_IMAGE_ERANGE,
+		     "the section table [64, 288) and section #0 (META)");
+	expect_entry(buf, size, IRDM_SEC_META, e_in_header, IRDM_IMAGE_ERANGE,
+		     "the header [0, 64) and section #0 (META) [0, 256) overlap");
+	expect_entry(buf, size, IRDM_SEC_SURFACE, e_elem, IRDM_IMAGE_EINVAL,
+		     "unknown element type 9");
+	expect_entry(buf, size, IRDM_SEC_SURFACE, e_reserved, IRDM_IMAGE_EINVAL,
+		     "reserved");
+	/* 4 bytes fewer leave non-zero data as "padding"; the size check
+	 * would name it otherwise. */
+	expect_entry(buf, size, IRDM_SEC_PROVENANCE, e_shrink,
+		     IRDM_IMAGE_EINVAL, "padding byte");
+	expect_entry(buf, size, IRDM_SEC_SURFACE, e_dup_nodes,
+		     IRDM_IMAGE_EMISSING, "appears twice");
+
+	/* Overlap: two payloads share bytes. */
+	a = get_entry(buf, entry_of(buf, IRDM_SEC_NODES));
+	b = get_entry(buf, entry_of(buf, IRDM_SEC_COLUMNS));
+	b.offset = a.offset + 64;
+	put_entry(buf, entry_of(buf, IRDM_SEC_COLUMNS), &b);
+	img_fixture_reseal(buf, size);
+	expect_parse(buf, size, IRDM_IMAGE_ERANGE, "overlap");
+	free(buf);
+	img_fixture_free(&fx);
+}
+
+static void test_padding_must_be_zero(void **state)
+{
+	struct img_fixture fx;
+	struct irdm_image_section s;
+	size_t size;
+	uint8_t *buf;
+
+	(void)state;
+	small_fir(&fx);
+	fixture_buffer(&fx, (void **)&buf, &size);
+	buf[64 + 7 * 32 + 1] = 0x5a;    /* after the table of 7 */
+	expect_parse(buf, size, IRDM_IMAGE_EINVAL,
+		     "padding byte at offset 289 is 0x5a");
+	buf[64 + 7 * 32 + 1] = 0;
+	s = get_entry(buf, entry_of(buf, IRDM_SEC_PROVENANCE));
+	buf[s.offset + s.size] = 1;     /* after a payload */
+	expect_parse(buf, size, IRDM_IMAGE_EINVAL, "padding");
+	free(buf);
+	img_fixture_free(&fx);
+}
+
+static void test_unaligned_buffer(void **state)
+{
+	struct img_fixture fx;
+	struct irdm_image img;
+	char err[256];
+	size_t size;
+	uint8_t *buf, *odd;
+
+	(void)state;
+	small_fir(&fx);
+	fixture_buffer(&fx, (void **)&buf, &size);
+	odd = malloc(size + 8);
+	assert_non_null(odd);
+	memcpy(odd + 4, buf, size);
+	assert_int_equal(irdm_image_parse(odd + 4, size, &img, err, sizeof(err)),
+			 IRDM_IMAGE_EINVAL);
+	assert_non_null(strstr(err, "8-byte aligned"));
+	assert_int_equal(irdm_image_parse(NULL, 0, &img, NULL, 0),
+			 IRDM_IMAGE_ETRUNC);
+	free(odd);
+	free(buf);
+	img_fixture_free(&fx);
+}
+
+/* Unknown kinds are skipped (forward compatibility) but still checked. */
+static void test_unknown_kind(void **state)
+{
+	static const uint8_t blob[40] = { 1, 2, 3 };
+	struct irdm_image_writer w;
+	struct img_fixture fx;
+	struct irdm_image_section s;
+	size_t size;
+	uint8_t *buf;
+	unsigned i;
+
+	(void)state;
+	small_fir(&fx);
+	irdm_iw_init(&w);
+	img_fixture_add(&fx, &w);
+	assert_int_equal(irdm_iw_add(&w, 0x1000, IRDM_ELEM_BYTES, blob, 40), 0);
+	assert_int_equal(irdm_iw_add(&w, IRDM_SEC_CONTACT_BVH, IRDM_ELEM_U32,
+				     blob, 40), 0);
+	assert_int_equal(irdm_iw_to_buffer(&w, (void **)&buf, &size), 0);
+	expect_parse(buf, size, IRDM_IMAGE_OK, NULL);
+
+	i = entry_of(buf, 0x1000);
+	s = get_entry(buf, i);
+	buf[s.offset] ^= 1;
+	expect_parse(buf, size, IRDM_IMAGE_ECRC, "(unknown kind) checksum");
+	buf[s.offset] ^= 1;
+	s.offset = size + 64;
+	put_entry(buf, i, &s);
+	img_fixture_reseal(buf, size);
+	expect_parse(buf, size, IRDM_IMAGE_ERANGE, "unknown kind");
+	free(buf);
+	img_fixture_free(&fx);
+}
+
+/* ---------------------------------------------------- semantic validation */
+
+static void w_remove(struct irdm_image_writer *w, uint32_t kind)
+{
+	unsigned j = 0;
+
+	for (unsigned i = 0; i < w->n; i++)
+		if (w->sec[i].kind != kind)
+			w->sec[j++] = w->sec[i];
+	w->n = j;
+}
+
+static struct irdm_mode spare_modes[2];
+static uint8_t spare_bytes[256];
+
+static void w_no_meta(struct irdm_image_writer *w) { w_remove(w, IRDM_SEC_META); }
+static void w_no_prov(struct irdm_image_writer *w) { w_remove(w, IRDM_SEC_PROVENANCE); }
+static void w_no_nodes(struct irdm_image_writer *w) { w_remove(w, IRDM_SEC_NODES); }
+static void w_no_cols(struct irdm_image_writer *w) { w_remove(w, IRDM_SEC_COLUMNS); }
+static void w_no_surface(struct irdm_image_writer *w) { w_remove(w, IRDM_SEC_SURFACE); }
+static void w_no_stab(struct irdm_image_writer *w) { w_remove(w, IRDM_SEC_STABILITY); }
+static void w_no_fir(struct irdm_image_writer *w) { w_remove(w, IRDM_SEC_FIR); }
+static void w_no_modes(struct irdm_image_writer *w) { w_remove(w, IRDM_SEC_MODES); }
+static void w_no_shapes(struct irdm_image_writer *w) { w_remove(w, IRDM_SEC_MODE_SHAPES); }
+static void w_no_rigid(struct irdm_image_writer *w) { w_remove(w, IRDM_SEC_RIGID); }
+static void w_no_corr(struct irdm_image_writer *w) { w_remove(w, IRDM_SEC_STATIC_CORR); }
+
+static void w_add_modes(struct irdm_image_writer *w)
+{
+	irdm_iw_add(w, IRDM_SEC_MODES, IRDM_ELEM_BYTES, spare_modes,
+		    sizeof(spare_modes));
+}
+
+static void w_add_rigid(struct irdm_image_writer *w)
+{
+	irdm_iw_add(w, IRDM_SEC_RIGID, IRDM_ELEM_BYTES, spare_bytes, 128);
+}
+
+static void w_add_fir(struct irdm_image_writer *w)
+{
+	irdm_iw_add(w, IRDM_SEC_FIR, IRDM_ELEM_F64, spare_bytes, 64);
+}
+
+static void w_meta_short(struct irdm_image_writer *w)
+{
+	w->sec[0].size = 248;           /* META is added first */
+}
+
+static void w_surface_short(struct irdm_image_writer *w)
+{
+	for (unsigned i = 0; i < w->n; i++)
+		if (w->sec[i].kind == IRDM_SEC_SURFACE)
+			w->sec[i].size -= 12;
+}
+
+static void w_modes_short(struct irdm_image_writer *w)
+{
+	for (unsigned i = 0; i < w->n; i++)
+		if (w->sec[i].kind == IRDM_SEC_MODES)
+			w->sec[i].size -= 64;
+}
+
+static void w_fir_elem(struct irdm_image_writer *w)
+{
+	for (unsigned i = 0; i < w->n; i++)
+		if (w->sec[i].kind == IRDM_SEC_FIR)
+			w->sec[i].elem = IRDM_ELEM_U32;
+}
+
+#define FX(name, stmt) \
+	static void name(struct img_fixture *fx) { stmt; }
+
+FX(m_dt_zero, fx->meta.dt_s = 0)
+FX(m_dt_big, fx->meta.dt_s = 1.5)
+FX(m_dt_nan, fx->meta.dt_s = NAN)
+FX(m_dt_one, fx->meta.dt_s = 1)
+FX(m_young, fx->meta.young_pa = 0)
+FX(m_poisson_half, fx->meta.poisson = 0.5)
+FX(m_poisson_m1, fx->meta.poisson = -1)
+FX(m_poisson_auxetic, fx->meta.poisson = -0.9)
+FX(m_density, fx->meta.density_kg_m3 = -110)
+FX(m_rayleigh_inf, fx->meta.rayleigh_a_per_s = INFINITY)
+FX(m_first_hz_nan, fx->meta.first_elastic_hz = NAN)
+FX(m_repr, fx->meta.representation = 3)
+FX(m_prec_u32, fx->meta.precision = IRDM_ELEM_U32)
+FX(m_no_nodes, fx->meta.n_nodes = 0)
+FX(m_cols_gt_nodes, fx->meta.n_cols = fx->meta.n_nodes + 1)
+FX(m_no_cols, fx->meta.n_cols = 0)
+FX(m_fir_len0, fx->meta.fir_length = 0)
+FX(m_fir_len5, fx->meta.fir_length = 5)
+FX(m_fir_modes, fx->meta.n_modes = 1)
+FX(m_fir_corr_flag, fx->meta.flags |= IRDM_META_STATIC_CORR)
+FX(m_unknown_flag, fx->meta.flags |= 1u << 9)
+FX(m_reserved0, fx->meta.reserved0 = 1)
+FX(m_reserved, fx->meta.reserved[7] = 1)
+FX(m_tool_nul, memset(fx->meta.tool_version, 'x', 32))
+FX(m_name_nul, memset(fx->meta.mesh_name, 'x', 64))
+FX(m_node_nan, fx->nodes[3].pos_m[1] = NAN)
+FX(m_mesh_node, fx->nodes[2].mesh_node = fx->meta.mesh_nodes)
+FX(m_col_range, fx->columns[1] = fx->meta.n_nodes)
+FX(m_col_dup, fx->columns[1] = fx->columns[0])
+FX(m_tri_range, fx->tris[7] = fx->meta.n_nodes)
+FX(m_fir_nan, ((float *)fx->fir)[100] = NAN)
+FX(m_fir_inf, ((float *)fx->fir)[fx->fir_bytes / 4 - 1] = -INFINITY)
+FX(m_stab_nan, fx->stability[1].spectral_radius = NAN)
+FX(m_stab_neg, fx->stability[0].spectral_radius = -0.5f)
+FX(m_stab_flag, fx->stability[1].flags |= IRDM_STAB_STABLE)
+FX(m_prov_nul, fx->provenance[10] = '\0')
+FX(m_floating, fx->meta.flags |= IRDM_META_FLOATING)
+FX(m_mass, fx->rigid.mass_kg = 0)
+FX(m_inertia, fx->rigid.inertia_kg_m2[4] = NAN)
+FX(m_rigid_res, fx->rigid.reserved[2] = 1)
+FX(m_no_corr_flag, fx->meta.flags &= ~(uint32_t)IRDM_META_STATIC_CORR)
+FX(m_grounded, fx->meta.flags &= ~(uint32_t)IRDM_META_FLOATING)
+FX(m_modes0, fx->meta.n_modes = 0)
+FX(m_modal_fir_len, fx->meta.fir_length = 1)
+FX(m_zeta_neg, fx->modes[1].zeta = -0.05)
+FX(m_omega_nan, fx->modes[0].omega_rad_s = NAN)
+FX(m_omega_neg, fx->modes[2].omega_rad_s = -1)
+FX(m_a_inf, fx->modes[2].a[3] = INFINITY)
+FX(m_b_nan, fx->modes[0].b[1] = NAN)
+FX(m_shape_nan, ((double *)fx->mode_shapes)[7] = NAN)
+FX(m_corr_inf, ((double *)fx->static_corr)[29] = INFINITY)
+
+enum base { FIR, MODAL };
+
+struct sem_case {
+	const char *name;
+	enum base base;
+	void (*fx_edit)(struct img_fixture *);
+	void (*w_edit)(struct irdm_image_writer *);
+	int code;
+	const char *needle;
+};
+
+static const struct sem_case sem_cases[] = {
+	{ "dt 0", FIR, m_dt_zero, NULL, IRDM_IMAGE_EINVAL, "dt_s is 0 s" },
+	{ "dt 1.5", FIR, m_dt_big, NULL, IRDM_IMAGE_EINVAL, "dt_s is 1.5" },
+	{ "dt NaN", FIR, m_dt_nan, NULL, IRDM_IMAGE_EINVAL, "dt_s is not finite" },
+	{ "dt 1", FIR, m_dt_one, NULL, IRDM_IMAGE_OK, NULL },
+	{ "young", FIR, m_young, NULL, IRDM_IMAGE_EINVAL, "young_pa" },
+	{ "poisson 0.5", FIR, m_poisson_half, NULL, IRDM_IMAGE_EINVAL, "poisson is 0.5" },
+	{ "poisson -1", FIR, m_poisson_m1, NULL, IRDM_IMAGE_EINVAL, "poisson is -1" },
+	{ "poisson -0.9", FIR, m_poisson_auxetic, NULL, IRDM_IMAGE_OK, NULL },
+	{ "density", FIR, m_density, NULL, IRDM_IMAGE_EINVAL, "density_kg_m3 is -110" },
+	{ "rayleigh inf", FIR, m_rayleigh_inf, NULL, IRDM_IMAGE_EINVAL, "rayleigh_a_per_s" },
+	{ "first hz", FIR, m_first_hz_nan, NULL, IRDM_IMAGE_EINVAL, "first_elastic_hz" },
+	{ "repr", FIR, m_repr, NULL, IRDM_IMAGE_EINVAL, "representation is 3" },
+	{ "precision", FIR, m_prec_u32, NULL, IRDM_IMAGE_EINVAL, "precision is 4" },
+	{ "n_nodes 0", FIR, m_no_nodes, NULL, IRDM_IMAGE_EINVAL, "n_nodes 0" },
+	{ "n_cols > n_nodes", FIR, m_cols_gt_nodes, NULL, IRDM_IMAGE_EINVAL, "n_cols 7" },
+	{ "n_cols 0", FIR, m_no_cols, NULL, IRDM_IMAGE_EINVAL, "n_cols 0" },
+	{ "T 0", FIR, m_fir_len0, NULL, IRDM_IMAGE_EINVAL, "fir_length 0" },
+	{ "T mismatch", FIR, m_fir_len5, NULL, IRDM_IMAGE_EINVAL, "section FIR has 1728 bytes, expected 2160" },
+	{ "FIR n_modes", FIR, m_fir_modes, NULL, IRDM_IMAGE_EINVAL, "n_modes 1" },
+	{ "FIR corr flag", FIR, m_fir_corr_flag, NULL, IRDM_IMAGE_EINVAL, "STATIC_CORR" },
+	{ "meta flag", FIR, m_unknown_flag, NULL, IRDM_IMAGE_EINVAL, "unknown flags" },
+	{ "meta reserved0", FIR, m_reserved0, NULL, IRDM_IMAGE_EINVAL, "reserved" },
+	{ "meta reserved", FIR, m_reserved, NULL, IRDM_IMAGE_EINVAL, "reserved" },
+	{ "tool_version", FIR, m_tool_nul, NULL, IRDM_IMAGE_EINVAL, "NUL-terminated" },
+	{ "mesh_name", FIR, m_name_nul, NULL, IRDM_IMAGE_EINVAL, "NUL-terminated" },
+	{ "node NaN", FIR, m_node_nan, NULL, IRDM_IMAGE_EINVAL, "node 3 has a non-finite position" },
+	{ "mesh_node", FIR, m_mesh_node, NULL, IRDM_IMAGE_EINVAL, "mesh_node 12 >= mesh_nodes 12" },
+	{ "column range", FIR, m_col_range, NULL, IRDM_IMAGE_EINVAL, "column 1 names node 6" },
+	{ "column dup", FIR, m_col_dup, NULL, IRDM_IMAGE_EINVAL, "column 1 repeats node 5" },
+	{ "triangle", FIR, m_tri_range, NULL, IRDM_IMAGE_EINVAL, "triangle 2 names node 6" },
+	{ "n_tris", FIR, NULL, w_surface_short, IRDM_IMAGE_EINVAL, "section SURFACE has 36 bytes, expected 48 (n_tris x 3 x 4)" },
+	{ "FIR NaN", FIR, m_fir_nan, NULL, IRDM_IMAGE_EINVAL, "FIR element 100 (column 0, row 2, sample 3, entry 0,1) is not finite" },
+	{ "FIR inf", FIR, m_fir_inf, NULL, IRDM_IMAGE_EINVAL, "FIR element 431 (column 1, row 5, sample 3, entry 2,2)" },
+	{ "stability NaN", FIR, m_stab_nan, NULL, IRDM_IMAGE_EINVAL, "column 1: spectral radius" },
+	{ "stability < 0", FIR, m_stab_neg, NULL, IRDM_IMAGE_EINVAL, "spectral radius -0.5" },
+	{ "stable flag", FIR, m_stab_flag, NULL, IRDM_IMAGE_EINVAL, "flagged stable" },
+	{ "provenance NUL", FIR, m_prov_nul, NULL, IRDM_IMAGE_EINVAL, "NUL byte at offset 10" },
+	{ "no META", FIR, NULL, w_no_meta, IRDM_IMAGE_EMISSING, "META is missing" },
+	{ "no PROVENANCE", FIR, NULL, w_no_prov, IRDM_IMAGE_EMISSING, "PROVENANCE is missing" },
+	{ "no NODES", FIR, NULL, w_no_nodes, IRDM_IMAGE_EMISSING, "NODES is missing" },
+	{ "no COLUMNS", FIR, NULL, w_no_cols, IRDM_IMAGE_EMISSING, "COLUMNS is missing" },
+	{ "no SURFACE", FIR, NULL, w_no_surface, IRDM_IMAGE_EMISSING, "SURFACE is missing" },
+	{ "no STABILITY", FIR, NULL, w_no_stab, IRDM_IMAGE_EMISSING, "STABILITY is missing" },
+	{ "no FIR", FIR, NULL, w_no_fir, IRDM_IMAGE_EMISSING, "FIR is missing" },
+	{ "FIR + MODES", FIR, NULL, w_add_modes, IRDM_IMAGE_EINVAL, "MODES must not be present (FIR image)" },
+	{ "grounded + RIGID", FIR, NULL, w_add_rigid, IRDM_IMAGE_EINVAL, "RIGID must not be present (meta flags say grounded)" },
+	{ "floating, no RIGID", FIR, m_floating, w_no_rigid, IRDM_IMAGE_EMISSING, "RIGID is missing" },
+	{ "META short", FIR, NULL, w_meta_short, IRDM_IMAGE_EINVAL, "META has 248 bytes" },
+	{ "FIR elem", FIR, NULL, w_fir_elem, IRDM_IMAGE_EINVAL, "FIR has element type U32, expected F32" },
+	{ "modal ok", MODAL, NULL, NULL, IRDM_IMAGE_OK, NULL },
+	{ "modal no RIGID", MODAL, NULL, w_no_rigid, IRDM_IMAGE_EMISSING, "RIGID is missing (meta flags say floating)" },
+	{ "mass 0", MODAL, m_mass, NULL, IRDM_IMAGE_EINVAL, "mass_kg is 0" },
+	{ "inertia", MODAL, m_inertia, NULL, IRDM_IMAGE_EINVAL, "inertia_kg_m2[4]" },
+	{ "rigid reserved", MODAL, m_rigid_res, NULL, IRDM_IMAGE_EINVAL, "rigid reserved" },
+	{ "grounded modal + RIGID", MODAL, m_grounded, w_add_rigid, IRDM_IMAGE_EINVAL, "RIGID must not be present" },
+	{ "no STATIC_CORR", MODAL, NULL, w_no_corr, IRDM_IMAGE_EMISSING, "STATIC_CORR is missing" },
+	{ "STATIC_CORR unflagged", MODAL, m_no_corr_flag, NULL, IRDM_IMAGE_EINVAL, "STATIC_CORR must not be present" },
+	{ "n_modes 0", MODAL, m_modes0, NULL, IRDM_IMAGE_EINVAL, "n_modes 0" },
+	{ "modal T", MODAL, m_modal_fir_len, NULL, IRDM_IMAGE_EINVAL, "fir_length 1" },
+	{ "MODES short", MODAL, NULL, w_modes_short, IRDM_IMAGE_EINVAL, "section MODES has 128 bytes, expected 192 (n_modes x 64)" },
+	{ "zeta < 0", MODAL, m_zeta_neg, NULL, IRDM_IMAGE_EINVAL, "mode 1" },
+	{ "omega NaN", MODAL, m_omega_nan, NULL, IRDM_IMAGE_EINVAL, "mode 0" },
+	{ "omega < 0", MODAL, m_omega_neg, NULL, IRDM_IMAGE_EINVAL, "mode 2: omega -1" },
+	{ "A inf", MODAL, m_a_inf, NULL, IRDM_IMAGE_EINVAL, "mode 2" },
+	{ "b NaN", MODAL, m_b_nan, NULL, IRDM_IMAGE_EINVAL, "mode 0" },
+	{ "shape NaN", MODAL, m_shape_nan, NULL, IRDM_IMAGE_EINVAL, "MODE_SHAPES element 7 is not finite" },
+	{ "corr inf", MODAL, m_corr_inf, NULL, IRDM_IMAGE_EINVAL, "STATIC_CORR element 29 is not finite" },
+	{ "no MODES", MODAL, NULL, w_no_modes, IRDM_IMAGE_EMISSING, "MODES is missing" },
+	{ "no MODE_SHAPES", MODAL, NULL, w_no_shapes, IRDM_IMAGE_EMISSING, "MODE_SHAPES is missing" },
+	{ "modal + FIR", MODAL, NULL, w_add_fir, IRDM_IMAGE_EINVAL, "FIR must not be present (modal image)" },
+};
+
+static void test_semantic_validation(void **state)
+{
+	(void)state;
+	for (size_t i = 0; i < sizeof(sem_cases) / sizeof(sem_cases[0]); i++) {
+		const struct sem_case *c = &sem_cases[i];
+		struct irdm_image_writer w;
+		struct img_fixture fx;
+		size_t size;
+		void *buf;
+
+		current_case = c->name;
+		if (c->base == FIR)
+			small_fir(&fx);
+		else
+			small_modal(&fx);
+		if (c->fx_edit)
+			c->fx_edit(&fx);
+		irdm_iw_init(&w);
+		img_fixture_add(&fx, &w);
+		if (c->w_edit)
+			c->w_edit(&w);
+		assert_int_equal(irdm_iw_to_buffer(&w, &buf, &size), 0);
+		expect_parse(buf, size, c->code, c->needle);
+		free(buf);
+		img_fixture_free(&fx);
+	}
+	current_case = "";
+}
+
+/* Empty payloads (no surface) are valid, also as the last section, where
+ * the file ends at the (aligned) offset of the empty payload. */
+static void test_empty_section(void **state)
+{
+	struct irdm_image_writer w;
+	struct img_fixture fx;
+	struct irdm_image img;
+	char err[256];
+	size_t size;
+	uint8_t *buf;
+
+	(void)state;
+	assert_int_equal(img_fixture_fir(&fx, IRDM_ELEM_F32, 2, 1, 1), 0);
+	assert_int_equal(fx.meta.n_tris, 0);
+	fixture_buffer(&fx, (void **)&buf, &size);
+	expect_parse(buf, size, IRDM_IMAGE_OK, NULL);
+	free(buf);
+
+	irdm_iw_init(&w);
+	img_fixture_add(&fx, &w);
+	w_remove(&w, IRDM_SEC_SURFACE);
+	assert_int_equal(irdm_iw_add(&w, IRDM_SEC_SURFACE, IRDM_ELEM_U32,
+				     NULL, 0), 0);
+	assert_int_equal(irdm_iw_to_buffer(&w, (void **)&buf, &size), 0);
+	assert_int_equal(size % 64, 0);
+	assert_int_equal(get_entry(buf, w.n - 1).offset, size);
+	assert_int_equal(irdm_image_parse(buf, size, &img, err, sizeof(err)), 0);
+	assert_non_null(img.tris);
+	free(buf);
+	img_fixture_free(&fx);
+}
+
+static void test_f16_nan_in_fir(void **state)
+{
+	struct img_fixture fx;
+	size_t size;
+	void *buf;
+
+	(void)state;
+	assert_int_equal(img_fixture_fir(&fx, IRDM_ELEM_F16, 4, 1, 2), 0);
+	((uint16_t *)fx.fir)[5] = 0x7e00;
+	fixture_buffer(&fx, &buf, &size);
+	expect_parse(buf, size, IRDM_IMAGE_EINVAL, "FIR element 5");
+	free(buf);
+	((uint16_t *)fx.fir)[5] = 0xfc00;       /* -inf */
+	fixture_buffer(&fx, &buf, &size);
+	expect_parse(buf, size, IRDM_IMAGE_EINVAL, "FIR element 5");
+	free(buf);
+	((uint16_t *)fx.fir)[5] = 0x7bff;       /* 65504: finite */
+	fixture_buffer(&fx, &buf, &size);
+	expect_parse(buf, size, IRDM_IMAGE_OK, NULL);
+	free(buf);
+	img_fixture_free(&fx);
+}
+
+static void test_strerror(void **state)
+{
+	(void)state;
+	for (int c = IRDM_IMAGE_OK; c >= IRDM_IMAGE_EINVAL; c--) {
+		assert_true(strlen(irdm_image_strerror(c)) > 0);
+		for (int d = c + 1; d <= IRDM_IMAGE_OK; d++)
+			assert_string_not_equal(irdm_image_strerror(c),
+						irdm_image_strerror(d));
+	}
+	assert_string_equal(irdm_image_strerror(IRDM_IMAGE_ECRC), "bad checksum");
+	assert_true(strlen(irdm_image_strerror(-99)) > 0);
+}
+
+/* ------------------------------------------------------ writer atomicity */
+
+static void test_write_missing_dir(void **state)
+{
+	struct img_fixture fx;
+	char path[2 * PATH_MAX], dir[PATH_MAX], err[512] = "";
+
+	(void)state;
+	small_fir(&fx);
+	path_in(dir, sizeof(dir), "no-such-dir");
+	snprintf(path, sizeof(path), "%s/x.img", dir);
+	assert_int_equal(img_fixture_write(&fx, path, err, sizeof(err)), -1);
+	assert_non_null(strstr(err, path));
+	assert_non_null(strstr(err, strerror(ENOENT)));
+	assert_null(strchr(err, '\n'));
+	assert_int_equal(access(dir, F_OK), -1);
+	assert_int_equal(count_tmp_files(tmpdir), 0);
+	img_fixture_free(&fx);
+}
+
+static void test_write_replaces_atomically(void **state)
+{
+	struct img_fixture a, b;
+	struct irdm_image img;
+	char path[PATH_MAX], err[512];
+	struct stat st;
+
+	(void)state;
+	small_fir(&a);
+	small_modal(&b);
+	path_in(path, sizeof(path), "replace.img");
+	assert_int_equal(img_fixture_write(&a, path, err, sizeof(err)), 0);
+	assert_int_equal(count_tmp_files(tmpdir), 0);
+	assert_int_equal(stat(path, &st), 0);
+	assert_int_equal(st.st_mode & 0777, 0644);
+	/* A mapping of the old image survives its replacement. */
+	assert_int_equal(irdm_image_map(path, 0, &img, err, sizeof(err)), 0);
+	assert_int_equal(img_fixture_write(&b, path, err, sizeof(err)), 0);
+	assert_int_equal(count_tmp_files(tmpdir), 0);
+	assert_int_equal(img.meta->representation, IRDM_REPR_FIR);
+	check_fir_values(&img, IRDM_ELEM_F32);
+	irdm_image_unmap(&img);
+	assert_int_equal(irdm_image_map(path, 0, &img, err, sizeof(err)), 0);
+	assert_int_equal(img.meta->representation, IRDM_REPR_MODAL);
+	irdm_image_unmap(&img);
+	img_fixture_free(&a);
+	img_fixture_free(&b);
+}
+
+static void test_write_over_directory_fails(void **state)
+{
+	struct img_fixture fx;
+	char path[PATH_MAX], inner[2 * PATH_MAX], err[512] = "";
+	struct stat st;
+	size_t len;
+	void *back;
+
+	(void)state;
+	small_fir(&fx);
+	path_in(path, sizeof(path), "is-a-dir");
+	assert_int_equal(mkdir(path, 0755), 0);
+	snprintf(inner, sizeof(inner), "%s/keep", path);
+	write_file(inner, "old content", 11);
+	assert_int_equal(img_fixture_write(&fx, path, err, sizeof(err)), -1);
+	assert_non_null(strstr(err, path));
+	assert_non_null(strstr(err, strerror(EISDIR)));
+	assert_int_equal(stat(path, &st), 0);
+	assert_true(S_ISDIR(st.st_mode));
+	back = read_file(inner, &len);
+	assert_int_equal(len, 11);
+	assert_memory_equal(back, "old content", 11);
+	free(back);
+	assert_int_equal(count_tmp_files(tmpdir), 0);
+	img_fixture_free(&fx);
+}
+
+/* A write that fails half way (file size limit: EFBIG) leaves the old
+ * image byte for byte and no temporary file. */
+static void test_write_failure_keeps_old_image(void **state)
+{
+	struct img_fixture small, big;
+	char path[PATH_MAX], err[512] = "";
+	struct rlimit old, lim;
+	void (*old_handler)(int);
+	void *before, *after;
+	size_t blen, alen;
+	int ret;
+
+	(void)state;
+	small_fir(&small);
+	assert_int_equal(img_fixture_fir(&big, IRDM_ELEM_F64, 40, 10, 50), 0);
+	path_in(path, sizeof(path), "keep.img");
+	assert_int_equal(img_fixture_write(&small, path, err, sizeof(err)), 0);
+	before = read_file(path, &blen);
+
+	assert_int_equal(getrlimit(RLIMIT_FSIZE, &old), 0);
+	old_handler = signal(SIGXFSZ, SIG_IGN);
+	lim = old;
+	lim.rlim_cur = 64 * 1024;       /* big image is ~1.4 MB */
+	assert_int_equal(setrlimit(RLIMIT_FSIZE, &lim), 0);
+	ret = img_fixture_write(&big, path, err, sizeof(err));
+	assert_int_equal(setrlimit(RLIMIT_FSIZE, &old), 0);
+	signal(SIGXFSZ, old_handler);
+
+	assert_int_equal(ret, -1);
+	assert_non_null(strstr(err, path));
+	assert_non_null(strstr(err, strerror(EFBIG)));
+	after = read_file(path, &alen);
+	assert_int_equal(alen, blen);
+	assert_memory_equal(after, before, blen);
+	assert_int_equal(count_tmp_files(tmpdir), 0);
+	free(before);
+	free(after);
+	img_fixture_free(&small);
+	img_fixture_free(&big);
+}
+
+/* ------------------------------------------------------------------ main */
+
+static int setup(void **state)
+{
+	const char *base = getenv("TMPDIR");
+
+	(void)state;
+	snprintf(tmpdir, sizeof(tmpdir), "%s/irdm-test-image.XXXXXX",
+		 base && *base ? base : "/tmp");
+	return mkdtemp(tmpdir) ? 0 : -1;
+}
+
+static int teardown(void **state)
+{
+	(void)state;
+	return rm_tree(tmpdir);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_crc32c_check_value),
+		cmocka_unit_test(test_crc32c_all_lengths_and_alignments),
+		cmocka_unit_test(test_f16_known_patterns),
+		cmocka_unit_test(test_f16_roundtrip_all),
+		cmocka_unit_test(test_f16_rounding_all_midpoints),
+		cmocka_unit_test(test_elem_size_and_get),
+		cmocka_unit_test(test_writer_layout),
+		cmocka_unit_test(test_writer_add_rejects),
+		cmocka_unit_test(test_fir_roundtrip),
+		cmocka_unit_test(test_modal_floating_roundtrip),
+		cmocka_unit_test(test_modal_grounded_f16_roundtrip),
+		cmocka_unit_test(test_map_lock),
+		cmocka_unit_test(test_map_errors),
+		cmocka_unit_test(test_truncated_every_length),
+		cmocka_unit_test(test_every_byte_flip_detected),
+		cmocka_unit_test(test_bad_magic_and_version),
+		cmocka_unit_test(test_bad_checksums),
+		cmocka_unit_test(test_file_size_mismatch),
+		cmocka_unit_test(test_table_out_of_range),
+		cmocka_unit_test(test_section_out_of_range),
+		cmocka_unit_test(test_padding_must_be_zero),
+		cmocka_unit_test(test_unaligned_buffer),
+		cmocka_unit_test(test_unknown_kind),
+		cmocka_unit_test(test_semantic_validation),
+		cmocka_unit_test(test_empty_section),
+		cmocka_unit_test(test_f16_nan_in_fir),
+		cmocka_unit_test(test_strerror),
+		cmocka_unit_test(test_write_missing_dir),
+		cmocka_unit_test(test_write_replaces_atomically),
+		cmocka_unit_test(test_write_over_directory_fails),
+		cmocka_unit_test(test_write_failure_keeps_old_image),
+	};
+
+	return cmocka_run_group_tests(tests, setup, teardown);
+}
