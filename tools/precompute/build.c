@@ -555,7 +555,7 @@ static void report(const struct build *b, struct irdm_precompute_report *rep)
 	rep->tris = m->n_tris;
 	rep->modes = m->modes.n_modes;
 	rep->modes_total = m->modes.n_elastic_total;
-	rep->first_elastic_hz = b->meta.first_elastic_hz;
+	rep->first_elastic_hz = m->modes.n_modes ? sqrt(m->modes.omega2[0]) / (2 * M_PI) : 0;
 	rep->max_spectral_radius = b->meta.max_spectral_radius;
 	for (size_t c = 0; b->stab && c < m->n_cols; c++)
 		rep->unstable_cols += !(b->stab[c].flags & IRDM_STAB_STABLE);

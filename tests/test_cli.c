@@ -1,0 +1,400 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * The irdm command line, end to end: bad input of every kind gives a
+ * non-zero exit, one line on stderr that names the thing and the reason,
+ * and leaves no output behind (an existing image stays as it was); the
+ * happy paths agree with independent computations.
+ */
+#define _GNU_SOURCE
+#include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <setjmp.h>
+#include <spawn.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmocka.h>
+
+#include "modal/response.h"
+#include "support/model_fixture.h"
+
+extern char **environ;
+
+static char dir[256];
+static char out_text[65536], err_text[8192];
+
+static const char *irdm_path(void)
+{
+	const char *p = getenv("IRDM");
+
+	return p ? p : "build/irdm";
+}
+
+static void slurp(const char *path, char *buf, size_t len)
+{
+	FILE *f = fopen(path, "r");
+	size_t n = f ? fread(buf, 1, len - 1, f) : 0;
+
+	buf[n] = 0;
+	if (f)
+		fclose(f);
+}
+
+/* Run irdm with a NULL-terminated argument list; capture stdout/stderr. */
+static int run(const char *first, ...)
+{
+	const char *argv[64];
+	char out_path[300], err_path[300];
+	posix_spawn_file_actions_t fa;
+	va_list ap;
+	int n = 0, status = 0;
+	pid_t pid;
+
+	argv[n++] = irdm_path();
+	va_start(ap, first);
+	for (const char *a = first; a && n < 63; a = va_arg(ap, const char *))
+		argv[n++] = a;
+	va_end(ap);
+	argv[n] = NULL;
+	snprintf(out_path, sizeof(out_path), "%s/stdout", dir);
+	snprintf(err_path, sizeof(err_path), "%s/stderr", dir);
+	posix_spawn_file_actions_init(&fa);
+	posix_spawn_file_actions_addopen(&fa, 1, out_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+	posix_spawn_file_actions_addopen(&fa, 2, err_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+	assert_int_equal(posix_spawn(&pid, argv[0], &fa, NULL, (char *const *)argv, environ), 0);
+	posix_spawn_file_actions_destroy(&fa);
+	assert_int_equal(waitpid(pid, &status, 0), pid);
+	slurp(out_path, out_text, sizeof(out_text));
+	slurp(err_path, err_text, sizeof(err_text));
+	return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+static char *path_in_dir(const char *name)
+{
+	static char buf[16][300];
+	static int k;
+
+	k = (k + 1) % 16;
+	snprintf(buf[k], sizeof(buf[k]), "%s/%s", dir, name);
+	return buf[k];
+}
+
+static bool exists(const char *p)
+{
+	struct stat st;
+
+	return stat(p, &st) == 0;
+}
+
+/*
+ * A failure: non-zero exit, and the error is one line starting "irdm" that
+ * contains `needle` (progress lines may come before it).
+ */
+static void expect_failure(int rc, const char *needle)
+{
+	size_t len = strlen(err_text);
+	const char *last;
+
+	while (len && err_text[len - 1] == '\n')
+		len--;
+	last = err_text + len;
+	while (last > err_text && last[-1] != '\n')
+		last--;
+	if (rc == 0 || strncmp(last, "irdm", 4) || !strstr(last, needle))
+		fail_msg("expected a one-line error with '%s' (exit %d): %s", needle, rc, err_text);
+	assert_true(rc > 0 && rc < 128);   /* an error exit, not a crash */
+}
+
+static void write_file(const char *path, const char *text)
+{
+	FILE *f = fopen(path, "w");
+
+	assert_non_null(f);
+	fputs(text, f);
+	fclose(f);
+}
+
+static int setup(void **state)
+{
+	(void)state;
+	snprintf(dir, sizeof(dir), "/tmp/irdm-cli-XXXXXX");
+	return mkdtemp(dir) ? 0 : -1;
+}
+
+static int teardown(void **state)
+{
+	char cmd[300];
+
+	(void)state;
+	snprintf(cmd, sizeof(cmd), "rm -rf '%s'", dir);
+	return system(cmd) == 0 ? 0 : -1;
+}
+
+#define SMALL "--mesh", "box:0.1,0.1,0.2", "--resolution", "2,2,4", "--representation", "modal:10"
+
+static void test_bad_scene_values(void **state)
+{
+	const char *img = path_in_dir("bad.img");
+
+	(void)state;
+	expect_failure(run("precompute", SMALL, "--poisson", "0.5", "-o", img, NULL), "Poisson");
+	expect_failure(run("precompute", SMALL, "--poisson", "0.7", "-o", img, NULL), "Poisson");
+	expect_failure(run("precompute", SMALL, "--young", "0", "-o", img, NULL), "Young");
+	expect_failure(run("precompute", SMALL, "--young", "-5", "-o", img, NULL), "Young");
+	expect_failure(run("precompute", SMALL, "--density", "nan", "-o", img, NULL), "density");
+	expect_failure(run("precompute", SMALL, "--dt", "0", "-o", img, NULL), "--dt");
+	expect_failure(run("precompute", SMALL, "--dt", "-0.001", "-o", img, NULL), "--dt");
+	expect_failure(run("precompute", SMALL, "--fixed", "z<=-1", "-o", img, NULL), "selects no node");
+	expect_failure(run("precompute", SMALL, "--fixed", "none", "-o", img, NULL), "fixed");
+	expect_failure(run("precompute", SMALL, "--floating", "yes", "--fixed", "z<=0", "-o", img, NULL),
+		       "floating");
+	expect_failure(run("precompute", SMALL, "--colour", "red", "-o", img, NULL), "unknown scene key");
+	expect_failure(run("precompute", SMALL, "--representation", "fir:0", "-o", img, NULL),
+		       "representation");
+	expect_failure(run("precompute", SMALL, "--touch", "z>=5", "-o", img, NULL), "selects no");
+	expect_failure(run("precompute", SMALL, NULL), "-o");
+	expect_failure(run("precompute", "--scene", path_in_dir("missing.scene"), "-o", img, NULL),
+		       "missing.scene");
+	write_file(path_in_dir("bad.scene"), "young = 2000\nthis line has no equals sign\n");
+	expect_failure(run("precompute", "--scene", path_in_dir("bad.scene"), "-o", img, NULL),
+		       "bad.scene:2");
+	assert_false(exists(img));
+}
+
+static void test_bad_meshes(void **state)
+{
+	const char *img = path_in_dir("mesh.img");
+	static const char nodes[] =
+		"5 3 0 0\n1 0 0 0\n2 0.1 0 0\n3 0 0.1 0\n4 0 0 0.1\n5 0.1 0.1 0.1\n";
+
+	(void)state;
+	/* element 2 lists its nodes in the inverted order */
+	write_file(path_in_dir("inv.node"), nodes);
+	write_file(path_in_dir("inv.ele"), "2 4 0\n1 1 2 3 4\n2 5 2 3 4\n");
+	expect_failure(run("precompute", "--mesh", path_in_dir("inv.node"), "--fixed", "z<=0",
+			   "-o", img, NULL), "element 2");
+	/* zero volume: four coplanar nodes */
+	write_file(path_in_dir("flat.node"), "4 3 0 0\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 1 1 0\n");
+	write_file(path_in_dir("flat.ele"), "1 4 0\n1 1 2 3 4\n");
+	expect_failure(run("precompute", "--mesh", path_in_dir("flat.ele"), "-o", img, NULL), "element 1");
+	/* NaN coordinate */
+	write_file(path_in_dir("nan.node"), "4 3 0 0\n1 0 0 0\n2 nan 0 0\n3 0 1 0\n4 0 0 1\n");
+	write_file(path_in_dir("nan.ele"), "1 4 0\n1 1 2 3 4\n");
+	expect_failure(run("precompute", "--mesh", path_in_dir("nan.node"), "-o", img, NULL), "node 2");
+	/* node 5 is in no element */
+	write_file(path_in_dir("unref.node"), nodes);
+	write_file(path_in_dir("unref.ele"), "1 4 0\n1 1 2 3 4\n");
+	expect_failure(run("precompute", "--mesh", path_in_dir("unref.node"), "-o", img, NULL), "node 5");
+	expect_failure(run("precompute", "--mesh", path_in_dir("nothing.msh"), "-o", img, NULL),
+		       "nothing.msh");
+	expect_failure(run("precompute", "--mesh", path_in_dir("x.xyz"), "-o", img, NULL), "x.xyz");
+	assert_false(exists(img));
+}
+
+/* A failing run over an existing image leaves it byte for byte. */
+static void test_failure_keeps_existing_image(void **state)
+{
+	const char *img = path_in_dir("keep.img");
+	char before[65536], after[65536];
+
+	(void)state;
+	assert_int_equal(run("precompute", "-q", SMALL, "-o", img, NULL), 0);
+	slurp(img, before, sizeof(before));
+	struct stat st0, st1;
+	assert_int_equal(stat(img, &st0), 0);
+	expect_failure(run("precompute", SMALL, "--young", "-1", "-o", img, NULL), "Young");
+	assert_int_equal(stat(img, &st1), 0);
+	slurp(img, after, sizeof(after));
+	assert_int_equal(st0.st_size, st1.st_size);
+	assert_memory_equal(before, after, sizeof(before) < (size_t)st0.st_size ? sizeof(before) : (size_t)st0.st_size);
+	assert_int_equal(run("image", "verify", img, NULL), 0);
+}
+
+static void corrupt(const char *src, const char *dst, long at, int truncate_to)
+{
+	FILE *in = fopen(src, "rb"), *out = fopen(dst, "wb");
+	int c;
+	long i = 0;
+
+	assert_non_null(in);
+	assert_non_null(out);
+	while ((c = fgetc(in)) != EOF) {
+		if (truncate_to >= 0 && i >= truncate_to)
+			break;
+		fputc(i == at ? c ^ 0x40 : c, out);
+		i++;
+	}
+	fclose(in);
+	fclose(out);
+}
+
+static void test_bad_images(void **state)
+{
+	const char *img = path_in_dir("good.img"), *bad = path_in_dir("bad.img");
+
+	(void)state;
+	assert_int_equal(run("precompute", "-q", SMALL, "-o", img, NULL), 0);
+	corrupt(img, bad, -1, 100);
+	expect_failure(run("image", "verify", bad, NULL), "truncated");
+	corrupt(img, bad, 0, -1);
+	expect_failure(run("image", "verify", bad, NULL), "magic");
+	corrupt(img, bad, 2000, -1);
+	expect_failure(run("image", "info", bad, NULL), "checksum");
+	write_file(bad, "");
+	expect_failure(run("image", "verify", bad, NULL), "bad.img");
+	expect_failure(run("image", "verify", path_in_dir("none.img"), NULL), "none.img");
+	expect_failure(run("image", "export", img, "--column", "99999", NULL), "99999");
+	expect_failure(run("image", "export", img, "--column", "x", NULL), "--column");
+	expect_failure(run("image", "export", img, "--column", "0", "--samples", "0", NULL), "--samples");
+}
+
+/*
+ * export writes R[s] of the image; compare with the modal closed form
+ * computed here from the same scene's model (f64 storage, so only
+ * rounding separates the two).
+ */
+static void test_export_matches_library(void **state)
+{
+	const char *img = path_in_dir("exp.img"), *csv = path_in_dir("exp.csv");
+	struct irdm_model m;
+	char node[32];
+
+	(void)state;
+	assert_int_equal(run("precompute", "-q", "--mesh", "box:0.1,0.1,0.2", "--resolution", "2,2,4",
+			     "--tets_per_hex", "6", "--representation", "modal:all", "--precision", "f64",
+			     "--dt", "0.002", "-o", img, NULL), 0);
+	fixture_model(&m, 0.1, 0.1, 0.2, 2, 2, 4, 6, 0.49, false, 0, IRDM_EIG_AUTO, 0.002);
+	const double top[3] = { 0.05, 0.05, 0.2 };
+	uint32_t c = fixture_nearest_node(&m.mesh, top);
+	snprintf(node, sizeof(node), "%u", c);
+	assert_int_equal(run("image", "export", img, "--column", node, "--samples", "50", "-o", csv, NULL), 0);
+	int64_t cd[3];
+	for (int a = 0; a < 3; a++)
+		cd[a] = fixture_free_dof(&m, c, a);
+	struct irdm_mode *zoh = malloc(m.modes.n_modes * sizeof(*zoh));
+	double fir[50 * 9];
+	irdm_modes_discretise(&m.modes, &m.damping, 0.002, zoh);
+	irdm_fir_from_modes(&m.modes, zoh, cd, 1, cd, 1, 50, NULL, fir, NULL, NULL);
+	char text[65536];
+	slurp(csv, text, sizeof(text));
+	char want[64];
+	snprintf(want, sizeof(want), "s,t_s,n%u_ux_fx,n%u_ux_fy", c, c);
+	assert_non_null(strstr(text, want));
+	char *line = strchr(text, '\n') + 1;
+	double scale = 0, diff = 0;
+	for (int s = 0; s < 50; s++) {
+		double v[11];
+		char *p = line;
+		for (int k = 0; k < 11; k++) {
+			v[k] = strtod(p, &p);
+			p++;
+		}
+		assert_true(fabs(v[1] - (s + 1) * 0.002) < 1e-12);
+		for (int e = 0; e < 9; e++) {
+			diff = fmax(diff, fabs(v[2 + e] - fir[9 * s + e]));
+			scale = fmax(scale, fabs(fir[9 * s + e]));
+		}
+		line = strchr(line, '\n') + 1;
+	}
+	assert_true(diff <= 1e-7 * scale);
+	free(zoh);
+	irdm_model_free(&m);
+}
+
+/* max |a - b| / max |a| over the numbers of two CSV texts of one shape */
+static double csv_max_diff(const char *a, const char *b)
+{
+	double diff = 0, scale = 0;
+
+	a = strchr(a, '\n');
+	b = strchr(b, '\n');
+	assert_non_null(a);
+	assert_non_null(b);
+	while (*a && *b) {
+		char *ea, *eb;
+		double x = strtod(a + 1, &ea), y = strtod(b + 1, &eb);
+		assert_true(ea > a + 1 && eb > b + 1);
+		diff = fmax(diff, fabs(x - y));
+		scale = fmax(scale, fabs(x));
+		a = ea;
+		b = eb;
+		if (*a == '\n' && !a[1])
+			break;
+	}
+	return diff / scale;
+}
+
+/* Time-domain work split over parts and merged = the same run in one go. */
+static void test_time_domain_split_and_merge(void **state)
+{
+	const char *whole = path_in_dir("whole.img"), *merged = path_in_dir("merged.img");
+	const char *p1 = path_in_dir("p1.part"), *p2 = path_in_dir("p2.part");
+	char parts[700], both[700], range2[32], whole_csv[65536], merged_csv[65536];
+#define TD SMALL, "--representation", "fir:20", "--method", "time-domain", "--touch", "z>=0.2", \
+	   "--display", "touch", "--substeps", "4", "--dt", "0.002"
+
+	(void)state;
+	assert_int_equal(run("precompute", "-q", TD, "--count-inputs", NULL), 0);
+	int n = atoi(out_text);
+	assert_true(n > 3);
+	snprintf(range2, sizeof(range2), "3:%d", n);
+	assert_int_equal(run("precompute", "-q", TD, "-o", whole, NULL), 0);
+	assert_int_equal(run("precompute", "-q", TD, "--part", "0:3", "-o", p1, NULL), 0);
+	assert_int_equal(run("precompute", "-q", TD, "--part", range2, "-o", p2, NULL), 0);
+	snprintf(parts, sizeof(parts), "%s,%s", p2, p1);
+	assert_int_equal(run("precompute", "-q", TD, "--merge", parts, "-o", merged, NULL), 0);
+	if (run("image", "verify", merged, NULL))
+		fail_msg("verify merged: %s", err_text);
+	assert_int_equal(run("image", "export", whole, "--column", "40", NULL), 0);
+	memcpy(whole_csv, out_text, sizeof(whole_csv));
+	assert_int_equal(run("image", "export", merged, "--column", "40", NULL), 0);
+	memcpy(merged_csv, out_text, sizeof(merged_csv));
+	/* equal to rounding: the solver blocks right-hand sides by share size */
+	assert_true(csv_max_diff(whole_csv, merged_csv) <= 1e-12);
+	/* a missing share, a repeated share, a part of another scene */
+	expect_failure(run("precompute", TD, "--merge", p1, "-o", merged, NULL), "in no part");
+	snprintf(both, sizeof(both), "%s,%s,%s", p1, p2, p1);
+	expect_failure(run("precompute", TD, "--merge", both, "-o", merged, NULL), "earlier part");
+	expect_failure(run("precompute", TD, "--young", "3000", "--merge", parts, "-o", merged, NULL),
+		       "different scene");
+	write_file(p1, "IRDMPART garbage");
+	expect_failure(run("precompute", TD, "--merge", parts, "-o", merged, NULL), "p1.part");
+#undef TD
+}
+
+static void test_help_for_every_command(void **state)
+{
+	(void)state;
+	assert_int_equal(run("--help", NULL), 0);
+	assert_non_null(strstr(out_text, "precompute"));
+	assert_int_equal(run("precompute", "--help", NULL), 0);
+	assert_non_null(strstr(out_text, "representation"));
+	const char *sub[] = { "info", "verify", "export" };
+	for (int i = 0; i < 3; i++) {
+		assert_int_equal(run("image", sub[i], "--help", NULL), 0);
+		assert_non_null(strstr(out_text, "export IMAGE --column"));
+	}
+	expect_failure(run("frobnicate", NULL), "frobnicate");
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_bad_scene_values),
+		cmocka_unit_test(test_bad_meshes),
+		cmocka_unit_test(test_failure_keeps_existing_image),
+		cmocka_unit_test(test_bad_images),
+		cmocka_unit_test(test_export_matches_library),
+		cmocka_unit_test(test_time_domain_split_and_merge),
+		cmocka_unit_test(test_help_for_every_command),
+	};
+
+	return cmocka_run_group_tests(tests, setup, teardown);
+}
