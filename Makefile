@@ -4,6 +4,7 @@
 #   make test       build and run every test (tests/run-tests.sh)
 #   make san        the same tests under AddressSanitizer + UBSan (build-san/)
 #   make fuzz       libFuzzer targets, each for FUZZ_SECONDS (clang only)
+#   make check      what CI runs: fuzz, clang + sanitizer tests, then the tests
 #   make bench      benchmarks (print figures; never pass/fail on time)
 #   make run        the main job: the built-in default scene, end to end
 #
@@ -44,7 +45,7 @@ IRDM     := $(BUILD)/irdm
 TESTS    := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 BENCHES  := $(patsubst tests/bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC))
 
-.PHONY: all test san fuzz bench run clean
+.PHONY: all test san fuzz bench bench-precompute run check deps clean
 .SECONDARY:
 all: $(IRDM) $(FW_LIB)
 
@@ -92,11 +93,30 @@ fuzz:
 	    $(FUZZ_BUILD)/corpus/$$n $$seeds 2>&1 | tail -n 4; \
 	done
 
-bench: $(BENCHES) $(IRDM)
+bench: $(BENCHES) $(IRDM) bench-precompute
 	@set -e; for b in $(BENCHES); do echo "== $$b"; IRDM=$(IRDM) $$b; done
 
-run: $(IRDM)
+# Paper-scale images (cuboid, bunny): time and size beside the paper's.
+bench-precompute: $(IRDM) $(BUILD)/data/bunny.off
+	tools/scripts/bench-precompute.sh $(IRDM)
+
+$(BUILD)/data/bunny.off:
+	@mkdir -p $(dir $@)
+	tools/scripts/bunny-off.sh $@
+
+# The gcc run comes last so its summary line closes the output.
+check: deps
+	$(MAKE) fuzz FUZZ_SECONDS=$(FUZZ_SECONDS)
+	$(MAKE) CC=clang BUILD=build-clang test
+	$(MAKE) san
+	$(MAKE) test
+
+run: deps
+	$(MAKE) $(IRDM)
 	tools/scripts/run-default-scene.sh $(IRDM)
+
+deps:
+	tools/scripts/install-deps.sh
 
 clean:
 	rm -rf build build-san build-fuzz
