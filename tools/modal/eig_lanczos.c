@@ -169,8 +169,10 @@ int irdm_eig_lanczos(const struct irdm_fem *fem, size_t n_lowest, double sigma,
 		goto out_free;
 	}
 	o.b = cholmod_l_allocate_dense(o.n, 1, o.n, CHOLMOD_REAL, &o.cc);
-	if (!o.b)
+	if (!o.b) {
+		snprintf(err, errlen, "Lanczos: out of memory");
 		goto out_free;
+	}
 	ret = run_arpack(&o, fem, (int)n_lowest, sigma, progress, pctx, w2, phi, err, errlen);
 	goto out_free;
 

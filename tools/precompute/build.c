@@ -122,8 +122,8 @@ static int fir_from_modes(struct build *b, char *err, size_t errlen)
 	return 0;
 }
 
-/* Input i of the time-domain work: column c = i / n_free_axes ... we list
- * the free column DoFs in order. */
+/* The time-domain inputs are the free DoFs of the columns, in column order;
+ * global[] gets their global DoF, slot[] their index in col_dofs. */
 static size_t list_inputs(const struct irdm_model *m, int64_t *global, size_t *slot)
 {
 	size_t n = 0;

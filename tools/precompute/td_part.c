@@ -19,9 +19,8 @@ struct part_header {
 	uint32_t header_crc32c;
 };
 
-/* Written through the image writer's atomic path: a section of raw bytes
- * would need the image container; a part is simpler, so write it to a
- * temporary file and rename, the same way. */
+/* A part is written to "<path>.tmp" and renamed into place, so a reader
+ * never sees half a part. */
 int irdm_td_part_write(const char *path, const struct irdm_td_part *p, char *err, size_t errlen)
 {
 	struct part_header h = { .version = 1, .scene_hash = p->scene_hash,

@@ -251,11 +251,6 @@ static int parse_resolution(struct irdm_scene *sc, const char *s)
 	return 0;
 }
 
-struct key {
-	const char *name;
-	const char *expect;
-};
-
 static int set_key(struct irdm_scene *sc, const char *k, const char *v)
 {
 	bool b;
