@@ -13,36 +13,9 @@
 #include <arpack/arpack.h>
 #include <cholmod.h>
 
+#include "fem/factor.h"
+
 #include "modal/modal.h"
-
-/* K - sigma M as a CHOLMOD matrix (upper triangle; stype 1). */
-static cholmod_sparse *shifted(const struct irdm_fem *fem, double sigma, cholmod_common *cc)
-{
-	size_t n = fem->K.n, nnz = fem->K.nnz + fem->M.nnz;
-	cholmod_triplet *t = cholmod_l_allocate_triplet(n, n, nnz, 1, CHOLMOD_REAL, cc);
-	cholmod_sparse *a;
-
-	if (!t)
-		return NULL;
-	int64_t *ti = t->i, *tj = t->j;
-	double *tx = t->x;
-	size_t k = 0;
-	const struct irdm_csc *mats[2] = { &fem->K, &fem->M };
-	double scale[2] = { 1.0, -sigma };
-	for (int q = 0; q < 2; q++)
-		for (size_t j = 0; j < n; j++)
-			for (int64_t p = mats[q]->colptr[j]; p < mats[q]->colptr[j + 1]; p++) {
-				if (mats[q]->rowind[p] > (int64_t)j)
-					continue;
-				ti[k] = mats[q]->rowind[p];
-				tj[k] = (int64_t)j;
-				tx[k++] = scale[q] * mats[q]->val[p];
-			}
-	t->nnz = k;
-	a = cholmod_l_triplet_to_sparse(t, k, cc);
-	cholmod_l_free_triplet(&t, cc);
-	return a;
-}
 
 struct op_ctx {
 	cholmod_common cc;
@@ -145,7 +118,6 @@ int irdm_eig_lanczos(const struct irdm_fem *fem, size_t n_lowest, double sigma,
 		     char *err, size_t errlen)
 {
 	struct op_ctx o = { .n = fem->K.n };
-	cholmod_sparse *a = NULL;
 	int ret = -1;
 
 	if (n_lowest >= fem->K.n) {
@@ -155,33 +127,19 @@ int irdm_eig_lanczos(const struct irdm_fem *fem, size_t n_lowest, double sigma,
 	}
 	cholmod_l_start(&o.cc);
 	o.cc.print = 0;
-	a = shifted(fem, sigma, &o.cc);
-	if (!a)
-		goto out_finish;
 	if (progress)
 		progress(pctx, "sparse factorisation", 0.0);
-	o.f = cholmod_l_analyze(a, &o.cc);
-	if (!o.f || !cholmod_l_factorize(a, o.f, &o.cc) ||
-	    o.cc.status != CHOLMOD_OK) {
-		snprintf(err, errlen,
-			 "Lanczos: K - sigma M is not positive definite (sigma %g): is the object fixed where it should be?",
-			 sigma);
+	if (irdm_fem_factor(fem, 1.0, -sigma, "Lanczos", &o.cc, &o.f, err, errlen))
 		goto out_free;
-	}
 	o.b = cholmod_l_allocate_dense(o.n, 1, o.n, CHOLMOD_REAL, &o.cc);
 	if (!o.b) {
 		snprintf(err, errlen, "Lanczos: out of memory");
 		goto out_free;
 	}
 	ret = run_arpack(&o, fem, (int)n_lowest, sigma, progress, pctx, w2, phi, err, errlen);
-	goto out_free;
-
-out_finish:
-	snprintf(err, errlen, "Lanczos: out of memory");
 out_free:
 	cholmod_l_free_dense(&o.b, &o.cc);
 	cholmod_l_free_factor(&o.f, &o.cc);
-	cholmod_l_free_sparse(&a, &o.cc);
 	cholmod_l_finish(&o.cc);
 	return ret;
 }

@@ -17,35 +17,11 @@
 
 #include <cholmod.h>
 
+#include "fem/factor.h"
+
 #include "modal/response.h"
 
 #define REFINE_STEPS 8
-
-static cholmod_sparse *upper_shifted(const struct irdm_fem *fem, double eps, cholmod_common *cc)
-{
-	size_t n = fem->K.n;
-	cholmod_triplet *t = cholmod_l_allocate_triplet(n, n, fem->K.nnz + fem->M.nnz, 1,
-							 CHOLMOD_REAL, cc);
-	const struct irdm_csc *mats[2] = { &fem->K, &fem->M };
-	double scale[2] = { 1.0, eps };
-	size_t k = 0;
-
-	if (!t)
-		return NULL;
-	for (int q = 0; q < 2; q++)
-		for (size_t j = 0; j < n && scale[q] != 0.0; j++)
-			for (int64_t p = mats[q]->colptr[j]; p < mats[q]->colptr[j + 1]; p++) {
-				if (mats[q]->rowind[p] > (int64_t)j)
-					continue;
-				((int64_t *)t->i)[k] = mats[q]->rowind[p];
-				((int64_t *)t->j)[k] = (int64_t)j;
-				((double *)t->x)[k++] = scale[q] * mats[q]->val[p];
-			}
-	t->nnz = k;
-	cholmod_sparse *a = cholmod_l_triplet_to_sparse(t, k, cc);
-	cholmod_l_free_triplet(&t, cc);
-	return a;
-}
 
 /* x <- x - Phi_r Phi_r^T M x for each of the n_in columns. */
 static void remove_rigid(const struct irdm_fem *fem, const struct irdm_modes *m,
@@ -97,7 +73,6 @@ int irdm_compliance_solve(const struct irdm_fem *fem, const struct irdm_modes *m
 	size_t n = fem->K.n;
 	double eps = floating ? 1e-2 * m->omega2[0] : 0.0;
 	cholmod_common cc;
-	cholmod_sparse *a = NULL;
 	cholmod_factor *f = NULL;
 	cholmod_dense *rhs = NULL, *sol = NULL;
 	double *tmp = malloc(n * sizeof(double)), *load = NULL;
@@ -105,18 +80,14 @@ int irdm_compliance_solve(const struct irdm_fem *fem, const struct irdm_modes *m
 
 	cholmod_l_start(&cc);
 	cc.print = 0;
-	a = upper_shifted(fem, eps, &cc);
 	rhs = cholmod_l_allocate_dense(n, n_in, n, CHOLMOD_REAL, &cc);
 	load = malloc(n * n_in * sizeof(double));
-	if (!a || !rhs || !tmp || !load) {
+	if (!rhs || !tmp || !load) {
 		snprintf(err, errlen, "static compliance: out of memory");
 		goto out_free;
 	}
-	f = cholmod_l_analyze(a, &cc);
-	if (!f || !cholmod_l_factorize(a, f, &cc) || cc.status != CHOLMOD_OK) {
-		snprintf(err, errlen, "static compliance: stiffness is not positive definite (grounded object with too few fixed nodes?)");
+	if (irdm_fem_factor(fem, 1.0, eps, "static compliance", &cc, &f, err, errlen))
 		goto out_free;
-	}
 	for (size_t c = 0; c < n_in; c++)
 		elastic_load(fem, m, in[c], &load[c * n], tmp);
 	memset(X, 0, n * n_in * sizeof(double));
@@ -144,7 +115,6 @@ out_free:
 	cholmod_l_free_dense(&sol, &cc);
 	cholmod_l_free_dense(&rhs, &cc);
 	cholmod_l_free_factor(&f, &cc);
-	cholmod_l_free_sparse(&a, &cc);
 	cholmod_l_finish(&cc);
 	return ret;
 }

@@ -32,6 +32,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "fem/factor.h"
 #include "timedomain/rigid_fit.h"
 #include "timedomain/td_priv.h"
 #include "timedomain/timedomain.h"
@@ -446,9 +447,10 @@ int irdm_td_responses(const struct irdm_mesh *mesh, const struct irdm_fem *fem,
 	cholmod_l_start(&cc);
 	cc.print = 0;
 	/* S = M + h/2 (a M + b K) + h^2/4 K */
-	if (irdm_td_factor(fem, 1.0 + 0.5 * job.h * o->damping.a_per_s,
-			   0.5 * job.h * o->damping.b_s + 0.25 * job.h * job.h, &cc, &job.L,
-			   err, errlen))
+	/* S = M + h/2 C + h^2/4 K with C = a M + b K */
+	if (irdm_fem_factor(fem, 0.5 * job.h * o->damping.b_s + 0.25 * job.h * job.h,
+			    1.0 + 0.5 * job.h * o->damping.a_per_s, "time-domain", &cc, &job.L,
+			    err, errlen))
 		goto out_finish;
 	job.n_blocks = (n_in + TD_BLOCK - 1) / TD_BLOCK;
 	nt = thread_count(o->threads, job.n_blocks);

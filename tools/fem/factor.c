@@ -1,12 +1,13 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * The Newmark effective matrix S = cm M + ck K and its sparse Cholesky
- * factor.  K and M may have different patterns (lumped M is diagonal,
- * consistent M shares K's), so S is built by merging their columns.
+ * Sparse Cholesky factors of ck K + cm M: the Newmark effective matrix, the
+ * Lanczos shift K - sigma M, the static solve K (+ eps M).  K and M may have
+ * different patterns (lumped M is diagonal, consistent M shares K's), so
+ * the sum is built by merging their columns.
  */
 #include <stdio.h>
 
-#include "timedomain/td_priv.h"
+#include "fem/factor.h"
 
 /*
  * Merge column j of cm M + ck K, rows <= j only (CHOLMOD with stype = 1
@@ -62,27 +63,28 @@ static cholmod_sparse *build_s(const struct irdm_fem *fem, double cm, double ck,
 	return s;
 }
 
-int irdm_td_factor(const struct irdm_fem *fem, double cm, double ck, cholmod_common *cc,
-		   cholmod_factor **L, char *err, size_t errlen)
+int irdm_fem_factor(const struct irdm_fem *fem, double ck, double cm, const char *what,
+		    cholmod_common *cc, cholmod_factor **L, char *err, size_t errlen)
 {
 	cholmod_sparse *s = build_s(fem, cm, ck, cc);
 
 	*L = NULL;
 	if (!s) {
-		snprintf(err, errlen, "time-domain: out of memory building S (%zu DoFs)",
-			 fem->K.n);
+		snprintf(err, errlen, "%s: out of memory building the matrix (%zu DoFs)",
+			 what, fem->K.n);
 		return -1;
 	}
 	/*
-	 * Every step of every input solves with this factor, so its fill is
-	 * worth a second ordering: try AMD and METIS (CHOLMOD's default tries
-	 * METIS only for very dense factors) and keep the sparser.  On 3D
+	 * Every solve (each time step of each input, each Lanczos step) uses
+	 * this factor, so its fill is worth a second ordering: try AMD and
+	 * METIS (CHOLMOD's default tries METIS only for very dense factors)
+	 * and keep the sparser.  On 3D
 	 * meshes METIS typically wins by ~40 %.  Both are deterministic.
 	 */
 	cc->nmethods = 3;	/* given ordering (none: skipped), AMD, METIS */
 	*L = cholmod_l_analyze(s, cc);
 	if (!*L) {
-		snprintf(err, errlen, "time-domain: CHOLMOD analysis failed (status %d)",
+		snprintf(err, errlen, "%s: CHOLMOD analysis failed (status %d)", what,
 			 cc->status);
 		goto out_free_s;
 	}
@@ -90,12 +92,11 @@ int irdm_td_factor(const struct irdm_fem *fem, double cm, double ck, cholmod_com
 	if (!cholmod_l_factorize(s, *L, cc) || cc->status == CHOLMOD_NOT_POSDEF) {
 		if (cc->status == CHOLMOD_NOT_POSDEF)
 			snprintf(err, errlen,
-				 "time-domain: M + h/2 C + h^2/4 K is not positive definite (free DoF %ld); check the mass matrix and damping",
-				 (long)(*L)->minor);
+				 "%s: %g K + %g M is not positive definite at free DoF %ld (too few fixed nodes?)",
+				 what, ck, cm, (long)(*L)->minor);
 		else
-			snprintf(err, errlen,
-				 "time-domain: CHOLMOD factorisation failed (status %d)",
-				 cc->status);
+			snprintf(err, errlen, "%s: CHOLMOD factorisation failed (status %d)",
+				 what, cc->status);
 		goto out_free_l;
 	}
 	cholmod_l_free_sparse(&s, cc);
@@ -106,21 +107,4 @@ out_free_l:
 out_free_s:
 	cholmod_l_free_sparse(&s, cc);
 	return -1;
-}
-
-void irdm_td_matvec_block(const struct irdm_csc *a, const double *x, double *y, size_t k)
-{
-	size_t n = a->n;
-
-	for (size_t i = 0; i < n * k; i++)
-		y[i] = 0.0;
-	for (size_t j = 0; j < n; j++) {
-		for (int64_t p = a->colptr[j]; p < a->colptr[j + 1]; p++) {
-			size_t r = (size_t)a->rowind[p];
-			double v = a->val[p];
-
-			for (size_t c = 0; c < k; c++)
-				y[c * n + r] += v * x[c * n + j];
-		}
-	}
 }

@@ -1,0 +1,19 @@
+/* SPDX-License-Identifier: MIT */
+/* Sparse Cholesky factors of ck K + cm M (CHOLMOD). */
+#ifndef IRDM_TOOLS_FEM_FACTOR_H
+#define IRDM_TOOLS_FEM_FACTOR_H
+
+#include <cholmod.h>
+
+#include "fem/fem.h"
+
+/*
+ * Factorise ck K + cm M (over the free DoFs) in the caller's CHOLMOD common;
+ * only the upper triangle is handed over (stype = 1).  `what` names the
+ * caller in messages.  Returns 0, or -1 with a one-line message (out of
+ * memory, or not positive definite: a mechanism or a bad shift).
+ */
+int irdm_fem_factor(const struct irdm_fem *fem, double ck, double cm, const char *what,
+		    cholmod_common *cc, cholmod_factor **L, char *err, size_t errlen);
+
+#endif
