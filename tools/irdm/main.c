@@ -13,6 +13,7 @@ static const char usage[] =
 	"  image info   show an image's header, sections, provenance and stability\n"
 	"  image verify validate an image the way the firmware does, plus physical checks\n"
 	"  image export write R[s] 3x3 blocks of one column as CSV\n"
+	"  replay       run the force engine on a prescribed displacement trajectory\n"
 	"\n"
 	"'irdm COMMAND --help' for each.  Version: " IRDM_TOOL_VERSION "\n";
 
@@ -30,6 +31,8 @@ int main(int argc, char **argv)
 		return irdm_cmd_precompute(argc - 1, argv + 1);
 	if (!strcmp(argv[1], "image"))
 		return irdm_cmd_image(argc - 1, argv + 1);
+	if (!strcmp(argv[1], "replay"))
+		return irdm_cmd_replay(argc - 1, argv + 1);
 	fprintf(stderr, "irdm: unknown command '%s' (see irdm --help)\n", argv[1]);
 	return 2;
 }

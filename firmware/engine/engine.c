@@ -1,0 +1,282 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * The force engine: memory layout and initialisation, contact sites, and
+ * the tick (eq. 3-8 with a virtual coupling, unilateral release, passivity
+ * control, fault on a bad input or an excessive force).
+ */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "engine_priv.h"
+
+#define ALIGN 64u
+
+static size_t up(size_t n)
+{
+	return (n + ALIGN - 1) & ~(size_t)(ALIGN - 1);
+}
+
+struct layout {
+	size_t engine, col_of_row, phi, x, y, ring, tail, total;
+};
+
+static int plan(const struct irdm_image *img, const struct irdm_engine_config *cfg,
+		struct layout *l)
+{
+	const struct irdm_meta *m = img->meta;
+	bool modal = m->representation == IRDM_REPR_MODAL;
+	size_t K = modal ? m->n_modes : 0, T = modal ? 0 : m->fir_length;
+
+	if (!cfg || cfg->max_contacts < 1 || cfg->max_contacts > IRDM_MAX_CONTACTS ||
+	    !(cfg->coupling_k_n_per_m >= 0) || !(cfg->coupling_b_ns_per_m >= 0) ||
+	    !(cfg->stable_radius >= 0 && cfg->stable_radius < 1) || !(cfg->max_force_n >= 0) ||
+	    (cfg->solve != IRDM_SOLVE_COUPLED && cfg->solve != IRDM_SOLVE_PER_VERTEX))
+		return -1;
+	l->engine = 0;
+	l->col_of_row = up(sizeof(struct irdm_engine));
+	l->phi = l->col_of_row + up(m->n_nodes * sizeof(uint32_t));
+	l->x = l->phi + up((size_t)m->n_cols * 3 * K * sizeof(double));
+	l->y = l->x + up(2 * K * sizeof(double));
+	l->ring = l->y + up(2 * K * sizeof(double));
+	l->tail = l->ring + up(T * sizeof(struct irdm_force_tick));
+	l->total = l->tail + up(T * sizeof(double));
+	return 0;
+}
+
+size_t irdm_engine_mem_size(const struct irdm_image *img, const struct irdm_engine_config *cfg)
+{
+	struct layout l;
+
+	return plan(img, cfg, &l) ? 0 : l.total;
+}
+
+void irdm_engine_config_default(struct irdm_engine_config *cfg)
+{
+	memset(cfg, 0, sizeof(*cfg));
+	cfg->max_contacts = 2;
+	cfg->solve = IRDM_SOLVE_COUPLED;
+	cfg->stable_radius = 0.999;
+}
+
+void irdm_engine_coupling_for_device(double k_max, double b_device, double dt,
+				     double *k, double *b)
+{
+	/* b_device > K dt / 2 + |B|: spend half the margin on K, half on B */
+	double k_pass = b_device / dt;      /* K dt / 2 = b_device / 2 */
+
+	*k = fmin(k_max, k_pass);
+	*b = fmax(0.0, 0.5 * (b_device - *k * dt / 2));
+}
+
+/* FIR tail damping: r = stable_radius / (largest recorded radius), if >= 1. */
+static void fir_tail(struct irdm_engine *e, double *w)
+{
+	double rho = e->img->meta->max_spectral_radius, r = 1.0, stable = e->cfg.stable_radius;
+
+	if (stable == 0)
+		stable = 0.999;
+	if (rho >= stable)
+		r = stable / rho;
+	e->tail_r = r;
+	w[0] = 1.0;
+	for (uint32_t s = 1; s < e->T; s++)
+		w[s] = w[s - 1] * r;
+}
+
+static void convert_shapes(struct irdm_engine *e, double *phi)
+{
+	const struct irdm_image *img = e->img;
+
+	for (uint32_t c = 0; c < e->n_cols; c++) {
+		size_t row = img->columns[c];
+		for (size_t i = 0; i < 3 * (size_t)e->K; i++)
+			phi[(size_t)c * 3 * e->K + i] =
+				irdm_elem_get(img->mode_shapes, img->meta->precision, row * 3 * e->K + i);
+	}
+}
+
+int irdm_engine_init(struct irdm_engine **out, const struct irdm_image *img,
+		     const struct irdm_engine_config *cfg, void *mem, size_t mem_size,
+		     char *err, size_t errlen)
+{
+	struct layout l;
+	struct irdm_engine *e = mem;
+	uint8_t *base = mem;
+
+	*out = NULL;
+	if (!img || !img->meta || plan(img, cfg, &l)) {
+		snprintf(err, errlen, "engine: invalid configuration (contacts 1..%d, coupling >= 0, stable radius in [0, 1), force limit >= 0)",
+			 IRDM_MAX_CONTACTS);
+		return IRDM_ENGINE_EINVAL;
+	}
+	if (!mem || ((uintptr_t)mem & 15) || mem_size < l.total) {
+		snprintf(err, errlen, "engine: needs %zu bytes of 16-byte aligned memory, got %zu",
+			 l.total, mem_size);
+		return IRDM_ENGINE_ENOMEM;
+	}
+	memset(mem, 0, l.total);            /* also pre-faults every page */
+	e->img = img;
+	e->cfg = *cfg;
+	e->dt_s = img->meta->dt_s;
+	e->repr = img->meta->representation;
+	e->n_nodes = img->meta->n_nodes;
+	e->n_cols = img->meta->n_cols;
+	e->K = e->repr == IRDM_REPR_MODAL ? img->meta->n_modes : 0;
+	e->T = e->repr == IRDM_REPR_FIR ? img->meta->fir_length : 0;
+	uint32_t *cor = (uint32_t *)(base + l.col_of_row);
+	for (uint32_t r = 0; r < e->n_nodes; r++)
+		cor[r] = NO_COL;
+	for (uint32_t c = 0; c < e->n_cols; c++)
+		cor[img->columns[c]] = c;
+	e->col_of_row = cor;
+	e->x = (double *)(base + l.x);
+	e->y = (double *)(base + l.y);
+	if (e->K)
+		convert_shapes(e, (double *)(base + l.phi));
+	e->phi = (const double *)(base + l.phi);
+	e->ring.T = e->T;
+	e->ring.tick = (struct irdm_force_tick *)(base + l.ring);
+	if (e->T)
+		fir_tail(e, (double *)(base + l.tail));
+	e->tail_w = (const double *)(base + l.tail);
+	for (int i = 0; i < R0_CACHE; i++)
+		e->r0[i].col_force = e->r0[i].col_disp = NO_COL;
+	*out = e;
+	return IRDM_ENGINE_OK;
+}
+
+void irdm_engine_reset(struct irdm_engine *e)
+{
+	for (uint32_t k = 0; k < 2 * e->K; k++)
+		e->x[k] = e->y[k] = 0;
+	for (uint32_t s = 0; s < e->T; s++)
+		e->ring.tick[s].n = 0;
+	for (unsigned i = 0; i < IRDM_MAX_CONTACTS; i++)
+		irdm_engine_contact_end(e, i);
+	e->faulted = false;
+}
+
+/* ---- contact sites ---- */
+
+static void rest_pos(const struct irdm_image *img, uint32_t row, double p[3])
+{
+	for (int a = 0; a < 3; a++)
+		p[a] = img->nodes[row].pos_m[a];
+}
+
+int irdm_engine_site_node(const struct irdm_engine *e, uint32_t row, struct irdm_contact_site *s)
+{
+	double n[3] = { 0, 0, 0 };
+
+	if (row >= e->n_nodes || e->col_of_row[row] == NO_COL)
+		return IRDM_ENGINE_ECONTACT;
+	memset(s, 0, sizeof(*s));
+	s->n_nodes = 1;
+	s->row[0] = row;
+	s->col[0] = e->col_of_row[row];
+	s->weight[0] = 1.0;
+	rest_pos(e->img, row, s->rest_m);
+	/* area-weighted normal of the surface triangles around the node */
+	for (uint32_t t = 0; t < e->img->meta->n_tris; t++) {
+		const uint32_t *v = &e->img->tris[3 * t];
+		if (v[0] != row && v[1] != row && v[2] != row)
+			continue;
+		double a[3], b[3], c[3];
+		rest_pos(e->img, v[0], a);
+		rest_pos(e->img, v[1], b);
+		rest_pos(e->img, v[2], c);
+		double u[3] = { b[0] - a[0], b[1] - a[1], b[2] - a[2] };
+		double w[3] = { c[0] - a[0], c[1] - a[1], c[2] - a[2] };
+		n[0] += u[1] * w[2] - u[2] * w[1];
+		n[1] += u[2] * w[0] - u[0] * w[2];
+		n[2] += u[0] * w[1] - u[1] * w[0];
+	}
+	double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+	for (int a = 0; a < 3; a++)
+		s->normal[a] = len > 0 ? n[a] / len : 0;
+	return IRDM_ENGINE_OK;
+}
+
+int irdm_engine_site_point(const struct irdm_engine *e, uint32_t tri, const double bary[3],
+			   struct irdm_contact_site *s)
+{
+	const struct irdm_image *img = e->img;
+	double p[3][3];
+
+	if (tri >= img->meta->n_tris)
+		return IRDM_ENGINE_ECONTACT;
+	double sum = bary[0] + bary[1] + bary[2];
+	if (!(fabs(sum - 1) < 1e-9) || !(bary[0] >= -1e-12 && bary[1] >= -1e-12 && bary[2] >= -1e-12))
+		return IRDM_ENGINE_EINVAL;
+	memset(s, 0, sizeof(*s));
+	s->n_nodes = 3;
+	for (int k = 0; k < 3; k++) {
+		uint32_t row = img->tris[3 * tri + (uint32_t)k];
+		s->row[k] = row;
+		s->col[k] = e->col_of_row[row];
+		s->weight[k] = bary[k];
+		rest_pos(img, row, p[k]);
+		for (int a = 0; a < 3; a++)
+			s->rest_m[a] += bary[k] * p[k][a];
+	}
+	/* every vertex must move with a response, or be fixed (zero response) */
+	for (int k = 0; k < 3; k++)
+		if (s->col[k] == NO_COL && bary[k] > 0 && e->repr == IRDM_REPR_MODAL) {
+			const struct irdm_meta *m = img->meta;
+			for (size_t i = 0; i < 3 * (size_t)m->n_modes; i++)
+				if (irdm_elem_get(img->mode_shapes, m->precision, s->row[k] * 3 * (size_t)m->n_modes + i) != 0)
+					return IRDM_ENGINE_ECONTACT;
+		}
+	double u[3], w[3], n[3];
+	for (int a = 0; a < 3; a++) {
+		u[a] = p[1][a] - p[0][a];
+		w[a] = p[2][a] - p[0][a];
+	}
+	n[0] = u[1] * w[2] - u[2] * w[1];
+	n[1] = u[2] * w[0] - u[0] * w[2];
+	n[2] = u[0] * w[1] - u[1] * w[0];
+	double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+	if (!(len > 0))
+		return IRDM_ENGINE_ECONTACT;   /* degenerate triangle */
+	for (int a = 0; a < 3; a++)
+		s->normal[a] = n[a] / len;
+	return IRDM_ENGINE_OK;
+}
+
+int irdm_engine_contact_begin(struct irdm_engine *e, unsigned i, const struct irdm_contact_site *site,
+			      enum irdm_contact_mode mode)
+{
+	if (i >= e->cfg.max_contacts || !site || site->n_nodes < 1 || site->n_nodes > 3 ||
+	    (mode != IRDM_CONTACT_PUSH && mode != IRDM_CONTACT_GRAB))
+		return IRDM_ENGINE_EINVAL;
+	struct irdm_contact_state *c = &e->c[i];
+	/* a contact that moves to a new site (sliding) keeps its past target,
+	 * displacement and port energy; a new one starts from rest */
+	if (c->mode == IRDM_CONTACT_OFF)
+		memset(c, 0, sizeof(*c));
+	c->mode = mode;
+	c->site = *site;
+	return IRDM_ENGINE_OK;
+}
+
+void irdm_engine_contact_end(struct irdm_engine *e, unsigned i)
+{
+	if (i < IRDM_MAX_CONTACTS)
+		memset(&e->c[i], 0, sizeof(e->c[i]));
+}
+
+const struct irdm_contact_state *irdm_engine_contact(const struct irdm_engine *e, unsigned i)
+{
+	return i < IRDM_MAX_CONTACTS ? &e->c[i] : NULL;
+}
+
+const struct irdm_engine_stats *irdm_engine_stats(const struct irdm_engine *e)
+{
+	return &e->stats;
+}
+
+void irdm_engine_attach_deform(struct irdm_engine *e, struct irdm_deform *d)
+{
+	e->deform = d;
+}

@@ -1,0 +1,57 @@
+/* SPDX-License-Identifier: MIT */
+/* Internals of the force engine shared by its files. */
+#ifndef IRDM_ENGINE_PRIV_H
+#define IRDM_ENGINE_PRIV_H
+
+#include "irdm/deform.h"
+#include "irdm/engine.h"
+#include "irdm/history.h"
+
+#define NO_COL UINT32_MAX
+#define R0_CACHE 64                 /* direct-mapped (force col, disp col) blocks */
+#define MAX_SOLVE (3 * IRDM_MAX_CONTACTS)
+
+struct r0_entry {
+	uint32_t col_force, col_disp;       /* NO_COL: empty */
+	double blk[9];                      /* displacement at col_disp per force at col_force */
+};
+
+struct irdm_engine {
+	const struct irdm_image *img;
+	struct irdm_engine_config cfg;
+	double dt_s;
+	uint32_t repr, n_nodes, n_cols, K, T;
+	const uint32_t *col_of_row;         /* n_nodes, NO_COL if not touchable */
+	/* modal */
+	const double *phi;                  /* [col][3][K], converted at init */
+	double *x;                          /* 2K: (q, q') per mode, x[t] */
+	double *y;                          /* 2K: A x[t], the free evolution */
+	/* FIR */
+	struct irdm_fir_ring ring;
+	const double *tail_w;               /* T: r^s tail damping (1 when stable) */
+	double tail_r;
+	/* contacts and solve */
+	struct irdm_contact_state c[IRDM_MAX_CONTACTS];
+	struct r0_entry r0[R0_CACHE];
+	struct irdm_force_tick last;        /* forces applied this tick */
+	struct irdm_engine_stats stats;
+	uint64_t tick;
+	bool faulted;
+	struct irdm_deform *deform;
+};
+
+/* engine_modal.c / engine_fir.c: the history term and the R[0] blocks. */
+void irdm_modal_begin_tick(struct irdm_engine *e);
+void irdm_modal_free_disp(const struct irdm_engine *e, uint32_t col, double u[3]);
+void irdm_modal_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp, double blk[9]);
+void irdm_modal_apply(struct irdm_engine *e, const struct irdm_force_tick *f);
+void irdm_fir_free_disp(const struct irdm_engine *e, uint32_t col, double u[3]);
+void irdm_fir_disp_now(const struct irdm_engine *e, uint32_t col, double u[3]);
+void irdm_fir_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp, double blk[9]);
+void irdm_fir_apply(struct irdm_engine *e, const struct irdm_force_tick *f);
+
+/* solve.c: (W + C) F = rhs, n = 3 m unknowns, SPD up to regularisation.
+ * Returns 1 if the system had to be regularised, 0 otherwise. */
+int irdm_solve_spd(double *a, double *rhs, int n);
+
+#endif

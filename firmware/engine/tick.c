@@ -1,0 +1,388 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * One tick of the force engine.
+ *
+ * For the active contacts i (points with barycentric weights a_iv on their
+ * site nodes v), with U~ the history term and R0 the first response block:
+ *   u_i = sum_j W_ij F_j + U~_i,  W_ij = sum_vw a_iv a_jw R0(v <- w),
+ *   U~_i = sum_v a_iv U~_v                        (eq. 5-8, 10-11)
+ * and the virtual coupling F_i = k (p_i - u_i) + b ((p_i - p_i') - (u_i - u_i')) / dt
+ * gives (W + I / kappa) F = p - U~ - (b / (kappa dt)) (p' - u'), kappa = k + b / dt;
+ * k = 0 imposes u_i = p_i (eq. 8).
+ */
+#include <math.h>
+#include <string.h>
+
+#include "engine_priv.h"
+
+static void r0_block(struct irdm_engine *e, uint32_t col_force, uint32_t col_disp, double blk[9])
+{
+	if (col_force == NO_COL || col_disp == NO_COL) {
+		memset(blk, 0, 9 * sizeof(double));
+		return;
+	}
+	struct r0_entry *c = &e->r0[(col_force * 31u + col_disp) % R0_CACHE];
+	if (c->col_force != col_force || c->col_disp != col_disp) {
+		if (e->repr == IRDM_REPR_MODAL)
+			irdm_modal_r0(e, col_force, col_disp, c->blk);
+		else
+			irdm_fir_r0(e, col_force, col_disp, c->blk);
+		c->col_force = col_force;
+		c->col_disp = col_disp;
+	}
+	memcpy(blk, c->blk, 9 * sizeof(double));
+}
+
+static void free_disp(const struct irdm_engine *e, uint32_t col, double u[3])
+{
+	if (col == NO_COL) {
+		u[0] = u[1] = u[2] = 0;
+		return;
+	}
+	if (e->repr == IRDM_REPR_MODAL)
+		irdm_modal_free_disp(e, col, u);
+	else
+		irdm_fir_free_disp(e, col, u);
+}
+
+struct system {
+	int m;                              /* active contacts */
+	unsigned idx[IRDM_MAX_CONTACTS];    /* their slots */
+	double u_free[IRDM_MAX_CONTACTS][3];
+	double w[MAX_SOLVE * MAX_SOLVE];    /* W, row-major 3m x 3m */
+	double f[MAX_SOLVE];
+};
+
+/* W_ij = sum_vw a_iv a_jw R0(v <- w) for contacts i (displacement), j (force). */
+static void build_w(struct irdm_engine *e, struct system *s)
+{
+	int n = 3 * s->m;
+
+	for (int i = 0; i < s->m; i++)
+		for (int j = 0; j < s->m; j++) {
+			const struct irdm_contact_site *si = &e->c[s->idx[i]].site;
+			const struct irdm_contact_site *sj = &e->c[s->idx[j]].site;
+			double acc[9] = { 0 }, blk[9];
+			for (uint32_t v = 0; v < si->n_nodes; v++)
+				for (uint32_t w = 0; w < sj->n_nodes; w++) {
+					double a = si->weight[v] * sj->weight[w];
+					if (a == 0)
+						continue;
+					r0_block(e, sj->col[w], si->col[v], blk);
+					for (int k = 0; k < 9; k++)
+						acc[k] += a * blk[k];
+				}
+			for (int r = 0; r < 3; r++)
+				for (int c = 0; c < 3; c++)
+					s->w[(3 * i + r) * n + 3 * j + c] = acc[3 * r + c];
+		}
+}
+
+static void history_terms(struct irdm_engine *e, struct system *s)
+{
+	for (int i = 0; i < s->m; i++) {
+		const struct irdm_contact_site *st = &e->c[s->idx[i]].site;
+		double *u = s->u_free[i];
+		u[0] = u[1] = u[2] = 0;
+		for (uint32_t v = 0; v < st->n_nodes; v++) {
+			double uv[3];
+			if (st->weight[v] == 0)
+				continue;
+			free_disp(e, st->col[v], uv);
+			for (int a = 0; a < 3; a++)
+				u[a] += st->weight[v] * uv[a];
+		}
+	}
+}
+
+static double coupling_kappa(const struct irdm_engine *e)
+{
+	if (e->cfg.coupling_k_n_per_m == 0)
+		return INFINITY;            /* rigid: the target is the displacement */
+	return e->cfg.coupling_k_n_per_m + e->cfg.coupling_b_ns_per_m / e->dt_s;
+}
+
+/* Coupled solve of all active contacts (the default). */
+static void solve_coupled(struct irdm_engine *e, struct system *s,
+			  const struct irdm_contact_cmd *cmd)
+{
+	int n = 3 * s->m;
+	double kappa = coupling_kappa(e), a[MAX_SOLVE * MAX_SOLVE];
+	double bterm = isinf(kappa) ? 0 : e->cfg.coupling_b_ns_per_m / (kappa * e->dt_s);
+
+	memcpy(a, s->w, (size_t)n * n * sizeof(double));
+	for (int i = 0; i < s->m; i++) {
+		const struct irdm_contact_state *c = &e->c[s->idx[i]];
+		const double *p = cmd[s->idx[i]].target_m;
+		for (int r = 0; r < 3; r++) {
+			if (!isinf(kappa))
+				a[(3 * i + r) * n + 3 * i + r] += 1.0 / kappa;
+			s->f[3 * i + r] = p[r] - s->u_free[i][r]
+					  - bterm * (c->target_prev_m[r] - c->disp_prev_m[r]);
+		}
+	}
+	if (irdm_solve_spd(a, s->f, n))
+		e->stats.singular_solves++;
+}
+
+/*
+ * The paper's eq. 10-11: each vertex v of contact i alone takes
+ * F_v = R0(v <- v)^-1 (p_i - U~_v), weighted by a_iv; no cross terms.
+ */
+static void solve_per_vertex(struct irdm_engine *e, struct system *s,
+			     const struct irdm_contact_cmd *cmd)
+{
+	double kappa = coupling_kappa(e);
+
+	for (int i = 0; i < s->m; i++) {
+		const struct irdm_contact_site *st = &e->c[s->idx[i]].site;
+		const double *p = cmd[s->idx[i]].target_m;
+		double *F = &s->f[3 * i];
+		F[0] = F[1] = F[2] = 0;
+		for (uint32_t v = 0; v < st->n_nodes; v++) {
+			double a[9], rhs[3], uv[3];
+			if (st->weight[v] == 0 || st->col[v] == NO_COL)
+				continue;
+			r0_block(e, st->col[v], st->col[v], a);
+			if (!isinf(kappa))
+				for (int r = 0; r < 3; r++)
+					a[4 * r] += 1.0 / kappa;
+			free_disp(e, st->col[v], uv);
+			for (int r = 0; r < 3; r++)
+				rhs[r] = p[r] - uv[r];
+			if (irdm_solve_spd(a, rhs, 3))
+				e->stats.singular_solves++;
+			for (int r = 0; r < 3; r++)
+				F[r] += st->weight[v] * rhs[r];
+		}
+	}
+}
+
+static void solve(struct irdm_engine *e, struct system *s, const struct irdm_contact_cmd *cmd)
+{
+	if (e->cfg.solve == IRDM_SOLVE_PER_VERTEX)
+		solve_per_vertex(e, s, cmd);
+	else
+		solve_coupled(e, s, cmd);
+}
+
+/* Push contacts whose force would pull the tool are released; re-solve. */
+static void release_pulling(struct irdm_engine *e, struct system *s,
+			    const struct irdm_contact_cmd *cmd)
+{
+	for (int pass = 0; pass < IRDM_MAX_CONTACTS && s->m > 0; pass++) {
+		int keep = 0, dropped = 0;
+		for (int i = 0; i < s->m; i++) {
+			struct irdm_contact_state *c = &e->c[s->idx[i]];
+			const double *F = &s->f[3 * i], *nrm = c->site.normal;
+			/* F acts on the object; pushing means F . n_out < 0 */
+			if (c->mode == IRDM_CONTACT_PUSH &&
+			    F[0] * nrm[0] + F[1] * nrm[1] + F[2] * nrm[2] > 0) {
+				memset(c, 0, sizeof(*c));
+				e->stats.releases++;
+				dropped = 1;
+				continue;
+			}
+			s->idx[keep] = s->idx[i];
+			memcpy(s->u_free[keep], s->u_free[i], sizeof(s->u_free[i]));
+			keep++;
+		}
+		if (!dropped)
+			return;
+		s->m = keep;
+		if (s->m) {
+			build_w(e, s);
+			solve(e, s, cmd);
+		}
+	}
+}
+
+/* u_i = sum_j W_ij F_j + U~_i */
+static void contact_disp(const struct system *s, int i, double u[3])
+{
+	int n = 3 * s->m;
+
+	for (int r = 0; r < 3; r++) {
+		double acc = s->u_free[i][r];
+		for (int k = 0; k < n; k++)
+			acc += s->w[(3 * i + r) * n + k] * s->f[k];
+		u[r] = acc;
+	}
+}
+
+/*
+ * Hannaford-Ryu at each contact port: E = sum F . du is the work done on
+ * the object.  When the model has given out more than it received (E < 0)
+ * the controller adds the damping alpha = -E / (dt |v|^2) along the
+ * contact velocity, which returns E to zero.
+ */
+static void passivity(struct irdm_engine *e, struct system *s)
+{
+	for (int i = 0; i < s->m; i++) {
+		struct irdm_contact_state *c = &e->c[s->idx[i]];
+		double u[3], du[3], v2 = 0, work = 0;
+		contact_disp(s, i, u);
+		for (int r = 0; r < 3; r++) {
+			du[r] = u[r] - c->disp_prev_m[r];
+			v2 += du[r] * du[r];
+			work += s->f[3 * i + r] * du[r];
+		}
+		double energy = c->port_energy_j + work;
+		c->pc_damping_ns_per_m = 0;
+		if (e->cfg.passivity_control && energy < 0 && v2 > 0) {
+			double alpha = -energy * e->dt_s / v2;   /* N s/m, with v = du / dt */
+			for (int r = 0; r < 3; r++)
+				s->f[3 * i + r] += alpha * du[r] / e->dt_s;
+			energy = 0;
+			c->pc_damping_ns_per_m = alpha;
+			e->stats.pc_activations++;
+		}
+		c->port_energy_j = energy;
+	}
+}
+
+/* Spread contact forces over their nodes, merging shared columns. */
+static void gather_forces(struct irdm_engine *e, const struct system *s, struct irdm_force_tick *t)
+{
+	t->n = 0;
+	for (int i = 0; i < s->m; i++) {
+		const struct irdm_contact_site *st = &e->c[s->idx[i]].site;
+		for (uint32_t v = 0; v < st->n_nodes; v++) {
+			uint32_t col = st->col[v], k;
+			if (col == NO_COL || st->weight[v] == 0)
+				continue;           /* a fixed node takes its share to ground */
+			for (k = 0; k < t->n && t->col[k] != col; k++)
+				;
+			if (k == t->n) {
+				t->col[t->n] = col;
+				memset(t->f_n[t->n], 0, sizeof(t->f_n[t->n]));
+				t->n++;
+			}
+			for (int r = 0; r < 3; r++)
+				t->f_n[k][r] += st->weight[v] * s->f[3 * i + r];
+		}
+	}
+}
+
+static bool finite3(const double *v)
+{
+	return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]);
+}
+
+static int fault(struct irdm_engine *e)
+{
+	e->faulted = true;
+	for (unsigned i = 0; i < IRDM_MAX_CONTACTS; i++)
+		memset(e->c[i].force_n, 0, sizeof(e->c[i].force_n));
+	return IRDM_ENGINE_EFAULT;
+}
+
+static void record(struct irdm_engine *e, struct system *s, const struct irdm_contact_cmd *cmd)
+{
+	for (unsigned i = 0; i < IRDM_MAX_CONTACTS; i++)
+		if (e->c[i].mode == IRDM_CONTACT_OFF)
+			memset(e->c[i].force_n, 0, sizeof(e->c[i].force_n));
+	for (int i = 0; i < s->m; i++) {
+		struct irdm_contact_state *c = &e->c[s->idx[i]];
+		contact_disp(s, i, c->disp_m);
+		memcpy(c->force_n, &s->f[3 * i], sizeof(c->force_n));
+		memcpy(c->disp_prev_m, c->disp_m, sizeof(c->disp_m));
+		memcpy(c->target_prev_m, cmd[s->idx[i]].target_m, sizeof(c->target_prev_m));
+	}
+}
+
+int irdm_engine_tick(struct irdm_engine *e, const struct irdm_contact_cmd *cmd)
+{
+	struct system s;
+
+	if (e->faulted)
+		return IRDM_ENGINE_EFAULT;
+	s.m = 0;
+	for (unsigned i = 0; i < e->cfg.max_contacts; i++) {
+		if (cmd[i].mode == IRDM_CONTACT_OFF && e->c[i].mode != IRDM_CONTACT_OFF)
+			irdm_engine_contact_end(e, i);
+		if (e->c[i].mode == IRDM_CONTACT_OFF)
+			continue;
+		if (!finite3(cmd[i].target_m))
+			return fault(e);
+		s.idx[s.m++] = i;
+	}
+	if (e->repr == IRDM_REPR_MODAL)
+		irdm_modal_begin_tick(e);
+	if (s.m) {
+		history_terms(e, &s);
+		build_w(e, &s);
+		solve(e, &s, cmd);
+		release_pulling(e, &s, cmd);
+		passivity(e, &s);
+	}
+	for (int i = 0; i < 3 * s.m; i++)
+		if (!isfinite(s.f[i]) ||
+		    (e->cfg.max_force_n > 0 && fabs(s.f[i]) > e->cfg.max_force_n))
+			return fault(e);
+	record(e, &s, cmd);
+	gather_forces(e, &s, &e->last);
+	if (e->repr == IRDM_REPR_MODAL)
+		irdm_modal_apply(e, &e->last);
+	else
+		irdm_fir_apply(e, &e->last);
+	e->tick++;
+	e->stats.ticks++;
+	if (e->deform && e->cfg.publish_every && e->tick % e->cfg.publish_every == 0) {
+		if (e->repr == IRDM_REPR_MODAL)
+			irdm_deform_publish_modal(e->deform, e->tick, e->x, &e->last, NULL);
+		else
+			irdm_deform_publish_fir(e->deform, e->tick, &e->ring, NULL);
+	}
+	return IRDM_ENGINE_OK;
+}
+
+void irdm_engine_node_disp(const struct irdm_engine *e, uint32_t row, double u[3])
+{
+	/*
+	 * The free response: where the node will be at the next sample if no
+	 * new force acts.  That is the surface a new contact meets.
+	 */
+	uint32_t col = row < e->n_nodes ? e->col_of_row[row] : NO_COL;
+
+	u[0] = u[1] = u[2] = 0;
+	if (col == NO_COL)
+		return;
+	if (e->repr == IRDM_REPR_FIR) {
+		irdm_fir_free_disp(e, col, u);
+		return;
+	}
+	const struct irdm_mode *m = e->img->modes;
+	const double *phi = &e->phi[(size_t)col * 3 * e->K];
+	for (uint32_t k = 0; k < e->K; k++) {
+		double yq = m[k].a[0] * e->x[2 * k] + m[k].a[1] * e->x[2 * k + 1];
+		for (int i = 0; i < 3; i++)
+			u[i] += phi[(size_t)i * e->K + k] * yq;
+	}
+}
+
+void irdm_engine_node_u(const struct irdm_engine *e, uint32_t row, double u[3])
+{
+	uint32_t col = row < e->n_nodes ? e->col_of_row[row] : NO_COL;
+
+	u[0] = u[1] = u[2] = 0;
+	if (col == NO_COL)
+		return;
+	if (e->repr == IRDM_REPR_FIR) {
+		irdm_fir_disp_now(e, col, u);
+		return;
+	}
+	/* u[t] = sum_k phi_k x_k,q[t+1] + sum_e D(col <- e) f_e[t] */
+	const double *phi = &e->phi[(size_t)col * 3 * e->K];
+	for (uint32_t k = 0; k < e->K; k++)
+		for (int i = 0; i < 3; i++)
+			u[i] += phi[(size_t)i * e->K + k] * e->x[2 * k];
+	if (!e->img->static_corr)
+		return;
+	for (uint32_t n = 0; n < e->last.n; n++)
+		for (int i = 0; i < 3; i++)
+			for (int j = 0; j < 3; j++)
+				u[i] += irdm_elem_get(e->img->static_corr, e->img->meta->precision,
+						      (((size_t)e->last.col[n] * e->n_cols + col) * 3 + (size_t)i) * 3 + (size_t)j)
+					* e->last.f_n[n][j];
+}

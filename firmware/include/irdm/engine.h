@@ -1,0 +1,179 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * The IRDM force engine: from contact displacements (or device positions
+ * through a virtual coupling) to contact forces, one tick at a time, with
+ * the force history of a mapped image (FIR ring or exact modal states).
+ *
+ * One struct owned by the caller, sized by irdm_engine_mem_size() and
+ * initialised once in caller-provided memory; irdm_engine_tick() then never
+ * allocates, blocks, or makes a system call.  It is *given* the contact
+ * targets of the tick; it reads no clock.
+ *
+ * Frames and signs (SPEC section 2): positions in metres in the object
+ * frame; a contact's force is the force applied TO the object (the device
+ * renders its negative); the displacement u[t] is observed at (t+1) dt.
+ */
+#ifndef IRDM_ENGINE_H
+#define IRDM_ENGINE_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+
+#include "irdm/image.h"
+
+#define IRDM_MAX_CONTACTS 4
+#define IRDM_MAX_FORCE_NODES (3 * IRDM_MAX_CONTACTS)  /* a contact spreads over <= 3 nodes */
+
+enum irdm_engine_error {
+	IRDM_ENGINE_OK = 0,
+	IRDM_ENGINE_EINVAL = -1,    /* bad configuration or argument */
+	IRDM_ENGINE_ENOMEM = -2,    /* the memory given is smaller than irdm_engine_mem_size() */
+	IRDM_ENGINE_ECONTACT = -3,  /* contact location not touchable (node not a column, ...) */
+	IRDM_ENGINE_EFAULT = -4,    /* non-finite input or force limit exceeded: engine faulted */
+};
+
+enum irdm_solve_mode {
+	IRDM_SOLVE_COUPLED = 0,     /* all contact points in one system (default) */
+	IRDM_SOLVE_PER_VERTEX = 1,  /* the paper's eq. 10-11, each contact alone */
+};
+
+enum irdm_contact_mode {
+	IRDM_CONTACT_OFF = 0,
+	IRDM_CONTACT_PUSH = 1,      /* unilateral: released when the object would pull */
+	IRDM_CONTACT_GRAB = 2,      /* bilateral: held until released */
+};
+
+struct irdm_engine_config {
+	unsigned max_contacts;          /* 1..IRDM_MAX_CONTACTS */
+	enum irdm_solve_mode solve;
+	/*
+	 * Virtual coupling between the target (device) and the contact point:
+	 * F = k (p - u) + b ((p - p') - (u - u')) / dt.  k = 0 means rigid:
+	 * the target IS the contact displacement (eq. 8; replay, references).
+	 */
+	double coupling_k_n_per_m;
+	double coupling_b_ns_per_m;
+	/* Hannaford-Ryu passivity observer/controller at each contact port. */
+	bool passivity_control;
+	/*
+	 * Unstable recursions are never run unprotected: an image column whose
+	 * recorded spectral radius is >= 1 gets its FIR tail damped by r^s so
+	 * that the radius becomes <= stable_radius (<1).  0 = 0.999.
+	 */
+	double stable_radius;
+	double max_force_n;             /* > 0: a larger force faults the engine (torque off) */
+	unsigned publish_every;         /* deformation snapshot every N ticks (0: never) */
+};
+
+/* Where a contact acts: on a triangle of the image surface, or on a node. */
+struct irdm_contact_site {
+	uint32_t n_nodes;               /* 1 (node) or 3 (triangle) */
+	uint32_t col[3];                /* column index of each node, or UINT32_MAX if fixed */
+	uint32_t row[3];                /* image node (row) index of each node */
+	double weight[3];               /* barycentric, sum 1 */
+	double rest_m[3];               /* rest position of the contact point */
+	double normal[3];               /* outward unit normal at the point */
+};
+
+/* One contact's command for a tick. */
+struct irdm_contact_cmd {
+	enum irdm_contact_mode mode;
+	/* target displacement of the contact point from its rest position (k = 0)
+	 * or device position minus the contact's rest position (k > 0) */
+	double target_m[3];
+};
+
+struct irdm_contact_state {
+	enum irdm_contact_mode mode;    /* OFF after a push released */
+	struct irdm_contact_site site;
+	double force_n[3];              /* on the object this tick */
+	double disp_m[3];               /* contact point displacement u[t] */
+	double target_prev_m[3];
+	double disp_prev_m[3];
+	double port_energy_j;           /* passivity observer: work done on the object */
+	double pc_damping_ns_per_m;     /* passivity controller's damping this tick */
+};
+
+/* Snapshot handed to the deformation context (lock-free, see deform.h). */
+struct irdm_history_snapshot {
+	uint64_t tick;
+	uint32_t n_force_nodes;
+	uint32_t force_col[IRDM_MAX_FORCE_NODES];
+	double force_n[IRDM_MAX_FORCE_NODES][3];  /* at tick `tick` */
+	/* modal: the states x[t+1] (2 n_modes doubles, after this tick's force);
+	 * FIR: the ring and its head are copied (see engine_fir.c) */
+	const double *state;            /* points into the snapshot buffer */
+	size_t state_len;
+};
+
+struct irdm_engine_stats {
+	uint64_t ticks;
+	uint64_t releases;              /* push contacts released */
+	uint64_t singular_solves;       /* regularised coupled systems */
+	uint64_t pc_activations;        /* passivity controller added damping */
+};
+
+struct irdm_engine;   /* opaque; lives in the caller's memory */
+
+/* Bytes irdm_engine_init() needs (0 on invalid configuration). */
+size_t irdm_engine_mem_size(const struct irdm_image *img, const struct irdm_engine_config *cfg);
+
+/* Defaults: 2 contacts, coupled, rigid coupling, no PC, radius 0.999, no
+ * force limit, no snapshots. */
+void irdm_engine_config_default(struct irdm_engine_config *cfg);
+
+/*
+ * Virtual coupling from a device's limits (Colgate & Schenkel: passive iff
+ * b_device > K T / 2 + |B|): the stiffest K <= k_max_n_per_m that leaves
+ * half of the device's damping margin, and B = the other half.
+ */
+void irdm_engine_coupling_for_device(double k_max_n_per_m, double b_device_ns_per_m,
+				     double dt_s, double *k_n_per_m, double *b_ns_per_m);
+
+/*
+ * Initialise in `mem` (16-byte aligned, at least irdm_engine_mem_size()
+ * bytes, pre-faulted by this call).  The image must stay mapped.
+ */
+int irdm_engine_init(struct irdm_engine **eng, const struct irdm_image *img,
+		     const struct irdm_engine_config *cfg, void *mem, size_t mem_size,
+		     char *err, size_t errlen);
+
+/* Contact sites (init-time helpers; they do not allocate either). */
+int irdm_engine_site_node(const struct irdm_engine *eng, uint32_t image_node,
+			  struct irdm_contact_site *site);
+int irdm_engine_site_point(const struct irdm_engine *eng, uint32_t tri, const double bary[3],
+			   struct irdm_contact_site *site);
+
+/* Begin / end a contact in slot i (0..max_contacts-1). */
+int irdm_engine_contact_begin(struct irdm_engine *eng, unsigned i,
+			      const struct irdm_contact_site *site, enum irdm_contact_mode mode);
+void irdm_engine_contact_end(struct irdm_engine *eng, unsigned i);
+
+/*
+ * One tick: cmd[i] for each slot (mode OFF = no contact).  Solves the
+ * contact forces, advances the history, optionally publishes a snapshot.
+ * Returns 0, or IRDM_ENGINE_EFAULT (non-finite target or |F| over the
+ * limit): the engine then holds zero force until irdm_engine_reset().
+ */
+int irdm_engine_tick(struct irdm_engine *eng, const struct irdm_contact_cmd *cmd);
+
+const struct irdm_contact_state *irdm_engine_contact(const struct irdm_engine *eng, unsigned i);
+const struct irdm_engine_stats *irdm_engine_stats(const struct irdm_engine *eng);
+
+/* Free response of image node `row` (a column): its displacement at the
+ * next sample if no new force acts (object frame, without rigid motion).
+ * The surface a new contact meets.  Zero for nodes that are not columns. */
+void irdm_engine_node_disp(const struct irdm_engine *eng, uint32_t row, double u_m[3]);
+
+/* Publish snapshots to a deformation context (init-time). */
+struct irdm_deform;
+void irdm_engine_attach_deform(struct irdm_engine *eng, struct irdm_deform *d);
+
+/* Displacement u[t] of image node `row` (a column) after the last tick. */
+void irdm_engine_node_u(const struct irdm_engine *eng, uint32_t row, double u_m[3]);
+
+/* Zero the history and all contacts (out of a fault). */
+void irdm_engine_reset(struct irdm_engine *eng);
+
+#endif /* IRDM_ENGINE_H */

@@ -1,0 +1,177 @@
+/* SPDX-License-Identifier: MIT */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cmocka.h>
+
+#include "engine_fixture.h"
+#include "image/image_response.h"
+#include "precompute/precompute.h"
+
+void efx_image(struct irdm_image *img, const char *path, ...)
+{
+	struct irdm_scene sc;
+	struct irdm_precompute_opts o = { .out_path = path };
+	struct irdm_precompute_report rep;
+	char err[1024];
+	va_list ap;
+
+	irdm_scene_defaults(&sc);
+	va_start(ap, path);
+	for (const char *k = va_arg(ap, const char *); k; k = va_arg(ap, const char *)) {
+		const char *v = va_arg(ap, const char *);
+		if (irdm_scene_set(&sc, k, v, "test", err, sizeof(err)))
+			fail_msg("%s", err);
+	}
+	va_end(ap);
+	if (irdm_precompute(&sc, &o, &rep, err, sizeof(err)))
+		fail_msg("precompute: %s", err);
+	if (irdm_image_map(path, 0, img, err, sizeof(err)))
+		fail_msg("map: %s", err);
+}
+
+struct irdm_engine *efx_engine(const struct irdm_image *img, const struct irdm_engine_config *cfg)
+{
+	size_t n = irdm_engine_mem_size(img, cfg);
+	void *mem = n ? aligned_alloc(64, (n + 63) & ~(size_t)63) : NULL;
+	struct irdm_engine *e;
+	char err[512];
+
+	assert_non_null(mem);
+	if (irdm_engine_init(&e, img, cfg, mem, n, err, sizeof(err)))
+		fail_msg("engine init: %s", err);
+	assert_ptr_equal(e, mem);
+	return e;
+}
+
+void efx_engine_free(struct irdm_engine *e)
+{
+	free(e);   /* the engine lives at the start of its memory */
+}
+
+uint32_t efx_column_row_near(const struct irdm_image *img, const double p[3])
+{
+	double best = INFINITY;
+	uint32_t br = 0;
+
+	for (uint32_t c = 0; c < img->meta->n_cols; c++) {
+		uint32_t r = img->columns[c];
+		double d = 0;
+		for (int a = 0; a < 3; a++)
+			d += pow(img->nodes[r].pos_m[a] - p[a], 2);
+		if (d < best) {
+			best = d;
+			br = r;
+		}
+	}
+	return br;
+}
+
+/* W[s] (3m x 3m, row-major per s) of the contact points. */
+static double *contact_responses(const struct irdm_image *img, const struct irdm_contact_site *st,
+				 int m, size_t N)
+{
+	int n = 3 * m;
+	double *W = calloc(N * (size_t)n * n, sizeof(double));
+	double *R = malloc(N * 9 * sizeof(double));
+
+	assert_non_null(W);
+	assert_non_null(R);
+	for (int i = 0; i < m; i++)
+		for (int j = 0; j < m; j++)
+			for (uint32_t v = 0; v < st[i].n_nodes; v++)
+				for (uint32_t w = 0; w < st[j].n_nodes; w++) {
+					double a = st[i].weight[v] * st[j].weight[w];
+					if (a == 0 || st[i].col[v] == UINT32_MAX || st[j].col[w] == UINT32_MAX)
+						continue;
+					/* displacement at v (row) per force at w (column) */
+					assert_int_equal(irdm_image_response(img, st[j].col[w], st[i].row[v], N, R), 0);
+					for (size_t s = 0; s < N; s++)
+						for (int r = 0; r < 3; r++)
+							for (int c = 0; c < 3; c++)
+								W[s * n * n + (size_t)(3 * i + r) * n + 3 * j + c] +=
+									a * R[9 * s + 3 * (size_t)r + (size_t)c];
+				}
+	free(R);
+	return W;
+}
+
+/* Solve the n x n system a x = b (Gaussian elimination, partial pivoting). */
+static void dense_solve(double *a, double *b, int n)
+{
+	for (int k = 0; k < n; k++) {
+		int p = k;
+		for (int i = k + 1; i < n; i++)
+			if (fabs(a[i * n + k]) > fabs(a[p * n + k]))
+				p = i;
+		for (int j = 0; j < n; j++) {
+			double t = a[k * n + j];
+			a[k * n + j] = a[p * n + j];
+			a[p * n + j] = t;
+		}
+		double t = b[k];
+		b[k] = b[p];
+		b[p] = t;
+		for (int i = k + 1; i < n; i++) {
+			double f = a[i * n + k] / a[k * n + k];
+			for (int j = k; j < n; j++)
+				a[i * n + j] -= f * a[k * n + j];
+			b[i] -= f * b[k];
+		}
+	}
+	for (int i = n - 1; i >= 0; i--) {
+		for (int j = i + 1; j < n; j++)
+			b[i] -= a[i * n + j] * b[j];
+		b[i] /= a[i * n + i];
+	}
+}
+
+void efx_reference(const struct irdm_image *img, const struct irdm_contact_site *sites, int m,
+		   size_t N, const double *target, double *F)
+{
+	int n = 3 * m;
+	double *W = contact_responses(img, sites, m, N);
+
+	for (size_t t = 0; t < N; t++) {
+		double rhs[12], a[144];
+		int act[12], na = 0;
+		/* active unknowns this tick (released contacts carry no force) */
+		for (int i = 0; i < m; i++)
+			if (!isnan(target[t * n + 3 * i]))
+				for (int r = 0; r < 3; r++)
+					act[na++] = 3 * i + r;
+		for (int k = 0; k < n; k++)
+			F[t * n + k] = 0;
+		for (int q = 0; q < na; q++) {
+			int k = act[q];
+			double u = 0;
+			for (size_t s = 1; s <= t; s++)
+				for (int j = 0; j < n; j++)
+					u += W[s * n * n + (size_t)k * n + j] * F[(t - s) * n + j];
+			rhs[q] = target[t * n + k] - u;
+			for (int p = 0; p < na; p++)
+				a[q * na + p] = W[(size_t)k * n + act[p]];
+		}
+		if (na)
+			dense_solve(a, rhs, na);
+		for (int q = 0; q < na; q++)
+			F[t * n + act[q]] = rhs[q];
+	}
+	free(W);
+}
+
+double efx_rel_rms(const double *a, const double *b, size_t n)
+{
+	double d = 0, r = 0;
+
+	for (size_t i = 0; i < n; i++) {
+		d += (a[i] - b[i]) * (a[i] - b[i]);
+		r += b[i] * b[i];
+	}
+	return sqrt(d / r);
+}

@@ -1,0 +1,33 @@
+/* SPDX-License-Identifier: MIT */
+/* Images and engines for the engine tests, and the brute-force reference. */
+#ifndef IRDM_TESTS_ENGINE_FIXTURE_H
+#define IRDM_TESTS_ENGINE_FIXTURE_H
+
+#include "irdm/engine.h"
+#include "irdm/image.h"
+
+/* Build an image with the library from "key=value" pairs (NULL-terminated),
+ * map it.  Aborts the test on failure. */
+void efx_image(struct irdm_image *img, const char *path, ...);
+
+/* An engine in malloc'd memory (freed by efx_engine_free). */
+struct irdm_engine *efx_engine(const struct irdm_image *img, const struct irdm_engine_config *cfg);
+void efx_engine_free(struct irdm_engine *e);
+
+/*
+ * Brute-force reference: forces at contact sites (fixed per run, m sites)
+ * for prescribed displacements of the contact points, by direct double
+ * convolution  sum_{s=0}^{t} W[s] F[t-s] = U[t]  with W[s] assembled from
+ * R[s] blocks read back from the image (tools/image/image_response.c).
+ * target: N x 3m (NAN = released), F_out: N x 3m.
+ */
+void efx_reference(const struct irdm_image *img, const struct irdm_contact_site *sites, int m,
+		   size_t N, const double *target, double *F_out);
+
+/* Relative RMS of a - b over n values: |a - b|_2 / |b|_2. */
+double efx_rel_rms(const double *a, const double *b, size_t n);
+
+/* Image node (row) index nearest to p among the columns. */
+uint32_t efx_column_row_near(const struct irdm_image *img, const double p[3]);
+
+#endif

@@ -1,0 +1,384 @@
+/* SPDX-License-Identifier: MIT */
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "image/image_response.h"
+#include "replay/replay.h"
+
+#define MAX_NODES_OUT 256
+
+void irdm_replay_opts_default(struct irdm_replay_opts *o)
+{
+	memset(o, 0, sizeof(*o));
+	o->mode = IRDM_CONTACT_GRAB;
+	o->solve = IRDM_SOLVE_COUPLED;
+}
+
+/* Closest point of triangle abc to p (Ericson, Real-Time Collision
+ * Detection 5.1.5): barycentrics of the closest point. */
+static void closest_on_triangle(const double p[3], const double a[3], const double b[3],
+				const double c[3], double bary[3])
+{
+	double ab[3], ac[3], ap[3], bp[3], cp[3];
+
+	for (int k = 0; k < 3; k++) {
+		ab[k] = b[k] - a[k];
+		ac[k] = c[k] - a[k];
+		ap[k] = p[k] - a[k];
+		bp[k] = p[k] - b[k];
+		cp[k] = p[k] - c[k];
+	}
+#define DOT(x, y) ((x)[0] * (y)[0] + (x)[1] * (y)[1] + (x)[2] * (y)[2])
+	double d1 = DOT(ab, ap), d2 = DOT(ac, ap), d3 = DOT(ab, bp), d4 = DOT(ac, bp);
+	double d5 = DOT(ab, cp), d6 = DOT(ac, cp);
+#undef DOT
+	double va = d3 * d6 - d5 * d4, vb = d5 * d2 - d1 * d6, vc = d1 * d4 - d3 * d2;
+
+	if (d1 <= 0 && d2 <= 0) {
+		bary[0] = 1, bary[1] = 0, bary[2] = 0;
+	} else if (d3 >= 0 && d4 <= d3) {
+		bary[0] = 0, bary[1] = 1, bary[2] = 0;
+	} else if (vc <= 0 && d1 >= 0 && d3 <= 0) {
+		double v = d1 / (d1 - d3);
+		bary[0] = 1 - v, bary[1] = v, bary[2] = 0;
+	} else if (d6 >= 0 && d5 <= d6) {
+		bary[0] = 0, bary[1] = 0, bary[2] = 1;
+	} else if (vb <= 0 && d2 >= 0 && d6 <= 0) {
+		double w = d2 / (d2 - d6);
+		bary[0] = 1 - w, bary[1] = 0, bary[2] = w;
+	} else if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+		double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+		bary[0] = 0, bary[1] = 1 - w, bary[2] = w;
+	} else {
+		double den = 1 / (va + vb + vc);
+		bary[1] = vb * den;
+		bary[2] = vc * den;
+		bary[0] = 1 - bary[1] - bary[2];
+	}
+}
+
+int irdm_replay_locate(const struct irdm_image *img, const double p[3], uint32_t *tri,
+		       double bary[3])
+{
+	double best = INFINITY;
+
+	for (uint32_t t = 0; t < img->meta->n_tris; t++) {
+		const uint32_t *v = &img->tris[3 * t];
+		double x[3][3], b[3], q[3] = { 0, 0, 0 }, d = 0;
+		bool touchable = true;
+		for (int k = 0; k < 3; k++) {
+			touchable &= irdm_image_col_of(img, v[k]) >= 0;
+			for (int a = 0; a < 3; a++)
+				x[k][a] = img->nodes[v[k]].pos_m[a];
+		}
+		if (!touchable)
+			continue;
+		closest_on_triangle(p, x[0], x[1], x[2], b);
+		for (int a = 0; a < 3; a++) {
+			q[a] = b[0] * x[0][a] + b[1] * x[1][a] + b[2] * x[2][a];
+			d += (q[a] - p[a]) * (q[a] - p[a]);
+		}
+		if (d < best) {
+			best = d;
+			*tri = t;
+			memcpy(bary, b, sizeof(b));
+		}
+	}
+	return isinf(best) ? -1 : 0;
+}
+
+/* ---- trajectory CSV ---- */
+
+struct trajectory {
+	size_t n_rows, n_cols;
+	double *v;          /* n_rows x n_cols */
+};
+
+static int parse_line(char *line, double *v, size_t want, size_t *got)
+{
+	char *p = line;
+	size_t k = 0;
+
+	for (;;) {
+		while (*p == ' ' || *p == '\t')
+			p++;
+		if (k == want)
+			return -1;
+		if (*p == ',' || *p == '\n' || *p == '\r' || *p == 0) {
+			v[k++] = NAN;   /* empty: released */
+		} else {
+			char *end;
+			v[k++] = strtod(p, &end);
+			if (end == p)
+				return -2;   /* not a number */
+			p = end;
+			while (*p == ' ' || *p == '\t')
+				p++;
+		}
+		if (*p == ',') {
+			p++;
+			continue;
+		}
+		if (*p == '\n' || *p == '\r' || *p == 0)
+			break;
+		return -2;
+	}
+	*got = k;
+	return 0;
+}
+
+static int read_trajectory(const char *path, size_t n_cols, double dt, struct trajectory *tr,
+			   char *err, size_t errlen)
+{
+	FILE *f = fopen(path, "r");
+	char line[4096];
+	size_t cap = 0, lineno = 0;
+
+	memset(tr, 0, sizeof(*tr));
+	tr->n_cols = n_cols;
+	if (!f) {
+		snprintf(err, errlen, "%s: cannot open: %s", path, strerror(errno));
+		return -1;
+	}
+	while (fgets(line, sizeof(line), f)) {
+		double v[1 + 3 * IRDM_MAX_CONTACTS];
+		size_t got = 0;
+		lineno++;
+		int rc = parse_line(line, v, n_cols, &got);
+		if (rc == -2 && lineno == 1 && tr->n_rows == 0)
+			continue;   /* header */
+		if (rc || got != n_cols) {
+			snprintf(err, errlen, "%s:%zu: expected %zu numeric columns (t and 3 per contact)",
+				 path, lineno, n_cols);
+			goto out_fail;
+		}
+		double t_expect = (double)tr->n_rows * dt;
+		if (!isfinite(v[0]) || fabs(v[0] - t_expect) > 1e-6 * dt + 1e-9 * fabs(t_expect)) {
+			snprintf(err, errlen, "%s:%zu: t = %g, expected %g: one row per sample of the image's dt = %g s",
+				 path, lineno, v[0], t_expect, dt);
+			goto out_fail;
+		}
+		for (size_t k = 1; k < n_cols; k++)
+			if (isinf(v[k]) || fabs(v[k]) > 10.0) {
+				snprintf(err, errlen, "%s:%zu: displacement %g m is out of range (|u| <= 10 m)",
+					 path, lineno, v[k]);
+				goto out_fail;
+			}
+		if (tr->n_rows == cap) {
+			cap = cap ? 2 * cap : 1024;
+			double *nv = realloc(tr->v, cap * n_cols * sizeof(double));
+			if (!nv) {
+				snprintf(err, errlen, "%s: out of memory", path);
+				goto out_fail;
+			}
+			tr->v = nv;
+		}
+		memcpy(&tr->v[tr->n_rows * n_cols], v, n_cols * sizeof(double));
+		tr->n_rows++;
+	}
+	fclose(f);
+	if (!tr->n_rows) {
+		snprintf(err, errlen, "%s: no samples", path);
+		return -1;
+	}
+	return 0;
+out_fail:
+	fclose(f);
+	free(tr->v);
+	tr->v = NULL;
+	return -1;
+}
+
+/* ---- sites and output nodes ---- */
+
+static int make_sites(const struct irdm_replay_opts *o, const struct irdm_image *img,
+		      const struct irdm_engine *eng, struct irdm_contact_site *site,
+		      char *err, size_t errlen)
+{
+	for (unsigned i = 0; i < o->n_contacts; i++) {
+		const struct irdm_replay_contact *c = &o->contact[i];
+		int rc;
+		if (c->is_node) {
+			int64_t row = irdm_image_node_of(img, c->mesh_node);
+			rc = row < 0 ? IRDM_ENGINE_ECONTACT : irdm_engine_site_node(eng, (uint32_t)row, &site[i]);
+			if (rc) {
+				snprintf(err, errlen, "--contact %u: mesh node %u is not a touchable node of %s",
+					 c->mesh_node, c->mesh_node, o->image);
+				return -1;
+			}
+		} else {
+			uint32_t tri;
+			double bary[3];
+			if (irdm_replay_locate(img, c->point_m, &tri, bary) ||
+			    irdm_engine_site_point(eng, tri, bary, &site[i])) {
+				snprintf(err, errlen, "--contact %g,%g,%g: no touchable surface in %s",
+					 c->point_m[0], c->point_m[1], c->point_m[2], o->image);
+				return -1;
+			}
+		}
+	}
+	return 0;
+}
+
+static int parse_nodes(const char *list, const struct irdm_image *img, uint32_t *rows,
+		       uint32_t *mesh, size_t *n, char *err, size_t errlen)
+{
+	const char *p = list;
+
+	*n = 0;
+	while (p && *p) {
+		char *end;
+		errno = 0;
+		unsigned long v = strtoul(p, &end, 10);
+		int64_t row = (end == p || errno || v > UINT32_MAX) ? -1 : irdm_image_node_of(img, (uint32_t)v);
+		if (row < 0 || irdm_image_col_of(img, (uint32_t)row) < 0 || *n == MAX_NODES_OUT ||
+		    (*end && *end != ',')) {
+			snprintf(err, errlen, "--nodes: '%.20s' is not a touchable node of the image (at most %d)",
+				 p, MAX_NODES_OUT);
+			return -1;
+		}
+		rows[*n] = (uint32_t)row;
+		mesh[(*n)++] = (uint32_t)v;
+		p = *end ? end + 1 : end;
+	}
+	return 0;
+}
+
+/* ---- the run ---- */
+
+struct run {
+	struct irdm_image img;
+	struct trajectory tr;
+	void *mem;
+	struct irdm_engine *eng;
+	struct irdm_contact_site site[IRDM_MAX_CONTACTS];
+	uint32_t rows[MAX_NODES_OUT], mesh[MAX_NODES_OUT];
+	size_t n_nodes;
+	FILE *out;
+	char tmp[4096];
+};
+
+static int start(const struct irdm_replay_opts *o, struct run *r, char *err, size_t errlen)
+{
+	struct irdm_engine_config cfg;
+
+	if (irdm_image_map(o->image, 0, &r->img, err, errlen))
+		return -1;
+	if (r->img.rigid) {
+		snprintf(err, errlen, "%s: a floating object: replay drives grounded objects (floating replay is not built yet)",
+			 o->image);
+		return -1;
+	}
+	irdm_engine_config_default(&cfg);
+	cfg.max_contacts = o->n_contacts;
+	cfg.solve = o->solve;
+	cfg.coupling_k_n_per_m = o->coupling_k;
+	cfg.coupling_b_ns_per_m = o->coupling_b;
+	size_t need = irdm_engine_mem_size(&r->img, &cfg);
+	r->mem = need ? aligned_alloc(64, (need + 63) & ~(size_t)63) : NULL;
+	if (!r->mem) {
+		snprintf(err, errlen, "engine: out of memory (%zu bytes)", need);
+		return -1;
+	}
+	if (irdm_engine_init(&r->eng, &r->img, &cfg, r->mem, need, err, errlen))
+		return -1;
+	if (make_sites(o, &r->img, r->eng, r->site, err, errlen))
+		return -1;
+	if (o->nodes && parse_nodes(o->nodes, &r->img, r->rows, r->mesh, &r->n_nodes, err, errlen))
+		return -1;
+	return read_trajectory(o->trajectory, 1 + 3 * (size_t)o->n_contacts, r->img.meta->dt_s,
+			       &r->tr, err, errlen);
+}
+
+static void header(const struct irdm_replay_opts *o, struct run *r)
+{
+	fprintf(r->out, "t");
+	for (unsigned i = 0; i < o->n_contacts; i++)
+		fprintf(r->out, ",c%u_fx,c%u_fy,c%u_fz", i + 1, i + 1, i + 1);
+	for (size_t k = 0; k < r->n_nodes; k++)
+		fprintf(r->out, ",n%u_ux,n%u_uy,n%u_uz", r->mesh[k], r->mesh[k], r->mesh[k]);
+	fputc('\n', r->out);
+}
+
+static int step(const struct irdm_replay_opts *o, struct run *r, size_t row, char *err,
+		size_t errlen)
+{
+	struct irdm_contact_cmd cmd[IRDM_MAX_CONTACTS];
+	const double *v = &r->tr.v[row * r->tr.n_cols];
+
+	memset(cmd, 0, sizeof(cmd));
+	for (unsigned i = 0; i < o->n_contacts; i++) {
+		const double *u = &v[1 + 3 * i];
+		if (isnan(u[0]) || isnan(u[1]) || isnan(u[2]))
+			continue;   /* released this sample */
+		if (irdm_engine_contact(r->eng, i)->mode == IRDM_CONTACT_OFF)
+			irdm_engine_contact_begin(r->eng, i, &r->site[i], o->mode);
+		cmd[i].mode = o->mode;
+		memcpy(cmd[i].target_m, u, sizeof(cmd[i].target_m));
+	}
+	if (irdm_engine_tick(r->eng, cmd)) {
+		snprintf(err, errlen, "engine fault at t = %g s (non-finite or excessive force)", v[0]);
+		return -1;
+	}
+	fprintf(r->out, "%.9g", v[0]);
+	for (unsigned i = 0; i < o->n_contacts; i++) {
+		const double *f = irdm_engine_contact(r->eng, i)->force_n;
+		fprintf(r->out, ",%.12g,%.12g,%.12g", f[0], f[1], f[2]);
+	}
+	for (size_t k = 0; k < r->n_nodes; k++) {
+		double u[3];
+		irdm_engine_node_u(r->eng, r->rows[k], u);
+		fprintf(r->out, ",%.12g,%.12g,%.12g", u[0], u[1], u[2]);
+	}
+	fputc('\n', r->out);
+	return 0;
+}
+
+int irdm_replay_run(const struct irdm_replay_opts *o, char *err, size_t errlen)
+{
+	struct run *r = calloc(1, sizeof(*r));
+	int ret = -1;
+
+	if (!r) {
+		snprintf(err, errlen, "out of memory");
+		return -1;
+	}
+	if (start(o, r, err, errlen))
+		goto out_free;
+	snprintf(r->tmp, sizeof(r->tmp), "%s.tmp", o->out);
+	r->out = fopen(r->tmp, "w");
+	if (!r->out) {
+		snprintf(err, errlen, "%s: cannot create: %s", r->tmp, strerror(errno));
+		goto out_free;
+	}
+	header(o, r);
+	for (size_t row = 0; row < r->tr.n_rows; row++)
+		if (step(o, r, row, err, errlen))
+			goto out_remove;
+	if (fclose(r->out)) {
+		r->out = NULL;
+		snprintf(err, errlen, "%s: write failed: %s", r->tmp, strerror(errno));
+		goto out_remove;
+	}
+	r->out = NULL;
+	if (rename(r->tmp, o->out)) {
+		snprintf(err, errlen, "%s: cannot rename into place: %s", o->out, strerror(errno));
+		goto out_remove;
+	}
+	ret = 0;
+	goto out_free;
+out_remove:
+	if (r->out)
+		fclose(r->out);
+	remove(r->tmp);
+out_free:
+	free(r->tr.v);
+	free(r->mem);
+	if (r->img.base)
+		irdm_image_unmap(&r->img);
+	free(r);
+	return ret;
+}

@@ -1,0 +1,33 @@
+/* SPDX-License-Identifier: MIT */
+/* Running the force engine on a prescribed trajectory (irdm replay). */
+#ifndef IRDM_TOOLS_REPLAY_H
+#define IRDM_TOOLS_REPLAY_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "irdm/engine.h"
+
+struct irdm_replay_contact {
+	bool is_node;
+	uint32_t mesh_node;
+	double point_m[3];
+};
+
+struct irdm_replay_opts {
+	const char *image, *trajectory, *out, *nodes;
+	unsigned n_contacts;
+	struct irdm_replay_contact contact[IRDM_MAX_CONTACTS];
+	enum irdm_contact_mode mode;
+	enum irdm_solve_mode solve;
+	double coupling_k, coupling_b;
+};
+
+void irdm_replay_opts_default(struct irdm_replay_opts *o);
+int irdm_replay_run(const struct irdm_replay_opts *o, char *err, size_t errlen);
+
+/* Nearest point of the touchable surface: triangle and barycentrics. */
+int irdm_replay_locate(const struct irdm_image *img, const double p[3], uint32_t *tri,
+		       double bary[3]);
+
+#endif
