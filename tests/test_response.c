@@ -280,9 +280,9 @@ static void test_stability_certificate(void **state)
 		double wind = irdm_stability_fir(fir, T);
 		double comp = irdm_stability_fir_companion(fir, T);
 		print_message("T = %zu: spectral radius %.6f (winding), %.6f (companion)\n", T, wind, comp);
-		/* a certified upper bound, tight to 2e-3 (it stops refining where
-		 * cancellation near a zero makes the phase unreliable) */
-		assert_true(wind >= comp - 1e-9 && wind - comp <= 2e-3);
+		/* a certified upper bound, tight to 1e-4 (near a zero, rounding
+		 * noise in det Q ends the refinement on the certified side) */
+		assert_true(wind >= comp - 1e-9 && wind - comp <= 1e-4);
 		assert_true(comp > 1.0);   /* truncation destabilises */
 		free(fir);
 	}

@@ -69,6 +69,16 @@ void irdm_engine_coupling_for_device(double k_max, double b_device, double dt,
 	*b = fmax(0.0, 0.5 * (b_device - *k * dt / 2));
 }
 
+void irdm_engine_config_haptic(struct irdm_engine_config *cfg, double dt, double k_max,
+			       double b_device, double max_force)
+{
+	irdm_engine_config_default(cfg);
+	irdm_engine_coupling_for_device(k_max, b_device, dt, &cfg->coupling_k_n_per_m,
+					&cfg->coupling_b_ns_per_m);
+	cfg->passivity_control = true;
+	cfg->max_force_n = max_force;
+}
+
 /* FIR tail damping: r = stable_radius / (largest recorded radius), if >= 1. */
 static void fir_tail(struct irdm_engine *e, double *w)
 {

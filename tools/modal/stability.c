@@ -109,11 +109,10 @@ double irdm_stability_fir(const double *R, size_t T)
 		n_fft = n0;
 		int c = zeros_inside(R, T, r, buf, &n_fft);
 		if (c == 0)
-			r_lo = r;
-		else if (c > 0)
-			r_hi = r;
+			r_lo = r;   /* certified: no zero inside r */
 		else
-			break;      /* too close to a zero to tell: stop, stay certain */
+			r_hi = r;   /* zeros inside, or too close to one to tell:
+				     * either way only below r can be certified */
 	}
 	rho = 1.0 / r_lo;
 out_free:

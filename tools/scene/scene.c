@@ -24,6 +24,7 @@ const char *const irdm_scene_help =
 	"  fixed = none | x|y|z<=V | x|y|z>=V | box:X0,Y0,Z0,X1,Y1,Z1 | nodes:I,J,...\n"
 	"  dt = SECONDS           sample period (default 0.001)\n"
 	"  representation = modal:K | modal:all | fir:T\n"
+	"  modes = K | all        modes that synthesise a modal-method FIR (default 300)\n"
 	"  static_correction = yes | no   residual compliance of dropped modes (modal)\n"
 	"  precision = f16 | f32 | f64\n"
 	"  touch = surface | REGION      touchable surface nodes (columns)\n"
@@ -303,6 +304,13 @@ static int set_key(struct irdm_scene *sc, const char *k, const char *v)
 		return parse_double(v, &sc->dt_s) || sc->dt_s <= 0 || sc->dt_s > 1;
 	if (!strcmp(k, "representation"))
 		return parse_representation(sc, v);
+	if (!strcmp(k, "modes")) {
+		if (!strcmp(v, "all") || !strcmp(v, "0")) {
+			sc->modes = 0;
+			return 0;
+		}
+		return parse_uint(v, 1000000, &sc->modes) || sc->modes == 0;
+	}
 	if (!strcmp(k, "static_correction"))
 		return parse_bool(v, &sc->static_correction);
 	if (!strcmp(k, "precision")) {
@@ -478,7 +486,7 @@ int irdm_scene_format(const struct irdm_scene *sc, char *buf, size_t len)
 		"name=%s\nmesh=%s\nresolution=%u,%u,%u\ntets_per_hex=%u\nmesh_scale=%.17g\n"
 		"tetgen=%s\nyoung=%.17g\npoisson=%.17g\ndensity=%.17g\nmass=%s\ndamping=%s\n"
 		"floating=%s\nfixed=%s\ndt=%.17g\nrepresentation=%s\nstatic_correction=%s\n"
-		"precision=%s\ntouch=%s\ndisplay=%s\nmethod=%s\nsubsteps=%u\neigensolver=%s\n",
+		"precision=%s\ntouch=%s\ndisplay=%s\nmethod=%s\nsubsteps=%u\neigensolver=%s\nmodes=%u\n",
 		sc->name, sc->mesh, sc->res[0], sc->res[1], sc->res[2], sc->tets_per_hex,
 		sc->mesh_scale, sc->tetgen, sc->mat.young_pa, sc->mat.poisson,
 		sc->mat.density_kg_m3, sc->mass == IRDM_MASS_LUMPED ? "lumped" : "consistent",
@@ -486,7 +494,7 @@ int irdm_scene_format(const struct irdm_scene *sc, char *buf, size_t len)
 		sc->static_correction ? "yes" : "no", prec[sc->precision & 3],
 		region_text(&sc->touch), region_text(&sc->display),
 		sc->method == IRDM_METHOD_MODAL ? "modal" : "time-domain", sc->substeps,
-		eig[sc->eigensolver]);
+		eig[sc->eigensolver], sc->modes);
 	return (n < 0 || (size_t)n >= len) ? -1 : 0;
 }
 

@@ -132,6 +132,15 @@ void irdm_engine_coupling_for_device(double k_max_n_per_m, double b_device_ns_pe
 				     double dt_s, double *k_n_per_m, double *b_ns_per_m);
 
 /*
+ * The haptic default: a virtual coupling sized from the device (above),
+ * the passivity controller on, and the device's force limit.  A device
+ * described by CHAI3D's PHANToM Desktop figures: 1000 N/m, 7.9 N; its
+ * damping margin b_device (N s/m) bounds the coupling (Colgate).
+ */
+void irdm_engine_config_haptic(struct irdm_engine_config *cfg, double dt_s, double k_max_n_per_m,
+			       double b_device_ns_per_m, double max_force_n);
+
+/*
  * Initialise in `mem` (16-byte aligned, at least irdm_engine_mem_size()
  * bytes, pre-faulted by this call).  The image must stay mapped.
  */

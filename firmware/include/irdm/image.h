@@ -48,6 +48,9 @@ struct irdm_image {
 	const void *static_corr;            /* modal, optional: n_cols*n_cols*9 */
 	const struct irdm_rigid *rigid;     /* floating only, else NULL */
 	const struct irdm_stability *stability; /* n_cols */
+	/* optional CONTACT_BVH (NULL if absent): validated header, payload bytes */
+	const struct irdm_bvh_header *contact_bvh;
+	size_t contact_bvh_size;
 };
 
 /*

@@ -65,7 +65,7 @@ enum irdm_section_kind {
 	IRDM_SEC_STATIC_CORR = 9,  /* modal, optional: residual compliance [col][col'][3][3] */
 	IRDM_SEC_RIGID = 10,       /* floating only: struct irdm_rigid */
 	IRDM_SEC_STABILITY = 11,   /* n_cols x struct irdm_stability */
-	IRDM_SEC_CONTACT_BVH = 12, /* reserved for the contact acceleration structure */
+	IRDM_SEC_CONTACT_BVH = 12, /* optional: contact BVH + adjacency, struct irdm_bvh_header */
 };
 
 enum irdm_repr {
@@ -142,6 +142,57 @@ struct irdm_stability {                     /* 8 bytes, one per column */
 	uint32_t flags;                     /* enum irdm_stability_flags */
 };
 
+/*
+ * CONTACT_BVH (kind 12, elem BYTES, optional): a bounding volume hierarchy
+ * over the contactable SURFACE triangles (all three vertices are columns),
+ * their edge adjacency and the row -> column map.  The payload is
+ *
+ *   struct irdm_bvh_header                        64 bytes at 0
+ *   struct irdm_bvh_node[n_bvh_nodes]             at nodes_offset
+ *   u32 index[n_contact_tris]                     at index_offset
+ *   u32 adjacency[n_surface_tris][3]              at adj_offset
+ *   u32 col_of_row[n_rows]                        at col_of_row_offset
+ *
+ * contiguous in that order (the offsets are exactly the running sums, the
+ * payload ends after col_of_row).  Triangles are named by their SURFACE
+ * index.  Nodes are numbered in depth-first preorder: node 0 is the root,
+ * every child index is greater than its parent's.  adjacency[t][e] is the
+ * contactable triangle across edge e = (v[e], v[(e + 1) % 3]) of t, or
+ * IRDM_BVH_NONE at a boundary of the contactable region (or a non-manifold
+ * edge); it is symmetric.  col_of_row[r] is the column of row r, or
+ * IRDM_BVH_NONE.  Boxes are the exact float bounds of the REST positions.
+ */
+#define IRDM_BVH_NONE 0xffffffffu
+#define IRDM_BVH_INTERNAL 0x80000000u       /* in count_or_right: internal node */
+#define IRDM_BVH_LEAF_MAX 4u                /* triangles per leaf */
+#define IRDM_BVH_MAX_DEPTH 48u              /* levels, the root is level 1 */
+
+struct irdm_bvh_header {                    /* 64 bytes */
+	uint32_t n_surface_tris;            /* = meta n_tris */
+	uint32_t n_rows;                    /* = meta n_nodes */
+	uint32_t n_contact_tris;            /* contactable triangles = index entries */
+	uint32_t n_bvh_nodes;               /* 0 iff n_contact_tris = 0 */
+	uint32_t depth;                     /* levels, 1..IRDM_BVH_MAX_DEPTH (0 if empty) */
+	uint32_t leaf_max;                  /* most triangles in a leaf, <= IRDM_BVH_LEAF_MAX */
+	uint32_t nodes_offset;              /* bytes from the payload start */
+	uint32_t index_offset;
+	uint32_t adj_offset;
+	uint32_t col_of_row_offset;
+	uint32_t reserved[6];               /* 0 */
+};
+
+/*
+ * Leaf: count_or_right = number of triangles (1..leaf_max), left_or_first =
+ * first entry of index[].  Internal: count_or_right = IRDM_BVH_INTERNAL |
+ * right child, left_or_first = left child.
+ */
+struct irdm_bvh_node {                      /* 32 bytes */
+	float    lo[3];                     /* rest-position bounds, finite, lo <= hi */
+	float    hi[3];
+	uint32_t left_or_first;
+	uint32_t count_or_right;
+};
+
 _Static_assert(sizeof(struct irdm_image_header) == 64, "header size");
 _Static_assert(sizeof(struct irdm_image_section) == 32, "section size");
 _Static_assert(sizeof(struct irdm_meta) == 256, "meta size");
@@ -149,5 +200,7 @@ _Static_assert(sizeof(struct irdm_node) == 16, "node size");
 _Static_assert(sizeof(struct irdm_mode) == 64, "mode size");
 _Static_assert(sizeof(struct irdm_rigid) == 128, "rigid size");
 _Static_assert(sizeof(struct irdm_stability) == 8, "stability size");
+_Static_assert(sizeof(struct irdm_bvh_header) == 64, "bvh header size");
+_Static_assert(sizeof(struct irdm_bvh_node) == 32, "bvh node size");
 
 #endif /* IRDM_IMAGE_FORMAT_H */

@@ -1,0 +1,503 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * Contact detection on the deformed surface: closest point query over the
+ * image's CONTACT_BVH and a frictionless god-object.  Runs in the force
+ * loop: no allocation, no system call, no recursion, bounded work.
+ *
+ * The BVH boxes bound the REST surface; the surface the device touches is
+ * rest + u.  With |u| <= max_disp_m for every node, a box grown by
+ * max_disp_m on every side bounds the displaced triangles of its subtree,
+ * so pruning on the grown boxes is exact.
+ */
+#include <math.h>
+#include <stddef.h>
+#include <string.h>
+
+#include "irdm/contact.h"
+
+_Static_assert(IRDM_CONTACT_STACK > IRDM_BVH_MAX_DEPTH, "stack holds a root-leaf path");
+
+/* Two distances whose squares differ by less than this are a tie (the same
+ * edge point seen from its two triangles differs by a few ulps). */
+#define TIE_REL 1e-13
+#define TIE_ABS 1e-30
+/* sin^2 of the smallest angle of a triangle that still has a normal */
+#define DEGENERATE_SIN2 1e-24
+
+static double dot3(const double *a, const double *b)
+{
+	return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+static void sub3(double *r, const double *a, const double *b)
+{
+	r[0] = a[0] - b[0];
+	r[1] = a[1] - b[1];
+	r[2] = a[2] - b[2];
+}
+
+static void cross3(double *r, const double *a, const double *b)
+{
+	r[0] = a[1] * b[2] - a[2] * b[1];
+	r[1] = a[2] * b[0] - a[0] * b[2];
+	r[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+static bool finite3(const double *p)
+{
+	return isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]);
+}
+
+static void disp_of(const struct irdm_contact_disp *d, uint32_t row, double u[3])
+{
+	if (d && d->u_m) {
+		u[0] = d->u_m[3 * (size_t)row];
+		u[1] = d->u_m[3 * (size_t)row + 1];
+		u[2] = d->u_m[3 * (size_t)row + 2];
+	} else if (d && d->fn) {
+		d->fn(d->ctx, row, u);
+	} else {
+		u[0] = u[1] = u[2] = 0;
+	}
+}
+
+int irdm_contact_mesh_init(struct irdm_contact_mesh *cm, const struct irdm_image *img)
+{
+	const uint8_t *base;
+	const struct irdm_bvh_header *h;
+
+	memset(cm, 0, sizeof(*cm));
+	if (!img || !img->meta || !img->contact_bvh)
+		return IRDM_CONTACT_EINVAL;
+	h = img->contact_bvh;
+	base = (const uint8_t *)h;
+	cm->img = img;
+	cm->hdr = h;
+	cm->nodes = (const struct irdm_bvh_node *)(base + h->nodes_offset);
+	cm->index = (const uint32_t *)(base + h->index_offset);
+	cm->adj = (const uint32_t *)(base + h->adj_offset);
+	cm->col_of_row = (const uint32_t *)(base + h->col_of_row_offset);
+	cm->tris = img->tris;
+	cm->rest = img->nodes;
+	cm->n_tris = img->meta->n_tris;
+	cm->n_rows = img->meta->n_nodes;
+	return IRDM_CONTACT_OK;
+}
+
+bool irdm_contact_tri_contactable(const struct irdm_contact_mesh *cm, uint32_t t)
+{
+	const uint32_t *v;
+
+	if (t >= cm->n_tris)
+		return false;
+	v = &cm->tris[3 * (size_t)t];
+	return cm->col_of_row[v[0]] != IRDM_BVH_NONE && cm->col_of_row[v[1]] != IRDM_BVH_NONE &&
+	       cm->col_of_row[v[2]] != IRDM_BVH_NONE;
+}
+
+void irdm_contact_tri_pos(const struct irdm_contact_mesh *cm, const struct irdm_contact_disp *d,
+			  uint32_t t, double v[3][3])
+{
+	for (unsigned k = 0; k < 3; k++) {
+		uint32_t r = cm->tris[3 * (size_t)t + k];
+		const float *x = cm->rest[r].pos_m;
+		double u[3];
+
+		disp_of(d, r, u);
+		for (unsigned a = 0; a < 3; a++)
+			v[k][a] = (double)x[a] + u[a];
+	}
+}
+
+/* Unit outward normal of (a, b, c); false for a zero-area triangle. */
+static bool tri_normal(const double v[3][3], double n[3])
+{
+	double ab[3], ac[3], nn;
+
+	sub3(ab, v[1], v[0]);
+	sub3(ac, v[2], v[0]);
+	cross3(n, ab, ac);
+	nn = dot3(n, n);
+	if (!(nn > DEGENERATE_SIN2 * dot3(ab, ab) * dot3(ac, ac)) || !isfinite(nn))
+		return false;
+	nn = 1 / sqrt(nn);
+	n[0] *= nn;
+	n[1] *= nn;
+	n[2] *= nn;
+	return true;
+}
+
+static void set_bary(double *bary, double u, double v, double w)
+{
+	bary[0] = u;
+	bary[1] = v;
+	bary[2] = w;
+}
+
+/* Closest point on segment ab: parameter t of a + t (b - a). */
+static double seg_param(const double *a, const double *b, const double *p)
+{
+	double ab[3], ap[3], l2, t;
+
+	sub3(ab, b, a);
+	sub3(ap, p, a);
+	l2 = dot3(ab, ab);
+	if (!(l2 > 0))
+		return 0;
+	t = dot3(ap, ab) / l2;
+	return t < 0 ? 0 : t > 1 ? 1 : t;
+}
+
+static double finish(const double *a, const double *b, const double *c, const double *p,
+		     const double *bary, double *q)
+{
+	double d[3];
+
+	for (unsigned i = 0; i < 3; i++)
+		q[i] = bary[0] * a[i] + bary[1] * b[i] + bary[2] * c[i];
+	sub3(d, p, q);
+	return dot3(d, d);
+}
+
+/* A triangle with no interior: the best of its three edges. */
+static double closest_on_edges(const double *a, const double *b, const double *c,
+			       const double *p, double *bary, double *q)
+{
+	const double *v[3] = { a, b, c };
+	double best = INFINITY, bb[3], qq[3];
+
+	for (unsigned e = 0; e < 3; e++) {
+		double t = seg_param(v[e], v[(e + 1) % 3], p), d2;
+
+		bb[e] = 1 - t;
+		bb[(e + 1) % 3] = t;
+		bb[(e + 2) % 3] = 0;
+		d2 = finish(a, b, c, p, bb, qq);
+		if (d2 < best) {
+			best = d2;
+			memcpy(bary, bb, sizeof(bb));
+			memcpy(q, qq, sizeof(qq));
+		}
+	}
+	return best;
+}
+
+double irdm_contact_closest_on_tri(const double a[3], const double b[3], const double c[3],
+				   const double p[3], double bary[3], double q[3])
+{
+	double ab[3], ac[3], ap[3], bp[3], cp[3], n[3];
+	double d1, d2, d3, d4, d5, d6, va, vb, vc, den, t;
+
+	sub3(ab, b, a);
+	sub3(ac, c, a);
+	/* The region tests below rely on the signs of areas: meaningless for
+	 * (nearly) collinear vertices, whose closest point is on an edge. */
+	cross3(n, ab, ac);
+	if (!(dot3(n, n) > DEGENERATE_SIN2 * dot3(ab, ab) * dot3(ac, ac)))
+		return closest_on_edges(a, b, c, p, bary, q);
+	sub3(ap, p, a);
+	d1 = dot3(ab, ap);
+	d2 = dot3(ac, ap);
+	if (d1 <= 0 && d2 <= 0) {               /* vertex region a */
+		set_bary(bary, 1, 0, 0);
+		return finish(a, b, c, p, bary, q);
+	}
+	sub3(bp, p, b);
+	d3 = dot3(ab, bp);
+	d4 = dot3(ac, bp);
+	if (d3 >= 0 && d4 <= d3) {              /* vertex region b */
+		set_bary(bary, 0, 1, 0);
+		return finish(a, b, c, p, bary, q);
+	}
+	vc = d1 * d4 - d3 * d2;
+	if (vc <= 0 && d1 >= 0 && d3 <= 0) {    /* edge ab; d1 - d3 = |ab|^2 */
+		t = d1 - d3 > 0 ? d1 / (d1 - d3) : 0;
+		set_bary(bary, 1 - t, t, 0);
+		return finish(a, b, c, p, bary, q);
+	}
+	sub3(cp, p, c);
+	d5 = dot3(ab, cp);
+	d6 = dot3(ac, cp);
+	if (d6 >= 0 && d5 <= d6) {              /* vertex region c */
+		set_bary(bary, 0, 0, 1);
+		return finish(a, b, c, p, bary, q);
+	}
+	vb = d5 * d2 - d1 * d6;
+	if (vb <= 0 && d2 >= 0 && d6 <= 0) {    /* edge ac; d2 - d6 = |ac|^2 */
+		t = d2 - d6 > 0 ? d2 / (d2 - d6) : 0;
+		set_bary(bary, 1 - t, 0, t);
+		return finish(a, b, c, p, bary, q);
+	}
+	va = d3 * d6 - d5 * d4;
+	if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0) {  /* edge bc */
+		den = (d4 - d3) + (d5 - d6);
+		t = den > 0 ? (d4 - d3) / den : 0;
+		set_bary(bary, 0, 1 - t, t);
+		return finish(a, b, c, p, bary, q);
+	}
+	den = va + vb + vc;                     /* = |ab x ac|^2 */
+	if (!(den > 0) || !isfinite(den))
+		return closest_on_edges(a, b, c, p, bary, q);
+	vb /= den;
+	vc /= den;
+	set_bary(bary, 1 - vb - vc, vb, vc);
+	return finish(a, b, c, p, bary, q);
+}
+
+/* Squared distance from p to the box of nd grown by g. */
+static double box_d2(const struct irdm_bvh_node *nd, const double *p, double g)
+{
+	double d2 = 0;
+
+	for (unsigned a = 0; a < 3; a++) {
+		double lo = (double)nd->lo[a] - g, hi = (double)nd->hi[a] + g, e = 0;
+
+		if (p[a] < lo)
+			e = lo - p[a];
+		else if (p[a] > hi)
+			e = p[a] - hi;
+		d2 += e * e;
+	}
+	return d2;
+}
+
+struct query {
+	const struct irdm_contact_mesh *cm;
+	const struct irdm_contact_disp *d;
+	const double *p;
+	double best;                    /* squared distance bound / best so far */
+	double best_cos;                /* |cos| between p - q and the normal */
+	bool found;
+	struct irdm_contact_hit *hit;
+};
+
+static void query_tri(struct query *qr, uint32_t t)
+{
+	double v[3][3], n[3], bary[3], q[3], pq[3], d2, s, c;
+	bool better;
+
+	irdm_contact_tri_pos(qr->cm, qr->d, t, v);
+	if (!tri_normal(v, n))
+		return;
+	d2 = irdm_contact_closest_on_tri(v[0], v[1], v[2], qr->p, bary, q);
+	if (!(d2 <= qr->best * (1 + TIE_REL) + TIE_ABS))
+		return;
+	sub3(pq, qr->p, q);
+	s = dot3(pq, n);
+	c = d2 > 0 ? fabs(s) / sqrt(d2) : 1;
+	if (!qr->found || d2 < qr->best * (1 - TIE_REL) - TIE_ABS)
+		better = d2 <= qr->best;
+	else    /* a tie: the face that sees p best gives the sign */
+		better = c > qr->best_cos || (c == qr->best_cos && d2 < qr->best);
+	if (!better)
+		return;
+	qr->found = true;
+	qr->best = d2;
+	qr->best_cos = c;
+	qr->hit->tri = t;
+	memcpy(qr->hit->bary, bary, sizeof(bary));
+	memcpy(qr->hit->point_m, q, sizeof(q));
+	memcpy(qr->hit->normal, n, sizeof(n));
+	qr->hit->dist_m = s < 0 ? -sqrt(d2) : sqrt(d2);
+}
+
+int irdm_contact_closest(const struct irdm_contact_mesh *cm, const struct irdm_contact_disp *d,
+			 double max_disp_m, const double p[3], double radius_m,
+			 struct irdm_contact_hit *hit)
+{
+	struct query qr = { cm, d, p, radius_m * radius_m, 0, false, hit };
+	uint32_t stack[IRDM_CONTACT_STACK];
+	unsigned sp = 0;
+
+	if (!cm || !cm->hdr || !hit || !p || !finite3(p) || !(radius_m >= 0) ||
+	    !isfinite(radius_m) || !(max_disp_m >= 0) || !isfinite(max_disp_m))
+		return IRDM_CONTACT_EINVAL;
+	if (!cm->hdr->n_bvh_nodes)
+		return 0;
+	stack[sp++] = 0;
+	while (sp) {
+		const struct irdm_bvh_node *nd = &cm->nodes[stack[--sp]];
+		uint32_t l, r;
+		double dl, dr;
+
+		if (box_d2(nd, p, max_disp_m) > qr.best * (1 + TIE_REL) + TIE_ABS)
+			continue;
+		if (!(nd->count_or_right & IRDM_BVH_INTERNAL)) {
+			for (uint32_t k = 0; k < nd->count_or_right; k++)
+				query_tri(&qr, cm->index[nd->left_or_first + k]);
+			continue;
+		}
+		if (sp + 2 > IRDM_CONTACT_STACK)        /* never: depth <= 48 */
+			return IRDM_CONTACT_EINVAL;
+		l = nd->left_or_first;
+		r = nd->count_or_right & ~IRDM_BVH_INTERNAL;
+		dl = box_d2(&cm->nodes[l], p, max_disp_m);
+		dr = box_d2(&cm->nodes[r], p, max_disp_m);
+		/* nearer child on top: it shrinks the bound first */
+		if (dl <= dr) {
+			stack[sp++] = r;
+			stack[sp++] = l;
+		} else {
+			stack[sp++] = l;
+			stack[sp++] = r;
+		}
+	}
+	return qr.found ? 1 : 0;
+}
+
+/* ------------------------------------------------------------ god-object */
+
+void irdm_proxy_config_default(struct irdm_proxy_config *cfg)
+{
+	cfg->radius_m = 0.01;
+	cfg->max_disp_m = 0.05;
+	cfg->max_walk = 16;
+}
+
+void irdm_proxy_reset(struct irdm_proxy *px)
+{
+	memset(px, 0, sizeof(*px));
+}
+
+/*
+ * Barycentrics of the projection of p on the plane of v (not clamped);
+ * false for a zero-area triangle.
+ */
+static bool plane_bary(const double v[3][3], const double *p, double *lam)
+{
+	double ab[3], ac[3], ap[3], n[3], x[3], nn;
+
+	sub3(ab, v[1], v[0]);
+	sub3(ac, v[2], v[0]);
+	sub3(ap, p, v[0]);
+	cross3(n, ab, ac);
+	nn = dot3(n, n);
+	if (!(nn > DEGENERATE_SIN2 * dot3(ab, ab) * dot3(ac, ac)) || !isfinite(nn))
+		return false;
+	cross3(x, ap, ac);
+	lam[1] = dot3(x, n) / nn;
+	cross3(x, ab, ap);
+	lam[2] = dot3(x, n) / nn;
+	lam[0] = 1 - lam[1] - lam[2];
+	return true;
+}
+
+/*
+ * The neighbour to walk to: across the edge opposite the most negative
+ * barycentric that has a neighbour other than `from` (going back means a
+ * concave crease: stay).  Edge e of the image joins v[e] and v[e + 1], so
+ * the edge opposite vertex i is (i + 1) % 3.
+ */
+static uint32_t next_tri(const struct irdm_contact_mesh *cm, uint32_t t, const double *lam,
+			 uint32_t from)
+{
+	unsigned order[3] = { 0, 1, 2 };
+
+	for (unsigned i = 0; i < 2; i++)        /* sort vertices by lam, ascending */
+		for (unsigned j = 0; j + 1 < 3 - i; j++)
+			if (lam[order[j + 1]] < lam[order[j]]) {
+				unsigned x = order[j];
+
+				order[j] = order[j + 1];
+				order[j + 1] = x;
+			}
+	for (unsigned k = 0; k < 3 && lam[order[k]] < 0; k++) {
+		uint32_t u = cm->adj[3 * (size_t)t + (order[k] + 1) % 3];
+
+		if (u != IRDM_BVH_NONE && u != from)
+			return u;
+	}
+	return IRDM_BVH_NONE;
+}
+
+static int proxy_release(struct irdm_proxy *px, int ret)
+{
+	px->active = false;
+	return ret;
+}
+
+int irdm_proxy_update(struct irdm_proxy *px, const struct irdm_contact_mesh *cm,
+		      const struct irdm_contact_disp *d, const struct irdm_proxy_config *cfg,
+		      const double p[3])
+{
+	double v[3][3], lam[3], n[3], pq[3];
+	uint32_t t, from = IRDM_BVH_NONE;
+	unsigned steps = 0, max_walk;
+
+	if (!px || !cm || !cm->hdr || !cfg || !p)
+		return IRDM_CONTACT_EINVAL;
+	if (!finite3(p))
+		return px->active = false, IRDM_CONTACT_EINVAL;
+	if (!px->active) {
+		struct irdm_contact_hit hit;
+		int r = irdm_contact_closest(cm, d, cfg->max_disp_m, p, cfg->radius_m, &hit);
+
+		if (r < 0)
+			return r;
+		if (r == 0 || hit.dist_m > 0)
+			return IRDM_PROXY_FREE;
+		px->active = true;
+		px->tri = hit.tri;
+		memcpy(px->bary, hit.bary, sizeof(px->bary));
+		memcpy(px->point_m, hit.point_m, sizeof(px->point_m));
+		memcpy(px->normal, hit.normal, sizeof(px->normal));
+		px->depth_m = hit.dist_m;
+		px->steps = 0;
+		return IRDM_PROXY_TOUCH;
+	}
+	t = px->tri;
+	if (t >= cm->n_tris || !irdm_contact_tri_contactable(cm, t))
+		return proxy_release(px, IRDM_CONTACT_EINVAL);
+	max_walk = cfg->max_walk < IRDM_CONTACT_MAX_WALK ? cfg->max_walk : IRDM_CONTACT_MAX_WALK;
+	for (;;) {
+		uint32_t u;
+
+		irdm_contact_tri_pos(cm, d, t, v);
+		if (!plane_bary(v, p, lam))     /* crushed flat: detect afresh */
+			return proxy_release(px, IRDM_PROXY_RELEASE);
+		if (lam[0] >= 0 && lam[1] >= 0 && lam[2] >= 0)
+			break;
+		u = steps < max_walk ? next_tri(cm, t, lam, from) : IRDM_BVH_NONE;
+		if (u == IRDM_BVH_NONE) {       /* boundary, crease or walked enough */
+			irdm_contact_closest_on_tri(v[0], v[1], v[2], p, lam, pq);
+			break;
+		}
+		from = t;
+		t = u;
+		steps++;
+	}
+	tri_normal(v, n);
+	px->tri = t;
+	memcpy(px->bary, lam, sizeof(lam));
+	for (unsigned a = 0; a < 3; a++)
+		px->point_m[a] = lam[0] * v[0][a] + lam[1] * v[1][a] + lam[2] * v[2][a];
+	memcpy(px->normal, n, sizeof(n));
+	sub3(pq, p, px->point_m);
+	px->depth_m = dot3(pq, n);
+	px->steps = steps;
+	if (px->depth_m > 0)
+		return proxy_release(px, IRDM_PROXY_RELEASE);
+	return IRDM_PROXY_SLIDE;
+}
+
+int irdm_proxy_site(const struct irdm_proxy *px, const struct irdm_contact_mesh *cm,
+		    struct irdm_contact_site *site)
+{
+	if (!px || !cm || !cm->hdr || !site || !px->active || px->tri >= cm->n_tris)
+		return IRDM_CONTACT_EINVAL;
+	site->n_nodes = 3;
+	for (unsigned k = 0; k < 3; k++) {
+		uint32_t r = cm->tris[3 * (size_t)px->tri + k];
+
+		site->row[k] = r;
+		site->col[k] = cm->col_of_row[r];
+		site->weight[k] = px->bary[k];
+	}
+	for (unsigned a = 0; a < 3; a++) {
+		site->rest_m[a] = 0;
+		for (unsigned k = 0; k < 3; k++)
+			site->rest_m[a] += px->bary[k] * (double)cm->rest[site->row[k]].pos_m[a];
+		site->normal[a] = px->normal[a];
+	}
+	return IRDM_CONTACT_OK;
+}
