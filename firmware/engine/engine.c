@@ -106,6 +106,21 @@ static void convert_shapes(struct irdm_engine *e, double *phi)
 	}
 }
 
+/* A floating object starts at rest with its object frame on the world frame. */
+static int start_rigid(struct irdm_engine *e)
+{
+	struct irdm_rigid_params p;
+	struct irdm_rigid_state s0;
+
+	memset(&s0, 0, sizeof(s0));
+	irdm_rigid_params_from_image(e->img->rigid, &p);
+	for (int a = 0; a < 3; a++)
+		e->com_rest_m[a] = s0.com_m[a] = e->img->rigid->com_m[a];
+	s0.q[0] = 1.0;
+	e->floating = true;
+	return irdm_rigid_init(&e->rb, &p, &s0);
+}
+
 int irdm_engine_init(struct irdm_engine **out, const struct irdm_image *img,
 		     const struct irdm_engine_config *cfg, void *mem, size_t mem_size,
 		     char *err, size_t errlen)
@@ -152,12 +167,19 @@ int irdm_engine_init(struct irdm_engine **out, const struct irdm_image *img,
 	e->tail_w = (const double *)(base + l.tail);
 	for (int i = 0; i < R0_CACHE; i++)
 		e->r0[i].col_force = e->r0[i].col_disp = NO_COL;
+	if (img->rigid && start_rigid(e)) {
+		snprintf(err, errlen, "engine: the image's rigid-body data is not usable (mass %g kg)",
+			 img->rigid->mass_kg);
+		return IRDM_ENGINE_EINVAL;
+	}
 	*out = e;
 	return IRDM_ENGINE_OK;
 }
 
 void irdm_engine_reset(struct irdm_engine *e)
 {
+	if (e->floating)
+		start_rigid(e);
 	for (uint32_t k = 0; k < 2 * e->K; k++)
 		e->x[k] = e->y[k] = 0;
 	for (uint32_t s = 0; s < e->T; s++)
@@ -263,8 +285,10 @@ int irdm_engine_contact_begin(struct irdm_engine *e, unsigned i, const struct ir
 	struct irdm_contact_state *c = &e->c[i];
 	/* a contact that moves to a new site (sliding) keeps its past target,
 	 * displacement and port energy; a new one starts from rest */
-	if (c->mode == IRDM_CONTACT_OFF)
+	if (c->mode == IRDM_CONTACT_OFF) {
 		memset(c, 0, sizeof(*c));
+		c->fresh = 1;
+	}
 	c->mode = mode;
 	c->site = *site;
 	return IRDM_ENGINE_OK;

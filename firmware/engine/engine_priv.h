@@ -6,6 +6,7 @@
 #include "irdm/deform.h"
 #include "irdm/engine.h"
 #include "irdm/history.h"
+#include "irdm/rigid.h"
 
 #define NO_COL UINT32_MAX
 #define R0_CACHE 64                 /* direct-mapped (force col, disp col) blocks */
@@ -38,6 +39,10 @@ struct irdm_engine {
 	uint64_t tick;
 	bool faulted;
 	struct irdm_deform *deform;
+	/* floating objects: the rigid motion, integrated with the contact forces */
+	bool floating;
+	struct irdm_rigid_body rb;
+	double com_rest_m[3];               /* body origin in the object frame */
 };
 
 /* engine_modal.c / engine_fir.c: the history term and the R[0] blocks. */

@@ -9,6 +9,11 @@
  * and the virtual coupling F_i = k (p_i - u_i) + b ((p_i - p_i') - (u_i - u_i')) / dt
  * gives (W + I / kappa) F = p - U~ - (b / (kappa dt)) (p' - u'), kappa = k + b / dt;
  * k = 0 imposes u_i = p_i (eq. 8).
+ *
+ * A floating object is solved in the world frame: the deformation's W is
+ * rotated, the rigid body adds its one-tick compliance at the contact
+ * points and its free motion to the history term, and the solved forces
+ * drive both the deformation (in the body frame) and the rigid motion.
  */
 #include <math.h>
 #include <string.h>
@@ -48,9 +53,15 @@ static void free_disp(const struct irdm_engine *e, uint32_t col, double u[3])
 struct system {
 	int m;                              /* active contacts */
 	unsigned idx[IRDM_MAX_CONTACTS];    /* their slots */
+	double u_body[IRDM_MAX_CONTACTS][3];    /* history term, object (body) frame */
+	double w_body[MAX_SOLVE * MAX_SOLVE];   /* W in the object frame */
+	/* in the solve frame: the object frame, or the world for a floating object */
 	double u_free[IRDM_MAX_CONTACTS][3];
-	double w[MAX_SOLVE * MAX_SOLVE];    /* W, row-major 3m x 3m */
+	double normal[IRDM_MAX_CONTACTS][3];
+	double w[MAX_SOLVE * MAX_SOLVE];    /* row-major 3m x 3m */
 	double f[MAX_SOLVE];
+	double f_body[MAX_SOLVE];
+	double x_now[IRDM_MAX_CONTACTS][3];     /* floating: world position of each point */
 };
 
 /* W_ij = sum_vw a_iv a_jw R0(v <- w) for contacts i (displacement), j (force). */
@@ -74,15 +85,90 @@ static void build_w(struct irdm_engine *e, struct system *s)
 				}
 			for (int r = 0; r < 3; r++)
 				for (int c = 0; c < 3; c++)
-					s->w[(3 * i + r) * n + 3 * j + c] = acc[3 * r + c];
+					s->w_body[(3 * i + r) * n + 3 * j + c] = acc[3 * r + c];
 		}
+}
+
+/* The body-frame material point of a contact: rest point about the COM plus u. */
+static void body_point(const struct irdm_engine *e, const struct irdm_contact_site *st,
+		       const double u[3], double b[3])
+{
+	for (int a = 0; a < 3; a++)
+		b[a] = st->rest_m[a] - e->com_rest_m[a] + u[a];
+}
+
+static void rotation(const struct irdm_engine *e, double R[9])
+{
+	for (int k = 0; k < 3; k++) {
+		double ek[3] = { 0, 0, 0 }, col[3];
+		ek[k] = 1;
+		irdm_rigid_rotate(&e->rb, ek, col);
+		for (int r = 0; r < 3; r++)
+			R[3 * r + k] = col[r];
+	}
+}
+
+/*
+ * World-frame system of a floating object: W_ij = R W_body,ij R^T + the
+ * rigid body's compliance between the points; the free term is where the
+ * free motion takes each point, as a displacement from its rest position.
+ */
+static void to_world(struct irdm_engine *e, struct system *s)
+{
+	int n = 3 * s->m;
+	double R[9], arm[IRDM_MAX_CONTACTS][3], com[3], zero[3] = { 0, 0, 0 };
+
+	rotation(e, R);
+	irdm_rigid_body_to_world(&e->rb, zero, com);
+	for (int i = 0; i < s->m; i++) {
+		const struct irdm_contact_site *st = &e->c[s->idx[i]].site;
+		double b[3], p[3];
+		body_point(e, st, s->u_body[i], b);
+		irdm_rigid_body_to_world(&e->rb, b, s->x_now[i]);
+		irdm_rigid_predict_point(&e->rb, b, e->dt_s, p);
+		irdm_rigid_rotate(&e->rb, st->normal, s->normal[i]);
+		for (int a = 0; a < 3; a++) {
+			s->u_free[i][a] = p[a] - st->rest_m[a];
+			arm[i][a] = s->x_now[i][a] - com[a];
+		}
+	}
+	for (int i = 0; i < s->m; i++)
+		for (int j = 0; j < s->m; j++) {
+			double c[9];
+			irdm_rigid_point_compliance(&e->rb, arm[j], arm[i], e->dt_s, c);
+			for (int r = 0; r < 3; r++)
+				for (int q = 0; q < 3; q++) {
+					double v = c[3 * r + q];
+					for (int k = 0; k < 3; k++)
+						for (int l = 0; l < 3; l++)
+							v += R[3 * r + k] * s->w_body[(3 * i + k) * n + 3 * j + l] * R[3 * q + l];
+					s->w[(3 * i + r) * n + 3 * j + q] = v;
+				}
+		}
+}
+
+/* W, the free term and the normals in the solve frame. */
+static void assemble(struct irdm_engine *e, struct system *s)
+{
+	int n = 3 * s->m;
+
+	build_w(e, s);
+	if (e->floating) {
+		to_world(e, s);
+		return;
+	}
+	memcpy(s->w, s->w_body, (size_t)n * n * sizeof(double));
+	for (int i = 0; i < s->m; i++) {
+		memcpy(s->u_free[i], s->u_body[i], sizeof(s->u_free[i]));
+		memcpy(s->normal[i], e->c[s->idx[i]].site.normal, sizeof(s->normal[i]));
+	}
 }
 
 static void history_terms(struct irdm_engine *e, struct system *s)
 {
 	for (int i = 0; i < s->m; i++) {
 		const struct irdm_contact_site *st = &e->c[s->idx[i]].site;
-		double *u = s->u_free[i];
+		double *u = s->u_body[i];
 		u[0] = u[1] = u[2] = 0;
 		for (uint32_t v = 0; v < st->n_nodes; v++) {
 			double uv[3];
@@ -174,7 +260,7 @@ static void release_pulling(struct irdm_engine *e, struct system *s,
 		int keep = 0, dropped = 0;
 		for (int i = 0; i < s->m; i++) {
 			struct irdm_contact_state *c = &e->c[s->idx[i]];
-			const double *F = &s->f[3 * i], *nrm = c->site.normal;
+			const double *F = &s->f[3 * i], *nrm = s->normal[i];
 			/* F acts on the object; pushing means F . n_out < 0 */
 			if (c->mode == IRDM_CONTACT_PUSH &&
 			    F[0] * nrm[0] + F[1] * nrm[1] + F[2] * nrm[2] > 0) {
@@ -184,14 +270,14 @@ static void release_pulling(struct irdm_engine *e, struct system *s,
 				continue;
 			}
 			s->idx[keep] = s->idx[i];
-			memcpy(s->u_free[keep], s->u_free[i], sizeof(s->u_free[i]));
+			memcpy(s->u_body[keep], s->u_body[i], sizeof(s->u_body[i]));
 			keep++;
 		}
 		if (!dropped)
 			return;
 		s->m = keep;
 		if (s->m) {
-			build_w(e, s);
+			assemble(e, s);
 			solve(e, s, cmd);
 		}
 	}
@@ -259,7 +345,7 @@ static void gather_forces(struct irdm_engine *e, const struct system *s, struct 
 				t->n++;
 			}
 			for (int r = 0; r < 3; r++)
-				t->f_n[k][r] += st->weight[v] * s->f[3 * i + r];
+				t->f_n[k][r] += st->weight[v] * s->f_body[3 * i + r];
 		}
 	}
 }
@@ -277,6 +363,119 @@ static int fault(struct irdm_engine *e)
 	return IRDM_ENGINE_EFAULT;
 }
 
+/*
+ * Where a floating contact point really is after the step: its body-frame
+ * deformation u_body + W_body F_body, carried by the new pose (the solve
+ * used the linearised rigid motion).
+ */
+static void floating_disp(const struct irdm_engine *e, const struct system *s, int i, double d[3])
+{
+	const struct irdm_contact_site *st = &e->c[s->idx[i]].site;
+	int n = 3 * s->m;
+	double u[3], b[3], x[3];
+
+	for (int r = 0; r < 3; r++) {
+		u[r] = s->u_body[i][r];
+		for (int k = 0; k < n; k++)
+			u[r] += s->w_body[(3 * i + r) * n + k] * s->f_body[k];
+	}
+	body_point(e, st, u, b);
+	irdm_rigid_body_to_world(&e->rb, b, x);
+	for (int a = 0; a < 3; a++)
+		d[a] = x[a] - st->rest_m[a];
+}
+
+/* Forces in the object frame (for the deformation history). */
+static void body_forces(struct irdm_engine *e, struct system *s)
+{
+	for (int i = 0; i < s->m; i++) {
+		if (e->floating)
+			irdm_rigid_rotate_inverse(&e->rb, &s->f[3 * i], &s->f_body[3 * i]);
+		else
+			memcpy(&s->f_body[3 * i], &s->f[3 * i], 3 * sizeof(double));
+	}
+}
+
+/*
+ * Floating, displacement imposed (k = 0): the solve used the rigid motion
+ * linearised over the tick, which misses the gyroscopic coupling (error
+ * O(|w| dt)).  Newton on the true end-of-tick positions, from a trial step
+ * of a copy of the body, puts the points on their targets to rounding.
+ */
+#define NEWTON_STEPS 3
+
+static void trial_positions(const struct irdm_engine *e, const struct system *s, double *x)
+{
+	struct irdm_rigid_body trial = e->rb;
+	int n = 3 * s->m;
+	double fb[MAX_SOLVE];
+
+	for (int i = 0; i < s->m; i++) {
+		irdm_rigid_accumulate(&trial, &s->f[3 * i], s->x_now[i]);
+		irdm_rigid_rotate_inverse(&e->rb, &s->f[3 * i], &fb[3 * i]);
+	}
+	irdm_rigid_step(&trial, e->dt_s);
+	for (int i = 0; i < s->m; i++) {
+		const struct irdm_contact_site *st = &e->c[s->idx[i]].site;
+		double u[3], b[3];
+		for (int r = 0; r < 3; r++) {
+			u[r] = s->u_body[i][r];
+			for (int k = 0; k < n; k++)
+				u[r] += s->w_body[(3 * i + r) * n + k] * fb[k];
+		}
+		body_point(e, st, u, b);
+		irdm_rigid_body_to_world(&trial, b, &x[3 * i]);
+	}
+}
+
+static void newton_floating(struct irdm_engine *e, struct system *s,
+			    const struct irdm_contact_cmd *cmd)
+{
+	int n = 3 * s->m;
+
+	if (!e->floating || e->cfg.coupling_k_n_per_m != 0 || e->cfg.solve != IRDM_SOLVE_COUPLED)
+		return;
+	for (int it = 0; it < NEWTON_STEPS; it++) {
+		double x[MAX_SOLVE], r[MAX_SOLVE], a[MAX_SOLVE * MAX_SOLVE], big = 0;
+		trial_positions(e, s, x);
+		for (int i = 0; i < s->m; i++)
+			for (int k = 0; k < 3; k++) {
+				const struct irdm_contact_site *st = &e->c[s->idx[i]].site;
+				r[3 * i + k] = st->rest_m[k] + cmd[s->idx[i]].target_m[k] - x[3 * i + k];
+				big = fmax(big, fabs(r[3 * i + k]));
+			}
+		if (big < 1e-15)
+			return;
+		memcpy(a, s->w, (size_t)n * n * sizeof(double));
+		irdm_solve_spd(a, r, n);
+		for (int k = 0; k < n; k++)
+			s->f[k] += r[k];
+	}
+}
+
+/* The contact forces push the rigid body for one tick. */
+static int move_rigid(struct irdm_engine *e, const struct system *s)
+{
+	for (int i = 0; i < s->m; i++)
+		irdm_rigid_accumulate(&e->rb, &s->f[3 * i], s->x_now[i]);
+	return irdm_rigid_step(&e->rb, e->dt_s);
+}
+
+/* A contact that just began: its past target and displacement are where
+ * the point is now, so neither the coupling damper nor the passivity
+ * observer sees a jump. */
+static void start_fresh(struct irdm_engine *e, struct system *s)
+{
+	for (int i = 0; i < s->m; i++) {
+		struct irdm_contact_state *c = &e->c[s->idx[i]];
+		if (!c->fresh)
+			continue;
+		memcpy(c->disp_prev_m, s->u_free[i], sizeof(c->disp_prev_m));
+		memcpy(c->target_prev_m, s->u_free[i], sizeof(c->target_prev_m));
+		c->fresh = 0;
+	}
+}
+
 static void record(struct irdm_engine *e, struct system *s, const struct irdm_contact_cmd *cmd)
 {
 	for (unsigned i = 0; i < IRDM_MAX_CONTACTS; i++)
@@ -285,6 +484,8 @@ static void record(struct irdm_engine *e, struct system *s, const struct irdm_co
 	for (int i = 0; i < s->m; i++) {
 		struct irdm_contact_state *c = &e->c[s->idx[i]];
 		contact_disp(s, i, c->disp_m);
+		if (e->floating)
+			floating_disp(e, s, i, c->disp_m);
 		memcpy(c->force_n, &s->f[3 * i], sizeof(c->force_n));
 		memcpy(c->disp_prev_m, c->disp_m, sizeof(c->disp_m));
 		memcpy(c->target_prev_m, cmd[s->idx[i]].target_m, sizeof(c->target_prev_m));
@@ -311,15 +512,20 @@ int irdm_engine_tick(struct irdm_engine *e, const struct irdm_contact_cmd *cmd)
 		irdm_modal_begin_tick(e);
 	if (s.m) {
 		history_terms(e, &s);
-		build_w(e, &s);
+		assemble(e, &s);
+		start_fresh(e, &s);
 		solve(e, &s, cmd);
 		release_pulling(e, &s, cmd);
+		newton_floating(e, &s, cmd);
 		passivity(e, &s);
 	}
 	for (int i = 0; i < 3 * s.m; i++)
 		if (!isfinite(s.f[i]) ||
 		    (e->cfg.max_force_n > 0 && fabs(s.f[i]) > e->cfg.max_force_n))
 			return fault(e);
+	body_forces(e, &s);
+	if (e->floating && move_rigid(e, &s))
+		return fault(e);
 	record(e, &s, cmd);
 	gather_forces(e, &s, &e->last);
 	if (e->repr == IRDM_REPR_MODAL)
@@ -329,10 +535,15 @@ int irdm_engine_tick(struct irdm_engine *e, const struct irdm_contact_cmd *cmd)
 	e->tick++;
 	e->stats.ticks++;
 	if (e->deform && e->cfg.publish_every && e->tick % e->cfg.publish_every == 0) {
+		struct irdm_pose pose, *pp = NULL;
+		if (e->floating) {
+			irdm_rigid_pose(&e->rb, &pose);
+			pp = &pose;
+		}
 		if (e->repr == IRDM_REPR_MODAL)
-			irdm_deform_publish_modal(e->deform, e->tick, e->x, &e->last, NULL);
+			irdm_deform_publish_modal(e->deform, e->tick, e->x, &e->last, pp);
 		else
-			irdm_deform_publish_fir(e->deform, e->tick, &e->ring, NULL);
+			irdm_deform_publish_fir(e->deform, e->tick, &e->ring, pp);
 	}
 	return IRDM_ENGINE_OK;
 }

@@ -267,11 +267,6 @@ static int start(const struct irdm_replay_opts *o, struct run *r, char *err, siz
 
 	if (irdm_image_map(o->image, 0, &r->img, err, errlen))
 		return -1;
-	if (r->img.rigid) {
-		snprintf(err, errlen, "%s: a floating object: replay drives grounded objects (floating replay is not built yet)",
-			 o->image);
-		return -1;
-	}
 	irdm_engine_config_default(&cfg);
 	cfg.max_contacts = o->n_contacts;
 	cfg.solve = o->solve;

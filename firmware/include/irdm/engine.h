@@ -10,8 +10,10 @@
  * targets of the tick; it reads no clock.
  *
  * Frames and signs (SPEC section 2): positions in metres in the object
- * frame; a contact's force is the force applied TO the object (the device
- * renders its negative); the displacement u[t] is observed at (t+1) dt.
+ * frame (for a floating object: targets, forces and contact displacements
+ * in the world frame, which coincides with the object frame at start); a
+ * contact's force is the force applied TO the object (the device renders
+ * its negative); the displacement u[t] is observed at (t+1) dt.
  */
 #ifndef IRDM_ENGINE_H
 #define IRDM_ENGINE_H
@@ -93,6 +95,7 @@ struct irdm_contact_state {
 	double disp_prev_m[3];
 	double port_energy_j;           /* passivity observer: work done on the object */
 	double pc_damping_ns_per_m;     /* passivity controller's damping this tick */
+	uint32_t fresh;                 /* began since the last tick */
 };
 
 /* Snapshot handed to the deformation context (lock-free, see deform.h). */
