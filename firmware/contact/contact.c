@@ -427,7 +427,7 @@ int irdm_proxy_update(struct irdm_proxy *px, const struct irdm_contact_mesh *cm,
 	if (!px || !cm || !cm->hdr || !cfg || !p)
 		return IRDM_CONTACT_EINVAL;
 	if (!finite3(p))
-		return px->active = false, IRDM_CONTACT_EINVAL;
+		return proxy_release(px, IRDM_CONTACT_EINVAL);
 	if (!px->active) {
 		struct irdm_contact_hit hit;
 		int r = irdm_contact_closest(cm, d, cfg->max_disp_m, p, cfg->radius_m, &hit);

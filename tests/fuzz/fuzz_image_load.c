@@ -58,7 +58,7 @@ static void walk_views(const struct irdm_image *img)
 		read_values(img->mode_shapes, m->precision,
 			    nodes * 3 * m->n_modes);
 	if (img->static_corr)
-		read_values(img->static_corr, m->precision, cols * nodes * 9);
+		read_values(img->static_corr, m->precision, cols * cols * 9);
 	if (img->rigid)
 		read_bytes(img->rigid, sizeof(*img->rigid));
 	for (uint32_t k = 0; k <= IRDM_SEC_CONTACT_BVH + 1; k++) {

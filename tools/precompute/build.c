@@ -8,6 +8,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "image/bvh_build.h"
 #include "image/image_writer.h"
 #include "irdm/image.h"
 #include "modal/lapack.h"
@@ -465,8 +466,13 @@ static int write_image(struct build *b, size_t *bytes, char *err, size_t errlen)
 	struct irdm_model *m = &b->m;
 	struct irdm_image_writer w;
 	uint32_t p = b->sc->precision;
+	void *bvh;
+	size_t bvh_bytes;
 	FILE *f;
 
+	if (irdm_bvh_build(b->nodes, (uint32_t)m->n_rows, m->cols, (uint32_t)m->n_cols, m->tris,
+			   (uint32_t)m->n_tris, &bvh, &bvh_bytes, err, errlen))
+		return -1;
 	irdm_iw_init(&w);
 	irdm_iw_add(&w, IRDM_SEC_META, IRDM_ELEM_BYTES, &b->meta, sizeof(b->meta));
 	irdm_iw_add(&w, IRDM_SEC_PROVENANCE, IRDM_ELEM_BYTES, b->prov, strlen(b->prov));
@@ -484,8 +490,12 @@ static int write_image(struct build *b, size_t *bytes, char *err, size_t errlen)
 	if (b->sc->floating)
 		irdm_iw_add(&w, IRDM_SEC_RIGID, IRDM_ELEM_BYTES, &b->rigid, sizeof(b->rigid));
 	irdm_iw_add(&w, IRDM_SEC_STABILITY, IRDM_ELEM_BYTES, b->stab, m->n_cols * sizeof(*b->stab));
-	if (irdm_iw_write(&w, b->o->out_path, err, errlen))
+	irdm_iw_add(&w, IRDM_SEC_CONTACT_BVH, IRDM_ELEM_BYTES, bvh, bvh_bytes);
+	if (irdm_iw_write(&w, b->o->out_path, err, errlen)) {
+		free(bvh);
 		return -1;
+	}
+	free(bvh);
 	f = fopen(b->o->out_path, "rb");
 	if (f) {
 		fseek(f, 0, SEEK_END);
