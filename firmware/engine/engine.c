@@ -165,8 +165,6 @@ int irdm_engine_init(struct irdm_engine **out, const struct irdm_image *img,
 	if (e->T)
 		fir_tail(e, (double *)(base + l.tail));
 	e->tail_w = (const double *)(base + l.tail);
-	for (int i = 0; i < R0_CACHE; i++)
-		e->r0[i].col_force = e->r0[i].col_disp = NO_COL;
 	if (img->rigid && start_rigid(e)) {
 		snprintf(err, errlen, "engine: the image's rigid-body data is not usable (mass %g kg)",
 			 img->rigid->mass_kg);

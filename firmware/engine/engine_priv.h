@@ -9,12 +9,17 @@
 #include "irdm/rigid.h"
 
 #define NO_COL UINT32_MAX
-#define R0_CACHE 64                 /* direct-mapped (force col, disp col) blocks */
 #define MAX_SOLVE (3 * IRDM_MAX_CONTACTS)
 
-struct r0_entry {
-	uint32_t col_force, col_disp;       /* NO_COL: empty */
-	double blk[9];                      /* displacement at col_disp per force at col_force */
+/*
+ * R[0] blocks between the distinct nodes of the active contact sites (at
+ * most IRDM_MAX_FORCE_NODES): blk[a][b] = displacement at node a per force
+ * at node b.  Rebuilt only for nodes that are new when the sites change.
+ */
+struct r0_table {
+	uint32_t n;
+	uint32_t col[IRDM_MAX_FORCE_NODES];
+	double blk[IRDM_MAX_FORCE_NODES][IRDM_MAX_FORCE_NODES][9];
 };
 
 struct irdm_engine {
@@ -33,7 +38,7 @@ struct irdm_engine {
 	double tail_r;
 	/* contacts and solve */
 	struct irdm_contact_state c[IRDM_MAX_CONTACTS];
-	struct r0_entry r0[R0_CACHE];
+	struct r0_table r0, r0_next;
 	struct irdm_force_tick last;        /* forces applied this tick */
 	struct irdm_engine_stats stats;
 	uint64_t tick;

@@ -20,22 +20,60 @@
 
 #include "engine_priv.h"
 
-static void r0_block(struct irdm_engine *e, uint32_t col_force, uint32_t col_disp, double blk[9])
+static int r0_index(const struct r0_table *t, uint32_t col)
 {
-	if (col_force == NO_COL || col_disp == NO_COL) {
-		memset(blk, 0, 9 * sizeof(double));
+	for (uint32_t k = 0; k < t->n; k++)
+		if (t->col[k] == col)
+			return (int)k;
+	return -1;
+}
+
+/*
+ * Bring the R[0] table to the nodes of the active sites: blocks between
+ * nodes already there are kept, the others computed (9 K multiply-adds
+ * each for a modal image, a read for FIR).  Nothing happens while the
+ * sites stay the same.
+ */
+static void r0_refresh(struct irdm_engine *e, const unsigned *idx, int m)
+{
+	struct r0_table *old = &e->r0, *nt = &e->r0_next;
+	bool same = true;
+
+	nt->n = 0;
+	for (int i = 0; i < m; i++) {
+		const struct irdm_contact_site *st = &e->c[idx[i]].site;
+		for (uint32_t v = 0; v < st->n_nodes; v++)
+			if (st->col[v] != NO_COL && r0_index(nt, st->col[v]) < 0)
+				nt->col[nt->n++] = st->col[v];
+	}
+	same = nt->n == old->n && !memcmp(nt->col, old->col, nt->n * sizeof(uint32_t));
+	if (same)
 		return;
-	}
-	struct r0_entry *c = &e->r0[(col_force * 31u + col_disp) % R0_CACHE];
-	if (c->col_force != col_force || c->col_disp != col_disp) {
-		if (e->repr == IRDM_REPR_MODAL)
-			irdm_modal_r0(e, col_force, col_disp, c->blk);
-		else
-			irdm_fir_r0(e, col_force, col_disp, c->blk);
-		c->col_force = col_force;
-		c->col_disp = col_disp;
-	}
-	memcpy(blk, c->blk, 9 * sizeof(double));
+	for (uint32_t a = 0; a < nt->n; a++)
+		for (uint32_t b = 0; b < nt->n; b++) {
+			int oa = r0_index(old, nt->col[a]), ob = r0_index(old, nt->col[b]);
+			double *blk = nt->blk[a][b];
+			if (oa >= 0 && ob >= 0)
+				memcpy(blk, old->blk[oa][ob], 9 * sizeof(double));
+			else if (e->repr == IRDM_REPR_MODAL)
+				irdm_modal_r0(e, nt->col[b], nt->col[a], blk);
+			else
+				irdm_fir_r0(e, nt->col[b], nt->col[a], blk);
+		}
+	old->n = nt->n;
+	memcpy(old->col, nt->col, nt->n * sizeof(uint32_t));
+	for (uint32_t a = 0; a < nt->n; a++)
+		memcpy(old->blk[a], nt->blk[a], nt->n * 9 * sizeof(double));
+}
+
+/* R[0] block: displacement at col_disp per force at col_force (fixed: 0). */
+static const double *r0_block(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp)
+{
+	static const double zero[9];
+	int a = col_disp == NO_COL ? -1 : r0_index(&e->r0, col_disp);
+	int b = col_force == NO_COL ? -1 : r0_index(&e->r0, col_force);
+
+	return (a < 0 || b < 0) ? zero : e->r0.blk[a][b];
 }
 
 static void free_disp(const struct irdm_engine *e, uint32_t col, double u[3])
@@ -73,13 +111,13 @@ static void build_w(struct irdm_engine *e, struct system *s)
 		for (int j = 0; j < s->m; j++) {
 			const struct irdm_contact_site *si = &e->c[s->idx[i]].site;
 			const struct irdm_contact_site *sj = &e->c[s->idx[j]].site;
-			double acc[9] = { 0 }, blk[9];
+			double acc[9] = { 0 };
 			for (uint32_t v = 0; v < si->n_nodes; v++)
 				for (uint32_t w = 0; w < sj->n_nodes; w++) {
 					double a = si->weight[v] * sj->weight[w];
 					if (a == 0)
 						continue;
-					r0_block(e, sj->col[w], si->col[v], blk);
+					const double *blk = r0_block(e, sj->col[w], si->col[v]);
 					for (int k = 0; k < 9; k++)
 						acc[k] += a * blk[k];
 				}
@@ -152,6 +190,7 @@ static void assemble(struct irdm_engine *e, struct system *s)
 {
 	int n = 3 * s->m;
 
+	r0_refresh(e, s->idx, s->m);
 	build_w(e, s);
 	if (e->floating) {
 		to_world(e, s);
@@ -229,7 +268,7 @@ static void solve_per_vertex(struct irdm_engine *e, struct system *s,
 			double a[9], rhs[3], uv[3];
 			if (st->weight[v] == 0 || st->col[v] == NO_COL)
 				continue;
-			r0_block(e, st->col[v], st->col[v], a);
+			memcpy(a, r0_block(e, st->col[v], st->col[v]), sizeof(a));
 			if (!isinf(kappa))
 				for (int r = 0; r < 3; r++)
 					a[4 * r] += 1.0 / kappa;

@@ -1,0 +1,461 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * Force tick benchmark: irdm_engine_tick() timed one tick at a time with
+ * CLOCK_MONOTONIC over N_TICKS ticks after a warm-up, median / p99 / max,
+ * for no contact (the history alone), one contact point at a node, two at
+ * nodes, and one on a triangle point; on the paper's cuboid (FIR T = 500
+ * at 2 ms, modal 300 modes + static correction, modal with every mode) and
+ * on the bunny.  The haptic configuration (virtual coupling, passivity
+ * control) and grab contacts (never released, so every timed tick solves
+ * its contacts).  Prints figures beside the issue's targets and the paper's
+ * Itanium2 times; never fails on time.
+ *
+ * Run from the repository root: images are reused from out/bench/ and made
+ * there when missing.  Runs under SCHED_FIFO on CPU 1 with mlockall when it
+ * may, and says so in the header when it may not.
+ */
+#define _GNU_SOURCE
+#include <errno.h>
+#include <math.h>
+#include <sched.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
+#include <sys/utsname.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "irdm/engine.h"
+#include "irdm/image.h"
+#include "precompute/precompute.h"
+#include "../support/engine_fixture.h"
+
+#define N_TICKS 20000
+#define N_WARMUP 2000
+#define PAUSE_EVERY 100            /* ticks; then sleep PAUSE_NS (untimed) */
+#define PAUSE_NS 200000L
+#define FIFO_PRIO 80
+#define BENCH_CPU 1
+
+/* A PHANToM-Desktop-class device, as in the tests. */
+#define DEVICE_K 1000.0
+#define DEVICE_B 5.0
+
+enum kase { K_FREE, K_NODE, K_NODES, K_TRI, K_COUNT };
+
+static const char *const kase_name[K_COUNT] = { "free   ", "1 node ", "2 nodes", "1 tri  " };
+
+/* p99 of the interesting cases, for the closing summary */
+struct figures {
+	double median, p99, max;
+	bool ok;
+};
+
+static double ts_ns(const struct timespec *a, const struct timespec *b)
+{
+	return (double)(b->tv_sec - a->tv_sec) * 1e9 + (double)(b->tv_nsec - a->tv_nsec);
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+	double x = *(const double *)a, y = *(const double *)b;
+
+	return (x > y) - (x < y);
+}
+
+static bool file_exists(const char *path)
+{
+	struct stat st;
+
+	return !stat(path, &st);
+}
+
+static void pause_untimed(void)
+{
+	struct timespec d = { 0, PAUSE_NS };
+
+	clock_nanosleep(CLOCK_MONOTONIC, 0, &d, NULL);
+}
+
+/* ---- images ---- */
+
+/*
+ * The image at path, made when missing: from a scene file (if given), then
+ * the key/value pairs on top (NULL-terminated).
+ */
+static int ensure_image(const char *path, const char *scene_file, const char *const *kv)
+{
+	struct irdm_scene sc;
+	struct irdm_precompute_opts o = { .out_path = path };
+	struct irdm_precompute_report rep;
+	char err[1024];
+	struct timespec t0, t1;
+
+	if (file_exists(path))
+		return 0;
+	if ((mkdir("out", 0777) && errno != EEXIST) || (mkdir("out/bench", 0777) && errno != EEXIST)) {
+		fprintf(stderr, "tick  cannot create out/bench: %s\n", strerror(errno));
+		return -1;
+	}
+	irdm_scene_defaults(&sc);
+	if (scene_file && irdm_scene_load(&sc, scene_file, err, sizeof(err)))
+		goto fail;
+	for (; kv && kv[0]; kv += 2)
+		if (irdm_scene_set(&sc, kv[0], kv[1], "bench", err, sizeof(err)))
+			goto fail;
+	if (irdm_scene_check(&sc, err, sizeof(err)))
+		goto fail;
+	printf("tick  precomputing %s ...\n", path);
+	fflush(stdout);
+	clock_gettime(CLOCK_MONOTONIC, &t0);
+	if (irdm_precompute(&sc, &o, &rep, err, sizeof(err)))
+		goto fail;
+	clock_gettime(CLOCK_MONOTONIC, &t1);
+	printf("tick  precomputed %s in %.0f s (%zu modes of %zu, %zu columns)\n", path,
+	       ts_ns(&t0, &t1) * 1e-9, rep.modes, rep.modes_total, rep.cols);
+	return 0;
+fail:
+	fprintf(stderr, "tick  %s: %s\n", path, err);
+	return -1;
+}
+
+/* ---- contact sites ---- */
+
+static bool is_col(const struct irdm_image *img, uint32_t row)
+{
+	for (uint32_t c = 0; c < img->meta->n_cols; c++)
+		if (img->columns[c] == row)
+			return true;
+	return false;
+}
+
+/*
+ * Where the contacts go: the column nearest the top centre of the
+ * touchable region, its nearest other column, and the all-column triangle
+ * whose centroid is nearest the first.
+ */
+struct sites {
+	uint32_t row[2];
+	uint32_t tri;
+	bool have_tri;
+};
+
+static void pick_sites(const struct irdm_image *img, struct sites *s)
+{
+	double top[3] = { 0, 0, -INFINITY }, best = INFINITY;
+	uint32_t nc = img->meta->n_cols;
+
+	for (uint32_t c = 0; c < nc; c++) {
+		const float *p = img->nodes[img->columns[c]].pos_m;
+		top[0] += p[0] / nc;
+		top[1] += p[1] / nc;
+		top[2] = fmax(top[2], p[2]);
+	}
+	s->row[0] = efx_column_row_near(img, top);
+	const float *p0 = img->nodes[s->row[0]].pos_m;
+	s->row[1] = s->row[0];
+	for (uint32_t c = 0; c < nc; c++) {
+		uint32_t r = img->columns[c];
+		const float *p = img->nodes[r].pos_m;
+		double d = 0;
+		for (int a = 0; a < 3; a++)
+			d += ((double)p[a] - p0[a]) * ((double)p[a] - p0[a]);
+		if (r != s->row[0] && d < best) {
+			best = d;
+			s->row[1] = r;
+		}
+	}
+	best = INFINITY;
+	s->have_tri = false;
+	s->tri = 0;
+	for (uint32_t t = 0; t < img->meta->n_tris; t++) {
+		const uint32_t *v = &img->tris[3 * t];
+		double d = 0;
+		if (!is_col(img, v[0]) || !is_col(img, v[1]) || !is_col(img, v[2]))
+			continue;
+		for (int a = 0; a < 3; a++) {
+			double cen = ((double)img->nodes[v[0]].pos_m[a] + img->nodes[v[1]].pos_m[a] +
+				      img->nodes[v[2]].pos_m[a]) / 3;
+			d += (cen - p0[a]) * (cen - p0[a]);
+		}
+		if (d < best) {
+			best = d;
+			s->tri = t;
+			s->have_tri = true;
+		}
+	}
+}
+
+/* ---- one case ---- */
+
+static double *samples;
+
+static struct figures bench_case(const char *scene, const char *repr, const struct irdm_image *img,
+				 const struct sites *st, enum kase k)
+{
+	struct figures fig = { 0, 0, 0, false };
+	struct irdm_engine_config cfg;
+	struct irdm_contact_cmd cmd[IRDM_MAX_CONTACTS];
+	struct irdm_contact_site site[2];
+	struct irdm_engine *e;
+	unsigned n_contacts = k == K_FREE ? 0 : k == K_NODES ? 2 : 1;
+	char err[512];
+	size_t n;
+	void *mem;
+	int rc = 0;
+
+	if (k == K_TRI && !st->have_tri) {
+		printf("tick  %-14s %-16s %s  skipped: no triangle with all vertices touchable\n",
+		       scene, repr, kase_name[k]);
+		return fig;
+	}
+	irdm_engine_config_haptic(&cfg, img->meta->dt_s, DEVICE_K, DEVICE_B, 0 /* no limit */);
+	n = irdm_engine_mem_size(img, &cfg);
+	mem = n ? aligned_alloc(64, (n + 63) & ~(size_t)63) : NULL;
+	if (!mem || irdm_engine_init(&e, img, &cfg, mem, n, err, sizeof(err))) {
+		printf("tick  %-14s %-16s %s  engine init failed: %s\n", scene, repr, kase_name[k],
+		       mem ? err : "out of memory");
+		free(mem);
+		return fig;
+	}
+	memset(cmd, 0, sizeof(cmd));
+	for (unsigned i = 0; i < n_contacts; i++) {
+		if (k == K_TRI) {
+			const double bary[3] = { 0.5, 0.3, 0.2 };
+			rc = irdm_engine_site_point(e, st->tri, bary, &site[i]);
+		} else {
+			rc = irdm_engine_site_node(e, st->row[i], &site[i]);
+		}
+		if (rc || (rc = irdm_engine_contact_begin(e, i, &site[i], IRDM_CONTACT_GRAB))) {
+			printf("tick  %-14s %-16s %s  contact site failed (%d)\n", scene, repr,
+			       kase_name[k], rc);
+			free(mem);
+			return fig;
+		}
+		cmd[i].mode = IRDM_CONTACT_GRAB;
+	}
+	/* a first contact needs a history: settle it in before timing */
+	for (long t = -N_WARMUP; t < N_TICKS && !rc; t++) {
+		struct timespec t0, t1;
+		double ph = 2 * M_PI * (double)(t + N_WARMUP) * img->meta->dt_s;
+		for (unsigned i = 0; i < n_contacts; i++) {
+			/* 2..4 mm into the surface, 1 mm stroke sideways */
+			double depth = 0.003 + 0.001 * sin(2 * ph + i);
+			for (int a = 0; a < 3; a++)
+				cmd[i].target_m[a] = -depth * site[i].normal[a];
+			cmd[i].target_m[0] += 0.001 * sin(ph);
+		}
+		if (t >= 0 && t % PAUSE_EVERY == 0)
+			pause_untimed();
+		clock_gettime(CLOCK_MONOTONIC, &t0);
+		rc = irdm_engine_tick(e, cmd);
+		clock_gettime(CLOCK_MONOTONIC, &t1);
+		if (t >= 0)
+			samples[t] = ts_ns(&t0, &t1) * 1e-3;
+	}
+	if (rc) {
+		printf("tick  %-14s %-16s %s  the engine faulted (%d): no figures\n", scene, repr,
+		       kase_name[k], rc);
+		free(mem);
+		return fig;
+	}
+	qsort(samples, N_TICKS, sizeof(*samples), cmp_double);
+	fig.median = samples[N_TICKS / 2];
+	fig.p99 = samples[(size_t)N_TICKS * 99 / 100];
+	fig.max = samples[N_TICKS - 1];
+	fig.ok = true;
+	const double *f = irdm_engine_contact(e, 0)->force_n;
+	printf("tick  %-14s %-16s %s  median %6.2f us  p99 %6.2f us  max %7.2f us  (|F0| %.3f N, PC %llu)\n",
+	       scene, repr, kase_name[k], fig.median, fig.p99, fig.max,
+	       sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]),
+	       (unsigned long long)irdm_engine_stats(e)->pc_activations);
+	fflush(stdout);
+	free(mem);
+	return fig;
+}
+
+static uint32_t all_modes;       /* of the all-modes image */
+
+static void bench_image(const char *scene, const char *repr, const char *path,
+			struct figures fig[K_COUNT])
+{
+	struct irdm_image img;
+	struct sites st;
+	char err[512];
+
+	if (irdm_image_map(path, 0, &img, err, sizeof(err))) {
+		printf("tick  %-14s %-16s skipped: %s\n", scene, repr, err);
+		return;
+	}
+	pick_sites(&img, &st);
+	all_modes = img.meta->n_modes;
+	printf("tick  %-14s %-16s %u rows, %u columns, %u %s, dt %.0f ms%s%s\n", scene, repr,
+	       img.meta->n_nodes, img.meta->n_cols,
+	       img.meta->representation == IRDM_REPR_MODAL ? img.meta->n_modes : img.meta->fir_length,
+	       img.meta->representation == IRDM_REPR_MODAL ? "modes" : "taps", img.meta->dt_s * 1e3,
+	       img.static_corr ? ", static correction" : "",
+	       img.locked ? ", locked" : "");
+	for (int k = 0; k < K_COUNT; k++)
+		fig[k] = bench_case(scene, repr, &img, &st, (enum kase)k);
+	irdm_image_unmap(&img);
+}
+
+/* ---- real-time conditions ---- */
+
+static void header(void)
+{
+	struct sched_param sp = { .sched_priority = FIFO_PRIO };
+	struct utsname u;
+	cpu_set_t set;
+	char line[256], model[128] = "unknown";
+	long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
+	int cpu = ncpu > BENCH_CPU ? BENCH_CPU : 0;
+	bool rt_kernel = false;
+	FILE *f;
+
+	uname(&u);
+	f = fopen("/sys/kernel/realtime", "r");
+	if (f) {
+		rt_kernel = fgetc(f) == '1';
+		fclose(f);
+	}
+	if (strstr(u.version, "PREEMPT_RT"))
+		rt_kernel = true;
+	f = fopen("/proc/cpuinfo", "r");
+	while (f && fgets(line, sizeof(line), f))
+		if (!strncmp(line, "model name", 10) && strchr(line, ':')) {
+			snprintf(model, sizeof(model), "%s", strchr(line, ':') + 2);
+			model[strcspn(model, "\n")] = 0;
+			break;
+		}
+	if (f)
+		fclose(f);
+	printf("tick  kernel %s %s (%s), %ld CPUs, %s\n", u.release, u.machine,
+	       rt_kernel ? "PREEMPT_RT" : "not PREEMPT_RT: latency figures are not real-time claims",
+	       ncpu, model);
+
+	CPU_ZERO(&set);
+	CPU_SET(cpu, &set);
+	if (sched_setaffinity(0, sizeof(set), &set))
+		printf("tick  affinity: could not pin to CPU %d: %s\n", cpu, strerror(errno));
+	else
+		printf("tick  affinity: pinned to CPU %d%s\n", cpu,
+		       cpu == BENCH_CPU ? "" : " (only one CPU online)");
+	if (sched_setscheduler(0, SCHED_FIFO, &sp))
+		printf("tick  scheduling: SCHED_FIFO refused (%s): running SCHED_OTHER\n", strerror(errno));
+	else
+		printf("tick  scheduling: SCHED_FIFO priority %d\n", FIFO_PRIO);
+	if (mlockall(MCL_CURRENT | MCL_FUTURE))
+		printf("tick  memory: mlockall refused (%s): pages may fault\n", strerror(errno));
+	else
+		printf("tick  memory: mlockall(MCL_CURRENT | MCL_FUTURE)\n");
+	f = fopen("/proc/sys/kernel/sched_rt_runtime_us", "r");
+	if (f) {
+		long rt = 0;
+		if (fscanf(f, "%ld", &rt) == 1)
+			printf("tick  RT throttling: sched_rt_runtime_us %ld%s\n", rt,
+			       rt < 0 ? " (off)" : "");
+		fclose(f);
+	}
+
+	/* the timer's own cost, which every figure below includes */
+	struct timespec a, b;
+	for (int i = 0; i < N_TICKS; i++) {
+		clock_gettime(CLOCK_MONOTONIC, &a);
+		clock_gettime(CLOCK_MONOTONIC, &b);
+		samples[i] = ts_ns(&a, &b) * 1e-3;
+	}
+	qsort(samples, N_TICKS, sizeof(*samples), cmp_double);
+	printf("tick  timer overhead (two clock_gettime): median %.3f us, max %.2f us\n",
+	       samples[N_TICKS / 2], samples[N_TICKS - 1]);
+	printf("tick  %d ticks timed one by one after %d warm-up ticks; %ld us pause every %d ticks (untimed); "
+	       "haptic coupling %.0f N/m + passivity control, grab contacts\n",
+	       N_TICKS, N_WARMUP, PAUSE_NS / 1000, PAUSE_EVERY, DEVICE_K);
+	fflush(stdout);
+}
+
+static void target(const char *what, double limit_us, const struct figures *f)
+{
+	if (!f->ok) {
+		printf("tick  target %-46s <= %4.0f us: not measured\n", what, limit_us);
+		return;
+	}
+	printf("tick  target %-46s <= %4.0f us: median %6.2f, p99 %6.2f, max %7.2f us -> %s\n", what,
+	       limit_us, f->median, f->p99, f->max,
+	       f->max <= limit_us ? "met (max)" : f->p99 <= limit_us ? "met at p99, not at max" :
+	       "NOT met");
+}
+
+int main(void)
+{
+	static const char *const fir_kv[] = {
+		"name", "cuboid-fir500-patch", "resolution", "11,11,22", "dt", "0.002",
+		"representation", "fir:500", "touch", "box:0.035,0.035,0.199,0.065,0.065,0.201",
+		"display", "touch", NULL,
+	};
+	static const char *const all_kv[] = {
+		"name", "cuboid-6x6x12-all", "resolution", "6,6,12", "representation", "modal:all",
+		"modes", "all", "touch", "box:0.03,0.03,0.199,0.07,0.07,0.201", "display", "touch",
+		NULL,
+	};
+	struct figures fir[K_COUNT] = { 0 }, m300[K_COUNT] = { 0 }, mall[K_COUNT] = { 0 };
+	struct figures bunny[K_COUNT] = { 0 };
+	uint32_t mall_modes = 1;
+
+	samples = malloc(N_TICKS * sizeof(*samples));
+	if (!samples)
+		return 1;
+	/*
+	 * Images first (the precompute wants every core), then the real-time
+	 * conditions.
+	 *  - FIR T = 500 at the paper's 2 ms on the paper's mesh: the
+	 *    precompute's stability check costs ~10 s of CPU per column at
+	 *    T = 500 and the image 18 kB per (column, row) pair, so a 4 x 4
+	 *    patch of the top face is touchable.  The tick reads only the
+	 *    contact columns' blocks: its cost does not depend on how many
+	 *    columns the image has.
+	 *  - Modal with every mode: the paper's mesh has 9504; its stability
+	 *    check is an eigenproblem of order 2 x 9504 per column (hours), so
+	 *    the all-modes case uses the 6 x 6 x 12 cuboid (1764 modes), a 3 x 3
+	 *    patch of the top touchable.  The modal tick is linear in the
+	 *    number of modes.
+	 */
+	int have_fir = !ensure_image("out/bench/cuboid-fir500-patch.img", NULL, fir_kv);
+	int have_m300 = !ensure_image("out/bench/cuboid-paper.img", "scenes/cuboid-paper.scene", NULL);
+	int have_mall = !ensure_image("out/bench/cuboid-6x6x12-all.img", NULL, all_kv);
+	int have_bunny = file_exists("out/bench/bunny.img");
+	if (!have_bunny && file_exists("build/data/bunny.off"))
+		have_bunny = !ensure_image("out/bench/bunny.img", "scenes/bunny.scene", NULL);
+
+	header();
+	if (have_fir)
+		bench_image("cuboid-paper", "fir-500 (2 ms)", "out/bench/cuboid-fir500-patch.img", fir);
+	if (have_m300)
+		bench_image("cuboid-paper", "modal-300+sc", "out/bench/cuboid-paper.img", m300);
+	if (have_mall) {
+		bench_image("cuboid-6x6x12", "modal-all", "out/bench/cuboid-6x6x12-all.img", mall);
+		mall_modes = all_modes;
+	}
+	if (have_bunny)
+		bench_image("bunny", "modal-300+sc", "out/bench/bunny.img", bunny);
+	else
+		printf("tick  bunny skipped: neither out/bench/bunny.img nor build/data/bunny.off (make bench-precompute)\n");
+
+	printf("tick  -- issue targets (figures include the timer overhead) --\n");
+	target("FIR T=500, one point (node)", 10, &fir[K_NODE]);
+	target("FIR T=500, one point (triangle)", 10, &fir[K_TRI]);
+	target("FIR T=500, two points", 20, &fir[K_NODES]);
+	target("modal 300 + static corr, one point (node)", 5, &m300[K_NODE]);
+	target("modal 300 + static corr, one point (triangle)", 5, &m300[K_TRI]);
+	target("modal 300 + static corr, two points", 5, &m300[K_NODES]);
+	if (mall[K_NODE].ok)
+		printf("tick  modal all modes (6x6x12 cuboid, %u modes): one point median %.2f us, two points median %.2f us "
+		       "(x %.1f for the paper mesh's 9504 modes if linear)\n",
+		       mall_modes, mall[K_NODE].median, mall[K_NODES].median, 9504.0 / mall_modes);
+	printf("tick  paper (Itanium2, FIR T=500): 78-105 us one point, 285-436 us two points\n");
+	free(samples);
+	return 0;
+}
