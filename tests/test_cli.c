@@ -23,6 +23,8 @@
 #include <cmocka.h>
 
 #include "modal/response.h"
+#include "image/image_response.h"
+#include "support/engine_fixture.h"
 #include "support/model_fixture.h"
 
 extern char **environ;
@@ -369,11 +371,75 @@ static void test_time_domain_split_and_merge(void **state)
 #undef TD
 }
 
+/*
+ * replay: a 1 cm step at a node; the forces written equal the brute-force
+ * convolution of the image's responses; bad trajectories fail cleanly.
+ */
+static void test_replay(void **state)
+{
+	const char *img = path_in_dir("rp.img"), *traj = path_in_dir("rp.csv"), *out = path_in_dir("rpf.csv");
+	char text[8192 * 8], *p = text;
+	static double target[300 * 3], ref[300 * 3];
+	struct irdm_image im;
+	char err[256];
+
+	(void)state;
+	assert_int_equal(run("precompute", "-q", SMALL, "--representation", "modal:all", "--precision", "f64",
+			     "--touch", "z>=0.2", "-o", img, NULL), 0);
+	p += sprintf(p, "t,ux,uy,uz\n");
+	for (int t = 0; t < 300; t++) {
+		target[3 * t + 2] = -0.01;
+		p += sprintf(p, "%.3f,0,0,-0.01\n", t * 0.001);
+	}
+	write_file(traj, text);
+	assert_int_equal(run("replay", "--image", img, "--contact", "40", "--displacement", traj, "-o", out, NULL), 0);
+	assert_int_equal(irdm_image_map(img, 0, &im, err, sizeof(err)), 0);
+	struct irdm_engine_config cfg;
+	irdm_engine_config_default(&cfg);
+	struct irdm_contact_site site;
+	struct irdm_engine *e = efx_engine(&im, &cfg);
+	assert_int_equal(irdm_engine_site_node(e, (uint32_t)irdm_image_node_of(&im, 40), &site), 0);
+	efx_engine_free(e);
+	efx_reference(&im, &site, 1, 300, target, ref);
+	slurp(out, text, sizeof(text));
+	assert_non_null(strstr(text, "t,c1_fx,c1_fy,c1_fz"));
+	p = strchr(text, '\n') + 1;
+	double got[300 * 3];
+	for (int t = 0; t < 300; t++) {
+		strtod(p, &p);
+		for (int a = 0; a < 3; a++)
+			got[3 * t + a] = strtod(p + 1, &p);
+		p++;
+	}
+	assert_true(efx_rel_rms(got, ref, 300 * 3) < 1e-9);
+	irdm_image_unmap(&im);
+	remove(out);
+	write_file(traj, "t,ux,uy,uz\n0,0,0,0\n0.002,0,0,0\n");
+	expect_failure(run("replay", "--image", img, "--contact", "40", "--displacement", traj, "-o", out, NULL),
+		       "one row per sample");
+	write_file(traj, "0,0,0\n");
+	expect_failure(run("replay", "--image", img, "--contact", "40", "--displacement", traj, "-o", out, NULL),
+		       "numeric columns");
+	write_file(traj, "0,0,0,1e9\n");
+	expect_failure(run("replay", "--image", img, "--contact", "40", "--displacement", traj, "-o", out, NULL),
+		       "out of range");
+	expect_failure(run("replay", "--image", img, "--contact", "0", "--displacement", traj, "-o", out, NULL),
+		       "not a touchable node");
+	expect_failure(run("replay", "--image", img, "--contact", "1,2", "--displacement", traj, "-o", out, NULL),
+		       "--contact");
+	expect_failure(run("replay", "--image", img, "--contact", "40", "--displacement", path_in_dir("no.csv"),
+			   "-o", out, NULL), "no.csv");
+	expect_failure(run("replay", "--image", img, "--contact", "40", NULL), "needs");
+	assert_false(exists(out));
+}
+
 static void test_help_for_every_command(void **state)
 {
 	(void)state;
 	assert_int_equal(run("--help", NULL), 0);
 	assert_non_null(strstr(out_text, "precompute"));
+	assert_int_equal(run("replay", "--help", NULL), 0);
+	assert_non_null(strstr(out_text, "--displacement"));
 	assert_int_equal(run("precompute", "--help", NULL), 0);
 	assert_non_null(strstr(out_text, "representation"));
 	const char *sub[] = { "info", "verify", "export" };
@@ -393,6 +459,7 @@ int main(void)
 		cmocka_unit_test(test_bad_images),
 		cmocka_unit_test(test_export_matches_library),
 		cmocka_unit_test(test_time_domain_split_and_merge),
+		cmocka_unit_test(test_replay),
 		cmocka_unit_test(test_help_for_every_command),
 	};
 

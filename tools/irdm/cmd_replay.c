@@ -27,7 +27,8 @@ static const char usage[] =
 	"the nearest point of the touchable surface.\n"
 	"FORCES.csv: t, then c<i>_fx, c<i>_fy, c<i>_fz: the force applied TO the\n"
 	"object at contact i (the device renders its negative), then n<N>_ux.. :\n"
-	"displacement u[t] of each --nodes node (touchable nodes).\n"
+	"displacement u[t] of each --nodes node (any node of the image; for a\n"
+	"floating object the world displacement, rigid motion included).\n"
 	"--push releases a contact when the object would pull (default: held).\n"
 	"--coupling K,B couples through a spring-damper (N/m, N s/m) instead.\n";
 
