@@ -56,14 +56,23 @@ static int winding(const double *R, size_t T, double r, size_t n, double complex
  * Zeros of det Q inside |w| < r.  The sampled winding number is exact when
  * no true phase step between samples exceeds pi; we accept a count only when
  * every sampled step is below pi/2, doubling the sampling until it is.
- * -1 when that needs more than MAX_FFT points (a zero too close to the
- * circle, or rounding noise in det Q near it): the caller stays on the
- * side it has already certified.
+ * -1 when that needs more than 8x the starting points (at least 2^16) (a zero too close
+ * to the circle, or rounding noise in det Q near it): the caller stays on
+ * the side it has already certified.
  */
 static int zeros_inside(const double *R, size_t T, double r, double complex *buf,
 			size_t *n_fft)
 {
-	for (size_t n = *n_fft; n <= MAX_FFT; n *= 2) {
+	/* Past 8x the starting sampling, large phase steps are rounding noise
+	 * next to a zero, which finer sampling does not remove: give up there
+	 * (the caller stays on its certified side) instead of paying for
+	 * ever larger FFTs. */
+	size_t cap = 8 * *n_fft > ((size_t)1 << 16) ? 8 * *n_fft : ((size_t)1 << 16);
+
+	if (cap > MAX_FFT)
+		cap = MAX_FFT;
+
+	for (size_t n = *n_fft; n <= cap; n *= 2) {
 		double worst;
 		int c = winding(R, T, r, n, buf, &worst);
 		if (c != INT_MIN && worst < M_PI / 2) {
