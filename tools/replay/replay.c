@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "image/image_response.h"
+#include "irdm/contact.h"
 #include "irdm/deform.h"
 #include "replay/replay.h"
 
@@ -18,77 +19,20 @@ void irdm_replay_opts_default(struct irdm_replay_opts *o)
 	o->solve = IRDM_SOLVE_COUPLED;
 }
 
-/* Closest point of triangle abc to p (Ericson, Real-Time Collision
- * Detection 5.1.5): barycentrics of the closest point. */
-static void closest_on_triangle(const double p[3], const double a[3], const double b[3],
-				const double c[3], double bary[3])
-{
-	double ab[3], ac[3], ap[3], bp[3], cp[3];
-
-	for (int k = 0; k < 3; k++) {
-		ab[k] = b[k] - a[k];
-		ac[k] = c[k] - a[k];
-		ap[k] = p[k] - a[k];
-		bp[k] = p[k] - b[k];
-		cp[k] = p[k] - c[k];
-	}
-#define DOT(x, y) ((x)[0] * (y)[0] + (x)[1] * (y)[1] + (x)[2] * (y)[2])
-	double d1 = DOT(ab, ap), d2 = DOT(ac, ap), d3 = DOT(ab, bp), d4 = DOT(ac, bp);
-	double d5 = DOT(ab, cp), d6 = DOT(ac, cp);
-#undef DOT
-	double va = d3 * d6 - d5 * d4, vb = d5 * d2 - d1 * d6, vc = d1 * d4 - d3 * d2;
-
-	if (d1 <= 0 && d2 <= 0) {
-		bary[0] = 1, bary[1] = 0, bary[2] = 0;
-	} else if (d3 >= 0 && d4 <= d3) {
-		bary[0] = 0, bary[1] = 1, bary[2] = 0;
-	} else if (vc <= 0 && d1 >= 0 && d3 <= 0) {
-		double v = d1 / (d1 - d3);
-		bary[0] = 1 - v, bary[1] = v, bary[2] = 0;
-	} else if (d6 >= 0 && d5 <= d6) {
-		bary[0] = 0, bary[1] = 0, bary[2] = 1;
-	} else if (vb <= 0 && d2 >= 0 && d6 <= 0) {
-		double w = d2 / (d2 - d6);
-		bary[0] = 1 - w, bary[1] = 0, bary[2] = w;
-	} else if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
-		double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-		bary[0] = 0, bary[1] = 1 - w, bary[2] = w;
-	} else {
-		double den = 1 / (va + vb + vc);
-		bary[1] = vb * den;
-		bary[2] = vc * den;
-		bary[0] = 1 - bary[1] - bary[2];
-	}
-}
-
 int irdm_replay_locate(const struct irdm_image *img, const double p[3], uint32_t *tri,
 		       double bary[3])
 {
-	double best = INFINITY;
+	struct irdm_contact_mesh cm;
+	struct irdm_contact_hit hit;
 
-	for (uint32_t t = 0; t < img->meta->n_tris; t++) {
-		const uint32_t *v = &img->tris[3 * t];
-		double x[3][3], b[3], q[3] = { 0, 0, 0 }, d = 0;
-		bool touchable = true;
-		for (int k = 0; k < 3; k++) {
-			touchable &= irdm_image_col_of(img, v[k]) >= 0;
-			for (int a = 0; a < 3; a++)
-				x[k][a] = img->nodes[v[k]].pos_m[a];
-		}
-		if (!touchable)
-			continue;
-		closest_on_triangle(p, x[0], x[1], x[2], b);
-		for (int a = 0; a < 3; a++) {
-			q[a] = b[0] * x[0][a] + b[1] * x[1][a] + b[2] * x[2][a];
-			d += (q[a] - p[a]) * (q[a] - p[a]);
-		}
-		if (d < best) {
-			best = d;
-			*tri = t;
-			memcpy(bary, b, sizeof(b));
-		}
-	}
-	return isinf(best) ? -1 : 0;
+	/* the nearest point of the rest surface (no displacement); 1 km covers
+	 * any object (the query wants a finite radius) */
+	if (irdm_contact_mesh_init(&cm, img) ||
+	    irdm_contact_closest(&cm, NULL, 0.0, p, 1e3, &hit) != 1)
+		return -1;
+	*tri = hit.tri;
+	memcpy(bary, hit.bary, sizeof(hit.bary));
+	return 0;
 }
 
 /* ---- trajectory CSV ---- */

@@ -26,7 +26,8 @@ struct irdm_replay_opts {
 void irdm_replay_opts_default(struct irdm_replay_opts *o);
 int irdm_replay_run(const struct irdm_replay_opts *o, char *err, size_t errlen);
 
-/* Nearest point of the touchable surface: triangle and barycentrics. */
+/* Nearest point of the touchable surface (the image's contact BVH):
+ * triangle and barycentrics; -1 if the image has none. */
 int irdm_replay_locate(const struct irdm_image *img, const double p[3], uint32_t *tri,
 		       double bary[3]);
 
