@@ -88,7 +88,6 @@ static void fir_tail(struct irdm_engine *e, double *w)
 		stable = 0.999;
 	if (rho >= stable)
 		r = stable / rho;
-	e->tail_r = r;
 	w[0] = 1.0;
 	for (uint32_t s = 1; s < e->T; s++)
 		w[s] = w[s - 1] * r;

@@ -17,21 +17,20 @@ static size_t fir_index(const struct irdm_engine *e, uint32_t col, uint32_t row,
 }
 
 /*
- * sum_{s=s0}^{T-1} w[s] sum_e R[s](col_e -> row) f_e[t-s], ages counted
- * from the tick after slot `head` (s0 = 1 with the newest slot: the free
- * response of the coming tick; s0 = 0 with the slot before it: u[t] of the
- * last tick).  One pass over the ring; each entry reads one 3x3 block.
+ * The free response of the coming tick at column col:
+ *   sum_{s=1}^{T-1} w[s] sum_e R[s](col_e -> row) f_e[t-s],
+ * one pass over the ring; each entry reads one 3x3 block.
  */
-static void sum_history(const struct irdm_engine *e, uint32_t col, uint32_t s0, uint32_t head,
-			double u[3])
+void irdm_fir_free_disp(const struct irdm_engine *e, uint32_t col, double u[3])
 {
 	const struct irdm_image *img = e->img;
 	const struct irdm_fir_ring *r = &e->ring;
 	uint32_t prec = img->meta->precision, row = img->columns[col];
 	double acc[3] = { 0, 0, 0 };
 
-	for (uint32_t s = s0; s < e->T; s++) {
-		const struct irdm_force_tick *t = &r->tick[(head + e->T + 1 - s) % e->T];
+	for (uint32_t s = 1; s < e->T; s++) {
+		/* age s is the slot s - 1 before the newest */
+		const struct irdm_force_tick *t = &r->tick[(r->head + e->T + 1 - s) % e->T];
 		double w = e->tail_w[s];
 		for (uint32_t n = 0; n < t->n; n++) {
 			const double *f = t->f_n[n];
@@ -48,17 +47,6 @@ static void sum_history(const struct irdm_engine *e, uint32_t col, uint32_t s0, 
 		}
 	}
 	memcpy(u, acc, sizeof(acc));
-}
-
-void irdm_fir_free_disp(const struct irdm_engine *e, uint32_t col, double u[3])
-{
-	sum_history(e, col, 1, e->ring.head, u);
-}
-
-void irdm_fir_disp_now(const struct irdm_engine *e, uint32_t col, double u[3])
-{
-	/* u[t] = sum_{s=0}^{T-1} R[s] f[t-s]: ages from 0, the ring one tick back */
-	sum_history(e, col, 0, (e->ring.head + e->T - 1) % e->T, u);
 }
 
 void irdm_fir_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp, double blk[9])

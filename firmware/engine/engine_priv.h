@@ -35,7 +35,6 @@ struct irdm_engine {
 	/* FIR */
 	struct irdm_fir_ring ring;
 	const double *tail_w;               /* T: r^s tail damping (1 when stable) */
-	double tail_r;
 	/* contacts and solve */
 	struct irdm_contact_state c[IRDM_MAX_CONTACTS];
 	struct r0_table r0, r0_next;
@@ -56,7 +55,6 @@ void irdm_modal_free_disp(const struct irdm_engine *e, uint32_t col, double u[3]
 void irdm_modal_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp, double blk[9]);
 void irdm_modal_apply(struct irdm_engine *e, const struct irdm_force_tick *f);
 void irdm_fir_free_disp(const struct irdm_engine *e, uint32_t col, double u[3]);
-void irdm_fir_disp_now(const struct irdm_engine *e, uint32_t col, double u[3]);
 void irdm_fir_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp, double blk[9]);
 void irdm_fir_apply(struct irdm_engine *e, const struct irdm_force_tick *f);
 

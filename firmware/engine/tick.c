@@ -610,29 +610,3 @@ void irdm_engine_node_disp(const struct irdm_engine *e, uint32_t row, double u[3
 			u[i] += phi[(size_t)i * e->K + k] * yq;
 	}
 }
-
-void irdm_engine_node_u(const struct irdm_engine *e, uint32_t row, double u[3])
-{
-	uint32_t col = row < e->n_nodes ? e->col_of_row[row] : NO_COL;
-
-	u[0] = u[1] = u[2] = 0;
-	if (col == NO_COL)
-		return;
-	if (e->repr == IRDM_REPR_FIR) {
-		irdm_fir_disp_now(e, col, u);
-		return;
-	}
-	/* u[t] = sum_k phi_k x_k,q[t+1] + sum_e D(col <- e) f_e[t] */
-	const double *phi = &e->phi[(size_t)col * 3 * e->K];
-	for (uint32_t k = 0; k < e->K; k++)
-		for (int i = 0; i < 3; i++)
-			u[i] += phi[(size_t)i * e->K + k] * e->x[2 * k];
-	if (!e->img->static_corr)
-		return;
-	for (uint32_t n = 0; n < e->last.n; n++)
-		for (int i = 0; i < 3; i++)
-			for (int j = 0; j < 3; j++)
-				u[i] += irdm_elem_get(e->img->static_corr, e->img->meta->precision,
-						      (((size_t)e->last.col[n] * e->n_cols + col) * 3 + (size_t)i) * 3 + (size_t)j)
-					* e->last.f_n[n][j];
-}

@@ -98,18 +98,6 @@ struct irdm_contact_state {
 	uint32_t fresh;                 /* began since the last tick */
 };
 
-/* Snapshot handed to the deformation context (lock-free, see deform.h). */
-struct irdm_history_snapshot {
-	uint64_t tick;
-	uint32_t n_force_nodes;
-	uint32_t force_col[IRDM_MAX_FORCE_NODES];
-	double force_n[IRDM_MAX_FORCE_NODES][3];  /* at tick `tick` */
-	/* modal: the states x[t+1] (2 n_modes doubles, after this tick's force);
-	 * FIR: the ring and its head are copied (see engine_fir.c) */
-	const double *state;            /* points into the snapshot buffer */
-	size_t state_len;
-};
-
 struct irdm_engine_stats {
 	uint64_t ticks;
 	uint64_t releases;              /* push contacts released */
@@ -181,9 +169,6 @@ void irdm_engine_node_disp(const struct irdm_engine *eng, uint32_t row, double u
 /* Publish snapshots to a deformation context (init-time). */
 struct irdm_deform;
 void irdm_engine_attach_deform(struct irdm_engine *eng, struct irdm_deform *d);
-
-/* Displacement u[t] of image node `row` (a column) after the last tick. */
-void irdm_engine_node_u(const struct irdm_engine *eng, uint32_t row, double u_m[3]);
 
 /* Zero the history and all contacts (out of a fault). */
 void irdm_engine_reset(struct irdm_engine *eng);
