@@ -205,8 +205,7 @@ static void ref_tick(struct ref *r, size_t t, const double target[3], double F[3
 			F[a] += g[a];
 	}
 	/* commit the tick */
-	double x[3], fb[3];
-	end_position(r, t, F, x);   /* (for symmetry; state advanced below) */
+	double fb[3];
 	double u_start[3] = { 0, 0, 0 }, p[3], xn[3], arm[3], tau[3];
 	for (size_t s = 1; s <= t; s++)
 		for (int i = 0; i < 3; i++)

@@ -60,17 +60,20 @@ static int winding(const double *R, size_t T, double r, size_t n, double complex
  * to the circle, or rounding noise in det Q near it): the caller stays on
  * the side it has already certified.
  */
+/* Past 8x the starting sampling (at least 2^16) large phase steps are
+ * rounding noise next to a zero, which finer sampling does not remove. */
+static size_t fft_cap(size_t n0)
+{
+	size_t cap = 8 * n0 > ((size_t)1 << 16) ? 8 * n0 : ((size_t)1 << 16);
+
+	return cap < MAX_FFT ? cap : MAX_FFT;
+}
+
 static int zeros_inside(const double *R, size_t T, double r, double complex *buf,
 			size_t *n_fft)
 {
-	/* Past 8x the starting sampling, large phase steps are rounding noise
-	 * next to a zero, which finer sampling does not remove: give up there
-	 * (the caller stays on its certified side) instead of paying for
-	 * ever larger FFTs. */
-	size_t cap = 8 * *n_fft > ((size_t)1 << 16) ? 8 * *n_fft : ((size_t)1 << 16);
-
-	if (cap > MAX_FFT)
-		cap = MAX_FFT;
+	/* give up at the cap: the caller stays on its certified side */
+	size_t cap = fft_cap(*n_fft);
 
 	for (size_t n = *n_fft; n <= cap; n *= 2) {
 		double worst;
@@ -94,8 +97,8 @@ static size_t pow2_at_least(size_t n)
 
 double irdm_stability_fir(const double *R, size_t T)
 {
-	double complex *buf = malloc(9 * (size_t)MAX_FFT * sizeof(*buf));
 	size_t n_fft = pow2_at_least(4 * T + 16);
+	double complex *buf = malloc(9 * fft_cap(n_fft) * sizeof(*buf));
 	/* search w radius r = 1/rho in [1/RHO_MAX, 1/RHO_MIN] */
 	double r_lo = 1.0 / IRDM_STAB_RHO_MAX, r_hi = 1.0 / IRDM_STAB_RHO_MIN, rho = -1;
 

@@ -94,8 +94,6 @@ static int pick_damping(const struct irdm_scene *sc, struct irdm_model *m, char 
 					 2 * M_PI * sc->damp_hz[1], &m->damping, err, errlen);
 }
 
-int irdm_model_select(const struct irdm_scene *sc, struct irdm_model *m, char *err, size_t errlen);
-
 int irdm_model_build(const struct irdm_scene *sc, size_t n_modes_needed,
 		     irdm_progress_fn progress, void *ctx, struct irdm_model *m,
 		     char *err, size_t errlen)

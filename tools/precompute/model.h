@@ -40,4 +40,7 @@ int irdm_model_build(const struct irdm_scene *sc, size_t n_modes_needed,
 		     char *err, size_t errlen);
 void irdm_model_free(struct irdm_model *m);
 
+/* The scene's rows, columns and surface (select.c; part of irdm_model_build). */
+int irdm_model_select(const struct irdm_scene *sc, struct irdm_model *m, char *err, size_t errlen);
+
 #endif

@@ -11,8 +11,6 @@
 
 #include "precompute/model.h"
 
-int irdm_model_select(const struct irdm_scene *sc, struct irdm_model *m, char *err, size_t errlen);
-
 static int node_dofs(const struct irdm_model *m, uint32_t node, int64_t *dofs)
 {
 	for (int a = 0; a < 3; a++)
