@@ -3,14 +3,28 @@
 #   make            host tool build/irdm and the firmware library
 #   make test       build and run every test (tests/run-tests.sh)
 #   make san        the same tests under AddressSanitizer + UBSan (build-san/)
-#   make fuzz       libFuzzer targets, each for FUZZ_SECONDS (clang only)
+#   make fuzz       libFuzzer targets, each for FUZZ_SECONDS (clang only);
+#                   any finding fails the build and keeps the input
 #   make check      what CI runs: fuzz, clang + sanitizer tests, then the tests
 #   make bench      benchmarks (print figures; never pass/fail on time)
 #   make run        the main job: the built-in default scene, end to end
 #
-# CC=clang works too.  Sources are found by directory, so adding a file needs
-# no edit here: firmware/*/*.c -> libirdmfw.a, tools/*/*.c (but tools/irdm)
-# -> libirdmtools.a, tools/irdm/*.c -> irdm, tests/test_*.c -> one binary each.
+# CC=clang works too.  The layers point one way and the include paths
+# enforce it (docs/architecture.md):
+#
+#   firmware/*/*.c  -> libirdmfw.a     sees firmware/include only
+#   hal/*/*.c       -> libirdmhal.a    sees firmware/include, hal/include
+#   sim/*/*.c       -> libirdmsim.a    sees firmware/include, hal/include, sim/include
+#   tools/*/*.c     -> libirdmtools.a  sees firmware/include, tools/ (not tools/irdm)
+#   tools/irdm/*.c  -> irdm
+#   tests/test_*.c  -> one binary each; tests/test_tick_*.c link the firmware
+#                      library alone (no BLAS, no threads: the force tick's
+#                      dependencies, checked by tests/test_layers.c)
+#
+# Adding a file needs no edit here.
+
+SHELL   := bash
+.SHELLFLAGS := -o pipefail -ec
 
 CC      ?= cc
 BUILD   ?= build
@@ -20,9 +34,15 @@ FUZZ_SECONDS ?= 30
 CSTD     = -std=c11 -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE
 WARN     = -Wall -Wextra -Werror -Wshadow -Wstrict-prototypes -Wvla
 OPT     ?= -O2 -g
-INC      = -Ifirmware/include -Itools -I/usr/include/suitesparse
-CFLAGS  += $(CSTD) $(WARN) $(OPT) $(INC) -MMD -MP
+CFLAGS  += $(CSTD) $(WARN) $(OPT) -MMD -MP
 LDLIBS   = -lcholmod -larpack -lopenblas -lpthread -lm
+
+# Include paths, one set per layer (target-specific: an object sees only its own).
+FW_INC    = -Ifirmware/include
+HAL_INC   = $(FW_INC) -Ihal/include
+SIM_INC   = $(HAL_INC) -Isim/include
+TOOL_INC  = $(FW_INC) -Itools -I/usr/include/suitesparse
+TEST_INC  = $(SIM_INC) -Itools -I/usr/include/suitesparse
 
 ifneq ($(SAN),)
 CFLAGS  += -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all
@@ -30,9 +50,12 @@ LDFLAGS += -fsanitize=address,undefined
 endif
 
 FW_SRC    := $(wildcard firmware/*/*.c)
+HAL_SRC   := $(wildcard hal/*/*.c)
+SIM_SRC   := $(wildcard sim/*/*.c)
 TOOL_SRC  := $(filter-out tools/irdm/%,$(wildcard tools/*/*.c))
 CLI_SRC   := $(wildcard tools/irdm/*.c)
 TEST_SRC  := $(wildcard tests/test_*.c)
+TICK_TEST_SRC := $(wildcard tests/test_tick_*.c)
 TESTSUP_SRC := $(wildcard tests/support/*.c)
 BENCH_SRC := $(wildcard tests/bench/*.c)
 FUZZ_SRC  := $(wildcard tests/fuzz/fuzz_*.c)
@@ -40,62 +63,94 @@ FUZZ_SRC  := $(wildcard tests/fuzz/fuzz_*.c)
 obj = $(patsubst %.c,$(BUILD)/obj/%.o,$(1))
 
 FW_LIB   := $(BUILD)/libirdmfw.a
+HAL_LIB  := $(BUILD)/libirdmhal.a
+SIM_LIB  := $(BUILD)/libirdmsim.a
 TOOL_LIB := $(BUILD)/libirdmtools.a
 IRDM     := $(BUILD)/irdm
 TESTS    := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
+TICK_TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TICK_TEST_SRC))
 BENCHES  := $(patsubst tests/bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC))
 
 .PHONY: all test san fuzz bench bench-precompute run check deps clean
 .SECONDARY:
-all: $(IRDM) $(FW_LIB)
+all: $(IRDM) $(FW_LIB) $(HAL_LIB) $(SIM_LIB)
+
+$(BUILD)/obj/firmware/%.o: LAYER_INC = $(FW_INC)
+$(BUILD)/obj/hal/%.o:      LAYER_INC = $(HAL_INC)
+$(BUILD)/obj/sim/%.o:      LAYER_INC = $(SIM_INC)
+$(BUILD)/obj/tools/%.o:    LAYER_INC = $(TOOL_INC)
+$(BUILD)/obj/tests/%.o:    LAYER_INC = $(TEST_INC)
 
 $(BUILD)/obj/%.o: %.c
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) -c $< -o $@
+	$(CC) $(CFLAGS) $(LAYER_INC) -c $< -o $@
 
-$(FW_LIB): $(call obj,$(FW_SRC))
+# An empty layer still gets its (empty) archive, so links need no special case.
+$(BUILD)/lib%.a:
 	@mkdir -p $(dir $@)
+	rm -f $@
 	$(AR) rcs $@ $^
 
+$(FW_LIB):   $(call obj,$(FW_SRC))
+$(HAL_LIB):  $(call obj,$(HAL_SRC))
+$(SIM_LIB):  $(call obj,$(SIM_SRC))
 $(TOOL_LIB): $(call obj,$(TOOL_SRC))
-	@mkdir -p $(dir $@)
-	$(AR) rcs $@ $^
 
 $(IRDM): $(call obj,$(CLI_SRC)) $(TOOL_LIB) $(FW_LIB)
 	$(CC) $(LDFLAGS) $^ -o $@ $(LDLIBS)
 
-$(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(call obj,$(TESTSUP_SRC)) $(TOOL_LIB) $(FW_LIB)
+TEST_LIBS := $(TOOL_LIB) $(SIM_LIB) $(HAL_LIB) $(FW_LIB)
+
+# The force tick alone: the firmware library, libm and cmocka, nothing else.
+$(TICK_TESTS): $(BUILD)/tests/test_tick_%: $(BUILD)/obj/tests/test_tick_%.o $(FW_LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(LDFLAGS) $^ -o $@ -lcmocka -lm
+
+$(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(call obj,$(TESTSUP_SRC)) $(TEST_LIBS)
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) $^ -o $@ $(LDLIBS) -lcmocka
 
 # benches share the test fixtures, which report through cmocka
-$(BUILD)/bench/%: $(BUILD)/obj/tests/bench/%.o $(call obj,$(TESTSUP_SRC)) $(TOOL_LIB) $(FW_LIB)
+$(BUILD)/bench/%: $(BUILD)/obj/tests/bench/%.o $(call obj,$(TESTSUP_SRC)) $(TEST_LIBS)
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) $^ -o $@ $(LDLIBS) -lcmocka
 
 test: $(TESTS) $(IRDM)
-	IRDM=$(IRDM) tests/run-tests.sh $(TESTS)
+	IRDM=$(IRDM) IRDM_BUILD=$(BUILD) tests/run-tests.sh $(TESTS)
 
 san:
 	$(MAKE) BUILD=build-san SAN=1 OPT="-O1 -g" test
 
-# libFuzzer needs clang; each target gets its own seed corpus directory.
+# libFuzzer needs clang.  Each target gets its own corpus directory; a
+# finding (crash, leak, sanitizer report: none recovers) stops the build and
+# leaves the input in $(FUZZ_BUILD)/findings/ to replay with
+#   $(FUZZ_BUILD)/TARGET $(FUZZ_BUILD)/findings/TARGET-crash-...
 FUZZ_BUILD := build-fuzz
+FUZZ_CFLAGS := -O1 -g -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=all
 fuzz:
-	$(MAKE) CC=clang BUILD=$(FUZZ_BUILD) OPT="-O1 -g -fsanitize=fuzzer-no-link,address,undefined" $(FUZZ_BUILD)/libirdmtools.a $(FUZZ_BUILD)/libirdmfw.a
-	@set -e; for f in $(FUZZ_SRC); do \
+	$(MAKE) CC=clang BUILD=$(FUZZ_BUILD) OPT="$(FUZZ_CFLAGS)" \
+	  $(FUZZ_BUILD)/libirdmtools.a $(FUZZ_BUILD)/libirdmfw.a
+	mkdir -p $(FUZZ_BUILD)/findings
+	for f in $(FUZZ_SRC); do \
 	  n=$$(basename $$f .c); \
-	  clang $(CSTD) $(WARN) -O1 -g $(INC) -fsanitize=fuzzer,address,undefined $$f \
+	  clang $(CSTD) $(WARN) -O1 -g $(TOOL_INC) -fsanitize=fuzzer,address,undefined \
+	    -fno-sanitize-recover=all $$f \
 	    $(FUZZ_BUILD)/libirdmtools.a $(FUZZ_BUILD)/libirdmfw.a -o $(FUZZ_BUILD)/$$n $(LDLIBS); \
 	  mkdir -p $(FUZZ_BUILD)/corpus/$$n; \
 	  seeds=tests/fuzz/seeds/$$n; [ -d $$seeds ] || seeds=; \
 	  echo "fuzz: $$n for $(FUZZ_SECONDS) s"; \
-	  $(FUZZ_BUILD)/$$n -max_total_time=$(FUZZ_SECONDS) -max_len=65536 -print_final_stats=1 \
-	    $(FUZZ_BUILD)/corpus/$$n $$seeds 2>&1 | tail -n 4; \
+	  if ! $(FUZZ_BUILD)/$$n -max_total_time=$(FUZZ_SECONDS) -max_len=65536 -print_final_stats=1 \
+	      -artifact_prefix=$(FUZZ_BUILD)/findings/$$n- \
+	      $(FUZZ_BUILD)/corpus/$$n $$seeds > $(FUZZ_BUILD)/$$n.log 2>&1; then \
+	    tail -n 60 $(FUZZ_BUILD)/$$n.log; \
+	    echo "fuzz: $$n FOUND A BUG; input kept in $(FUZZ_BUILD)/findings/ (replay: $(FUZZ_BUILD)/$$n FILE)"; \
+	    exit 1; \
+	  fi; \
+	  tail -n 4 $(FUZZ_BUILD)/$$n.log; \
 	done
 
 bench: $(BENCHES) $(IRDM) bench-precompute
-	@set -e; for b in $(BENCHES); do echo "== $$b"; IRDM=$(IRDM) $$b; done
+	for b in $(BENCHES); do echo "== $$b"; IRDM=$(IRDM) $$b; done
 
 # Paper-scale images (cuboid, bunny): time and size beside the paper's.
 bench-precompute: $(IRDM) $(BUILD)/data/bunny.off
@@ -120,6 +175,6 @@ deps:
 	tools/scripts/install-deps.sh
 
 clean:
-	rm -rf build build-san build-fuzz
+	rm -rf build build-san build-fuzz build-clang
 
 -include $(shell find $(BUILD) -name '*.d' 2>/dev/null)

@@ -12,6 +12,7 @@
 #include <stdint.h>
 
 #include "irdm/image_format.h"
+#include "irdm/precision.h"
 
 /* Errors (negative return values). */
 enum irdm_image_error {
@@ -74,16 +75,6 @@ const char *irdm_image_strerror(int code);
 /* Section lookup (NULL if absent). */
 const struct irdm_image_section *irdm_image_find(const struct irdm_image *img,
 						 uint32_t kind);
-
-/* Bytes per element of a precision (0 for an unknown one). */
-size_t irdm_elem_size(uint32_t elem);
-
-/* Read element i of an array of the given precision as double. */
-double irdm_elem_get(const void *data, uint32_t elem, size_t i);
-
-/* IEEE binary16 <-> binary32 (round to nearest even; overflow -> inf). */
-float irdm_f16_to_f32(uint16_t h);
-uint16_t irdm_f32_to_f16(float f);
 
 /* CRC-32C (Castagnoli), reflected, init/xorout 0xFFFFFFFF. */
 uint32_t irdm_crc32c(const void *data, size_t len);

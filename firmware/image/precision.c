@@ -10,7 +10,7 @@
 #include <stdint.h>
 #include <string.h>
 
-#include "irdm/image.h"
+#include "irdm/precision.h"
 
 static uint32_t f32_bits(float f)
 {
@@ -94,33 +94,5 @@ size_t irdm_elem_size(uint32_t elem)
 		return 8;
 	default:
 		return 0;
-	}
-}
-
-double irdm_elem_get(const void *data, uint32_t elem, size_t i)
-{
-	const uint8_t *p = data;
-	uint16_t h;
-	uint32_t u;
-	float f;
-	double d;
-
-	switch (elem) {
-	case IRDM_ELEM_BYTES:
-		return p[i];
-	case IRDM_ELEM_F16:
-		memcpy(&h, p + i * 2, sizeof(h));
-		return irdm_f16_to_f32(h);
-	case IRDM_ELEM_F32:
-		memcpy(&f, p + i * 4, sizeof(f));
-		return f;
-	case IRDM_ELEM_U32:
-		memcpy(&u, p + i * 4, sizeof(u));
-		return u;
-	case IRDM_ELEM_F64:
-		memcpy(&d, p + i * 8, sizeof(d));
-		return d;
-	default:
-		return NAN;
 	}
 }
