@@ -1,11 +1,14 @@
 /* SPDX-License-Identifier: MIT */
-/* Internals of the deformation context (firmware/deform/). */
+/*
+ * Internals of the deformation channel (deform.c), shared with its reader,
+ * the worker (deform_worker.c).  Nothing here needs BLAS or threads.
+ */
 #ifndef IRDM_DEFORM_PRIV_H
 #define IRDM_DEFORM_PRIV_H
 
-#include <pthread.h>
-#include <semaphore.h>
 #include <stdatomic.h>
+#include <stdbool.h>
+#include <string.h>
 
 #include "irdm/deform.h"
 
@@ -28,34 +31,12 @@ struct deform_snap {
 	struct irdm_force_tick f;           /* modal: this tick's forces */
 };
 
-struct irdm_deform_thread {
-	pthread_t tid;
-	struct irdm_deform *d;
-	void (*frame)(void *ctx, const double *pos_m, uint64_t tick);
-	void *ctx;
-	struct timespec period;
-	atomic_bool stop;
-	sem_t started;                      /* init-time handshake only */
-	int prio_errno;                     /* nice + 5 failed in the thread */
-	bool running;
-};
-
 struct irdm_deform {
 	const struct irdm_image *img;
-	uint32_t repr, prec;
-	uint32_t n_nodes, n_cols, n_modes, T;
+	uint32_t repr;
+	uint32_t n_modes, T;                /* modal: n_modes; FIR: T */
 	size_t slot_bytes, payload_off;
 	unsigned char *slot[3];
-
-	/* mode shapes as a row-major (3 n_nodes) x n_modes BLAS matrix: the
-	 * image's own for f32/f64, converted for f16 */
-	const void *shapes;
-	bool shapes_f64;
-	void *y;                            /* n_modes of the matrix's type */
-	float *uf;                          /* f32 product, 3 n_nodes */
-	double *frame_pos;                  /* the thread's frame, 3 n_nodes */
-
-	struct irdm_deform_thread th;
 
 	/* one cache line each, so the two sides do not share one */
 	_Alignas(DEFORM_ALIGN) _Atomic uint32_t mid;
@@ -63,23 +44,36 @@ struct irdm_deform {
 	_Alignas(DEFORM_ALIGN) uint32_t front;  /* reader's */
 };
 
-/* Writer: the slot to fill, then hand it over. */
-static inline struct deform_snap *deform_back(struct irdm_deform *d)
+static inline size_t deform_align_up(size_t x)
 {
-	return (struct deform_snap *)d->slot[d->back];
+	return (x + DEFORM_ALIGN - 1) & ~(size_t)(DEFORM_ALIGN - 1);
 }
 
-static inline void *deform_payload(struct irdm_deform *d, struct deform_snap *s)
+/*
+ * Caller memory of any alignment -> its first DEFORM_ALIGN boundary, with
+ * every page touched now (nothing page-faults later); NULL if `need` bytes
+ * from there do not fit.
+ */
+static inline unsigned char *deform_place(void *mem, size_t mem_size, size_t need)
+{
+	uintptr_t p = (uintptr_t)mem;
+	size_t pad = (size_t)(((p + DEFORM_ALIGN - 1) & ~(uintptr_t)(DEFORM_ALIGN - 1)) - p);
+
+	if (!mem || mem_size < pad || mem_size - pad < need)
+		return NULL;
+	memset(mem, 0, mem_size);
+	return (unsigned char *)mem + pad;
+}
+
+static inline void *deform_payload(const struct irdm_deform *d, struct deform_snap *s)
 {
 	return (unsigned char *)s + d->payload_off;
 }
 
-void deform_swap_back(struct irdm_deform *d);
-/* Reader: the newest snapshot if one is fresh, else NULL. */
+/*
+ * Reader: the newest snapshot if one was published since the last take,
+ * else NULL.  The slot is the reader's until its next take.
+ */
 struct deform_snap *deform_take(struct irdm_deform *d);
-
-void deform_warmup(struct irdm_deform *d);
-void deform_modal(struct irdm_deform *d, struct deform_snap *s, double *pos);
-void deform_fir(struct irdm_deform *d, struct deform_snap *s, double *pos);
 
 #endif

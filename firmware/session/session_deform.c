@@ -1,0 +1,40 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * The session's deformation worker.  Apart from session.c so that only a
+ * program that asks for the worker links BLAS and threads (the static
+ * library pulls this object in only then); session.c frees its memory with
+ * the rest and never calls into the worker.
+ */
+#include <stdio.h>
+
+#include "irdm/deform_worker.h"
+#include "session_priv.h"
+
+int irdm_session_deform_open(struct irdm_session *s, char *err, size_t errlen)
+{
+	size_t n;
+	int rc;
+
+	if (!s->deform) {
+		snprintf(err, errlen, "session: no deformation channel to read (open it with deform)");
+		return IRDM_EINVAL;
+	}
+	if (s->worker) {
+		snprintf(err, errlen, "session: the deformation worker is already open");
+		return IRDM_EBUSY;
+	}
+	n = irdm_deform_worker_mem_size(s->img);
+	if (!n)
+		return irdm_deform_worker_init(&s->worker, s->deform, NULL, 0, err, errlen);
+	s->worker_mem = session_alloc(n);
+	if (!s->worker_mem) {
+		snprintf(err, errlen, "deform: out of memory (%zu bytes)", n);
+		return IRDM_ENOMEM;
+	}
+	rc = irdm_deform_worker_init(&s->worker, s->deform, s->worker_mem, n, err, errlen);
+	if (rc) {
+		free(s->worker_mem);
+		s->worker_mem = NULL;
+	}
+	return rc;
+}
