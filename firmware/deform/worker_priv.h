@@ -9,7 +9,7 @@
 #include <stdatomic.h>
 #include <time.h>
 
-#include "deform_priv.h"
+#include "channel_priv.h"
 #include "irdm/deform_worker.h"
 
 struct irdm_deform_thread {

@@ -5,80 +5,91 @@
  * threads: the worker is session_deform.c's.
  */
 #include <stdio.h>
-#include <string.h>
+#include <stdlib.h>
 
 #include "session_priv.h"
+
+#define SESSION_ALIGN 64u
+
+int session_part_mem(void **mem, size_t n, const char *part, char *err, size_t errlen)
+{
+	*mem = NULL;
+	if (!n)
+		return IRDM_OK;
+	*mem = aligned_alloc(SESSION_ALIGN, (n + SESSION_ALIGN - 1) & ~(size_t)(SESSION_ALIGN - 1));
+	if (!*mem) {
+		snprintf(err, errlen, "%s: out of memory (%zu bytes)", part, n);
+		return IRDM_ENOMEM;
+	}
+	return IRDM_OK;
+}
 
 static int open_engine(struct irdm_session *s, const struct irdm_engine_config *cfg,
 		       char *err, size_t errlen)
 {
 	size_t n = irdm_engine_mem_size(s->img, cfg);
+	int rc = session_part_mem(&s->eng_mem, n, "engine", err, errlen);
 
-	/* size 0: the configuration does not fit; init says which way */
-	if (!n)
-		return irdm_engine_init(&s->eng, s->img, cfg, NULL, 0, err, errlen);
-	s->eng_mem = session_alloc(n);
-	if (!s->eng_mem) {
-		snprintf(err, errlen, "engine: out of memory (%zu bytes)", n);
-		return IRDM_ENOMEM;
-	}
+	if (rc)
+		return rc;
 	return irdm_engine_init(&s->eng, s->img, cfg, s->eng_mem, n, err, errlen);
 }
 
 static int open_deform(struct irdm_session *s, char *err, size_t errlen)
 {
 	size_t n = irdm_deform_mem_size(s->img);
-	int rc;
+	int rc = session_part_mem(&s->deform_mem, n, "deform", err, errlen);
 
-	if (!n)
-		return irdm_deform_init(&s->deform, s->img, NULL, 0, err, errlen);
-	s->deform_mem = session_alloc(n);
-	if (!s->deform_mem) {
-		snprintf(err, errlen, "deform: out of memory (%zu bytes)", n);
-		return IRDM_ENOMEM;
-	}
-	rc = irdm_deform_init(&s->deform, s->img, s->deform_mem, n, err, errlen);
+	if (!rc)
+		rc = irdm_deform_init(&s->deform, s->img, s->deform_mem, n, err, errlen);
 	if (!rc)
 		irdm_engine_attach_deform(s->eng, s->deform);
 	return rc;
 }
 
-/* s->img is set; the rest of s is zero. */
-static int open_parts(struct irdm_session *s, const struct irdm_session_config *cfg,
-		      char *err, size_t errlen)
+/*
+ * The parts on s->img; then s is the caller's.  On error everything goes,
+ * the mapping too if the session made it.
+ */
+static int open_parts(struct irdm_session **sp, struct irdm_session *s,
+		      const struct irdm_session_config *cfg, char *err, size_t errlen)
 {
 	int rc = open_engine(s, &cfg->engine, err, errlen);
 
 	if (!rc && cfg->deform)
 		rc = open_deform(s, err, errlen);
-	return rc;
+	if (rc) {
+		irdm_session_close(s);
+		return rc;
+	}
+	*sp = s;
+	return IRDM_OK;
+}
+
+static struct irdm_session *new_session(char *err, size_t errlen)
+{
+	struct irdm_session *s = calloc(1, sizeof(*s));
+
+	if (!s)
+		snprintf(err, errlen, "session: out of memory");
+	return s;
 }
 
 int irdm_session_open_image(struct irdm_session **sp, const struct irdm_image *img,
 			    const struct irdm_session_config *cfg, char *err, size_t errlen)
 {
 	struct irdm_session *s;
-	int rc;
 
 	*sp = NULL;
 	if (!img || !img->meta || !cfg) {
 		snprintf(err, errlen, "session: no image or no configuration");
 		return IRDM_EINVAL;
 	}
-	s = calloc(1, sizeof(*s));
-	if (!s) {
-		snprintf(err, errlen, "session: out of memory");
+	s = new_session(err, errlen);
+	if (!s)
 		return IRDM_ENOMEM;
-	}
 	s->img = img;
-	rc = open_parts(s, cfg, err, errlen);
-	if (rc)
-		goto out_close;
-	*sp = s;
-	return IRDM_OK;
-out_close:
-	irdm_session_close(s);
-	return rc;
+	return open_parts(sp, s, cfg, err, errlen);
 }
 
 int irdm_session_open(struct irdm_session **sp, const char *path,
@@ -92,23 +103,16 @@ int irdm_session_open(struct irdm_session **sp, const char *path,
 		snprintf(err, errlen, "session: no image path or no configuration");
 		return IRDM_EINVAL;
 	}
-	s = calloc(1, sizeof(*s));
-	if (!s) {
-		snprintf(err, errlen, "session: out of memory");
+	s = new_session(err, errlen);
+	if (!s)
 		return IRDM_ENOMEM;
-	}
 	rc = irdm_image_map(path, cfg->map_flags, &s->mapped, err, errlen);
-	if (rc)
-		goto out_close;
+	if (rc) {
+		free(s);
+		return rc;
+	}
 	s->img = &s->mapped;
-	rc = open_parts(s, cfg, err, errlen);
-	if (rc)
-		goto out_close;
-	*sp = s;
-	return IRDM_OK;
-out_close:
-	irdm_session_close(s);
-	return rc;
+	return open_parts(sp, s, cfg, err, errlen);
 }
 
 void irdm_session_close(struct irdm_session *s)

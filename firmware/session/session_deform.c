@@ -6,6 +6,7 @@
  * the rest and never calls into the worker.
  */
 #include <stdio.h>
+#include <stdlib.h>
 
 #include "irdm/deform_worker.h"
 #include "session_priv.h"
@@ -24,14 +25,9 @@ int irdm_session_deform_open(struct irdm_session *s, char *err, size_t errlen)
 		return IRDM_EBUSY;
 	}
 	n = irdm_deform_worker_mem_size(s->img);
-	if (!n)
-		return irdm_deform_worker_init(&s->worker, s->deform, NULL, 0, err, errlen);
-	s->worker_mem = session_alloc(n);
-	if (!s->worker_mem) {
-		snprintf(err, errlen, "deform: out of memory (%zu bytes)", n);
-		return IRDM_ENOMEM;
-	}
-	rc = irdm_deform_worker_init(&s->worker, s->deform, s->worker_mem, n, err, errlen);
+	rc = session_part_mem(&s->worker_mem, n, "deform worker", err, errlen);
+	if (!rc)
+		rc = irdm_deform_worker_init(&s->worker, s->deform, s->worker_mem, n, err, errlen);
 	if (rc) {
 		free(s->worker_mem);
 		s->worker_mem = NULL;

@@ -3,20 +3,17 @@
 #ifndef IRDM_SESSION_PRIV_H
 #define IRDM_SESSION_PRIV_H
 
-#include <stdlib.h>
-
 #include "irdm/session.h"
 
-#define SESSION_ALIGN 64u
-
 /*
- * Cache-line aligned memory for one part (the engine wants 16 bytes; 64
- * keeps a part's hot data off its neighbour's lines).  NULL for n == 0.
+ * Memory for one part of the session: *mem = n bytes, cache-line aligned
+ * (the engine wants 16; 64 keeps a part's hot data off its neighbour's
+ * lines).  n == 0 means the part's size call refused the image or the
+ * configuration: nothing is allocated and IRDM_OK returned, so that the
+ * part's init, given no memory, says why.
+ *
+ * Return: IRDM_OK; IRDM_ENOMEM (err says which part) if allocation failed.
  */
-static inline void *session_alloc(size_t n)
-{
-	return n ? aligned_alloc(SESSION_ALIGN, (n + SESSION_ALIGN - 1) &
-						~(size_t)(SESSION_ALIGN - 1)) : NULL;
-}
+int session_part_mem(void **mem, size_t n, const char *part, char *err, size_t errlen);
 
 #endif

@@ -1,10 +1,10 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * Internals of the deformation channel (deform.c), shared with its reader,
- * the worker (deform_worker.c).  Nothing here needs BLAS or threads.
+ * Internals of the deformation channel (deform_channel.c), shared with its
+ * reader, the worker (deform_worker.c).  Nothing here needs BLAS or threads.
  */
-#ifndef IRDM_DEFORM_PRIV_H
-#define IRDM_DEFORM_PRIV_H
+#ifndef IRDM_DEFORM_CHANNEL_PRIV_H
+#define IRDM_DEFORM_CHANNEL_PRIV_H
 
 #include <stdatomic.h>
 #include <stdbool.h>

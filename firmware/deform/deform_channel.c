@@ -6,7 +6,7 @@
 #include <limits.h>
 #include <stdio.h>
 
-#include "deform_priv.h"
+#include "channel_priv.h"
 
 struct deform_layout {
 	size_t payload_off, slot_bytes;
