@@ -517,8 +517,8 @@ static void test_misaligned_memory(void **state)
 	char *mem = malloc(sz + 8), *wmem = malloc(wsz + 8);
 	double *x = calloc(2 * img->meta->n_modes, sizeof(double));
 	double *pos = calloc(3 * (size_t)img->meta->n_nodes, sizeof(double));
-	struct irdm_deform_worker *w;
-	struct irdm_deform *d;
+	struct irdm_deform_worker *w = NULL;
+	struct irdm_deform *d = NULL;
 	uint64_t tick = 0;
 	char err[256];
 
