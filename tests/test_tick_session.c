@@ -44,12 +44,21 @@ static const char *image_path(void)
 	return p;
 }
 
+/* Mode shape k at image node row, axis i. */
+static double phi(const struct irdm_image *img, uint32_t row, int i, size_t k)
+{
+	size_t K = img->meta->n_modes;
+
+	return irdm_elem_get(img->mode_shapes, img->meta->precision,
+			     ((size_t)row * 3 + (size_t)i) * K + k);
+}
+
 /* R[0] block of column col on itself: displacement per force (m/N). */
 static void r0_self(const struct irdm_image *img, uint32_t col, double R[9])
 {
 	const struct irdm_meta *m = img->meta;
 	uint32_t row = img->columns[col], prec = m->precision;
-	size_t K = m->n_modes;
+	size_t sc = ((size_t)col * m->n_cols + col) * 9;
 
 	memset(R, 0, 9 * sizeof(double));
 	if (m->representation == IRDM_REPR_FIR) {
@@ -60,16 +69,12 @@ static void r0_self(const struct irdm_image *img, uint32_t col, double R[9])
 	}
 	for (int i = 0; i < 3; i++)
 		for (int j = 0; j < 3; j++) {
-			for (size_t k = 0; k < K; k++)
-				R[3 * i + j] += irdm_elem_get(img->mode_shapes, prec,
-							      ((size_t)row * 3 + (size_t)i) * K + k) *
-						irdm_elem_get(img->mode_shapes, prec,
-							      ((size_t)row * 3 + (size_t)j) * K + k) *
+			for (size_t k = 0; k < m->n_modes; k++)
+				R[3 * i + j] += phi(img, row, i, k) * phi(img, row, j, k) *
 						img->modes[k].b[0];
 			if (img->static_corr)
 				R[3 * i + j] += irdm_elem_get(img->static_corr, prec,
-							      (((size_t)col * m->n_cols + col) * 3 +
-							       (size_t)i) * 3 + (size_t)j);
+							      sc + (size_t)(3 * i + j));
 		}
 }
 

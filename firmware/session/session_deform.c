@@ -17,7 +17,7 @@ int irdm_session_deform_open(struct irdm_session *s, char *err, size_t errlen)
 	int rc;
 
 	if (!s->deform) {
-		snprintf(err, errlen, "session: no deformation channel to read (open it with deform)");
+		snprintf(err, errlen, "session: opened without the deformation channel");
 		return IRDM_EINVAL;
 	}
 	if (s->worker) {
