@@ -397,9 +397,10 @@ static void test_replay(void **state)
 	struct irdm_engine_config cfg;
 	irdm_engine_config_default(&cfg);
 	struct irdm_contact_site site;
-	struct irdm_engine *e = efx_engine(&im, &cfg);
+	struct irdm_session *ses = efx_session(&im, &cfg);
+	struct irdm_engine *e = ses->eng;
 	assert_int_equal(irdm_engine_site_node(e, (uint32_t)irdm_image_node_of(&im, 40), &site), 0);
-	efx_engine_free(e);
+	irdm_session_close(ses);
 	efx_reference(&im, &site, 1, 300, target, ref);
 	slurp(out, text, sizeof(text));
 	assert_non_null(strstr(text, "t,c1_fx,c1_fy,c1_fz"));

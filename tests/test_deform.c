@@ -30,7 +30,8 @@
 #include <cmocka.h>
 
 #include "image/image_response.h"
-#include "irdm/deform.h"
+#include "irdm/deform_worker.h"
+#include "irdm/session.h"
 #include "precompute/precompute.h"
 
 void openblas_set_num_threads(int n);
@@ -116,33 +117,38 @@ static int group_teardown(void **state)
 	return 0;
 }
 
-/* A deform context in malloc'd memory, deliberately misaligned by 8. */
+/*
+ * A session with the deformation channel and its worker; the tests publish
+ * to the channel themselves (the engine is there, never ticked).
+ */
 struct ctx {
-	void *mem;
-	struct irdm_deform *d;
+	struct irdm_session *s;
+	struct irdm_deform *d;              /* the session's channel */
+	struct irdm_deform_worker *w;       /* and its worker */
 	double *pos;
 	const struct irdm_image *img;
 };
 
 static void ctx_init(struct ctx *c, const struct irdm_image *img)
 {
-	size_t sz = irdm_deform_mem_size(img);
+	struct irdm_session_config sc = { .deform = true };
 	char err[256];
 
-	assert_true(sz > 0);
+	irdm_engine_config_default(&sc.engine);
 	c->img = img;
-	c->mem = malloc(sz + 8);
 	c->pos = calloc(3 * (size_t)img->meta->n_nodes, sizeof(double));
-	assert_non_null(c->mem);
 	assert_non_null(c->pos);
-	if (irdm_deform_init(&c->d, img, (char *)c->mem + 8, sz, err, sizeof(err)))
-		fail_msg("deform init: %s", err);
-	assert_int_equal(irdm_deform_rows(c->d), img->meta->n_nodes);
+	if (irdm_session_open_image(&c->s, img, &sc, err, sizeof(err)) ||
+	    irdm_session_deform_open(c->s, err, sizeof(err)))
+		fail_msg("session: %s", err);
+	c->d = c->s->deform;
+	c->w = c->s->worker;
+	assert_int_equal(irdm_deform_rows(c->w), img->meta->n_nodes);
 }
 
 static void ctx_free(struct ctx *c)
 {
-	free(c->mem);
+	irdm_session_close(c->s);
 	free(c->pos);
 }
 
@@ -264,7 +270,7 @@ static double modal_case(int which)
 	ctx_init(&c, img);
 	force_tick(h, N_TICKS - 1, &ft);
 	irdm_deform_publish_modal(c.d, N_TICKS - 1, x, &ft, NULL);
-	assert_true(irdm_deform_update(c.d, c.pos, &tick));
+	assert_true(irdm_deform_update(c.w, c.pos, &tick));
 	assert_int_equal(tick, N_TICKS - 1);
 	e = rel_error(img, c.pos, uref);
 	ctx_free(&c);
@@ -320,7 +326,7 @@ static void test_fir(void **state)
 	ticks[ring.head].n++;
 	ctx_init(&c, img);
 	irdm_deform_publish_fir(c.d, N_TICKS - 1, &ring, NULL);
-	assert_true(irdm_deform_update(c.d, c.pos, &tick));
+	assert_true(irdm_deform_update(c.w, c.pos, &tick));
 	assert_int_equal(tick, N_TICKS - 1);
 	double e = rel_error(img, c.pos, uref);
 	print_message("FIR f64: relative error %.3g\n", e);
@@ -378,7 +384,7 @@ static void test_floating_pose(void **state)
 
 	/* undeformed: the rest shape rotated about the rest centre of mass */
 	irdm_deform_publish_modal(c.d, 1, x, NULL, &pose);
-	assert_true(irdm_deform_update(c.d, c.pos, &tick));
+	assert_true(irdm_deform_update(c.w, c.pos, &tick));
 	check_pose(img, c.pos, NULL, pose.com_m, 1e-12);
 
 	/* deformed: the deformation is applied in the body frame, then moved */
@@ -389,14 +395,14 @@ static void test_floating_pose(void **state)
 		umax = fmax(umax, fabs(uref[i]));
 	force_tick(h, N_TICKS - 1, &ft);
 	irdm_deform_publish_modal(c.d, 2, x, &ft, &pose);
-	assert_true(irdm_deform_update(c.d, c.pos, &tick));
+	assert_true(irdm_deform_update(c.w, c.pos, &tick));
 	check_pose(img, c.pos, uref, pose.com_m, 1e-9 * umax + 1e-12);
 
 	/* an unnormalised quaternion is the same rotation */
 	for (int i = 0; i < 4; i++)
 		pose.q[i] *= 3.0;
 	irdm_deform_publish_modal(c.d, 3, x, &ft, &pose);
-	assert_true(irdm_deform_update(c.d, c.pos, &tick));
+	assert_true(irdm_deform_update(c.w, c.pos, &tick));
 	check_pose(img, c.pos, uref, pose.com_m, 1e-9 * umax + 1e-12);
 	ctx_free(&c);
 	free(h);
@@ -416,7 +422,7 @@ static void test_grounded_ignores_pose(void **state)
 	assert_non_null(x);
 	ctx_init(&c, img);
 	irdm_deform_publish_modal(c.d, 1, x, NULL, &pose);
-	assert_true(irdm_deform_update(c.d, c.pos, &tick));
+	assert_true(irdm_deform_update(c.w, c.pos, &tick));
 	for (uint32_t r = 0; r < img->meta->n_nodes; r++)
 		for (int i = 0; i < 3; i++)
 			assert_close(c.pos[3 * r + (uint32_t)i], img->nodes[r].pos_m[i], 0);
@@ -436,21 +442,21 @@ static void test_newest_and_nothing_new(void **state)
 	(void)state;
 	assert_non_null(x);
 	ctx_init(&c, img);
-	assert_false(irdm_deform_update(c.d, c.pos, &tick));
+	assert_false(irdm_deform_update(c.w, c.pos, &tick));
 	for (uint64_t t = 1; t <= 3; t++)
 		irdm_deform_publish_modal(c.d, t, x, NULL, NULL);
-	assert_true(irdm_deform_update(c.d, c.pos, &tick));
+	assert_true(irdm_deform_update(c.w, c.pos, &tick));
 	assert_int_equal(tick, 3);
-	assert_false(irdm_deform_update(c.d, c.pos, &tick));
+	assert_false(irdm_deform_update(c.w, c.pos, &tick));
 	assert_int_equal(tick, 3);
 	irdm_deform_publish_modal(c.d, 4, x, NULL, NULL);
-	assert_true(irdm_deform_update(c.d, c.pos, &tick));
+	assert_true(irdm_deform_update(c.w, c.pos, &tick));
 	assert_int_equal(tick, 4);
-	assert_false(irdm_deform_update(c.d, c.pos, &tick));
+	assert_false(irdm_deform_update(c.w, c.pos, &tick));
 	/* a publish of the wrong representation is ignored */
 	struct irdm_fir_ring ring = { 0 };
 	irdm_deform_publish_fir(c.d, 5, &ring, NULL);
-	assert_false(irdm_deform_update(c.d, c.pos, &tick));
+	assert_false(irdm_deform_update(c.w, c.pos, &tick));
 	ctx_free(&c);
 	free(x);
 }
@@ -458,21 +464,82 @@ static void test_newest_and_nothing_new(void **state)
 static void test_init_errors(void **state)
 {
 	const struct irdm_image *img = &images[IMG_MODAL64];
-	size_t sz = irdm_deform_mem_size(img);
-	void *mem = malloc(sz);
+	size_t sz = irdm_deform_mem_size(img), wsz = irdm_deform_worker_mem_size(img);
+	void *mem = malloc(sz), *wmem = malloc(wsz);
+	struct irdm_session_config sc = { .deform = false };
+	struct irdm_session *s;
+	struct irdm_deform_worker *w;
 	struct irdm_deform *d;
 	struct irdm_image bad = { 0 };
 	char err[256];
 
 	(void)state;
 	assert_non_null(mem);
+	assert_non_null(wmem);
 	assert_int_equal(irdm_deform_mem_size(&bad), 0);
-	assert_int_equal(irdm_deform_init(&d, &bad, mem, sz, err, sizeof(err)), IRDM_DEFORM_EINVAL);
-	assert_int_equal(irdm_deform_init(&d, img, mem, sz - 65, err, sizeof(err)),
-			 IRDM_DEFORM_ENOMEM);
+	assert_int_equal(irdm_deform_worker_mem_size(&bad), 0);
+	assert_int_equal(irdm_deform_init(&d, &bad, mem, sz, err, sizeof(err)), IRDM_EINVAL);
+	assert_int_equal(irdm_deform_init(&d, img, mem, sz - 65, err, sizeof(err)), IRDM_ENOMEM);
 	assert_null(d);
 	assert_non_null(strstr(err, "needed"));
+	assert_int_equal(irdm_deform_worker_init(&w, NULL, wmem, wsz, err, sizeof(err)), IRDM_EINVAL);
+	assert_int_equal(irdm_deform_init(&d, img, mem, sz, err, sizeof(err)), IRDM_OK);
+	assert_int_equal(irdm_deform_worker_init(&w, d, wmem, wsz - 65, err, sizeof(err)),
+			 IRDM_ENOMEM);
+	assert_null(w);
+	assert_non_null(strstr(err, "needed"));
+
+	/* a session without the channel has nothing for a worker to read */
+	irdm_engine_config_default(&sc.engine);
+	assert_int_equal(irdm_session_open_image(&s, img, &sc, err, sizeof(err)), IRDM_OK);
+	assert_null(s->deform);
+	assert_int_equal(irdm_session_deform_open(s, err, sizeof(err)), IRDM_EINVAL);
+	irdm_session_close(s);
+	/* one worker per channel */
+	sc.deform = true;
+	assert_int_equal(irdm_session_open_image(&s, img, &sc, err, sizeof(err)), IRDM_OK);
+	assert_int_equal(irdm_session_deform_open(s, err, sizeof(err)), IRDM_OK);
+	assert_int_equal(irdm_session_deform_open(s, err, sizeof(err)), IRDM_EBUSY);
+	irdm_session_close(s);
+	/* a configuration the engine refuses */
+	sc.engine.max_contacts = IRDM_MAX_CONTACTS + 1;
+	assert_int_equal(irdm_session_open_image(&s, img, &sc, err, sizeof(err)), IRDM_EINVAL);
+	assert_null(s);
 	free(mem);
+	free(wmem);
+}
+
+/* Channel and worker in memory of any alignment (here 8 past malloc's). */
+static void test_misaligned_memory(void **state)
+{
+	const struct irdm_image *img = &images[IMG_MODAL16];
+	size_t sz = irdm_deform_mem_size(img), wsz = irdm_deform_worker_mem_size(img);
+	char *mem = malloc(sz + 8), *wmem = malloc(wsz + 8);
+	double *x = calloc(2 * img->meta->n_modes, sizeof(double));
+	double *pos = calloc(3 * (size_t)img->meta->n_nodes, sizeof(double));
+	struct irdm_deform_worker *w = NULL;
+	struct irdm_deform *d = NULL;
+	uint64_t tick = 0;
+	char err[256];
+
+	(void)state;
+	assert_non_null(mem);
+	assert_non_null(wmem);
+	assert_non_null(x);
+	assert_non_null(pos);
+	if (irdm_deform_init(&d, img, mem + 8, sz, err, sizeof(err)) ||
+	    irdm_deform_worker_init(&w, d, wmem + 8, wsz, err, sizeof(err)))
+		fail_msg("deform init: %s", err);
+	irdm_deform_publish_modal(d, 7, x, NULL, NULL);
+	assert_true(irdm_deform_update(w, pos, &tick));
+	assert_int_equal(tick, 7);
+	for (uint32_t r = 0; r < img->meta->n_nodes; r++)
+		for (int i = 0; i < 3; i++)
+			assert_close(pos[3 * r + (uint32_t)i], img->nodes[r].pos_m[i], 0);
+	free(mem);
+	free(wmem);
+	free(x);
+	free(pos);
 }
 
 /*
@@ -568,7 +635,7 @@ static void test_no_torn_snapshot(void **state)
 	hm.d = c.d;
 	hammer_state(1, hm.K, hm.col, x, &ft);
 	irdm_deform_publish_modal(c.d, 1, x, &ft, NULL);
-	assert_true(irdm_deform_update(c.d, c.pos, &tick));
+	assert_true(irdm_deform_update(c.w, c.pos, &tick));
 	for (uint32_t k = 0; k < n3; k++)
 		w[k] = c.pos[k] - img->nodes[k / 3].pos_m[k % 3];
 	for (uint32_t k = 0; k < n3; k++)
@@ -580,7 +647,7 @@ static void test_no_torn_snapshot(void **state)
 	atomic_init(&hm.last, 0);
 	assert_int_equal(pthread_create(&tid, NULL, hammer_writer, &hm), 0);
 	while (!atomic_load(&hm.done)) {
-		if (!irdm_deform_update(c.d, c.pos, &tick))
+		if (!irdm_deform_update(c.w, c.pos, &tick))
 			continue;
 		assert_true(tick > last);         /* never an old one again */
 		check_linear(img, c.pos, w, wmax, tick);
@@ -590,12 +657,12 @@ static void test_no_torn_snapshot(void **state)
 	}
 	pthread_join(tid, NULL);
 	/* the newest is there once, then nothing */
-	if (irdm_deform_update(c.d, c.pos, &tick)) {
+	if (irdm_deform_update(c.w, c.pos, &tick)) {
 		check_linear(img, c.pos, w, wmax, tick);
 		last = tick;
 	}
 	assert_int_equal(last, atomic_load(&hm.last));
-	assert_false(irdm_deform_update(c.d, c.pos, &tick));
+	assert_false(irdm_deform_update(c.w, c.pos, &tick));
 	print_message("triple buffer: %llu consistent frames read during %llu publishes\n",
 		      (unsigned long long)frames, (unsigned long long)last);
 	assert_true(frames > 0);
@@ -652,15 +719,15 @@ static void run_thread(struct frames *fr)
 	memset(fr, 0, sizeof(*fr));
 	atomic_store(&fr->finite, true);
 	fr->n3 = 3 * img->meta->n_nodes;
-	assert_int_equal(irdm_deform_thread_start(&th, c.d, 0, on_frame, fr, err, sizeof(err)),
-			 IRDM_DEFORM_EINVAL);
-	if (irdm_deform_thread_start(&th, c.d, 500, on_frame, fr, err, sizeof(err)))
+	assert_int_equal(irdm_deform_thread_start(&th, c.w, 0, on_frame, fr, err, sizeof(err)),
+			 IRDM_EINVAL);
+	if (irdm_deform_thread_start(&th, c.w, 500, on_frame, fr, err, sizeof(err)))
 		fail_msg("%s", err);
 	if (err[0])
 		print_message("%s\n", err);
 	struct irdm_deform_thread *th2;
-	assert_int_equal(irdm_deform_thread_start(&th2, c.d, 500, on_frame, fr, err, sizeof(err)),
-			 IRDM_DEFORM_EBUSY);
+	assert_int_equal(irdm_deform_thread_start(&th2, c.w, 500, on_frame, fr, err, sizeof(err)),
+			 IRDM_EBUSY);
 	for (uint64_t t = 1; t <= 5; t++) {
 		x[0] = 1e-3 * (double)t;
 		irdm_deform_publish_modal(c.d, t, x, NULL, NULL);
@@ -716,6 +783,7 @@ int main(void)
 		cmocka_unit_test(test_grounded_ignores_pose),
 		cmocka_unit_test(test_newest_and_nothing_new),
 		cmocka_unit_test(test_init_errors),
+		cmocka_unit_test(test_misaligned_memory),
 		cmocka_unit_test(test_no_torn_snapshot),
 		cmocka_unit_test(test_thread_other),
 		cmocka_unit_test(test_thread_fifo),

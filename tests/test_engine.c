@@ -63,7 +63,8 @@ static void run_engine(const struct irdm_image *img, const struct irdm_contact_s
 
 	irdm_engine_config_default(&cfg);
 	cfg.max_contacts = (unsigned)m;
-	struct irdm_engine *e = efx_engine(img, &cfg);
+	struct irdm_session *ses = efx_session(img, &cfg);
+	struct irdm_engine *e = ses->eng;
 	for (size_t t = 0; t < N; t++) {
 		memset(cmd, 0, sizeof(cmd));
 		for (int i = 0; i < m; i++) {
@@ -81,7 +82,7 @@ static void run_engine(const struct irdm_image *img, const struct irdm_contact_s
 			memcpy(&F[t * 3 * (size_t)m + 3 * (size_t)i], irdm_engine_contact(e, (unsigned)i)->force_n,
 			       3 * sizeof(double));
 	}
-	efx_engine_free(e);
+	irdm_session_close(ses);
 }
 
 static void node_site(const struct irdm_image *img, const double p[3], struct irdm_contact_site *s)
@@ -89,9 +90,10 @@ static void node_site(const struct irdm_image *img, const double p[3], struct ir
 	struct irdm_engine_config cfg;
 
 	irdm_engine_config_default(&cfg);
-	struct irdm_engine *e = efx_engine(img, &cfg);
+	struct irdm_session *ses = efx_session(img, &cfg);
+	struct irdm_engine *e = ses->eng;
 	assert_int_equal(irdm_engine_site_node(e, efx_column_row_near(img, p), s), 0);
-	efx_engine_free(e);
+	irdm_session_close(ses);
 }
 
 static void compare(const char *what, const struct irdm_image *img,
@@ -267,7 +269,8 @@ static void test_stroke(void **state)
 	(void)state;
 	irdm_engine_config_default(&cfg);
 	cfg.max_contacts = 1;
-	struct irdm_engine *e = efx_engine(&exact, &cfg);
+	struct irdm_session *ses = efx_session(&exact, &cfg);
+	struct irdm_engine *e = ses->eng;
 	unsigned changes = 0;
 	for (size_t t = 0; t < N_STROKE; t++) {
 		double p[3] = { 0.02 + 0.06 * (double)t / N_STROKE, 0.043, 0.2 }, bary[3];
@@ -284,7 +287,7 @@ static void test_stroke(void **state)
 		assert_int_equal(irdm_engine_contact(e, 0)->mode, IRDM_CONTACT_PUSH);
 		memcpy(&F[3 * t], irdm_engine_contact(e, 0)->force_n, 3 * sizeof(double));
 	}
-	efx_engine_free(e);
+	irdm_session_close(ses);
 	stroke_reference(&exact, sites, u, R);
 	double err = efx_rel_rms(F, R, N_STROKE * 3);
 	/*

@@ -50,8 +50,9 @@
 
 #include <cmocka.h>
 
-#include "irdm/deform.h"
+#include "irdm/deform_worker.h"
 #include "irdm/engine.h"
+#include "irdm/session.h"
 #include "support/engine_fixture.h"
 
 /*
@@ -364,9 +365,8 @@ static struct irdm_image modal_img, fir_img;
 
 struct rig {
 	const struct irdm_image *img;
-	void *mem, *dmem;
-	struct irdm_engine *e;
-	struct irdm_deform *d;
+	struct irdm_session *s;        /* engine, deformation channel and worker */
+	struct irdm_engine *e;         /* the session's */
 	uint32_t push_row[4];          /* the push slides over these */
 	int n_push;
 	struct irdm_contact_site grab;
@@ -435,28 +435,18 @@ static void rig_init(struct rig *r, const struct irdm_image *img)
 {
 	static const double push_at[2][3] = { { 0.035, 0.05, 0.2 }, { 0.05, 0.05, 0.2 } };
 	const double grab_at[3] = { 0.07, 0.05, 0.2 };
-	struct irdm_engine_config cfg;
+	struct irdm_session_config sc = { .deform = true };
 	char err[512];
-	size_t n, dn;
 	uint32_t tri = 0;
 
 	memset(r, 0, sizeof(*r));
 	r->img = img;
-	irdm_engine_config_haptic(&cfg, img->meta->dt_s, DEVICE_K, DEVICE_B, DEVICE_F);
-	cfg.publish_every = PUBLISH_EVERY;
-	n = irdm_engine_mem_size(img, &cfg);
-	assert_true(n > 0);
-	r->mem = aligned_alloc(64, (n + 63) & ~(size_t)63);
-	assert_non_null(r->mem);
-	if (irdm_engine_init(&r->e, img, &cfg, r->mem, n, err, sizeof(err)))
-		fail_msg("engine init: %s", err);
-	dn = irdm_deform_mem_size(img);
-	assert_true(dn > 0);
-	r->dmem = aligned_alloc(64, (dn + 63) & ~(size_t)63);
-	assert_non_null(r->dmem);
-	if (irdm_deform_init(&r->d, img, r->dmem, dn, err, sizeof(err)))
-		fail_msg("deform init: %s", err);
-	irdm_engine_attach_deform(r->e, r->d);
+	irdm_engine_config_haptic(&sc.engine, img->meta->dt_s, DEVICE_K, DEVICE_B, DEVICE_F);
+	sc.engine.publish_every = PUBLISH_EVERY;
+	if (irdm_session_open_image(&r->s, img, &sc, err, sizeof(err)) ||
+	    irdm_session_deform_open(r->s, err, sizeof(err)))
+		fail_msg("session: %s", err);
+	r->e = r->s->eng;
 
 	/* push: alternates between two neighbouring top nodes, so each slide
 	 * lands on a new node */
@@ -484,8 +474,7 @@ static void rig_init(struct rig *r, const struct irdm_image *img)
 
 static void rig_free(struct rig *r)
 {
-	free(r->mem);
-	free(r->dmem);
+	irdm_session_close(r->s);
 }
 
 /*
@@ -627,7 +616,7 @@ static void alloc_and_fault_free(const struct irdm_image *img)
 	/* the snapshots did go out: the newest is the last multiple of 16 */
 	double *pos = malloc(3 * (size_t)img->meta->n_nodes * sizeof(double));
 	uint64_t tick = 0;
-	bool updated = pos && irdm_deform_update(r.d, pos, &tick), pos_finite = true;
+	bool updated = pos && irdm_deform_update(r.s->worker, pos, &tick), pos_finite = true;
 	for (size_t i = 0; updated && i < 3 * (size_t)img->meta->n_nodes; i++)
 		pos_finite = pos_finite && isfinite(pos[i]);
 	free(pos);

@@ -259,7 +259,8 @@ static void engine_run(const struct irdm_contact_site *site, const double *targe
 
 	irdm_engine_config_default(&cfg);
 	cfg.max_contacts = 1;
-	struct irdm_engine *e = efx_engine(&cube, &cfg);
+	struct irdm_session *ses = efx_session(&cube, &cfg);
+	struct irdm_engine *e = ses->eng;
 	for (size_t t = 0; t < N_TICKS; t++) {
 		memset(cmd, 0, sizeof(cmd));
 		if (!isnan(target[3 * t])) {
@@ -271,7 +272,7 @@ static void engine_run(const struct irdm_contact_site *site, const double *targe
 		assert_int_equal(irdm_engine_tick(e, cmd), 0);
 		memcpy(&F[3 * t], irdm_engine_contact(e, 0)->force_n, 3 * sizeof(double));
 	}
-	efx_engine_free(e);
+	irdm_session_close(ses);
 }
 
 static void compare(const char *what, const double *target)
@@ -282,9 +283,10 @@ static void compare(const char *what, const double *target)
 	double *Fe = malloc(N_TICKS * 3 * sizeof(double)), *Fr = malloc(N_TICKS * 3 * sizeof(double));
 
 	irdm_engine_config_default(&cfg);
-	struct irdm_engine *e = efx_engine(&cube, &cfg);
+	struct irdm_session *ses = efx_session(&cube, &cfg);
+	struct irdm_engine *e = ses->eng;
 	assert_int_equal(irdm_engine_site_node(e, efx_column_row_near(&cube, top), &site), 0);
-	efx_engine_free(e);
+	irdm_session_close(ses);
 	engine_run(&site, target, Fe);
 	reference(&site, target, Fr);
 	double err = efx_rel_rms(Fe, Fr, N_TICKS * 3), peak = 0;

@@ -43,7 +43,8 @@ static void test_retouch_sees_the_deformed_surface(void **state)
 		  "display", "touch", NULL);
 	irdm_engine_config_haptic(&cfg, img.meta->dt_s, 1000, 5, 7.9);
 	cfg.max_contacts = 1;
-	struct irdm_engine *e = efx_engine(&img, &cfg);
+	struct irdm_session *ses = efx_session(&img, &cfg);
+	struct irdm_engine *e = ses->eng;
 	assert_int_equal(irdm_contact_mesh_init(&cm, &img), 0);
 	irdm_proxy_config_default(&pcfg);
 	pcfg.max_disp_m = 0.05;
@@ -99,7 +100,7 @@ static void test_retouch_sees_the_deformed_surface(void **state)
 	assert_true(fabs(surface_touch - 0.2) > 5e-4);
 	assert_true(surface_touch - z_touch >= 0 && surface_touch - z_touch < 1e-4);
 	assert_true(max_f <= 7.9);
-	efx_engine_free(e);
+	irdm_session_close(ses);
 	irdm_image_unmap(&img);
 	snprintf(cmdline, sizeof(cmdline), "rm -rf '%s'", dir);
 	assert_int_equal(system(cmdline), 0);

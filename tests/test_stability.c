@@ -64,7 +64,8 @@ static struct outcome hold_step(const struct irdm_image *img, double seconds)
 	double work = 0;
 
 	irdm_engine_config_haptic(&cfg, img->meta->dt_s, DEVICE_K, DEVICE_B, 0 /* observe, no fault */);
-	struct irdm_engine *e = efx_engine(img, &cfg);
+	struct irdm_session *ses = efx_session(img, &cfg);
+	struct irdm_engine *e = ses->eng;
 	assert_int_equal(irdm_engine_site_node(e, efx_column_row_near(img, top), &site), 0);
 	memset(cmd, 0, sizeof(cmd));
 	cmd[0].mode = IRDM_CONTACT_PUSH;
@@ -100,7 +101,7 @@ static struct outcome hold_step(const struct irdm_image *img, double seconds)
 	}
 	o.first_rms = sqrt(o.first_rms / (double)tenth);
 	o.last_rms = sqrt(o.last_rms / (double)tenth);
-	efx_engine_free(e);
+	irdm_session_close(ses);
 	return o;
 }
 

@@ -13,7 +13,7 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "deform_priv.h"
+#include "worker_priv.h"
 
 /* OpenBLAS's own; not in every cblas.h. */
 void openblas_set_num_threads(int n);
@@ -75,8 +75,8 @@ static void *deform_thread(void *arg)
 	clock_gettime(CLOCK_MONOTONIC, &next);
 	while (!atomic_load_explicit(&th->stop, memory_order_acquire)) {
 		uint64_t tick;
-		if (irdm_deform_update(th->d, th->d->frame_pos, &tick))
-			th->frame(th->ctx, th->d->frame_pos, tick);
+		if (irdm_deform_update(th->w, th->w->frame_pos, &tick))
+			th->frame(th->ctx, th->w->frame_pos, tick);
 		timespec_add(&next, &th->period);
 		/* a display frame late is a frame lost: skip, never catch up */
 		clock_gettime(CLOCK_MONOTONIC, &now);
@@ -139,12 +139,12 @@ static bool caller_is_rt(void)
 	       (policy == SCHED_FIFO || policy == SCHED_RR);
 }
 
-int irdm_deform_thread_start(struct irdm_deform_thread **thp, struct irdm_deform *d,
+int irdm_deform_thread_start(struct irdm_deform_thread **thp, struct irdm_deform_worker *w,
 			     double rate_hz, void (*frame)(void *ctx, const double *pos_m,
 							   uint64_t tick),
 			     void *ctx, char *err, size_t errlen)
 {
-	struct irdm_deform_thread *th = &d->th;
+	struct irdm_deform_thread *th = &w->th;
 	double period;
 	int rc;
 
@@ -152,14 +152,14 @@ int irdm_deform_thread_start(struct irdm_deform_thread **thp, struct irdm_deform
 	if (!frame || !(rate_hz > 0) || rate_hz > IRDM_DEFORM_MAX_RATE_HZ) {
 		snprintf(err, errlen, "deform thread: rate %g Hz not in (0, %g]", rate_hz,
 			 IRDM_DEFORM_MAX_RATE_HZ);
-		return IRDM_DEFORM_EINVAL;
+		return IRDM_EINVAL;
 	}
 	if (th->running) {
 		snprintf(err, errlen, "deform thread: already running");
-		return IRDM_DEFORM_EBUSY;
+		return IRDM_EBUSY;
 	}
 	period = 1.0 / rate_hz;
-	th->d = d;
+	th->w = w;
 	th->frame = frame;
 	th->ctx = ctx;
 	th->period.tv_sec = (time_t)period;
@@ -168,7 +168,7 @@ int irdm_deform_thread_start(struct irdm_deform_thread **thp, struct irdm_deform
 	atomic_store(&th->stop, false);
 	if (sem_init(&th->started, 0, 0)) {
 		snprintf(err, errlen, "deform thread: sem_init: %s", strerror(errno));
-		return IRDM_DEFORM_ETHREAD;
+		return IRDM_ETHREAD;
 	}
 	openblas_set_num_threads(IRDM_DEFORM_BLAS_THREADS);
 	if (err && errlen)
@@ -191,10 +191,10 @@ int irdm_deform_thread_start(struct irdm_deform_thread **thp, struct irdm_deform
 			 DEFORM_NICE, strerror(th->prio_errno));
 	th->running = true;
 	*thp = th;
-	return IRDM_DEFORM_OK;
+	return IRDM_OK;
 fail:
 	sem_destroy(&th->started);
-	return IRDM_DEFORM_ETHREAD;
+	return IRDM_ETHREAD;
 }
 
 void irdm_deform_thread_stop(struct irdm_deform_thread *th)

@@ -23,14 +23,14 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/mman.h>
-#include <sys/stat.h>
 #include <sys/utsname.h>
 #include <time.h>
 #include <unistd.h>
 
 #include "irdm/engine.h"
 #include "irdm/image.h"
-#include "precompute/precompute.h"
+#include "irdm/session.h"
+#include "../support/bench_util.h"
 #include "../support/engine_fixture.h"
 
 #define N_TICKS 20000
@@ -54,72 +54,11 @@ struct figures {
 	bool ok;
 };
 
-static double ts_ns(const struct timespec *a, const struct timespec *b)
-{
-	return (double)(b->tv_sec - a->tv_sec) * 1e9 + (double)(b->tv_nsec - a->tv_nsec);
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-	double x = *(const double *)a, y = *(const double *)b;
-
-	return (x > y) - (x < y);
-}
-
-static bool file_exists(const char *path)
-{
-	struct stat st;
-
-	return !stat(path, &st);
-}
-
 static void pause_untimed(void)
 {
 	struct timespec d = { 0, PAUSE_NS };
 
 	clock_nanosleep(CLOCK_MONOTONIC, 0, &d, NULL);
-}
-
-/* ---- images ---- */
-
-/*
- * The image at path, made when missing: from a scene file (if given), then
- * the key/value pairs on top (NULL-terminated).
- */
-static int ensure_image(const char *path, const char *scene_file, const char *const *kv)
-{
-	struct irdm_scene sc;
-	struct irdm_precompute_opts o = { .out_path = path };
-	struct irdm_precompute_report rep;
-	char err[1024];
-	struct timespec t0, t1;
-
-	if (file_exists(path))
-		return 0;
-	if ((mkdir("out", 0777) && errno != EEXIST) || (mkdir("out/bench", 0777) && errno != EEXIST)) {
-		fprintf(stderr, "tick  cannot create out/bench: %s\n", strerror(errno));
-		return -1;
-	}
-	irdm_scene_defaults(&sc);
-	if (scene_file && irdm_scene_load(&sc, scene_file, err, sizeof(err)))
-		goto fail;
-	for (; kv && kv[0]; kv += 2)
-		if (irdm_scene_set(&sc, kv[0], kv[1], "bench", err, sizeof(err)))
-			goto fail;
-	if (irdm_scene_check(&sc, err, sizeof(err)))
-		goto fail;
-	printf("tick  precomputing %s ...\n", path);
-	fflush(stdout);
-	clock_gettime(CLOCK_MONOTONIC, &t0);
-	if (irdm_precompute(&sc, &o, &rep, err, sizeof(err)))
-		goto fail;
-	clock_gettime(CLOCK_MONOTONIC, &t1);
-	printf("tick  precomputed %s in %.0f s (%zu modes of %zu, %zu columns)\n", path,
-	       ts_ns(&t0, &t1) * 1e-9, rep.modes, rep.modes_total, rep.cols);
-	return 0;
-fail:
-	fprintf(stderr, "tick  %s: %s\n", path, err);
-	return -1;
 }
 
 /* ---- contact sites ---- */
@@ -197,14 +136,14 @@ static struct figures bench_case(const char *scene, const char *repr, const stru
 				 const struct sites *st, enum kase k)
 {
 	struct figures fig = { 0, 0, 0, false };
-	struct irdm_engine_config cfg;
+	struct irdm_session_config sc = { .deform = false };
 	struct irdm_contact_cmd cmd[IRDM_MAX_CONTACTS];
 	struct irdm_contact_site site[2];
+	struct irdm_session *ses;
 	struct irdm_engine *e;
+	struct bench_stats bs;
 	unsigned n_contacts = k == K_FREE ? 0 : k == K_NODES ? 2 : 1;
 	char err[512];
-	size_t n;
-	void *mem;
 	int rc = 0;
 
 	if (k == K_TRI && !st->have_tri) {
@@ -212,15 +151,13 @@ static struct figures bench_case(const char *scene, const char *repr, const stru
 		       scene, repr, kase_name[k]);
 		return fig;
 	}
-	irdm_engine_config_haptic(&cfg, img->meta->dt_s, DEVICE_K, DEVICE_B, 0 /* no limit */);
-	n = irdm_engine_mem_size(img, &cfg);
-	mem = n ? aligned_alloc(64, (n + 63) & ~(size_t)63) : NULL;
-	if (!mem || irdm_engine_init(&e, img, &cfg, mem, n, err, sizeof(err))) {
+	irdm_engine_config_haptic(&sc.engine, img->meta->dt_s, DEVICE_K, DEVICE_B, 0 /* no limit */);
+	if (irdm_session_open_image(&ses, img, &sc, err, sizeof(err))) {
 		printf("tick  %-14s %-16s %s  engine init failed: %s\n", scene, repr, kase_name[k],
-		       mem ? err : "out of memory");
-		free(mem);
+		       err);
 		return fig;
 	}
+	e = ses->eng;
 	memset(cmd, 0, sizeof(cmd));
 	for (unsigned i = 0; i < n_contacts; i++) {
 		if (k == K_TRI) {
@@ -232,7 +169,7 @@ static struct figures bench_case(const char *scene, const char *repr, const stru
 		if (rc || (rc = irdm_engine_contact_begin(e, i, &site[i], IRDM_CONTACT_GRAB))) {
 			printf("tick  %-14s %-16s %s  contact site failed (%d)\n", scene, repr,
 			       kase_name[k], rc);
-			free(mem);
+			irdm_session_close(ses);
 			return fig;
 		}
 		cmd[i].mode = IRDM_CONTACT_GRAB;
@@ -254,18 +191,18 @@ static struct figures bench_case(const char *scene, const char *repr, const stru
 		rc = irdm_engine_tick(e, cmd);
 		clock_gettime(CLOCK_MONOTONIC, &t1);
 		if (t >= 0)
-			samples[t] = ts_ns(&t0, &t1) * 1e-3;
+			samples[t] = bench_elapsed_ns(&t0, &t1) * 1e-3;
 	}
 	if (rc) {
 		printf("tick  %-14s %-16s %s  the engine faulted (%d): no figures\n", scene, repr,
 		       kase_name[k], rc);
-		free(mem);
+		irdm_session_close(ses);
 		return fig;
 	}
-	qsort(samples, N_TICKS, sizeof(*samples), cmp_double);
-	fig.median = samples[N_TICKS / 2];
-	fig.p99 = samples[(size_t)N_TICKS * 99 / 100];
-	fig.max = samples[N_TICKS - 1];
+	bench_stats(samples, N_TICKS, &bs);
+	fig.median = bs.median;
+	fig.p99 = bs.p99;
+	fig.max = bs.max;
 	fig.ok = true;
 	const double *f = irdm_engine_contact(e, 0)->force_n;
 	printf("tick  %-14s %-16s %s  median %6.2f us  p99 %6.2f us  max %7.2f us  (|F0| %.3f N, PC %llu)\n",
@@ -273,7 +210,7 @@ static struct figures bench_case(const char *scene, const char *repr, const stru
 	       sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]),
 	       (unsigned long long)irdm_engine_stats(e)->pc_activations);
 	fflush(stdout);
-	free(mem);
+	irdm_session_close(ses);
 	return fig;
 }
 
@@ -366,11 +303,12 @@ static void header(void)
 	for (int i = 0; i < N_TICKS; i++) {
 		clock_gettime(CLOCK_MONOTONIC, &a);
 		clock_gettime(CLOCK_MONOTONIC, &b);
-		samples[i] = ts_ns(&a, &b) * 1e-3;
+		samples[i] = bench_elapsed_ns(&a, &b) * 1e-3;
 	}
-	qsort(samples, N_TICKS, sizeof(*samples), cmp_double);
+	struct bench_stats st;
+	bench_stats(samples, N_TICKS, &st);
 	printf("tick  timer overhead (two clock_gettime): median %.3f us, max %.2f us\n",
-	       samples[N_TICKS / 2], samples[N_TICKS - 1]);
+	       st.median, st.max);
 	printf("tick  %d ticks timed one by one after %d warm-up ticks; %ld us pause every %d ticks (untimed); "
 	       "haptic coupling %.0f N/m + passivity control, grab contacts\n",
 	       N_TICKS, N_WARMUP, PAUSE_NS / 1000, PAUSE_EVERY, DEVICE_K);
@@ -423,12 +361,16 @@ int main(void)
 	 *    patch of the top touchable.  The modal tick is linear in the
 	 *    number of modes.
 	 */
-	int have_fir = !ensure_image("out/bench/cuboid-fir500-patch.img", NULL, fir_kv);
-	int have_m300 = !ensure_image("out/bench/cuboid-paper.img", "scenes/cuboid-paper.scene", NULL);
-	int have_mall = !ensure_image("out/bench/cuboid-6x6x12-all.img", NULL, all_kv);
-	int have_bunny = file_exists("out/bench/bunny.img");
-	if (!have_bunny && file_exists("build/data/bunny.off"))
-		have_bunny = !ensure_image("out/bench/bunny.img", "scenes/bunny.scene", NULL);
+	int have_fir = !bench_ensure_image("tick", "out/bench/cuboid-fir500-patch.img", NULL,
+					   fir_kv);
+	int have_m300 = !bench_ensure_image("tick", "out/bench/cuboid-paper.img",
+					    "scenes/cuboid-paper.scene", NULL);
+	int have_mall = !bench_ensure_image("tick", "out/bench/cuboid-6x6x12-all.img", NULL,
+					    all_kv);
+	int have_bunny = bench_file_exists("out/bench/bunny.img");
+	if (!have_bunny && bench_file_exists("build/data/bunny.off"))
+		have_bunny = !bench_ensure_image("tick", "out/bench/bunny.img", "scenes/bunny.scene",
+						 NULL);
 
 	header();
 	if (have_fir)

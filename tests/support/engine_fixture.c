@@ -35,23 +35,15 @@ void efx_image(struct irdm_image *img, const char *path, ...)
 		fail_msg("map: %s", err);
 }
 
-struct irdm_engine *efx_engine(const struct irdm_image *img, const struct irdm_engine_config *cfg)
+struct irdm_session *efx_session(const struct irdm_image *img, const struct irdm_engine_config *cfg)
 {
-	size_t n = irdm_engine_mem_size(img, cfg);
-	void *mem = n ? aligned_alloc(64, (n + 63) & ~(size_t)63) : NULL;
-	struct irdm_engine *e;
+	struct irdm_session_config sc = { .engine = *cfg };
+	struct irdm_session *s;
 	char err[512];
 
-	assert_non_null(mem);
-	if (irdm_engine_init(&e, img, cfg, mem, n, err, sizeof(err)))
-		fail_msg("engine init: %s", err);
-	assert_ptr_equal(e, mem);
-	return e;
-}
-
-void efx_engine_free(struct irdm_engine *e)
-{
-	free(e);   /* the engine lives at the start of its memory */
+	if (irdm_session_open_image(&s, img, &sc, err, sizeof(err)))
+		fail_msg("session: %s", err);
+	return s;
 }
 
 uint32_t efx_column_row_near(const struct irdm_image *img, const double p[3])

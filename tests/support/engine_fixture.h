@@ -5,14 +5,15 @@
 
 #include "irdm/engine.h"
 #include "irdm/image.h"
+#include "irdm/session.h"
 
 /* Build an image with the library from "key=value" pairs (NULL-terminated),
  * map it.  Aborts the test on failure. */
 void efx_image(struct irdm_image *img, const char *path, ...);
 
-/* An engine in malloc'd memory (freed by efx_engine_free). */
-struct irdm_engine *efx_engine(const struct irdm_image *img, const struct irdm_engine_config *cfg);
-void efx_engine_free(struct irdm_engine *e);
+/* A session (engine only) on img, which it borrows; aborts the test on
+ * failure.  irdm_session_close() frees it. */
+struct irdm_session *efx_session(const struct irdm_image *img, const struct irdm_engine_config *cfg);
 
 /*
  * Brute-force reference: forces at contact sites (fixed per run, m sites)

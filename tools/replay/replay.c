@@ -7,7 +7,8 @@
 
 #include "image/image_response.h"
 #include "irdm/contact.h"
-#include "irdm/deform.h"
+#include "irdm/deform_worker.h"
+#include "irdm/session.h"
 #include "replay/replay.h"
 
 #define MAX_NODES_OUT 256
@@ -194,12 +195,10 @@ static int parse_nodes(const char *list, const struct irdm_image *img, uint32_t 
 /* ---- the run ---- */
 
 struct run {
-	struct irdm_image img;
+	struct irdm_session *s;         /* image, engine, deformation of the --nodes */
+	const struct irdm_image *img;   /* the session's */
+	struct irdm_engine *eng;        /* the session's */
 	struct trajectory tr;
-	void *mem;
-	struct irdm_engine *eng;
-	void *dmem;
-	struct irdm_deform *deform;     /* displacements of the --nodes */
 	double *pos;                    /* every image node's position */
 	struct irdm_contact_site site[IRDM_MAX_CONTACTS];
 	uint32_t rows[MAX_NODES_OUT], mesh[MAX_NODES_OUT];
@@ -208,50 +207,38 @@ struct run {
 	char tmp[4096];
 };
 
-/* The deformation context gives any node's position (world, for floating). */
+/* The deformation worker gives any node's position (world, for floating). */
 static int start_deform(struct run *r, char *err, size_t errlen)
 {
-	size_t need = irdm_deform_mem_size(&r->img);
-
-	r->dmem = need ? aligned_alloc(64, (need + 63) & ~(size_t)63) : NULL;
-	r->pos = malloc(3 * (size_t)r->img.meta->n_nodes * sizeof(double));
-	if (!r->dmem || !r->pos) {
+	r->pos = malloc(3 * (size_t)r->img->meta->n_nodes * sizeof(double));
+	if (!r->pos) {
 		snprintf(err, errlen, "--nodes: out of memory");
 		return -1;
 	}
-	if (irdm_deform_init(&r->deform, &r->img, r->dmem, need, err, errlen))
-		return -1;
-	irdm_engine_attach_deform(r->eng, r->deform);
-	return 0;
+	return irdm_session_deform_open(r->s, err, errlen) ? -1 : 0;
 }
 
 static int start(const struct irdm_replay_opts *o, struct run *r, char *err, size_t errlen)
 {
-	struct irdm_engine_config cfg;
+	struct irdm_session_config sc = { .deform = o->nodes != NULL };
 
-	if (irdm_image_map(o->image, 0, &r->img, err, errlen))
+	irdm_engine_config_default(&sc.engine);
+	sc.engine.max_contacts = o->n_contacts;
+	sc.engine.solve = o->solve;
+	sc.engine.coupling_k_n_per_m = o->coupling_k;
+	sc.engine.coupling_b_ns_per_m = o->coupling_b;
+	sc.engine.publish_every = o->nodes ? 1 : 0;
+	if (irdm_session_open(&r->s, o->image, &sc, err, errlen))
 		return -1;
-	irdm_engine_config_default(&cfg);
-	cfg.max_contacts = o->n_contacts;
-	cfg.solve = o->solve;
-	cfg.coupling_k_n_per_m = o->coupling_k;
-	cfg.coupling_b_ns_per_m = o->coupling_b;
-	cfg.publish_every = o->nodes ? 1 : 0;
-	size_t need = irdm_engine_mem_size(&r->img, &cfg);
-	r->mem = need ? aligned_alloc(64, (need + 63) & ~(size_t)63) : NULL;
-	if (!r->mem) {
-		snprintf(err, errlen, "engine: out of memory (%zu bytes)", need);
-		return -1;
-	}
-	if (irdm_engine_init(&r->eng, &r->img, &cfg, r->mem, need, err, errlen))
-		return -1;
-	if (make_sites(o, &r->img, r->eng, r->site, err, errlen))
+	r->img = r->s->img;
+	r->eng = r->s->eng;
+	if (make_sites(o, r->img, r->eng, r->site, err, errlen))
 		return -1;
 	if (o->nodes && start_deform(r, err, errlen))
 		return -1;
-	if (o->nodes && parse_nodes(o->nodes, &r->img, r->rows, r->mesh, &r->n_nodes, err, errlen))
+	if (o->nodes && parse_nodes(o->nodes, r->img, r->rows, r->mesh, &r->n_nodes, err, errlen))
 		return -1;
-	return read_trajectory(o->trajectory, 1 + 3 * (size_t)o->n_contacts, r->img.meta->dt_s,
+	return read_trajectory(o->trajectory, 1 + 3 * (size_t)o->n_contacts, r->img->meta->dt_s,
 			       &r->tr, err, errlen);
 }
 
@@ -291,12 +278,12 @@ static int step(const struct irdm_replay_opts *o, struct run *r, size_t row, cha
 		fprintf(r->out, ",%.12g,%.12g,%.12g", f[0], f[1], f[2]);
 	}
 	uint64_t tick;
-	if (r->n_nodes && !irdm_deform_update(r->deform, r->pos, &tick)) {
+	if (r->n_nodes && !irdm_deform_update(r->s->worker, r->pos, &tick)) {
 		snprintf(err, errlen, "internal: no deformation snapshot at t = %g s", v[0]);
 		return -1;
 	}
 	for (size_t k = 0; k < r->n_nodes; k++) {
-		const float *rest = r->img.nodes[r->rows[k]].pos_m;
+		const float *rest = r->img->nodes[r->rows[k]].pos_m;
 		const double *x = &r->pos[3 * (size_t)r->rows[k]];
 		fprintf(r->out, ",%.12g,%.12g,%.12g", x[0] - rest[0], x[1] - rest[1], x[2] - rest[2]);
 	}
@@ -343,11 +330,8 @@ out_remove:
 	remove(r->tmp);
 out_free:
 	free(r->tr.v);
-	free(r->mem);
-	free(r->dmem);
 	free(r->pos);
-	if (r->img.base)
-		irdm_image_unmap(&r->img);
+	irdm_session_close(r->s);
 	free(r);
 	return ret;
 }

@@ -1,57 +1,45 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * Deformation of the displayed nodes (eq. 9/12) in its own, lower-priority
- * context at its own rate.  The force tick publishes the history through a
- * lock-free triple buffer (irdm_deform_publish_*: a bounded copy, no lock,
- * no system call, no wait); the deformation context takes the newest
- * snapshot and computes the displaced positions with OpenBLAS.  The force
- * tick never waits for it, and the reader never sees a torn snapshot.
+ * The deformation channel: how the force tick hands its history to the
+ * deformation context (irdm/deform_worker.h), which computes the displayed
+ * node positions (eq. 9/12) at its own, lower rate.
  *
- * Exactly one writer (the force context) and one reader (the deformation
- * context, or the thread of irdm_deform_thread_start()) per struct.
+ * A lock-free triple buffer in caller memory.  Publishing is a bounded copy
+ * with no lock, no system call and no wait; the reader takes the newest
+ * snapshot and never sees a torn one.  This side needs neither BLAS nor
+ * threads: a program that only runs the force tick links without them.
  *
- * Positions are world positions: rest + displacement, and for a floating
- * image (img->rigid != NULL) the rigid pose on top of that:
- *   world = com + R(q) (rest + u - com_rest),  com_rest = img->rigid->com_m.
- * A grounded image ignores the pose (its object frame is the world frame).
- *
- * BLAS threads: OpenBLAS's thread count is process-wide.  The deformation
- * context must not spread over the force loop's core, so
- * irdm_deform_thread_start() sets it to IRDM_DEFORM_BLAS_THREADS (1) before
- * it starts; a caller that runs irdm_deform_update() itself should do the
- * same (openblas_set_num_threads(1)).
+ * Exactly one writer (the force context) and one reader (the worker, or its
+ * thread) per struct.
  */
 #ifndef IRDM_DEFORM_H
 #define IRDM_DEFORM_H
 
-#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
+#include "irdm/error.h"
 #include "irdm/history.h"
 #include "irdm/image.h"
-
-#define IRDM_DEFORM_BLAS_THREADS 1
-#define IRDM_DEFORM_MAX_RATE_HZ 10000.0
-
-enum irdm_deform_error {
-	IRDM_DEFORM_OK = 0,
-	IRDM_DEFORM_EINVAL = -1,    /* bad image or argument */
-	IRDM_DEFORM_ENOMEM = -2,    /* memory smaller than irdm_deform_mem_size() */
-	IRDM_DEFORM_EBUSY = -3,     /* a deformation thread already runs on it */
-	IRDM_DEFORM_ETHREAD = -4,   /* the thread could not be created */
-};
 
 struct irdm_deform;   /* opaque, in caller memory */
 
 /*
- * Bytes irdm_deform_init() needs for this image (0 if the image is not
- * usable): three snapshots, the BLAS operands (an f16 image's mode shapes
- * converted to f32), the thread's frame buffer.  Any alignment is fine.
+ * Bytes irdm_deform_init() needs for this image: three snapshots of its
+ * history.  0 if the image is not a usable FIR or modal image.  Any
+ * alignment of the memory is fine.
  */
 size_t irdm_deform_mem_size(const struct irdm_image *img);
 
-/* Initialise in `mem` (pre-faulted here); the image must stay mapped. */
+/*
+ * Initialise the channel in `mem` (pre-faulted here: publishing never
+ * page-faults).  The image must stay mapped while the channel is used.
+ *
+ * Return: IRDM_OK;
+ * IRDM_EINVAL if img is not a usable FIR or modal image;
+ * IRDM_ENOMEM if mem is NULL or smaller than irdm_deform_mem_size().
+ * On error *d is NULL and err says why.
+ */
 int irdm_deform_init(struct irdm_deform **d, const struct irdm_image *img, void *mem,
 		     size_t mem_size, char *err, size_t errlen);
 
@@ -71,36 +59,5 @@ void irdm_deform_publish_modal(struct irdm_deform *d, uint64_t tick, const doubl
  */
 void irdm_deform_publish_fir(struct irdm_deform *d, uint64_t tick,
 			     const struct irdm_fir_ring *ring, const struct irdm_pose *pose);
-
-/*
- * Deformation context (reader): if a snapshot newer than the last one taken
- * is there, compute every image node's world position into pos_m
- * (3 n_nodes, node-major) and return true with its tick; false (pos_m
- * untouched) if nothing new was published.  Force nodes whose column is out
- * of range are ignored.
- */
-bool irdm_deform_update(struct irdm_deform *d, double *pos_m, uint64_t *tick);
-
-/* Rows (image nodes) the positions hold. */
-uint32_t irdm_deform_rows(const struct irdm_deform *d);
-
-/*
- * Run irdm_deform_update() at rate_hz (0 < rate <= IRDM_DEFORM_MAX_RATE_HZ,
- * absolute-time clock_nanosleep on CLOCK_MONOTONIC; missed periods are
- * skipped, not caught up) in a thread of lower priority than the caller:
- * SCHED_FIFO one below a SCHED_FIFO/RR caller, else SCHED_OTHER at the
- * caller's nice + 5.  The callback receives each new frame in that thread
- * (pos_m is valid during the call only).  If the priority cannot be set the
- * thread still runs (at SCHED_OTHER, never at the caller's priority), 0 is
- * returned and err says why.  One thread per struct irdm_deform; its state
- * lives in the deform memory (no allocation).  Init-time only.
- */
-struct irdm_deform_thread;
-int irdm_deform_thread_start(struct irdm_deform_thread **th, struct irdm_deform *d,
-			     double rate_hz, void (*frame)(void *ctx, const double *pos_m,
-							   uint64_t tick),
-			     void *ctx, char *err, size_t errlen);
-/* Stop (within one period) and join.  NULL is fine. */
-void irdm_deform_thread_stop(struct irdm_deform_thread *th);
 
 #endif

@@ -1,0 +1,37 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * What the benchmarks (tests/bench/) share: timing, order statistics of
+ * the samples, and the paper-scale images they make in out/bench/ when
+ * missing.
+ */
+#ifndef IRDM_TESTS_BENCH_UTIL_H
+#define IRDM_TESTS_BENCH_UTIL_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <time.h>
+
+/* CLOCK_MONOTONIC now, in microseconds. */
+double bench_now_us(void);
+
+/* b - a in nanoseconds. */
+double bench_elapsed_ns(const struct timespec *a, const struct timespec *b);
+
+/* Median, 99th percentile and maximum of n > 0 samples (sorted in place). */
+struct bench_stats {
+	double median, p99, max;
+};
+void bench_stats(double *samples, size_t n, struct bench_stats *st);
+
+bool bench_file_exists(const char *path);
+
+/*
+ * The image at path (under out/bench/), precomputed when missing from a
+ * scene file (NULL: the defaults) and the key/value pairs on top
+ * (NULL-terminated, or NULL).  Progress and errors are printed with the
+ * bench's tag ("tick", "deform").  Returns 0, or -1 with the reason printed.
+ */
+int bench_ensure_image(const char *tag, const char *path, const char *scene_file,
+		       const char *const *kv);
+
+#endif
