@@ -115,8 +115,15 @@ $(BUILD)/bench/%: $(BUILD)/obj/tests/bench/%.o $(call obj,$(TESTSUP_SRC)) $(TEST
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) $^ -o $@ $(LDLIBS) -lcmocka
 
-test: $(TESTS) $(IRDM)
-	IRDM=$(IRDM) IRDM_BUILD=$(BUILD) tests/run-tests.sh $(TESTS)
+# The image the tick-only tests run on (they cannot make one: no tools).
+TICK_IMAGE := $(BUILD)/data/tick.img
+$(TICK_IMAGE): $(IRDM)
+	@mkdir -p $(dir $@)
+	$(IRDM) precompute -q --mesh box:0.04,0.04,0.08 --resolution 2,2,4 --fixed 'z<=0' \
+	  --touch 'z>=0.08' --display surface --representation modal:all -o $@
+
+test: $(TESTS) $(IRDM) $(TICK_IMAGE)
+	IRDM=$(IRDM) IRDM_BUILD=$(BUILD) IRDM_TICK_IMAGE=$(TICK_IMAGE) tests/run-tests.sh $(TESTS)
 
 san:
 	$(MAKE) BUILD=build-san SAN=1 OPT="-O1 -g" test
