@@ -587,8 +587,8 @@ static void check_result(const char *what, const struct run_result *res, unsigne
 	assert_true(res->max_f > 1e-3);
 	assert_true(res->max_f < DEVICE_F);
 	assert_true(res->slides >= n / SLIDE_EVERY - 1);
-	assert_int_equal(res->nan_rc, IRDM_ENGINE_EFAULT);
-	assert_int_equal(res->nan_rc2, IRDM_ENGINE_EFAULT);
+	assert_int_equal(res->nan_rc, IRDM_EFAULT);
+	assert_int_equal(res->nan_rc2, IRDM_EFAULT);
 	assert_true(res->nan_zero_force);
 }
 
@@ -645,7 +645,7 @@ static void alloc_and_fault_free(const struct irdm_image *img)
 	assert_true(pos_finite);
 	assert_int_equal(tick % PUBLISH_EVERY, 0);
 	assert_true(tick + PUBLISH_EVERY > ticks - 1);   /* the newest, before the reset tick */
-	assert_int_equal(reset_rc, IRDM_ENGINE_OK);
+	assert_int_equal(reset_rc, IRDM_OK);
 }
 
 static void test_modal_alloc_and_fault_free(void **state)

@@ -79,7 +79,7 @@ static const double *r0_block(const struct irdm_engine *e, uint32_t col_force, u
 static void free_disp(const struct irdm_engine *e, uint32_t col, double u[3])
 {
 	if (col == NO_COL) {
-		u[0] = u[1] = u[2] = 0;
+		irdm_v3_zero(u);
 		return;
 	}
 	if (e->repr == IRDM_REPR_MODAL)
@@ -131,8 +131,8 @@ static void build_w(struct irdm_engine *e, struct system *s)
 static void body_point(const struct irdm_engine *e, const struct irdm_contact_site *st,
 		       const double u[3], double b[3])
 {
-	for (int a = 0; a < 3; a++)
-		b[a] = st->rest_m[a] - e->com_rest_m[a] + u[a];
+	irdm_v3_sub(b, st->rest_m, e->com_rest_m);
+	irdm_v3_add(b, b, u);
 }
 
 static void rotation(const struct irdm_engine *e, double R[9])
@@ -165,10 +165,8 @@ static void to_world(struct irdm_engine *e, struct system *s)
 		irdm_rigid_body_to_world(&e->rb, b, s->x_now[i]);
 		irdm_rigid_predict_point(&e->rb, b, e->dt_s, p);
 		irdm_rigid_rotate(&e->rb, st->normal, s->normal[i]);
-		for (int a = 0; a < 3; a++) {
-			s->u_free[i][a] = p[a] - st->rest_m[a];
-			arm[i][a] = s->x_now[i][a] - com[a];
-		}
+		irdm_v3_sub(s->u_free[i], p, st->rest_m);
+		irdm_v3_sub(arm[i], s->x_now[i], com);
 	}
 	for (int i = 0; i < s->m; i++)
 		for (int j = 0; j < s->m; j++) {
@@ -208,14 +206,13 @@ static void history_terms(struct irdm_engine *e, struct system *s)
 	for (int i = 0; i < s->m; i++) {
 		const struct irdm_contact_site *st = &e->c[s->idx[i]].site;
 		double *u = s->u_body[i];
-		u[0] = u[1] = u[2] = 0;
+		irdm_v3_zero(u);
 		for (uint32_t v = 0; v < st->n_nodes; v++) {
 			double uv[3];
 			if (st->weight[v] == 0)
 				continue;
 			free_disp(e, st->col[v], uv);
-			for (int a = 0; a < 3; a++)
-				u[a] += st->weight[v] * uv[a];
+			irdm_v3_axpy(u, st->weight[v], uv);
 		}
 	}
 }
@@ -263,7 +260,7 @@ static void solve_per_vertex(struct irdm_engine *e, struct system *s,
 		const struct irdm_contact_site *st = &e->c[s->idx[i]].site;
 		const double *p = cmd[s->idx[i]].target_m;
 		double *F = &s->f[3 * i];
-		F[0] = F[1] = F[2] = 0;
+		irdm_v3_zero(F);
 		for (uint32_t v = 0; v < st->n_nodes; v++) {
 			double a[9], rhs[3], uv[3];
 			if (st->weight[v] == 0 || st->col[v] == NO_COL)
@@ -273,12 +270,10 @@ static void solve_per_vertex(struct irdm_engine *e, struct system *s,
 				for (int r = 0; r < 3; r++)
 					a[4 * r] += 1.0 / kappa;
 			free_disp(e, st->col[v], uv);
-			for (int r = 0; r < 3; r++)
-				rhs[r] = p[r] - uv[r];
+			irdm_v3_sub(rhs, p, uv);
 			if (irdm_solve_spd(a, rhs, 3))
 				e->stats.singular_solves++;
-			for (int r = 0; r < 3; r++)
-				F[r] += st->weight[v] * rhs[r];
+			irdm_v3_axpy(F, st->weight[v], rhs);
 		}
 	}
 }
@@ -301,8 +296,7 @@ static void release_pulling(struct irdm_engine *e, struct system *s,
 			struct irdm_contact_state *c = &e->c[s->idx[i]];
 			const double *F = &s->f[3 * i], *nrm = s->normal[i];
 			/* F acts on the object; pushing means F . n_out < 0 */
-			if (c->mode == IRDM_CONTACT_PUSH &&
-			    F[0] * nrm[0] + F[1] * nrm[1] + F[2] * nrm[2] > 0) {
+			if (c->mode == IRDM_CONTACT_PUSH && irdm_v3_dot(F, nrm) > 0) {
 				memset(c, 0, sizeof(*c));
 				e->stats.releases++;
 				dropped = 1;
@@ -383,15 +377,9 @@ static void gather_forces(struct irdm_engine *e, const struct system *s, struct 
 				memset(t->f_n[t->n], 0, sizeof(t->f_n[t->n]));
 				t->n++;
 			}
-			for (int r = 0; r < 3; r++)
-				t->f_n[k][r] += st->weight[v] * s->f_body[3 * i + r];
+			irdm_v3_axpy(t->f_n[k], st->weight[v], &s->f_body[3 * i]);
 		}
 	}
-}
-
-static bool finite3(const double *v)
-{
-	return isfinite(v[0]) && isfinite(v[1]) && isfinite(v[2]);
 }
 
 static int fault(struct irdm_engine *e)
@@ -399,7 +387,7 @@ static int fault(struct irdm_engine *e)
 	e->faulted = true;
 	for (unsigned i = 0; i < IRDM_MAX_CONTACTS; i++)
 		memset(e->c[i].force_n, 0, sizeof(e->c[i].force_n));
-	return IRDM_ENGINE_EFAULT;
+	return IRDM_EFAULT;
 }
 
 /*
@@ -420,8 +408,7 @@ static void floating_disp(const struct irdm_engine *e, const struct system *s, i
 	}
 	body_point(e, st, u, b);
 	irdm_rigid_body_to_world(&e->rb, b, x);
-	for (int a = 0; a < 3; a++)
-		d[a] = x[a] - st->rest_m[a];
+	irdm_v3_sub(d, x, st->rest_m);
 }
 
 /* Forces in the object frame (for the deformation history). */
@@ -536,14 +523,14 @@ int irdm_engine_tick(struct irdm_engine *e, const struct irdm_contact_cmd *cmd)
 	struct system s;
 
 	if (e->faulted)
-		return IRDM_ENGINE_EFAULT;
+		return IRDM_EFAULT;
 	s.m = 0;
 	for (unsigned i = 0; i < e->cfg.max_contacts; i++) {
 		if (cmd[i].mode == IRDM_CONTACT_OFF && e->c[i].mode != IRDM_CONTACT_OFF)
 			irdm_engine_contact_end(e, i);
 		if (e->c[i].mode == IRDM_CONTACT_OFF)
 			continue;
-		if (!finite3(cmd[i].target_m))
+		if (!irdm_v3_finite(cmd[i].target_m))
 			return fault(e);
 		s.idx[s.m++] = i;
 	}
@@ -584,7 +571,7 @@ int irdm_engine_tick(struct irdm_engine *e, const struct irdm_contact_cmd *cmd)
 		else
 			irdm_deform_publish_fir(e->deform, e->tick, &e->ring, pp);
 	}
-	return IRDM_ENGINE_OK;
+	return IRDM_OK;
 }
 
 void irdm_engine_node_disp(const struct irdm_engine *e, uint32_t row, double u[3])
@@ -595,7 +582,7 @@ void irdm_engine_node_disp(const struct irdm_engine *e, uint32_t row, double u[3
 	 */
 	uint32_t col = row < e->n_nodes ? e->col_of_row[row] : NO_COL;
 
-	u[0] = u[1] = u[2] = 0;
+	irdm_v3_zero(u);
 	if (col == NO_COL)
 		return;
 	if (e->repr == IRDM_REPR_FIR) {
