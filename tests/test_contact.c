@@ -803,8 +803,8 @@ static void expect_reject(struct bvh_copy *c, const char *needle)
 
 	img_fixture_reseal(c->buf, c->size);
 	ret = irdm_image_parse(c->buf, c->size, &img, err, sizeof(err));
-	if (ret != IRDM_IMAGE_EINVAL || !strstr(err, needle) || strchr(err, '\n'))
-		fail_msg("expected EINVAL with \"%s\", got %d: %s", needle, ret, err);
+	if (ret != IRDM_EFORMAT || !strstr(err, needle) || strchr(err, '\n'))
+		fail_msg("expected EFORMAT with \"%s\", got %d: %s", needle, ret, err);
 	assert_null(img.contact_bvh);
 	assert_null(img.meta);
 	free(c->buf);
@@ -997,7 +997,7 @@ static void test_fixture_images(void **state)
 	img_fixture_add(&fx, &w);
 	assert_int_equal(irdm_iw_add(&w, IRDM_SEC_CONTACT_BVH, IRDM_ELEM_BYTES, blob, 40), 0);
 	assert_int_equal(irdm_iw_to_buffer(&w, &buf, &size), 0);
-	assert_int_equal(irdm_image_parse(buf, size, &img, err, sizeof(err)), IRDM_IMAGE_EINVAL);
+	assert_int_equal(irdm_image_parse(buf, size, &img, err, sizeof(err)), IRDM_EFORMAT);
 	assert_non_null(strstr(err, "CONTACT_BVH"));
 	free(buf);
 	/* built: a fan on a 4 x 4 grid, all nodes columns (some triangles are
