@@ -9,11 +9,12 @@
  * allocates, blocks, or makes a system call.  It is *given* the contact
  * targets of the tick; it reads no clock.
  *
- * Frames and signs (docs/architecture.md, "Frames and signs"): positions
- * in metres in the object frame (for a floating object: targets, forces and contact displacements
- * in the world frame, which coincides with the object frame at start); a
- * contact's force is the force applied TO the object (the device renders
- * its negative); the displacement u[t] is observed at (t+1) dt.
+ * Frames and signs (docs/architecture.md, "Frames and signs" and "Sample
+ * convention"): positions in metres in the object frame (for a floating
+ * object: targets, forces and contact displacements in the world frame,
+ * which coincides with the object frame at start); a contact's force is the
+ * force applied TO the object (the device renders its negative); the
+ * displacement u[t] is observed at (t+1) dt.
  */
 #ifndef IRDM_ENGINE_H
 #define IRDM_ENGINE_H
@@ -118,7 +119,7 @@ void irdm_engine_config_haptic(struct irdm_engine_config *cfg, double dt_s, doub
  * bytes, pre-faulted by this call).  The image must stay mapped.
  *
  * Return: IRDM_OK;
- * IRDM_EINVAL if img has no metadata, cfg is not valid (contacts
+ * IRDM_EINVAL if img is NULL or has no metadata, cfg is not valid (contacts
  * 1..IRDM_MAX_CONTACTS, coupling >= 0, stable radius in [0, 1), force
  * limit >= 0, a known solve mode), or the image's rigid-body section is not
  * usable (irdm_rigid_init());
