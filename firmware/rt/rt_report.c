@@ -94,7 +94,7 @@ static int read_memory(struct irdm_rt_report *r)
 	fclose(f);
 	if (found != 3)
 		return IRDM_EIO;
-	r->memory_locked = r->locked_kb > 0 && r->locked_kb + UNLOCKABLE_KB >= r->mapped_kb;
+	r->memory_locked = r->locked_kb + UNLOCKABLE_KB >= r->mapped_kb;
 	return IRDM_OK;
 }
 
