@@ -62,16 +62,7 @@
  * Under ASan only the allocator interposition is left out -- the page fault
  * and system call proofs still run.
  */
-#if defined(__SANITIZE_ADDRESS__)
-#define RT_ASAN 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define RT_ASAN 1
-#endif
-#endif
-#ifndef RT_ASAN
-#define RT_ASAN 0
-#endif
+#define RT_ASAN IRDM_RT_ASAN
 
 #ifndef SECCOMP_MODE_STRICT
 #define SECCOMP_MODE_STRICT 1

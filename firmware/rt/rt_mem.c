@@ -12,17 +12,7 @@
 
 #include "irdm/rt.h"
 
-#if defined(__SANITIZE_ADDRESS__)
-#define RT_ASAN 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define RT_ASAN 1
-#endif
-#endif
-#ifndef RT_ASAN
-#define RT_ASAN 0
-#endif
-#if RT_ASAN
+#if IRDM_RT_ASAN
 #include <sanitizer/asan_interface.h>
 #endif
 
@@ -34,7 +24,7 @@
 
 int irdm_rt_lock_memory(void)
 {
-#if RT_ASAN
+#if IRDM_RT_ASAN
 	/* ASan's mlockall returns 0 and locks nothing: do not pretend */
 	return IRDM_ENOTSUP;
 #else
@@ -83,7 +73,7 @@ static __attribute__((noinline)) void touch_stack(size_t depth_bytes)
 	for (size_t i = depth_bytes; i > 0; i = i > TOUCH_STRIDE ? i - TOUCH_STRIDE : 0)
 		p[i - 1] = 0;
 	p[0] = 0;
-#if RT_ASAN
+#if IRDM_RT_ASAN
 	/*
 	 * The instrumented writes above only read the block's shadow (mapping
 	 * the shared zero page); the first redzone a deeper frame poisons there

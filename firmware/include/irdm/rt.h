@@ -26,6 +26,22 @@
 
 #define IRDM_RT_ANY_CPU (-1)
 
+/*
+ * 1 in a build with AddressSanitizer, whose mlockall() locks nothing (so
+ * irdm_rt_lock_memory() says IRDM_ENOTSUP) and which owns the allocator and
+ * the stack's shadow: what a real-time check can prove differs there.
+ */
+#if defined(__SANITIZE_ADDRESS__)
+#define IRDM_RT_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define IRDM_RT_ASAN 1
+#endif
+#endif
+#ifndef IRDM_RT_ASAN
+#define IRDM_RT_ASAN 0
+#endif
+
 /* How a thread is to be scheduled. */
 struct irdm_rt_sched {
 	int policy;     /* SCHED_FIFO or SCHED_OTHER */
