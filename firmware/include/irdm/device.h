@@ -150,4 +150,47 @@ int irdm_device_counts_from_angles(const struct irdm_device_config *cfg, const d
 /* Radians per count of joint i. */
 double irdm_device_rad_per_count(const struct irdm_device_config *cfg, unsigned i);
 
+/*
+ * Velocity from quantised positions: first-order adaptive windowing
+ * (Janabi-Sharifi, Hayward & Chen 2000, the least-squares variant).  Each
+ * sample, the window grows one sample at a time from the two newest; a
+ * least-squares line is fitted to the window, and the window stops growing
+ * at the first length whose line leaves the band +-band of one of its
+ * samples.  The velocity is the slope of the last line that stayed within
+ * the band.  Slow motion thus averages over many samples (quantisation
+ * noise falls as the window grows) and fast motion over few (little lag).
+ * band is the position uncertainty: for an encoder, about one count.
+ *
+ * Fixed memory (IRDM_VELOCITY_WINDOW_MAX samples); the caller gives the
+ * sample period; no clock.  At most window^2 / 2 multiply-adds per sample.
+ */
+#define IRDM_VELOCITY_WINDOW_MAX 64
+
+struct irdm_velocity {
+	double period_s;
+	double band;
+	unsigned window;                        /* longest window, samples */
+	unsigned count;                         /* samples held, <= window */
+	unsigned head;                          /* slot of the newest sample */
+	unsigned last_window;                   /* window the last estimate used */
+	double y[IRDM_VELOCITY_WINDOW_MAX];     /* ring of the newest samples */
+};
+
+/*
+ * Return: IRDM_OK; IRDM_EINVAL if period_s or band is not finite and
+ * positive or window is outside [2, IRDM_VELOCITY_WINDOW_MAX].
+ */
+int irdm_velocity_init(struct irdm_velocity *v, double period_s, double band, unsigned window);
+
+/* Forget the samples (after a fault or a re-calibration jump). */
+void irdm_velocity_reset(struct irdm_velocity *v);
+
+/*
+ * Add the newest position sample and estimate the velocity (position units
+ * per second; 0 until two samples are held).
+ * Return: IRDM_OK; IRDM_EFAULT if the position is not finite (the sample is
+ * dropped, *vel is 0).
+ */
+int irdm_velocity_update(struct irdm_velocity *v, double position, double *vel);
+
 #endif /* IRDM_DEVICE_H */
