@@ -184,10 +184,9 @@ int irdm_device_counts_from_angles(const struct irdm_device_config *cfg, const d
 	double c[3];
 
 	for (unsigned i = 0; i < 3; i++) {
-		if (!isfinite(q[i]))
-			return IRDM_EFAULT;
 		c[i] = count_of(cfg, i, q[i]);
-		/* compare as doubles: a huge angle must not overflow the cast */
+		/* compared as doubles, so a huge angle cannot overflow the cast,
+		 * and written so that a NaN or infinite angle fails too */
 		if (!(c[i] >= cfg->count_min[i] && c[i] <= cfg->count_max[i]))
 			return IRDM_EFAULT;
 	}
