@@ -30,47 +30,75 @@ void irdm_velocity_reset(struct irdm_velocity *v)
 	v->last_window = 0;
 }
 
-/* Sample `age` steps before the newest, relative to the newest. */
-static double rel(const struct irdm_velocity *v, unsigned age)
+/* The newest sample is y[head + MAX], older ones below it: each sample is
+ * stored twice (slots i and i + MAX) so any window is contiguous. */
+static const double *newest(const struct irdm_velocity *v)
 {
-	unsigned i = (v->head + IRDM_VELOCITY_WINDOW_MAX - age) % IRDM_VELOCITY_WINDOW_MAX;
-
-	return v->y[i] - v->y[v->head];
+	return &v->y[v->head + IRDM_VELOCITY_WINDOW_MAX];
 }
 
 /* Does the line a + b t stay within the band of the n newest samples? */
 static int within_band(const struct irdm_velocity *v, unsigned n, double a, double b)
 {
+	const double *y = newest(v), y0 = y[0];
+
 	for (unsigned age = 0; age < n; age++)
-		if (fabs(rel(v, age) - (a - b * age)) > v->band)
+		if (fabs(y[-(int)age] - y0 - (a - b * age)) > v->band)
 			return 0;
 	return 1;
 }
 
-/* Slope (per sample) of the longest window that stays within the band. */
-static double adaptive_slope(struct irdm_velocity *v)
+/*
+ * Least-squares slope (per sample) of the n >= 2 newest samples; returns
+ * whether that line stays within the band of all of them.  Times run 0,
+ * -1, ... back from the newest sample.
+ */
+static int fit(const struct irdm_velocity *v, unsigned n, double *slope)
 {
-	double st = 0, stt = 0, sy = 0, sty = 0, slope = 0;
-	unsigned n;
+	const double *y = newest(v), y0 = y[0];
+	double st = 0, stt = 0, sy = 0, sty = 0, a;
 
-	for (n = 1; n <= v->count; n++) {
-		double t = -(double)(n - 1), y = rel(v, n - 1), den, b, a;
+	for (unsigned age = 0; age < n; age++) {
+		double t = -(double)age, d = y[-(int)age] - y0;
 
 		st += t;
 		stt += t * t;
-		sy += y;
-		sty += t * y;
-		if (n < 2)
-			continue;
-		den = n * stt - st * st;
-		b = (n * sty - st * sy) / den;
-		a = (sy - b * st) / n;
-		/* two samples always fit: the window is at least a difference */
-		if (n > 2 && !within_band(v, n, a, b))
-			break;
-		slope = b;
+		sy += d;
+		sty += t * d;
 	}
-	v->last_window = n - 1;
+	*slope = (n * sty - st * sy) / (n * stt - st * st);
+	a = (sy - *slope * st) / n;
+	return within_band(v, n, a, *slope);
+}
+
+/*
+ * The longest window that fits, searched from last sample's length: grow
+ * while the next longer one fits, else shrink until one fits (two samples
+ * always do).  Windows change slowly from sample to sample, so this takes
+ * a few O(n) fits where growing from two every sample would take O(n^2).
+ */
+static double adaptive_slope(struct irdm_velocity *v)
+{
+	double slope = 0, longer;
+	unsigned n = v->last_window + 1;
+
+	if (v->count < 2) {
+		v->last_window = v->count;
+		return 0;
+	}
+	n = n < 2 ? 2 : n > v->count ? v->count : n;
+	if (fit(v, n, &slope) || n == 2) {
+		while (n < v->count && fit(v, n + 1, &longer)) {
+			n++;
+			slope = longer;
+		}
+	} else {
+		while (--n > 2 && !fit(v, n, &slope))
+			;
+		if (n == 2)
+			fit(v, 2, &slope);
+	}
+	v->last_window = n;
 	return slope;
 }
 
@@ -81,6 +109,7 @@ int irdm_velocity_update(struct irdm_velocity *v, double position, double *vel)
 		return IRDM_EFAULT;
 	v->head = (v->head + 1) % IRDM_VELOCITY_WINDOW_MAX;
 	v->y[v->head] = position;
+	v->y[v->head + IRDM_VELOCITY_WINDOW_MAX] = position;
 	if (v->count < v->window)
 		v->count++;
 	*vel = adaptive_slope(v) / v->period_s;

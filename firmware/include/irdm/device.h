@@ -152,17 +152,21 @@ double irdm_device_rad_per_count(const struct irdm_device_config *cfg, unsigned 
 
 /*
  * Velocity from quantised positions: first-order adaptive windowing
- * (Janabi-Sharifi, Hayward & Chen 2000, the least-squares variant).  Each
- * sample, the window grows one sample at a time from the two newest; a
- * least-squares line is fitted to the window, and the window stops growing
- * at the first length whose line leaves the band +-band of one of its
- * samples.  The velocity is the slope of the last line that stayed within
- * the band.  Slow motion thus averages over many samples (quantisation
- * noise falls as the window grows) and fast motion over few (little lag).
- * band is the position uncertainty: for an encoder, about one count.
+ * (Janabi-Sharifi, Hayward & Chen 2000, the least-squares variant): the
+ * velocity is the slope of the least-squares line through the longest
+ * window of newest samples whose line stays within +-band of every sample
+ * in it.  Slow motion thus averages over many samples (quantisation noise
+ * falls as the window grows) and fast motion over few (little lag).  band
+ * is the position uncertainty: for an encoder, about one count.
+ *
+ * The search starts from the previous sample's window (grow while one
+ * longer fits, else shrink until one fits) instead of growing from two
+ * samples every time as the paper does: windows change slowly, so a sample
+ * costs a few O(window) fits instead of O(window^2) (tests/test_velocity.c
+ * compares it with the paper's search).
  *
  * Fixed memory (IRDM_VELOCITY_WINDOW_MAX samples); the caller gives the
- * sample period; no clock.  At most window^2 / 2 multiply-adds per sample.
+ * sample period; no clock.
  */
 #define IRDM_VELOCITY_WINDOW_MAX 64
 
@@ -173,7 +177,7 @@ struct irdm_velocity {
 	unsigned count;                         /* samples held, <= window */
 	unsigned head;                          /* slot of the newest sample */
 	unsigned last_window;                   /* window the last estimate used */
-	double y[IRDM_VELOCITY_WINDOW_MAX];     /* ring of the newest samples */
+	double y[2 * IRDM_VELOCITY_WINDOW_MAX]; /* ring of the newest samples, twice */
 };
 
 /*
