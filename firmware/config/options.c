@@ -369,8 +369,10 @@ static int parse_arg(const struct irdm_opt_set *sets, size_t n_sets, int argc,
 	if (!o)
 		return unknown_key(sets[n_sets - 1].table, a, a + 2, err, errlen);
 	if (o->type == IRDM_OPT_FLAG) {
-		if (o->size != sizeof(bool))
+		if (o->size != sizeof(bool)) {
+			snprintf(err, errlen, "%s: option table entry is not a bool", a);
 			return IRDM_EINVAL;
+		}
 		*(bool *)((char *)obj + o->offset) = true;
 		return IRDM_OK;
 	}

@@ -2,9 +2,9 @@
 /*
  * Option tables: one constant table of keys (name, type, range, unit, help,
  * where the value goes) drives the parsing of "key = value" files, of
- * "--key value" arguments, and the help and documentation the tools print
- * from it (tools/opt/opt_doc.h).  The scene of the offline tool and the
- * controller's board file use the same machinery.
+ * "--key value" arguments, and the help and documentation printed from it
+ * (irdm_opt_range_text() gives the range in words).  The scene of the
+ * offline tool and the controller's board file use the same machinery.
  *
  * No allocation, no I/O: values are stored into a caller's struct (offsetof)
  * or handed to a parse callback; messages go to a caller's buffer.
