@@ -209,6 +209,37 @@ static int parse_args(struct irdm_scene *sc, struct precompute_args *a, int argc
 	return 0;
 }
 
+/* Where the work goes: an image, a part, or parts merged; exit status or 0. */
+static int output_opts(const struct irdm_scene *sc, const struct precompute_args *a,
+		       struct irdm_precompute_opts *o, const char **parts)
+{
+	bool td = sc->method == IRDM_METHOD_TIME_DOMAIN;
+
+	/* the list is argv's text, which is writable: split it in place */
+	if (a->merge && split_parts((char *)a->merge, parts, &o->n_merge)) {
+		fprintf(stderr, "irdm precompute: --merge: expected 1 to %d comma-separated part files\n", MAX_PARTS);
+		return 2;
+	}
+	o->merge = a->merge ? parts : NULL;
+	if (!a->out) {
+		fprintf(stderr, "irdm precompute: missing -o IMAGE (see --help)\n");
+		return 2;
+	}
+	o->out_path = a->part_end ? NULL : a->out;
+	o->part_out = a->part_end ? a->out : NULL;
+	o->part_begin = a->part_begin;
+	o->part_end = a->part_end;
+	if (a->part_end && !td) {
+		fprintf(stderr, "irdm precompute: --part splits time-domain work: set --method time-domain\n");
+		return 2;
+	}
+	if (o->n_merge && !td) {
+		fprintf(stderr, "irdm precompute: --merge takes time-domain parts: set --method time-domain\n");
+		return 2;
+	}
+	return 0;
+}
+
 int irdm_cmd_precompute(int argc, char **argv)
 {
 	struct irdm_scene sc;
@@ -235,17 +266,6 @@ int irdm_cmd_precompute(int argc, char **argv)
 	if (rc)
 		return rc;
 	prog.quiet = args.quiet;
-	o.out_path = args.out;
-	o.part_begin = args.part_begin;
-	o.part_end = args.part_end;
-	/* the list is argv's text, which is writable: split it in place */
-	if (args.merge) {
-		if (split_parts((char *)args.merge, parts, &o.n_merge)) {
-			fprintf(stderr, "irdm precompute: --merge: expected 1 to %d comma-separated part files\n", MAX_PARTS);
-			return 2;
-		}
-		o.merge = parts;
-	}
 	if (args.count_only) {
 		size_t n;
 		if (irdm_precompute_count_inputs(&sc, &n, err, sizeof(err))) {
@@ -255,22 +275,9 @@ int irdm_cmd_precompute(int argc, char **argv)
 		printf("%zu\n", n);
 		return 0;
 	}
-	if (!o.out_path) {
-		fprintf(stderr, "irdm precompute: missing -o IMAGE (see --help)\n");
-		return 2;
-	}
-	if (o.part_end) {
-		o.part_out = o.out_path;
-		o.out_path = NULL;
-		if (sc.method != IRDM_METHOD_TIME_DOMAIN) {
-			fprintf(stderr, "irdm precompute: --part splits time-domain work: set --method time-domain\n");
-			return 2;
-		}
-	}
-	if (o.n_merge && sc.method != IRDM_METHOD_TIME_DOMAIN) {
-		fprintf(stderr, "irdm precompute: --merge takes time-domain parts: set --method time-domain\n");
-		return 2;
-	}
+	rc = output_opts(&sc, &args, &o, parts);
+	if (rc)
+		return rc;
 	o.progress = irdm_cli_progress;
 	o.ctx = &prog;
 	if (irdm_precompute(&sc, &o, &rep, err, sizeof(err))) {
