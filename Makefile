@@ -128,7 +128,8 @@ test: $(TESTS) $(IRDM) $(TICK_IMAGE)
 
 # Generated from the scene key table (tests/test_cli.c checks it is current).
 docs: $(IRDM)
-	$(IRDM) precompute --help-markdown > docs/scene-format.md
+	$(IRDM) precompute --help-markdown > docs/scene-format.md.tmp
+	mv docs/scene-format.md.tmp docs/scene-format.md
 
 san:
 	$(MAKE) BUILD=build-san SAN=1 OPT="-O1 -g" test
