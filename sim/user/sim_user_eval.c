@@ -48,15 +48,12 @@ static void blend(const struct irdm_sim_user_seg *s, double t_s, double target_m
 	}
 	w = min_jerk((t_s - s->t0_s) / (s->t1_s - s->t0_s));
 	/*
-	 * Each half from its own end: exact at both keyframes, and a
-	 * coordinate that does not move stays bit for bit where it is
-	 * ((1 - w) a + w a need not be a).
+	 * from + w (to - from), not (1 - w) from + w to: a coordinate the move
+	 * does not change stays bit for bit where it is.  The keyframes are
+	 * exact anyway: u = 0 gives from, and t >= t1 returns to above.
 	 */
-	for (i = 0; i < 3; i++) {
-		double d = s->to_m[i] - s->from_m[i];
-
-		target_m[i] = w <= 0.5 ? s->from_m[i] + w * d : s->to_m[i] - (1.0 - w) * d;
-	}
+	for (i = 0; i < 3; i++)
+		target_m[i] = s->from_m[i] + w * (s->to_m[i] - s->from_m[i]);
 }
 
 int irdm_sim_user_target(const struct irdm_sim_user *u, unsigned hand, double t_s,

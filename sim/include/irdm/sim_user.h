@@ -35,9 +35,9 @@
  * Motion.  A move eases with the minimum-jerk profile (Flash & Hogan 1985,
  * the shape of an unconstrained human reaching movement):
  *   s(u) = 10 u^3 - 15 u^4 + 6 u^5,  u = (t - t0) / D in [0, 1],
- *   target = from + s (to - from)  (for s > 1/2: to - (1 - s)(to - from)),
+ *   target = from + s (to - from),  and exactly `to` from t0 + D on,
  * so position, velocity and acceleration are continuous and velocity and
- * acceleration are zero at both keyframes; the blend is exact at them
+ * acceleration are zero at both keyframes; the target is exact at them
  * (from at u = 0, to at u = 1, bit for bit) and a coordinate the move does
  * not change stays exactly constant.
  *
