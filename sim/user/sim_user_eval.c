@@ -56,22 +56,32 @@ static void blend(const struct irdm_sim_user_seg *s, double t_s, double target_m
 		target_m[i] = s->from_m[i] + w * (s->to_m[i] - s->from_m[i]);
 }
 
+/* The hand's segment at t (NULL before its first) and its target. */
+static int evaluate(const struct irdm_sim_user *u, unsigned hand, double t_s, double target_m[3],
+		    const struct irdm_sim_user_seg **seg)
+{
+	if (!u || !target_m || hand >= IRDM_SIM_USER_HANDS || !isfinite(t_s))
+		return IRDM_EINVAL;
+	*seg = segment_at(&u->hand[hand], t_s);
+	if (*seg)
+		blend(*seg, t_s, target_m);
+	else
+		memset(target_m, 0, 3 * sizeof(double));
+	return IRDM_OK;
+}
+
 int irdm_sim_user_target(const struct irdm_sim_user *u, unsigned hand, double t_s,
 			 double target_m[3], int *active)
 {
 	const struct irdm_sim_user_seg *s;
+	int ret;
 
-	if (!u || !target_m || !active || hand >= IRDM_SIM_USER_HANDS || !isfinite(t_s))
+	if (!active)
 		return IRDM_EINVAL;
-	s = segment_at(&u->hand[hand], t_s);
-	if (!s) {
-		memset(target_m, 0, 3 * sizeof(double));
-		*active = 0;
-		return IRDM_OK;
-	}
-	blend(s, t_s, target_m);
-	*active = s->active;
-	return IRDM_OK;
+	ret = evaluate(u, hand, t_s, target_m, &s);
+	if (!ret)
+		*active = s && s->active;
+	return ret;
 }
 
 int irdm_sim_user_hand_force(const struct irdm_sim_user *u, unsigned hand, double t_s,
@@ -80,22 +90,21 @@ int irdm_sim_user_hand_force(const struct irdm_sim_user *u, unsigned hand, doubl
 {
 	const struct irdm_sim_user_seg *s;
 	double target_m[3];
-	int active, ret, i;
+	int ret, i;
 
 	if (!force_n)
 		return IRDM_EINVAL;
 	memset(force_n, 0, 3 * sizeof(double));
 	if (!tip_m || !tip_vel_m_per_s)
 		return IRDM_EINVAL;
-	ret = irdm_sim_user_target(u, hand, t_s, target_m, &active);
+	ret = evaluate(u, hand, t_s, target_m, &s);
 	if (ret)
 		return ret;
 	for (i = 0; i < 3; i++)
 		if (!isfinite(tip_m[i]) || !isfinite(tip_vel_m_per_s[i]))
 			return IRDM_EFAULT;
-	if (!active)
+	if (!s || !s->active)
 		return IRDM_OK;
-	s = segment_at(&u->hand[hand], t_s);
 	for (i = 0; i < 3; i++)
 		force_n[i] = s->k_n_per_m * (target_m[i] - tip_m[i]) -
 			     s->b_ns_per_m * tip_vel_m_per_s[i];

@@ -95,11 +95,10 @@ static int number(struct parser *p, const struct cmd *c, const char *tok, const 
 
 	if (!tok)
 		return fail(p, IRDM_EFORMAT, c->what, "expected %s", name);
-	errno = 0;
 	*v = strtod(tok, &end);
 	if (end == tok || *end)
 		return fail(p, IRDM_EFORMAT, c->what, "expected %s, got '%s'", name, tok);
-	if (!isfinite(*v) || errno == ERANGE)
+	if (!isfinite(*v))              /* "inf", "nan", or overflowed to inf */
 		return fail(p, IRDM_EFORMAT, c->what, "%s '%s' is not finite", name, tok);
 	return IRDM_OK;
 }
@@ -123,11 +122,10 @@ static int vector(struct parser *p, const struct cmd *c, const char *tok, double
 	if (!tok)
 		return fail(p, IRDM_EFORMAT, c->what, "expected X,Y,Z");
 	for (i = 0; i < 3; i++) {
-		errno = 0;
 		v[i] = strtod(s, &end);
 		if (end == s || *end != (i < 2 ? ',' : '\0'))
 			return fail(p, IRDM_EFORMAT, c->what, "expected X,Y,Z, got '%s'", tok);
-		if (!isfinite(v[i]) || errno == ERANGE)
+		if (!isfinite(v[i]))
 			return fail(p, IRDM_EFORMAT, c->what, "'%s' is not finite", tok);
 		s = end + 1;
 	}
@@ -404,7 +402,7 @@ static int parse_line(struct parser *p, char *s)
 
 /* ---- whole scripts --------------------------------------------------------- */
 
-static void begin(struct parser *p, struct irdm_sim_user *u, const char *name, char *err,
+static void parse_begin(struct parser *p, struct irdm_sim_user *u, const char *name, char *err,
 		  size_t errlen)
 {
 	unsigned i;
@@ -423,7 +421,7 @@ static void begin(struct parser *p, struct irdm_sim_user *u, const char *name, c
 		err[0] = '\0';
 }
 
-static int end(struct parser *p, int ret)
+static int parse_end(struct parser *p, int ret)
 {
 	unsigned i;
 
@@ -462,7 +460,7 @@ int irdm_sim_user_parse(struct irdm_sim_user *u, const char *name, const char *t
 
 	if (!u || !text)
 		return IRDM_EINVAL;
-	begin(&p, u, name ? name : "(script)", err, errlen);
+	parse_begin(&p, u, name ? name : "(script)", err, errlen);
 	while (!ret && *s) {
 		const char *nl = strchr(s, '\n');
 		size_t len = nl ? (size_t)(nl - s) + 1 : strlen(s);
@@ -477,7 +475,7 @@ int irdm_sim_user_parse(struct irdm_sim_user *u, const char *name, const char *t
 		ret = parse_line(&p, buf);
 		s += len;
 	}
-	return end(&p, ret);
+	return parse_end(&p, ret);
 }
 
 int irdm_sim_user_load(struct irdm_sim_user *u, const char *path, char *err, size_t errlen)
@@ -489,7 +487,7 @@ int irdm_sim_user_load(struct irdm_sim_user *u, const char *path, char *err, siz
 
 	if (!u || !path)
 		return IRDM_EINVAL;
-	begin(&p, u, path, err, errlen);
+	parse_begin(&p, u, path, err, errlen);
 	f = fopen(path, "r");
 	if (!f) {
 		ret = fail(&p, IRDM_EIO, NULL, "cannot open: %s", strerror(errno));
@@ -506,5 +504,5 @@ int irdm_sim_user_load(struct irdm_sim_user *u, const char *path, char *err, siz
 		ret = fail(&p, IRDM_EIO, NULL, "read error");
 	fclose(f);
 out:
-	return end(&p, ret);
+	return parse_end(&p, ret);
 }
