@@ -53,7 +53,8 @@
  * device's.
  *
  * The script is read once, at load, into a caller-owned struct of fixed
- * size; evaluation is pure arithmetic on it (no allocation, no system
+ * size (about 45 kB: keep it static or on the heap, not on a tick's
+ * stack); evaluation is pure arithmetic on it (no allocation, no system
  * call, no clock: the caller gives the time), safe to call every tick.
  */
 #ifndef IRDM_SIM_USER_H
@@ -125,7 +126,8 @@ int irdm_sim_user_target(const struct irdm_sim_user *u, unsigned hand, double t_
 /*
  * The force the hand puts on the tip at t_s (object frame, N):
  * K (target - tip_m) - B tip_vel_m_per_s, zero if the hand does not hold.
- * Return: IRDM_OK; IRDM_EINVAL as irdm_sim_user_target() (force zeroed);
+ * Return: IRDM_OK; IRDM_EINVAL as irdm_sim_user_target() or if tip_m,
+ * tip_vel_m_per_s or force_n is NULL (force zeroed if it can be);
  * IRDM_EFAULT if the tip's position or velocity is not finite (force
  * zeroed: a hand does not push on garbage).
  */
