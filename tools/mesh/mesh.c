@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "mesh/mesh_priv.h"
+#include "util/fnv1a.h"
 
 void irdm_mesh_free(struct irdm_mesh *m)
 {
@@ -53,26 +54,14 @@ double irdm_mesh_volume(const struct irdm_mesh *m)
 	return sum / 6.0;
 }
 
-static uint64_t fnv1a(uint64_t h, const void *p, size_t n)
-{
-	const unsigned char *b = p;
-	size_t i;
-
-	for (i = 0; i < n; i++) {
-		h ^= b[i];
-		h *= 1099511628211ULL;
-	}
-	return h;
-}
-
 uint64_t irdm_mesh_hash(const struct irdm_mesh *m)
 {
-	uint64_t h = 14695981039346656037ULL;
+	uint64_t h = IRDM_FNV1A_INIT;
 
 	if (m->pos_m)
-		h = fnv1a(h, m->pos_m, 3 * m->n_nodes * sizeof(*m->pos_m));
+		h = irdm_fnv1a(h, m->pos_m, 3 * m->n_nodes * sizeof(*m->pos_m));
 	if (m->tets)
-		h = fnv1a(h, m->tets, 4 * m->n_tets * sizeof(*m->tets));
+		h = irdm_fnv1a(h, m->tets, 4 * m->n_tets * sizeof(*m->tets));
 	return h;
 }
 

@@ -33,20 +33,10 @@
 #include <unistd.h>
 
 #include "fem/factor.h"
+#include "modal/lapack.h"
 #include "timedomain/rigid_fit.h"
 #include "timedomain/td_priv.h"
 #include "timedomain/timedomain.h"
-
-/*
- * OpenBLAS thread control (declared here: no OpenBLAS header is needed for
- * two calls).  During the parallel phase OpenBLAS must run single-threaded:
- * our workers already occupy the CPUs, nested BLAS threads would
- * oversubscribe them, and a BLAS thread count that differs between runs
- * could change reduction order and so break bitwise reproducibility.  The
- * setting is process-wide; it is restored afterwards.
- */
-void openblas_set_num_threads(int n);
-int openblas_get_num_threads(void);
 
 /*
  * At most this many input columns are integrated together: several
@@ -406,16 +396,15 @@ static unsigned thread_count(unsigned asked, size_t n_blocks)
  * blocks from the shared queue. */
 static void run_workers(struct td_worker *w, unsigned nt)
 {
-	int blas_threads = openblas_get_num_threads();
+	int blas_threads = irdm_blas_serial_begin();
 
-	openblas_set_num_threads(1);
 	for (unsigned t = 1; t < nt; t++)
 		w[t].started = !pthread_create(&w[t].tid, NULL, worker_main, &w[t]);
 	worker_main(&w[0]);
 	for (unsigned t = 1; t < nt; t++)
 		if (w[t].started)
 			pthread_join(w[t].tid, NULL);
-	openblas_set_num_threads(blas_threads);
+	irdm_blas_serial_end(blas_threads);
 }
 
 int irdm_td_responses(const struct irdm_mesh *mesh, const struct irdm_fem *fem,
