@@ -15,6 +15,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "irdm/error.h"
+
 struct irdm_mesh {
 	size_t    n_nodes;
 	double   *pos_m;      /* 3 * n_nodes, metres */

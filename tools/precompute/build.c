@@ -114,9 +114,11 @@ static int fir_from_modes(struct build *b, char *err, size_t errlen)
 			 m->n_cols, m->n_rows, T, (double)m->n_cols * m->n_rows * T * 72 / (1 << 30));
 		return IRDM_ENOMEM;
 	}
-	irdm_fir_from_modes(&m->modes, b->zoh, m->col_dofs, m->n_cols, m->row_dofs, m->n_rows,
-			    T, b->corr, b->fir, b->o->progress, b->o->ctx);
-	return IRDM_OK;
+	ret = irdm_fir_from_modes(&m->modes, b->zoh, m->col_dofs, m->n_cols, m->row_dofs,
+				  m->n_rows, T, b->corr, b->fir, b->o->progress, b->o->ctx);
+	if (ret)
+		snprintf(err, errlen, "precompute: out of memory synthesising the FIR from modes");
+	return ret;
 }
 
 /* The time-domain inputs are the free DoFs of the columns, in column order;

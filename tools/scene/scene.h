@@ -14,6 +14,7 @@
 #include <stdint.h>
 
 #include "fem/fem.h"
+#include "irdm/error.h"
 #include "modal/modal.h"
 
 enum irdm_region_kind {

@@ -22,6 +22,7 @@
 #include <stdint.h>
 
 #include "fem/fem.h"
+#include "irdm/error.h"
 #include "mesh/mesh.h"
 
 /*
@@ -75,8 +76,10 @@ struct irdm_td_opts {
  * The result does not depend on `threads` (bit for bit).  While it runs,
  * OpenBLAS is switched to one thread process-wide (restored on return), so
  * do not run it concurrently with itself or with other OpenBLAS work that
- * relies on its thread setting.  Returns 0, or -1 with a one-line message
- * in err.
+ * relies on its thread setting.  A one-line reason goes to err.
+ * Return: IRDM_OK; IRDM_EINVAL if an option, the model or an index is
+ * invalid; IRDM_ENOMEM; IRDM_ENUMERIC if the factorisation, a solve or a
+ * rigid-motion fit fails; IRDM_ETHREAD if no mutex can be made.
  */
 int irdm_td_responses(const struct irdm_mesh *mesh, const struct irdm_fem *fem,
 		      const struct irdm_td_opts *o, const int64_t *in_dofs, size_t n_in,
