@@ -92,8 +92,9 @@ int irdm_cmd_precompute(int argc, char **argv)
 				fprintf(stderr, "irdm precompute: --scene needs a file\n");
 				return 2;
 			}
-			if (irdm_scene_load(&sc, argv[i + 1], err, sizeof(err))) {
-				fprintf(stderr, "irdm precompute: %s\n", err);
+			int rc = irdm_scene_load(&sc, argv[i + 1], err, sizeof(err));
+			if (rc) {
+				irdm_cli_fail("precompute", rc, err);
 				return 1;
 			}
 		}
@@ -138,16 +139,18 @@ int irdm_cmd_precompute(int argc, char **argv)
 			o.merge = parts;
 		} else {
 			snprintf(where, sizeof(where), "%.100s", a);
-			if (irdm_scene_set(&sc, a + 2, v, where, err, sizeof(err))) {
-				fprintf(stderr, "irdm precompute: %s\n", err);
+			int rc = irdm_scene_set(&sc, a + 2, v, where, err, sizeof(err));
+			if (rc) {
+				irdm_cli_fail("precompute", rc, err);
 				return 2;
 			}
 		}
 	}
 	if (count_only) {
 		size_t n;
-		if (irdm_precompute_count_inputs(&sc, &n, err, sizeof(err))) {
-			fprintf(stderr, "irdm precompute: %s\n", err);
+		int rc = irdm_precompute_count_inputs(&sc, &n, err, sizeof(err));
+		if (rc) {
+			irdm_cli_fail("precompute", rc, err);
 			return 1;
 		}
 		printf("%zu\n", n);
@@ -171,8 +174,9 @@ int irdm_cmd_precompute(int argc, char **argv)
 	}
 	o.progress = irdm_cli_progress;
 	o.ctx = &prog;
-	if (irdm_precompute(&sc, &o, &rep, err, sizeof(err))) {
-		fprintf(stderr, "irdm precompute: %s\n", err);
+	int rc = irdm_precompute(&sc, &o, &rep, err, sizeof(err));
+	if (rc) {
+		irdm_cli_fail("precompute", rc, err);
 		return 1;
 	}
 	if (!prog.quiet)

@@ -363,14 +363,14 @@ int irdm_scene_set(struct irdm_scene *sc, const char *key, const char *value,
 	if (r == -2) {
 		snprintf(err, errlen, "%s: unknown scene key '%s' (see irdm precompute --help)",
 			 where, key);
-		return -1;
+		return IRDM_EINVAL;
 	}
 	if (r) {
 		snprintf(err, errlen, "%s: invalid value '%s' for '%s' (see irdm precompute --help)",
 			 where, value, key);
-		return -1;
+		return IRDM_EINVAL;
 	}
-	return 0;
+	return IRDM_OK;
 }
 
 static char *trim(char *s)
@@ -389,11 +389,11 @@ int irdm_scene_load(struct irdm_scene *sc, const char *path, char *err, size_t e
 {
 	FILE *f = fopen(path, "r");
 	char line[1024], where[600];
-	int lineno = 0, ret = -1;
+	int lineno = 0, ret = IRDM_EFORMAT;
 
 	if (!f) {
 		snprintf(err, errlen, "%s: cannot open scene: %s", path, strerror(errno));
-		return -1;
+		return IRDM_EIO;
 	}
 	while (fgets(line, sizeof(line), f)) {
 		lineno++;
@@ -414,14 +414,17 @@ int irdm_scene_load(struct irdm_scene *sc, const char *path, char *err, size_t e
 			goto out_close;
 		}
 		*eq = 0;
-		if (irdm_scene_set(sc, trim(s), trim(eq + 1), where, err, errlen))
+		ret = irdm_scene_set(sc, trim(s), trim(eq + 1), where, err, errlen);
+		if (ret)
 			goto out_close;
+		ret = IRDM_EFORMAT;
 	}
 	if (ferror(f)) {
-		snprintf(err, errlen, "%s: read error", path);
+		snprintf(err, errlen, "%s: read failed: %s", path, strerror(errno));
+		ret = IRDM_EIO;
 		goto out_close;
 	}
-	ret = 0;
+	ret = IRDM_OK;
 out_close:
 	fclose(f);
 	return ret;
@@ -429,31 +432,33 @@ out_close:
 
 int irdm_scene_check(const struct irdm_scene *sc, char *err, size_t errlen)
 {
-	if (irdm_material_check(&sc->mat, err, errlen))
-		return -1;
+	int ret = irdm_material_check(&sc->mat, err, errlen);
+
+	if (ret)
+		return ret;
 	if (!sc->floating && sc->fixed.kind == IRDM_REGION_NONE) {
 		snprintf(err, errlen, "scene: a grounded object needs fixed nodes (set 'fixed' or 'floating = yes')");
-		return -1;
+		return IRDM_EINVAL;
 	}
 	if (sc->floating && sc->fixed.kind != IRDM_REGION_NONE) {
 		snprintf(err, errlen, "scene: a floating object cannot have fixed nodes ('fixed = %s')",
 			 sc->fixed.text);
-		return -1;
+		return IRDM_EINVAL;
 	}
 	if (sc->touch.kind == IRDM_REGION_NONE) {
 		snprintf(err, errlen, "scene: nothing is touchable ('touch = none')");
-		return -1;
+		return IRDM_EINVAL;
 	}
 	if (sc->method == IRDM_METHOD_TIME_DOMAIN && sc->representation != IRDM_REPR_FIR) {
 		snprintf(err, errlen, "scene: method = time-domain makes FIR responses: use representation = fir:T");
-		return -1;
+		return IRDM_EINVAL;
 	}
 	if (sc->damping == IRDM_DAMP_RATIOS && sc->damp_hz[0] > 0 &&
 	    fabs(sc->damp_hz[0] - sc->damp_hz[1]) < 1e-9) {
 		snprintf(err, errlen, "scene: damping needs two different frequencies");
-		return -1;
+		return IRDM_EINVAL;
 	}
-	return 0;
+	return IRDM_OK;
 }
 
 static const char *region_text(const struct irdm_region *r)

@@ -75,14 +75,18 @@ struct irdm_scene {
 void irdm_scene_defaults(struct irdm_scene *sc);
 
 /* Set one key.  `where` names the source for messages ("cube.scene:7" or
- * "--dt"). */
+ * "--dt").  Return: IRDM_OK; IRDM_EINVAL if the key is unknown or the
+ * value invalid. */
 int irdm_scene_set(struct irdm_scene *sc, const char *key, const char *value,
 		   const char *where, char *err, size_t errlen);
 
-/* Read a scene file on top of *sc. */
+/* Read a scene file on top of *sc.  Return: IRDM_OK; IRDM_EIO if it cannot
+ * be opened or read; IRDM_EFORMAT if a line is not 'key = value' or too
+ * long; IRDM_EINVAL as irdm_scene_set(). */
 int irdm_scene_load(struct irdm_scene *sc, const char *path, char *err, size_t errlen);
 
-/* Cross-field checks (after all keys are set). */
+/* Cross-field checks (after all keys are set).  Return: IRDM_OK;
+ * IRDM_EINVAL naming the first conflict. */
 int irdm_scene_check(const struct irdm_scene *sc, char *err, size_t errlen);
 
 /* Canonical text of every key (provenance, scene hash). */
