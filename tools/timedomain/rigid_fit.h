@@ -5,7 +5,8 @@
  * All fits are weighted; for IRDM the weights are the lumped node masses,
  * because the rigid motion that the runtime integrates (Newton-Euler) is the
  * motion of the centre of mass and the rotation about it.  An unweighted fit
- * on a mesh with uneven node masses leaves a visible error (SPEC section 3).
+ * on a mesh with uneven node masses leaves a visible error
+ * (docs/architecture.md, "Frames and signs").
  *
  * Points and displacements are packed xyz triples: x[3 * i + axis].
  *

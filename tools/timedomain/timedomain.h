@@ -3,9 +3,10 @@
  * Time-domain impulse-response precompute (the paper's FIR R[s]) by direct
  * integration of the FEM model  M u'' + C u' + K u = f,  C = a M + b K.
  *
- * Convention (SPEC section 2): R[s] is the displacement at (s + 1) dt caused
- * by a unit force held constant over [0, dt) (zero-order hold) and zero
- * afterwards, starting from rest; u[t] = sum_s R[s] f[t - s].
+ * Convention (docs/architecture.md, "Sample convention"): R[s] is the
+ * displacement at (s + 1) dt caused by a unit force held constant over
+ * [0, dt) (zero-order hold) and zero afterwards, starting from rest;
+ * u[t] = sum_s R[s] f[t - s].
  *
  * Integrator: Newmark average acceleration (trapezoidal rule, beta = 1/4,
  * gamma = 1/2): unconditionally stable, second order, no numerical damping.
@@ -27,8 +28,9 @@
 
 /*
  * How a floating object's responses lose their rigid motion.  Both are the
- * mass-weighted least-squares rigid fit (SPEC section 3); they differ in how
- * the fit meets a response that is linear in the force:
+ * mass-weighted least-squares rigid fit (docs/architecture.md, "Frames
+ * and signs"); they differ in how the fit meets a response that is linear
+ * in the force:
  *
  * LINEAR (default): the fit's exact small-motion limit, the mass-orthogonal
  *   projection off the six rigid modes (rigid_fit.h).  Linear in the force,
