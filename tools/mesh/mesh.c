@@ -41,6 +41,14 @@ static void scale_positions(double *x, size_t n, double scale)
 		x[i] *= scale;
 }
 
+/* A parsed volume mesh in file units to metres, then checked. */
+static int scale_and_finish(struct irdm_mesh *m, const struct mesh_labels *lab, double scale,
+			    char *err, size_t errlen)
+{
+	scale_positions(m->pos_m, 3 * m->n_nodes, scale);
+	return mesh_finish_labeled(m, lab, err, errlen);
+}
+
 /* foo.node or foo.ele: both files, named after the one they describe. */
 static int read_tetgen(const char *path, double scale, struct irdm_mesh *m,
 		       char *err, size_t errlen)
@@ -72,10 +80,8 @@ static int read_tetgen(const char *path, double scale, struct irdm_mesh *m,
 	lab.tet_what = ele_path;
 	ret = mesh_parse_tetgen_labeled(node_txt, node_len, ele_txt, ele_len, m,
 					&lab, err, errlen);
-	if (ret)
-		goto out_free;
-	scale_positions(m->pos_m, 3 * m->n_nodes, scale);
-	ret = mesh_finish_labeled(m, &lab, err, errlen);
+	if (!ret)
+		ret = scale_and_finish(m, &lab, scale, err, errlen);
 
 out_free:
 	mesh_labels_free(&lab);
@@ -98,12 +104,8 @@ static int read_gmsh(const char *path, double scale, struct irdm_mesh *m,
 	if (ret)
 		return ret;
 	ret = mesh_parse_gmsh_labeled(txt, len, path, m, &lab, err, errlen);
-	if (ret)
-		goto out_free;
-	scale_positions(m->pos_m, 3 * m->n_nodes, scale);
-	ret = mesh_finish_labeled(m, &lab, err, errlen);
-
-out_free:
+	if (!ret)
+		ret = scale_and_finish(m, &lab, scale, err, errlen);
 	mesh_labels_free(&lab);
 	free(txt);
 	return ret;

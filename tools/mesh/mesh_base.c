@@ -29,28 +29,30 @@ void irdm_surface_free(struct irdm_surface *s)
 	memset(s, 0, sizeof(*s));
 }
 
+double mesh_tet_vol6(const double *x, const uint32_t *t)
+{
+	const double *a = x + 3 * t[0], *b = x + 3 * t[1];
+	const double *c = x + 3 * t[2], *d = x + 3 * t[3];
+	double u[3], v[3], w[3];
+	int i;
+
+	for (i = 0; i < 3; i++) {
+		u[i] = b[i] - a[i];
+		v[i] = c[i] - a[i];
+		w[i] = d[i] - a[i];
+	}
+	return (u[1] * v[2] - u[2] * v[1]) * w[0] +
+	       (u[2] * v[0] - u[0] * v[2]) * w[1] +
+	       (u[0] * v[1] - u[1] * v[0]) * w[2];
+}
+
 double irdm_mesh_volume(const struct irdm_mesh *m)
 {
-	const double *x = m->pos_m;
 	double sum = 0.0;
 	size_t e;
 
-	for (e = 0; e < m->n_tets; e++) {
-		const uint32_t *t = m->tets + 4 * e;
-		const double *a = x + 3 * t[0], *b = x + 3 * t[1];
-		const double *c = x + 3 * t[2], *d = x + 3 * t[3];
-		double u[3], v[3], w[3];
-		int i;
-
-		for (i = 0; i < 3; i++) {
-			u[i] = b[i] - a[i];
-			v[i] = c[i] - a[i];
-			w[i] = d[i] - a[i];
-		}
-		sum += (u[1] * v[2] - u[2] * v[1]) * w[0] +
-		       (u[2] * v[0] - u[0] * v[2]) * w[1] +
-		       (u[0] * v[1] - u[1] * v[0]) * w[2];
-	}
+	for (e = 0; e < m->n_tets; e++)
+		sum += mesh_tet_vol6(m->pos_m, m->tets + 4 * e);
 	return sum / 6.0;
 }
 

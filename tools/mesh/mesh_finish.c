@@ -60,23 +60,6 @@ static double sq_dist(const double *a, const double *b)
 	return dx * dx + dy * dy + dz * dz;
 }
 
-/* Six times the signed volume: (b-a)x(c-a).(d-a). */
-static double vol6(const double *a, const double *b, const double *c,
-		   const double *d)
-{
-	double u[3], v[3], w[3];
-	int i;
-
-	for (i = 0; i < 3; i++) {
-		u[i] = b[i] - a[i];
-		v[i] = c[i] - a[i];
-		w[i] = d[i] - a[i];
-	}
-	return (u[1] * v[2] - u[2] * v[1]) * w[0] +
-	       (u[2] * v[0] - u[0] * v[2]) * w[1] +
-	       (u[0] * v[1] - u[1] * v[0]) * w[2];
-}
-
 static int check_nodes(const struct irdm_mesh *m, const struct mesh_labels *lab,
 		       char *err, size_t errlen)
 {
@@ -132,7 +115,7 @@ static int check_tet_volume(const struct irdm_mesh *m, size_t e,
 		for (j = i + 1; j < 4; j++)
 			l2 = fmax(l2, sq_dist(x + 3 * t[i], x + 3 * t[j]));
 	l3 = l2 * sqrt(l2);
-	v6 = vol6(x + 3 * t[0], x + 3 * t[1], x + 3 * t[2], x + 3 * t[3]);
+	v6 = mesh_tet_vol6(x, t);
 	if (!isfinite(v6) || !isfinite(l3)) {
 		mesh_err(err, errlen, lab->tet_what,
 			 "element %llu is too large to measure (coordinates overflow)",
