@@ -8,6 +8,7 @@
 #   make check      what CI runs: fuzz, clang + sanitizer tests, then the tests
 #   make bench      benchmarks (print figures; never pass/fail on time)
 #   make run        the main job: the built-in default scene, end to end
+#   make docs       docs/scene-format.md from the scene key table
 #
 # CC=clang works too.  The layers point one way and the include paths
 # enforce it (docs/architecture.md):
@@ -71,7 +72,7 @@ TESTS    := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 TICK_TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TICK_TEST_SRC))
 BENCHES  := $(patsubst tests/bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC))
 
-.PHONY: all test san fuzz bench bench-precompute run check deps clean
+.PHONY: all test san fuzz bench bench-precompute run check deps clean docs
 .SECONDARY:
 all: $(IRDM) $(FW_LIB) $(HAL_LIB) $(SIM_LIB)
 
@@ -124,6 +125,11 @@ $(TICK_IMAGE): $(IRDM)
 
 test: $(TESTS) $(IRDM) $(TICK_IMAGE)
 	IRDM=$(IRDM) IRDM_BUILD=$(BUILD) IRDM_TICK_IMAGE=$(TICK_IMAGE) tests/run-tests.sh $(TESTS)
+
+# Generated from the scene key table (tests/test_cli.c checks it is current).
+docs: $(IRDM)
+	$(IRDM) precompute --help-markdown > docs/scene-format.md.tmp
+	mv docs/scene-format.md.tmp docs/scene-format.md
 
 san:
 	$(MAKE) BUILD=build-san SAN=1 OPT="-O1 -g" test

@@ -162,10 +162,13 @@ static void test_bad_scene_values(void **state)
 	const char *img = path_in_dir("bad.img");
 
 	(void)state;
-	expect_failure(run("precompute", SMALL, "--poisson", "0.5", "-o", img, NULL), "Poisson");
-	expect_failure(run("precompute", SMALL, "--poisson", "0.7", "-o", img, NULL), "Poisson");
-	expect_failure(run("precompute", SMALL, "--young", "0", "-o", img, NULL), "Young");
-	expect_failure(run("precompute", SMALL, "--young", "-5", "-o", img, NULL), "Young");
+	/* ranges are checked as the key is read: the message names key, value and bound */
+	expect_failure(run("precompute", SMALL, "--poisson", "0.5", "-o", img, NULL),
+		       "--poisson 0.5: must be < 0.5");
+	expect_failure(run("precompute", SMALL, "--poisson", "0.7", "-o", img, NULL), "poisson");
+	expect_failure(run("precompute", SMALL, "--young", "0", "-o", img, NULL),
+		       "--young 0: must be > 0 Pa");
+	expect_failure(run("precompute", SMALL, "--young", "-5", "-o", img, NULL), "young");
 	expect_failure(run("precompute", SMALL, "--density", "nan", "-o", img, NULL), "density");
 	expect_failure(run("precompute", SMALL, "--dt", "0", "-o", img, NULL), "--dt");
 	expect_failure(run("precompute", SMALL, "--dt", "-0.001", "-o", img, NULL), "--dt");
@@ -183,6 +186,12 @@ static void test_bad_scene_values(void **state)
 	write_file(path_in_dir("bad.scene"), "young = 2000\nthis line has no equals sign\n");
 	expect_failure(run("precompute", "--scene", path_in_dir("bad.scene"), "-o", img, NULL),
 		       "bad.scene:2");
+	write_file(path_in_dir("bad.scene"), "# material\nyoung = 2000\npoisson = 0.6\n");
+	expect_failure(run("precompute", "--scene", path_in_dir("bad.scene"), "-o", img, NULL),
+		       "bad.scene:3: poisson = 0.6: must be < 0.5");
+	write_file(path_in_dir("bad.scene"), "mass = heavy\n");
+	expect_failure(run("precompute", "--scene", path_in_dir("bad.scene"), "-o", img, NULL),
+		       "bad.scene:1: mass = heavy: expected lumped | consistent");
 	assert_false(exists(img));
 }
 
@@ -290,7 +299,7 @@ static void test_failure_keeps_existing_image(void **state)
 	slurp(img, before, sizeof(before));
 	struct stat st0, st1;
 	assert_int_equal(stat(img, &st0), 0);
-	expect_failure(run("precompute", SMALL, "--young", "-1", "-o", img, NULL), "Young");
+	expect_failure(run("precompute", SMALL, "--young", "-1", "-o", img, NULL), "young");
 	assert_int_equal(stat(img, &st1), 0);
 	slurp(img, after, sizeof(after));
 	assert_int_equal(st0.st_size, st1.st_size);
@@ -527,7 +536,30 @@ static void test_help_for_every_command(void **state)
 		assert_int_equal(run("image", sub[i], "--help", NULL), 0);
 		assert_non_null(strstr(out_text, "export IMAGE --column"));
 	}
+	/* generated from the tables: every key, its syntax and its range */
+	assert_int_equal(run("image", "export", "--help", NULL), 0);
+	assert_non_null(strstr(out_text, "1 <= samples <= 10000000"));
+	assert_int_equal(run("precompute", "--help", NULL), 0);
+	assert_non_null(strstr(out_text, "-1 < poisson < 0.5"));
+	assert_non_null(strstr(out_text, "--count-inputs"));
 	expect_failure(run("frobnicate", NULL), "frobnicate");
+}
+
+/*
+ * docs/scene-format.md is generated from the scene key table ("make docs");
+ * regenerate it and compare, so that it cannot go stale.
+ */
+static void test_scene_docs_current(void **state)
+{
+	static char committed[65536];
+	const char *path = getenv("IRDM_SCENE_DOC");
+
+	(void)state;
+	slurp(path ? path : "docs/scene-format.md", committed, sizeof(committed));
+	assert_true(strlen(committed) > 0);
+	assert_int_equal(run("precompute", "--help-markdown", NULL), 0);
+	if (strcmp(out_text, committed))
+		fail_msg("docs/scene-format.md is not what 'irdm precompute --help-markdown' writes: run 'make docs'");
 }
 
 int main(void)
@@ -543,6 +575,7 @@ int main(void)
 		cmocka_unit_test(test_time_domain_split_and_merge),
 		cmocka_unit_test(test_replay),
 		cmocka_unit_test(test_help_for_every_command),
+		cmocka_unit_test(test_scene_docs_current),
 	};
 
 	return cmocka_run_group_tests(tests, setup, teardown);

@@ -292,9 +292,10 @@ static void test_stroke(void **state)
 	double err = efx_rel_rms(F, R, N_STROKE * 3);
 	/*
 	 * Smooth (Fig. 6c): crossing an edge adds no jump of its own.  With the
-	 * displacement imposed rigidly the force rings every tick (SPEC
-	 * section 5, in the reference just the same); the change across a
-	 * crossing must look like any other tick's.
+	 * displacement imposed rigidly the force rings every tick
+	 * (docs/architecture.md, "Numerical hazards"; in the reference just
+	 * the same); the change across a crossing must look like any other
+	 * tick's.
 	 */
 	double at_cross = 0, elsewhere = 0, mean = 0;
 	for (size_t t = 200; t < N_STROKE; t++) {
@@ -317,6 +318,57 @@ static void test_stroke(void **state)
 	free(R);
 }
 
+/* Each error the engine's header documents, from the call that returns it. */
+static void test_errors(void **state)
+{
+	static _Alignas(16) unsigned char small[64];
+	const double bary[3] = { 0.5, 0.3, 0.2 }, bad_bary[3] = { 0.5, 0.5, 0.5 };
+	struct irdm_engine_config cfg, bad;
+	struct irdm_contact_cmd cmd[IRDM_MAX_CONTACTS];
+	struct irdm_contact_site site;
+	struct irdm_session *ses;
+	struct irdm_engine *e;
+	char err[256];
+
+	(void)state;
+	irdm_engine_config_default(&cfg);
+	bad = cfg;
+	bad.max_contacts = IRDM_MAX_CONTACTS + 1;
+	assert_int_equal(irdm_engine_init(&e, &exact, &bad, small, sizeof(small), err, sizeof(err)),
+			 IRDM_EINVAL);
+	assert_null(e);
+	assert_int_equal(irdm_engine_init(&e, &exact, &cfg, small, sizeof(small), err, sizeof(err)),
+			 IRDM_ENOMEM);
+	assert_null(e);
+
+	ses = efx_session(&exact, &cfg);
+	e = ses->eng;
+	assert_int_equal(irdm_engine_site_node(e, exact.meta->n_nodes, &site), IRDM_ECONTACT);
+	uint32_t row = 0;                       /* a displayed node nobody may touch */
+	while (row < exact.meta->n_nodes && irdm_engine_site_node(e, row, &site) == IRDM_OK)
+		row++;
+	assert_true(row < exact.meta->n_nodes);
+	assert_int_equal(irdm_engine_site_node(e, row, &site), IRDM_ECONTACT);
+	assert_int_equal(irdm_engine_site_point(e, exact.meta->n_tris, bary, &site), IRDM_ECONTACT);
+	assert_int_equal(irdm_engine_site_point(e, 0, bad_bary, &site), IRDM_EINVAL);
+	assert_int_equal(irdm_engine_site_node(e, exact.columns[0], &site), IRDM_OK);
+	assert_int_equal(irdm_engine_contact_begin(e, cfg.max_contacts, &site, IRDM_CONTACT_GRAB),
+			 IRDM_EINVAL);
+	assert_int_equal(irdm_engine_contact_begin(e, 0, &site, IRDM_CONTACT_OFF), IRDM_EINVAL);
+	assert_int_equal(irdm_engine_contact_begin(e, 0, &site, IRDM_CONTACT_GRAB), IRDM_OK);
+
+	memset(cmd, 0, sizeof(cmd));
+	cmd[0].mode = IRDM_CONTACT_GRAB;
+	cmd[0].target_m[2] = NAN;
+	assert_int_equal(irdm_engine_tick(e, cmd), IRDM_EFAULT);
+	cmd[0].target_m[2] = -0.001;
+	assert_int_equal(irdm_engine_tick(e, cmd), IRDM_EFAULT);    /* held until reset */
+	irdm_engine_reset(e);
+	assert_int_equal(irdm_engine_contact_begin(e, 0, &site, IRDM_CONTACT_GRAB), IRDM_OK);
+	assert_int_equal(irdm_engine_tick(e, cmd), IRDM_OK);
+	irdm_session_close(ses);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -324,6 +376,7 @@ int main(void)
 		cmocka_unit_test(test_release),
 		cmocka_unit_test(test_two_points),
 		cmocka_unit_test(test_stroke),
+		cmocka_unit_test(test_errors),
 	};
 
 	return cmocka_run_group_tests(tests, setup, teardown);

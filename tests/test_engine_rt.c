@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * The force tick is hard real time (SPEC section 7), proven rather than
- * claimed.  Issue must-show: "Allocation-free and fault-free, proven".
+ * The force tick is hard real time (docs/architecture.md, "Memory and
+ * threading"), proven rather than claimed.  Issue must-show: "Allocation-free and fault-free, proven".
  *
  *  - No allocation: this executable interposes the allocator (malloc,
  *    calloc, realloc, reallocarray, free, aligned_alloc, posix_memalign,
@@ -10,7 +10,7 @@
  *    realistic haptic scenario after init must count none.
  *  - No page fault: getrusage(RUSAGE_THREAD) minor and major fault counts
  *    do not move across those ticks (after a warm-up, with the memory
- *    locked and the stack pre-faulted as SPEC section 7 asks).
+ *    locked and the stack pre-faulted as docs/architecture.md asks).
  *  - No system call: the same ticks run in a forked child that has put
  *    itself in seccomp strict mode, where any system call but read, write,
  *    _exit and sigreturn kills it with SIGKILL.
@@ -52,6 +52,7 @@
 
 #include "irdm/deform_worker.h"
 #include "irdm/engine.h"
+#include "irdm/rt.h"
 #include "irdm/session.h"
 #include "support/engine_fixture.h"
 
@@ -62,19 +63,7 @@
  * Under ASan only the allocator interposition is left out -- the page fault
  * and system call proofs still run.
  */
-#if defined(__SANITIZE_ADDRESS__)
-#define RT_ASAN 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define RT_ASAN 1
-#endif
-#endif
-#ifndef RT_ASAN
-#define RT_ASAN 0
-#endif
-#if RT_ASAN
-#include <sanitizer/asan_interface.h>
-#endif
+#define RT_ASAN IRDM_RT_ASAN
 
 #ifndef SECCOMP_MODE_STRICT
 #define SECCOMP_MODE_STRICT 1
@@ -326,28 +315,12 @@ void *sbrk(intptr_t inc)
 }
 #endif /* !RT_ASAN */
 
-/* ---- the real-time conditions of SPEC section 7 ---- */
+/* ---- the real-time conditions (docs/architecture.md, "Memory and threading") ---- */
 
 static bool locked;
 
-/*
- * Touch 256 KiB of stack below the caller: the tick's frames never fault.
- * Under ASan the stack's shadow must be written too: the instrumented
- * writes above only read it (mapping the shared zero page), and the first
- * redzone a deeper frame poisons there would be a copy-on-write fault.
- */
-static __attribute__((noinline)) void prefault_stack(void)
-{
-	volatile unsigned char buf[256 * 1024];
-
-	for (size_t i = 0; i < sizeof(buf); i += 1024)
-		buf[i] = (unsigned char)i;
-	buf[sizeof(buf) - 1] = 0;
-#if RT_ASAN
-	__asan_poison_memory_region((void *)buf, sizeof(buf));
-	__asan_unpoison_memory_region((void *)buf, sizeof(buf));
-#endif
-}
+/* Stack pre-faulted below the warm-up: the tick's frames never fault. */
+#define STACK_PREFAULT (256 * 1024)
 
 static void faults(long *minflt, long *majflt)
 {
@@ -570,7 +543,8 @@ static void warm_up(struct rig *r)
 	nan_target(r, &warm);
 	irdm_engine_reset(r->e);
 	run(r, N_WARMUP, &warm);
-	prefault_stack();
+	/* a refusal (no room on the stack) would show as page faults */
+	irdm_rt_prefault_stack(STACK_PREFAULT);
 	/* and the harness: its counters' first write is a fault too */
 	arm();
 	disarm();
@@ -587,8 +561,8 @@ static void check_result(const char *what, const struct run_result *res, unsigne
 	assert_true(res->max_f > 1e-3);
 	assert_true(res->max_f < DEVICE_F);
 	assert_true(res->slides >= n / SLIDE_EVERY - 1);
-	assert_int_equal(res->nan_rc, IRDM_ENGINE_EFAULT);
-	assert_int_equal(res->nan_rc2, IRDM_ENGINE_EFAULT);
+	assert_int_equal(res->nan_rc, IRDM_EFAULT);
+	assert_int_equal(res->nan_rc2, IRDM_EFAULT);
 	assert_true(res->nan_zero_force);
 }
 
@@ -645,7 +619,7 @@ static void alloc_and_fault_free(const struct irdm_image *img)
 	assert_true(pos_finite);
 	assert_int_equal(tick % PUBLISH_EVERY, 0);
 	assert_true(tick + PUBLISH_EVERY > ticks - 1);   /* the newest, before the reset tick */
-	assert_int_equal(reset_rc, IRDM_ENGINE_OK);
+	assert_int_equal(reset_rc, IRDM_OK);
 }
 
 static void test_modal_alloc_and_fault_free(void **state)
@@ -870,16 +844,17 @@ static int setup(void **state)
 	efx_image(&fir_img, p2, "resolution", "6,6,12", "representation", "fir:500",
 		  "touch", "box:0.03,0.049,0.199,0.09,0.051,0.201", "display", "touch", NULL);
 	/*
-	 * Lock what is mapped and what will be (SPEC section 7).  Best effort:
-	 * without it the fault check can still pass on an idle machine, and
-	 * says "NOT locked".  Under ASan mlockall would be a no-op (ASan
-	 * ignores it) and its shadow memory is not ours to lock.
+	 * Lock what is mapped and what will be.  Best effort: without it the
+	 * fault check can still pass on an idle machine, and says "NOT
+	 * locked".  Under ASan it is not supported (ASan's mlockall does
+	 * nothing) and its shadow memory is not ours to lock.
 	 */
-	if (!RT_ASAN)
-		locked = !mlockall(MCL_CURRENT | MCL_FUTURE);
+	int rc = irdm_rt_lock_memory();
+
+	locked = rc == IRDM_OK;
 	if (!locked)
 		print_message("mlockall: %s: the page fault check runs without locked memory\n",
-			      RT_ASAN ? "skipped under ASan" : strerror(errno));
+			      irdm_strerror(rc));
 	return 0;
 }
 
@@ -889,7 +864,7 @@ static int teardown(void **state)
 
 	(void)state;
 	if (locked)
-		munlockall();
+		irdm_rt_unlock_memory();
 	irdm_image_unmap(&modal_img);
 	irdm_image_unmap(&fir_img);
 	snprintf(cmd, sizeof(cmd), "rm -rf '%s'", dir);

@@ -40,6 +40,7 @@ static const char *const tick_globs[] = {
 	"firmware/rigid/*.o",
 	"firmware/session/session.o",
 	"firmware/deform/deform_channel.o",
+	"firmware/device/*.o",
 };
 
 static const char *const forbidden[] = { "cblas_", "openblas_", "pthread_", "sem_", NULL };

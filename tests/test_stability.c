@@ -4,8 +4,8 @@
  * scenario -- a device pushed 1 cm into the top of the paper's cuboid and
  * held -- stays bounded and passive for 60 s of simulated time: for FIR
  * images with T = 50, 100, 250, 500 (whose bare force recursions are
- * unstable, SPEC section 5) and a modal image, and for E from 2e3 to 2e9 Pa
- * with nu up to 0.4999.
+ * unstable: docs/architecture.md, "Numerical hazards") and a modal image,
+ * and for E from 2e3 to 2e9 Pa with nu up to 0.4999.
  *
  * Passive: the work done on the object through the contact port,
  * W(t) = sum F . du, never goes below zero by more than a tiny tolerance

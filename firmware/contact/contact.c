@@ -14,6 +14,7 @@
 #include <string.h>
 
 #include "irdm/contact.h"
+#include "irdm/vec3.h"
 
 _Static_assert(IRDM_CONTACT_STACK > IRDM_BVH_MAX_DEPTH, "stack holds a root-leaf path");
 
@@ -24,30 +25,6 @@ _Static_assert(IRDM_CONTACT_STACK > IRDM_BVH_MAX_DEPTH, "stack holds a root-leaf
 /* sin^2 of the smallest angle of a triangle that still has a normal */
 #define DEGENERATE_SIN2 1e-24
 
-static double dot3(const double *a, const double *b)
-{
-	return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-static void sub3(double *r, const double *a, const double *b)
-{
-	r[0] = a[0] - b[0];
-	r[1] = a[1] - b[1];
-	r[2] = a[2] - b[2];
-}
-
-static void cross3(double *r, const double *a, const double *b)
-{
-	r[0] = a[1] * b[2] - a[2] * b[1];
-	r[1] = a[2] * b[0] - a[0] * b[2];
-	r[2] = a[0] * b[1] - a[1] * b[0];
-}
-
-static bool finite3(const double *p)
-{
-	return isfinite(p[0]) && isfinite(p[1]) && isfinite(p[2]);
-}
-
 static void disp_of(const struct irdm_contact_disp *d, uint32_t row, double u[3])
 {
 	if (d && d->u_m) {
@@ -57,7 +34,7 @@ static void disp_of(const struct irdm_contact_disp *d, uint32_t row, double u[3]
 	} else if (d && d->fn) {
 		d->fn(d->ctx, row, u);
 	} else {
-		u[0] = u[1] = u[2] = 0;
+		irdm_v3_zero(u);
 	}
 }
 
@@ -68,7 +45,7 @@ int irdm_contact_mesh_init(struct irdm_contact_mesh *cm, const struct irdm_image
 
 	memset(cm, 0, sizeof(*cm));
 	if (!img || !img->meta || !img->contact_bvh)
-		return IRDM_CONTACT_EINVAL;
+		return IRDM_EINVAL;
 	h = img->contact_bvh;
 	base = (const uint8_t *)h;
 	cm->img = img;
@@ -81,7 +58,7 @@ int irdm_contact_mesh_init(struct irdm_contact_mesh *cm, const struct irdm_image
 	cm->rest = img->nodes;
 	cm->n_tris = img->meta->n_tris;
 	cm->n_rows = img->meta->n_nodes;
-	return IRDM_CONTACT_OK;
+	return IRDM_OK;
 }
 
 bool irdm_contact_tri_contactable(const struct irdm_contact_mesh *cm, uint32_t t)
@@ -114,24 +91,14 @@ static bool tri_normal(const double v[3][3], double n[3])
 {
 	double ab[3], ac[3], nn;
 
-	sub3(ab, v[1], v[0]);
-	sub3(ac, v[2], v[0]);
-	cross3(n, ab, ac);
-	nn = dot3(n, n);
-	if (!(nn > DEGENERATE_SIN2 * dot3(ab, ab) * dot3(ac, ac)) || !isfinite(nn))
+	irdm_v3_sub(ab, v[1], v[0]);
+	irdm_v3_sub(ac, v[2], v[0]);
+	irdm_v3_cross(n, ab, ac);
+	nn = irdm_v3_dot(n, n);
+	if (!(nn > DEGENERATE_SIN2 * irdm_v3_dot(ab, ab) * irdm_v3_dot(ac, ac)) || !isfinite(nn))
 		return false;
-	nn = 1 / sqrt(nn);
-	n[0] *= nn;
-	n[1] *= nn;
-	n[2] *= nn;
+	irdm_v3_scale(n, 1 / sqrt(nn), n);
 	return true;
-}
-
-static void set_bary(double *bary, double u, double v, double w)
-{
-	bary[0] = u;
-	bary[1] = v;
-	bary[2] = w;
 }
 
 /* Closest point on segment ab: parameter t of a + t (b - a). */
@@ -139,12 +106,12 @@ static double seg_param(const double *a, const double *b, const double *p)
 {
 	double ab[3], ap[3], l2, t;
 
-	sub3(ab, b, a);
-	sub3(ap, p, a);
-	l2 = dot3(ab, ab);
+	irdm_v3_sub(ab, b, a);
+	irdm_v3_sub(ap, p, a);
+	l2 = irdm_v3_dot(ab, ab);
 	if (!(l2 > 0))
 		return 0;
-	t = dot3(ap, ab) / l2;
+	t = irdm_v3_dot(ap, ab) / l2;
 	return t < 0 ? 0 : t > 1 ? 1 : t;
 }
 
@@ -153,10 +120,9 @@ static double finish(const double *a, const double *b, const double *c, const do
 {
 	double d[3];
 
-	for (unsigned i = 0; i < 3; i++)
-		q[i] = bary[0] * a[i] + bary[1] * b[i] + bary[2] * c[i];
-	sub3(d, p, q);
-	return dot3(d, d);
+	irdm_v3_bary(q, bary, a, b, c);
+	irdm_v3_sub(d, p, q);
+	return irdm_v3_dot(d, d);
 }
 
 /* A triangle with no interior: the best of its three edges. */
@@ -182,66 +148,83 @@ static double closest_on_edges(const double *a, const double *b, const double *c
 	return best;
 }
 
+/* One closest point query on a triangle: its vertices, the query point,
+ * and where the answer goes. */
+struct tri_query {
+	const double *a, *b, *c, *p;
+	double *bary, *q;
+};
+
+/* Answer with the point of weights (u, v, w); returns its squared distance. */
+static double answer(const struct tri_query *tq, double u, double v, double w)
+{
+	tq->bary[0] = u;
+	tq->bary[1] = v;
+	tq->bary[2] = w;
+	return finish(tq->a, tq->b, tq->c, tq->p, tq->bary, tq->q);
+}
+
+/* Answer with the point at t = num / den (0 unless den > 0) on the edge
+ * from vertex i to vertex j. */
+static double answer_edge(const struct tri_query *tq, unsigned i, unsigned j, double num,
+			  double den)
+{
+	double t = den > 0 ? num / den : 0, w[3] = { 0, 0, 0 };
+
+	w[i] = 1 - t;
+	w[j] = t;
+	return answer(tq, w[0], w[1], w[2]);
+}
+
+/* Where p lies seen from vertex v: (p - v) . ab and (p - v) . ac. */
+static void vertex_dots(const double *ab, const double *ac, const double *p, const double *v,
+			double *d_ab, double *d_ac)
+{
+	double vp[3];
+
+	irdm_v3_sub(vp, p, v);
+	*d_ab = irdm_v3_dot(ab, vp);
+	*d_ac = irdm_v3_dot(ac, vp);
+}
+
 double irdm_contact_closest_on_tri(const double a[3], const double b[3], const double c[3],
 				   const double p[3], double bary[3], double q[3])
 {
-	double ab[3], ac[3], ap[3], bp[3], cp[3], n[3];
-	double d1, d2, d3, d4, d5, d6, va, vb, vc, den, t;
+	const struct tri_query tq = { a, b, c, p, bary, q };
+	double ab[3], ac[3], n[3];
+	double d1, d2, d3, d4, d5, d6, va, vb, vc, den;
 
-	sub3(ab, b, a);
-	sub3(ac, c, a);
+	irdm_v3_sub(ab, b, a);
+	irdm_v3_sub(ac, c, a);
 	/* The region tests below rely on the signs of areas: meaningless for
 	 * (nearly) collinear vertices, whose closest point is on an edge. */
-	cross3(n, ab, ac);
-	if (!(dot3(n, n) > DEGENERATE_SIN2 * dot3(ab, ab) * dot3(ac, ac)))
+	irdm_v3_cross(n, ab, ac);
+	if (!(irdm_v3_dot(n, n) > DEGENERATE_SIN2 * irdm_v3_dot(ab, ab) * irdm_v3_dot(ac, ac)))
 		return closest_on_edges(a, b, c, p, bary, q);
-	sub3(ap, p, a);
-	d1 = dot3(ab, ap);
-	d2 = dot3(ac, ap);
-	if (d1 <= 0 && d2 <= 0) {               /* vertex region a */
-		set_bary(bary, 1, 0, 0);
-		return finish(a, b, c, p, bary, q);
-	}
-	sub3(bp, p, b);
-	d3 = dot3(ab, bp);
-	d4 = dot3(ac, bp);
-	if (d3 >= 0 && d4 <= d3) {              /* vertex region b */
-		set_bary(bary, 0, 1, 0);
-		return finish(a, b, c, p, bary, q);
-	}
+	vertex_dots(ab, ac, p, a, &d1, &d2);
+	if (d1 <= 0 && d2 <= 0)                 /* vertex region a */
+		return answer(&tq, 1, 0, 0);
+	vertex_dots(ab, ac, p, b, &d3, &d4);
+	if (d3 >= 0 && d4 <= d3)                /* vertex region b */
+		return answer(&tq, 0, 1, 0);
 	vc = d1 * d4 - d3 * d2;
-	if (vc <= 0 && d1 >= 0 && d3 <= 0) {    /* edge ab; d1 - d3 = |ab|^2 */
-		t = d1 - d3 > 0 ? d1 / (d1 - d3) : 0;
-		set_bary(bary, 1 - t, t, 0);
-		return finish(a, b, c, p, bary, q);
-	}
-	sub3(cp, p, c);
-	d5 = dot3(ab, cp);
-	d6 = dot3(ac, cp);
-	if (d6 >= 0 && d5 <= d6) {              /* vertex region c */
-		set_bary(bary, 0, 0, 1);
-		return finish(a, b, c, p, bary, q);
-	}
+	if (vc <= 0 && d1 >= 0 && d3 <= 0)      /* edge ab; d1 - d3 = |ab|^2 */
+		return answer_edge(&tq, 0, 1, d1, d1 - d3);
+	vertex_dots(ab, ac, p, c, &d5, &d6);
+	if (d6 >= 0 && d5 <= d6)                /* vertex region c */
+		return answer(&tq, 0, 0, 1);
 	vb = d5 * d2 - d1 * d6;
-	if (vb <= 0 && d2 >= 0 && d6 <= 0) {    /* edge ac; d2 - d6 = |ac|^2 */
-		t = d2 - d6 > 0 ? d2 / (d2 - d6) : 0;
-		set_bary(bary, 1 - t, 0, t);
-		return finish(a, b, c, p, bary, q);
-	}
+	if (vb <= 0 && d2 >= 0 && d6 <= 0)      /* edge ac; d2 - d6 = |ac|^2 */
+		return answer_edge(&tq, 0, 2, d2, d2 - d6);
 	va = d3 * d6 - d5 * d4;
-	if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0) {  /* edge bc */
-		den = (d4 - d3) + (d5 - d6);
-		t = den > 0 ? (d4 - d3) / den : 0;
-		set_bary(bary, 0, 1 - t, t);
-		return finish(a, b, c, p, bary, q);
-	}
+	if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0)    /* edge bc */
+		return answer_edge(&tq, 1, 2, d4 - d3, (d4 - d3) + (d5 - d6));
 	den = va + vb + vc;                     /* = |ab x ac|^2 */
 	if (!(den > 0) || !isfinite(den))
 		return closest_on_edges(a, b, c, p, bary, q);
 	vb /= den;
 	vc /= den;
-	set_bary(bary, 1 - vb - vc, vb, vc);
-	return finish(a, b, c, p, bary, q);
+	return answer(&tq, 1 - vb - vc, vb, vc);
 }
 
 /* Squared distance from p to the box of nd grown by g. */
@@ -282,8 +265,8 @@ static void query_tri(struct query *qr, uint32_t t)
 	d2 = irdm_contact_closest_on_tri(v[0], v[1], v[2], qr->p, bary, q);
 	if (!(d2 <= qr->best * (1 + TIE_REL) + TIE_ABS))
 		return;
-	sub3(pq, qr->p, q);
-	s = dot3(pq, n);
+	irdm_v3_sub(pq, qr->p, q);
+	s = irdm_v3_dot(pq, n);
 	c = d2 > 0 ? fabs(s) / sqrt(d2) : 1;
 	if (!qr->found || d2 < qr->best * (1 - TIE_REL) - TIE_ABS)
 		better = d2 <= qr->best;
@@ -309,9 +292,9 @@ int irdm_contact_closest(const struct irdm_contact_mesh *cm, const struct irdm_c
 	uint32_t stack[IRDM_CONTACT_STACK];
 	unsigned sp = 0;
 
-	if (!cm || !cm->hdr || !hit || !p || !finite3(p) || !(radius_m >= 0) ||
+	if (!cm || !cm->hdr || !hit || !p || !irdm_v3_finite(p) || !(radius_m >= 0) ||
 	    !isfinite(radius_m) || !(max_disp_m >= 0) || !isfinite(max_disp_m))
-		return IRDM_CONTACT_EINVAL;
+		return IRDM_EINVAL;
 	if (!cm->hdr->n_bvh_nodes)
 		return 0;
 	stack[sp++] = 0;
@@ -328,7 +311,7 @@ int irdm_contact_closest(const struct irdm_contact_mesh *cm, const struct irdm_c
 			continue;
 		}
 		if (sp + 2 > IRDM_CONTACT_STACK)        /* never: depth <= 48 */
-			return IRDM_CONTACT_EINVAL;
+			return IRDM_EINVAL;
 		l = nd->left_or_first;
 		r = nd->count_or_right & ~IRDM_BVH_INTERNAL;
 		dl = box_d2(&cm->nodes[l], p, max_disp_m);
@@ -367,17 +350,17 @@ static bool plane_bary(const double v[3][3], const double *p, double *lam)
 {
 	double ab[3], ac[3], ap[3], n[3], x[3], nn;
 
-	sub3(ab, v[1], v[0]);
-	sub3(ac, v[2], v[0]);
-	sub3(ap, p, v[0]);
-	cross3(n, ab, ac);
-	nn = dot3(n, n);
-	if (!(nn > DEGENERATE_SIN2 * dot3(ab, ab) * dot3(ac, ac)) || !isfinite(nn))
+	irdm_v3_sub(ab, v[1], v[0]);
+	irdm_v3_sub(ac, v[2], v[0]);
+	irdm_v3_sub(ap, p, v[0]);
+	irdm_v3_cross(n, ab, ac);
+	nn = irdm_v3_dot(n, n);
+	if (!(nn > DEGENERATE_SIN2 * irdm_v3_dot(ab, ab) * irdm_v3_dot(ac, ac)) || !isfinite(nn))
 		return false;
-	cross3(x, ap, ac);
-	lam[1] = dot3(x, n) / nn;
-	cross3(x, ab, ap);
-	lam[2] = dot3(x, n) / nn;
+	irdm_v3_cross(x, ap, ac);
+	lam[1] = irdm_v3_dot(x, n) / nn;
+	irdm_v3_cross(x, ab, ap);
+	lam[2] = irdm_v3_dot(x, n) / nn;
 	lam[0] = 1 - lam[1] - lam[2];
 	return true;
 }
@@ -425,9 +408,9 @@ int irdm_proxy_update(struct irdm_proxy *px, const struct irdm_contact_mesh *cm,
 	unsigned steps = 0, max_walk;
 
 	if (!px || !cm || !cm->hdr || !cfg || !p)
-		return IRDM_CONTACT_EINVAL;
-	if (!finite3(p))
-		return proxy_release(px, IRDM_CONTACT_EINVAL);
+		return IRDM_EINVAL;
+	if (!irdm_v3_finite(p))
+		return proxy_release(px, IRDM_EINVAL);
 	if (!px->active) {
 		struct irdm_contact_hit hit;
 		int r = irdm_contact_closest(cm, d, cfg->max_disp_m, p, cfg->radius_m, &hit);
@@ -447,7 +430,7 @@ int irdm_proxy_update(struct irdm_proxy *px, const struct irdm_contact_mesh *cm,
 	}
 	t = px->tri;
 	if (t >= cm->n_tris || !irdm_contact_tri_contactable(cm, t))
-		return proxy_release(px, IRDM_CONTACT_EINVAL);
+		return proxy_release(px, IRDM_EINVAL);
 	max_walk = cfg->max_walk < IRDM_CONTACT_MAX_WALK ? cfg->max_walk : IRDM_CONTACT_MAX_WALK;
 	for (;;) {
 		uint32_t u;
@@ -469,11 +452,10 @@ int irdm_proxy_update(struct irdm_proxy *px, const struct irdm_contact_mesh *cm,
 	tri_normal(v, n);
 	px->tri = t;
 	memcpy(px->bary, lam, sizeof(lam));
-	for (unsigned a = 0; a < 3; a++)
-		px->point_m[a] = lam[0] * v[0][a] + lam[1] * v[1][a] + lam[2] * v[2][a];
+	irdm_v3_bary(px->point_m, lam, v[0], v[1], v[2]);
 	memcpy(px->normal, n, sizeof(n));
-	sub3(pq, p, px->point_m);
-	px->depth_m = dot3(pq, n);
+	irdm_v3_sub(pq, p, px->point_m);
+	px->depth_m = irdm_v3_dot(pq, n);
 	px->steps = steps;
 	if (px->depth_m > 0)
 		return proxy_release(px, IRDM_PROXY_RELEASE);
@@ -484,7 +466,7 @@ int irdm_proxy_site(const struct irdm_proxy *px, const struct irdm_contact_mesh 
 		    struct irdm_contact_site *site)
 {
 	if (!px || !cm || !cm->hdr || !site || !px->active || px->tri >= cm->n_tris)
-		return IRDM_CONTACT_EINVAL;
+		return IRDM_EINVAL;
 	site->n_nodes = 3;
 	for (unsigned k = 0; k < 3; k++) {
 		uint32_t r = cm->tris[3 * (size_t)px->tri + k];
@@ -499,5 +481,5 @@ int irdm_proxy_site(const struct irdm_proxy *px, const struct irdm_contact_mesh 
 			site->rest_m[a] += px->bary[k] * (double)cm->rest[site->row[k]].pos_m[a];
 		site->normal[a] = px->normal[a];
 	}
-	return IRDM_CONTACT_OK;
+	return IRDM_OK;
 }

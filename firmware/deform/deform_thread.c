@@ -13,6 +13,8 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "irdm/rt.h"
+
 #include "worker_priv.h"
 
 /* OpenBLAS's own; not in every cblas.h. */
@@ -20,30 +22,6 @@ void openblas_set_num_threads(int n);
 
 #define DEFORM_NICE 5
 #define STACK_PREFAULT (64 * 1024)
-
-static void timespec_add(struct timespec *t, const struct timespec *dt)
-{
-	t->tv_sec += dt->tv_sec;
-	t->tv_nsec += dt->tv_nsec;
-	if (t->tv_nsec >= 1000000000L) {
-		t->tv_nsec -= 1000000000L;
-		t->tv_sec++;
-	}
-}
-
-static bool timespec_before(const struct timespec *a, const struct timespec *b)
-{
-	return a->tv_sec < b->tv_sec || (a->tv_sec == b->tv_sec && a->tv_nsec < b->tv_nsec);
-}
-
-/* Touch the stack the update will use, so it never faults in the loop. */
-static void prefault_stack(void)
-{
-	volatile unsigned char buf[STACK_PREFAULT];
-
-	for (size_t i = 0; i < sizeof(buf); i += 256)
-		buf[i] = 0;
-}
 
 /* SCHED_OTHER: nice applies per thread on Linux (setpriority on the tid). */
 static int lower_nice(void)
@@ -70,20 +48,21 @@ static void *deform_thread(void *arg)
 
 	if (!pthread_getschedparam(pthread_self(), &policy, &sp) && policy == SCHED_OTHER)
 		th->prio_errno = lower_nice();
-	prefault_stack();
+	/* the stack the update will use, so it never faults in the loop; a
+	 * thread stack far larger than this cannot refuse it */
+	(void)irdm_rt_prefault_stack(STACK_PREFAULT);
 	sem_post(&th->started);
 	clock_gettime(CLOCK_MONOTONIC, &next);
 	while (!atomic_load_explicit(&th->stop, memory_order_acquire)) {
 		uint64_t tick;
 		if (irdm_deform_update(th->w, th->w->frame_pos, &tick))
 			th->frame(th->ctx, th->w->frame_pos, tick);
-		timespec_add(&next, &th->period);
+		irdm_rt_timespec_add(&next, &th->period);
 		/* a display frame late is a frame lost: skip, never catch up */
 		clock_gettime(CLOCK_MONOTONIC, &now);
-		if (timespec_before(&next, &now))
+		if (irdm_rt_timespec_cmp(&next, &now) < 0)
 			next = now;
-		while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &next, NULL) == EINTR)
-			;
+		irdm_rt_sleep_until(&next);
 	}
 	return NULL;
 }
@@ -95,37 +74,29 @@ static void *deform_thread(void *arg)
  */
 static int make_attr(pthread_attr_t *a, bool rt)
 {
-	struct sched_param sp = { 0 };
-	int policy, rc;
+	struct irdm_rt_sched s = { SCHED_OTHER, 0, IRDM_RT_ANY_CPU };
+	struct sched_param sp;
+	int policy;
 
-	rc = pthread_attr_init(a);
-	if (rc)
-		return rc;
-	rc = pthread_attr_setinheritsched(a, PTHREAD_EXPLICIT_SCHED);
-	if (!rc && rt && !pthread_getschedparam(pthread_self(), &policy, &sp) &&
+	if (rt && !pthread_getschedparam(pthread_self(), &policy, &sp) &&
 	    (policy == SCHED_FIFO || policy == SCHED_RR) &&
 	    sp.sched_priority > sched_get_priority_min(SCHED_FIFO)) {
-		sp.sched_priority--;
-		rc = pthread_attr_setschedpolicy(a, SCHED_FIFO);
-		if (!rc)
-			rc = pthread_attr_setschedparam(a, &sp);
-		return rc;
+		s.policy = SCHED_FIFO;
+		s.priority = sp.sched_priority - 1;
 	}
-	sp.sched_priority = 0;
-	if (!rc)
-		rc = pthread_attr_setschedpolicy(a, SCHED_OTHER);
-	if (!rc)
-		rc = pthread_attr_setschedparam(a, &sp);
-	return rc;
+	return irdm_rt_thread_attr(a, &s);
 }
 
+/* Returns an errno value, as pthread_create(). */
 static int spawn(struct irdm_deform_thread *th, bool rt)
 {
 	pthread_attr_t a;
-	int rc = make_attr(&a, rt);
+	int rc;
 
-	if (!rc)
-		rc = pthread_create(&th->tid, &a, deform_thread, th);
+	/* what make_attr() asks is valid: only memory can be short */
+	if (make_attr(&a, rt))
+		return ENOMEM;
+	rc = pthread_create(&th->tid, &a, deform_thread, th);
 	pthread_attr_destroy(&a);
 	return rc;
 }

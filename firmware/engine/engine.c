@@ -132,12 +132,12 @@ int irdm_engine_init(struct irdm_engine **out, const struct irdm_image *img,
 	if (!img || !img->meta || plan(img, cfg, &l)) {
 		snprintf(err, errlen, "engine: invalid configuration (contacts 1..%d, coupling >= 0, stable radius in [0, 1), force limit >= 0)",
 			 IRDM_MAX_CONTACTS);
-		return IRDM_ENGINE_EINVAL;
+		return IRDM_EINVAL;
 	}
 	if (!mem || ((uintptr_t)mem & 15) || mem_size < l.total) {
 		snprintf(err, errlen, "engine: needs %zu bytes of 16-byte aligned memory, got %zu",
 			 l.total, mem_size);
-		return IRDM_ENGINE_ENOMEM;
+		return IRDM_ENOMEM;
 	}
 	memset(mem, 0, l.total);            /* also pre-faults every page */
 	e->img = img;
@@ -167,10 +167,10 @@ int irdm_engine_init(struct irdm_engine **out, const struct irdm_image *img,
 	if (img->rigid && start_rigid(e)) {
 		snprintf(err, errlen, "engine: the image's rigid-body data is not usable (mass %g kg)",
 			 img->rigid->mass_kg);
-		return IRDM_ENGINE_EINVAL;
+		return IRDM_EINVAL;
 	}
 	*out = e;
-	return IRDM_ENGINE_OK;
+	return IRDM_OK;
 }
 
 void irdm_engine_reset(struct irdm_engine *e)
@@ -199,7 +199,7 @@ int irdm_engine_site_node(const struct irdm_engine *e, uint32_t row, struct irdm
 	double n[3] = { 0, 0, 0 };
 
 	if (row >= e->n_nodes || e->col_of_row[row] == NO_COL)
-		return IRDM_ENGINE_ECONTACT;
+		return IRDM_ECONTACT;
 	memset(s, 0, sizeof(*s));
 	s->n_nodes = 1;
 	s->row[0] = row;
@@ -215,16 +215,16 @@ int irdm_engine_site_node(const struct irdm_engine *e, uint32_t row, struct irdm
 		rest_pos(e->img, v[0], a);
 		rest_pos(e->img, v[1], b);
 		rest_pos(e->img, v[2], c);
-		double u[3] = { b[0] - a[0], b[1] - a[1], b[2] - a[2] };
-		double w[3] = { c[0] - a[0], c[1] - a[1], c[2] - a[2] };
-		n[0] += u[1] * w[2] - u[2] * w[1];
-		n[1] += u[2] * w[0] - u[0] * w[2];
-		n[2] += u[0] * w[1] - u[1] * w[0];
+		double u[3], w[3], nt[3];
+		irdm_v3_sub(u, b, a);
+		irdm_v3_sub(w, c, a);
+		irdm_v3_cross(nt, u, w);
+		irdm_v3_add(n, n, nt);
 	}
-	double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+	double len = irdm_v3_norm(n);
 	for (int a = 0; a < 3; a++)
 		s->normal[a] = len > 0 ? n[a] / len : 0;
-	return IRDM_ENGINE_OK;
+	return IRDM_OK;
 }
 
 int irdm_engine_site_point(const struct irdm_engine *e, uint32_t tri, const double bary[3],
@@ -234,10 +234,10 @@ int irdm_engine_site_point(const struct irdm_engine *e, uint32_t tri, const doub
 	double p[3][3];
 
 	if (tri >= img->meta->n_tris)
-		return IRDM_ENGINE_ECONTACT;
+		return IRDM_ECONTACT;
 	double sum = bary[0] + bary[1] + bary[2];
 	if (!(fabs(sum - 1) < 1e-9) || !(bary[0] >= -1e-12 && bary[1] >= -1e-12 && bary[2] >= -1e-12))
-		return IRDM_ENGINE_EINVAL;
+		return IRDM_EINVAL;
 	memset(s, 0, sizeof(*s));
 	s->n_nodes = 3;
 	for (int k = 0; k < 3; k++) {
@@ -246,8 +246,7 @@ int irdm_engine_site_point(const struct irdm_engine *e, uint32_t tri, const doub
 		s->col[k] = e->col_of_row[row];
 		s->weight[k] = bary[k];
 		rest_pos(img, row, p[k]);
-		for (int a = 0; a < 3; a++)
-			s->rest_m[a] += bary[k] * p[k][a];
+		irdm_v3_axpy(s->rest_m, bary[k], p[k]);
 	}
 	/* every vertex must move with a response, or be fixed (zero response) */
 	for (int k = 0; k < 3; k++)
@@ -255,22 +254,18 @@ int irdm_engine_site_point(const struct irdm_engine *e, uint32_t tri, const doub
 			const struct irdm_meta *m = img->meta;
 			for (size_t i = 0; i < 3 * (size_t)m->n_modes; i++)
 				if (irdm_elem_get(img->mode_shapes, m->precision, s->row[k] * 3 * (size_t)m->n_modes + i) != 0)
-					return IRDM_ENGINE_ECONTACT;
+					return IRDM_ECONTACT;
 		}
 	double u[3], w[3], n[3];
-	for (int a = 0; a < 3; a++) {
-		u[a] = p[1][a] - p[0][a];
-		w[a] = p[2][a] - p[0][a];
-	}
-	n[0] = u[1] * w[2] - u[2] * w[1];
-	n[1] = u[2] * w[0] - u[0] * w[2];
-	n[2] = u[0] * w[1] - u[1] * w[0];
-	double len = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+	irdm_v3_sub(u, p[1], p[0]);
+	irdm_v3_sub(w, p[2], p[0]);
+	irdm_v3_cross(n, u, w);
+	double len = irdm_v3_norm(n);
 	if (!(len > 0))
-		return IRDM_ENGINE_ECONTACT;   /* degenerate triangle */
+		return IRDM_ECONTACT;   /* degenerate triangle */
 	for (int a = 0; a < 3; a++)
 		s->normal[a] = n[a] / len;
-	return IRDM_ENGINE_OK;
+	return IRDM_OK;
 }
 
 int irdm_engine_contact_begin(struct irdm_engine *e, unsigned i, const struct irdm_contact_site *site,
@@ -278,7 +273,7 @@ int irdm_engine_contact_begin(struct irdm_engine *e, unsigned i, const struct ir
 {
 	if (i >= e->cfg.max_contacts || !site || site->n_nodes < 1 || site->n_nodes > 3 ||
 	    (mode != IRDM_CONTACT_PUSH && mode != IRDM_CONTACT_GRAB))
-		return IRDM_ENGINE_EINVAL;
+		return IRDM_EINVAL;
 	struct irdm_contact_state *c = &e->c[i];
 	/* a contact that moves to a new site (sliding) keeps its past target,
 	 * displacement and port energy; a new one starts from rest */
@@ -288,7 +283,7 @@ int irdm_engine_contact_begin(struct irdm_engine *e, unsigned i, const struct ir
 	}
 	c->mode = mode;
 	c->site = *site;
-	return IRDM_ENGINE_OK;
+	return IRDM_OK;
 }
 
 void irdm_engine_contact_end(struct irdm_engine *e, unsigned i)

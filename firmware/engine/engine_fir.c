@@ -3,9 +3,9 @@
  * FIR history: a ring of the last T ticks' forces and the history term
  *   U~_v[t] = sum_{s=1}^{T-1} w[s] sum_e R[s](e -> v) f_e[t-s]
  * summed in double (float sums lose 1e-3 of the static force to
- * cancellation, SPEC section 5).  w[s] = r^s damps the tail of images whose
- * truncated recursion is unstable (r = 1 otherwise): it moves every pole of
- * the recursion by the factor r.
+ * cancellation; docs/architecture.md, "Numerical hazards").  w[s] = r^s
+ * damps the tail of images whose truncated recursion is unstable (r = 1
+ * otherwise): it moves every pole of the recursion by the factor r.
  */
 #include <string.h>
 
@@ -35,14 +35,14 @@ void irdm_fir_free_disp(const struct irdm_engine *e, uint32_t col, double u[3])
 		for (uint32_t n = 0; n < t->n; n++) {
 			const double *f = t->f_n[n];
 			size_t o = fir_index(e, t->col[n], row, s);
-			if (prec == IRDM_ELEM_F32) {
-				const float *R = (const float *)img->fir + o;
-				for (int i = 0; i < 3; i++)
-					acc[i] += w * (R[3 * i] * f[0] + R[3 * i + 1] * f[1] + R[3 * i + 2] * f[2]);
-			} else {
-				for (int i = 0; i < 3; i++)
-					for (int j = 0; j < 3; j++)
-						acc[i] += w * irdm_elem_get(img->fir, prec, o + 3 * (size_t)i + (size_t)j) * f[j];
+			/* One row of R[s] against f, then w: 3 multiplies by w
+			 * where a per-entry sum needs 9 (the tick's hot loop). */
+			for (int i = 0; i < 3; i++) {
+				size_t k = o + 3 * (size_t)i;
+
+				acc[i] += w * (irdm_elem_get(img->fir, prec, k) * f[0] +
+					       irdm_elem_get(img->fir, prec, k + 1) * f[1] +
+					       irdm_elem_get(img->fir, prec, k + 2) * f[2]);
 			}
 		}
 	}

@@ -5,7 +5,8 @@
  *   u_v[t]   = sum_k phi_v,k x_k,q[t+1] + sum_e D(v <- e) f_e,
  * split into the free part (no force this tick: sum_k phi_v,k (A_k x_k)_q)
  * and R[0] (sum_k phi_v,k phi_e,k^T b_k,q + D).  Infinite memory at
- * O(modes) per tick; double precision throughout (SPEC section 5).
+ * O(modes) per tick; double precision throughout (float history sums
+ * lose to cancellation: docs/architecture.md, "Numerical hazards").
  */
 #include "engine_priv.h"
 

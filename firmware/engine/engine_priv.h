@@ -7,6 +7,7 @@
 #include "irdm/engine.h"
 #include "irdm/history.h"
 #include "irdm/rigid.h"
+#include "irdm/vec3.h"
 
 #define NO_COL UINT32_MAX
 #define MAX_SOLVE (3 * IRDM_MAX_CONTACTS)

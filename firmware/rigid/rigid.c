@@ -40,37 +40,22 @@
  */
 #include <math.h>
 #include <stddef.h>
+#include <string.h>
 
 #include "irdm/rigid.h"
+#include "irdm/vec3.h"
 
 #define SYM_TOL 1e-12           /* inertia asymmetry allowed, relative to its largest entry */
 #define PIVOT_TOL 1e-12         /* smallest Cholesky pivot, relative to the trace */
 #define Q_MIN_NORM 1e-6         /* a quaternion shorter than this is "zero" */
 #define NEWTON_TOL 1e-13        /* relative Newton step at which w has converged */
 
-/* ---- small vector algebra ---------------------------------------------- */
-
-static double dot3(const double a[3], const double b[3])
-{
-	return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-/* c = a x b; c may alias a or b. */
-static void cross3(const double a[3], const double b[3], double c[3])
-{
-	double x = a[1] * b[2] - a[2] * b[1];
-	double y = a[2] * b[0] - a[0] * b[2];
-	double z = a[0] * b[1] - a[1] * b[0];
-
-	c[0] = x;
-	c[1] = y;
-	c[2] = z;
-}
+/* ---- small matrix algebra (vectors: irdm/vec3.h) ------------------------ */
 
 static void mat_vec(const double m[9], const double v[3], double out[3])
 {
 	for (int i = 0; i < 3; i++)
-		out[i] = m[3 * i] * v[0] + m[3 * i + 1] * v[1] + m[3 * i + 2] * v[2];
+		out[i] = irdm_v3_dot(&m[3 * i], v);
 }
 
 static void mat_mul(const double a[9], const double b[9], double c[9])
@@ -169,13 +154,13 @@ static double x_minus_sin_over_x3(double x)
 /* out = exp([phi]x) v (Rodrigues); 1 - cos t is written 2 sin^2(t/2). */
 static void rotvec_apply(const double phi[3], const double v[3], double out[3])
 {
-	double th = sqrt(dot3(phi, phi));
+	double th = irdm_v3_norm(phi);
 	double s = sinc(0.5 * th);
 	double a = sinc(th), b = 0.5 * s * s;
 	double pv[3], ppv[3];
 
-	cross3(phi, v, pv);
-	cross3(phi, pv, ppv);
+	irdm_v3_cross(pv, phi, v);
+	irdm_v3_cross(ppv, phi, pv);
 	for (int i = 0; i < 3; i++)
 		out[i] = v[i] + a * pv[i] + b * ppv[i];
 }
@@ -183,7 +168,7 @@ static void rotvec_apply(const double phi[3], const double v[3], double out[3])
 /* Left Jacobian of SO(3): exp(phi + d) = exp(J_l(phi) d) exp(phi) + O(d^2). */
 static void left_jacobian(const double phi[3], double j[9])
 {
-	double th = sqrt(dot3(phi, phi));
+	double th = irdm_v3_norm(phi);
 	double s = sinc(0.5 * th);
 	double b = 0.5 * s * s, c = x_minus_sin_over_x3(th);
 	double k[9], k2[9];
@@ -200,7 +185,7 @@ static void left_jacobian(const double phi[3], double j[9])
 /* The unit quaternion exp(phi/2) of the rotation vector phi. */
 static void quat_exp(const double phi[3], double q[4])
 {
-	double h = 0.5 * sqrt(dot3(phi, phi));
+	double h = 0.5 * irdm_v3_norm(phi);
 	double s = 0.5 * sinc(h);   /* sin(h) / |phi| */
 
 	q[0] = cos(h);
@@ -239,10 +224,9 @@ static void quat_rotate(const double q[4], int inverse, const double v[3], doubl
 
 	if (inverse)
 		w = -w;     /* conj(q) and -conj(q) are the same rotation */
-	cross3(u, v, t);
-	for (int i = 0; i < 3; i++)
-		t[i] *= 2;
-	cross3(u, t, ut);
+	irdm_v3_cross(t, u, v);
+	irdm_v3_scale(t, 2, t);
+	irdm_v3_cross(ut, u, t);
 	for (int i = 0; i < 3; i++)
 		out[i] = v[i] + w * t[i] + ut[i];
 }
@@ -320,30 +304,30 @@ int irdm_rigid_init(struct irdm_rigid_body *rb, const struct irdm_rigid_params *
 	struct irdm_rigid_body b = { 0 };
 
 	if (!rb || !p || !s0)
-		return IRDM_RIGID_EINVAL;
+		return IRDM_EINVAL;
 	if (!isfinite(p->mass_kg) || !(p->mass_kg > 0))
-		return IRDM_RIGID_EINVAL;
+		return IRDM_EINVAL;
 	if (inertia_inverse(p->inertia_body_kg_m2, b.inertia_body_kg_m2,
 			    b.inv_inertia_body_per_kg_m2))
-		return IRDM_RIGID_EINVAL;
+		return IRDM_EINVAL;
 	b.s = *s0;
-	if (!finite_n(b.s.com_m, 3) || !finite_n(b.s.vel_m_s, 3) || !finite_n(b.s.q, 4) ||
-	    !finite_n(b.s.omega_body_rad_s, 3))
-		return IRDM_RIGID_EINVAL;
-	if (!(sqrt(dot3(b.s.q + 1, b.s.q + 1) + b.s.q[0] * b.s.q[0]) >= Q_MIN_NORM))
-		return IRDM_RIGID_EINVAL;
+	if (!irdm_v3_finite(b.s.com_m) || !irdm_v3_finite(b.s.vel_m_s) || !finite_n(b.s.q, 4) ||
+	    !irdm_v3_finite(b.s.omega_body_rad_s))
+		return IRDM_EINVAL;
+	if (!(sqrt(irdm_v3_dot(b.s.q + 1, b.s.q + 1) + b.s.q[0] * b.s.q[0]) >= Q_MIN_NORM))
+		return IRDM_EINVAL;
 	quat_normalise(b.s.q);
 	b.mass_kg = p->mass_kg;
 	*rb = b;
-	return IRDM_RIGID_OK;
+	return IRDM_OK;
 }
 
 /* ---- forces -------------------------------------------------------------- */
 
 void irdm_rigid_clear(struct irdm_rigid_body *rb)
 {
-	for (int i = 0; i < 3; i++)
-		rb->force_n[i] = rb->torque_n_m[i] = 0;
+	irdm_v3_zero(rb->force_n);
+	irdm_v3_zero(rb->torque_n_m);
 }
 
 void irdm_rigid_accumulate(struct irdm_rigid_body *rb, const double f_world_n[3],
@@ -351,19 +335,15 @@ void irdm_rigid_accumulate(struct irdm_rigid_body *rb, const double f_world_n[3]
 {
 	double r[3], tau[3];
 
-	for (int i = 0; i < 3; i++)
-		r[i] = x_world_m[i] - rb->s.com_m[i];
-	cross3(r, f_world_n, tau);
-	for (int i = 0; i < 3; i++) {
-		rb->force_n[i] += f_world_n[i];
-		rb->torque_n_m[i] += tau[i];
-	}
+	irdm_v3_sub(r, x_world_m, rb->s.com_m);
+	irdm_v3_cross(tau, r, f_world_n);
+	irdm_v3_add(rb->force_n, rb->force_n, f_world_n);
+	irdm_v3_add(rb->torque_n_m, rb->torque_n_m, tau);
 }
 
 void irdm_rigid_accumulate_torque(struct irdm_rigid_body *rb, const double tau_world_n_m[3])
 {
-	for (int i = 0; i < 3; i++)
-		rb->torque_n_m[i] += tau_world_n_m[i];
+	irdm_v3_add(rb->torque_n_m, rb->torque_n_m, tau_world_n_m);
 }
 
 /* ---- the step ------------------------------------------------------------ */
@@ -382,8 +362,7 @@ static unsigned drift(const struct irdm_rigid_body *rb, double q[4], double l[3]
 	mat_vec(rb->inv_inertia_body_per_kg_m2, l, w);  /* explicit guess, O(dt) off */
 	while (it < IRDM_RIGID_MAX_NEWTON) {
 		it++;
-		for (int i = 0; i < 3; i++)
-			phi[i] = -dt * w[i];
+		irdm_v3_scale(phi, -dt, w);
 		rotvec_apply(phi, l, lp);
 		mat_vec(in, w, g);
 		for (int i = 0; i < 3; i++)
@@ -396,13 +375,11 @@ static unsigned drift(const struct irdm_rigid_body *rb, double q[4], double l[3]
 			jac[i] = in[i] - 0.5 * dt * jac[i];
 		if (solve3(jac, g, d))
 			break;
-		for (int i = 0; i < 3; i++)
-			w[i] -= d[i];
-		if (!(dot3(d, d) > NEWTON_TOL * NEWTON_TOL * dot3(w, w)))
+		irdm_v3_sub(w, w, d);
+		if (!(irdm_v3_dot(d, d) > NEWTON_TOL * NEWTON_TOL * irdm_v3_dot(w, w)))
 			break;
 	}
-	for (int i = 0; i < 3; i++)
-		phi[i] = dt * w[i];
+	irdm_v3_scale(phi, dt, w);
 	quat_exp(phi, qi);
 	quat_mul(q, qi, q);
 	quat_normalise(q);
@@ -417,8 +394,7 @@ static void kick(const double q[4], const double tau_world[3], double h, double 
 	double tb[3];
 
 	quat_rotate(q, 1, tau_world, tb);
-	for (int i = 0; i < 3; i++)
-		l[i] += h * tb[i];
+	irdm_v3_axpy(l, h, tb);
 }
 
 int irdm_rigid_step(struct irdm_rigid_body *rb, double dt_s)
@@ -427,13 +403,13 @@ int irdm_rigid_step(struct irdm_rigid_body *rb, double dt_s)
 	double f[3], tau[3], l[3];
 	unsigned it;
 
-	for (int i = 0; i < 3; i++) {
-		f[i] = rb->force_n[i];
-		tau[i] = rb->torque_n_m[i];
-	}
+	memcpy(f, rb->force_n, sizeof(f));
+	memcpy(tau, rb->torque_n_m, sizeof(tau));
 	irdm_rigid_clear(rb);
-	if (!isfinite(dt_s) || !(dt_s > 0) || !finite_n(f, 3) || !finite_n(tau, 3))
-		return IRDM_RIGID_EINVAL;
+	if (!isfinite(dt_s) || !(dt_s > 0))
+		return IRDM_EINVAL;
+	if (!irdm_v3_finite(f) || !irdm_v3_finite(tau))
+		return IRDM_EFAULT;
 
 	for (int i = 0; i < 3; i++) {
 		double a = f[i] / rb->mass_kg;
@@ -448,12 +424,12 @@ int irdm_rigid_step(struct irdm_rigid_body *rb, double dt_s)
 	kick(s.q, tau, 0.5 * dt_s, l);
 	mat_vec(rb->inv_inertia_body_per_kg_m2, l, s.omega_body_rad_s);
 
-	if (!finite_n(s.com_m, 3) || !finite_n(s.vel_m_s, 3) || !finite_n(s.q, 4) ||
-	    !finite_n(s.omega_body_rad_s, 3))
-		return IRDM_RIGID_EINVAL;
+	if (!irdm_v3_finite(s.com_m) || !irdm_v3_finite(s.vel_m_s) || !finite_n(s.q, 4) ||
+	    !irdm_v3_finite(s.omega_body_rad_s))
+		return IRDM_EFAULT;
 	rb->s = s;
 	rb->last_newton_iters = it;
-	return IRDM_RIGID_OK;
+	return IRDM_OK;
 }
 
 /* ---- queries ------------------------------------------------------------- */
@@ -475,8 +451,7 @@ void irdm_rigid_body_to_world(const struct irdm_rigid_body *rb, const double x_b
 			      double x_world_m[3])
 {
 	quat_rotate(rb->s.q, 0, x_body_m, x_world_m);
-	for (int i = 0; i < 3; i++)
-		x_world_m[i] += rb->s.com_m[i];
+	irdm_v3_add(x_world_m, x_world_m, rb->s.com_m);
 }
 
 void irdm_rigid_world_to_body(const struct irdm_rigid_body *rb, const double x_world_m[3],
@@ -484,8 +459,7 @@ void irdm_rigid_world_to_body(const struct irdm_rigid_body *rb, const double x_w
 {
 	double r[3];
 
-	for (int i = 0; i < 3; i++)
-		r[i] = x_world_m[i] - rb->s.com_m[i];
+	irdm_v3_sub(r, x_world_m, rb->s.com_m);
 	quat_rotate(rb->s.q, 1, r, x_body_m);
 }
 
@@ -511,11 +485,11 @@ void irdm_rigid_point_compliance(const struct irdm_rigid_body *rb, const double 
 		double e[3] = { 0, 0, 0 }, t[3], tb[3], wb[3], w[3], d[3];
 
 		e[j] = 1;
-		cross3(r_world_m, e, t);        /* torque of a unit force along e_j */
+		irdm_v3_cross(t, r_world_m, e); /* torque of a unit force along e_j */
 		quat_rotate(rb->s.q, 1, t, tb);
 		mat_vec(rb->inv_inertia_body_per_kg_m2, tb, wb);
 		quat_rotate(rb->s.q, 0, wb, w); /* I_world^-1 (r x e_j) */
-		cross3(r2_world_m, w, d);
+		irdm_v3_cross(d, r2_world_m, w);
 		for (int i = 0; i < 3; i++)
 			c_m_per_n[3 * i + j] = (i == j) * h / rb->mass_kg - h * d[i];
 		same &= r_world_m[j] == r2_world_m[j];
@@ -547,14 +521,13 @@ double irdm_rigid_kinetic_energy_j(const struct irdm_rigid_body *rb)
 	double l[3];
 
 	mat_vec(rb->inertia_body_kg_m2, rb->s.omega_body_rad_s, l);
-	return 0.5 * rb->mass_kg * dot3(rb->s.vel_m_s, rb->s.vel_m_s) +
-	       0.5 * dot3(rb->s.omega_body_rad_s, l);
+	return 0.5 * rb->mass_kg * irdm_v3_dot(rb->s.vel_m_s, rb->s.vel_m_s) +
+	       0.5 * irdm_v3_dot(rb->s.omega_body_rad_s, l);
 }
 
 void irdm_rigid_linear_momentum_world(const struct irdm_rigid_body *rb, double p_kg_m_s[3])
 {
-	for (int i = 0; i < 3; i++)
-		p_kg_m_s[i] = rb->mass_kg * rb->s.vel_m_s[i];
+	irdm_v3_scale(p_kg_m_s, rb->mass_kg, rb->s.vel_m_s);
 }
 
 void irdm_rigid_angular_momentum_world(const struct irdm_rigid_body *rb, double l_kg_m2_s[3])

@@ -22,13 +22,13 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/mman.h>
 #include <sys/utsname.h>
 #include <time.h>
 #include <unistd.h>
 
 #include "irdm/engine.h"
 #include "irdm/image.h"
+#include "irdm/rt.h"
 #include "irdm/session.h"
 #include "../support/bench_util.h"
 #include "../support/engine_fixture.h"
@@ -244,23 +244,15 @@ static void bench_image(const char *scene, const char *repr, const char *path,
 
 static void header(void)
 {
-	struct sched_param sp = { .sched_priority = FIFO_PRIO };
+	struct irdm_rt_report rep;
 	struct utsname u;
-	cpu_set_t set;
 	char line[256], model[128] = "unknown";
 	long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
-	int cpu = ncpu > BENCH_CPU ? BENCH_CPU : 0;
-	bool rt_kernel = false;
+	int cpu = ncpu > BENCH_CPU ? BENCH_CPU : 0, rc;
 	FILE *f;
 
 	uname(&u);
-	f = fopen("/sys/kernel/realtime", "r");
-	if (f) {
-		rt_kernel = fgetc(f) == '1';
-		fclose(f);
-	}
-	if (strstr(u.version, "PREEMPT_RT"))
-		rt_kernel = true;
+	irdm_rt_report_get(&rep);
 	f = fopen("/proc/cpuinfo", "r");
 	while (f && fgets(line, sizeof(line), f))
 		if (!strncmp(line, "model name", 10) && strchr(line, ':')) {
@@ -271,24 +263,20 @@ static void header(void)
 	if (f)
 		fclose(f);
 	printf("tick  kernel %s %s (%s), %ld CPUs, %s\n", u.release, u.machine,
-	       rt_kernel ? "PREEMPT_RT" : "not PREEMPT_RT: latency figures are not real-time claims",
+	       rep.preempt_rt ? "PREEMPT_RT" : "not PREEMPT_RT: latency figures are not real-time claims",
 	       ncpu, model);
 
-	CPU_ZERO(&set);
-	CPU_SET(cpu, &set);
-	if (sched_setaffinity(0, sizeof(set), &set))
-		printf("tick  affinity: could not pin to CPU %d: %s\n", cpu, strerror(errno));
-	else
-		printf("tick  affinity: pinned to CPU %d%s\n", cpu,
-		       cpu == BENCH_CPU ? "" : " (only one CPU online)");
-	if (sched_setscheduler(0, SCHED_FIFO, &sp))
-		printf("tick  scheduling: SCHED_FIFO refused (%s): running SCHED_OTHER\n", strerror(errno));
-	else
-		printf("tick  scheduling: SCHED_FIFO priority %d\n", FIFO_PRIO);
-	if (mlockall(MCL_CURRENT | MCL_FUTURE))
-		printf("tick  memory: mlockall refused (%s): pages may fault\n", strerror(errno));
-	else
-		printf("tick  memory: mlockall(MCL_CURRENT | MCL_FUTURE)\n");
+	rc = irdm_rt_set_self(&(struct irdm_rt_sched){ SCHED_FIFO, FIFO_PRIO, cpu });
+	if (rc)
+		printf("tick  scheduling: SCHED_FIFO %d on CPU %d refused: %s\n", FIFO_PRIO, cpu,
+		       irdm_strerror(rc));
+	rc = irdm_rt_lock_memory();
+	if (rc)
+		printf("tick  memory: mlockall refused: %s: pages may fault\n", irdm_strerror(rc));
+	/* what holds, read back */
+	irdm_rt_report_get(&rep);
+	irdm_rt_report_format(&rep, line, sizeof(line));
+	printf("tick  %s%s\n", line, cpu == BENCH_CPU ? "" : " (only one CPU online)");
 	f = fopen("/proc/sys/kernel/sched_rt_runtime_us", "r");
 	if (f) {
 		long rt = 0;

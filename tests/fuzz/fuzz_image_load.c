@@ -78,7 +78,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 	if (!buf)
 		return 0;
 	memcpy(buf, data, size);
-	if (irdm_image_parse(buf, size, &img, err, sizeof(err)) == IRDM_IMAGE_OK)
+	if (irdm_image_parse(buf, size, &img, err, sizeof(err)) == IRDM_OK)
 		walk_views(&img);
 	else if (!err[0] || img.base)
 		abort();        /* every rejection has a reason and no views */

@@ -5,12 +5,14 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "irdm/rt.h"
+
 #include "bench_util.h"
 #include "precompute/precompute.h"
 
 double bench_elapsed_ns(const struct timespec *a, const struct timespec *b)
 {
-	return (double)(b->tv_sec - a->tv_sec) * 1e9 + (double)(b->tv_nsec - a->tv_nsec);
+	return (double)irdm_rt_timespec_diff_ns(a, b);
 }
 
 double bench_now_us(void)

@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /*
  * CONTACT_BVH builder.  Offline, so it may allocate and sort freely; what it
- * writes is what firmware/image/image_load.c checks, and the firmware walks
+ * writes is what firmware/image/image_bvh.c checks, and the firmware walks
  * it with a fixed stack (firmware/contact/contact.c).
  */
 #include <stdbool.h>

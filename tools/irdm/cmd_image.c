@@ -10,6 +10,8 @@
 #include "image/image_response.h"
 #include "irdm/error.h"
 #include "irdm/image.h"
+#include "irdm/options.h"
+#include "opt/opt_doc.h"
 
 static const char usage[] =
 	"usage: irdm image info IMAGE\n"
@@ -235,6 +237,7 @@ out_unmap:
 	return bad;
 }
 
+/* A --rows entry: strtoul's syntax (" 7" and "+7" pass, as they always have). */
 static int parse_u32(const char *s, uint32_t *out)
 {
 	char *end;
@@ -279,54 +282,76 @@ static int write_csv(FILE *f, const struct irdm_image *img, uint32_t col, const 
 	return ferror(f) ? IRDM_EIO : IRDM_OK;
 }
 
+/* What export was asked for. */
+struct export_args {
+	const char *path;
+	const char *out;
+	const char *rows;
+	uint64_t column;        /* UINT64_MAX: not given */
+	uint32_t samples;       /* 0: the FIR length, or one second */
+};
+
+#define EA(member) IRDM_OPT_FIELD(struct export_args, member)
+#define EA_REF(member) IRDM_OPT_TEXT_REF(struct export_args, member)
+
+static const struct irdm_opt export_opts[] = {
+	{ .name = "column", .type = IRDM_OPT_UNSIGNED, EA(column), .metavar = "NODE",
+	  .range = IRDM_OPT_LE, .max = UINT32_MAX,
+	  .help = "the touchable mesh node whose responses are written (required)" },
+	{ .name = "rows", .type = IRDM_OPT_STRING, EA_REF(rows), .metavar = "NODE,...",
+	  .help = "the mesh nodes whose displacement is written (default: NODE)" },
+	{ .name = "samples", .type = IRDM_OPT_UNSIGNED, EA(samples), .metavar = "N",
+	  .range = IRDM_OPT_GE | IRDM_OPT_LE, .min = 1, .max = 10000000,
+	  .help = "samples written (default: the FIR length, or one second)" },
+	{ .name = "output", .short_name = 'o', .type = IRDM_OPT_STRING, EA_REF(out),
+	  .metavar = "FILE.csv", .help = "write here, atomically (default: standard output)" },
+};
+
+static const struct irdm_opt_table export_options = {
+	.what = "option",
+	.see = "irdm image export --help",
+	.opts = export_opts,
+	.n_opts = sizeof(export_opts) / sizeof(export_opts[0]),
+};
+
+static int export_image_arg(void *ctx, const char *arg, char *err, size_t errlen)
+{
+	struct export_args *a = ctx;
+
+	if (a->path) {
+		snprintf(err, errlen, "unexpected argument '%s'", arg);
+		return IRDM_EINVAL;
+	}
+	a->path = arg;
+	return IRDM_OK;
+}
+
 static int cmd_export(int argc, char **argv)
 {
-	const char *path = NULL, *out = NULL, *rows_arg = NULL;
-	uint32_t col_node = 0, n_samples = 0;
-	int have_col = 0, ret = 1;
+	struct export_args args = { .column = UINT64_MAX };
+	const struct irdm_opt_set set = { &export_options, &args };
+	const char *path, *out, *rows_arg;
+	uint32_t col_node, n_samples;
+	int ret = 1;
 	uint32_t rows[MAX_EXPORT_ROWS];
 	size_t n_rows = 0;
 	struct irdm_image img;
+	char err[512];
+	int rc = irdm_opt_parse_args(&set, 1, argc, argv, export_image_arg, &args, err, sizeof(err));
 
-	for (int i = 0; i < argc; i++) {
-		const char *a = argv[i];
-		if (a[0] != '-') {
-			if (path) {
-				fprintf(stderr, "irdm image export: unexpected argument '%s'\n", a);
-				return 2;
-			}
-			path = a;
-			continue;
-		}
-		if (i + 1 >= argc) {
-			fprintf(stderr, "irdm image export: %s needs a value\n", a);
-			return 2;
-		}
-		const char *v = argv[++i];
-		if (!strcmp(a, "--column")) {
-			if (parse_u32(v, &col_node)) {
-				fprintf(stderr, "irdm image export: --column '%s': expected a mesh node index\n", v);
-				return 2;
-			}
-			have_col = 1;
-		} else if (!strcmp(a, "--rows")) {
-			rows_arg = v;
-		} else if (!strcmp(a, "--samples")) {
-			if (parse_u32(v, &n_samples) || n_samples == 0 || n_samples > 10000000) {
-				fprintf(stderr, "irdm image export: --samples '%s': expected 1..10000000\n", v);
-				return 2;
-			}
-		} else if (!strcmp(a, "-o")) {
-			out = v;
-		} else {
-			fprintf(stderr, "irdm image export: unknown option '%s'\n", a);
-			return 2;
-		}
+	if (rc) {
+		irdm_cli_fail("image export", rc, err);
+		return 2;
 	}
-	if (!path || !have_col) {
+	if (!args.path || args.column == UINT64_MAX) {
 		fputs(usage, stderr);
 		return 2;
 	}
+	path = args.path;
+	out = args.out;
+	rows_arg = args.rows;
+	col_node = (uint32_t)args.column;
+	n_samples = args.samples;
 	if (open_image(path, &img))
 		return 1;
 	int64_t cr = irdm_image_node_of(&img, col_node), c = cr < 0 ? -1 : irdm_image_col_of(&img, (uint32_t)cr);
@@ -403,6 +428,10 @@ int irdm_cmd_image(int argc, char **argv)
 	}
 	if (argc >= 3 && (!strcmp(argv[2], "--help") || !strcmp(argv[2], "-h"))) {
 		fputs(usage, stdout);
+		if (!strcmp(argv[1], "export")) {
+			fputs("\nexport options:\n", stdout);
+			irdm_opt_print_help(stdout, &export_options, IRDM_OPT_STYLE_ARG);
+		}
 		return 0;
 	}
 	if (!strcmp(argv[1], "info")) {

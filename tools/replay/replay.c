@@ -156,7 +156,7 @@ static int make_sites(const struct irdm_replay_opts *o, const struct irdm_image 
 		int rc;
 		if (c->is_node) {
 			int64_t row = irdm_image_node_of(img, c->mesh_node);
-			rc = row < 0 ? IRDM_ENGINE_ECONTACT : irdm_engine_site_node(eng, (uint32_t)row, &site[i]);
+			rc = row < 0 ? IRDM_ECONTACT : irdm_engine_site_node(eng, (uint32_t)row, &site[i]);
 			if (rc) {
 				snprintf(err, errlen, "--contact %u: mesh node %u is not a touchable node of %s",
 					 c->mesh_node, c->mesh_node, o->image);

@@ -7,32 +7,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "irdm/error.h"
+#include "irdm/options.h"
 #include "scene/scene.h"
-
-const char *const irdm_scene_help =
-	"  name = TEXT            scene name (provenance)\n"
-	"  mesh = cuboid | cube | box:LX,LY,LZ | FILE   (.node/.ele .msh .obj .off .stl)\n"
-	"  resolution = NX,NY,NZ  hexes per axis for builtin meshes (cuboid 11,11,22; cube 10,10,10)\n"
-	"  tets_per_hex = 5 | 6   builtin split (5: the paper's cuboid, 13310 tets)\n"
-	"  mesh_scale = S         multiply file coordinates by S (0.001 for mm)\n"
-	"  tetgen = SWITCHES      tetgen quality switches for surface meshes (default pq1.414)\n"
-	"  young = PA  poisson = NU  density = KG_M3   (default 2000, 0.49, 110: the paper)\n"
-	"  mass = lumped | consistent\n"
-	"  damping = Z1@F1,Z2@F2  ratios at two frequencies in Hz; F1 may be 'mode1'\n"
-	"            | rayleigh:A,B   C = A M + B K      (default 0.05@mode1,0.05@100)\n"
-	"  floating = yes | no    non-grounded object (rigid motion separated)\n"
-	"  fixed = none | x|y|z<=V | x|y|z>=V | box:X0,Y0,Z0,X1,Y1,Z1 | nodes:I,J,...\n"
-	"  dt = SECONDS           sample period (default 0.001)\n"
-	"  representation = modal:K | modal:all | fir:T\n"
-	"  modes = K | all        modes that synthesise a modal-method FIR (default 300)\n"
-	"  static_correction = yes | no   residual compliance of dropped modes (modal)\n"
-	"  precision = f16 | f32 | f64\n"
-	"  touch = surface | REGION      touchable surface nodes (columns)\n"
-	"  display = surface | touch | REGION   displayed surface nodes (rows)\n"
-	"  method = modal | time-domain  how FIR responses are computed\n"
-	"  substeps = N           time-domain integration steps per sample (default 8)\n"
-	"  eigensolver = auto | dense | lanczos\n"
-	"  threads = N            worker threads (0: all cores)\n";
 
 void irdm_scene_defaults(struct irdm_scene *sc)
 {
@@ -110,17 +87,6 @@ static int parse_list(const char *s, double *v, int n)
 		k++;
 	}
 	return k;
-}
-
-static int parse_bool(const char *s, bool *out)
-{
-	if (!strcmp(s, "yes") || !strcmp(s, "true") || !strcmp(s, "1") || !strcmp(s, "on"))
-		*out = true;
-	else if (!strcmp(s, "no") || !strcmp(s, "false") || !strcmp(s, "0") || !strcmp(s, "off"))
-		*out = false;
-	else
-		return -1;
-	return 0;
 }
 
 static int parse_nodes(const char *s, struct irdm_region *r)
@@ -252,180 +218,225 @@ static int parse_resolution(struct irdm_scene *sc, const char *s)
 	return 0;
 }
 
-static int set_key(struct irdm_scene *sc, const char *k, const char *v)
+/*
+ * Keys with a composite syntax parse with the functions above; the table
+ * below gives every key its type, range, unit and help, so that parsing,
+ * `irdm precompute --help` and docs/scene-format.md come from one place.
+ */
+static int set_resolution(const struct irdm_opt *o, void *obj, const char *v, char *why,
+			  size_t len)
 {
-	bool b;
-
-	if (!strcmp(k, "name"))
-		return snprintf(sc->name, sizeof(sc->name), "%s", v) >= (int)sizeof(sc->name);
-	if (!strcmp(k, "mesh"))
-		return snprintf(sc->mesh, sizeof(sc->mesh), "%s", v) >= (int)sizeof(sc->mesh);
-	if (!strcmp(k, "resolution"))
-		return parse_resolution(sc, v);
-	if (!strcmp(k, "tets_per_hex"))
-		return parse_uint(v, 6, &sc->tets_per_hex) ||
-		       (sc->tets_per_hex != 5 && sc->tets_per_hex != 6);
-	if (!strcmp(k, "mesh_scale"))
-		return parse_double(v, &sc->mesh_scale) || sc->mesh_scale <= 0;
-	if (!strcmp(k, "tetgen")) {
-		for (const char *p = v; *p; p++)
-			if (!isalnum((unsigned char)*p) && *p != '.' && *p != '/')
-				return -1;
-		return snprintf(sc->tetgen, sizeof(sc->tetgen), "%s", v) >= (int)sizeof(sc->tetgen);
-	}
-	if (!strcmp(k, "young"))
-		return parse_double(v, &sc->mat.young_pa);
-	if (!strcmp(k, "poisson"))
-		return parse_double(v, &sc->mat.poisson);
-	if (!strcmp(k, "density"))
-		return parse_double(v, &sc->mat.density_kg_m3);
-	if (!strcmp(k, "mass")) {
-		if (!strcmp(v, "lumped"))
-			sc->mass = IRDM_MASS_LUMPED;
-		else if (!strcmp(v, "consistent"))
-			sc->mass = IRDM_MASS_CONSISTENT;
-		else
-			return -1;
-		return 0;
-	}
-	if (!strcmp(k, "damping"))
-		return parse_damping(sc, v);
-	if (!strcmp(k, "floating")) {
-		if (parse_bool(v, &b))
-			return -1;
-		sc->floating = b;
-		if (b && sc->fixed.kind == IRDM_REGION_PLANE && !strcmp(sc->fixed.text, "z<=0"))
-			parse_region("none", &sc->fixed, false);   /* default constraint off */
-		return 0;
-	}
-	if (!strcmp(k, "fixed"))
-		return parse_region(v, &sc->fixed, false);
-	if (!strcmp(k, "dt"))
-		return parse_double(v, &sc->dt_s) || sc->dt_s <= 0 || sc->dt_s > 1;
-	if (!strcmp(k, "representation"))
-		return parse_representation(sc, v);
-	if (!strcmp(k, "modes")) {
-		if (!strcmp(v, "all") || !strcmp(v, "0")) {
-			sc->modes = 0;
-			return 0;
-		}
-		return parse_uint(v, 1000000, &sc->modes) || sc->modes == 0;
-	}
-	if (!strcmp(k, "static_correction"))
-		return parse_bool(v, &sc->static_correction);
-	if (!strcmp(k, "precision")) {
-		if (!strcmp(v, "f16"))
-			sc->precision = IRDM_ELEM_F16;
-		else if (!strcmp(v, "f32"))
-			sc->precision = IRDM_ELEM_F32;
-		else if (!strcmp(v, "f64"))
-			sc->precision = IRDM_ELEM_F64;
-		else
-			return -1;
-		return 0;
-	}
-	if (!strcmp(k, "touch"))
-		return parse_region(v, &sc->touch, false);
-	if (!strcmp(k, "display"))
-		return parse_region(v, &sc->display, true);
-	if (!strcmp(k, "method")) {
-		if (!strcmp(v, "modal"))
-			sc->method = IRDM_METHOD_MODAL;
-		else if (!strcmp(v, "time-domain"))
-			sc->method = IRDM_METHOD_TIME_DOMAIN;
-		else
-			return -1;
-		return 0;
-	}
-	if (!strcmp(k, "substeps"))
-		return parse_uint(v, 100000, &sc->substeps) || sc->substeps == 0;
-	if (!strcmp(k, "eigensolver")) {
-		if (!strcmp(v, "auto"))
-			sc->eigensolver = IRDM_EIG_AUTO;
-		else if (!strcmp(v, "dense"))
-			sc->eigensolver = IRDM_EIG_DENSE;
-		else if (!strcmp(v, "lanczos"))
-			sc->eigensolver = IRDM_EIG_LANCZOS;
-		else
-			return -1;
-		return 0;
-	}
-	if (!strcmp(k, "threads"))
-		return parse_uint(v, 256, &sc->threads);
-	return -2;
+	(void)o;
+	(void)why;
+	(void)len;
+	return parse_resolution(obj, v) ? IRDM_EFORMAT : IRDM_OK;
 }
+
+static int set_tetgen(const struct irdm_opt *o, void *obj, const char *v, char *why, size_t len)
+{
+	struct irdm_scene *sc = obj;
+
+	(void)o;
+	for (const char *p = v; *p; p++)
+		if (!isalnum((unsigned char)*p) && *p != '.' && *p != '/') {
+			snprintf(why, len, "'%c': switches are letters, digits, '.' and '/'", *p);
+			return IRDM_EFORMAT;
+		}
+	if (strlen(v) >= sizeof(sc->tetgen)) {
+		snprintf(why, len, "longer than %zu characters", sizeof(sc->tetgen) - 1);
+		return IRDM_EFORMAT;
+	}
+	snprintf(sc->tetgen, sizeof(sc->tetgen), "%s", v);
+	return IRDM_OK;
+}
+
+static int set_damping(const struct irdm_opt *o, void *obj, const char *v, char *why, size_t len)
+{
+	(void)o;
+	(void)why;
+	(void)len;
+	return parse_damping(obj, v) ? IRDM_EFORMAT : IRDM_OK;
+}
+
+/* yes/no like any bool, and "yes" drops the default constraint. */
+static int set_floating(const struct irdm_opt *o, void *obj, const char *v, char *why,
+			size_t len)
+{
+	static const struct irdm_opt yes_no = { .name = "floating", .type = IRDM_OPT_BOOL,
+						.size = sizeof(bool) };
+	struct irdm_scene *sc = obj;
+	bool b;
+	int ret = irdm_opt_parse_value(&yes_no, &b, v, why, len);
+
+	(void)o;
+	if (ret)
+		return ret;
+	sc->floating = b;
+	if (b && sc->fixed.kind == IRDM_REGION_PLANE && !strcmp(sc->fixed.text, "z<=0"))
+		parse_region("none", &sc->fixed, false);   /* default constraint off */
+	return IRDM_OK;
+}
+
+/* fixed and touch: the region at the entry's offset. */
+static int set_region(const struct irdm_opt *o, void *obj, const char *v, char *why, size_t len)
+{
+	(void)why;
+	(void)len;
+	return parse_region(v, (struct irdm_region *)((char *)obj + o->offset), false) ?
+	       IRDM_EFORMAT : IRDM_OK;
+}
+
+/* display: a region, or "touch" (the touchable nodes only). */
+static int set_display(const struct irdm_opt *o, void *obj, const char *v, char *why, size_t len)
+{
+	(void)why;
+	(void)len;
+	return parse_region(v, (struct irdm_region *)((char *)obj + o->offset), true) ?
+	       IRDM_EFORMAT : IRDM_OK;
+}
+
+static int set_representation(const struct irdm_opt *o, void *obj, const char *v, char *why,
+			      size_t len)
+{
+	(void)o;
+	(void)why;
+	(void)len;
+	return parse_representation(obj, v) ? IRDM_EFORMAT : IRDM_OK;
+}
+
+/* "all" or "0": every mode; otherwise 1 to 1000000. */
+static int set_modes(const struct irdm_opt *o, void *obj, const char *v, char *why, size_t len)
+{
+	static const struct irdm_opt count = { .name = "modes", .type = IRDM_OPT_UNSIGNED,
+		.size = sizeof(unsigned), .range = IRDM_OPT_GE | IRDM_OPT_LE, .min = 1, .max = 1000000 };
+	struct irdm_scene *sc = obj;
+
+	(void)o;
+	if (!strcmp(v, "all") || !strcmp(v, "0")) {
+		sc->modes = 0;
+		return IRDM_OK;
+	}
+	return irdm_opt_parse_value(&count, &sc->modes, v, why, len);
+}
+
+static const struct irdm_opt_name mass_names[] = {
+	{ "lumped", IRDM_MASS_LUMPED }, { "consistent", IRDM_MASS_CONSISTENT }, { NULL, 0 },
+};
+static const struct irdm_opt_name precision_names[] = {
+	{ "f16", IRDM_ELEM_F16 }, { "f32", IRDM_ELEM_F32 }, { "f64", IRDM_ELEM_F64 }, { NULL, 0 },
+};
+static const struct irdm_opt_name method_names[] = {
+	{ "modal", IRDM_METHOD_MODAL }, { "time-domain", IRDM_METHOD_TIME_DOMAIN }, { NULL, 0 },
+};
+static const struct irdm_opt_name eig_names[] = {
+	{ "auto", IRDM_EIG_AUTO }, { "dense", IRDM_EIG_DENSE }, { "lanczos", IRDM_EIG_LANCZOS },
+	{ NULL, 0 },
+};
+
+#define SC(member) IRDM_OPT_FIELD(struct irdm_scene, member)
+#define REGION "none | x|y|z<=V | x|y|z>=V | box:X0,Y0,Z0,X1,Y1,Z1 | nodes:I,J,..."
+
+static const struct irdm_opt scene_opts[] = {
+	{ .name = "name", .type = IRDM_OPT_STRING, SC(name), .metavar = "TEXT",
+	  .help = "scene name (provenance)" },
+	{ .name = "mesh", .type = IRDM_OPT_STRING, SC(mesh),
+	  .metavar = "cuboid | cube | box:LX,LY,LZ | FILE",
+	  .help = "builtin mesh, or a file (.node/.ele .msh .obj .off .stl)" },
+	{ .name = "resolution", .type = IRDM_OPT_CUSTOM, .parse = set_resolution,
+	  .metavar = "NX,NY,NZ",
+	  .help = "hexes per axis for builtin meshes, each 1 to 400 (cuboid 11,11,22; cube 10,10,10)" },
+	{ .name = "tets_per_hex", .type = IRDM_OPT_UNSIGNED, SC(tets_per_hex), .metavar = "5 | 6",
+	  .range = IRDM_OPT_GE | IRDM_OPT_LE, .min = 5, .max = 6,
+	  .help = "builtin split (5: the paper's cuboid, 13310 tets)" },
+	{ .name = "mesh_scale", .type = IRDM_OPT_DOUBLE, SC(mesh_scale), .metavar = "S",
+	  .range = IRDM_OPT_GT, .min = 0,
+	  .help = "multiply file coordinates by S (0.001 for mm)" },
+	{ .name = "tetgen", .type = IRDM_OPT_CUSTOM, .parse = set_tetgen, .metavar = "SWITCHES",
+	  .help = "tetgen quality switches for surface meshes (default pq1.414)" },
+	{ .name = "young", .type = IRDM_OPT_DOUBLE, SC(mat.young_pa), .metavar = "PA", .unit = "Pa",
+	  .range = IRDM_OPT_GT, .min = 0,
+	  .help = "Young's modulus (default 2000: the paper)" },
+	{ .name = "poisson", .type = IRDM_OPT_DOUBLE, SC(mat.poisson), .metavar = "NU",
+	  .range = IRDM_OPT_GT | IRDM_OPT_LT, .min = -1, .max = 0.5,
+	  .help = "Poisson's ratio (default 0.49: the paper; 0.5 is incompressible)" },
+	{ .name = "density", .type = IRDM_OPT_DOUBLE, SC(mat.density_kg_m3), .metavar = "KG_M3",
+	  .unit = "kg/m^3", .range = IRDM_OPT_GT, .min = 0,
+	  .help = "density (default 110: the paper)" },
+	{ .name = "mass", .type = IRDM_OPT_ENUM, SC(mass), .names = mass_names,
+	  .help = "mass matrix (default lumped)" },
+	{ .name = "damping", .type = IRDM_OPT_CUSTOM, .parse = set_damping,
+	  .metavar = "Z1@F1,Z2@F2 | rayleigh:A,B",
+	  .help = "ratios Z at two frequencies F in Hz, F1 may be 'mode1'; or C = A M + B K "
+		  "(default 0.05@mode1,0.05@100)" },
+	{ .name = "floating", .type = IRDM_OPT_CUSTOM, .parse = set_floating, .metavar = "yes | no",
+	  .help = "non-grounded object (rigid motion separated); yes turns the default fixed = z<=0 off" },
+	{ .name = "fixed", .type = IRDM_OPT_CUSTOM, .parse = set_region, SC(fixed), .metavar = REGION,
+	  .help = "fixed nodes, called REGION below (default z<=0)" },
+	{ .name = "dt", .type = IRDM_OPT_DOUBLE, SC(dt_s), .metavar = "SECONDS", .unit = "s",
+	  .range = IRDM_OPT_GT | IRDM_OPT_LE, .min = 0, .max = 1,
+	  .help = "sample period (default 0.001)" },
+	{ .name = "representation", .type = IRDM_OPT_CUSTOM, .parse = set_representation,
+	  .metavar = "modal:K | modal:all | fir:T",
+	  .help = "K modes (1 to 1000000) or all, or an FIR of T samples (1 to 1000000) (default modal:300)" },
+	{ .name = "modes", .type = IRDM_OPT_CUSTOM, .parse = set_modes, .metavar = "K | all",
+	  .help = "modes that synthesise a modal-method FIR, 1 to 1000000 (default 300)" },
+	{ .name = "static_correction", .type = IRDM_OPT_BOOL, SC(static_correction),
+	  .help = "residual compliance of dropped modes (modal; default yes)" },
+	{ .name = "precision", .type = IRDM_OPT_ENUM, SC(precision), .names = precision_names,
+	  .help = "storage of the responses (default f32)" },
+	{ .name = "touch", .type = IRDM_OPT_CUSTOM, .parse = set_region, SC(touch),
+	  .metavar = "surface | REGION", .help = "touchable surface nodes: columns (default surface)" },
+	{ .name = "display", .type = IRDM_OPT_CUSTOM, .parse = set_display, SC(display),
+	  .metavar = "surface | touch | REGION",
+	  .help = "displayed surface nodes: rows (default surface)" },
+	{ .name = "method", .type = IRDM_OPT_ENUM, SC(method), .names = method_names,
+	  .help = "how FIR responses are computed (default modal)" },
+	{ .name = "substeps", .type = IRDM_OPT_UNSIGNED, SC(substeps), .metavar = "N",
+	  .range = IRDM_OPT_GE | IRDM_OPT_LE, .min = 1, .max = 100000,
+	  .help = "time-domain integration steps per sample (default 8)" },
+	{ .name = "eigensolver", .type = IRDM_OPT_ENUM, SC(eigensolver), .names = eig_names,
+	  .help = "eigenvalue solver (default auto: by size)" },
+	{ .name = "threads", .type = IRDM_OPT_UNSIGNED, SC(threads), .metavar = "N",
+	  .range = IRDM_OPT_LE, .max = 256, .help = "worker threads (0: all cores)" },
+};
+
+const struct irdm_opt_table irdm_scene_options = {
+	.what = "scene key",
+	.see = "irdm precompute --help",
+	.opts = scene_opts,
+	.n_opts = sizeof(scene_opts) / sizeof(scene_opts[0]),
+};
 
 int irdm_scene_set(struct irdm_scene *sc, const char *key, const char *value,
 		   const char *where, char *err, size_t errlen)
 {
-	int r = set_key(sc, key, value);
-
-	if (r == -2) {
-		snprintf(err, errlen, "%s: unknown scene key '%s' (see irdm precompute --help)",
-			 where, key);
-		return IRDM_EINVAL;
-	}
-	if (r) {
-		snprintf(err, errlen, "%s: invalid value '%s' for '%s' (see irdm precompute --help)",
-			 where, value, key);
-		return IRDM_EINVAL;
-	}
-	return IRDM_OK;
-}
-
-static char *trim(char *s)
-{
-	char *e;
-
-	while (isspace((unsigned char)*s))
-		s++;
-	e = s + strlen(s);
-	while (e > s && isspace((unsigned char)e[-1]))
-		*--e = 0;
-	return s;
+	return irdm_opt_set(&irdm_scene_options, sc, where, key, value, err, errlen);
 }
 
 int irdm_scene_load(struct irdm_scene *sc, const char *path, char *err, size_t errlen)
 {
+	struct irdm_opt_file file = { .table = &irdm_scene_options, .obj = sc, .name = path };
 	FILE *f = fopen(path, "r");
-	char line[1024], where[600];
-	int lineno = 0, ret = IRDM_EFORMAT;
+	char line[1024];
+	int ret = IRDM_OK;
 
 	if (!f) {
 		snprintf(err, errlen, "%s: cannot open scene: %s", path, strerror(errno));
 		return IRDM_EIO;
 	}
-	while (fgets(line, sizeof(line), f)) {
-		lineno++;
-		snprintf(where, sizeof(where), "%s:%d", path, lineno);
+	while (!ret && fgets(line, sizeof(line), f)) {
+		file.line_no++;
 		if (!strchr(line, '\n') && !feof(f)) {
-			snprintf(err, errlen, "%s: line too long", where);
-			goto out_close;
+			snprintf(err, errlen, "%s:%u: line too long", path, file.line_no);
+			ret = IRDM_EFORMAT;
+		} else {
+			ret = irdm_opt_parse_line(&file, line, err, errlen);
 		}
-		char *hash = strchr(line, '#');
-		if (hash)
-			*hash = 0;
-		char *s = trim(line);
-		if (!*s)
-			continue;
-		char *eq = strchr(s, '=');
-		if (!eq) {
-			snprintf(err, errlen, "%s: expected 'key = value'", where);
-			goto out_close;
-		}
-		*eq = 0;
-		ret = irdm_scene_set(sc, trim(s), trim(eq + 1), where, err, errlen);
-		if (ret)
-			goto out_close;
-		ret = IRDM_EFORMAT;
 	}
-	if (ferror(f)) {
-		snprintf(err, errlen, "%s: read failed: %s", path, strerror(errno));
+	if (!ret && ferror(f)) {
+		snprintf(err, errlen, "%s: read error", path);
 		ret = IRDM_EIO;
-		goto out_close;
 	}
-	ret = IRDM_OK;
-out_close:
 	fclose(f);
 	return ret;
 }

@@ -4,7 +4,8 @@
  * damping, constraints), the sample period, the representation, and which
  * nodes can be touched (columns) or are displayed (rows).  It is given as a
  * small "key = value" file, as --key value options, or both (options win).
- * docs/scenes.md lists the keys.
+ * The keys are one table (irdm_scene_options); docs/scene-format.md is
+ * generated from it.
  */
 #ifndef IRDM_TOOLS_SCENE_H
 #define IRDM_TOOLS_SCENE_H
@@ -13,6 +14,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "irdm/options.h"
 #include "fem/fem.h"
 #include "irdm/error.h"
 #include "modal/modal.h"
@@ -74,15 +76,23 @@ struct irdm_scene {
  * correction, 1 ms, float32, top face touchable, whole surface displayed. */
 void irdm_scene_defaults(struct irdm_scene *sc);
 
-/* Set one key.  `where` names the source for messages ("cube.scene:7" or
- * "--dt").  Return: IRDM_OK; IRDM_EINVAL if the key is unknown or the
- * value invalid. */
+/* Every scene key: type, range, unit, help and where it goes in the struct. */
+extern const struct irdm_opt_table irdm_scene_options;
+
+/*
+ * Set one key.  `where` names the source for messages ("cube.scene:7").
+ * Return: IRDM_OK; IRDM_EINVAL if the key is unknown; IRDM_EFORMAT if the
+ * value is invalid or out of range.
+ */
 int irdm_scene_set(struct irdm_scene *sc, const char *key, const char *value,
 		   const char *where, char *err, size_t errlen);
 
-/* Read a scene file on top of *sc.  Return: IRDM_OK; IRDM_EIO if it cannot
- * be opened or read; IRDM_EFORMAT if a line is not 'key = value' or too
- * long; IRDM_EINVAL as irdm_scene_set(). */
+/*
+ * Read a scene file on top of *sc; messages name the line ("cube.scene:7").
+ * Return: IRDM_OK; IRDM_EIO if the file cannot be opened or read;
+ * IRDM_EINVAL for an unknown key; IRDM_EFORMAT for a line that is not
+ * "key = value", too long, or has an invalid value.
+ */
 int irdm_scene_load(struct irdm_scene *sc, const char *path, char *err, size_t errlen);
 
 /* Cross-field checks (after all keys are set).  Return: IRDM_OK;
@@ -96,8 +106,5 @@ int irdm_scene_format(const struct irdm_scene *sc, char *buf, size_t len);
  * boundary node. */
 bool irdm_region_contains(const struct irdm_region *r, uint32_t node, const double p[3],
 			  bool on_surface);
-
-/* The list of keys with one-line help (for --help). */
-extern const char *const irdm_scene_help;
 
 #endif

@@ -20,15 +20,24 @@
 #include <stdbool.h>
 #include <stdint.h>
 
-#include "irdm/engine.h"
+#include "irdm/error.h"
 #include "irdm/image.h"
 
 #define IRDM_CONTACT_STACK 64           /* > IRDM_BVH_MAX_DEPTH */
 #define IRDM_CONTACT_MAX_WALK 64        /* upper limit of max_walk */
 
-enum irdm_contact_error {
-	IRDM_CONTACT_OK = 0,
-	IRDM_CONTACT_EINVAL = -1,       /* bad argument, or the image has no CONTACT_BVH */
+/*
+ * Where a contact acts, as the force engine takes it (irdm/engine.h): on a
+ * triangle of the image surface, or on a node.  Made by irdm_proxy_site()
+ * here, or by irdm_engine_site_node() / irdm_engine_site_point().
+ */
+struct irdm_contact_site {
+	uint32_t n_nodes;               /* 1 (node) or 3 (triangle) */
+	uint32_t col[3];                /* column index of each node, or UINT32_MAX if fixed */
+	uint32_t row[3];                /* image node (row) index of each node */
+	double weight[3];               /* barycentric, sum 1 */
+	double rest_m[3];               /* rest position of the contact point */
+	double normal[3];               /* outward unit normal at the point */
 };
 
 /* Views of a validated image's CONTACT_BVH (set up once, read only). */
@@ -66,7 +75,12 @@ struct irdm_contact_hit {
 					 * < 0 behind the triangle (inside) */
 };
 
-/* Set up the views; IRDM_CONTACT_EINVAL if the image has no CONTACT_BVH. */
+/*
+ * Set up the views (cm is zeroed first).
+ *
+ * Return: IRDM_OK;
+ * IRDM_EINVAL if img is NULL, has no metadata or has no CONTACT_BVH.
+ */
 int irdm_contact_mesh_init(struct irdm_contact_mesh *cm, const struct irdm_image *img);
 
 /* True when every vertex of SURFACE triangle t is a column. */
@@ -90,8 +104,12 @@ double irdm_contact_closest_on_tri(const double a[3], const double b[3], const d
  * grown by it).  Zero-area triangles are skipped (their edges belong to
  * their neighbours).  Of equally distant triangles (an edge or a vertex)
  * the one whose plane p is farthest from wins, so the sign of an edge hit
- * comes from the face that sees p best.  Returns 1 and fills *hit, 0 when
- * nothing is within radius_m, or IRDM_CONTACT_EINVAL.
+ * comes from the face that sees p best.
+ *
+ * Return: 1 and *hit filled; 0 when nothing is within radius_m;
+ * IRDM_EINVAL if cm (or its BVH), p or hit is NULL, p is not finite,
+ * radius_m or max_disp_m is negative or not finite, or the BVH is deeper
+ * than IRDM_CONTACT_STACK (the loader never lets such an image through).
  */
 int irdm_contact_closest(const struct irdm_contact_mesh *cm, const struct irdm_contact_disp *d,
 			 double max_disp_m, const double p[3], double radius_m,
@@ -137,8 +155,13 @@ void irdm_proxy_reset(struct irdm_proxy *px);
  * the edge it left by (at most max_walk steps); at a boundary of the
  * contactable region (or a concave crease) it stops at the closest point
  * of its triangle.  The contact ends when the device is outside the plane
- * of the proxy's triangle (depth > 0).  Returns an enum irdm_proxy_event,
- * or IRDM_CONTACT_EINVAL (non-finite p: the proxy is released).
+ * of the proxy's triangle (depth > 0).
+ *
+ * Return: an enum irdm_proxy_event (>= 0);
+ * IRDM_EINVAL if px, cm (or its BVH), cfg or p is NULL (px untouched), if
+ * p is not finite or the active proxy's triangle is no longer contactable
+ * (the proxy is released), or as irdm_contact_closest() for an inactive
+ * proxy.
  */
 int irdm_proxy_update(struct irdm_proxy *px, const struct irdm_contact_mesh *cm,
 		      const struct irdm_contact_disp *d, const struct irdm_proxy_config *cfg,
@@ -148,6 +171,10 @@ int irdm_proxy_update(struct irdm_proxy *px, const struct irdm_contact_mesh *cm,
  * The engine's contact site of an active proxy: n_nodes 3, rows and
  * columns of its triangle, weights = its barycentrics, rest_m = the same
  * barycentric point on the REST surface, normal = the displaced normal.
+ *
+ * Return: IRDM_OK;
+ * IRDM_EINVAL if px, cm (or its BVH) or site is NULL, or the proxy is not
+ * active or its triangle is out of range.
  */
 int irdm_proxy_site(const struct irdm_proxy *px, const struct irdm_contact_mesh *cm,
 		    struct irdm_contact_site *site);

@@ -9,11 +9,12 @@
  * allocates, blocks, or makes a system call.  It is *given* the contact
  * targets of the tick; it reads no clock.
  *
- * Frames and signs (SPEC section 2): positions in metres in the object
- * frame (for a floating object: targets, forces and contact displacements
- * in the world frame, which coincides with the object frame at start); a
- * contact's force is the force applied TO the object (the device renders
- * its negative); the displacement u[t] is observed at (t+1) dt.
+ * Frames and signs (docs/architecture.md, "Frames and signs" and "Sample
+ * convention"): positions in metres in the object frame (for a floating
+ * object: targets, forces and contact displacements in the world frame,
+ * which coincides with the object frame at start); a contact's force is the
+ * force applied TO the object (the device renders its negative); the
+ * displacement u[t] is observed at (t+1) dt.
  */
 #ifndef IRDM_ENGINE_H
 #define IRDM_ENGINE_H
@@ -22,18 +23,10 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "irdm/contact.h"    /* struct irdm_contact_site */
+#include "irdm/error.h"
 #include "irdm/image.h"
-
-#define IRDM_MAX_CONTACTS 4
-#define IRDM_MAX_FORCE_NODES (3 * IRDM_MAX_CONTACTS)  /* a contact spreads over <= 3 nodes */
-
-enum irdm_engine_error {
-	IRDM_ENGINE_OK = 0,
-	IRDM_ENGINE_EINVAL = -1,    /* bad configuration or argument */
-	IRDM_ENGINE_ENOMEM = -2,    /* the memory given is smaller than irdm_engine_mem_size() */
-	IRDM_ENGINE_ECONTACT = -3,  /* contact location not touchable (node not a column, ...) */
-	IRDM_ENGINE_EFAULT = -4,    /* non-finite input or force limit exceeded: engine faulted */
-};
+#include "irdm/limits.h"     /* IRDM_MAX_CONTACTS */
 
 enum irdm_solve_mode {
 	IRDM_SOLVE_COUPLED = 0,     /* all contact points in one system (default) */
@@ -66,16 +59,6 @@ struct irdm_engine_config {
 	double stable_radius;
 	double max_force_n;             /* > 0: a larger force faults the engine (torque off) */
 	unsigned publish_every;         /* deformation snapshot every N ticks (0: never) */
-};
-
-/* Where a contact acts: on a triangle of the image surface, or on a node. */
-struct irdm_contact_site {
-	uint32_t n_nodes;               /* 1 (node) or 3 (triangle) */
-	uint32_t col[3];                /* column index of each node, or UINT32_MAX if fixed */
-	uint32_t row[3];                /* image node (row) index of each node */
-	double weight[3];               /* barycentric, sum 1 */
-	double rest_m[3];               /* rest position of the contact point */
-	double normal[3];               /* outward unit normal at the point */
 };
 
 /* One contact's command for a tick. */
@@ -134,30 +117,70 @@ void irdm_engine_config_haptic(struct irdm_engine_config *cfg, double dt_s, doub
 /*
  * Initialise in `mem` (16-byte aligned, at least irdm_engine_mem_size()
  * bytes, pre-faulted by this call).  The image must stay mapped.
+ *
+ * Return: IRDM_OK;
+ * IRDM_EINVAL if img is NULL or has no metadata, cfg is not valid (contacts
+ * 1..IRDM_MAX_CONTACTS, coupling >= 0, stable radius in [0, 1), force
+ * limit >= 0, a known solve mode), or the image's rigid-body section is not
+ * usable (irdm_rigid_init());
+ * IRDM_ENOMEM if mem is NULL, not 16-byte aligned or smaller than
+ * irdm_engine_mem_size().
+ * On error *eng is NULL and err says why.
  */
 int irdm_engine_init(struct irdm_engine **eng, const struct irdm_image *img,
 		     const struct irdm_engine_config *cfg, void *mem, size_t mem_size,
 		     char *err, size_t errlen);
 
-/* Contact sites (init-time helpers; they do not allocate either). */
+/*
+ * Contact sites (init-time helpers; they do not allocate either).
+ *
+ * The site of image node `image_node` (a row index), with the area-weighted
+ * normal of the surface triangles around it.
+ *
+ * Return: IRDM_OK;
+ * IRDM_ECONTACT if image_node is out of range or not a column.
+ */
 int irdm_engine_site_node(const struct irdm_engine *eng, uint32_t image_node,
 			  struct irdm_contact_site *site);
+
+/*
+ * The site of the point of barycentric weights bary on SURFACE triangle tri.
+ *
+ * Return: IRDM_OK;
+ * IRDM_EINVAL if the weights do not sum to 1 (to 1e-9) or one is negative;
+ * IRDM_ECONTACT if tri is out of range, the triangle has no area, or (modal
+ * images) a vertex of positive weight is not a column yet moves (a non-zero
+ * mode shape).
+ */
 int irdm_engine_site_point(const struct irdm_engine *eng, uint32_t tri, const double bary[3],
 			   struct irdm_contact_site *site);
 
-/* Begin / end a contact in slot i (0..max_contacts-1). */
+/*
+ * Begin a contact in slot i (0..max_contacts-1), or move an active one to a
+ * new site (sliding: it keeps its past target, displacement and energy).
+ *
+ * Return: IRDM_OK;
+ * IRDM_EINVAL if i >= max_contacts, site is NULL or has no 1..3 nodes, or
+ * mode is neither IRDM_CONTACT_PUSH nor IRDM_CONTACT_GRAB.
+ */
 int irdm_engine_contact_begin(struct irdm_engine *eng, unsigned i,
 			      const struct irdm_contact_site *site, enum irdm_contact_mode mode);
+
+/* End the contact in slot i (any i: out of range does nothing). */
 void irdm_engine_contact_end(struct irdm_engine *eng, unsigned i);
 
 /*
  * One tick: cmd[i] for each slot (mode OFF = no contact).  Solves the
  * contact forces, advances the history, optionally publishes a snapshot.
- * Returns 0, or IRDM_ENGINE_EFAULT (non-finite target or |F| over the
- * limit): the engine then holds zero force until irdm_engine_reset().
+ *
+ * Return: IRDM_OK;
+ * IRDM_EFAULT if a target is not finite, a force is not finite or over
+ * max_force_n, or a floating object's rigid step failed, or the engine had
+ * already faulted: it then holds zero force until irdm_engine_reset().
  */
 int irdm_engine_tick(struct irdm_engine *eng, const struct irdm_contact_cmd *cmd);
 
+/* The state of slot i, or NULL if i >= IRDM_MAX_CONTACTS. */
 const struct irdm_contact_state *irdm_engine_contact(const struct irdm_engine *eng, unsigned i);
 const struct irdm_engine_stats *irdm_engine_stats(const struct irdm_engine *eng);
 

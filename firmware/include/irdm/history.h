@@ -5,7 +5,7 @@
 
 #include <stdint.h>
 
-#include "irdm/engine.h"
+#include "irdm/limits.h"     /* IRDM_MAX_FORCE_NODES */
 
 /* The forces of one tick, applied at up to IRDM_MAX_FORCE_NODES columns. */
 struct irdm_force_tick {

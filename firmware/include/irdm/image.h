@@ -11,21 +11,9 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "irdm/error.h"
 #include "irdm/image_format.h"
 #include "irdm/precision.h"
-
-/* Errors (negative return values). */
-enum irdm_image_error {
-	IRDM_IMAGE_OK = 0,
-	IRDM_IMAGE_EIO = -1,        /* cannot open, stat, map or lock the file */
-	IRDM_IMAGE_ETRUNC = -2,     /* file shorter than its header says */
-	IRDM_IMAGE_EMAGIC = -3,     /* not an IRDM image */
-	IRDM_IMAGE_EVERSION = -4,   /* unsupported major version */
-	IRDM_IMAGE_ECRC = -5,       /* header, table or section checksum mismatch */
-	IRDM_IMAGE_ERANGE = -6,     /* offset/size/alignment out of range or overlapping */
-	IRDM_IMAGE_EMISSING = -7,   /* a required section is absent or duplicated */
-	IRDM_IMAGE_EINVAL = -8,     /* a field's value is invalid (counts, dt, indices, NaN) */
-};
 
 enum irdm_image_map_flags {
 	IRDM_IMAGE_MAP_LOCK = 1u << 0,  /* mlock the mapping; fail if that is refused */
@@ -56,23 +44,47 @@ struct irdm_image {
 
 /*
  * Map and validate the image at path.  Populates the mapping (no page fault
- * later) and, with IRDM_IMAGE_MAP_LOCK, locks it.  Returns IRDM_IMAGE_OK or a
- * negative enum irdm_image_error with a one-line reason in err.
+ * later) and, with IRDM_IMAGE_MAP_LOCK, locks it.  On failure img is zeroed,
+ * nothing stays mapped, and err holds "path: reason" on one line.
+ *
+ * Return: IRDM_OK;
+ * IRDM_EINVAL if flags has a bit other than IRDM_IMAGE_MAP_LOCK;
+ * IRDM_EIO if the file cannot be opened, stat'ed, mapped or locked, is not
+ * a regular file or is too large to map;
+ * IRDM_ETRUNC if it is shorter than an image header;
+ * otherwise any error of irdm_image_parse().
  */
 int irdm_image_map(const char *path, unsigned flags, struct irdm_image *img,
 		   char *err, size_t errlen);
 
-/* Validate an image already in memory (buf must stay valid; it must be
- * 8-byte aligned).  Same checks and errors as irdm_image_map(). */
+/*
+ * Validate an image already in memory (buf must stay valid; it must be
+ * 8-byte aligned).  The checks run in the order of docs/image-format.md
+ * section 9 and the first failure is returned, with a one-line reason in
+ * err; on failure img is zeroed.
+ *
+ * Return: IRDM_OK;
+ * IRDM_EINVAL if buf is not 8-byte aligned (or NULL with size > 0);
+ * IRDM_ENOMEM if the scratch memory of a check cannot be allocated;
+ * IRDM_ETRUNC if the image is shorter than its header or its header says;
+ * IRDM_EMAGIC if it is not an IRDM image;
+ * IRDM_EVERSION if its major version is not IRDM_IMAGE_VERSION_MAJOR;
+ * IRDM_ECRC if the header, table or a section checksum does not match;
+ * IRDM_ERANGE if an offset, size or alignment is out of range, regions
+ * overlap or bytes trail the image;
+ * IRDM_EMISSING if a required section is absent or a kind appears twice;
+ * IRDM_EFORMAT if a field's value is invalid (counts, dt, indices, NaN,
+ * non-zero padding or reserved bytes, a section that must be absent).
+ */
 int irdm_image_parse(const void *buf, size_t size, struct irdm_image *img,
 		     char *err, size_t errlen);
 
+/* Unmap an image from irdm_image_map() (no-op for irdm_image_parse's) and
+ * zero img.  Cannot fail. */
 void irdm_image_unmap(struct irdm_image *img);
 
-/* Name of an error code, e.g. "bad checksum". */
-const char *irdm_image_strerror(int code);
-
-/* Section lookup (NULL if absent). */
+/* Section lookup in a validated image: the table entry of kind, or NULL if
+ * absent (or img holds no image).  Cannot fail otherwise. */
 const struct irdm_image_section *irdm_image_find(const struct irdm_image *img,
 						 uint32_t kind);
 

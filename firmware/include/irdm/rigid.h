@@ -1,8 +1,9 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * Rigid motion of a floating object (SPEC sections 3-4, the paper's
- * section 4): Newton-Euler equations for the centre of mass and the
- * rotation; IRDM holds only the deformation on top of this pose.
+ * Rigid motion of a floating object (the paper's section 4; its place in
+ * the tick: docs/architecture.md, "Where each step lives"): Newton-Euler
+ * equations for the centre of mass and the rotation; IRDM holds only the
+ * deformation on top of this pose.
  *
  * One struct owned by the caller, set up once by irdm_rigid_init();
  * irdm_rigid_step() then never allocates, blocks or makes a system call, and
@@ -13,9 +14,10 @@
  * vectors into world vectors, and a body point x_body is at
  * com_m + R(q) x_body in the world.
  *
- * Forces follow SPEC section 2: a force is applied TO the object and held
- * constant over [t, t + dt) (zero-order hold), at a point fixed in the world
- * over the tick.  The forces of one tick are accumulated
+ * Forces follow docs/architecture.md ("Frames and signs", "Sample
+ * convention"): a force is applied TO the object and held constant over
+ * [t, t + dt) (zero-order hold), at a point fixed in the world over the
+ * tick.  The forces of one tick are accumulated
  * (irdm_rigid_accumulate*) and consumed by the next irdm_rigid_step(), which
  * clears them.  Torques are about the centre of mass at the start of the
  * tick.
@@ -25,15 +27,11 @@
 #ifndef IRDM_RIGID_H
 #define IRDM_RIGID_H
 
+#include "irdm/error.h"
 #include "irdm/history.h"       /* struct irdm_pose */
 #include "irdm/image_format.h"  /* struct irdm_rigid (the image's section) */
 
 #define IRDM_RIGID_MAX_NEWTON 8 /* bound on the iterations of one step */
-
-enum irdm_rigid_error {
-	IRDM_RIGID_OK = 0,
-	IRDM_RIGID_EINVAL = -1,     /* init: bad parameters; step: bad dt, non-finite force or state */
-};
 
 struct irdm_rigid_params {
 	double mass_kg;
@@ -65,7 +63,10 @@ void irdm_rigid_params_from_image(const struct irdm_rigid *img, struct irdm_rigi
  * 1e-12 of its largest entry) and positive definite (every L D L^T pivot
  * above 1e-12 of the trace); state finite; q not (near) zero: |q| < 1e-6 is
  * rejected, otherwise q is normalised.
- * Returns IRDM_RIGID_OK or IRDM_RIGID_EINVAL (rb untouched).
+ *
+ * Return: IRDM_OK;
+ * IRDM_EINVAL if rb, p or s0 is NULL or any of the above fails (rb
+ * untouched).
  */
 int irdm_rigid_init(struct irdm_rigid_body *rb, const struct irdm_rigid_params *p,
 		    const struct irdm_rigid_state *s0);
@@ -81,10 +82,14 @@ void irdm_rigid_accumulate(struct irdm_rigid_body *rb, const double f_world_n[3]
 void irdm_rigid_accumulate_torque(struct irdm_rigid_body *rb, const double tau_world_n_m[3]);
 
 /*
- * Advance by dt under the accumulated forces and torques (then cleared).
- * Returns IRDM_RIGID_EINVAL, leaving the state as it was, if dt is not
- * finite and > 0, if the forces are not finite, or if the new state would
- * not be finite: the caller faults.
+ * Advance by dt under the accumulated forces and torques (then cleared,
+ * whatever the outcome).
+ *
+ * Return: IRDM_OK;
+ * IRDM_EINVAL if dt is not finite and > 0;
+ * IRDM_EFAULT if the forces or torques are not finite, or the new state
+ * would not be finite: the caller faults.
+ * On error the state is left as it was.
  */
 int irdm_rigid_step(struct irdm_rigid_body *rb, double dt_s);
 

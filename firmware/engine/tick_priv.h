@@ -1,0 +1,49 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * What the steps of one tick share: the contact system and the functions of
+ * the files that hold each step (docs/architecture.md, "Where each step
+ * lives").  Private to firmware/engine.
+ */
+#ifndef IRDM_TICK_PRIV_H
+#define IRDM_TICK_PRIV_H
+
+#include "engine_priv.h"
+
+struct system {
+	int m;                              /* active contacts */
+	unsigned idx[IRDM_MAX_CONTACTS];    /* their slots */
+	double u_body[IRDM_MAX_CONTACTS][3];    /* history term, object (body) frame */
+	double w_body[MAX_SOLVE * MAX_SOLVE];   /* W in the object frame */
+	/* in the solve frame: the object frame, or the world for a floating object */
+	double u_free[IRDM_MAX_CONTACTS][3];
+	double normal[IRDM_MAX_CONTACTS][3];
+	double w[MAX_SOLVE * MAX_SOLVE];    /* row-major 3m x 3m */
+	double f[MAX_SOLVE];
+	double f_body[MAX_SOLVE];
+	double x_now[IRDM_MAX_CONTACTS][3];     /* floating: world position of each point */
+};
+
+/* r0_table.c */
+void tick_r0_refresh(struct irdm_engine *e, const unsigned *idx, int m);
+const double *tick_r0_block(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp);
+
+/* contact_system.c */
+void tick_free_disp(const struct irdm_engine *e, uint32_t col, double u[3]);
+void tick_history_terms(struct irdm_engine *e, struct system *s);
+void tick_assemble(struct irdm_engine *e, struct system *s);
+void tick_contact_disp(const struct system *s, int i, double u[3]);
+
+/* floating.c */
+void tick_to_world(struct irdm_engine *e, struct system *s);
+void tick_floating_disp(const struct irdm_engine *e, const struct system *s, int i, double d[3]);
+void tick_newton_floating(struct irdm_engine *e, struct system *s, const struct irdm_contact_cmd *cmd);
+int tick_move_rigid(struct irdm_engine *e, const struct system *s);
+
+/* contact_solve.c */
+void tick_solve(struct irdm_engine *e, struct system *s, const struct irdm_contact_cmd *cmd);
+void tick_release_pulling(struct irdm_engine *e, struct system *s, const struct irdm_contact_cmd *cmd);
+
+/* passivity.c */
+void tick_passivity(struct irdm_engine *e, struct system *s);
+
+#endif

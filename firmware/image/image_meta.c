@@ -1,0 +1,141 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * META and PROVENANCE: the values every other section is checked against,
+ * and the text the firmware prints about where the image came from.
+ */
+#include <stdint.h>
+#include <string.h>
+
+#include "image_priv.h"
+
+#define META_FLAGS_KNOWN (IRDM_META_FLOATING | IRDM_META_STATIC_CORR | \
+			  IRDM_META_CONSISTENT_MASS | IRDM_META_TIME_DOMAIN)
+
+static int check_meta_numbers(struct parse *p)
+{
+	const struct irdm_meta *m = &p->meta;
+	const struct {
+		const char *name;
+		double v;
+	} d[] = {
+		{ "dt_s", m->dt_s },
+		{ "young_pa", m->young_pa },
+		{ "poisson", m->poisson },
+		{ "density_kg_m3", m->density_kg_m3 },
+		{ "rayleigh_a_per_s", m->rayleigh_a_per_s },
+		{ "rayleigh_b_s", m->rayleigh_b_s },
+		{ "damping_ratio[0]", m->damping_ratio[0] },
+		{ "damping_ratio[1]", m->damping_ratio[1] },
+		{ "damping_freq_hz[0]", m->damping_freq_hz[0] },
+		{ "damping_freq_hz[1]", m->damping_freq_hz[1] },
+		{ "max_spectral_radius", m->max_spectral_radius },
+		{ "first_elastic_hz", m->first_elastic_hz },
+	};
+
+	for (size_t i = 0; i < sizeof(d) / sizeof(d[0]); i++)
+		if (!f64_finite(d[i].v))
+			return img_fail(p, IRDM_EFORMAT,
+					"meta %s is not finite", d[i].name);
+	if (!(m->dt_s > 0 && m->dt_s <= 1))
+		return img_fail(p, IRDM_EFORMAT,
+				"meta dt_s is %g s, must be in (0, 1]", m->dt_s);
+	if (!(m->young_pa > 0))
+		return img_fail(p, IRDM_EFORMAT,
+				"meta young_pa is %g, must be > 0", m->young_pa);
+	if (!(m->poisson > -1 && m->poisson < 0.5))
+		return img_fail(p, IRDM_EFORMAT,
+				"meta poisson is %g, must be in (-1, 0.5)", m->poisson);
+	if (!(m->density_kg_m3 > 0))
+		return img_fail(p, IRDM_EFORMAT,
+				"meta density_kg_m3 is %g, must be > 0",
+				m->density_kg_m3);
+	return IRDM_OK;
+}
+
+static int check_meta_counts(struct parse *p)
+{
+	const struct irdm_meta *m = &p->meta;
+
+	if (m->n_nodes < 1 || m->n_cols < 1 || m->n_cols > m->n_nodes)
+		return img_fail(p, IRDM_EFORMAT,
+				"meta n_nodes %u, n_cols %u: need 1 <= n_cols <= n_nodes",
+				m->n_nodes, m->n_cols);
+	if (m->representation == IRDM_REPR_FIR &&
+	    (m->fir_length < 1 || m->n_modes != 0))
+		return img_fail(p, IRDM_EFORMAT,
+				"FIR image has fir_length %u, n_modes %u: need T >= 1 and no modes",
+				m->fir_length, m->n_modes);
+	if (m->representation == IRDM_REPR_MODAL &&
+	    (m->n_modes < 1 || m->fir_length != 0))
+		return img_fail(p, IRDM_EFORMAT,
+				"modal image has n_modes %u, fir_length %u: need modes >= 1 and T = 0",
+				m->n_modes, m->fir_length);
+	if (m->representation == IRDM_REPR_FIR &&
+	    (m->flags & IRDM_META_STATIC_CORR))
+		return img_fail(p, IRDM_EFORMAT,
+				"FIR image has the STATIC_CORR flag (modal only)");
+	return IRDM_OK;
+}
+
+int img_check_meta(struct parse *p)
+{
+	const struct irdm_image_section *s = p->by_kind[IRDM_SEC_META];
+	const struct irdm_meta *m = &p->meta;
+	int ret;
+
+	ret = img_check_presence(p, IRDM_SEC_META, true, "always");
+	if (ret)
+		return ret;
+	ret = img_check_presence(p, IRDM_SEC_PROVENANCE, true, "always");
+	if (ret)
+		return ret;
+	if (s->size != sizeof(struct irdm_meta) || s->elem != IRDM_ELEM_BYTES)
+		return img_fail(p, IRDM_EFORMAT,
+				"section META has %llu bytes of %s, expected %zu of BYTES",
+				(unsigned long long)s->size, img_elem_name(s->elem),
+				sizeof(struct irdm_meta));
+	memcpy(&p->meta, p->base + s->offset, sizeof(p->meta));
+	if (m->representation != IRDM_REPR_FIR &&
+	    m->representation != IRDM_REPR_MODAL)
+		return img_fail(p, IRDM_EFORMAT,
+				"meta representation is %u, expected 1 (FIR) or 2 (MODAL)",
+				m->representation);
+	if (m->precision != IRDM_ELEM_F16 && m->precision != IRDM_ELEM_F32 &&
+	    m->precision != IRDM_ELEM_F64)
+		return img_fail(p, IRDM_EFORMAT,
+				"meta precision is %u, expected 1 (F16), 2 (F32) or 3 (F64)",
+				m->precision);
+	p->es = irdm_elem_size(m->precision);
+	if (p->strict && ((m->flags & ~META_FLAGS_KNOWN) || m->reserved0 ||
+			  !all_zero(m->reserved, sizeof(m->reserved))))
+		return img_fail(p, IRDM_EFORMAT,
+				"meta has unknown flags (0x%08x) or non-zero reserved fields",
+				m->flags);
+	if (!memchr(m->tool_version, 0, sizeof(m->tool_version)) ||
+	    !memchr(m->mesh_name, 0, sizeof(m->mesh_name)))
+		return img_fail(p, IRDM_EFORMAT,
+				"meta tool_version or mesh_name is not NUL-terminated");
+	ret = check_meta_numbers(p);
+	if (ret)
+		return ret;
+	return check_meta_counts(p);
+}
+
+int img_check_provenance(struct parse *p)
+{
+	const struct irdm_image_section *s = p->by_kind[IRDM_SEC_PROVENANCE];
+	const char *text = img_payload(p, IRDM_SEC_PROVENANCE);
+
+	if (s->elem != IRDM_ELEM_BYTES)
+		return img_fail(p, IRDM_EFORMAT,
+				"section PROVENANCE has element type %s, expected BYTES",
+				img_elem_name(s->elem));
+	/* Text the firmware prints: an embedded NUL would hide the rest. */
+	if (memchr(text, 0, (size_t)s->size))
+		return img_fail(p, IRDM_EFORMAT,
+				"PROVENANCE contains a NUL byte at offset %td",
+				(const char *)memchr(text, 0, (size_t)s->size) - text);
+	p->img.provenance = text;
+	p->img.provenance_len = (size_t)s->size;
+	return IRDM_OK;
+}

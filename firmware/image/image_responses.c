@@ -1,0 +1,164 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * The responses: STABILITY of the force recursion per column, then either
+ * the FIR (R[s] blocks) or the modal form (MODES, MODE_SHAPES and the
+ * optional STATIC_CORR), every value scanned for NaN and infinity.
+ */
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "image_priv.h"
+
+int img_check_stability(struct parse *p)
+{
+	const struct irdm_stability *st;
+	int ret;
+
+	ret = img_check_presence(p, IRDM_SEC_STABILITY, true, "always");
+	if (!ret)
+		ret = img_check_shape(p, IRDM_SEC_STABILITY,
+				      (uint64_t[]){ p->meta.n_cols, sizeof(*st) }, 2,
+				      "n_cols x 8");
+	if (ret)
+		return ret;
+	st = img_payload(p, IRDM_SEC_STABILITY);
+	for (uint32_t i = 0; i < p->meta.n_cols; i++) {
+		float rho = st[i].spectral_radius;
+
+		if (!f32_finite(rho) || rho < 0)
+			return img_fail(p, IRDM_EFORMAT,
+					"column %u: spectral radius %g is not a finite value >= 0",
+					i, (double)rho);
+		if ((st[i].flags & IRDM_STAB_STABLE) && !(rho < 1))
+			return img_fail(p, IRDM_EFORMAT,
+					"column %u is flagged stable with spectral radius %g >= 1",
+					i, (double)rho);
+	}
+	p->img.stability = st;
+	return IRDM_OK;
+}
+
+/* Index of the first non-finite element of an array, or count if none. */
+static uint64_t first_non_finite(const void *data, uint32_t elem, uint64_t count)
+{
+	uint64_t i;
+
+	for (i = 0; i < count; i++)
+		if (!f64_finite(irdm_elem_get(data, elem, (size_t)i)))
+			return i;
+	return i;
+}
+
+/* Scan a response array (elements of the meta precision) for NaN/inf. */
+static int check_finite(struct parse *p, uint32_t kind, uint64_t count)
+{
+	const void *data = img_payload(p, kind);
+	uint64_t bad = first_non_finite(data, p->meta.precision, count);
+
+	if (bad == count)
+		return IRDM_OK;
+	if (kind == IRDM_SEC_FIR) {
+		uint64_t t = p->meta.fir_length;
+		uint64_t blk = bad / 9;
+
+		return img_fail(p, IRDM_EFORMAT,
+				"FIR element %llu (column %llu, row %llu, sample %llu, entry %llu,%llu) is not finite",
+				(unsigned long long)bad,
+				(unsigned long long)(blk / t / p->meta.n_nodes),
+				(unsigned long long)(blk / t % p->meta.n_nodes),
+				(unsigned long long)(blk % t),
+				(unsigned long long)(bad / 3 % 3),
+				(unsigned long long)(bad % 3));
+	}
+	return img_fail(p, IRDM_EFORMAT, "%s element %llu is not finite",
+			img_kind_name(kind), (unsigned long long)bad);
+}
+
+int img_check_fir(struct parse *p)
+{
+	const struct irdm_meta *m = &p->meta;
+	const uint64_t f[] = { m->n_cols, m->n_nodes, m->fir_length, 9 };
+	int ret;
+
+	ret = img_check_presence(p, IRDM_SEC_FIR, true, "FIR image");
+	if (!ret)
+		ret = img_check_presence(p, IRDM_SEC_MODES, false, "FIR image");
+	if (!ret)
+		ret = img_check_presence(p, IRDM_SEC_MODE_SHAPES, false, "FIR image");
+	if (!ret)
+		ret = img_check_presence(p, IRDM_SEC_STATIC_CORR, false, "FIR image");
+	if (!ret)
+		ret = img_check_shape(p, IRDM_SEC_FIR, f, 4, "n_cols x n_nodes x T x 9");
+	if (!ret)
+		ret = check_finite(p, IRDM_SEC_FIR, p->by_kind[IRDM_SEC_FIR]->size / p->es);
+	if (ret)
+		return ret;
+	p->img.fir = img_payload(p, IRDM_SEC_FIR);
+	return IRDM_OK;
+}
+
+static int check_modes(struct parse *p)
+{
+	const struct irdm_mode *modes;
+	int ret;
+
+	ret = img_check_shape(p, IRDM_SEC_MODES,
+			      (uint64_t[]){ p->meta.n_modes, sizeof(*modes) }, 2,
+			      "n_modes x 64");
+	if (ret)
+		return ret;
+	modes = img_payload(p, IRDM_SEC_MODES);
+	for (uint32_t k = 0; k < p->meta.n_modes; k++) {
+		const struct irdm_mode *md = &modes[k];
+		bool ok = f64_finite(md->omega_rad_s) && md->omega_rad_s >= 0 &&
+			  f64_finite(md->zeta) && md->zeta >= 0;
+
+		for (unsigned i = 0; i < 4; i++)
+			ok = ok && f64_finite(md->a[i]);
+		ok = ok && f64_finite(md->b[0]) && f64_finite(md->b[1]);
+		if (!ok)
+			return img_fail(p, IRDM_EFORMAT,
+					"mode %u: omega %g, zeta %g: need finite omega >= 0, zeta >= 0, A and b",
+					k, md->omega_rad_s, md->zeta);
+	}
+	p->img.modes = modes;
+	return IRDM_OK;
+}
+
+int img_check_modal(struct parse *p)
+{
+	const struct irdm_meta *m = &p->meta;
+	bool corr = m->flags & IRDM_META_STATIC_CORR;
+	const uint64_t shapes[] = { m->n_nodes, 3, m->n_modes };
+	const uint64_t sc[] = { m->n_cols, m->n_cols, 9 };
+	int ret;
+
+	ret = img_check_presence(p, IRDM_SEC_FIR, false, "modal image");
+	if (!ret)
+		ret = img_check_presence(p, IRDM_SEC_MODES, true, "modal image");
+	if (!ret)
+		ret = img_check_presence(p, IRDM_SEC_MODE_SHAPES, true, "modal image");
+	if (!ret)
+		ret = img_check_presence(p, IRDM_SEC_STATIC_CORR, corr,
+					 corr ? "meta flags say STATIC_CORR" :
+						"meta flags lack STATIC_CORR");
+	if (!ret)
+		ret = check_modes(p);
+	if (!ret)
+		ret = img_check_shape(p, IRDM_SEC_MODE_SHAPES, shapes, 3,
+				      "n_nodes x 3 x n_modes");
+	if (!ret)
+		ret = check_finite(p, IRDM_SEC_MODE_SHAPES,
+				   p->by_kind[IRDM_SEC_MODE_SHAPES]->size / p->es);
+	if (!ret && corr)
+		ret = img_check_shape(p, IRDM_SEC_STATIC_CORR, sc, 3,
+				      "n_cols x n_cols x 9");
+	if (!ret && corr)
+		ret = check_finite(p, IRDM_SEC_STATIC_CORR,
+				   p->by_kind[IRDM_SEC_STATIC_CORR]->size / p->es);
+	if (ret)
+		return ret;
+	p->img.mode_shapes = img_payload(p, IRDM_SEC_MODE_SHAPES);
+	p->img.static_corr = img_payload(p, IRDM_SEC_STATIC_CORR);
+	return IRDM_OK;
+}

@@ -1,0 +1,188 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * Real-time set-up, in one place for every loop that must not be late: the
+ * deformation thread, the benches, the tests and the 1 kHz controller.
+ * docs/architecture.md ("Memory and threading") says why each step exists:
+ * locked memory and a pre-faulted stack so that the loop never takes a page
+ * fault, an explicit scheduling policy so that a thread never inherits one
+ * by accident, and a report read back from the system so that a program
+ * never claims real time it did not get.
+ *
+ * Only the sleep and the timespec helpers are meant for inside a loop; the
+ * rest is init-time (it may allocate, read /proc and make system calls).
+ * Linux (glibc) only: the module uses the _np thread calls and /proc.
+ */
+#ifndef IRDM_RT_H
+#define IRDM_RT_H
+
+#include <pthread.h>
+#include <sched.h>
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <time.h>
+
+#include "irdm/error.h"
+
+#define IRDM_RT_ANY_CPU (-1)
+
+/*
+ * 1 in a build with AddressSanitizer, whose mlockall() locks nothing (so
+ * irdm_rt_lock_memory() says IRDM_ENOTSUP) and which owns the allocator and
+ * the stack's shadow: what a real-time check can prove differs there.
+ */
+#if defined(__SANITIZE_ADDRESS__)
+#define IRDM_RT_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define IRDM_RT_ASAN 1
+#endif
+#endif
+#ifndef IRDM_RT_ASAN
+#define IRDM_RT_ASAN 0
+#endif
+
+/* How a thread is to be scheduled. */
+struct irdm_rt_sched {
+	int policy;     /* SCHED_FIFO or SCHED_OTHER */
+	int priority;   /* SCHED_FIFO: 1..99; SCHED_OTHER: 0 */
+	int cpu;        /* the one CPU it may run on, or IRDM_RT_ANY_CPU */
+};
+
+/* What the system granted, read back by irdm_rt_report_get(). */
+struct irdm_rt_report {
+	bool preempt_rt;            /* the kernel is PREEMPT_RT */
+	int policy;                 /* the calling thread's, -1 if unknown */
+	int priority;               /* its static priority (0 outside SCHED_FIFO/RR) */
+	int cpu;                    /* the CPU it ran on during the call, -1 if unknown */
+	uint64_t cpu_mask;          /* its affinity, CPUs 0..63: bit n is CPU n */
+	unsigned n_cpus;            /* CPUs in its affinity (any number), 0 if unknown */
+	bool memory_locked;         /* everything mapped is locked (VmLck covers VmSize) */
+	unsigned long locked_kb;    /* VmLck of /proc/self/status */
+	unsigned long mapped_kb;    /* VmSize */
+};
+
+/* ---- memory ---- */
+
+/*
+ * Lock every page mapped now and every page mapped later
+ * (mlockall(MCL_CURRENT | MCL_FUTURE)): with MCL_FUTURE the kernel
+ * populates each new mapping as it is made, so later allocations do not
+ * fault either and the heap needs no pre-faulting of its own.  Process-wide.
+ *
+ * Return: IRDM_OK; IRDM_EPERM if the system refused (no CAP_IPC_LOCK and
+ * RLIMIT_MEMLOCK too small; part of the memory may then be locked);
+ * IRDM_ENOTSUP under AddressSanitizer, whose mlockall does nothing;
+ * IRDM_EINVAL if the kernel rejects the flags.
+ */
+int irdm_rt_lock_memory(void);
+
+/* Undo irdm_rt_lock_memory() (munlockall: every lock of the process). */
+void irdm_rt_unlock_memory(void);
+
+/*
+ * Write to depth_bytes of the calling thread's stack below the caller, so
+ * that frames down to that depth never fault later (with memory locked the
+ * pages then stay).  Call from the thread that will run the loop, from the
+ * function that will run it.
+ *
+ * Return: IRDM_OK; IRDM_EINVAL if depth_bytes (and a margin for this call)
+ * does not fit in what is left of the thread's stack: nothing is touched;
+ * IRDM_EIO if the stack's bounds cannot be read.
+ */
+int irdm_rt_prefault_stack(size_t depth_bytes);
+
+/* ---- scheduling ---- */
+
+/*
+ * Initialise *attr for a thread with explicit scheduling s (it never
+ * inherits the creator's policy).  On IRDM_OK the caller owns *attr and
+ * destroys it with pthread_attr_destroy(); on an error *attr is not
+ * initialised.
+ *
+ * Return: IRDM_OK; IRDM_EINVAL if the policy is not SCHED_FIFO or
+ * SCHED_OTHER, the priority is out of the policy's range or the CPU is
+ * negative (other than IRDM_RT_ANY_CPU) or too large; IRDM_ENOMEM if the
+ * attributes cannot be allocated.
+ */
+int irdm_rt_thread_attr(pthread_attr_t *attr, const struct irdm_rt_sched *s);
+
+/*
+ * Start fn(arg) in a thread scheduled as s; nothing is downgraded: if the
+ * system refuses s, no thread is started.
+ *
+ * Return: IRDM_OK; IRDM_EPERM if the system refused the policy or
+ * priority; IRDM_EINVAL as irdm_rt_thread_attr(), or if the CPU is not
+ * available; IRDM_ENOMEM as irdm_rt_thread_attr(); IRDM_ETHREAD if no
+ * thread could be created (resources).
+ */
+int irdm_rt_thread_start(pthread_t *tid, const struct irdm_rt_sched *s,
+			 void *(*fn)(void *), void *arg);
+
+/*
+ * Schedule the calling thread as s: the CPU first (when one is given), then
+ * the policy and priority.  Stops at the first refusal, so on an error the
+ * CPU may be set without the policy: irdm_rt_report_get() says what holds.
+ *
+ * Return: IRDM_OK; IRDM_EINVAL as irdm_rt_thread_attr(), or if the CPU is
+ * not available; IRDM_EPERM if the system refused the policy or priority.
+ */
+int irdm_rt_set_self(const struct irdm_rt_sched *s);
+
+/* ---- report ---- */
+
+/*
+ * Whether a kernel is PREEMPT_RT, from the text of /sys/kernel/realtime
+ * (NULL if the file is absent: only PREEMPT_RT kernels have it) and the
+ * kernel version string (uname -v, NULL if unknown).  The file decides
+ * when present ("1"); without it, a version containing "PREEMPT_RT" does.
+ * Apart from irdm_rt_report_get() so that both cases can be tested.
+ */
+bool irdm_rt_kernel_is_preempt_rt(const char *sys_realtime, const char *uname_version);
+
+/*
+ * Fill *r for the calling thread from what the system says now: the
+ * kernel, the policy and priority (pthread_getschedparam), the CPU and the
+ * affinity, the locked and mapped memory.  A part that cannot be read is
+ * left at its "unknown" or "no" value and the rest is still filled.
+ *
+ * Return: IRDM_OK; IRDM_EIO if some part could not be read.
+ */
+int irdm_rt_report_get(struct irdm_rt_report *r);
+
+/*
+ * Real time as far as this process can make it: a PREEMPT_RT kernel,
+ * SCHED_FIFO or SCHED_RR at a priority above 0, all memory locked.
+ */
+bool irdm_rt_report_realtime(const struct irdm_rt_report *r);
+
+/*
+ * One line (no newline) for a program to print before its loop, e.g.
+ *   "real-time: yes (kernel PREEMPT_RT, SCHED_FIFO priority 80, memory locked); CPU 1, affinity 1"
+ *   "real-time: NO (kernel not PREEMPT_RT, SCHED_OTHER, memory not locked); CPU 0, affinity 0-1"
+ * It says "yes" only when irdm_rt_report_realtime() holds.
+ *
+ * Return: IRDM_OK; IRDM_EINVAL if buf is NULL or len is 0; IRDM_ENOMEM if
+ * the line was cut to fit len (buf still holds a terminated prefix).
+ */
+int irdm_rt_report_format(const struct irdm_rt_report *r, char *buf, size_t len);
+
+/* ---- time (safe inside a loop: no allocation, one system call) ---- */
+
+/*
+ * Sleep until t on CLOCK_MONOTONIC (absolute, so a loop's period does not
+ * drift by its own work), resuming after signals.
+ *
+ * Return: IRDM_OK; IRDM_EINVAL if t->tv_nsec is outside [0, 1e9).
+ */
+int irdm_rt_sleep_until(const struct timespec *t);
+
+/*
+ * Timespec arithmetic on normalised values (0 <= tv_nsec < 1e9; a negative
+ * time has a negative tv_sec, -0.25 s is { -1, 750000000 }).
+ */
+void irdm_rt_timespec_add(struct timespec *t, const struct timespec *dt);   /* t += dt */
+int64_t irdm_rt_timespec_diff_ns(const struct timespec *a, const struct timespec *b); /* b - a */
+int irdm_rt_timespec_cmp(const struct timespec *a, const struct timespec *b); /* <0, 0, >0 */
+
+#endif /* IRDM_RT_H */

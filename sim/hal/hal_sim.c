@@ -1,0 +1,205 @@
+/* SPDX-License-Identifier: MIT */
+/* The sim back-end of the HAL (irdm/hal_sim.h). */
+#include <math.h>
+#include <string.h>
+
+#include "irdm/error.h"
+#include "irdm/hal_sim.h"
+
+enum sim_state { SIM_CLOSED = 0, SIM_OPEN, SIM_RUNNING, SIM_OFF };
+
+struct sim_data {
+	struct irdm_sim_device arm;
+	enum sim_state state;
+	uint32_t faults;
+	uint64_t seq;
+};
+
+static struct sim_data *data_of(struct irdm_hal_dev *dev)
+{
+	return dev->data;
+}
+
+/* "key=value" with value an unsigned <= max. */
+static int option_uint(const char *tok, size_t len, const char *key, unsigned max,
+		       unsigned *out, int *matched)
+{
+	size_t klen = strlen(key);
+	unsigned long v = 0;
+	size_t i;
+
+	if (len <= klen + 1 || strncmp(tok, key, klen) != 0 || tok[klen] != '=')
+		return IRDM_OK;
+	*matched = 1;
+	for (i = klen + 1; i < len; i++) {
+		if (tok[i] < '0' || tok[i] > '9' || v > max)
+			return IRDM_EINVAL;
+		v = v * 10 + (unsigned long)(tok[i] - '0');
+	}
+	if (v > max)
+		return IRDM_EINVAL;
+	*out = (unsigned)v;
+	return IRDM_OK;
+}
+
+static int parse_token(const char *tok, size_t len, struct irdm_sim_params *p)
+{
+	int matched = 0, rc;
+
+	rc = option_uint(tok, len, "write_delay", IRDM_SIM_DELAY_MAX, &p->write_delay_ticks,
+			 &matched);
+	if (rc == IRDM_OK && !matched)
+		rc = option_uint(tok, len, "read_delay", IRDM_SIM_DELAY_MAX,
+				 &p->read_delay_ticks, &matched);
+	if (rc == IRDM_OK && !matched)
+		rc = option_uint(tok, len, "substeps", IRDM_SIM_SUBSTEPS_MAX, &p->substeps,
+				 &matched);
+	if (rc == IRDM_OK && !matched)
+		rc = IRDM_EINVAL;               /* unknown option */
+	return rc;
+}
+
+static int parse_options(const char *s, struct irdm_sim_params *p)
+{
+	while (s && *s) {
+		size_t len = strcspn(s, " ,\t");
+		int rc = len ? parse_token(s, len, p) : IRDM_OK;
+
+		if (rc != IRDM_OK)
+			return rc;
+		s += len;
+		s += strspn(s, " ,\t");
+	}
+	return IRDM_OK;
+}
+
+static int sim_open(struct irdm_hal_dev *dev)
+{
+	struct sim_data *d = data_of(dev);
+	const struct irdm_hal_config *cfg = dev->config;
+	struct irdm_sim_params p;
+	int rc;
+
+	if (d->state != SIM_CLOSED)
+		return IRDM_EBUSY;
+	if (!cfg->device || !(isfinite(cfg->period_s) && cfg->period_s > 0))
+		return IRDM_EINVAL;
+	irdm_sim_params_default(&p);
+	rc = parse_options(cfg->options, &p);
+	if (rc != IRDM_OK)
+		return rc;
+	rc = irdm_sim_device_init(&d->arm, cfg->device, &p);
+	if (rc != IRDM_OK)
+		return rc;
+	d->faults = 0;
+	d->seq = 0;
+	d->state = SIM_OPEN;
+	return IRDM_OK;
+}
+
+static int sim_start(struct irdm_hal_dev *dev)
+{
+	struct sim_data *d = data_of(dev);
+
+	if (d->state == SIM_CLOSED)
+		return IRDM_EINVAL;
+	if (d->faults)
+		return IRDM_EHW;
+	d->state = SIM_RUNNING;
+	return IRDM_OK;
+}
+
+static int sim_read(struct irdm_hal_dev *dev, struct irdm_hal_joint_state *st)
+{
+	struct sim_data *d = data_of(dev);
+	int32_t counts[IRDM_HAL_JOINTS];
+	int rc;
+
+	if (d->state == SIM_CLOSED)
+		return IRDM_EINVAL;
+	if (d->faults)
+		return IRDM_EHW;
+	rc = irdm_sim_device_step(&d->arm, dev->config->period_s);
+	if (rc == IRDM_OK)
+		rc = irdm_sim_device_read_counts(&d->arm, counts);
+	if (rc != IRDM_OK)
+		return IRDM_EFAULT;
+	memcpy(st->counts, counts, sizeof(st->counts));
+	st->seq = ++d->seq;
+	return IRDM_OK;
+}
+
+static int sim_write(struct irdm_hal_dev *dev, const double tau_nm[IRDM_HAL_JOINTS])
+{
+	struct sim_data *d = data_of(dev);
+
+	if (d->state != SIM_RUNNING)
+		return IRDM_EINVAL;
+	if (d->faults)
+		return IRDM_EHW;
+	return irdm_sim_device_set_torque(&d->arm, tau_nm);
+}
+
+static int sim_safe_off(struct irdm_hal_dev *dev)
+{
+	struct sim_data *d = data_of(dev);
+
+	irdm_sim_device_torque_off(&d->arm);
+	if (d->state == SIM_RUNNING)
+		d->state = SIM_OFF;
+	return IRDM_OK;
+}
+
+static int sim_poll(struct irdm_hal_dev *dev, uint32_t *faults)
+{
+	struct sim_data *d = data_of(dev);
+
+	if (d->state == SIM_CLOSED)
+		return IRDM_EINVAL;
+	*faults = d->faults;
+	return d->faults ? IRDM_EHW : IRDM_OK;
+}
+
+static void sim_close(struct irdm_hal_dev *dev)
+{
+	struct sim_data *d = data_of(dev);
+
+	irdm_sim_device_torque_off(&d->arm);
+	d->state = SIM_CLOSED;
+}
+
+static const struct irdm_hal_ops sim_ops = {
+	.open = sim_open,
+	.start = sim_start,
+	.read = sim_read,
+	.write = sim_write,
+	.safe_off = sim_safe_off,
+	.poll = sim_poll,
+	.close = sim_close,
+};
+
+const struct irdm_hal_backend irdm_hal_sim_backend = {
+	.name = "sim",
+	.ops = &sim_ops,
+	.data_size = sizeof(struct sim_data),
+};
+
+static int is_open_sim(const struct irdm_hal_dev *dev)
+{
+	return dev && dev->backend == &irdm_hal_sim_backend &&
+	       ((const struct sim_data *)dev->data)->state != SIM_CLOSED;
+}
+
+int irdm_hal_sim_inject_fault(struct irdm_hal_dev *dev, uint32_t faults)
+{
+	if (!is_open_sim(dev))
+		return IRDM_EINVAL;
+	data_of(dev)->faults |= faults;
+	irdm_sim_device_torque_off(&data_of(dev)->arm);
+	return IRDM_OK;
+}
+
+struct irdm_sim_device *irdm_hal_sim_device(struct irdm_hal_dev *dev)
+{
+	return is_open_sim(dev) ? &data_of(dev)->arm : NULL;
+}

@@ -1,0 +1,124 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * A simulated PHANToM-like arm: the arm of irdm/device.h with its masses
+ * moving, friction, motor saturation, encoders and an optional bus delay.
+ * It stands in for the hardware on a host (sim/README.md).
+ *
+ * Model (stated choices):
+ *  - Inertia: the FULL 3x3 mass matrix of the three point masses of
+ *    irdm/device.h (M = sum m_b J_b^T J_b, J_b the Jacobian of body b's
+ *    position), plus a constant joint-side inertia per joint on its diagonal
+ *    (rotor and capstan drum seen through the gear ratio).  Coriolis and
+ *    centrifugal torques come from the same point masses (exact for them).
+ *  - Gravity along -y on the three bodies (the device config's g).
+ *  - Friction per joint: viscous b q' and Coulomb with stick-slip (Karnopp):
+ *    a joint slower than stick_velocity whose static torque (motor + hand -
+ *    gravity) is within its Coulomb level sticks (velocity held at zero);
+ *    otherwise it slips against a torque of the Coulomb level opposing its
+ *    motion.  A joint whose velocity changes sign within a sub-step stops
+ *    there and the next sub-step decides whether it sticks.
+ *  - Motors: each joint's torque is clipped to +-torque_limit_nm (the
+ *    amplifier's own limit; the controller's direction-keeping saturation
+ *    comes before it).
+ *  - Encoders: floor-quantised counts (irdm_device_counts_from_angles()).
+ *  - Bus delay: commanded torques reach the motors write_delay_ticks ticks
+ *    late and encoder samples reach the reader read_delay_ticks ticks late,
+ *    through rings in the struct (fixed memory).
+ *  - Integration: classical RK4 over `substeps` sub-steps per step(dt_s);
+ *    torques and the hand force are held over the step (zero-order hold).
+ *
+ * A tick is one irdm_sim_device_step(): set the torque, step, read the
+ * counts.  The caller gives dt_s; nothing here reads a clock, allocates or
+ * makes a system call.
+ */
+#ifndef IRDM_SIM_DEVICE_H
+#define IRDM_SIM_DEVICE_H
+
+#include <stdint.h>
+
+#include "irdm/device.h"
+
+#define IRDM_SIM_DELAY_MAX 16           /* ticks, either direction */
+#define IRDM_SIM_SUBSTEPS_MAX 1000
+
+struct irdm_sim_params {
+	double joint_inertia_kg_m2[3];          /* added to the mass matrix's diagonal, > 0 */
+	double viscous_nm_s_per_rad[3];         /* >= 0 */
+	double coulomb_nm[3];                   /* >= 0 */
+	double stick_velocity_rad_per_s;        /* > 0 */
+	unsigned substeps;                      /* RK4 steps per tick, 1..IRDM_SIM_SUBSTEPS_MAX */
+	unsigned write_delay_ticks;             /* 0..IRDM_SIM_DELAY_MAX */
+	unsigned read_delay_ticks;              /* 0..IRDM_SIM_DELAY_MAX */
+	double q0_rad[3];                       /* initial pose, at rest */
+};
+
+struct irdm_sim_device {
+	struct irdm_device_config dev;
+	struct irdm_sim_params p;
+	double q_rad[3];
+	double qd_rad_per_s[3];
+	double cmd_nm[3];                       /* last command (clipped) */
+	double motor_nm[3];                     /* reaching the motors this tick */
+	double hand_n[3];                       /* external force on the tip */
+	uint64_t ticks;
+	double cmd_ring[IRDM_SIM_DELAY_MAX + 1][3];
+	int32_t count_ring[IRDM_SIM_DELAY_MAX + 1][3];
+	int count_status[IRDM_SIM_DELAY_MAX + 1];
+};
+
+/*
+ * Defaults for the default device: joint inertia 2e-4 kg m^2, viscous
+ * 2e-3 N m s/rad, Coulomb 5e-3 N m (figures of the right order for a
+ * desktop arm, not measured), stick below 1e-3 rad/s, 10 sub-steps, no
+ * delay, the home pose.
+ */
+void irdm_sim_params_default(struct irdm_sim_params *p);
+
+/*
+ * Set up at rest at p->q0_rad, zero torque, zero hand force.
+ * Return: IRDM_OK; IRDM_EINVAL if irdm_device_config_check() rejects dev or
+ * a parameter is out of its range (above).
+ */
+int irdm_sim_device_init(struct irdm_sim_device *s, const struct irdm_device_config *dev,
+			 const struct irdm_sim_params *p);
+
+/*
+ * Command joint torques (clipped per joint to the motors' limits).
+ * Return: IRDM_OK; IRDM_EFAULT if one is not finite (the command becomes
+ * zero).
+ */
+int irdm_sim_device_set_torque(struct irdm_sim_device *s, const double tau_nm[3]);
+
+/* Cut the torque now, past the bus delay (the amplifiers' enable line). */
+void irdm_sim_device_torque_off(struct irdm_sim_device *s);
+
+/*
+ * The virtual hand's force on the tip (device frame, N); the joints feel
+ * J(q)^T f as the arm moves.
+ * Return: IRDM_OK; IRDM_EFAULT if a component is not finite (the force
+ * becomes zero).
+ */
+int irdm_sim_device_set_hand_force(struct irdm_sim_device *s, const double f_n[3]);
+
+/*
+ * Advance one tick of dt_s.
+ * Return: IRDM_OK; IRDM_EINVAL if dt_s is not finite and positive;
+ * IRDM_EFAULT if the state became non-finite (it is then left as it was).
+ */
+int irdm_sim_device_step(struct irdm_sim_device *s, double dt_s);
+
+/*
+ * The encoder counts the reader sees this tick (read_delay_ticks old).
+ * Return: IRDM_OK; IRDM_EFAULT if that sample was outside the encoders'
+ * range (counts untouched).
+ */
+int irdm_sim_device_read_counts(const struct irdm_sim_device *s, int32_t counts[3]);
+
+/* The true joint state now (tests, the virtual user). */
+void irdm_sim_device_state(const struct irdm_sim_device *s, double q_rad[3],
+			   double qd_rad_per_s[3]);
+
+/* The torque that reached the motors in the last tick (after delay, clip). */
+void irdm_sim_device_motor_torque(const struct irdm_sim_device *s, double tau_nm[3]);
+
+#endif /* IRDM_SIM_DEVICE_H */
