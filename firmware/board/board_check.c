@@ -119,9 +119,13 @@ static int check_arm(const struct check *c)
 				    ": must be <= count_max (%s) on every joint; joint %d: %ld > %ld",
 				    line_text(c, "count_max", buf, sizeof(buf)), i + 1,
 				    (long)d->count_min[i], (long)d->count_max[i]);
-	/* every field has passed its own range: this holds unless the two disagree */
-	if (irdm_device_config_check(d))
-		return fail(c, IRDM_EINVAL, "l1_m", ": the arm is not valid (irdm_device_config_check)");
+	/* every field has passed its own range and the counts are in order, so
+	 * this cannot fail unless device.h asks for more than the table does */
+	if (irdm_device_config_check(d)) {
+		snprintf(c->err, c->errlen, "%s: the arm is not valid (irdm_device_config_check)",
+			 c->f->name);
+		return IRDM_EINVAL;
+	}
 	return IRDM_OK;
 }
 

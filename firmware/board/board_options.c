@@ -176,7 +176,7 @@ static const struct irdm_opt board_opts[] = {
 	  .help = "handed to the back-end as is; sim: write_delay=K,read_delay=K,substeps=N "
 		  "(default none)" },
 	{ .name = "devices", .type = IRDM_OPT_UNSIGNED, BF(devices),
-	  RANGE(IRDM_OPT_GE | IRDM_OPT_LE, 1, 2),
+	  RANGE(IRDM_OPT_GE | IRDM_OPT_LE, 1, IRDM_BOARD_DEVICES_MAX),
 	  .help = "arms: 2 for the two-hand pinch, the second at device2_base_offset_m (default 1)" },
 
 	/* kinematics (irdm/device.h draws the arm) */
@@ -201,7 +201,7 @@ static const struct irdm_opt board_opts[] = {
 	  .help = "joint angle at the start of count 0's cell (default 0,0,0)" },
 	{ .name = "encoder_sign", .type = IRDM_OPT_CUSTOM, .parse = parse_signs, DEV(sign),
 	  .metavar = "S1,S2,S3", .help = "+1 or -1: count direction against the joint angle "
-					 "(default 1,1,-1)" },
+					 "(device.h: sign) (default 1,1,-1)" },
 	{ .name = "count_min", .type = IRDM_OPT_CUSTOM, .parse = parse_joint_counts,
 	  DEV(count_min), .metavar = "C1,C2,C3",
 	  .help = "lowest valid count; a count outside [count_min, count_max] faults "
@@ -228,10 +228,11 @@ static const struct irdm_opt board_opts[] = {
 	  GT0_LE(100), .help = "largest tip force; the engine faults above it (default 7.9)" },
 	{ .name = "max_stiffness_n_per_m", .type = IRDM_OPT_DOUBLE, DEV(k_max_n_per_m),
 	  .unit = "N/m", GT0_LE(1e6),
-	  .help = "stiffest coupling the device renders (default 1000)" },
+	  .help = "stiffest coupling the device renders (device.h: k_max_n_per_m) (default 1000)" },
 	{ .name = "device_damping_ns_per_m", .type = IRDM_OPT_DOUBLE, DEV(b_device_ns_per_m),
 	  .unit = "N s/m", GT0_LE(1e4),
-	  .help = "the device's damping margin, bounds the coupling (Colgate) (default 5)" },
+	  .help = "the device's damping margin, bounds the coupling (Colgate) "
+		  "(device.h: b_device_ns_per_m) (default 5)" },
 	{ .name = "workspace_min_m", XYZ, BF(workspace_min_m), .unit = "m", WITHIN(LENGTH_MAX_M),
 	  .help = "low corner of the box every tip must stay in (required)" },
 	{ .name = "workspace_max_m", XYZ, BF(workspace_max_m), .unit = "m", WITHIN(LENGTH_MAX_M),
