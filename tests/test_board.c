@@ -400,7 +400,7 @@ static void test_good_values(void **state)
 	assert_true(board.coupling_k_n_per_m == 1000 && board.coupling_b_ns_per_m == 4.4);
 	expect_ok("coupling = 0,0\n");                /* rigid */
 	assert_true(board.coupling_k_n_per_m == 0 && board.coupling_b_ns_per_m == 0);
-	expect_ok("coupling = 0,0\ncoupling = auto\n" + 15);
+	expect_ok("coupling = auto\n");
 	assert_true(board.coupling_auto);
 	/* no newline at the end, CR LF line ends */
 	assert_int_equal(parse("name = t\r\nhal = sim\r\nworkspace_min_m = -1,-1,-1\r\n"

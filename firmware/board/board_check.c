@@ -196,21 +196,16 @@ static int check_calibration(const struct check *c)
 int irdm_board_finish(struct irdm_board *b, const struct irdm_opt_file *f, char *err,
 		      size_t errlen)
 {
+	/* in this order: the later checks rely on what the earlier ones proved */
+	static int (*const checks[])(const struct check *c) = {
+		check_required, check_workspace, check_devices, check_arm, check_loop,
+		check_coupling, check_calibration,
+	};
 	const struct check c = { .b = b, .f = f, .err = err, .errlen = errlen };
-	int ret = check_required(&c);
+	int ret = IRDM_OK;
 
-	if (!ret)
-		ret = check_workspace(&c);
-	if (!ret)
-		ret = check_devices(&c);
-	if (!ret)
-		ret = check_arm(&c);
-	if (!ret)
-		ret = check_loop(&c);
-	if (!ret)
-		ret = check_coupling(&c);
-	if (!ret)
-		ret = check_calibration(&c);
+	for (size_t i = 0; i < sizeof(checks) / sizeof(checks[0]) && !ret; i++)
+		ret = checks[i](&c);
 	if (!ret)
 		irdm_board_set_rotation(b);
 	return ret;

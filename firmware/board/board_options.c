@@ -5,7 +5,6 @@
  * from it; tests/test_board.c checks that every "(default X)" in a help
  * line is what irdm_board_default() sets.
  */
-#include <ctype.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -22,18 +21,6 @@
  * to catch a value written in the wrong unit (135 for 0.135 m). */
 #define LENGTH_MAX_M 1.0
 #define PLACE_MAX_M 10.0
-
-static char *trim(char *s)
-{
-	char *e;
-
-	while (isspace((unsigned char)*s))
-		s++;
-	e = s + strlen(s);
-	while (e > s && isspace((unsigned char)e[-1]))
-		*--e = 0;
-	return s;
-}
 
 /* Commas in s, plus one. */
 static unsigned count_items(const char *s)
@@ -70,7 +57,7 @@ static int parse_list(const struct irdm_opt *o, void *out, const char *value, un
 		if (comma)
 			*comma = 0;
 		e.offset = i * elem_size;
-		if (irdm_opt_parse_value(&e, tmp, trim(tok), item_why, sizeof(item_why))) {
+		if (irdm_opt_parse_value(&e, tmp, irdm_opt_trim(tok), item_why, sizeof(item_why))) {
 			snprintf(why, len, "%s: %s", labels[i], item_why);
 			return IRDM_EFORMAT;
 		}
@@ -169,7 +156,8 @@ static int parse_coupling(const struct irdm_opt *o, void *obj, const char *v, ch
 
 static const struct irdm_opt board_opts[] = {
 	/* the board */
-	{ .name = "name", .type = IRDM_OPT_STRING, BF(name), .help = "board name, in logs (required)" },
+	{ .name = "name", .type = IRDM_OPT_STRING, BF(name),
+	  .help = "board name, in logs (required)" },
 	{ .name = "hal", .type = IRDM_OPT_STRING, BF(hal), .metavar = "BACKEND",
 	  .help = "HAL back-end by its registered name, e.g. sim (required)" },
 	{ .name = "hal_options", .type = IRDM_OPT_STRING, BF(hal_options), .metavar = "TEXT",
@@ -177,7 +165,8 @@ static const struct irdm_opt board_opts[] = {
 		  "(default none)" },
 	{ .name = "devices", .type = IRDM_OPT_UNSIGNED, BF(devices),
 	  RANGE(IRDM_OPT_GE | IRDM_OPT_LE, 1, IRDM_BOARD_DEVICES_MAX),
-	  .help = "arms: 2 for the two-hand pinch, the second at device2_base_offset_m (default 1)" },
+	  .help = "arms: 2 for the two-hand pinch, the second at device2_base_offset_m "
+		  "(default 1)" },
 
 	/* kinematics (irdm/device.h draws the arm) */
 	{ .name = "l1_m", .type = IRDM_OPT_DOUBLE, DEV(l1_m), .unit = "m", GT0_LE(LENGTH_MAX_M),
@@ -214,11 +203,13 @@ static const struct irdm_opt board_opts[] = {
 	{ .name = "torque_limit_nm", JOINTS, DEV(torque_limit_nm), .unit = "N m", GT0_LE(100),
 	  .help = "joint-side torque limit; the tick scales torques to keep the force's "
 		  "direction (default 1.07,1.07,1.07)" },
-	{ .name = "mass_kg", BODIES, DEV(mass_kg), .unit = "kg", RANGE(IRDM_OPT_GE | IRDM_OPT_LE, 0, 10),
+	{ .name = "mass_kg", BODIES, DEV(mass_kg), .unit = "kg",
+	  RANGE(IRDM_OPT_GE | IRDM_OPT_LE, 0, 10),
 	  .help = "point masses for gravity compensation: upper arm, forearm, drive crank "
 		  "(default 0.06,0.045,0.09)" },
 	{ .name = "com_m", BODIES, DEV(com_m), .unit = "m", WITHIN(LENGTH_MAX_M),
-	  .help = "where each mass sits along its link (irdm/device.h) (default 0.065,0.08,-0.03)" },
+	  .help = "where each mass sits along its link (irdm/device.h) "
+		  "(default 0.065,0.08,-0.03)" },
 	{ .name = "gravity_m_per_s2", .type = IRDM_OPT_DOUBLE, DEV(gravity_m_per_s2),
 	  .unit = "m/s^2", RANGE(IRDM_OPT_GE | IRDM_OPT_LE, 0, 20),
 	  .help = "gravity along -y; 0 turns gravity compensation off (default 9.81)" },
