@@ -251,14 +251,32 @@ static void test_shipped_board(void **state)
 	irdm_board_device_to_object(&board, top, back);
 	assert_close3(back, top_obj, 1e-15, "top centre back");
 
-	/* every corner of the workspace box is reachable (the box is inside the reach) */
-	for (int k = 0; k < 8; k++) {
-		double p[3];
-		for (int i = 0; i < 3; i++)
-			p[i] = (k >> i & 1) ? board.workspace_max_m[i] : board.workspace_min_m[i];
-		assert_reachable(&board.device, p, "workspace corner");
+	/* the box is the arm's reach less 5 mm on every side: the reach's span by
+	 * brute force over the encoders' ranges (41 counts per joint) */
+	double lo[3] = { 1, 1, 1 }, hi[3] = { -1, -1, -1 };
+	for (int a = 0; a <= 40; a++)
+		for (int b = 0; b <= 40; b++)
+			for (int d = 0; d <= 40; d++) {
+				const int k[3] = { a, b, d };
+				int32_t cnt[3];
+				double q[3], tip[3];
+
+				for (int i = 0; i < 3; i++)
+					cnt[i] = dc.count_min[i] + (int32_t)((int64_t)(dc.count_max[i] -
+								dc.count_min[i]) * k[i] / 40);
+				assert_int_equal(irdm_device_angles_from_counts(&dc, cnt, q), IRDM_OK);
+				irdm_device_fk(&dc, q, tip);
+				for (int i = 0; i < 3; i++) {
+					lo[i] = fmin(lo[i], tip[i]);
+					hi[i] = fmax(hi[i], tip[i]);
+				}
+			}
+	for (int i = 0; i < 3; i++) {
+		printf("axis %d: reach %.4f..%.4f, box %.4f..%.4f m\n", i, lo[i], hi[i],
+		       board.workspace_min_m[i], board.workspace_max_m[i]);
+		assert_true(fabs(board.workspace_min_m[i] - lo[i] - 0.005) < 0.001);
+		assert_true(fabs(hi[i] - board.workspace_max_m[i] - 0.005) < 0.001);
 	}
-	printf("largest Newton residual %.2g m\n", worst_residual_m);
 }
 
 /* Every key of the table is written out in the shipped board (device2's
@@ -280,27 +298,91 @@ static void test_shipped_board_complete(void **state)
 	}
 }
 
-/* The sim back-end accepts the shipped board's arm and hal_options. */
-static void test_shipped_board_opens(void **state)
+/*
+ * Every shipped board: it loads, the sim back-end accepts its arms and
+ * hal_options, and every point the shipped user scripts (scenes/users/NAME.user,
+ * object frame) send a hand to on its scene lies in the workspace box and in
+ * reach of that hand's arm.
+ */
+struct hand_point {
+	unsigned arm;           /* 0, 1; LAST_POINT ends a list */
+	double p_obj[3];
+};
+
+#define LAST_POINT 9
+#define MAX_POINTS 16
+
+static const struct {
+	const char *path;
+	struct hand_point points[MAX_POINTS];
+} shipped_boards[] = {
+	/* press-hold-release, stroke, tap, pull-and-release on the cuboid scenes */
+	{ "boards/sim-phantom.board", {
+		{ 0, { 0.05, 0.05, 0.21 } }, { 0, { 0.05, 0.05, 0.19 } },
+		{ 0, { 0.02, 0.05, 0.21 } }, { 0, { 0.02, 0.05, 0.195 } },
+		{ 0, { 0.08, 0.05, 0.195 } }, { 0, { 0.05, 0.05, 0.197 } },
+		{ 0, { 0.05, 0.05, 0.205 } }, { LAST_POINT, { 0 } } } },
+	/* swing (the -x face, pushed 2 cm) and swirl (two 2 cm circles on top) */
+	{ "boards/sim-phantom-cube.board", {
+		{ 0, { -0.01, 0.06, 0.09 } }, { 0, { 0.02, 0.06, 0.09 } },
+		{ 0, { 0.005, 0.06, 0.09 } }, { 0, { 0.06, 0.06, 0.13 } },
+		{ 0, { 0.08, 0.06, 0.115 } }, { 0, { 0.04, 0.06, 0.115 } },
+		{ 0, { 0.06, 0.08, 0.115 } }, { 0, { 0.06, 0.04, 0.115 } },
+		{ LAST_POINT, { 0 } } } },
+	/* bunny-press */
+	{ "boards/sim-phantom-bunny.board", {
+		{ 0, { 0.02, -0.02, 0.14 } }, { 0, { 0.02, -0.02, 0.12 } },
+		{ LAST_POINT, { 0 } } } },
+	/* pinch: hand 1 on the face x = 0, hand 2 on x = 0.1, each squeezing 5 mm */
+	{ "boards/sim-phantom-pinch.board", {
+		{ 0, { -0.01, 0.05, 0.15 } }, { 0, { 0.005, 0.05, 0.15 } },
+		{ 1, { 0.11, 0.05, 0.15 } }, { 1, { 0.095, 0.05, 0.15 } },
+		{ LAST_POINT, { 0 } } } },
+};
+
+static void check_board_opens(const struct irdm_board *b, const struct irdm_device_config *dc)
 {
 	static _Alignas(max_align_t) unsigned char mem[1 << 16];
-	struct irdm_hal_config cfg;
+	struct irdm_hal_config cfg = {
+		.device = dc, .options = b->hal_options, .period_s = b->period_us * 1e-6,
+	};
 	struct irdm_hal_dev dev;
-	struct irdm_device_config dc;
 
-	(void)state;
-	if (irdm_board_load(&board, SHIPPED, err, sizeof(err)))
-		fail_msg("%s", err);
-	assert_int_equal(irdm_board_device(&board, 0, &dc), IRDM_OK);
-	cfg.device = &dc;
-	cfg.options = board.hal_options;
-	cfg.period_s = board.period_us * 1e-6;
 	assert_int_equal(irdm_hal_register(&irdm_hal_sim_backend), IRDM_OK);
 	assert_true(irdm_hal_sim_backend.data_size <= sizeof(mem));
-	assert_int_equal(irdm_hal_init(&dev, board.hal, &cfg, mem, sizeof(mem)), IRDM_OK);
+	assert_int_equal(irdm_hal_init(&dev, b->hal, &cfg, mem, sizeof(mem)), IRDM_OK);
 	assert_int_equal(irdm_hal_open(&dev), IRDM_OK);
 	assert_int_equal(irdm_hal_sim_device(&dev)->p.substeps, 10);
 	irdm_hal_close(&dev);
+}
+
+static void test_shipped_boards(void **state)
+{
+	(void)state;
+	for (size_t k = 0; k < sizeof(shipped_boards) / sizeof(shipped_boards[0]); k++) {
+		const char *path = shipped_boards[k].path;
+		struct irdm_device_config arm[IRDM_BOARD_DEVICES_MAX];
+
+		if (irdm_board_load(&board, path, err, sizeof(err)))
+			fail_msg("%s", err);
+		for (unsigned a = 0; a < board.devices; a++) {
+			assert_int_equal(irdm_board_device(&board, a, &arm[a]), IRDM_OK);
+			check_board_opens(&board, &arm[a]);
+		}
+		for (const struct hand_point *h = shipped_boards[k].points; h->arm != LAST_POINT; h++) {
+			double p[3];
+
+			assert_true(h->arm < board.devices);
+			irdm_board_object_to_device(&board, h->p_obj, p);
+			for (int i = 0; i < 3; i++)
+				if (!(p[i] > board.workspace_min_m[i] && p[i] < board.workspace_max_m[i]))
+					fail_msg("%s: (%g, %g, %g) is at device (%g, %g, %g), outside "
+						 "the workspace", path, h->p_obj[0], h->p_obj[1],
+						 h->p_obj[2], p[0], p[1], p[2]);
+			assert_reachable(&arm[h->arm], p, path);
+		}
+	}
+	printf("largest Newton residual %.2g m\n", worst_residual_m);
 }
 
 /* ---- bad values: every key type, file:line and the reason ---- */
@@ -712,7 +794,7 @@ int main(void)
 		cmocka_unit_test(test_documented_defaults),
 		cmocka_unit_test(test_shipped_board),
 		cmocka_unit_test(test_shipped_board_complete),
-		cmocka_unit_test(test_shipped_board_opens),
+		cmocka_unit_test(test_shipped_boards),
 		cmocka_unit_test(test_bad_values),
 		cmocka_unit_test(test_good_values),
 		cmocka_unit_test(test_refused_boards),
