@@ -18,6 +18,7 @@
 #   sim/*/*.c       -> libirdmsim.a    sees firmware/include, hal/include, sim/include
 #   tools/*/*.c     -> libirdmtools.a  sees firmware/include, tools/ (not tools/irdm)
 #   tools/irdm/*.c  -> irdm
+#   firmware/main/*.c -> irdm-fw (the controller; sees firmware, hal and sim headers)
 #   tests/test_*.c  -> one binary each; tests/test_tick_*.c link the firmware
 #                      library alone (no BLAS, no threads: the force tick's
 #                      dependencies, checked by tests/test_layers.c)
@@ -50,7 +51,8 @@ CFLAGS  += -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-re
 LDFLAGS += -fsanitize=address,undefined
 endif
 
-FW_SRC    := $(wildcard firmware/*/*.c)
+FW_SRC    := $(filter-out firmware/main/%,$(wildcard firmware/*/*.c))
+FWMAIN_SRC := $(wildcard firmware/main/*.c)
 HAL_SRC   := $(wildcard hal/*/*.c)
 SIM_SRC   := $(wildcard sim/*/*.c)
 TOOL_SRC  := $(filter-out tools/irdm/%,$(wildcard tools/*/*.c))
@@ -68,15 +70,19 @@ HAL_LIB  := $(BUILD)/libirdmhal.a
 SIM_LIB  := $(BUILD)/libirdmsim.a
 TOOL_LIB := $(BUILD)/libirdmtools.a
 IRDM     := $(BUILD)/irdm
+IRDM_FW  := $(BUILD)/irdm-fw
 TESTS    := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 TICK_TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TICK_TEST_SRC))
 BENCHES  := $(patsubst tests/bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC))
 
 .PHONY: all test san fuzz bench bench-precompute run check deps clean docs
 .SECONDARY:
-all: $(IRDM) $(FW_LIB) $(HAL_LIB) $(SIM_LIB)
+all: $(IRDM) $(FW_LIB) $(HAL_LIB) $(SIM_LIB) $(if $(FWMAIN_SRC),$(IRDM_FW))
 
 $(BUILD)/obj/firmware/%.o: LAYER_INC = $(FW_INC)
+# irdm-fw's main() is the composition root: it alone sees every layer below
+# the tools (it registers the HAL back-ends, the simulator's among them).
+$(BUILD)/obj/firmware/main/%.o: LAYER_INC = $(SIM_INC)
 $(BUILD)/obj/hal/%.o:      LAYER_INC = $(HAL_INC)
 $(BUILD)/obj/sim/%.o:      LAYER_INC = $(SIM_INC)
 $(BUILD)/obj/tools/%.o:    LAYER_INC = $(TOOL_INC)
@@ -101,6 +107,9 @@ $(IRDM): $(call obj,$(CLI_SRC)) $(TOOL_LIB) $(FW_LIB)
 	$(CC) $(LDFLAGS) $^ -o $@ $(LDLIBS)
 
 TEST_LIBS := $(TOOL_LIB) $(SIM_LIB) $(HAL_LIB) $(FW_LIB)
+
+$(IRDM_FW): $(call obj,$(FWMAIN_SRC)) $(SIM_LIB) $(HAL_LIB) $(FW_LIB)
+	$(CC) $(LDFLAGS) $^ -o $@ -lopenblas -lpthread -lm
 
 # The force tick alone: the firmware library, libm and cmocka, nothing else.
 $(TICK_TESTS): $(BUILD)/tests/test_tick_%: $(BUILD)/obj/tests/test_tick_%.o $(FW_LIB)
