@@ -592,46 +592,61 @@ static void slow_limit(struct irdm_ctrl_config *cfg, double v)
 	cfg->limits.max_tip_speed_m_per_s = v;
 }
 
-/* Slide in contact at speed_m_per_s (+x) for n ticks; the largest estimate. */
-static double slide(struct rig *r, double *x, double speed_m_per_s, int n, bool stop_on_fault)
+/*
+ * Slide in contact at speed_m_per_s along the object-frame direction
+ * (ux, uy) for n ticks.  Returns the ticks until a fault (stop_on_fault),
+ * else the largest speed estimate; *vec_err gets the largest error of the
+ * estimated velocity VECTOR (device frame) after the first 50 ticks.
+ */
+static double slide(struct rig *r, double *x, double *y, double ux, double uy,
+		    double speed_m_per_s, int n, bool stop_on_fault, double *vec_err)
 {
-	double vmax = 0;
+	const double v_obj[3] = { speed_m_per_s * ux, speed_m_per_s * uy, 0 };
+	double vmax = 0, v_dev[3];
 
+	for (int a = 0; a < 3; a++)            /* R^T v */
+		v_dev[a] = rot[a] * v_obj[0] + rot[3 + a] * v_obj[1] + rot[6 + a] * v_obj[2];
 	for (int k = 0; k < n; k++) {
-		double p[3];
-		*x += speed_m_per_s * PERIOD_US * 1e-6;
-		at(r, *x, 0, -0.0015, p);
+		double p[3], e[3];
+		*x += v_obj[0] * PERIOD_US * 1e-6;
+		*y += v_obj[1] * PERIOD_US * 1e-6;
+		at(r, *x, *y, -0.0015, p);
 		put(r, 0, p);
 		tick(r);
 		if (stop_on_fault && r->out.state == IRDM_SAFETY_FAULT)
 			return k + 1;
 		vmax = fmax(vmax, r->out.dev[0].speed_m_per_s);
+		irdm_v3_sub(e, r->out.dev[0].vel_m_per_s, v_dev);
+		if (vec_err && k >= 50)
+			*vec_err = fmax(*vec_err, irdm_v3_norm(e));
 	}
 	return vmax;
 }
 
 static void test_velocity(void **state)
 {
-	const double limit = 0.05;
-	double x = -0.015, vmax, ticks;
+	const double limit = 0.05, u = sqrt(0.5);
+	double x = -0.012, y = -0.012, vmax, ticks, err = 0;
 	struct rig r;
 	(void)state;
 
 	contact_rig(&r, slow_limit, limit);
-	/* re-place the press at x = -15 mm, at 25 mm/s */
-	for (int k = 1; k <= 600; k++) {
+	/* re-place the press at (-12, -12) mm, at 25 mm/s */
+	for (int k = 1; k <= 680; k++) {
 		double p[3];
-		at(&r, x * k / 600, 0, -0.0015, p);
+		at(&r, x * k / 680, y * k / 680, -0.0015, p);
 		put(&r, 0, p);
 		tick(&r);
 	}
-	vmax = slide(&r, &x, 0.7 * limit, 300, false);
-	print_message("  sliding at %.3f m/s: largest estimate %.4f m/s (limit %.3f)\n",
-		      0.7 * limit, vmax, limit);
+	/* diagonally across the top: every joint moves */
+	vmax = slide(&r, &x, &y, u, u, 0.7 * limit, 500, false, &err);
+	print_message("  sliding at %.3f m/s: largest estimate %.4f m/s, vector error <= %.4f m/s (limit %.3f)\n",
+		      0.7 * limit, vmax, err, limit);
 	assert_int_equal(r.out.state, IRDM_SAFETY_ENABLED);
 	assert_true(r.out.dev[0].contact);
 	assert_true(fabs(vmax - 0.7 * limit) < 0.1 * limit);
-	ticks = slide(&r, &x, 1.5 * limit, 50, true);
+	assert_true(err < 0.04 * limit);
+	ticks = slide(&r, &x, &y, u, u, 1.5 * limit, 50, true, NULL);
 	print_message("  at %.3f m/s the velocity fault came after %.0f ticks\n", 1.5 * limit, ticks);
 	assert_true(ticks <= 10);
 	assert_faulted(&r, IRDM_FAULT_VELOCITY);

@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * The controller's safety state machine (docs/architecture.md, "The
- * controller"): pure bookkeeping on one small struct, no clock, no I/O.
+ * The controller's safety state machine (irdm/controller.h runs it every
+ * tick): pure bookkeeping on one small struct, no clock, no I/O.
  *
  *   INIT --calibrated--> READY --enable--> ENABLED --disable--> READY
  *   INIT, READY, ENABLED --any fault--> FAULT --reset (cause gone)--> READY
