@@ -35,6 +35,7 @@
 #include "irdm/sim_device.h"
 #include "irdm/vec3.h"
 #include "support/alloc_count.h"
+#include "support/engine_fixture.h"
 
 #define GAP_M 0.002             /* home tip above the top face */
 #define PERIOD_US 1000
@@ -50,6 +51,7 @@ struct rig {
 	struct irdm_ctrl_output out;
 	double top_z, cx, cy;           /* object: top face height, centre of the top */
 	int rc;
+	const char *path;               /* the image; NULL: IRDM_TICK_IMAGE */
 };
 
 static const char *image_path(void)
@@ -182,7 +184,7 @@ static void rig_open(struct rig *r)
 	char err[512];
 
 	sc.engine = r->cfg.engine;
-	if (irdm_session_open(&r->s, image_path(), &sc, err, sizeof(err)))
+	if (irdm_session_open(&r->s, r->path ? r->path : image_path(), &sc, err, sizeof(err)))
 		fail_msg("session: %s", err);
 	box_of(r->s->img, r);
 	r->cfg.obj_offset_m[0] = r->cx;
@@ -1190,7 +1192,27 @@ static __attribute__((noreturn)) void strict_child(struct rig *r, int fd, bool s
 		;
 }
 
-static int run_strict(bool slip, struct rt_result *res)
+/* An image and an engine configuration the strict-mode run covers. */
+struct rt_variant {
+	const char *name;
+	const char *path;               /* NULL: IRDM_TICK_IMAGE */
+	enum irdm_solve_mode solve;
+	bool rigid;                     /* coupling_k = 0 */
+	bool floating;                  /* the object drifts off: fewer touches */
+};
+
+static char rt_dir[64];
+static char fir_path[128], float_path[128];
+
+static struct rt_variant variants[] = {
+	{ "modal, haptic coupling, coupled solve", NULL, IRDM_SOLVE_COUPLED, false, false },
+	{ "modal, haptic coupling, per-vertex solve", NULL, IRDM_SOLVE_PER_VERTEX, false, false },
+	{ "modal, rigid coupling", NULL, IRDM_SOLVE_COUPLED, true, false },
+	{ "FIR T = 100", fir_path, IRDM_SOLVE_COUPLED, false, false },
+	{ "floating cube, modal", float_path, IRDM_SOLVE_COUPLED, false, true },
+};
+
+static int run_strict(bool slip, struct rt_result *res, const struct rt_variant *v)
 {
 	struct rig r;
 	int fd[2], status;
@@ -1198,6 +1220,10 @@ static int run_strict(bool slip, struct rt_result *res)
 	pid_t pid;
 
 	rig_config(&r, 1);
+	r.path = v->path;
+	r.cfg.engine.solve = v->solve;
+	if (v->rigid)
+		irdm_engine_config_default(&r.cfg.engine);
 	rig_open(&r);
 	rig_enable(&r);
 	assert_int_equal(pipe(fd), 0);
@@ -1232,35 +1258,36 @@ static int run_strict(bool slip, struct rt_result *res)
 
 static void test_tick_makes_no_system_call_and_no_allocation(void **state)
 {
-	struct rt_result res;
-	int status;
 	(void)state;
 
-	status = run_strict(false, &res);
-	if (WIFSIGNALED(status))
-		fail_msg("strict-mode child died of signal %d (SIGKILL: a system call in the tick)",
-			 WTERMSIG(status));
-	assert_true(WIFEXITED(status));
-	assert_int_equal(WEXITSTATUS(status), 0);
-	assert_int_equal(res.magic, RT_MAGIC);
-	print_message("  strict mode: %lu ticks, %lu touches, %lu slide ticks (%lu new sites), %lu releases, %lu holds, %lu faults, %lu resets, max |f| %.3g N\n",
-		      res.ticks, res.touches, res.slides, res.site_changes, res.releases, res.holds,
-		      res.faults, res.resets, res.max_f);
-	if (alloc_counting())
-		print_message("  allocator calls in those ticks: %lu\n", res.allocs);
-	else
-		print_message("  allocator not counted: AddressSanitizer owns it\n");
-	assert_int_equal(res.bad, 0);
-	assert_int_equal(res.allocs, 0);
-	assert_int_equal(res.nonzero_in_fault, 0);
-	/* every path ran: it cannot pass by doing nothing */
-	assert_true(res.touches >= RT_CYCLES + 1);
-	assert_true(res.releases >= RT_CYCLES);
-	assert_int_equal(res.holds, RT_CYCLES);
-	assert_int_equal(res.faults, 2 * RT_CYCLES + 1);
-	assert_int_equal(res.resets, 2 * RT_CYCLES);
-	assert_true(res.site_changes >= res.slides - res.slides / 20);
-	assert_true(res.max_f > 0);
+	for (size_t i = 0; i < sizeof(variants) / sizeof(variants[0]); i++) {
+		const struct rt_variant *v = &variants[i];
+		struct rt_result res;
+		int status = run_strict(false, &res, v);
+
+		if (WIFSIGNALED(status))
+			fail_msg("%s: strict-mode child died of signal %d (SIGKILL: a system call in the tick)",
+				 v->name, WTERMSIG(status));
+		assert_true(WIFEXITED(status));
+		assert_int_equal(WEXITSTATUS(status), 0);
+		assert_int_equal(res.magic, RT_MAGIC);
+		print_message("  %s: %lu ticks, %lu touches, %lu slide ticks (%lu new sites), %lu releases, %lu holds, %lu faults, %lu resets, max |f| %.3g N, %lu allocator calls%s\n",
+			      v->name, res.ticks, res.touches, res.slides, res.site_changes,
+			      res.releases, res.holds, res.faults, res.resets, res.max_f, res.allocs,
+			      alloc_counting() ? "" : " (not counted: ASan owns the allocator)");
+		assert_int_equal(res.bad, 0);
+		assert_int_equal(res.allocs, 0);
+		assert_int_equal(res.nonzero_in_fault, 0);
+		/* every path ran: it cannot pass by doing nothing */
+		assert_true(res.touches >= (v->floating ? 1 : RT_CYCLES + 1));
+		assert_true(res.releases >= (v->floating ? 1 : RT_CYCLES));
+		assert_int_equal(res.holds, RT_CYCLES);
+		assert_int_equal(res.faults, 2 * RT_CYCLES + 1);
+		assert_int_equal(res.resets, 2 * RT_CYCLES);
+		assert_true(res.slides > 100);
+		assert_true(res.site_changes >= res.slides - res.slides / 20);
+		assert_true(res.max_f > 0);
+	}
 }
 
 static void test_a_system_call_is_caught(void **state)
@@ -1269,9 +1296,39 @@ static void test_a_system_call_is_caught(void **state)
 	int status;
 	(void)state;
 
-	status = run_strict(true, &res);
+	status = run_strict(true, &res, &variants[0]);
 	assert_true(WIFSIGNALED(status));
 	assert_int_equal(WTERMSIG(status), SIGKILL);
+}
+
+/* The FIR and floating images of the strict-mode run. */
+static int make_images(void **state)
+{
+	struct irdm_image img;
+	(void)state;
+
+	strcpy(rt_dir, "/tmp/irdm-ctrl-XXXXXX");
+	if (!mkdtemp(rt_dir))
+		return -1;
+	snprintf(fir_path, sizeof(fir_path), "%s/fir.img", rt_dir);
+	snprintf(float_path, sizeof(float_path), "%s/float.img", rt_dir);
+	efx_image(&img, fir_path, "mesh", "box:0.04,0.04,0.08", "resolution", "2,2,4",
+		  "fixed", "z<=0", "touch", "z>=0.08", "display", "surface",
+		  "representation", "fir:100", NULL);
+	irdm_image_unmap(&img);
+	efx_image(&img, float_path, "mesh", "cube", "resolution", "3,3,3", "floating", "yes",
+		  "representation", "modal:all", "touch", "surface", "display", "surface", NULL);
+	irdm_image_unmap(&img);
+	return 0;
+}
+
+static int remove_images(void **state)
+{
+	(void)state;
+	unlink(fir_path);
+	unlink(float_path);
+	rmdir(rt_dir);
+	return 0;
 }
 
 int main(void)
@@ -1296,5 +1353,5 @@ int main(void)
 		cmocka_unit_test(test_a_system_call_is_caught),
 	};
 
-	return cmocka_run_group_tests(tests, NULL, NULL);
+	return cmocka_run_group_tests(tests, make_images, remove_images);
 }
