@@ -1,0 +1,85 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * Step 6 of the tick: one proxy per device on the DEFORMED surface (the
+ * engine's free response, irdm_engine_node_disp(): the surface a contact
+ * meets this tick), its site handed to the engine every tick (sliding keeps
+ * the contact's past; the R[0] table is refreshed only when the site's
+ * nodes change), the target p_obj - the site's rest point, and one engine
+ * tick.  A device leaving the surface ends its push.  Device i drives
+ * engine slot i.
+ */
+#include <string.h>
+
+#include "controller_priv.h"
+#include "irdm/vec3.h"
+
+static void node_disp(const void *ctx, uint32_t row, double u_m[3])
+{
+	irdm_engine_node_disp(ctx, row, u_m);
+}
+
+static void proxy_out(const struct irdm_proxy *px, struct irdm_ctrl_device_output *o)
+{
+	o->tri = px->tri;
+	memcpy(o->bary, px->bary, sizeof(o->bary));
+	memcpy(o->proxy_m, px->point_m, sizeof(o->proxy_m));
+	memcpy(o->normal, px->normal, sizeof(o->normal));
+	o->depth_m = px->depth_m;
+}
+
+/* Device i's proxy and engine command.  Return: IRDM_OK; IRDM_EFAULT. */
+static int touch(struct irdm_ctrl *c, unsigned i, struct irdm_ctrl_device_output *o)
+{
+	const struct irdm_contact_disp disp = { .fn = node_disp, .ctx = c->s->eng };
+	struct irdm_ctrl_dev *d = &c->dev[i];
+	struct irdm_contact_site site;
+	int ev;
+
+	ev = irdm_proxy_update(&d->px, &c->cm, &disp, &c->cfg.proxy, o->tip_obj_m);
+	if (ev < 0)
+		return IRDM_EFAULT;
+	o->proxy_event = ev;
+	if (ev != IRDM_PROXY_TOUCH && ev != IRDM_PROXY_SLIDE)
+		return IRDM_OK;         /* FREE, or RELEASE: the command stays OFF */
+	proxy_out(&d->px, o);
+	if (irdm_proxy_site(&d->px, &c->cm, &site) ||
+	    irdm_engine_contact_begin(c->s->eng, i, &site, IRDM_CONTACT_PUSH))
+		return IRDM_EFAULT;
+	d->cmd.mode = IRDM_CONTACT_PUSH;
+	irdm_v3_sub(d->cmd.target_m, o->tip_obj_m, site.rest_m);
+	memcpy(o->target_m, d->cmd.target_m, sizeof(o->target_m));
+	return IRDM_OK;
+}
+
+void ctrl_contacts_end(struct irdm_ctrl *c)
+{
+	for (unsigned i = 0; i < c->cfg.n_devices; i++) {
+		irdm_proxy_reset(&c->dev[i].px);
+		irdm_engine_contact_end(c->s->eng, i);
+		memset(&c->dev[i].cmd, 0, sizeof(c->dev[i].cmd));
+	}
+}
+
+int ctrl_contacts(struct irdm_ctrl *c, struct irdm_ctrl_output *out, bool on)
+{
+	struct irdm_contact_cmd cmd[IRDM_MAX_CONTACTS];
+
+	memset(cmd, 0, sizeof(cmd));
+	for (unsigned i = 0; i < c->cfg.n_devices; i++) {
+		struct irdm_ctrl_device_output *o = &out->dev[i];
+
+		memset(&c->dev[i].cmd, 0, sizeof(c->dev[i].cmd));
+		if (on && c->dev[i].pose_ok && touch(c, i, o))
+			return IRDM_EFAULT;
+		cmd[i] = c->dev[i].cmd;
+	}
+	if (irdm_engine_tick(c->s->eng, cmd))
+		return IRDM_EFAULT;
+	for (unsigned i = 0; i < c->cfg.n_devices; i++) {
+		const struct irdm_contact_state *st = irdm_engine_contact(c->s->eng, i);
+
+		out->dev[i].contact = st->mode != IRDM_CONTACT_OFF;
+		memcpy(out->dev[i].force_obj_n, st->force_n, sizeof(st->force_n));
+	}
+	return IRDM_OK;
+}
