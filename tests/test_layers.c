@@ -42,6 +42,7 @@ static const char *const tick_globs[] = {
 	"firmware/deform/deform_channel.o",
 	"firmware/device/*.o",
 	"firmware/board/board_frame.o",
+	"firmware/runtime/*.o",
 };
 
 static const char *const forbidden[] = { "cblas_", "openblas_", "pthread_", "sem_", NULL };
