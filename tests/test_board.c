@@ -34,7 +34,7 @@
 #include "irdm/error.h"
 #include "irdm/hal.h"
 #include "irdm/hal_sim.h"
-#include "opt/opt_doc.h"
+#include "irdm/options_doc.h"
 
 #define SHIPPED "boards/sim-phantom.board"
 #define DOC "docs/boards.md"

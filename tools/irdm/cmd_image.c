@@ -11,7 +11,7 @@
 #include "irdm/error.h"
 #include "irdm/image.h"
 #include "irdm/options.h"
-#include "opt/opt_doc.h"
+#include "irdm/options_doc.h"
 
 static const char usage[] =
 	"usage: irdm image info IMAGE\n"

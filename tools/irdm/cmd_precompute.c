@@ -8,7 +8,7 @@
 #include "cli.h"
 #include "irdm/error.h"
 #include "irdm/options.h"
-#include "opt/opt_doc.h"
+#include "irdm/options_doc.h"
 #include "precompute/precompute.h"
 
 static const char usage[] =

@@ -2,10 +2,11 @@
 /*
  * Help and documentation from an option table (irdm/options.h): the
  * --help lines and the Markdown reference are printed from the same
- * entries that parse the values, so they cannot disagree.
+ * entries that parse the values, so they cannot disagree.  Init time only
+ * (stdio): the tools, irdm-fw and the board documentation use it.
  */
-#ifndef IRDM_TOOLS_OPT_DOC_H
-#define IRDM_TOOLS_OPT_DOC_H
+#ifndef IRDM_OPTIONS_DOC_H
+#define IRDM_OPTIONS_DOC_H
 
 #include <stdio.h>
 

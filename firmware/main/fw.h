@@ -1,0 +1,96 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * irdm-fw: the controller program.  main() (irdm_fw.c) is the composition
+ * root: it reads the arguments (fw_args.c) and the board, opens the session
+ * on the image, registers and opens the HAL back-ends, sets up real time
+ * (irdm/rt.h), maps the board onto the controller's configuration
+ * (fw_config.c), runs the loop (fw_loop.c) and prints the summary
+ * (fw_summary.c).  Private to firmware/main.
+ */
+#ifndef IRDM_FW_H
+#define IRDM_FW_H
+
+#include <signal.h>
+#include <stdbool.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#include "irdm/board.h"
+#include "irdm/clock.h"
+#include "irdm/controller.h"
+#include "irdm/hal.h"
+#include "irdm/session.h"
+#include "irdm/sim_user.h"
+
+/* Exit codes (irdm-fw --help lists them). */
+enum fw_exit {
+	FW_EXIT_OK = 0,         /* ran to the end, no fault */
+	FW_EXIT_USAGE = 2,      /* bad arguments */
+	FW_EXIT_INPUT = 3,      /* board, image or user script refused */
+	FW_EXIT_SETUP = 4,      /* HAL, real time (--require-rt) or memory refused */
+	FW_EXIT_FAULT = 5,      /* the controller faulted: torque off, reason printed */
+};
+
+struct fw_args {
+	const char *board;
+	const char *image;
+	const char *user;
+	const char *log;
+	double duration_s;              /* 0: the user script's end + 1 s, else 5 s */
+	int clock;                      /* enum irdm_clock_mode */
+	bool require_rt;
+	bool quiet;
+	bool help;
+};
+
+/* Per-tick figures kept for the summary (allocated once, before the loop). */
+struct fw_trace {
+	uint64_t n, cap;
+	double *force_n;                /* |force on the object|, device 0 */
+	double *fz_n;                   /* its component along the contact normal */
+	double *node_u_m;               /* the watched node's displacement along its normal */
+	uint8_t *contact;               /* device 0 in contact */
+	double *latency_us, *compute_us;
+};
+
+struct fw {
+	struct fw_args args;
+	struct irdm_board board;
+	struct irdm_session *s;
+	struct irdm_ctrl ctrl;
+	struct irdm_ctrl_config ccfg;
+	struct irdm_hal_config hcfg[IRDM_BOARD_DEVICES_MAX];
+	struct irdm_device_config dev[IRDM_BOARD_DEVICES_MAX];
+	struct irdm_hal_dev hal[IRDM_BOARD_DEVICES_MAX];
+	void *hal_mem[IRDM_BOARD_DEVICES_MAX];
+	bool hal_open[IRDM_BOARD_DEVICES_MAX];
+	struct irdm_sim_user *user;     /* NULL without --user */
+	struct irdm_clock clock;
+	struct fw_trace trace;
+	uint32_t watch_row;             /* the image node whose ringing is measured */
+	bool watching;
+	double watch_normal[3];
+	uint64_t ticks;
+	uint32_t last_cause;
+	int last_state;
+	char err[512];
+};
+
+/* fw_args.c */
+int fw_args_parse(struct fw_args *a, int argc, char **argv, char *err, size_t errlen);
+void fw_args_usage(FILE *f);
+
+/* fw_config.c: the board's arm, limits, placement and coupling, for the
+ * controller; the session's engine configuration. */
+int fw_config_from_board(struct irdm_ctrl_config *c, const struct irdm_board *b);
+
+/* fw_loop.c: runs until the duration is over, a fault or a signal.
+ * Returns FW_EXIT_OK or FW_EXIT_FAULT. */
+int fw_loop_run(struct fw *fw, volatile sig_atomic_t *signalled);
+
+/* fw_summary.c */
+int fw_trace_alloc(struct fw_trace *t, uint64_t ticks);
+void fw_trace_free(struct fw_trace *t);
+void fw_summary_print(const struct fw *fw);
+
+#endif /* IRDM_FW_H */
