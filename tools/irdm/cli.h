@@ -14,5 +14,6 @@ void irdm_cli_progress(void *ctx, const char *stage, double fraction);
 int irdm_cmd_precompute(int argc, char **argv);
 int irdm_cmd_image(int argc, char **argv);
 int irdm_cmd_replay(int argc, char **argv);
+int irdm_cmd_log(int argc, char **argv);
 
 #endif
