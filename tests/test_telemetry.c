@@ -871,6 +871,25 @@ static void test_cli_export_refuses_bad_logs(void **state)
 	assert_int_equal(rc, 1);
 	assert_non_null(strstr(err_text, "version 9"));
 	assert_false(exists(csv) || exists(in_dir("out.csv.tmp")));
+	/* a record found bad half way: no CSV, and one that was there stays as it was */
+	const uint8_t seven = 7;
+	char old[64] = "";
+	FILE *f = fopen(csv, "w");
+	assert_non_null(f);
+	fputs("earlier export\n", f);
+	fclose(f);
+	copy_patched(good, cut, -1, IRDM_LOG_HEADER_SIZE + 5 * IRDM_TICK_RECORD_SIZE +
+		     offsetof(struct irdm_tick_record, n_devices), &seven, 1);
+	rc = irdm_run((const char *[]){ "log", "export", cut, "-o", csv, NULL }, err_text,
+		      sizeof(err_text));
+	assert_int_equal(rc, 1);
+	assert_non_null(strstr(err_text, "record 5: n_devices 7"));
+	assert_false(exists(in_dir("out.csv.tmp")));
+	f = fopen(csv, "r");
+	assert_non_null(f);
+	assert_non_null(fgets(old, sizeof(old), f));
+	fclose(f);
+	assert_string_equal(old, "earlier export\n");
 	/* usage errors and --help */
 	assert_int_equal(irdm_run((const char *[]){ "log", "export", good, NULL }, err_text,
 				  sizeof(err_text)), 2);
