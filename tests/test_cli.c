@@ -10,12 +10,12 @@
 #include <fcntl.h>
 #include <math.h>
 #include <setjmp.h>
-#include <spawn.h>
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -49,12 +49,29 @@ static void slurp(const char *path, char *buf, size_t len)
 		fclose(f);
 }
 
+/* Address-space cap (bytes) for the children run() starts; 0: none. */
+static rlim_t child_as_limit;
+
+/* In the child: stdout/stderr to files, the address-space cap, exec. */
+static void exec_child(const char **argv, const char *out_path, const char *err_path)
+{
+	int fo = open(out_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+	int fe = open(err_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+	struct rlimit rl = { child_as_limit, child_as_limit };
+
+	if (fo < 0 || fe < 0 || dup2(fo, 1) < 0 || dup2(fe, 2) < 0)
+		_exit(126);
+	if (child_as_limit && setrlimit(RLIMIT_AS, &rl))
+		_exit(126);
+	execve(argv[0], (char *const *)argv, environ);
+	_exit(127);
+}
+
 /* Run irdm with a NULL-terminated argument list; capture stdout/stderr. */
 static int run(const char *first, ...)
 {
 	const char *argv[64];
 	char out_path[300], err_path[300];
-	posix_spawn_file_actions_t fa;
 	va_list ap;
 	int n = 0, status = 0;
 	pid_t pid;
@@ -67,11 +84,10 @@ static int run(const char *first, ...)
 	argv[n] = NULL;
 	snprintf(out_path, sizeof(out_path), "%s/stdout", dir);
 	snprintf(err_path, sizeof(err_path), "%s/stderr", dir);
-	posix_spawn_file_actions_init(&fa);
-	posix_spawn_file_actions_addopen(&fa, 1, out_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-	posix_spawn_file_actions_addopen(&fa, 2, err_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-	assert_int_equal(posix_spawn(&pid, argv[0], &fa, NULL, (char *const *)argv, environ), 0);
-	posix_spawn_file_actions_destroy(&fa);
+	pid = fork();
+	assert_true(pid >= 0);
+	if (pid == 0)
+		exec_child(argv, out_path, err_path);
 	assert_int_equal(waitpid(pid, &status, 0), pid);
 	slurp(out_path, out_text, sizeof(out_text));
 	slurp(err_path, err_text, sizeof(err_text));
@@ -210,6 +226,69 @@ static void test_bad_meshes(void **state)
 }
 
 /* A failing run over an existing image leaves it byte for byte. */
+/*
+ * A real read failure: a directory named like a mesh opens with fopen() and
+ * then fails in fread() with EISDIR.  It must surface as EIO, by name.
+ */
+static void test_read_failure_is_eio(void **state)
+{
+	const char *img = path_in_dir("eio.img");
+	const char *mesh = path_in_dir("dir.node");
+
+	(void)state;
+	assert_int_equal(mkdir(mesh, 0755), 0);
+	expect_failure(run("precompute", "--mesh", mesh, "--floating", "yes", "-o", img, NULL),
+		       "EIO");
+	assert_non_null(strstr(err_text, "dir.node"));
+	assert_false(exists(img));
+	rmdir(mesh);
+}
+
+#if defined(__SANITIZE_ADDRESS__)
+#define BUILT_WITH_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define BUILT_WITH_ASAN 1
+#endif
+#endif
+
+/*
+ * A real allocation failure: the built-in cuboid with the dense eigensolver
+ * asks for two 9504 x 9504 matrices (1.3 GiB) right after the FEM assembly;
+ * under a 300 MB address-space cap that malloc() returns NULL (OpenBLAS's
+ * own start-up and the assembly fit well below it).  It must surface as
+ * ENOMEM, by name, with no image left behind.  AddressSanitizer reserves
+ * terabytes of shadow memory, so RLIMIT_AS cannot work under it; there the
+ * same cap comes from ASan's allocator instead (max_allocation_size_mb with
+ * allocator_may_return_null: malloc() returns NULL, as libc would).  The
+ * test assumes irdm is built like this test (make test / make san do).
+ */
+static void test_alloc_failure_is_enomem(void **state)
+{
+	const char *img = path_in_dir("enomem.img");
+	const char *old = getenv("ASAN_OPTIONS");
+	char *saved = old ? strdup(old) : NULL;
+	int rc;
+
+	(void)state;
+#ifdef BUILT_WITH_ASAN
+	print_message("ASan build: allocation cap by ASAN_OPTIONS, not RLIMIT_AS\n");
+	setenv("ASAN_OPTIONS", "allocator_may_return_null=1:max_allocation_size_mb=300", 1);
+#else
+	child_as_limit = (rlim_t)300 << 20;
+#endif
+	rc = run("precompute", "-q", "--mesh", "cuboid", "--eigensolver", "dense", "-o", img, NULL);
+	child_as_limit = 0;
+	if (saved)
+		setenv("ASAN_OPTIONS", saved, 1);
+	else
+		unsetenv("ASAN_OPTIONS");
+	free(saved);
+	expect_failure(rc, "ENOMEM");
+	assert_non_null(strstr(err_text, "out of memory"));
+	assert_false(exists(img));
+}
+
 static void test_failure_keeps_existing_image(void **state)
 {
 	const char *img = path_in_dir("keep.img");
@@ -488,6 +567,8 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_bad_scene_values),
 		cmocka_unit_test(test_bad_meshes),
+		cmocka_unit_test(test_read_failure_is_eio),
+		cmocka_unit_test(test_alloc_failure_is_enomem),
 		cmocka_unit_test(test_failure_keeps_existing_image),
 		cmocka_unit_test(test_bad_images),
 		cmocka_unit_test(test_export_matches_library),

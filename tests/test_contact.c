@@ -1036,7 +1036,7 @@ static void test_fixture_images(void **state)
 	/* the builder refuses bad indices */
 	fx.tris[0] = 99;
 	assert_int_equal(irdm_bvh_build(fx.nodes, fx.meta.n_nodes, fx.columns, fx.meta.n_cols,
-					fx.tris, fx.meta.n_tris, &bvh, &bvh_size, err, sizeof(err)), -1);
+					fx.tris, fx.meta.n_tris, &bvh, &bvh_size, err, sizeof(err)), IRDM_EINVAL);
 	assert_non_null(strstr(err, "triangle 0"));
 	img_fixture_free(&fx);
 }

@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * The force tick is hard real time (SPEC section 7), proven rather than
- * claimed.  Issue must-show: "Allocation-free and fault-free, proven".
+ * The force tick is hard real time (docs/architecture.md, "Memory and
+ * threading"), proven rather than claimed.  Issue must-show: "Allocation-free and fault-free, proven".
  *
  *  - No allocation: this executable interposes the allocator (malloc,
  *    calloc, realloc, reallocarray, free, aligned_alloc, posix_memalign,
@@ -10,7 +10,7 @@
  *    realistic haptic scenario after init must count none.
  *  - No page fault: getrusage(RUSAGE_THREAD) minor and major fault counts
  *    do not move across those ticks (after a warm-up, with the memory
- *    locked and the stack pre-faulted as SPEC section 7 asks).
+ *    locked and the stack pre-faulted as docs/architecture.md asks).
  *  - No system call: the same ticks run in a forked child that has put
  *    itself in seccomp strict mode, where any system call but read, write,
  *    _exit and sigreturn kills it with SIGKILL.

@@ -405,19 +405,19 @@ static void test_writer_add_rejects(void **state)
 	(void)state;
 	irdm_iw_init(&w);
 	assert_int_equal(irdm_iw_add(&w, 1, IRDM_ELEM_BYTES, x, 4), 0);
-	assert_int_equal(irdm_iw_add(&w, 1, IRDM_ELEM_BYTES, x, 4), -1);
-	assert_int_equal(irdm_iw_add(&w, 2, IRDM_ELEM_BYTES, NULL, 4), -1);
-	assert_int_equal(irdm_iw_add(&w, 2, 9, x, 4), -1);
+	assert_int_equal(irdm_iw_add(&w, 1, IRDM_ELEM_BYTES, x, 4), IRDM_EINVAL);
+	assert_int_equal(irdm_iw_add(&w, 2, IRDM_ELEM_BYTES, NULL, 4), IRDM_EINVAL);
+	assert_int_equal(irdm_iw_add(&w, 2, 9, x, 4), IRDM_EINVAL);
 	for (uint32_t k = 2; k <= IRDM_IMAGE_MAX_SECTIONS; k++)
 		assert_int_equal(irdm_iw_add(&w, k, IRDM_ELEM_BYTES, x, 4), 0);
-	assert_int_equal(irdm_iw_add(&w, 99, IRDM_ELEM_BYTES, x, 4), -1);
+	assert_int_equal(irdm_iw_add(&w, 99, IRDM_ELEM_BYTES, x, 4), IRDM_EINVAL);
 	assert_int_equal(w.n, IRDM_IMAGE_MAX_SECTIONS);
 
 	irdm_iw_init(&w);
-	assert_int_equal(irdm_iw_to_buffer(&w, &buf, &size), -1);
+	assert_int_equal(irdm_iw_to_buffer(&w, &buf, &size), IRDM_EINVAL);
 	assert_null(buf);
 	path_in(path, sizeof(path), "empty.img");
-	assert_int_equal(irdm_iw_write(&w, path, err, sizeof(err)), -1);
+	assert_int_equal(irdm_iw_write(&w, path, err, sizeof(err)), IRDM_EINVAL);
 	assert_non_null(strstr(err, path));
 	assert_int_equal(access(path, F_OK), -1);
 	assert_int_equal(count_tmp_files(tmpdir), 0);
@@ -1362,7 +1362,7 @@ static void test_write_missing_dir(void **state)
 	small_fir(&fx);
 	path_in(dir, sizeof(dir), "no-such-dir");
 	snprintf(path, sizeof(path), "%s/x.img", dir);
-	assert_int_equal(img_fixture_write(&fx, path, err, sizeof(err)), -1);
+	assert_int_equal(img_fixture_write(&fx, path, err, sizeof(err)), IRDM_EIO);
 	assert_non_null(strstr(err, path));
 	assert_non_null(strstr(err, strerror(ENOENT)));
 	assert_null(strchr(err, '\n'));
@@ -1414,7 +1414,7 @@ static void test_write_over_directory_fails(void **state)
 	assert_int_equal(mkdir(path, 0755), 0);
 	snprintf(inner, sizeof(inner), "%s/keep", path);
 	write_file(inner, "old content", 11);
-	assert_int_equal(img_fixture_write(&fx, path, err, sizeof(err)), -1);
+	assert_int_equal(img_fixture_write(&fx, path, err, sizeof(err)), IRDM_EIO);
 	assert_non_null(strstr(err, path));
 	assert_non_null(strstr(err, strerror(EISDIR)));
 	assert_int_equal(stat(path, &st), 0);
@@ -1455,7 +1455,7 @@ static void test_write_failure_keeps_old_image(void **state)
 	assert_int_equal(setrlimit(RLIMIT_FSIZE, &old), 0);
 	signal(SIGXFSZ, old_handler);
 
-	assert_int_equal(ret, -1);
+	assert_int_equal(ret, IRDM_EIO);
 	assert_non_null(strstr(err, path));
 	assert_non_null(strstr(err, strerror(EFBIG)));
 	after = read_file(path, &alen);

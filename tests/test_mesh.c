@@ -116,8 +116,8 @@ static void assert_empty(const struct irdm_mesh *m)
 static void assert_err(int ret, const struct irdm_mesh *m, const char *err,
 		       const char *what, const char *needle)
 {
-	if (ret != -1)
-		fail_msg("expected failure with \"%s\"", needle);
+	if (ret >= 0 || ret < IRDM_ERR_MIN)
+		fail_msg("expected failure with \"%s\" (an IRDM_E* code, got %d)", needle, ret);
 	assert_empty(m);
 	if (strncmp(err, what, strlen(what)))
 		fail_msg("message \"%s\" does not start with \"%s\"", err, what);
@@ -495,9 +495,9 @@ static void test_tetgen_error_buffer_small(void **state)
 
 	(void)state;
 	memset(err, 'x', sizeof(err));
-	assert_int_equal(parse_tetgen_str("", 0, "", 0, &m, err, sizeof(err)), -1);
+	assert_int_equal(parse_tetgen_str("", 0, "", 0, &m, err, sizeof(err)), IRDM_EFORMAT);
 	assert_string_equal(err, "t.ele: ");
-	assert_int_equal(parse_tetgen_str("", 0, "", 0, &m, NULL, 0), -1);
+	assert_int_equal(parse_tetgen_str("", 0, "", 0, &m, NULL, 0), IRDM_EFORMAT);
 }
 
 /* Every prefix of a valid pair parses or fails cleanly, never overreads. */
@@ -518,7 +518,7 @@ static void test_tetgen_truncations(void **state)
 					   sizeof(err));
 
 		/* only the complete file (or all but its last newline) is valid */
-		assert_int_equal(ret, k >= el - 1 ? 0 : -1);
+		assert_int_equal(ret, k >= el - 1 ? IRDM_OK : IRDM_EFORMAT);
 		irdm_mesh_free(&m);
 	}
 }
@@ -647,7 +647,7 @@ static void test_gmsh_truncations(void **state)
 	for (k = 0; k <= n; k++) {
 		int ret = parse_gmsh_str(gmsh22_tet, k, &m, err, sizeof(err));
 
-		assert_int_equal(ret, k >= n - 1 ? 0 : -1);
+		assert_int_equal(ret, k >= n - 1 ? IRDM_OK : IRDM_EFORMAT);
 		if (ret)
 			assert_int_equal(strncmp(err, "t.msh: ", 7), 0);
 		else
@@ -684,9 +684,13 @@ static void test_read_errors(void **state)
 	char err[256];
 
 	(void)state;
+	assert_int_equal(irdm_mesh_read(DATA "missing.node", 1.0, NULL, &m, err, sizeof(err)),
+			 IRDM_EIO);
 	assert_err(irdm_mesh_read(DATA "missing.node", 1.0, NULL, &m, err,
 				  sizeof(err)), &m, err, DATA "missing.node",
 		   "cannot open");
+	assert_int_equal(irdm_mesh_read(DATA "cube5.vtk", 1.0, NULL, &m, err, sizeof(err)),
+			 IRDM_EFORMAT);
 	assert_err(irdm_mesh_read(DATA "cube5.vtk", 1.0, NULL, &m, err,
 				  sizeof(err)), &m, err, DATA "cube5.vtk",
 		   "unknown mesh format");

@@ -74,8 +74,8 @@ static char *load(const char *path, size_t *len)
 static void assert_err(int ret, const char *err, const char *what,
 		       const char *needle)
 {
-	if (ret != -1)
-		fail_msg("expected failure with \"%s\"", needle);
+	if (ret >= 0 || ret < IRDM_ERR_MIN)
+		fail_msg("expected failure with \"%s\" (an IRDM_E* code, got %d)", needle, ret);
 	if (strncmp(err, what, strlen(what)))
 		fail_msg("message \"%s\" does not start with \"%s\"", err, what);
 	assert_null(strchr(err, '\n'));

@@ -257,7 +257,7 @@ static void test_static_correction_restores_compliance(void **state)
 /*
  * The FIR force recursion: the argument-principle certificate matches the
  * companion-matrix eigenvalues; truncated FIRs are unstable and the exact
- * modal recursion is not (SPEC section 5).
+ * modal recursion is not (docs/architecture.md, "Numerical hazards").
  */
 static void test_stability_certificate(void **state)
 {

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "image/elem_store.h"
 #include "image_fixture.h"
 
 #define TWO_PI 6.283185307179586
@@ -17,26 +18,6 @@ double img_fixture_value(uint32_t kind, uint64_t i)
 	uint64_t k = ((i * 31 + kind * 7919u) * 2654435761u) % 1001;
 
 	return ((double)k - 500.0) / 1024.0;
-}
-
-static void store(void *data, uint32_t precision, uint64_t i, double v)
-{
-	uint16_t h;
-	float f;
-
-	switch (precision) {
-	case IRDM_ELEM_F16:
-		h = irdm_f32_to_f16((float)v);
-		memcpy((uint8_t *)data + i * 2, &h, sizeof(h));
-		break;
-	case IRDM_ELEM_F32:
-		f = (float)v;
-		memcpy((uint8_t *)data + i * 4, &f, sizeof(f));
-		break;
-	default:
-		memcpy((uint8_t *)data + i * 8, &v, sizeof(v));
-		break;
-	}
 }
 
 /* An array of n values of the given precision for section kind. */
@@ -51,7 +32,7 @@ static void *fill_values(uint32_t kind, uint32_t precision, uint64_t n,
 	if (!data)
 		return NULL;
 	for (uint64_t i = 0; i < n; i++)
-		store(data, precision, i, img_fixture_value(kind, i));
+		irdm_elem_put(data, precision, i, img_fixture_value(kind, i));
 	return data;
 }
 

@@ -15,18 +15,18 @@ int irdm_material_check(const struct irdm_material *mat, char *err, size_t errle
 	if (!isfinite(mat->young_pa) || mat->young_pa <= 0.0) {
 		snprintf(err, errlen, "material: Young's modulus E must be > 0 Pa (got %g)",
 			 mat->young_pa);
-		return -1;
+		return IRDM_EINVAL;
 	}
 	if (!isfinite(mat->poisson) || mat->poisson <= -1.0 || mat->poisson >= 0.5) {
 		snprintf(err, errlen,
 			 "material: Poisson's ratio must be in (-1, 0.5) (got %g); 0.5 is incompressible and has no displacement-only FEM",
 			 mat->poisson);
-		return -1;
+		return IRDM_EINVAL;
 	}
 	if (!isfinite(mat->density_kg_m3) || mat->density_kg_m3 <= 0.0) {
 		snprintf(err, errlen, "material: density must be > 0 kg/m^3 (got %g)",
 			 mat->density_kg_m3);
-		return -1;
+		return IRDM_EINVAL;
 	}
 	return 0;
 }
@@ -41,7 +41,7 @@ int irdm_dofmap_init(struct irdm_dofmap *map, size_t n_nodes, const bool *fixed,
 	if (!map->free_of || !map->global_of) {
 		irdm_dofmap_free(map);
 		snprintf(err, errlen, "dof map: out of memory");
-		return -1;
+		return IRDM_ENOMEM;
 	}
 	for (size_t d = 0; d < map->n_dof; d++) {
 		if (fixed && fixed[d / 3]) {
@@ -54,7 +54,7 @@ int irdm_dofmap_init(struct irdm_dofmap *map, size_t n_nodes, const bool *fixed,
 	if (map->n_free == 0) {
 		irdm_dofmap_free(map);
 		snprintf(err, errlen, "constraints: every node is fixed; nothing can move");
-		return -1;
+		return IRDM_EINVAL;
 	}
 	return 0;
 }
@@ -200,13 +200,16 @@ int irdm_fem_assemble(const struct irdm_mesh *mesh, const struct irdm_material *
 	struct irdm_triplet *tk = NULL, *tm = NULL;
 	size_t nk = 0, nm = 0;
 	double d[6][6];
+	int ret;
 
 	memset(fem, 0, sizeof(*fem));
 	fem->mass_kind = mass;
-	if (irdm_material_check(mat, err, errlen))
-		return -1;
-	if (irdm_dofmap_init(&fem->map, mesh->n_nodes, fixed, err, errlen))
-		return -1;
+	ret = irdm_material_check(mat, err, errlen);
+	if (ret)
+		return ret;
+	ret = irdm_dofmap_init(&fem->map, mesh->n_nodes, fixed, err, errlen);
+	if (ret)
+		return ret;
 	elasticity(mat, d);
 	tk = malloc(mesh->n_tets * 144 * sizeof(*tk));
 	tm = malloc((mass == IRDM_MASS_CONSISTENT ? mesh->n_tets * 48 : 0) * sizeof(*tm)
@@ -228,14 +231,14 @@ int irdm_fem_assemble(const struct irdm_mesh *mesh, const struct irdm_material *
 		goto out_nomem;
 	free(tk);
 	free(tm);
-	return 0;
+	return IRDM_OK;
 
 out_nomem:
 	free(tk);
 	free(tm);
 	irdm_fem_free(fem);
 	snprintf(err, errlen, "FEM assembly: out of memory (%zu tets)", mesh->n_tets);
-	return -1;
+	return IRDM_ENOMEM;
 }
 
 void irdm_fem_free(struct irdm_fem *fem)
@@ -256,7 +259,7 @@ int irdm_rayleigh_from_ratios(double z1, double w1, double z2, double w2,
 		snprintf(err, errlen,
 			 "damping: need two distinct positive frequencies and ratios >= 0 (got %g@%g rad/s, %g@%g rad/s)",
 			 z1, w1, z2, w2);
-		return -1;
+		return IRDM_EINVAL;
 	}
 	r->b_s = 2.0 * (z2 * w2 - z1 * w1) / (w2 * w2 - w1 * w1);
 	r->a_per_s = 2.0 * z1 * w1 - r->b_s * w1 * w1;
@@ -264,7 +267,7 @@ int irdm_rayleigh_from_ratios(double z1, double w1, double z2, double w2,
 		snprintf(err, errlen,
 			 "damping: ratios %g@%g rad/s and %g@%g rad/s need a negative Rayleigh coefficient (a=%g, b=%g)",
 			 z1, w1, z2, w2, r->a_per_s, r->b_s);
-		return -1;
+		return IRDM_EINVAL;
 	}
 	return 0;
 }

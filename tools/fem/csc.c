@@ -65,7 +65,7 @@ int irdm_csc_from_triplets(size_t n, struct irdm_triplet *t, size_t nt,
 	a->val = malloc((nnz ? nnz : 1) * sizeof(*a->val));
 	if (!a->colptr || !a->rowind || !a->val) {
 		irdm_csc_free(a);
-		return -1;
+		return IRDM_ENOMEM;
 	}
 	size_t k = (size_t)-1;
 	for (size_t i = 0; i < nt; i++) {

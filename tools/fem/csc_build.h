@@ -4,6 +4,7 @@
 #define IRDM_TOOLS_CSC_BUILD_H
 
 #include "fem/fem.h"
+#include "irdm/error.h"
 
 struct irdm_triplet {
 	int64_t row;
@@ -11,7 +12,7 @@ struct irdm_triplet {
 	double val;
 };
 
-/* Consumes (sorts) t.  Returns 0 or -1 on allocation failure. */
+/* Consumes (sorts) t.  Return: IRDM_OK; IRDM_ENOMEM. */
 int irdm_csc_from_triplets(size_t n, struct irdm_triplet *t, size_t nt,
 			   struct irdm_csc *a);
 

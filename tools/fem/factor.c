@@ -67,12 +67,13 @@ int irdm_fem_factor(const struct irdm_fem *fem, double ck, double cm, const char
 		    cholmod_common *cc, cholmod_factor **L, char *err, size_t errlen)
 {
 	cholmod_sparse *s = build_s(fem, cm, ck, cc);
+	int ret;
 
 	*L = NULL;
 	if (!s) {
 		snprintf(err, errlen, "%s: out of memory building the matrix (%zu DoFs)",
 			 what, fem->K.n);
-		return -1;
+		return IRDM_ENOMEM;
 	}
 	/*
 	 * Every solve (each time step of each input, each Lanczos step) uses
@@ -86,6 +87,7 @@ int irdm_fem_factor(const struct irdm_fem *fem, double ck, double cm, const char
 	if (!*L) {
 		snprintf(err, errlen, "%s: CHOLMOD analysis failed (status %d)", what,
 			 cc->status);
+		ret = cc->status == CHOLMOD_OUT_OF_MEMORY ? IRDM_ENOMEM : IRDM_ENUMERIC;
 		goto out_free_s;
 	}
 	/* factorize returns true on a non-SPD matrix too; the status tells */
@@ -97,14 +99,15 @@ int irdm_fem_factor(const struct irdm_fem *fem, double ck, double cm, const char
 		else
 			snprintf(err, errlen, "%s: CHOLMOD factorisation failed (status %d)",
 				 what, cc->status);
+		ret = cc->status == CHOLMOD_OUT_OF_MEMORY ? IRDM_ENOMEM : IRDM_ENUMERIC;
 		goto out_free_l;
 	}
 	cholmod_l_free_sparse(&s, cc);
-	return 0;
+	return IRDM_OK;
 
 out_free_l:
 	cholmod_l_free_factor(L, cc);
 out_free_s:
 	cholmod_l_free_sparse(&s, cc);
-	return -1;
+	return ret;
 }

@@ -6,12 +6,14 @@
 #include <cholmod.h>
 
 #include "fem/fem.h"
+#include "irdm/error.h"
 
 /*
  * Factorise ck K + cm M (over the free DoFs) in the caller's CHOLMOD common;
  * only the upper triangle is handed over (stype = 1).  `what` names the
- * caller in messages.  Returns 0, or -1 with a one-line message (out of
- * memory, or not positive definite: a mechanism or a bad shift).
+ * caller in messages.  A one-line reason goes to err.
+ * Return: IRDM_OK; IRDM_ENOMEM; IRDM_ENUMERIC if the matrix is not positive
+ * definite (a mechanism or a bad shift) or CHOLMOD fails otherwise.
  */
 int irdm_fem_factor(const struct irdm_fem *fem, double ck, double cm, const char *what,
 		    cholmod_common *cc, cholmod_factor **L, char *err, size_t errlen);

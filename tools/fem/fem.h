@@ -14,6 +14,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "irdm/error.h"
 #include "mesh/mesh.h"
 
 struct irdm_material {

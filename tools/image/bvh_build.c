@@ -196,20 +196,20 @@ int irdm_bvh_build(const struct irdm_node *nodes, uint32_t n_nodes,
 	uint32_t n_contact = 0;
 	uint8_t *out = NULL;
 	size_t bytes;
-	int ret = -1;
+	int ret = IRDM_EINVAL;
 
 	*payload = NULL;
 	*size = 0;
 	for (uint32_t c = 0; c < n_cols; c++)
 		if (columns[c] >= n_nodes) {
 			snprintf(err, errlen, "bvh: column %u names row %u of %u", c, columns[c], n_nodes);
-			return -1;
+			return IRDM_EINVAL;
 		}
 	for (size_t i = 0; i < 3 * (size_t)n_tris; i++)
 		if (tris[i] >= n_nodes) {
 			snprintf(err, errlen, "bvh: triangle %zu names row %u of %u", i / 3, tris[i],
 				 n_nodes);
-			return -1;
+			return IRDM_EINVAL;
 		}
 	col_of_row = malloc(((size_t)n_nodes + 1) * sizeof(uint32_t));
 	adj = malloc((3 * (size_t)n_tris + 1) * sizeof(uint32_t));
@@ -267,10 +267,11 @@ int irdm_bvh_build(const struct irdm_node *nodes, uint32_t n_nodes,
 	memcpy(out + h.col_of_row_offset, col_of_row, (size_t)n_nodes * 4);
 	*payload = out;
 	*size = bytes;
-	ret = 0;
+	ret = IRDM_OK;
 	goto out_free;
 out_nomem:
 	snprintf(err, errlen, "bvh: out of memory for %u triangles", n_tris);
+	ret = IRDM_ENOMEM;
 out_free:
 	free(col_of_row);
 	free(adj);

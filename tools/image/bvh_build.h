@@ -11,13 +11,15 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "irdm/error.h"
 #include "irdm/image_format.h"
 
 /*
  * Build the payload for an image with these NODES (the float rest
  * positions the image stores: boxes bound them exactly), COLUMNS and
- * SURFACE.  *payload is malloc'd (free() it).  Returns 0, or -1 with a
- * one-line reason (bad index, out of memory, tree too deep).
+ * SURFACE.  *payload is malloc'd (free() it).  A one-line reason goes to err.
+ * Return: IRDM_OK; IRDM_EINVAL if an index is out of range, the tree is
+ * too deep or the section would exceed 4 GiB; IRDM_ENOMEM.
  */
 int irdm_bvh_build(const struct irdm_node *nodes, uint32_t n_nodes,
 		   const uint32_t *columns, uint32_t n_cols,

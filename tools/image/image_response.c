@@ -42,7 +42,7 @@ static int modal_response(const struct irdm_image *img, uint32_t col, uint32_t r
 	if (!pr || !pc) {
 		free(pr);
 		free(pc);
-		return -1;
+		return IRDM_ENOMEM;
 	}
 	for (size_t i = 0; i < 3; i++)
 		for (size_t k = 0; k < K; k++) {
@@ -70,7 +70,7 @@ static int modal_response(const struct irdm_image *img, uint32_t col, uint32_t r
 						((size_t)col * m->n_cols + (size_t)rc) * 9 + (size_t)e);
 	free(pr);
 	free(pc);
-	return 0;
+	return IRDM_OK;
 }
 
 int irdm_image_response(const struct irdm_image *img, uint32_t col, uint32_t row,

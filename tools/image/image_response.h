@@ -6,6 +6,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "irdm/error.h"
 #include "irdm/image.h"
 
 /* Image node index of a mesh node, or -1. */
@@ -16,7 +17,7 @@ int64_t irdm_image_col_of(const struct irdm_image *img, uint32_t image_node);
 /*
  * R[s] for s < n_samples, column col, image row `row`: out[9 * s + 3 i + j]
  * (i: displacement axis at the row, j: force axis at the column).  FIR
- * images give zeros past T.  Returns 0, or -1 when out of memory.
+ * images give zeros past T.  Return: IRDM_OK; IRDM_ENOMEM.
  */
 int irdm_image_response(const struct irdm_image *img, uint32_t col, uint32_t row,
 			size_t n_samples, double *out);

@@ -67,10 +67,10 @@ int irdm_iw_add(struct irdm_image_writer *w, uint32_t kind, uint32_t elem,
 {
 	if (w->n >= IRDM_IMAGE_MAX_SECTIONS || !irdm_elem_size(elem) ||
 	    (size && !data) || size > SIZE_MAX)
-		return -1;
+		return IRDM_EINVAL;
 	for (unsigned i = 0; i < w->n; i++)
 		if (w->sec[i].kind == kind)
-			return -1;
+			return IRDM_EINVAL;
 	w->sec[w->n].kind = kind;
 	w->sec[w->n].elem = elem;
 	w->sec[w->n].data = data;
@@ -190,14 +190,17 @@ int irdm_iw_to_buffer(const struct irdm_image_writer *w, void **buf,
 {
 	struct layout *lo;
 	struct sink s = { .fd = -1 };
-	int ret = -1;
+	int ret = IRDM_EINVAL;
 
 	*buf = NULL;
 	*size = 0;
 	lo = malloc(sizeof(*lo));
 	if (!lo)
-		return -1;
-	if (plan(w, lo) || lo->file_size > SIZE_MAX)
+		return IRDM_ENOMEM;
+	if (plan(w, lo))
+		goto free_layout;
+	ret = IRDM_ENOMEM;
+	if (lo->file_size > SIZE_MAX)
 		goto free_layout;
 	s.mem = malloc((size_t)lo->file_size);
 	if (!s.mem)
@@ -205,7 +208,7 @@ int irdm_iw_to_buffer(const struct irdm_image_writer *w, void **buf,
 	emit(w, lo, &s);        /* into memory: cannot fail */
 	*buf = s.mem;
 	*size = (size_t)lo->file_size;
-	ret = 0;
+	ret = IRDM_OK;
 free_layout:
 	free(lo);
 	return ret;
@@ -264,19 +267,23 @@ int irdm_iw_write(const struct irdm_image_writer *w, const char *path,
 	static const char suffix[] = ".tmp.XXXXXX";
 	struct layout *lo;
 	char *tmp = NULL;
-	int fd, ret = -1;
+	int fd, ret;
 
 	lo = malloc(sizeof(*lo));
 	if (!lo || plan(w, lo)) {
 		snprintf(err, errlen, "%s: %s", path,
 			 lo ? "image has no sections" : strerror(ENOMEM));
+		ret = lo ? IRDM_EINVAL : IRDM_ENOMEM;
 		goto free_layout;
 	}
 	tmp = malloc(strlen(path) + sizeof(suffix));
 	if (!tmp) {
 		snprintf(err, errlen, "%s: %s", path, strerror(ENOMEM));
+		ret = IRDM_ENOMEM;
 		goto free_layout;
 	}
+	/* from here on every failure is the file system's */
+	ret = IRDM_EIO;
 	strcpy(tmp, path);
 	strcat(tmp, suffix);
 	fd = mkstemp(tmp);
@@ -301,7 +308,7 @@ int irdm_iw_write(const struct irdm_image_writer *w, const char *path,
 			 path, strerror(errno));
 		goto free_layout;
 	}
-	ret = 0;
+	ret = IRDM_OK;
 	goto free_layout;
 unlink_tmp:
 	unlink(tmp);

@@ -11,6 +11,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "irdm/error.h"
 #include "irdm/image_format.h"
 
 struct irdm_image_writer {
@@ -24,13 +25,17 @@ struct irdm_image_writer {
 };
 
 void irdm_iw_init(struct irdm_image_writer *w);
-/* Returns 0, or -1 if the table is full or kind repeats. */
+/* Return: IRDM_OK; IRDM_EINVAL if the table is full, kind repeats, elem is
+ * unknown or size bytes have no data. */
 int irdm_iw_add(struct irdm_image_writer *w, uint32_t kind, uint32_t elem,
 		const void *data, uint64_t size);
-/* Returns 0, or -1 with a one-line reason naming path. */
+/* Return: IRDM_OK; IRDM_EINVAL if there are no sections; IRDM_ENOMEM;
+ * IRDM_EIO if the file cannot be created, written, synced or renamed.  A
+ * one-line reason naming path goes to err. */
 int irdm_iw_write(const struct irdm_image_writer *w, const char *path,
 		  char *err, size_t errlen);
-/* Same layout into a malloc'd buffer (tests, fuzz seeds). */
+/* Same layout into a malloc'd buffer (tests, fuzz seeds).
+ * Return: IRDM_OK; IRDM_EINVAL if there are no sections; IRDM_ENOMEM. */
 int irdm_iw_to_buffer(const struct irdm_image_writer *w, void **buf, size_t *size);
 
 #endif /* IRDM_TOOLS_IMAGE_WRITER_H */

@@ -11,6 +11,10 @@ struct irdm_cli_progress {
 
 void irdm_cli_progress(void *ctx, const char *stage, double fraction);
 
+/* "irdm CMD: ENAME: reason" on stderr, code an IRDM_E* (irdm/error.h), so
+ * scripts and tests can tell an I/O error from a bad input or no memory. */
+void irdm_cli_fail(const char *cmd, int code, const char *reason);
+
 int irdm_cmd_precompute(int argc, char **argv);
 int irdm_cmd_image(int argc, char **argv);
 int irdm_cmd_replay(int argc, char **argv);

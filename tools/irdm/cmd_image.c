@@ -45,7 +45,7 @@ static int open_image(const char *path, struct irdm_image *img)
 	int rc = irdm_image_map(path, 0, img, err, sizeof(err));
 
 	if (rc) {
-		fprintf(stderr, "irdm image: %s\n", err);
+		irdm_cli_fail("image", rc, err);
 		return -1;
 	}
 	return 0;
@@ -196,7 +196,7 @@ static int cmd_verify(int argc, char **argv)
 	double max_rho = 0;
 
 	if (!a || !b) {
-		fprintf(stderr, "irdm image verify: out of memory\n");
+		irdm_cli_fail("image verify", IRDM_ENOMEM, "out of memory");
 		bad = 1;
 		goto out_unmap;
 	}
@@ -259,11 +259,11 @@ static int write_csv(FILE *f, const struct irdm_image *img, uint32_t col, const 
 	double *blk = malloc(n_rows * n_samples * 9 * sizeof(double));
 
 	if (!blk)
-		return -1;
+		return IRDM_ENOMEM;
 	for (size_t r = 0; r < n_rows; r++)
 		if (irdm_image_response(img, col, rows[r], n_samples, &blk[r * n_samples * 9])) {
 			free(blk);
-			return -1;
+			return IRDM_ENOMEM;
 		}
 	fprintf(f, "s,t_s");
 	for (size_t r = 0; r < n_rows; r++)
@@ -279,7 +279,7 @@ static int write_csv(FILE *f, const struct irdm_image *img, uint32_t col, const 
 		fputc('\n', f);
 	}
 	free(blk);
-	return ferror(f) ? -1 : 0;
+	return ferror(f) ? IRDM_EIO : IRDM_OK;
 }
 
 /* What export was asked for. */
@@ -337,9 +337,10 @@ static int cmd_export(int argc, char **argv)
 	size_t n_rows = 0;
 	struct irdm_image img;
 	char err[512];
+	int rc = irdm_opt_parse_args(&set, 1, argc, argv, export_image_arg, &args, err, sizeof(err));
 
-	if (irdm_opt_parse_args(&set, 1, argc, argv, export_image_arg, &args, err, sizeof(err))) {
-		fprintf(stderr, "irdm image export: %s\n", err);
+	if (rc) {
+		irdm_cli_fail("image export", rc, err);
 		return 2;
 	}
 	if (!args.path || args.column == UINT64_MAX) {
@@ -390,19 +391,27 @@ static int cmd_export(int argc, char **argv)
 		snprintf(tmp, sizeof(tmp), "%s.tmp", out);
 		f = fopen(tmp, "w");
 		if (!f) {
-			fprintf(stderr, "irdm image export: cannot create %s: %s\n", tmp, strerror(errno));
+			fprintf(stderr, "irdm image export: EIO: cannot create %s: %s\n", tmp, strerror(errno));
 			goto out_unmap;
 		}
 	}
 	int wr = write_csv(f, &img, (uint32_t)c, rows, n_rows, n_samples);
+	if (wr == IRDM_ENOMEM) {
+		irdm_cli_fail("image export", wr, "out of memory");
+		if (out) {
+			fclose(f);
+			remove(tmp);
+		}
+		goto out_unmap;
+	}
 	if (out) {
 		if (fclose(f) || wr || rename(tmp, out)) {
-			fprintf(stderr, "irdm image export: cannot write %s\n", out);
+			fprintf(stderr, "irdm image export: EIO: cannot write %s\n", out);
 			remove(tmp);
 			goto out_unmap;
 		}
 	} else if (wr || fflush(stdout)) {
-		fprintf(stderr, "irdm image export: write error\n");
+		fprintf(stderr, "irdm image export: EIO: write error\n");
 		goto out_unmap;
 	}
 	ret = 0;

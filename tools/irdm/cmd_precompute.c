@@ -174,6 +174,7 @@ static bool wants(int argc, char **argv, const char *opt, const char *short_opt)
 static int load_scenes(struct irdm_scene *sc, int argc, char **argv)
 {
 	char err[1024];
+	int rc;
 
 	for (int i = 1; i < argc; i++) {
 		if (strcmp(argv[i], "--scene"))
@@ -182,8 +183,9 @@ static int load_scenes(struct irdm_scene *sc, int argc, char **argv)
 			fprintf(stderr, "irdm precompute: --scene needs a file\n");
 			return 2;
 		}
-		if (irdm_scene_load(sc, argv[i + 1], err, sizeof(err))) {
-			fprintf(stderr, "irdm precompute: %s\n", err);
+		rc = irdm_scene_load(sc, argv[i + 1], err, sizeof(err));
+		if (rc) {
+			irdm_cli_fail("precompute", rc, err);
 			return 1;
 		}
 	}
@@ -202,8 +204,9 @@ static int parse_args(struct irdm_scene *sc, struct precompute_args *a, int argc
 
 	if (rc)
 		return rc;
-	if (irdm_opt_parse_args(sets, 2, argc - 1, argv + 1, NULL, NULL, err, sizeof(err))) {
-		fprintf(stderr, "irdm precompute: %s\n", err);
+	rc = irdm_opt_parse_args(sets, 2, argc - 1, argv + 1, NULL, NULL, err, sizeof(err));
+	if (rc) {
+		irdm_cli_fail("precompute", rc, err);
 		return 2;
 	}
 	return 0;
@@ -268,8 +271,9 @@ int irdm_cmd_precompute(int argc, char **argv)
 	prog.quiet = args.quiet;
 	if (args.count_only) {
 		size_t n;
-		if (irdm_precompute_count_inputs(&sc, &n, err, sizeof(err))) {
-			fprintf(stderr, "irdm precompute: %s\n", err);
+		rc = irdm_precompute_count_inputs(&sc, &n, err, sizeof(err));
+		if (rc) {
+			irdm_cli_fail("precompute", rc, err);
 			return 1;
 		}
 		printf("%zu\n", n);
@@ -280,8 +284,9 @@ int irdm_cmd_precompute(int argc, char **argv)
 		return rc;
 	o.progress = irdm_cli_progress;
 	o.ctx = &prog;
-	if (irdm_precompute(&sc, &o, &rep, err, sizeof(err))) {
-		fprintf(stderr, "irdm precompute: %s\n", err);
+	rc = irdm_precompute(&sc, &o, &rep, err, sizeof(err));
+	if (rc) {
+		irdm_cli_fail("precompute", rc, err);
 		return 1;
 	}
 	if (!prog.quiet)

@@ -123,8 +123,9 @@ int irdm_cmd_replay(int argc, char **argv)
 		fprintf(stderr, "irdm replay: needs --image, --contact, --displacement and -o (see --help)\n");
 		return 2;
 	}
-	if (irdm_replay_run(&o, err, sizeof(err))) {
-		fprintf(stderr, "irdm replay: %s\n", err);
+	int rc = irdm_replay_run(&o, err, sizeof(err));
+	if (rc) {
+		irdm_cli_fail("replay", rc, err);
 		return 1;
 	}
 	return 0;

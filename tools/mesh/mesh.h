@@ -15,6 +15,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "irdm/error.h"
+
 struct irdm_mesh {
 	size_t    n_nodes;
 	double   *pos_m;      /* 3 * n_nodes, metres */
@@ -47,6 +49,12 @@ void irdm_surface_free(struct irdm_surface *s);
  * scale is applied afterwards.  The result is validated and has its
  * boundary computed.  Messages name nodes and elements as the file numbers
  * them (TetGen index, Gmsh tag).
+ *
+ * Return: IRDM_OK; IRDM_EINVAL if there is no path, the scale is not
+ * positive or the tetgen switches are unusable; IRDM_EIO if a file cannot
+ * be opened or read; IRDM_ERANGE if it is larger than 2 GiB; IRDM_EFORMAT
+ * if the extension is unknown or the mesh malformed or invalid;
+ * IRDM_ENOMEM; IRDM_ECHILD if tetgen cannot run or fails.
  */
 int irdm_mesh_read(const char *path, double scale, const char *tetgen_switches,
 		   struct irdm_mesh *m, char *err, size_t errlen);
@@ -57,6 +65,7 @@ int irdm_mesh_read(const char *path, double scale, const char *tetgen_switches,
  * surface parsers do check indices, finiteness and degenerate triangles).
  * Inputs need no terminating NUL; only len bytes are read.  The output
  * struct is overwritten, not freed first.
+ * Return: IRDM_OK; IRDM_EFORMAT if the input is malformed; IRDM_ENOMEM.
  */
 int irdm_mesh_parse_tetgen(const char *node_txt, size_t node_len,
 			   const char *ele_txt, size_t ele_len, const char *what,
@@ -75,6 +84,10 @@ int irdm_surface_parse_stl(const void *buf, size_t len, const char *what,
  * Run Debian's `tetgen` on a closed surface in a private temp directory
  * (under $TMPDIR, always removed); $IRDM_TETGEN overrides the program.
  * switches as for irdm_mesh_read().
+ * Return: IRDM_OK; IRDM_EFORMAT if the surface is invalid or tetgen's
+ * output malformed; IRDM_EINVAL if the switches are unusable; IRDM_EIO if
+ * the temporary files cannot be made; IRDM_ENOMEM; IRDM_ECHILD if tetgen
+ * cannot run, fails or makes no tetrahedra.
  */
 int irdm_surface_tetrahedralize(const struct irdm_surface *s, const char *switches,
 				const char *what, struct irdm_mesh *m,
@@ -89,6 +102,7 @@ int irdm_surface_tetrahedralize(const struct irdm_surface *s, const char *switch
  * count; irdm_mesh_read() uses the file's own numbers instead.  Inverted
  * tets are an error, not silently flipped: a reader that knows its
  * convention orders nodes itself.  On failure the mesh is freed.
+ * Return: IRDM_OK; IRDM_EFORMAT if the mesh is invalid; IRDM_ENOMEM.
  */
 int irdm_mesh_finish(struct irdm_mesh *m, const char *what, char *err, size_t errlen);
 
@@ -97,6 +111,8 @@ int irdm_mesh_finish(struct irdm_mesh *m, const char *what, char *err, size_t er
  * split into nx*ny*nz hexahedra, each cut into 5 (alternating, conforming)
  * or 6 (Kuhn) tetrahedra.  The paper's cuboid is 0.1 x 0.1 x 0.2 m with
  * 11x11x22 hexes of 5 tets: 3312 nodes, 13310 tets.
+ * Return: IRDM_OK; IRDM_EINVAL if a size or count is out of range;
+ * IRDM_ENOMEM.
  */
 int irdm_mesh_gen_box(double lx, double ly, double lz, unsigned nx, unsigned ny,
 		      unsigned nz, unsigned tets_per_hex, struct irdm_mesh *m,

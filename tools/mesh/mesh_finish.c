@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "irdm/error.h"
 #include "mesh/mesh_priv.h"
 
 /*
@@ -59,23 +60,6 @@ static double sq_dist(const double *a, const double *b)
 	return dx * dx + dy * dy + dz * dz;
 }
 
-/* Six times the signed volume: (b-a)x(c-a).(d-a). */
-static double vol6(const double *a, const double *b, const double *c,
-		   const double *d)
-{
-	double u[3], v[3], w[3];
-	int i;
-
-	for (i = 0; i < 3; i++) {
-		u[i] = b[i] - a[i];
-		v[i] = c[i] - a[i];
-		w[i] = d[i] - a[i];
-	}
-	return (u[1] * v[2] - u[2] * v[1]) * w[0] +
-	       (u[2] * v[0] - u[0] * v[2]) * w[1] +
-	       (u[0] * v[1] - u[1] * v[0]) * w[2];
-}
-
 static int check_nodes(const struct irdm_mesh *m, const struct mesh_labels *lab,
 		       char *err, size_t errlen)
 {
@@ -86,7 +70,7 @@ static int check_nodes(const struct irdm_mesh *m, const struct mesh_labels *lab,
 			mesh_err(err, errlen, lab->node_what,
 				 "node %llu has a non-finite coordinate",
 				 (unsigned long long)mesh_node_label(lab, i / 3));
-			return -1;
+			return IRDM_EFORMAT;
 		}
 	}
 	return 0;
@@ -104,14 +88,14 @@ static int check_tet_nodes(const struct irdm_mesh *m, size_t e,
 			mesh_err(err, errlen, lab->tet_what,
 				 "element %llu refers to node index %lu, but there are only %zu nodes",
 				 el, (unsigned long)t[i], m->n_nodes);
-			return -1;
+			return IRDM_EFORMAT;
 		}
 		for (j = 0; j < i; j++) {
 			if (t[i] == t[j]) {
 				mesh_err(err, errlen, lab->tet_what,
 					 "element %llu uses node %llu twice", el,
 					 (unsigned long long)mesh_node_label(lab, t[i]));
-				return -1;
+				return IRDM_EFORMAT;
 			}
 		}
 	}
@@ -131,23 +115,23 @@ static int check_tet_volume(const struct irdm_mesh *m, size_t e,
 		for (j = i + 1; j < 4; j++)
 			l2 = fmax(l2, sq_dist(x + 3 * t[i], x + 3 * t[j]));
 	l3 = l2 * sqrt(l2);
-	v6 = vol6(x + 3 * t[0], x + 3 * t[1], x + 3 * t[2], x + 3 * t[3]);
+	v6 = mesh_tet_vol6(x, t);
 	if (!isfinite(v6) || !isfinite(l3)) {
 		mesh_err(err, errlen, lab->tet_what,
 			 "element %llu is too large to measure (coordinates overflow)",
 			 el);
-		return -1;
+		return IRDM_EFORMAT;
 	}
 	if (fabs(v6) <= DEGENERATE_REL * l3) {
 		mesh_err(err, errlen, lab->tet_what,
 			 "element %llu has zero volume (volume %.3g m^3, longest edge %.3g m)",
 			 el, v6 / 6.0, sqrt(l2));
-		return -1;
+		return IRDM_EFORMAT;
 	}
 	if (v6 < 0.0) {
 		mesh_err(err, errlen, lab->tet_what,
 			 "element %llu is inverted (volume %.3g m^3)", el, v6 / 6.0);
-		return -1;
+		return IRDM_EFORMAT;
 	}
 	return 0;
 }
@@ -162,7 +146,7 @@ static int check_referenced(const struct irdm_mesh *m,
 	used = calloc(m->n_nodes, 1);
 	if (!used) {
 		mesh_err(err, errlen, lab->tet_what, "out of memory");
-		return -1;
+		return IRDM_ENOMEM;
 	}
 	for (i = 0; i < 4 * m->n_tets; i++)
 		used[m->tets[i]] = 1;
@@ -171,7 +155,7 @@ static int check_referenced(const struct irdm_mesh *m,
 			mesh_err(err, errlen, lab->node_what,
 				 "node %llu is not used by any element",
 				 (unsigned long long)mesh_node_label(lab, i));
-			ret = -1;
+			ret = IRDM_EFORMAT;
 			break;
 		}
 	}
@@ -234,7 +218,7 @@ static int check_shared(const struct face *f, size_t n,
 			 (unsigned long long)mesh_tet_label(lab, f[0].tet),
 			 (unsigned long long)mesh_tet_label(lab, f[1].tet),
 			 (unsigned long long)mesh_tet_label(lab, f[2].tet));
-		return -1;
+		return IRDM_EFORMAT;
 	}
 	/* Two positive tets on opposite sides see the face with opposite turns. */
 	if (f[0].odd == f[1].odd) {
@@ -243,7 +227,7 @@ static int check_shared(const struct face *f, size_t n,
 			 (unsigned long long)mesh_tet_label(lab, f[0].tet),
 			 (unsigned long long)mesh_tet_label(lab, f[1].tet),
 			 a, b, c);
-		return -1;
+		return IRDM_EFORMAT;
 	}
 	return 0;
 }
@@ -258,7 +242,7 @@ static int compute_boundary(struct irdm_mesh *m, const struct mesh_labels *lab,
 	size_t nf = 4 * m->n_tets, i, j, k, nb = 0;
 	struct face *f;
 	uint32_t *tris = NULL;
-	int ret = -1;
+	int ret = IRDM_ENOMEM;
 
 	f = malloc(nf * sizeof(*f));
 	if (!f)
@@ -278,7 +262,8 @@ static int compute_boundary(struct irdm_mesh *m, const struct mesh_labels *lab,
 			if (memcmp(f[j].v, f[i].v, sizeof(f[i].v)))
 				break;
 		if (j - i > 1) {
-			if (check_shared(f + i, j - i, lab, err, errlen))
+			ret = check_shared(f + i, j - i, lab, err, errlen);
+			if (ret)
 				goto out_free;
 			continue;
 		}
@@ -306,6 +291,7 @@ int mesh_finish_labeled(struct irdm_mesh *m, const struct mesh_labels *lab,
 			char *err, size_t errlen)
 {
 	size_t e;
+	int ret = IRDM_EFORMAT;
 
 	if (!m->n_nodes || !m->n_tets || !m->pos_m || !m->tets) {
 		mesh_err(err, errlen, lab->tet_what,
@@ -319,23 +305,22 @@ int mesh_finish_labeled(struct irdm_mesh *m, const struct mesh_labels *lab,
 			 m->n_nodes, m->n_tets, MESH_MAX_ITEMS);
 		goto fail;
 	}
-	if (check_nodes(m, lab, err, errlen))
+	ret = check_nodes(m, lab, err, errlen);
+	for (e = 0; !ret && e < m->n_tets; e++)
+		ret = check_tet_nodes(m, e, lab, err, errlen);
+	for (e = 0; !ret && e < m->n_tets; e++)
+		ret = check_tet_volume(m, e, lab, err, errlen);
+	if (!ret)
+		ret = check_referenced(m, lab, err, errlen);
+	if (!ret)
+		ret = compute_boundary(m, lab, err, errlen);
+	if (ret)
 		goto fail;
-	for (e = 0; e < m->n_tets; e++)
-		if (check_tet_nodes(m, e, lab, err, errlen))
-			goto fail;
-	for (e = 0; e < m->n_tets; e++)
-		if (check_tet_volume(m, e, lab, err, errlen))
-			goto fail;
-	if (check_referenced(m, lab, err, errlen))
-		goto fail;
-	if (compute_boundary(m, lab, err, errlen))
-		goto fail;
-	return 0;
+	return IRDM_OK;
 
 fail:
 	irdm_mesh_free(m);
-	return -1;
+	return ret;
 }
 
 int irdm_mesh_finish(struct irdm_mesh *m, const char *what, char *err,

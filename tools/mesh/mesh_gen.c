@@ -15,6 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "irdm/error.h"
 #include "mesh/mesh_priv.h"
 
 static const unsigned char kuhn[6][4] = {
@@ -79,13 +80,13 @@ static int check_args(double lx, double ly, double lz, unsigned nx,
 	      lx > 0 && ly > 0 && lz > 0)) {
 		mesh_err(err, errlen, "box", "sizes must be positive (%g x %g x %g m)",
 			 lx, ly, lz);
-		return -1;
+		return IRDM_EINVAL;
 	}
 	if (!nx || !ny || !nz || (tph != 5 && tph != 6)) {
 		mesh_err(err, errlen, "box",
 			 "need at least 1x1x1 hexes and 5 or 6 tets per hex (got %ux%ux%u, %u)",
 			 nx, ny, nz, tph);
-		return -1;
+		return IRDM_EINVAL;
 	}
 	/* Each factor is checked before the next multiply, so nothing wraps. */
 	nn = (unsigned long long)nx + 1;
@@ -97,7 +98,7 @@ static int check_args(double lx, double ly, double lz, unsigned nx,
 	if (nn > MESH_MAX_ITEMS || nt > MESH_MAX_ITEMS) {
 		mesh_err(err, errlen, "box", "%ux%ux%u hexes is too many (limit %u)",
 			 nx, ny, nz, MESH_MAX_ITEMS);
-		return -1;
+		return IRDM_EINVAL;
 	}
 	*nodes = (size_t)nn;
 	*tets = (size_t)nt;
@@ -151,25 +152,28 @@ int irdm_mesh_gen_box(double lx, double ly, double lz, unsigned nx, unsigned ny,
 		      char *err, size_t errlen)
 {
 	size_t nodes, tets;
+	int ret;
 
 	memset(m, 0, sizeof(*m));
-	if (check_args(lx, ly, lz, nx, ny, nz, tets_per_hex, &nodes, &tets,
-		       err, errlen))
-		return -1;
+	ret = check_args(lx, ly, lz, nx, ny, nz, tets_per_hex, &nodes, &tets,
+			 err, errlen);
+	if (ret)
+		return ret;
 	m->pos_m = malloc(nodes * 3 * sizeof(*m->pos_m));
 	m->tets = malloc(tets * 4 * sizeof(*m->tets));
 	if (!m->pos_m || !m->tets) {
 		mesh_err(err, errlen, "box", "out of memory");
 		irdm_mesh_free(m);
-		return -1;
+		return IRDM_ENOMEM;
 	}
 	m->n_nodes = nodes;
 	m->n_tets = tets;
 	fill_nodes(m->pos_m, lx, ly, lz, nx, ny, nz);
 	fill_tets(m->tets, nx, ny, nz, tets_per_hex);
-	if (irdm_mesh_finish(m, "box", err, errlen))
-		return -1;
+	ret = irdm_mesh_finish(m, "box", err, errlen);
+	if (ret)
+		return ret;
 	snprintf(m->name, sizeof(m->name), "box-%ux%ux%u-%u", nx, ny, nz,
 		 tets_per_hex);
-	return 0;
+	return IRDM_OK;
 }

@@ -15,6 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "irdm/error.h"
 #include "mesh/mesh_priv.h"
 
 /* Shortest node record "1 0 0 0\n" (2.2) or tag line + "0 0 0" (4.1). */
@@ -35,8 +36,11 @@ struct gmsh {
 	uint64_t *tet_nodes;	/* 4 node tags per tet, mapped at the end */
 	uint64_t *tet_tag;
 
+	/* The helpers below return 0 or -1 with the reason in err; oom says
+	 * which kind of failure it was (IRDM_ENOMEM, else IRDM_EFORMAT). */
 	char *err;
 	size_t errlen;
+	bool oom;
 };
 
 struct tag_index {
@@ -141,6 +145,7 @@ static int alloc_nodes(struct gmsh *g, size_t n)
 	g->node_tag = malloc((n ? n : 1) * sizeof(*g->node_tag));
 	if (!g->pos || !g->node_tag) {
 		mesh_err(g->err, g->errlen, g->what, "out of memory for %zu nodes", n);
+		g->oom = true;
 		return -1;
 	}
 	return 0;
@@ -259,6 +264,7 @@ static int add_tet(struct gmsh *g, struct mline *l, uint64_t tag)
 
 fail_oom:
 	mesh_err(g->err, g->errlen, g->what, "out of memory (or too many elements)");
+	g->oom = true;
 	return -1;
 }
 
@@ -441,6 +447,7 @@ static struct tag_index *sorted_tags(struct gmsh *g)
 	t = malloc((g->n_nodes ? g->n_nodes : 1) * sizeof(*t));
 	if (!t) {
 		mesh_err(g->err, g->errlen, g->what, "out of memory");
+		g->oom = true;
 		return NULL;
 	}
 	for (i = 0; i < g->n_nodes; i++) {
@@ -513,6 +520,7 @@ static int map_nodes(struct gmsh *g, struct irdm_mesh *m, struct mesh_labels *la
 
 fail_oom:
 	mesh_err(g->err, g->errlen, g->what, "out of memory");
+	g->oom = true;
 out_free:
 	free(remap);
 	free(tags);
@@ -564,10 +572,10 @@ int mesh_parse_gmsh_labeled(const char *txt, size_t len, const char *what,
 	if (ret) {
 		mesh_labels_free(lab);
 		irdm_mesh_free(m);
-		return -1;
+		return g.oom ? IRDM_ENOMEM : IRDM_EFORMAT;
 	}
 	mesh_set_name(m, what);
-	return 0;
+	return IRDM_OK;
 }
 
 int irdm_mesh_parse_gmsh(const char *txt, size_t len, const char *what,

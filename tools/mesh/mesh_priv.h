@@ -28,6 +28,10 @@ void mesh_err(char *err, size_t errlen, const char *what, const char *fmt, ...);
 /* Copy a token for an error message: printable, short, always terminated. */
 void mesh_quote(char *dst, size_t dstlen, const char *tok, size_t n);
 
+/* Six times the signed volume of the tet with nodes t[0..3] of positions x:
+ * (b-a)x(c-a).(d-a), positive for our node order (mesh_base.c). */
+double mesh_tet_vol6(const double *x, const uint32_t *t);
+
 /* m->name = basename of `what` without its extension. */
 void mesh_set_name(struct irdm_mesh *m, const char *what);
 

@@ -15,6 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "irdm/error.h"
 #include "mesh/mesh_priv.h"
 
 /* Shortest possible records, "1 0 0 0" and "1 1 2 3 4": bounds headers. */
@@ -30,27 +31,27 @@ static int parse_header(struct mtext *t, const char *what, const char *kind,
 
 	if (!mtext_next_line(t, &l)) {
 		mesh_err(err, errlen, what, "empty %s file", kind);
-		return -1;
+		return IRDM_EFORMAT;
 	}
 	if (mline_ll(&l, count) || mline_ll(&l, second)) {
 		mesh_err(err, errlen, what, "line %zu: bad %s header", l.lineno, kind);
-		return -1;
+		return IRDM_EFORMAT;
 	}
 	if (*count <= 0) {
 		mesh_err(err, errlen, what, "declares %lld %ss (nothing to read)",
 			 *count, kind);
-		return -1;
+		return IRDM_EFORMAT;
 	}
 	if (*count > (long long)MESH_MAX_ITEMS) {
 		mesh_err(err, errlen, what, "declares %lld %ss (limit %u)", *count,
 			 kind, MESH_MAX_ITEMS);
-		return -1;
+		return IRDM_EFORMAT;
 	}
 	if ((unsigned long long)*count > t->len / min_bytes) {
 		mesh_err(err, errlen, what,
 			 "declares %lld %ss but has only %zu bytes (truncated?)",
 			 *count, kind, t->len);
-		return -1;
+		return IRDM_EFORMAT;
 	}
 	return 0;
 }
@@ -63,27 +64,27 @@ static int parse_node_line(struct mline *l, size_t i, long long *base,
 
 	if (mline_ll(l, &idx)) {
 		mesh_err(err, errlen, what, "line %zu: bad node index", l->lineno);
-		return -1;
+		return IRDM_EFORMAT;
 	}
 	if (i == 0) {
 		if (idx != 0 && idx != 1) {
 			mesh_err(err, errlen, what,
 				 "line %zu: first node index is %lld (expected 0 or 1)",
 				 l->lineno, idx);
-			return -1;
+			return IRDM_EFORMAT;
 		}
 		*base = idx;
 	} else if (idx != *base + (long long)i) {
 		mesh_err(err, errlen, what,
 			 "line %zu: node index %lld, expected %lld (indices must be consecutive)",
 			 l->lineno, idx, *base + (long long)i);
-		return -1;
+		return IRDM_EFORMAT;
 	}
 	if (mline_double(l, &x[0]) || mline_double(l, &x[1]) ||
 	    mline_double(l, &x[2])) {
 		mesh_err(err, errlen, what, "line %zu: node %lld needs 3 coordinates",
 			 l->lineno, idx);
-		return -1;
+		return IRDM_EFORMAT;
 	}
 	*tag = (uint64_t)idx;
 	return 0;
@@ -97,29 +98,32 @@ static int parse_nodes(const char *txt, size_t len, const char *what,
 	struct mline l;
 	long long n, dim;
 	size_t i;
+	int ret;
 
 	mtext_init(&t, txt, len, '#');
-	if (parse_header(&t, what, "node", NODE_MIN_BYTES, &n, &dim, err, errlen))
-		return -1;
+	ret = parse_header(&t, what, "node", NODE_MIN_BYTES, &n, &dim, err, errlen);
+	if (ret)
+		return ret;
 	if (dim != 3) {
 		mesh_err(err, errlen, what, "dimension is %lld, expected 3", dim);
-		return -1;
+		return IRDM_EFORMAT;
 	}
 	m->pos_m = malloc((size_t)n * 3 * sizeof(*m->pos_m));
 	lab->node_tag = malloc((size_t)n * sizeof(*lab->node_tag));
 	if (!m->pos_m || !lab->node_tag) {
 		mesh_err(err, errlen, what, "out of memory for %lld nodes", n);
-		return -1;
+		return IRDM_ENOMEM;
 	}
 	for (i = 0; i < (size_t)n; i++) {
 		if (!mtext_next_line(&t, &l)) {
 			mesh_err(err, errlen, what,
 				 "truncated: %zu of %lld nodes present", i, n);
-			return -1;
+			return IRDM_EFORMAT;
 		}
-		if (parse_node_line(&l, i, base, m->pos_m + 3 * i,
-				    &lab->node_tag[i], what, err, errlen))
-			return -1;
+		ret = parse_node_line(&l, i, base, m->pos_m + 3 * i,
+				      &lab->node_tag[i], what, err, errlen);
+		if (ret)
+			return ret;
 	}
 	m->n_nodes = (size_t)n;
 	return 0;
@@ -134,20 +138,20 @@ static int parse_ele_line(struct mline *l, struct irdm_mesh *m, size_t i,
 
 	if (mline_ll(l, &idx) || idx < 0) {
 		mesh_err(err, errlen, what, "line %zu: bad element index", l->lineno);
-		return -1;
+		return IRDM_EFORMAT;
 	}
 	for (k = 0; k < 4; k++) {
 		if (mline_ll(l, &ref)) {
 			mesh_err(err, errlen, what,
 				 "line %zu: element %lld needs 4 node numbers",
 				 l->lineno, idx);
-			return -1;
+			return IRDM_EFORMAT;
 		}
 		if (ref < base || (unsigned long long)(ref - base) >= m->n_nodes) {
 			mesh_err(err, errlen, what,
 				 "line %zu: element %lld refers to node %lld, which is not in the node file",
 				 l->lineno, idx, ref);
-			return -1;
+			return IRDM_EFORMAT;
 		}
 		m->tets[4 * i + k] = (uint32_t)(ref - base);
 	}
@@ -163,30 +167,33 @@ static int parse_eles(const char *txt, size_t len, const char *what,
 	struct mline l;
 	long long n, npt;
 	size_t i;
+	int ret;
 
 	mtext_init(&t, txt, len, '#');
-	if (parse_header(&t, what, "element", ELE_MIN_BYTES, &n, &npt, err, errlen))
-		return -1;
+	ret = parse_header(&t, what, "element", ELE_MIN_BYTES, &n, &npt, err, errlen);
+	if (ret)
+		return ret;
 	if (npt != 4 && npt != 10) {
 		mesh_err(err, errlen, what,
 			 "%lld nodes per element (expected 4 or 10)", npt);
-		return -1;
+		return IRDM_EFORMAT;
 	}
 	m->tets = malloc((size_t)n * 4 * sizeof(*m->tets));
 	lab->tet_tag = malloc((size_t)n * sizeof(*lab->tet_tag));
 	if (!m->tets || !lab->tet_tag) {
 		mesh_err(err, errlen, what, "out of memory for %lld elements", n);
-		return -1;
+		return IRDM_ENOMEM;
 	}
 	for (i = 0; i < (size_t)n; i++) {
 		if (!mtext_next_line(&t, &l)) {
 			mesh_err(err, errlen, what,
 				 "truncated: %zu of %lld elements present", i, n);
-			return -1;
+			return IRDM_EFORMAT;
 		}
-		if (parse_ele_line(&l, m, i, base, &lab->tet_tag[i], what,
-				   err, errlen))
-			return -1;
+		ret = parse_ele_line(&l, m, i, base, &lab->tet_tag[i], what,
+				     err, errlen);
+		if (ret)
+			return ret;
 	}
 	m->n_tets = (size_t)n;
 	return 0;
@@ -198,22 +205,25 @@ int mesh_parse_tetgen_labeled(const char *node_txt, size_t node_len,
 			      char *err, size_t errlen)
 {
 	long long base = 0;
+	int ret;
 
 	memset(m, 0, sizeof(*m));
 	lab->node_tag = NULL;
 	lab->tet_tag = NULL;
-	if (parse_nodes(node_txt, node_len, lab->node_what, m, lab, &base,
-			err, errlen))
+	ret = parse_nodes(node_txt, node_len, lab->node_what, m, lab, &base,
+			  err, errlen);
+	if (ret)
 		goto fail;
-	if (parse_eles(ele_txt, ele_len, lab->tet_what, m, lab, base, err, errlen))
+	ret = parse_eles(ele_txt, ele_len, lab->tet_what, m, lab, base, err, errlen);
+	if (ret)
 		goto fail;
 	mesh_set_name(m, lab->tet_what);
-	return 0;
+	return IRDM_OK;
 
 fail:
 	mesh_labels_free(lab);
 	irdm_mesh_free(m);
-	return -1;
+	return ret;
 }
 
 int irdm_mesh_parse_tetgen(const char *node_txt, size_t node_len,

@@ -12,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "irdm/error.h"
 #include "mesh/mesh_priv.h"
 
 /* Long enough for any sane number ("-1.2345678901234567e-308" is 24). */
@@ -237,13 +238,14 @@ int mesh_read_file(const char *path, char **buf, size_t *len,
 	size_t cap = 0, n = 0, got;
 	char *p = NULL, *np;
 	FILE *f;
+	int ret;
 
 	*buf = NULL;
 	*len = 0;
 	f = fopen(path, "rb");
 	if (!f) {
 		mesh_err(err, errlen, path, "cannot open: %s", strerror(errno));
-		return -1;
+		return IRDM_EIO;
 	}
 	do {
 		if (n == cap) {
@@ -251,6 +253,7 @@ int mesh_read_file(const char *path, char **buf, size_t *len,
 				mesh_err(err, errlen, path,
 					 "file is larger than %zu bytes",
 					 (size_t)MESH_MAX_FILE_BYTES);
+				ret = IRDM_ERANGE;
 				goto fail_free;
 			}
 			cap = cap ? cap * 2 : 65536;
@@ -258,6 +261,7 @@ int mesh_read_file(const char *path, char **buf, size_t *len,
 			if (!np) {
 				mesh_err(err, errlen, path,
 					 "out of memory reading the file");
+				ret = IRDM_ENOMEM;
 				goto fail_free;
 			}
 			p = np;
@@ -266,16 +270,17 @@ int mesh_read_file(const char *path, char **buf, size_t *len,
 		n += got;
 	} while (got);
 	if (ferror(f)) {
-		mesh_err(err, errlen, path, "read error");
+		mesh_err(err, errlen, path, "read failed: %s", strerror(errno));
+		ret = IRDM_EIO;
 		goto fail_free;
 	}
 	fclose(f);
 	*buf = p;
 	*len = n;
-	return 0;
+	return IRDM_OK;
 
 fail_free:
 	free(p);
 	fclose(f);
-	return -1;
+	return ret;
 }

@@ -6,6 +6,7 @@
  */
 #include <math.h>
 
+#include "irdm/error.h"
 #include "mesh/mesh_priv.h"
 
 int surface_add_vert(struct surface_build *b, const double x[3])
@@ -55,13 +56,13 @@ int surface_check(const struct irdm_surface *s, const char *what,
 		mesh_err(err, errlen, what,
 			 "surface has %zu vertices and %zu triangles; a closed surface needs at least 4 of each",
 			 s->n_verts, s->n_tris);
-		return -1;
+		return IRDM_EFORMAT;
 	}
 	for (i = 0; i < 3 * s->n_verts; i++) {
 		if (!isfinite(s->pos_m[i])) {
 			mesh_err(err, errlen, what,
 				 "vertex %zu has a non-finite coordinate", i / 3 + 1);
-			return -1;
+			return IRDM_EFORMAT;
 		}
 	}
 	for (i = 0; i < s->n_tris; i++) {
@@ -72,12 +73,12 @@ int surface_check(const struct irdm_surface *s, const char *what,
 			mesh_err(err, errlen, what,
 				 "triangle %zu refers to a vertex beyond the %zu defined",
 				 i + 1, s->n_verts);
-			return -1;
+			return IRDM_EFORMAT;
 		}
 		if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) {
 			mesh_err(err, errlen, what,
 				 "triangle %zu is degenerate (a vertex repeats)", i + 1);
-			return -1;
+			return IRDM_EFORMAT;
 		}
 	}
 	return 0;

@@ -8,6 +8,7 @@
  */
 #include <string.h>
 
+#include "irdm/error.h"
 #include "mesh/mesh_priv.h"
 
 struct obj {
@@ -25,12 +26,12 @@ static int obj_vertex(struct obj *o, struct mline *l)
 	    mline_double(l, &x[2])) {
 		mesh_err(o->err, o->errlen, o->what,
 			 "line %zu: a vertex needs 3 coordinates", l->lineno);
-		return -1;
+		return IRDM_EFORMAT;
 	}
 	if (surface_add_vert(&o->b, x)) {
 		mesh_err(o->err, o->errlen, o->what,
 			 "line %zu: out of memory or too many vertices", l->lineno);
-		return -1;
+		return IRDM_ENOMEM;
 	}
 	return 0;
 }
@@ -49,13 +50,13 @@ static int obj_corner(struct obj *o, const struct mline *l, const char *tok,
 		mesh_quote(q, sizeof(q), tok, n);
 		mesh_err(o->err, o->errlen, o->what,
 			 "line %zu: bad vertex reference '%s'", l->lineno, q);
-		return -1;
+		return IRDM_EFORMAT;
 	}
 	i = i < 0 ? nv + i : i - 1;
 	if (i < 0 || i >= (long long)MESH_MAX_ITEMS) {
 		mesh_err(o->err, o->errlen, o->what,
 			 "line %zu: vertex reference out of range", l->lineno);
-		return -1;
+		return IRDM_EFORMAT;
 	}
 	*v = (uint32_t)i;
 	return 0;
@@ -66,24 +67,26 @@ static int obj_face(struct obj *o, struct mline *l)
 	uint32_t first = 0, prev = 0, v;
 	const char *tok;
 	size_t n, k = 0;
+	int ret;
 
 	for (; mline_token(l, &tok, &n); k++) {
-		if (obj_corner(o, l, tok, n, &v))
-			return -1;
+		ret = obj_corner(o, l, tok, n, &v);
+		if (ret)
+			return ret;
 		if (k == 0)
 			first = v;
 		if (k >= 2 && surface_add_tri(&o->b, first, prev, v)) {
 			mesh_err(o->err, o->errlen, o->what,
 				 "line %zu: out of memory or too many triangles",
 				 l->lineno);
-			return -1;
+			return IRDM_ENOMEM;
 		}
 		prev = v;
 	}
 	if (k < 3) {
 		mesh_err(o->err, o->errlen, o->what,
 			 "line %zu: a face needs at least 3 vertices", l->lineno);
-		return -1;
+		return IRDM_EFORMAT;
 	}
 	return 0;
 }

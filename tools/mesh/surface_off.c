@@ -7,6 +7,7 @@
  */
 #include <string.h>
 
+#include "irdm/error.h"
 #include "mesh/mesh_priv.h"
 
 /* Shortest records: "0 0 0" and "3 0 1 2", plus a newline each. */
@@ -44,19 +45,19 @@ static int off_header(struct mtext *t, size_t *nv, size_t *nf, const char *what,
 	if (!mtext_next_line(t, &l) || !mline_token(&l, &tok, &n) ||
 	    off_keyword(tok, n)) {
 		mesh_err(err, errlen, what, "not an OFF file (no OFF header)");
-		return -1;
+		return IRDM_EFORMAT;
 	}
 	/* The counts may follow on the same line. */
 	if (l.pos >= l.len && !mtext_next_line(t, &l)) {
 		mesh_err(err, errlen, what, "truncated after the OFF header");
-		return -1;
+		return IRDM_EFORMAT;
 	}
 	if (off_count(&l, MESH_MAX_ITEMS, nv) ||
 	    off_count(&l, MESH_MAX_ITEMS, nf) ||
 	    *nv > t->len / VERT_MIN_BYTES || *nf > t->len / FACE_MIN_BYTES) {
 		mesh_err(err, errlen, what,
 			 "line %zu: bad or impossible vertex/face counts", l.lineno);
-		return -1;
+		return IRDM_EFORMAT;
 	}
 	return 0;
 }
@@ -72,19 +73,19 @@ static int off_face(struct surface_build *b, struct mline *l, const char *what,
 		mesh_err(err, errlen, what,
 			 "line %zu: a face needs a vertex count of at least 3",
 			 l->lineno);
-		return -1;
+		return IRDM_EFORMAT;
 	}
 	for (i = 0; i < k; i++) {
 		if (mline_ll(l, &v) || v < 0 || (unsigned long long)v >= b->s->n_verts) {
 			mesh_err(err, errlen, what,
 				 "line %zu: bad or out-of-range vertex index", l->lineno);
-			return -1;
+			return IRDM_EFORMAT;
 		}
 		if (i == 0)
 			first = (uint32_t)v;
 		if (i >= 2 && surface_add_tri(b, first, prev, (uint32_t)v)) {
 			mesh_err(err, errlen, what, "out of memory or too many triangles");
-			return -1;
+			return IRDM_ENOMEM;
 		}
 		prev = (uint32_t)v;
 	}
@@ -97,27 +98,29 @@ static int off_body(struct mtext *t, struct surface_build *b, size_t nv,
 	struct mline l;
 	double x[3];
 	size_t i;
+	int ret;
 
 	for (i = 0; i < nv + nf; i++) {
 		if (!mtext_next_line(t, &l)) {
 			mesh_err(err, errlen, what, "truncated: expected %zu vertices and %zu faces",
 				 nv, nf);
-			return -1;
+			return IRDM_EFORMAT;
 		}
 		if (i >= nv) {
-			if (off_face(b, &l, what, err, errlen))
-				return -1;
+			ret = off_face(b, &l, what, err, errlen);
+			if (ret)
+				return ret;
 			continue;
 		}
 		if (mline_double(&l, &x[0]) || mline_double(&l, &x[1]) ||
 		    mline_double(&l, &x[2])) {
 			mesh_err(err, errlen, what,
 				 "line %zu: a vertex needs 3 coordinates", l.lineno);
-			return -1;
+			return IRDM_EFORMAT;
 		}
 		if (surface_add_vert(b, x)) {
 			mesh_err(err, errlen, what, "out of memory");
-			return -1;
+			return IRDM_ENOMEM;
 		}
 	}
 	return 0;
@@ -129,14 +132,18 @@ int irdm_surface_parse_off(const char *txt, size_t len, const char *what,
 	struct surface_build b = { s, 0, 0 };
 	struct mtext t;
 	size_t nv, nf;
+	int ret;
 
 	memset(s, 0, sizeof(*s));
 	mtext_init(&t, txt, len, '#');
-	if (off_header(&t, &nv, &nf, what, err, errlen) ||
-	    off_body(&t, &b, nv, nf, what, err, errlen) ||
-	    surface_check(s, what, err, errlen)) {
+	ret = off_header(&t, &nv, &nf, what, err, errlen);
+	if (!ret)
+		ret = off_body(&t, &b, nv, nf, what, err, errlen);
+	if (!ret)
+		ret = surface_check(s, what, err, errlen);
+	if (ret) {
 		irdm_surface_free(s);
-		return -1;
+		return ret;
 	}
-	return 0;
+	return IRDM_OK;
 }

@@ -12,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "irdm/error.h"
 #include "mesh/mesh_priv.h"
 
 #define STL_HEADER 84
@@ -48,7 +49,7 @@ static int merge_corners(struct corner *c, size_t n, struct irdm_surface *s,
 	s->pos_m = malloc((n ? n : 1) * 3 * sizeof(*s->pos_m));
 	if (!s->tris || !s->pos_m) {
 		mesh_err(err, errlen, what, "out of memory");
-		return -1;
+		return IRDM_ENOMEM;
 	}
 	if (n)
 		qsort(c, n, sizeof(*c), corner_cmp);
@@ -73,7 +74,7 @@ static int set_corner(struct corner *c, size_t i, const double x[3],
 		if (!isfinite(x[k])) {
 			mesh_err(err, errlen, what,
 				 "triangle %zu has a non-finite coordinate", i / 3 + 1);
-			return -1;
+			return IRDM_EFORMAT;
 		}
 		c[i].x[k] = x[k] + 0.0;
 	}
@@ -103,12 +104,12 @@ static int parse_binary(const unsigned char *p, size_t n_tris,
 	struct corner *c;
 	size_t t, k;
 	double x[3];
-	int ret = -1;
+	int ret;
 
 	c = malloc((n_tris ? 3 * n_tris : 1) * sizeof(*c));
 	if (!c) {
 		mesh_err(err, errlen, what, "out of memory");
-		return -1;
+		return IRDM_ENOMEM;
 	}
 	for (t = 0; t < n_tris; t++) {
 		/* 12 bytes of normal, then 3 corners of 12 bytes each */
@@ -118,7 +119,8 @@ static int parse_binary(const unsigned char *p, size_t n_tris,
 			x[0] = le_float(r + 12 * k);
 			x[1] = le_float(r + 12 * k + 4);
 			x[2] = le_float(r + 12 * k + 8);
-			if (set_corner(c, 3 * t + k, x, what, err, errlen))
+			ret = set_corner(c, 3 * t + k, x, what, err, errlen);
+			if (ret)
 				goto out_free;
 		}
 	}
@@ -144,13 +146,13 @@ static int ascii_vertex(struct stl_ascii *a, struct mline *l, const char *what,
 	if (!a->open || a->in_facet >= 3) {
 		mesh_err(err, errlen, what,
 			 "line %zu: vertex outside a facet or a fourth vertex", l->lineno);
-		return -1;
+		return IRDM_EFORMAT;
 	}
 	if (mline_double(l, &x[0]) || mline_double(l, &x[1]) ||
 	    mline_double(l, &x[2])) {
 		mesh_err(err, errlen, what,
 			 "line %zu: a vertex needs 3 coordinates", l->lineno);
-		return -1;
+		return IRDM_EFORMAT;
 	}
 	if (a->n >= 3 * (size_t)MESH_MAX_ITEMS)
 		p = NULL;
@@ -158,7 +160,7 @@ static int ascii_vertex(struct stl_ascii *a, struct mline *l, const char *what,
 		p = mesh_grow(a->c, &a->cap, a->n + 1, sizeof(*p));
 	if (!p) {
 		mesh_err(err, errlen, what, "out of memory or too many triangles");
-		return -1;
+		return IRDM_ENOMEM;
 	}
 	a->c = p;
 	a->in_facet++;
@@ -189,7 +191,7 @@ static int ascii_line(struct stl_ascii *a, struct mline *l, const char *what,
 		return 0;
 	mesh_quote(q, sizeof(q), tok, n);
 	mesh_err(err, errlen, what, "line %zu: unexpected '%s'", l->lineno, q);
-	return -1;
+	return IRDM_EFORMAT;
 }
 
 static int parse_ascii(const char *txt, size_t len, struct irdm_surface *s,
@@ -198,14 +200,16 @@ static int parse_ascii(const char *txt, size_t len, struct irdm_surface *s,
 	struct stl_ascii a = { NULL, 0, 0, 0, false };
 	struct mtext t;
 	struct mline l;
-	int ret = -1;
+	int ret = IRDM_OK;
 
 	mtext_init(&t, txt, len, -1);
-	while (mtext_next_line(&t, &l))
-		if (ascii_line(&a, &l, what, err, errlen))
-			goto out_free;
+	while (!ret && mtext_next_line(&t, &l))
+		ret = ascii_line(&a, &l, what, err, errlen);
+	if (ret)
+		goto out_free;
 	if (a.open) {
 		mesh_err(err, errlen, what, "truncated inside a facet");
+		ret = IRDM_EFORMAT;
 		goto out_free;
 	}
 	ret = merge_corners(a.c, a.n, s, what, err, errlen);
@@ -248,10 +252,10 @@ int irdm_surface_parse_stl(const void *buf, size_t len, const char *what,
 		mesh_err(err, errlen, what,
 			 "binary STL declares %zu triangles but has only %zu bytes",
 			 n, len);
-		ret = -1;
+		ret = IRDM_EFORMAT;
 	} else {
 		mesh_err(err, errlen, what, "not an STL file");
-		ret = -1;
+		ret = IRDM_EFORMAT;
 	}
 	if (!ret)
 		ret = surface_check(s, what, err, errlen);

@@ -20,6 +20,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "irdm/error.h"
 #include "mesh/mesh_priv.h"
 
 extern char **environ;
@@ -57,14 +58,14 @@ static int build_switches(struct tg_run *r, const char *sw, const char *what,
 		      c == '-')) {
 			mesh_err(err, errlen, what,
 				 "tetgen switches may hold only letters, digits, '.', '/' and '-'");
-			return -1;
+			return IRDM_EINVAL;
 		}
 	}
 	n = snprintf(r->sw, sizeof(r->sw), "-%s%s%s", strchr(sw, 'p') ? "" : "p",
 		     sw, strchr(sw, 'Q') ? "" : "Q");
 	if (n < 0 || (size_t)n >= sizeof(r->sw)) {
 		mesh_err(err, errlen, what, "tetgen switches are too long");
-		return -1;
+		return IRDM_EINVAL;
 	}
 	return 0;
 }
@@ -80,12 +81,12 @@ static int make_paths(struct tg_run *r, const char *what, char *err,
 	n = snprintf(r->dir, sizeof(r->dir), "%s/irdm-mesh-XXXXXX", tmp);
 	if (n < 0 || (size_t)n >= sizeof(r->dir)) {
 		mesh_err(err, errlen, what, "TMPDIR is too long");
-		return -1;
+		return IRDM_EINVAL;
 	}
 	if (!mkdtemp(r->dir)) {
 		mesh_err(err, errlen, what, "cannot create a temporary directory in %s: %s",
 			 tmp, strerror(errno));
-		return -1;
+		return IRDM_EIO;
 	}
 	snprintf(r->smesh, sizeof(r->smesh), "%s/surf.smesh", r->dir);
 	snprintf(r->node, sizeof(r->node), "%s/surf.1.node", r->dir);
@@ -131,7 +132,7 @@ static int write_smesh(const struct tg_run *r, const struct irdm_surface *s,
 	remap = malloc(s->n_verts * sizeof(*remap));
 	if (!remap) {
 		mesh_err(err, errlen, what, "out of memory");
-		return -1;
+		return IRDM_ENOMEM;
 	}
 	for (i = 0; i < s->n_verts; i++)
 		remap[i] = UINT32_MAX;
@@ -145,7 +146,7 @@ static int write_smesh(const struct tg_run *r, const struct irdm_surface *s,
 		mesh_err(err, errlen, what, "cannot write %s: %s", r->smesh,
 			 strerror(errno));
 		free(remap);
-		return -1;
+		return IRDM_EIO;
 	}
 	fprintf(f, "%zu 3 0 0\n", nv);
 	for (i = 0; i < s->n_verts; i++)
@@ -163,9 +164,9 @@ static int write_smesh(const struct tg_run *r, const struct irdm_surface *s,
 	free(remap);
 	if (bad) {
 		mesh_err(err, errlen, what, "cannot write %s", r->smesh);
-		return -1;
+		return IRDM_EIO;
 	}
-	return 0;
+	return IRDM_OK;
 }
 
 /*
@@ -240,13 +241,13 @@ static int run_tetgen(const struct tg_run *r, const char *what, char *err,
 	if (rc) {
 		mesh_err(err, errlen, what, "cannot run %s: %s%s", prog, strerror(rc),
 			 rc == ENOENT ? " (install Debian's tetgen package)" : "");
-		return -1;
+		return IRDM_ECHILD;
 	}
 	while (waitpid(pid, &status, 0) < 0) {
 		if (errno != EINTR) {
 			mesh_err(err, errlen, what, "waiting for %s: %s", prog,
 				 strerror(errno));
-			return -1;
+			return IRDM_ECHILD;
 		}
 	}
 	if (WIFEXITED(status) && WEXITSTATUS(status) == 0)
@@ -257,7 +258,7 @@ static int run_tetgen(const struct tg_run *r, const char *what, char *err,
 		 prog, r->sw, WIFEXITED(status) ? "exit status" : "signal",
 		 WIFEXITED(status) ? WEXITSTATUS(status) : WTERMSIG(status),
 		 last[0] ? ": " : "", last);
-	return -1;
+	return IRDM_ECHILD;
 }
 
 static int read_result(const struct tg_run *r, struct irdm_mesh *m,
@@ -266,20 +267,22 @@ static int read_result(const struct tg_run *r, struct irdm_mesh *m,
 	struct mesh_labels lab = { r->out_what, r->out_what, NULL, NULL };
 	char *node_txt = NULL, *ele_txt = NULL, last[160];
 	size_t node_len, ele_len;
-	int ret = -1;
+	int ret;
 
 	if (access(r->ele, F_OK)) {
 		last_log_line(r->log, last, sizeof(last));
 		mesh_err(err, errlen, what,
 			 "tetgen produced no tetrahedra (is the surface closed?)%s%s",
 			 last[0] ? ": " : "", last);
-		return -1;
+		return IRDM_ECHILD;
 	}
-	if (mesh_read_file(r->node, &node_txt, &node_len, err, errlen) ||
-	    mesh_read_file(r->ele, &ele_txt, &ele_len, err, errlen))
-		goto out_free;
-	if (mesh_parse_tetgen_labeled(node_txt, node_len, ele_txt, ele_len, m,
-				      &lab, err, errlen))
+	ret = mesh_read_file(r->node, &node_txt, &node_len, err, errlen);
+	if (!ret)
+		ret = mesh_read_file(r->ele, &ele_txt, &ele_len, err, errlen);
+	if (!ret)
+		ret = mesh_parse_tetgen_labeled(node_txt, node_len, ele_txt, ele_len, m,
+						&lab, err, errlen);
+	if (ret)
 		goto out_free;
 	ret = mesh_finish_labeled(m, &lab, err, errlen);
 out_free:
@@ -294,23 +297,28 @@ int irdm_surface_tetrahedralize(const struct irdm_surface *s, const char *switch
 				char *err, size_t errlen)
 {
 	struct tg_run *r;
-	int ret = -1;
+	int ret;
 
 	memset(m, 0, sizeof(*m));
 	if (!what)
 		what = "surface";
-	if (surface_check(s, what, err, errlen))
-		return -1;
+	ret = surface_check(s, what, err, errlen);
+	if (ret)
+		return ret;
 	r = calloc(1, sizeof(*r));
 	if (!r) {
 		mesh_err(err, errlen, what, "out of memory");
-		return -1;
+		return IRDM_ENOMEM;
 	}
-	if (build_switches(r, switches, what, err, errlen) ||
-	    make_paths(r, what, err, errlen))
+	ret = build_switches(r, switches, what, err, errlen);
+	if (!ret)
+		ret = make_paths(r, what, err, errlen);
+	if (ret)
 		goto out_free;
-	if (!write_smesh(r, s, what, err, errlen) &&
-	    !run_tetgen(r, what, err, errlen))
+	ret = write_smesh(r, s, what, err, errlen);
+	if (!ret)
+		ret = run_tetgen(r, what, err, errlen);
+	if (!ret)
 		ret = read_result(r, m, what, err, errlen);
 	remove_dir(r->dir);
 	if (!ret)

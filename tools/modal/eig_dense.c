@@ -58,7 +58,7 @@ int irdm_eig_dense(const struct irdm_fem *fem, size_t n_lowest, double *w2, doub
 	int *isuppz = malloc(2 * (size_t)n * sizeof(int));
 	double *work = NULL;
 	int *iwork = NULL;
-	int ret = -1;
+	int ret = IRDM_ENUMERIC;
 
 	if (!a || (!diag && !l) || !dsqrt || !isuppz)
 		goto out_nomem;
@@ -90,12 +90,13 @@ int irdm_eig_dense(const struct irdm_fem *fem, size_t n_lowest, double *w2, doub
 	} else {
 		dtrsm_("L", "L", "T", "N", &n, &m, &one, l, &n, phi, &n);
 	}
-	ret = 0;
+	ret = IRDM_OK;
 	goto out_free;
 
 out_nomem:
 	snprintf(err, errlen, "dense eigensolver: out of memory for n = %d (needs %.1f GiB)",
 		 n, 2.0 * n * (double)n * 8 / (1 << 30));
+	ret = IRDM_ENOMEM;
 out_free:
 	free(a);
 	free(l);

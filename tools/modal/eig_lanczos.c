@@ -43,7 +43,7 @@ static int run_arpack(struct op_ctx *o, const struct irdm_fem *fem, int nev, dou
 	int n = (int)o->n, ncv = 2 * nev + 20, ido = 0, info = 0, lworkl;
 	int iparam[11] = { 0 }, ipntr[11] = { 0 };
 	double tol = 0.0;
-	int ret = -1;
+	int ret = IRDM_ENUMERIC;
 
 	if (ncv > n)
 		ncv = n;
@@ -56,6 +56,7 @@ static int run_arpack(struct op_ctx *o, const struct irdm_fem *fem, int nev, dou
 	int *select = calloc((size_t)ncv, sizeof(int));
 	if (!resid || !v || !workd || !workl || !d || !select) {
 		snprintf(err, errlen, "Lanczos: out of memory (n = %d, %d vectors)", n, ncv);
+		ret = IRDM_ENOMEM;
 		goto out_free;
 	}
 	iparam[0] = 1;          /* exact shifts */
@@ -98,7 +99,7 @@ static int run_arpack(struct op_ctx *o, const struct irdm_fem *fem, int nev, dou
 	/* dseupd returns ascending eigenvalues of K x = l M x for mode 3. */
 	memcpy(w2, d, (size_t)nev * sizeof(double));
 	memcpy(phi, v, (size_t)n * nev * sizeof(double));
-	ret = 0;
+	ret = IRDM_OK;
 	goto out_free;
 
 out_chol:
@@ -118,22 +119,24 @@ int irdm_eig_lanczos(const struct irdm_fem *fem, size_t n_lowest, double sigma,
 		     char *err, size_t errlen)
 {
 	struct op_ctx o = { .n = fem->K.n };
-	int ret = -1;
+	int ret;
 
 	if (n_lowest >= fem->K.n) {
 		snprintf(err, errlen, "Lanczos: %zu modes asked of a model with %zu DoFs; use the dense solver",
 			 n_lowest, fem->K.n);
-		return -1;
+		return IRDM_EINVAL;
 	}
 	cholmod_l_start(&o.cc);
 	o.cc.print = 0;
 	if (progress)
 		progress(pctx, "sparse factorisation", 0.0);
-	if (irdm_fem_factor(fem, 1.0, -sigma, "Lanczos", &o.cc, &o.f, err, errlen))
+	ret = irdm_fem_factor(fem, 1.0, -sigma, "Lanczos", &o.cc, &o.f, err, errlen);
+	if (ret)
 		goto out_free;
 	o.b = cholmod_l_allocate_dense(o.n, 1, o.n, CHOLMOD_REAL, &o.cc);
 	if (!o.b) {
 		snprintf(err, errlen, "Lanczos: out of memory");
+		ret = IRDM_ENOMEM;
 		goto out_free;
 	}
 	ret = run_arpack(&o, fem, (int)n_lowest, sigma, progress, pctx, w2, phi, err, errlen);

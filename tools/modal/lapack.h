@@ -22,5 +22,30 @@ void dgemm_(const char *ta, const char *tb, const int *m, const int *n, const in
 	    const double *alpha, const double *a, const int *lda, const double *b,
 	    const int *ldb, const double *beta, double *c, const int *ldc);
 void openblas_set_num_threads(int n);
+int openblas_get_num_threads(void);
+
+/*
+ * OpenBLAS single-threaded while our own workers run: they already occupy
+ * the CPUs, nested BLAS threads would oversubscribe them, and a BLAS thread
+ * count that differs between runs could change reduction order and so break
+ * bitwise reproducibility.  The count is process-wide state, so it is
+ * saved and given back as it was, not reset to some default:
+ *
+ *	int saved = irdm_blas_serial_begin();
+ *	... parallel phase ...
+ *	irdm_blas_serial_end(saved);
+ */
+static inline int irdm_blas_serial_begin(void)
+{
+	int saved = openblas_get_num_threads();
+
+	openblas_set_num_threads(1);
+	return saved;
+}
+
+static inline void irdm_blas_serial_end(int saved)
+{
+	openblas_set_num_threads(saved);
+}
 
 #endif

@@ -12,6 +12,7 @@
 #include <stddef.h>
 
 #include "fem/fem.h"
+#include "irdm/error.h"
 #include "irdm/image_format.h"
 
 enum irdm_eig_method {

@@ -51,13 +51,13 @@ static int split_rigid(struct irdm_modes *out, size_t n_req, const double *w2,
 		snprintf(err, errlen,
 			 "model: %zu zero-stiffness mode(s) in a grounded object (lowest eigenvalue %g): fix more nodes or declare it floating",
 			 r, w2[0]);
-		return -1;
+		return IRDM_EINVAL;
 	}
 	if (floating && r != 6) {
 		snprintf(err, errlen,
 			 "model: a floating object must have 6 rigid modes, found %zu (is the mesh in one piece?)",
 			 r);
-		return -1;
+		return IRDM_EINVAL;
 	}
 	out->n_rigid = r;
 	out->n_modes = n_req - r;
@@ -66,7 +66,7 @@ static int split_rigid(struct irdm_modes *out, size_t n_req, const double *w2,
 	out->rigid_phi = malloc(n * (r ? r : 1) * sizeof(double));
 	if (!out->omega2 || !out->phi || !out->rigid_phi) {
 		snprintf(err, errlen, "modes: out of memory");
-		return -1;
+		return IRDM_ENOMEM;
 	}
 	memcpy(out->omega2, w2 + r, out->n_modes * sizeof(double));
 	memcpy(out->phi, phi + n * r, n * out->n_modes * sizeof(double));
@@ -81,7 +81,7 @@ int irdm_modes_solve(const struct irdm_fem *fem, size_t n_wanted, bool floating,
 	size_t n = fem->K.n, n_rigid = floating ? 6 : 0, n_req;
 	double scale = stiffness_scale(fem);
 	double *w2 = NULL, *phi = NULL;
-	int ret = -1;
+	int ret;
 
 	memset(out, 0, sizeof(*out));
 	out->n = n;
@@ -89,7 +89,7 @@ int irdm_modes_solve(const struct irdm_fem *fem, size_t n_wanted, bool floating,
 		n_wanted = n > n_rigid ? n - n_rigid : 0;
 	if (n_wanted == 0) {
 		snprintf(err, errlen, "model: no elastic modes (%zu free DoFs)", n);
-		return -1;
+		return IRDM_EINVAL;
 	}
 	n_req = n_wanted + n_rigid;
 	if (method == IRDM_EIG_AUTO)
@@ -100,6 +100,7 @@ int irdm_modes_solve(const struct irdm_fem *fem, size_t n_wanted, bool floating,
 	phi = malloc(n * n_req * sizeof(double));
 	if (!w2 || !phi) {
 		snprintf(err, errlen, "modes: out of memory for %zu modes of %zu DoFs", n_req, n);
+		ret = IRDM_ENOMEM;
 		goto out_free;
 	}
 	if (progress)

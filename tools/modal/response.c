@@ -42,7 +42,7 @@ int irdm_fir_from_modes(const struct irdm_modes *m, const struct irdm_mode *zoh,
 	double *scaled = malloc((size_t)nc * K * sizeof(double));
 	double *blk = malloc((size_t)nr * nc * sizeof(double));
 	double one = 1.0, zero = 0.0;
-	int ret = -1;
+	int ret = IRDM_ENOMEM;
 
 	if (!pr || !pc || !h || !scaled || !blk)
 		goto out_free;
@@ -67,7 +67,7 @@ int irdm_fir_from_modes(const struct irdm_modes *m, const struct irdm_mode *zoh,
 		if (progress && (s % 16 == 0 || s + 1 == T))
 			progress(ctx, "FIR responses", (double)(s + 1) / T);
 	}
-	ret = 0;
+	ret = IRDM_OK;
 out_free:
 	free(pr);
 	free(pc);

@@ -6,6 +6,7 @@
 #ifndef IRDM_TOOLS_RESPONSE_H
 #define IRDM_TOOLS_RESPONSE_H
 
+#include "irdm/error.h"
 #include "modal/modal.h"
 
 /* Discretise every mode with its Rayleigh damping ratio. */
@@ -17,6 +18,7 @@ int irdm_modes_discretise(const struct irdm_modes *m, const struct irdm_rayleigh
  * nodes cols (3 DoFs each, free indices or -1) and row nodes rows, s < T:
  *   R = sum_k phi_r,k phi_c,k^T h_k[s]  (+ D[c][r] at s = 0 when D != NULL).
  * out has n_cols*n_rows*T*9 doubles, layout of the FIR section.
+ * Return: IRDM_OK; IRDM_ENOMEM (out is then not filled).
  */
 int irdm_fir_from_modes(const struct irdm_modes *m, const struct irdm_mode *zoh,
 			const int64_t *col_dofs, size_t n_cols, const int64_t *row_dofs,

@@ -10,6 +10,7 @@
 
 #include <stddef.h>
 
+#include "irdm/error.h"
 #include "irdm/image_format.h"
 
 /* Bounds of the search; a radius outside is reported as the bound. */

@@ -76,7 +76,7 @@ int irdm_compliance_solve(const struct irdm_fem *fem, const struct irdm_modes *m
 	cholmod_factor *f = NULL;
 	cholmod_dense *rhs = NULL, *sol = NULL;
 	double *tmp = malloc(n * sizeof(double)), *load = NULL;
-	int ret = -1;
+	int ret;
 
 	cholmod_l_start(&cc);
 	cc.print = 0;
@@ -84,9 +84,11 @@ int irdm_compliance_solve(const struct irdm_fem *fem, const struct irdm_modes *m
 	load = malloc(n * n_in * sizeof(double));
 	if (!rhs || !tmp || !load) {
 		snprintf(err, errlen, "static compliance: out of memory");
+		ret = IRDM_ENOMEM;
 		goto out_free;
 	}
-	if (irdm_fem_factor(fem, 1.0, eps, "static compliance", &cc, &f, err, errlen))
+	ret = irdm_fem_factor(fem, 1.0, eps, "static compliance", &cc, &f, err, errlen);
+	if (ret)
 		goto out_free;
 	for (size_t c = 0; c < n_in; c++)
 		elastic_load(fem, m, in[c], &load[c * n], tmp);
@@ -102,13 +104,14 @@ int irdm_compliance_solve(const struct irdm_fem *fem, const struct irdm_modes *m
 		sol = cholmod_l_solve(CHOLMOD_A, f, rhs, &cc);
 		if (!sol) {
 			snprintf(err, errlen, "static compliance: sparse solve failed");
+			ret = cc.status == CHOLMOD_OUT_OF_MEMORY ? IRDM_ENOMEM : IRDM_ENUMERIC;
 			goto out_free;
 		}
 		memcpy(X, sol->x, n * n_in * sizeof(double));
 		if (floating)
 			remove_rigid(fem, m, X, n_in, tmp);
 	}
-	ret = 0;
+	ret = IRDM_OK;
 out_free:
 	free(tmp);
 	free(load);
@@ -128,7 +131,7 @@ int irdm_static_correction(const struct irdm_fem *fem, const struct irdm_modes *
 	int64_t *in = malloc(3 * n_cols * sizeof(int64_t));
 	size_t *slot = malloc(3 * n_cols * sizeof(size_t));
 	double *X = NULL;
-	int ret = -1;
+	int ret = IRDM_OK;
 
 	if (!in || !slot)
 		goto out_nomem;
@@ -140,7 +143,9 @@ int irdm_static_correction(const struct irdm_fem *fem, const struct irdm_modes *
 	X = malloc(n * (n_in ? n_in : 1) * sizeof(double));
 	if (!X)
 		goto out_nomem;
-	if (n_in && irdm_compliance_solve(fem, m, floating, in, n_in, X, err, errlen))
+	if (n_in)
+		ret = irdm_compliance_solve(fem, m, floating, in, n_in, X, err, errlen);
+	if (ret)
 		goto out_free;
 	for (size_t c = 0; c < n_cols; c++)
 		for (size_t r = 0; r < n_rows; r++)
@@ -156,10 +161,10 @@ int irdm_static_correction(const struct irdm_fem *fem, const struct irdm_modes *
 					}
 					out[((c * n_rows + r) * 3 + i) * 3 + j] = v;
 				}
-	ret = 0;
 	goto out_free;
 out_nomem:
 	snprintf(err, errlen, "static correction: out of memory");
+	ret = IRDM_ENOMEM;
 out_free:
 	free(in);
 	free(slot);

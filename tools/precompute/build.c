@@ -9,7 +9,9 @@
 #include <unistd.h>
 
 #include "image/bvh_build.h"
+#include "image/elem_store.h"
 #include "image/image_writer.h"
+#include "irdm/error.h"
 #include "irdm/image.h"
 #include "modal/lapack.h"
 #include "modal/response.h"
@@ -17,6 +19,7 @@
 #include "precompute/precompute.h"
 #include "precompute/td_part.h"
 #include "timedomain/timedomain.h"
+#include "util/fnv1a.h"
 
 struct build {
 	const struct irdm_scene *sc;
@@ -45,17 +48,6 @@ static double now_s(void)
 	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-static uint64_t fnv1a(uint64_t h, const void *p, size_t n)
-{
-	const unsigned char *b = p;
-
-	for (size_t i = 0; i < n; i++) {
-		h ^= b[i];
-		h *= 1099511628211ull;
-	}
-	return h;
-}
-
 /* Modes the scene needs solved (0: all). */
 static size_t modes_needed(const struct irdm_scene *sc)
 {
@@ -75,6 +67,7 @@ static int modal_data(struct build *b, char *err, size_t errlen)
 {
 	struct irdm_model *m = &b->m;
 	size_t K = m->modes.n_modes, n = m->modes.n;
+	int ret;
 
 	b->n_modes = K;
 	b->zoh = malloc(K * sizeof(*b->zoh));
@@ -94,33 +87,38 @@ static int modal_data(struct build *b, char *err, size_t errlen)
 		b->corr = malloc(m->n_cols * n_out * 9 * sizeof(double));
 		if (!b->corr)
 			goto out_nomem;
-		if (irdm_static_correction(&m->fem, &m->modes, b->sc->floating, m->col_dofs,
-					   m->n_cols, fir ? m->row_dofs : m->col_dofs, n_out,
-					   b->corr, err, errlen))
-			return -1;
+		ret = irdm_static_correction(&m->fem, &m->modes, b->sc->floating, m->col_dofs,
+					     m->n_cols, fir ? m->row_dofs : m->col_dofs, n_out,
+					     b->corr, err, errlen);
+		if (ret)
+			return ret;
 	}
-	return 0;
+	return IRDM_OK;
 out_nomem:
 	snprintf(err, errlen, "precompute: out of memory for the modal data");
-	return -1;
+	return IRDM_ENOMEM;
 }
 
 static int fir_from_modes(struct build *b, char *err, size_t errlen)
 {
 	struct irdm_model *m = &b->m;
 	size_t T = b->sc->fir_length;
+	int ret;
 
-	if (modal_data(b, err, errlen))
-		return -1;
+	ret = modal_data(b, err, errlen);
+	if (ret)
+		return ret;
 	b->fir = malloc(m->n_cols * m->n_rows * T * 9 * sizeof(double));
 	if (!b->fir) {
 		snprintf(err, errlen, "precompute: FIR of %zu x %zu nodes x %zu samples does not fit in memory (%.1f GiB); use a modal image or a smaller touch/display region",
 			 m->n_cols, m->n_rows, T, (double)m->n_cols * m->n_rows * T * 72 / (1 << 30));
-		return -1;
+		return IRDM_ENOMEM;
 	}
-	irdm_fir_from_modes(&m->modes, b->zoh, m->col_dofs, m->n_cols, m->row_dofs, m->n_rows,
-			    T, b->corr, b->fir, b->o->progress, b->o->ctx);
-	return 0;
+	ret = irdm_fir_from_modes(&m->modes, b->zoh, m->col_dofs, m->n_cols, m->row_dofs,
+				  m->n_rows, T, b->corr, b->fir, b->o->progress, b->o->ctx);
+	if (ret)
+		snprintf(err, errlen, "precompute: out of memory synthesising the FIR from modes");
+	return ret;
 }
 
 /* The time-domain inputs are the free DoFs of the columns, in column order;
@@ -163,14 +161,15 @@ static int td_run(struct build *b, size_t begin, size_t end, double *R, char *er
 		.dt_s = b->sc->dt_s, .n_samples = b->sc->fir_length, .substeps = b->sc->substeps,
 		.damping = m->damping, .floating = b->sc->floating, .threads = b->sc->threads,
 		.progress = td_progress, .progress_ctx = &tp,
-		/* SPEC: rigid motion removed by a mass-weighted best fit (Kabsch) */
+		/* rigid motion removed by a mass-weighted best fit (Kabsch):
+		 * docs/architecture.md, "Frames and signs" */
 		.rigid = IRDM_TD_RIGID_KABSCH,
 	};
 	int ret;
 
 	if (!global) {
 		snprintf(err, errlen, "precompute: out of memory");
-		return -1;
+		return IRDM_ENOMEM;
 	}
 	list_inputs(m, global, NULL);
 	ret = irdm_td_responses(&m->mesh, &m->fem, &o, global + begin, end - begin, m->rows,
@@ -179,15 +178,20 @@ static int td_run(struct build *b, size_t begin, size_t end, double *R, char *er
 	return ret;
 }
 
-/* Scatter time-domain input columns into the FIR layout. */
-static void td_scatter(struct build *b, const double *R, size_t begin, size_t end)
+/* Scatter time-domain input columns into the FIR layout.
+ * Return: IRDM_OK; IRDM_ENOMEM if the input list does not fit (the FIR is
+ * then incomplete: the caller must not write it). */
+static int td_scatter(struct build *b, const double *R, size_t begin, size_t end,
+		      char *err, size_t errlen)
 {
 	struct irdm_model *m = &b->m;
 	size_t T = b->sc->fir_length, n_out = 3 * m->n_rows;
 	size_t *slot = malloc(3 * m->n_cols * sizeof(size_t));
 
-	if (!slot)
-		return;
+	if (!slot) {
+		snprintf(err, errlen, "precompute: out of memory scattering time-domain responses");
+		return IRDM_ENOMEM;
+	}
 	list_inputs(m, NULL, slot);
 	for (size_t i = begin; i < end; i++) {
 		size_t c = slot[i] / 3, j = slot[i] % 3;
@@ -198,61 +202,53 @@ static void td_scatter(struct build *b, const double *R, size_t begin, size_t en
 						R[((i - begin) * T + s) * n_out + 3 * r + a];
 	}
 	free(slot);
+	return IRDM_OK;
 }
 
-static int fir_time_domain(struct build *b, char *err, size_t errlen)
+/* Time-domain responses of inputs [part_begin, part_end) into a part file. */
+static int td_part(struct build *b, size_t n_in, char *err, size_t errlen)
 {
-	struct irdm_model *m = &b->m;
-	size_t T = b->sc->fir_length, n_out = 3 * m->n_rows, n_in = list_inputs(m, NULL, NULL);
-	size_t fir_n = m->n_cols * m->n_rows * T * 9;
 	const struct irdm_precompute_opts *o = b->o;
-	double *R = NULL;
-	int ret = -1;
+	size_t T = b->sc->fir_length, n_out = 3 * b->m.n_rows;
+	size_t e = o->part_end < n_in ? o->part_end : n_in;
+	int ret;
 
-	if (o->part_out) {
-		size_t e = o->part_end < n_in ? o->part_end : n_in;
-		if (o->part_begin >= e) {
-			snprintf(err, errlen, "precompute: part range %zu:%zu is empty (the scene has %zu inputs)",
-				 o->part_begin, o->part_end, n_in);
-			return -1;
-		}
-		struct irdm_td_part p = { b->scene_hash, n_in, o->part_begin, e, T, n_out, NULL };
-		p.data = malloc((e - o->part_begin) * T * n_out * sizeof(double));
-		if (!p.data) {
-			snprintf(err, errlen, "precompute: out of memory for the part");
-			return -1;
-		}
-		ret = td_run(b, o->part_begin, e, p.data, err, errlen);
-		if (!ret)
-			ret = irdm_td_part_write(o->part_out, &p, err, errlen);
-		free(p.data);
-		return ret;
+	if (o->part_begin >= e) {
+		snprintf(err, errlen, "precompute: part range %zu:%zu is empty (the scene has %zu inputs)",
+			 o->part_begin, o->part_end, n_in);
+		return IRDM_EINVAL;
 	}
-	b->fir = calloc(fir_n, sizeof(double));
-	if (!b->fir) {
-		snprintf(err, errlen, "precompute: FIR does not fit in memory");
-		return -1;
+	struct irdm_td_part p = { b->scene_hash, n_in, o->part_begin, e, T, n_out, NULL };
+	p.data = malloc((e - o->part_begin) * T * n_out * sizeof(double));
+	if (!p.data) {
+		snprintf(err, errlen, "precompute: out of memory for the part");
+		return IRDM_ENOMEM;
 	}
-	if (!o->n_merge) {
-		R = malloc(n_in * T * n_out * sizeof(double));
-		if (!R) {
-			snprintf(err, errlen, "precompute: out of memory for time-domain responses");
-			return -1;
-		}
-		ret = td_run(b, 0, n_in, R, err, errlen);
-		if (!ret)
-			td_scatter(b, R, 0, n_in);
-		free(R);
-		return ret;
-	}
-	/* merge: every input covered exactly once, same scene */
+	ret = td_run(b, o->part_begin, e, p.data, err, errlen);
+	if (!ret)
+		ret = irdm_td_part_write(o->part_out, &p, err, errlen);
+	free(p.data);
+	return ret;
+}
+
+/* Merge: every input covered exactly once, by parts of the same scene. */
+static int td_merge(struct build *b, size_t n_in, char *err, size_t errlen)
+{
+	const struct irdm_precompute_opts *o = b->o;
+	size_t T = b->sc->fir_length, n_out = 3 * b->m.n_rows;
 	unsigned char *seen = calloc(n_in ? n_in : 1, 1);
-	if (!seen)
-		return -1;
+	int ret = IRDM_EINVAL;
+
+	if (!seen) {
+		snprintf(err, errlen, "merge: out of memory");
+		return IRDM_ENOMEM;
+	}
 	for (size_t k = 0; k < o->n_merge; k++) {
 		struct irdm_td_part p;
-		if (irdm_td_part_read(o->merge[k], &p, err, errlen))
+		ret = irdm_td_part_read(o->merge[k], &p, err, errlen);
+		if (ret)
 			goto out_seen;
+		ret = IRDM_EINVAL;
 		if (p.scene_hash != b->scene_hash || p.n_inputs != n_in || p.T != T || p.n_out != n_out) {
 			snprintf(err, errlen, "%s: part was made from a different scene", o->merge[k]);
 			free(p.data);
@@ -265,17 +261,49 @@ static int fir_time_domain(struct build *b, char *err, size_t errlen)
 				goto out_seen;
 			}
 		}
-		td_scatter(b, p.data, p.begin, p.end);
+		ret = td_scatter(b, p.data, p.begin, p.end, err, errlen);
 		free(p.data);
+		if (ret)
+			goto out_seen;
 	}
+	ret = IRDM_EINVAL;
 	for (size_t i = 0; i < n_in; i++)
 		if (!seen[i]) {
 			snprintf(err, errlen, "merge: input %zu of %zu is in no part", i, n_in);
 			goto out_seen;
 		}
-	ret = 0;
+	ret = IRDM_OK;
 out_seen:
 	free(seen);
+	return ret;
+}
+
+static int fir_time_domain(struct build *b, char *err, size_t errlen)
+{
+	struct irdm_model *m = &b->m;
+	size_t T = b->sc->fir_length, n_out = 3 * m->n_rows, n_in = list_inputs(m, NULL, NULL);
+	size_t fir_n = m->n_cols * m->n_rows * T * 9;
+	double *R;
+	int ret;
+
+	if (b->o->part_out)
+		return td_part(b, n_in, err, errlen);
+	b->fir = calloc(fir_n, sizeof(double));
+	if (!b->fir) {
+		snprintf(err, errlen, "precompute: FIR does not fit in memory");
+		return IRDM_ENOMEM;
+	}
+	if (b->o->n_merge)
+		return td_merge(b, n_in, err, errlen);
+	R = malloc(n_in * T * n_out * sizeof(double));
+	if (!R) {
+		snprintf(err, errlen, "precompute: out of memory for time-domain responses");
+		return IRDM_ENOMEM;
+	}
+	ret = td_run(b, 0, n_in, R, err, errlen);
+	if (!ret)
+		ret = td_scatter(b, R, 0, n_in, err, errlen);
+	free(R);
 	return ret;
 }
 
@@ -289,17 +317,8 @@ static void *store(double *x, size_t n, uint32_t elem, size_t *bytes)
 	*bytes = n * es;
 	if (!out)
 		return NULL;
-	for (size_t i = 0; i < n; i++) {
-		if (elem == IRDM_ELEM_F64) {
-			((double *)out)[i] = x[i];
-		} else if (elem == IRDM_ELEM_F32) {
-			((float *)out)[i] = (float)x[i];
-			x[i] = ((float *)out)[i];
-		} else {
-			((uint16_t *)out)[i] = irdm_f32_to_f16((float)x[i]);
-			x[i] = irdm_f16_to_f32(((uint16_t *)out)[i]);
-		}
-	}
+	for (size_t i = 0; i < n; i++)
+		x[i] = irdm_elem_put(out, elem, i, x[i]);
 	return out;
 }
 
@@ -350,40 +369,41 @@ static int stability(struct build *b, char *err, size_t errlen)
 	long cpus = sysconf(_SC_NPROCESSORS_ONLN);
 	unsigned nt = b->sc->threads ? b->sc->threads : (unsigned)(cpus > 0 ? cpus : 1);
 	pthread_t th[64];
+	bool started[64];
 	struct stab_job jobs[64];
+	int blas_threads;
 
 	b->stab = calloc(n, sizeof(*b->stab));
 	if (!b->stab) {
 		snprintf(err, errlen, "precompute: out of memory");
-		return -1;
+		return IRDM_ENOMEM;
 	}
 	if (nt > 64)
 		nt = 64;
 	if (nt > n)
 		nt = (unsigned)n;
 	/* one LAPACK call per thread: OpenBLAS's own threads would oversubscribe */
-	openblas_set_num_threads(1);
+	blas_threads = irdm_blas_serial_begin();
 	for (unsigned t = 0; t < nt; t++) {
 		jobs[t] = (struct stab_job){ b, n * t / nt, n * (t + 1) / nt };
-		if (pthread_create(&th[t], NULL, stab_worker, &jobs[t])) {
+		started[t] = !pthread_create(&th[t], NULL, stab_worker, &jobs[t]);
+		if (!started[t])
 			stab_worker(&jobs[t]);
-			th[t] = 0;
-		}
 	}
 	for (unsigned t = 0; t < nt; t++)
-		if (th[t])
+		if (started[t])
 			pthread_join(th[t], NULL);
-	openblas_set_num_threads(cpus > 0 ? (int)cpus : 1);
+	irdm_blas_serial_end(blas_threads);
 	b->meta.max_spectral_radius = 0;
 	for (size_t c = 0; c < n; c++) {
 		if (b->stab[c].spectral_radius < 0) {
 			snprintf(err, errlen, "stability: could not compute the force recursion at column %zu (mesh node %u): R[0] singular?",
 				 c, b->m.rows[b->m.cols[c]]);
-			return -1;
+			return IRDM_ENUMERIC;
 		}
 		b->meta.max_spectral_radius = fmax(b->meta.max_spectral_radius, b->stab[c].spectral_radius);
 	}
-	return 0;
+	return IRDM_OK;
 }
 
 static void fill_meta(struct build *b)
@@ -431,7 +451,7 @@ static int fill_nodes_rigid(struct build *b)
 
 	b->nodes = calloc(m->n_rows, sizeof(*b->nodes));
 	if (!b->nodes)
-		return -1;
+		return IRDM_ENOMEM;
 	for (size_t r = 0; r < m->n_rows; r++) {
 		for (int a = 0; a < 3; a++)
 			b->nodes[r].pos_m[a] = (float)m->mesh.pos_m[3 * (size_t)m->rows[r] + (size_t)a];
@@ -439,7 +459,7 @@ static int fill_nodes_rigid(struct build *b)
 	}
 	irdm_mass_properties(&m->mesh, m->fem.lumped_mass_kg, &b->rigid.mass_kg, b->rigid.com_m,
 			     b->rigid.inertia_kg_m2);
-	return 0;
+	return IRDM_OK;
 }
 
 static int provenance(struct build *b)
@@ -448,8 +468,10 @@ static int provenance(struct build *b)
 	size_t len = 8192;
 
 	b->prov = malloc(len);
-	if (!b->prov || irdm_scene_format(b->sc, scene, sizeof(scene)))
-		return -1;
+	if (!b->prov)
+		return IRDM_ENOMEM;
+	if (irdm_scene_format(b->sc, scene, sizeof(scene)))
+		return IRDM_EINVAL;
 	snprintf(b->prov, len,
 		 "tool=%s\nmesh_name=%s\nmesh_nodes=%zu\nmesh_tets=%zu\nmesh_hash=%016llx\n"
 		 "free_dofs=%zu\nrayleigh_a_per_s=%.17g\nrayleigh_b_s=%.17g\n"
@@ -458,51 +480,70 @@ static int provenance(struct build *b)
 		 (unsigned long long)b->meta.mesh_hash, b->m.fem.map.n_free,
 		 b->m.damping.a_per_s, b->m.damping.b_s, b->m.modes.n_modes,
 		 b->m.modes.n_elastic_total, b->meta.first_elastic_hz, scene);
-	return 0;
+	return IRDM_OK;
+}
+
+/* The image's sections, in file order.
+ * Return: IRDM_OK; IRDM_EINVAL if the writer refuses one (table full, kind
+ * repeated, no data): a bug here, but never an image with a section missing. */
+static int add_sections(struct build *b, struct irdm_image_writer *w, const void *bvh,
+			size_t bvh_bytes, char *err, size_t errlen)
+{
+	struct irdm_model *m = &b->m;
+	uint32_t p = b->sc->precision;
+	int ret = 0;
+
+	irdm_iw_init(w);
+	ret |= irdm_iw_add(w, IRDM_SEC_META, IRDM_ELEM_BYTES, &b->meta, sizeof(b->meta));
+	ret |= irdm_iw_add(w, IRDM_SEC_PROVENANCE, IRDM_ELEM_BYTES, b->prov, strlen(b->prov));
+	ret |= irdm_iw_add(w, IRDM_SEC_NODES, IRDM_ELEM_BYTES, b->nodes, m->n_rows * sizeof(*b->nodes));
+	ret |= irdm_iw_add(w, IRDM_SEC_COLUMNS, IRDM_ELEM_U32, m->cols, m->n_cols * sizeof(uint32_t));
+	ret |= irdm_iw_add(w, IRDM_SEC_SURFACE, IRDM_ELEM_U32, m->tris, m->n_tris * 3 * sizeof(uint32_t));
+	if (b->sc->representation == IRDM_REPR_FIR) {
+		ret |= irdm_iw_add(w, IRDM_SEC_FIR, p, b->stored[0], b->stored_bytes[0]);
+	} else {
+		ret |= irdm_iw_add(w, IRDM_SEC_MODES, IRDM_ELEM_BYTES, b->zoh, b->n_modes * sizeof(*b->zoh));
+		ret |= irdm_iw_add(w, IRDM_SEC_MODE_SHAPES, p, b->stored[1], b->stored_bytes[1]);
+		if (b->stored[2])
+			ret |= irdm_iw_add(w, IRDM_SEC_STATIC_CORR, p, b->stored[2], b->stored_bytes[2]);
+	}
+	if (b->sc->floating)
+		ret |= irdm_iw_add(w, IRDM_SEC_RIGID, IRDM_ELEM_BYTES, &b->rigid, sizeof(b->rigid));
+	ret |= irdm_iw_add(w, IRDM_SEC_STABILITY, IRDM_ELEM_BYTES, b->stab, m->n_cols * sizeof(*b->stab));
+	ret |= irdm_iw_add(w, IRDM_SEC_CONTACT_BVH, IRDM_ELEM_BYTES, bvh, bvh_bytes);
+	if (ret) {
+		snprintf(err, errlen, "precompute: the image writer refused a section");
+		return IRDM_EINVAL;
+	}
+	return IRDM_OK;
 }
 
 static int write_image(struct build *b, size_t *bytes, char *err, size_t errlen)
 {
 	struct irdm_model *m = &b->m;
 	struct irdm_image_writer w;
-	uint32_t p = b->sc->precision;
 	void *bvh;
 	size_t bvh_bytes;
 	FILE *f;
+	int ret;
 
-	if (irdm_bvh_build(b->nodes, (uint32_t)m->n_rows, m->cols, (uint32_t)m->n_cols, m->tris,
-			   (uint32_t)m->n_tris, &bvh, &bvh_bytes, err, errlen))
-		return -1;
-	irdm_iw_init(&w);
-	irdm_iw_add(&w, IRDM_SEC_META, IRDM_ELEM_BYTES, &b->meta, sizeof(b->meta));
-	irdm_iw_add(&w, IRDM_SEC_PROVENANCE, IRDM_ELEM_BYTES, b->prov, strlen(b->prov));
-	irdm_iw_add(&w, IRDM_SEC_NODES, IRDM_ELEM_BYTES, b->nodes, m->n_rows * sizeof(*b->nodes));
-	irdm_iw_add(&w, IRDM_SEC_COLUMNS, IRDM_ELEM_U32, m->cols, m->n_cols * sizeof(uint32_t));
-	irdm_iw_add(&w, IRDM_SEC_SURFACE, IRDM_ELEM_U32, m->tris, m->n_tris * 3 * sizeof(uint32_t));
-	if (b->sc->representation == IRDM_REPR_FIR) {
-		irdm_iw_add(&w, IRDM_SEC_FIR, p, b->stored[0], b->stored_bytes[0]);
-	} else {
-		irdm_iw_add(&w, IRDM_SEC_MODES, IRDM_ELEM_BYTES, b->zoh, b->n_modes * sizeof(*b->zoh));
-		irdm_iw_add(&w, IRDM_SEC_MODE_SHAPES, p, b->stored[1], b->stored_bytes[1]);
-		if (b->stored[2])
-			irdm_iw_add(&w, IRDM_SEC_STATIC_CORR, p, b->stored[2], b->stored_bytes[2]);
-	}
-	if (b->sc->floating)
-		irdm_iw_add(&w, IRDM_SEC_RIGID, IRDM_ELEM_BYTES, &b->rigid, sizeof(b->rigid));
-	irdm_iw_add(&w, IRDM_SEC_STABILITY, IRDM_ELEM_BYTES, b->stab, m->n_cols * sizeof(*b->stab));
-	irdm_iw_add(&w, IRDM_SEC_CONTACT_BVH, IRDM_ELEM_BYTES, bvh, bvh_bytes);
-	if (irdm_iw_write(&w, b->o->out_path, err, errlen)) {
-		free(bvh);
-		return -1;
-	}
+	ret = irdm_bvh_build(b->nodes, (uint32_t)m->n_rows, m->cols, (uint32_t)m->n_cols, m->tris,
+			     (uint32_t)m->n_tris, &bvh, &bvh_bytes, err, errlen);
+	if (ret)
+		return ret;
+	ret = add_sections(b, &w, bvh, bvh_bytes, err, errlen);
+	if (!ret)
+		ret = irdm_iw_write(&w, b->o->out_path, err, errlen);
 	free(bvh);
+	if (ret)
+		return ret;
 	f = fopen(b->o->out_path, "rb");
 	if (f) {
 		fseek(f, 0, SEEK_END);
 		*bytes = (size_t)ftell(f);
 		fclose(f);
 	}
-	return 0;
+	return IRDM_OK;
 }
 
 static int responses(struct build *b, char *err, size_t errlen)
@@ -531,9 +572,9 @@ static int responses(struct build *b, char *err, size_t errlen)
 	    (b->shapes && b->sc->representation == IRDM_REPR_MODAL && !b->stored[1]) ||
 	    (b->corr && b->sc->representation == IRDM_REPR_MODAL && !b->stored[2])) {
 		snprintf(err, errlen, "precompute: out of memory converting to the storage precision");
-		return -1;
+		return IRDM_ENOMEM;
 	}
-	return 0;
+	return IRDM_OK;
 }
 
 static void build_free(struct build *b)
@@ -577,7 +618,7 @@ static uint64_t scene_hash(const struct irdm_scene *sc)
 
 	if (irdm_scene_format(sc, text, sizeof(text)))
 		return 0;
-	return fnv1a(14695981039346656037ull, text, strlen(text));
+	return irdm_fnv1a(IRDM_FNV1A_INIT, text, strlen(text));
 }
 
 int irdm_precompute(const struct irdm_scene *sc, const struct irdm_precompute_opts *o,
@@ -585,33 +626,38 @@ int irdm_precompute(const struct irdm_scene *sc, const struct irdm_precompute_op
 {
 	struct build b = { .sc = sc, .o = o };
 	double t0 = now_s(), t1;
-	int ret = -1;
+	int ret;
 
 	memset(rep, 0, sizeof(*rep));
 	b.scene_hash = scene_hash(sc);
-	if (irdm_model_build(sc, modes_needed(sc), o->progress, o->ctx, &b.m, err, errlen))
-		return -1;
-	b.scene_hash = fnv1a(b.scene_hash, &b.m.damping, sizeof(b.m.damping));
+	ret = irdm_model_build(sc, modes_needed(sc), o->progress, o->ctx, &b.m, err, errlen);
+	if (ret)
+		return ret;
+	b.scene_hash = irdm_fnv1a(b.scene_hash, &b.m.damping, sizeof(b.m.damping));
 	t1 = now_s();
-	if (responses(&b, err, errlen))
+	ret = responses(&b, err, errlen);
+	if (ret)
 		goto out_free;
 	rep->seconds_responses = now_s() - t1;
-	if (o->part_out) {
-		ret = 0;
+	if (o->part_out)
 		goto out_report;
-	}
 	fill_meta(&b);
 	t1 = now_s();
-	if (stability(&b, err, errlen))
+	ret = stability(&b, err, errlen);
+	if (ret)
 		goto out_free;
 	rep->seconds_stability = now_s() - t1;
-	if (fill_nodes_rigid(&b) || provenance(&b)) {
-		snprintf(err, errlen, "precompute: out of memory");
+	ret = fill_nodes_rigid(&b);
+	if (!ret)
+		ret = provenance(&b);
+	if (ret) {
+		snprintf(err, errlen, ret == IRDM_ENOMEM ? "precompute: out of memory"
+			 : "precompute: the scene does not fit in the provenance text");
 		goto out_free;
 	}
-	if (write_image(&b, &rep->image_bytes, err, errlen))
+	ret = write_image(&b, &rep->image_bytes, err, errlen);
+	if (ret)
 		goto out_free;
-	ret = 0;
 out_report:
 	report(&b, rep);
 	rep->seconds_total = now_s() - t0;
@@ -624,10 +670,12 @@ int irdm_precompute_count_inputs(const struct irdm_scene *sc, size_t *n_inputs,
 				 char *err, size_t errlen)
 {
 	struct irdm_model m;
+	int ret;
 
-	if (irdm_model_build(sc, 1, NULL, NULL, &m, err, errlen))
-		return -1;
+	ret = irdm_model_build(sc, 1, NULL, NULL, &m, err, errlen);
+	if (ret)
+		return ret;
 	*n_inputs = list_inputs(&m, NULL, NULL);
 	irdm_model_free(&m);
-	return 0;
+	return IRDM_OK;
 }

@@ -35,7 +35,7 @@ int irdm_model_mesh(const struct irdm_scene *sc, struct irdm_mesh *mesh, char *e
 		if (sscanf(sc->mesh + 4, "%lf,%lf,%lf", &l[0], &l[1], &l[2]) != 3 ||
 		    !(l[0] > 0 && l[1] > 0 && l[2] > 0 && isfinite(l[0] + l[1] + l[2]))) {
 			snprintf(err, errlen, "scene: mesh '%s': expected box:LX,LY,LZ in metres", sc->mesh);
-			return -1;
+			return IRDM_EINVAL;
 		}
 		if (!r[0])
 			r[0] = r[1] = r[2] = 4;
@@ -58,7 +58,7 @@ static int mark_nodes(const struct irdm_scene *sc, struct irdm_model *m, char *e
 	m->on_surface = calloc(n, sizeof(bool));
 	if (!m->fixed || !m->on_surface) {
 		snprintf(err, errlen, "model: out of memory");
-		return -1;
+		return IRDM_ENOMEM;
 	}
 	for (size_t t = 0; t < 3 * m->mesh.n_tris; t++)
 		m->on_surface[m->mesh.tris[t]] = true;
@@ -72,13 +72,13 @@ static int mark_nodes(const struct irdm_scene *sc, struct irdm_model *m, char *e
 			if (sc->fixed.nodes[k] >= n) {
 				snprintf(err, errlen, "scene: fixed node %u does not exist (mesh has %zu nodes)",
 					 sc->fixed.nodes[k], n);
-				return -1;
+				return IRDM_EINVAL;
 			}
 	if (!sc->floating && n_fixed == 0) {
 		snprintf(err, errlen,
 			 "scene: grounded object but 'fixed = %s' selects no node of mesh '%s'",
 			 sc->fixed.text, m->mesh.name);
-		return -1;
+		return IRDM_EINVAL;
 	}
 	return 0;
 }
@@ -99,34 +99,42 @@ int irdm_model_build(const struct irdm_scene *sc, size_t n_modes_needed,
 		     char *err, size_t errlen)
 {
 	double t0 = now_s();
+	int ret;
 
 	memset(m, 0, sizeof(*m));
-	if (irdm_scene_check(sc, err, errlen))
-		return -1;
+	ret = irdm_scene_check(sc, err, errlen);
+	if (ret)
+		return ret;
 	if (progress)
 		progress(ctx, "mesh", 0.0);
-	if (irdm_model_mesh(sc, &m->mesh, err, errlen))
+	ret = irdm_model_mesh(sc, &m->mesh, err, errlen);
+	if (ret)
 		goto out_fail;
-	if (mark_nodes(sc, m, err, errlen))
+	ret = mark_nodes(sc, m, err, errlen);
+	if (ret)
 		goto out_fail;
 	m->seconds_mesh = now_s() - t0;
 	t0 = now_s();
-	if (irdm_fem_assemble(&m->mesh, &sc->mat, sc->mass, m->fixed, &m->fem, err, errlen))
+	ret = irdm_fem_assemble(&m->mesh, &sc->mat, sc->mass, m->fixed, &m->fem, err, errlen);
+	if (ret)
 		goto out_fail;
 	m->seconds_fem = now_s() - t0;
 	t0 = now_s();
-	if (irdm_modes_solve(&m->fem, n_modes_needed, sc->floating, sc->eigensolver, progress,
-			     ctx, &m->modes, err, errlen))
+	ret = irdm_modes_solve(&m->fem, n_modes_needed, sc->floating, sc->eigensolver, progress,
+			       ctx, &m->modes, err, errlen);
+	if (ret)
 		goto out_fail;
 	m->seconds_eig = now_s() - t0;
-	if (pick_damping(sc, m, err, errlen))
+	ret = pick_damping(sc, m, err, errlen);
+	if (ret)
 		goto out_fail;
-	if (irdm_model_select(sc, m, err, errlen))
+	ret = irdm_model_select(sc, m, err, errlen);
+	if (ret)
 		goto out_fail;
-	return 0;
+	return IRDM_OK;
 out_fail:
 	irdm_model_free(m);
-	return -1;
+	return ret;
 }
 
 void irdm_model_free(struct irdm_model *m)

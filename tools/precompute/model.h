@@ -34,7 +34,9 @@ struct irdm_model {
 int irdm_model_mesh(const struct irdm_scene *sc, struct irdm_mesh *mesh, char *err, size_t errlen);
 
 /* Everything up to modes and selection.  n_modes_needed: modes to solve
- * (0: all). */
+ * (0: all).  Return: IRDM_OK; IRDM_EINVAL (scene, constraints, damping);
+ * IRDM_ENOMEM; IRDM_EIO, IRDM_EFORMAT, IRDM_ECHILD (mesh file, as
+ * irdm_mesh_read()); IRDM_ENUMERIC (factorisation, eigensolver). */
 int irdm_model_build(const struct irdm_scene *sc, size_t n_modes_needed,
 		     irdm_progress_fn progress, void *ctx, struct irdm_model *m,
 		     char *err, size_t errlen);

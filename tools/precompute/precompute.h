@@ -29,10 +29,18 @@ struct irdm_precompute_report {
 	size_t unstable_cols;
 };
 
+/*
+ * Return: IRDM_OK; IRDM_EINVAL if the scene or a part/merge is inconsistent;
+ * IRDM_ENOMEM; IRDM_EIO if a mesh, part or the image cannot be read or
+ * written; IRDM_EFORMAT if an input file is malformed; IRDM_ECHILD if tetgen
+ * fails; IRDM_ENUMERIC if a factorisation, eigensolve or stability
+ * computation fails.  A one-line reason goes to err.
+ */
 int irdm_precompute(const struct irdm_scene *sc, const struct irdm_precompute_opts *o,
 		    struct irdm_precompute_report *rep, char *err, size_t errlen);
 
-/* Number of column DoFs the scene has (for splitting time-domain work). */
+/* Number of column DoFs the scene has (for splitting time-domain work).
+ * Return: as irdm_model_build(). */
 int irdm_precompute_count_inputs(const struct irdm_scene *sc, size_t *n_inputs,
 				 char *err, size_t errlen);
 

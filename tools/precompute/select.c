@@ -23,7 +23,7 @@ int irdm_model_select(const struct irdm_scene *sc, struct irdm_model *m, char *e
 	size_t n = m->mesh.n_nodes;
 	bool *touch = calloc(n, sizeof(bool)), *row = calloc(n, sizeof(bool));
 	int64_t *image_of = malloc(n * sizeof(int64_t));
-	int ret = -1;
+	int ret = IRDM_EINVAL;
 
 	if (!touch || !row || !image_of)
 		goto out_nomem;
@@ -75,10 +75,11 @@ int irdm_model_select(const struct irdm_scene *sc, struct irdm_model *m, char *e
 			m->tris[3 * m->n_tris + (size_t)k] = (uint32_t)image_of[v[k]];
 		m->n_tris++;
 	}
-	ret = 0;
+	ret = IRDM_OK;
 	goto out_free;
 out_nomem:
 	snprintf(err, errlen, "selection: out of memory");
+	ret = IRDM_ENOMEM;
 out_free:
 	free(touch);
 	free(row);

@@ -35,37 +35,37 @@ int irdm_td_part_write(const char *path, const struct irdm_td_part *p, char *err
 	h.header_crc32c = irdm_crc32c(&h, offsetof(struct part_header, header_crc32c));
 	if (snprintf(tmp, sizeof(tmp), "%s.tmp", path) >= (int)sizeof(tmp)) {
 		snprintf(err, errlen, "%s: path too long", path);
-		return -1;
+		return IRDM_EINVAL;
 	}
 	f = fopen(tmp, "wb");
 	if (!f) {
 		snprintf(err, errlen, "%s: cannot create: %s", tmp, strerror(errno));
-		return -1;
+		return IRDM_EIO;
 	}
 	if (fwrite(&h, sizeof(h), 1, f) != 1 || fwrite(p->data, sizeof(double), n, f) != n ||
 	    fflush(f) || fclose(f)) {
 		snprintf(err, errlen, "%s: write failed: %s", tmp, strerror(errno));
 		remove(tmp);
-		return -1;
+		return IRDM_EIO;
 	}
 	if (rename(tmp, path)) {
 		snprintf(err, errlen, "%s: cannot rename into place: %s", path, strerror(errno));
 		remove(tmp);
-		return -1;
+		return IRDM_EIO;
 	}
-	return 0;
+	return IRDM_OK;
 }
 
 int irdm_td_part_read(const char *path, struct irdm_td_part *p, char *err, size_t errlen)
 {
 	struct part_header h;
 	FILE *f = fopen(path, "rb");
-	int ret = -1;
+	int ret = IRDM_EFORMAT;
 
 	memset(p, 0, sizeof(*p));
 	if (!f) {
 		snprintf(err, errlen, "%s: cannot open part: %s", path, strerror(errno));
-		return -1;
+		return IRDM_EIO;
 	}
 	if (fread(&h, sizeof(h), 1, f) != 1 || memcmp(h.magic, PART_MAGIC, 8) || h.version != 1 ||
 	    h.header_crc32c != irdm_crc32c(&h, offsetof(struct part_header, header_crc32c))) {
@@ -82,6 +82,7 @@ int irdm_td_part_read(const char *path, struct irdm_td_part *p, char *err, size_
 	p->data = malloc(n * sizeof(double));
 	if (!p->data) {
 		snprintf(err, errlen, "%s: out of memory for %zu values", path, n);
+		ret = IRDM_ENOMEM;
 		goto out_close;
 	}
 	if (fread(p->data, sizeof(double), n, f) != n || fgetc(f) != EOF ||
@@ -97,7 +98,7 @@ int irdm_td_part_read(const char *path, struct irdm_td_part *p, char *err, size_
 	p->end = h.end;
 	p->T = h.T;
 	p->n_out = h.n_out;
-	ret = 0;
+	ret = IRDM_OK;
 out_close:
 	fclose(f);
 	return ret;

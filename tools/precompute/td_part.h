@@ -11,6 +11,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "irdm/error.h"
+
 struct irdm_td_part {
 	uint64_t scene_hash;
 	uint64_t n_inputs;       /* of the whole scene */
@@ -19,8 +21,11 @@ struct irdm_td_part {
 	double *data;            /* (end - begin) * T * n_out */
 };
 
+/* Return: IRDM_OK; IRDM_EINVAL if the path is too long; IRDM_EIO. */
 int irdm_td_part_write(const char *path, const struct irdm_td_part *p, char *err, size_t errlen);
-/* Reads and validates (checksum, sizes); data is malloc'd. */
+/* Reads and validates (checksum, sizes); data is malloc'd.
+ * Return: IRDM_OK; IRDM_EIO if it cannot be opened; IRDM_EFORMAT if it is
+ * not a part, truncated or corrupted; IRDM_ENOMEM. */
 int irdm_td_part_read(const char *path, struct irdm_td_part *p, char *err, size_t errlen);
 
 #endif

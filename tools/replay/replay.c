@@ -82,12 +82,13 @@ static int read_trajectory(const char *path, size_t n_cols, double dt, struct tr
 	FILE *f = fopen(path, "r");
 	char line[4096];
 	size_t cap = 0, lineno = 0;
+	int ret = IRDM_EFORMAT;
 
 	memset(tr, 0, sizeof(*tr));
 	tr->n_cols = n_cols;
 	if (!f) {
 		snprintf(err, errlen, "%s: cannot open: %s", path, strerror(errno));
-		return -1;
+		return IRDM_EIO;
 	}
 	while (fgets(line, sizeof(line), f)) {
 		double v[1 + 3 * IRDM_MAX_CONTACTS];
@@ -118,6 +119,7 @@ static int read_trajectory(const char *path, size_t n_cols, double dt, struct tr
 			double *nv = realloc(tr->v, cap * n_cols * sizeof(double));
 			if (!nv) {
 				snprintf(err, errlen, "%s: out of memory", path);
+				ret = IRDM_ENOMEM;
 				goto out_fail;
 			}
 			tr->v = nv;
@@ -125,17 +127,22 @@ static int read_trajectory(const char *path, size_t n_cols, double dt, struct tr
 		memcpy(&tr->v[tr->n_rows * n_cols], v, n_cols * sizeof(double));
 		tr->n_rows++;
 	}
+	if (ferror(f)) {
+		snprintf(err, errlen, "%s: read failed: %s", path, strerror(errno));
+		ret = IRDM_EIO;
+		goto out_fail;
+	}
 	fclose(f);
 	if (!tr->n_rows) {
 		snprintf(err, errlen, "%s: no samples", path);
-		return -1;
+		return IRDM_EFORMAT;
 	}
-	return 0;
+	return IRDM_OK;
 out_fail:
 	fclose(f);
 	free(tr->v);
 	tr->v = NULL;
-	return -1;
+	return ret;
 }
 
 /* ---- sites and output nodes ---- */
@@ -153,7 +160,7 @@ static int make_sites(const struct irdm_replay_opts *o, const struct irdm_image 
 			if (rc) {
 				snprintf(err, errlen, "--contact %u: mesh node %u is not a touchable node of %s",
 					 c->mesh_node, c->mesh_node, o->image);
-				return -1;
+				return IRDM_EINVAL;
 			}
 		} else {
 			uint32_t tri;
@@ -162,7 +169,7 @@ static int make_sites(const struct irdm_replay_opts *o, const struct irdm_image 
 			    irdm_engine_site_point(eng, tri, bary, &site[i])) {
 				snprintf(err, errlen, "--contact %g,%g,%g: no touchable surface in %s",
 					 c->point_m[0], c->point_m[1], c->point_m[2], o->image);
-				return -1;
+				return IRDM_EINVAL;
 			}
 		}
 	}
@@ -183,7 +190,7 @@ static int parse_nodes(const char *list, const struct irdm_image *img, uint32_t 
 		if (row < 0 || *n == MAX_NODES_OUT || (*end && *end != ',')) {
 			snprintf(err, errlen, "--nodes: '%.20s' is not a node of the image (at most %d)",
 				 p, MAX_NODES_OUT);
-			return -1;
+			return IRDM_EINVAL;
 		}
 		rows[*n] = (uint32_t)row;
 		mesh[(*n)++] = (uint32_t)v;
@@ -213,14 +220,15 @@ static int start_deform(struct run *r, char *err, size_t errlen)
 	r->pos = malloc(3 * (size_t)r->img->meta->n_nodes * sizeof(double));
 	if (!r->pos) {
 		snprintf(err, errlen, "--nodes: out of memory");
-		return -1;
+		return IRDM_ENOMEM;
 	}
-	return irdm_session_deform_open(r->s, err, errlen) ? -1 : 0;
+	return irdm_session_deform_open(r->s, err, errlen);
 }
 
 static int start(const struct irdm_replay_opts *o, struct run *r, char *err, size_t errlen)
 {
 	struct irdm_session_config sc = { .deform = o->nodes != NULL };
+	int ret;
 
 	irdm_engine_config_default(&sc.engine);
 	sc.engine.max_contacts = o->n_contacts;
@@ -228,16 +236,21 @@ static int start(const struct irdm_replay_opts *o, struct run *r, char *err, siz
 	sc.engine.coupling_k_n_per_m = o->coupling_k;
 	sc.engine.coupling_b_ns_per_m = o->coupling_b;
 	sc.engine.publish_every = o->nodes ? 1 : 0;
-	if (irdm_session_open(&r->s, o->image, &sc, err, errlen))
-		return -1;
+	ret = irdm_session_open(&r->s, o->image, &sc, err, errlen);
+	if (ret)
+		return ret;
 	r->img = r->s->img;
 	r->eng = r->s->eng;
-	if (make_sites(o, r->img, r->eng, r->site, err, errlen))
-		return -1;
-	if (o->nodes && start_deform(r, err, errlen))
-		return -1;
-	if (o->nodes && parse_nodes(o->nodes, r->img, r->rows, r->mesh, &r->n_nodes, err, errlen))
-		return -1;
+	ret = make_sites(o, r->img, r->eng, r->site, err, errlen);
+	if (ret)
+		return ret;
+	if (o->nodes) {
+		ret = start_deform(r, err, errlen);
+		if (!ret)
+			ret = parse_nodes(o->nodes, r->img, r->rows, r->mesh, &r->n_nodes, err, errlen);
+		if (ret)
+			return ret;
+	}
 	return read_trajectory(o->trajectory, 1 + 3 * (size_t)o->n_contacts, r->img->meta->dt_s,
 			       &r->tr, err, errlen);
 }
@@ -270,7 +283,7 @@ static int step(const struct irdm_replay_opts *o, struct run *r, size_t row, cha
 	}
 	if (irdm_engine_tick(r->eng, cmd)) {
 		snprintf(err, errlen, "engine fault at t = %g s (non-finite or excessive force)", v[0]);
-		return -1;
+		return IRDM_EFAULT;
 	}
 	fprintf(r->out, "%.9g", v[0]);
 	for (unsigned i = 0; i < o->n_contacts; i++) {
@@ -280,7 +293,7 @@ static int step(const struct irdm_replay_opts *o, struct run *r, size_t row, cha
 	uint64_t tick;
 	if (r->n_nodes && !irdm_deform_update(r->s->worker, r->pos, &tick)) {
 		snprintf(err, errlen, "internal: no deformation snapshot at t = %g s", v[0]);
-		return -1;
+		return IRDM_EINVAL;
 	}
 	for (size_t k = 0; k < r->n_nodes; k++) {
 		const float *rest = r->img->nodes[r->rows[k]].pos_m;
@@ -294,24 +307,29 @@ static int step(const struct irdm_replay_opts *o, struct run *r, size_t row, cha
 int irdm_replay_run(const struct irdm_replay_opts *o, char *err, size_t errlen)
 {
 	struct run *r = calloc(1, sizeof(*r));
-	int ret = -1;
+	int ret;
 
 	if (!r) {
 		snprintf(err, errlen, "out of memory");
-		return -1;
+		return IRDM_ENOMEM;
 	}
-	if (start(o, r, err, errlen))
+	ret = start(o, r, err, errlen);
+	if (ret)
 		goto out_free;
 	snprintf(r->tmp, sizeof(r->tmp), "%s.tmp", o->out);
 	r->out = fopen(r->tmp, "w");
 	if (!r->out) {
 		snprintf(err, errlen, "%s: cannot create: %s", r->tmp, strerror(errno));
+		ret = IRDM_EIO;
 		goto out_free;
 	}
 	header(o, r);
-	for (size_t row = 0; row < r->tr.n_rows; row++)
-		if (step(o, r, row, err, errlen))
-			goto out_remove;
+	for (size_t row = 0; !ret && row < r->tr.n_rows; row++)
+		ret = step(o, r, row, err, errlen);
+	if (ret)
+		goto out_remove;
+	/* from here on every failure is the file system's */
+	ret = IRDM_EIO;
 	if (fclose(r->out)) {
 		r->out = NULL;
 		snprintf(err, errlen, "%s: write failed: %s", r->tmp, strerror(errno));
@@ -322,7 +340,7 @@ int irdm_replay_run(const struct irdm_replay_opts *o, char *err, size_t errlen)
 		snprintf(err, errlen, "%s: cannot rename into place: %s", o->out, strerror(errno));
 		goto out_remove;
 	}
-	ret = 0;
+	ret = IRDM_OK;
 	goto out_free;
 out_remove:
 	if (r->out)

@@ -7,6 +7,7 @@
 #include <stdint.h>
 
 #include "irdm/engine.h"
+#include "irdm/error.h"
 
 struct irdm_replay_contact {
 	bool is_node;

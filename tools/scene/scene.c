@@ -443,31 +443,33 @@ int irdm_scene_load(struct irdm_scene *sc, const char *path, char *err, size_t e
 
 int irdm_scene_check(const struct irdm_scene *sc, char *err, size_t errlen)
 {
-	if (irdm_material_check(&sc->mat, err, errlen))
-		return -1;
+	int ret = irdm_material_check(&sc->mat, err, errlen);
+
+	if (ret)
+		return ret;
 	if (!sc->floating && sc->fixed.kind == IRDM_REGION_NONE) {
 		snprintf(err, errlen, "scene: a grounded object needs fixed nodes (set 'fixed' or 'floating = yes')");
-		return -1;
+		return IRDM_EINVAL;
 	}
 	if (sc->floating && sc->fixed.kind != IRDM_REGION_NONE) {
 		snprintf(err, errlen, "scene: a floating object cannot have fixed nodes ('fixed = %s')",
 			 sc->fixed.text);
-		return -1;
+		return IRDM_EINVAL;
 	}
 	if (sc->touch.kind == IRDM_REGION_NONE) {
 		snprintf(err, errlen, "scene: nothing is touchable ('touch = none')");
-		return -1;
+		return IRDM_EINVAL;
 	}
 	if (sc->method == IRDM_METHOD_TIME_DOMAIN && sc->representation != IRDM_REPR_FIR) {
 		snprintf(err, errlen, "scene: method = time-domain makes FIR responses: use representation = fir:T");
-		return -1;
+		return IRDM_EINVAL;
 	}
 	if (sc->damping == IRDM_DAMP_RATIOS && sc->damp_hz[0] > 0 &&
 	    fabs(sc->damp_hz[0] - sc->damp_hz[1]) < 1e-9) {
 		snprintf(err, errlen, "scene: damping needs two different frequencies");
-		return -1;
+		return IRDM_EINVAL;
 	}
-	return 0;
+	return IRDM_OK;
 }
 
 static const char *region_text(const struct irdm_region *r)

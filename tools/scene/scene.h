@@ -16,6 +16,7 @@
 
 #include "irdm/options.h"
 #include "fem/fem.h"
+#include "irdm/error.h"
 #include "modal/modal.h"
 
 enum irdm_region_kind {
@@ -94,7 +95,8 @@ int irdm_scene_set(struct irdm_scene *sc, const char *key, const char *value,
  */
 int irdm_scene_load(struct irdm_scene *sc, const char *path, char *err, size_t errlen);
 
-/* Cross-field checks (after all keys are set). */
+/* Cross-field checks (after all keys are set).  Return: IRDM_OK;
+ * IRDM_EINVAL naming the first conflict. */
 int irdm_scene_check(const struct irdm_scene *sc, char *err, size_t errlen);
 
 /* Canonical text of every key (provenance, scene hash). */

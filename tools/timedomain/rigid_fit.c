@@ -129,7 +129,7 @@ int irdm_svd3(const double a[9], double u[9], double s[3], double v[9])
 
 	for (int i = 0; i < 9; i++)
 		if (!isfinite(a[i]))
-			return -1;
+			return IRDM_ENUMERIC;
 	memcpy(b, a, sizeof(b));
 	memset(v, 0, 9 * sizeof(double));
 	v[0] = v[4] = v[8] = 1.0;
@@ -163,10 +163,10 @@ static int kabsch_rotation(const double h[9], double rot[9])
 	double u[9], s[3], v[9], d;
 
 	if (irdm_svd3(h, u, s, v))
-		return -1;
+		return IRDM_ENUMERIC;
 	/* rank < 2: the points are collinear, rotation about them is free */
 	if (!(s[1] > 1e-12 * s[0]))
-		return -1;
+		return IRDM_ENUMERIC;
 	d = det3(u) * det3(v) < 0 ? -1.0 : 1.0;
 	for (int a = 0; a < 3; a++)
 		for (int b = 0; b < 3; b++)
@@ -198,7 +198,7 @@ int irdm_rigid_fit_kabsch(size_t n, const double *p, const double *q, const doub
 	double h[9] = { 0 };
 
 	if (!(centroid(n, p, w, fit->c_rest) > 0) || !(centroid(n, q, w, fit->c_def) > 0))
-		return -1;
+		return IRDM_ENUMERIC;
 	for (size_t i = 0; i < n; i++) {
 		double wi = weight(w, i), r[3], t[3];
 
@@ -276,10 +276,10 @@ int irdm_rigid_remove_kabsch(size_t n, const double *p, const double *w, const d
 
 	/* The translation is linear in u: remove it exactly, before scaling. */
 	if (!(centroid(n, u, w, t) > 0) || !(centroid(n, p, w, fit.c_rest) > 0))
-		return -1;
+		return IRDM_ENUMERIC;
 	extents(n, p, u, t, &diag, &umax);
 	if (!isfinite(umax) || !(diag > 0) || !(rel_eps > 0))
-		return -1;
+		return IRDM_ENUMERIC;
 	if (umax == 0.0) {
 		memset(d, 0, 3 * n * sizeof(*d));
 		return 0;
@@ -305,7 +305,7 @@ int irdm_rigid_remove_kabsch(size_t n, const double *p, const double *w, const d
 						* (q[b] - fit.c_def[b]);
 	}
 	if (kabsch_rotation(h, fit.rot))
-		return -1;
+		return IRDM_ENUMERIC;
 	for (size_t i = 0; i < n; i++) {
 		double q[3];
 
@@ -329,7 +329,7 @@ static int spd_solve3(const double a[9], const double b[3], double x[3])
 		for (int k = 0; k < j; k++)
 			s -= l[3 * j + k] * l[3 * j + k];
 		if (!(s > 1e-14 * scale))
-			return -1;
+			return IRDM_ENUMERIC;
 		l[3 * j + j] = sqrt(s);
 		for (int i = j + 1; i < 3; i++) {
 			double t = a[3 * i + j];
@@ -360,7 +360,7 @@ int irdm_rigid_project_linear(size_t n, const double *p, const double *w, const 
 	double c[3], t[3], mom[3] = { 0, 0, 0 }, inertia[9] = { 0 }, theta[3];
 
 	if (!(centroid(n, p, w, c) > 0) || !(centroid(n, u, w, t) > 0))
-		return -1;
+		return IRDM_ENUMERIC;
 	for (size_t i = 0; i < n; i++) {
 		double wi = weight(w, i), r[3], du[3], rxu[3], r2;
 
@@ -377,7 +377,7 @@ int irdm_rigid_project_linear(size_t n, const double *p, const double *w, const 
 		}
 	}
 	if (spd_solve3(inertia, mom, theta))
-		return -1;
+		return IRDM_ENUMERIC;
 	for (size_t i = 0; i < n; i++) {
 		double r[3], txr[3];
 

@@ -5,7 +5,8 @@
  * All fits are weighted; for IRDM the weights are the lumped node masses,
  * because the rigid motion that the runtime integrates (Newton-Euler) is the
  * motion of the centre of mass and the rotation about it.  An unweighted fit
- * on a mesh with uneven node masses leaves a visible error (SPEC section 3).
+ * on a mesh with uneven node masses leaves a visible error
+ * (docs/architecture.md, "Frames and signs").
  *
  * Points and displacements are packed xyz triples: x[3 * i + axis].
  *
@@ -22,6 +23,8 @@
 
 #include <stddef.h>
 
+#include "irdm/error.h"
+
 struct irdm_rigid_fit {
 	double rot[9];     /* row-major proper rotation: q_i ~ rot (p_i - c_rest) + c_def */
 	double c_rest[3];  /* weighted centroid of p */
@@ -32,7 +35,7 @@ struct irdm_rigid_fit {
  * Weighted Kabsch fit of rest points p to deformed points q (n points).
  * w: n weights >= 0 (NULL = all 1).  The rotation comes from an SVD of the
  * weighted cross-covariance with the reflection guard (det = +1).
- * Returns 0, or -1 if the total weight is not positive or the points are
+ * Returns IRDM_OK, or IRDM_ENUMERIC if the total weight is not positive or the points are
  * collinear (rotation about the line undetermined) or not finite.
  */
 int irdm_rigid_fit_kabsch(size_t n, const double *p, const double *q, const double *w,
@@ -52,7 +55,7 @@ void irdm_rigid_fit_residual(const struct irdm_rigid_fit *fit, size_t n, const d
  * O(1e-16 / rel_eps * (rigid / deformation)) from cancellation in forming
  * p + eps u, so no eps makes it exact: for a field that is linear in a load
  * prefer irdm_rigid_project_linear().  1e-6..1e-8 are sensible.  d may
- * alias u.  Returns 0 or -1 as irdm_rigid_fit_kabsch().
+ * alias u.  Returns as irdm_rigid_fit_kabsch().
  */
 int irdm_rigid_remove_kabsch(size_t n, const double *p, const double *w, const double *u,
 			     double rel_eps, double *d);
@@ -62,7 +65,7 @@ int irdm_rigid_remove_kabsch(size_t n, const double *p, const double *w, const d
  * theta solving I theta = sum_i w_i r_i x u_i (I: weighted inertia tensor
  * about the weighted centroid).  This is the w-orthogonal projection of u
  * onto the complement of the six infinitesimal rigid modes; exact for linear
- * responses.  d may alias u.  Returns 0, or -1 if the total weight is not
+ * responses.  d may alias u.  Returns IRDM_OK, or IRDM_ENUMERIC if the total weight is not
  * positive or the inertia tensor is singular (collinear points).
  */
 int irdm_rigid_project_linear(size_t n, const double *p, const double *w, const double *u,
@@ -71,7 +74,7 @@ int irdm_rigid_project_linear(size_t n, const double *p, const double *w, const 
 /*
  * 3x3 SVD a = u diag(s) v^T (row-major), s sorted descending, u and v
  * orthogonal (one-sided Jacobi; rank-deficient a gets a completed u).
- * Returns 0, or -1 if a is not finite.
+ * Returns IRDM_OK, or IRDM_ENUMERIC if a is not finite.
  */
 int irdm_svd3(const double a[9], double u[9], double s[3], double v[9]);
 

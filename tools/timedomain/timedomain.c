@@ -33,20 +33,10 @@
 #include <unistd.h>
 
 #include "fem/factor.h"
+#include "modal/lapack.h"
 #include "timedomain/rigid_fit.h"
 #include "timedomain/td_priv.h"
 #include "timedomain/timedomain.h"
-
-/*
- * OpenBLAS thread control (declared here: no OpenBLAS header is needed for
- * two calls).  During the parallel phase OpenBLAS must run single-threaded:
- * our workers already occupy the CPUs, nested BLAS threads would
- * oversubscribe them, and a BLAS thread count that differs between runs
- * could change reduction order and so break bitwise reproducibility.  The
- * setting is process-wide; it is restored afterwards.
- */
-void openblas_set_num_threads(int n);
-int openblas_get_num_threads(void);
 
 /*
  * At most this many input columns are integrated together: several
@@ -76,6 +66,7 @@ struct td_job {
 	size_t next_block;
 	size_t done;
 	bool failed;
+	int code;              /* the first failure's IRDM_E* */
 	char *err;
 	size_t errlen;
 };
@@ -100,31 +91,31 @@ static int check_opts(const struct irdm_td_opts *o, char *err, size_t errlen)
 	if (!isfinite(o->dt_s) || o->dt_s <= 0) {
 		snprintf(err, errlen, "time-domain: dt must be finite and > 0 s (got %g)",
 			 o->dt_s);
-		return -1;
+		return IRDM_EINVAL;
 	}
 	if (o->n_samples < 1 || o->substeps < 1) {
 		snprintf(err, errlen,
 			 "time-domain: need n_samples >= 1 and substeps >= 1 (got %u, %u)",
 			 o->n_samples, o->substeps);
-		return -1;
+		return IRDM_EINVAL;
 	}
 	if (!isfinite(o->damping.a_per_s) || !isfinite(o->damping.b_s) ||
 	    o->damping.a_per_s < 0 || o->damping.b_s < 0) {
 		snprintf(err, errlen,
 			 "time-domain: Rayleigh damping must be finite and >= 0 (got a=%g /s, b=%g s)",
 			 o->damping.a_per_s, o->damping.b_s);
-		return -1;
+		return IRDM_EINVAL;
 	}
 	if (o->rigid != IRDM_TD_RIGID_KABSCH && o->rigid != IRDM_TD_RIGID_LINEAR) {
 		snprintf(err, errlen, "time-domain: unknown rigid-removal method %d",
 			 (int)o->rigid);
-		return -1;
+		return IRDM_EINVAL;
 	}
 	if (!(o->kabsch_rel_eps >= 0 && o->kabsch_rel_eps <= 1e-2)) {
 		snprintf(err, errlen,
 			 "time-domain: kabsch_rel_eps must be in [0, 1e-2] (0: default; got %g)",
 			 o->kabsch_rel_eps);
-		return -1;
+		return IRDM_EINVAL;
 	}
 	return 0;
 }
@@ -137,13 +128,13 @@ static int check_model(const struct irdm_mesh *mesh, const struct irdm_fem *fem,
 		snprintf(err, errlen,
 			 "time-domain: FEM (%zu DoFs, %zu free) does not belong to the mesh (%zu nodes)",
 			 fem->map.n_dof, fem->map.n_free, mesh->n_nodes);
-		return -1;
+		return IRDM_EINVAL;
 	}
 	if (floating && fem->map.n_free != fem->map.n_dof) {
 		snprintf(err, errlen,
 			 "time-domain: a floating object must have no fixed node (%zu of %zu DoFs fixed)",
 			 fem->map.n_dof - fem->map.n_free, fem->map.n_dof);
-		return -1;
+		return IRDM_EINVAL;
 	}
 	return 0;
 }
@@ -157,13 +148,13 @@ static int check_io(const struct irdm_mesh *mesh, const struct irdm_fem *fem,
 
 	if ((n_in && !in_dofs) || (n_out && !out_nodes) || (n_in && n_out && !R)) {
 		snprintf(err, errlen, "time-domain: NULL input, output or result array");
-		return -1;
+		return IRDM_EINVAL;
 	}
 	if (n_out > SIZE_MAX / per_in / sizeof(double) ||
 	    (n_in && n_out * per_in > SIZE_MAX / sizeof(double) / n_in)) {
 		snprintf(err, errlen, "time-domain: %zu x %u x %zu responses do not fit in memory",
 			 n_in, o->n_samples, n_out);
-		return -1;
+		return IRDM_EINVAL;
 	}
 	for (size_t i = 0; i < n_in; i++) {
 		int64_t g = in_dofs[i];
@@ -172,13 +163,13 @@ static int check_io(const struct irdm_mesh *mesh, const struct irdm_fem *fem,
 			snprintf(err, errlen,
 				 "time-domain: input DoF %lld (entry %zu) out of range (mesh has %zu DoFs)",
 				 (long long)g, i, fem->map.n_dof);
-			return -1;
+			return IRDM_EINVAL;
 		}
 		if (fem->map.free_of[g] < 0) {
 			snprintf(err, errlen,
 				 "time-domain: input DoF %lld (node %lld axis %c) is fixed; responses exist only for free DoFs",
 				 (long long)g, (long long)(g / 3), "xyz"[g % 3]);
-			return -1;
+			return IRDM_EINVAL;
 		}
 	}
 	for (size_t i = 0; i < n_out; i++) {
@@ -186,7 +177,7 @@ static int check_io(const struct irdm_mesh *mesh, const struct irdm_fem *fem,
 			snprintf(err, errlen,
 				 "time-domain: output node %u (entry %zu) out of range (mesh has %zu nodes)",
 				 out_nodes[i], i, mesh->n_nodes);
-			return -1;
+			return IRDM_EINVAL;
 		}
 	}
 	return 0;
@@ -227,8 +218,8 @@ static int worker_init(struct td_worker *w, struct td_job *job)
 	}
 	if (!w->u || !w->v || !w->ku || !w->mv ||
 	    (job->o->floating && (!w->full || !w->def)))
-		return -1;
-	return 0;
+		return IRDM_ENOMEM;
+	return IRDM_OK;
 }
 
 /* Right-hand side holder with k columns (the last block may be short). */
@@ -241,7 +232,7 @@ static int worker_rhs(struct td_worker *w, size_t k)
 					CHOLMOD_REAL, &w->cc);
 	if (!w->b) {
 		snprintf(w->err, sizeof(w->err), "time-domain: out of memory (right-hand side)");
-		return -1;
+		return IRDM_ENOMEM;
 	}
 	return 0;
 }
@@ -280,9 +271,10 @@ static int worker_record(struct td_worker *w, size_t i0, size_t k, size_t s)
 	for (size_t c = 0; c < k; c++) {
 		const double *col = w->u + c * n;
 		double *dst = job->R + ((i0 + c) * job->o->n_samples + s) * 3 * no;
+		int ret = job->o->floating ? worker_rigid(w, col) : IRDM_OK;
 
-		if (job->o->floating && worker_rigid(w, col))
-			return -1;
+		if (ret)
+			return ret;
 		for (size_t o = 0; o < no; o++) {
 			for (size_t a = 0; a < 3; a++) {
 				size_t g = 3 * (size_t)job->out_nodes[o] + a;
@@ -322,9 +314,11 @@ static int worker_block(struct td_worker *w, size_t i0, size_t k)
 	size_t n = job->fem->K.n;
 	uint64_t m = job->o->substeps, steps = m * job->o->n_samples;
 	double h = job->h;
+	int ret;
 
-	if (worker_rhs(w, k))
-		return -1;
+	ret = worker_rhs(w, k);
+	if (ret)
+		return ret;
 	memset(w->u, 0, n * k * sizeof(double));
 	memset(w->v, 0, n * k * sizeof(double));
 	for (uint64_t st = 0; st < steps; st++) {
@@ -334,7 +328,7 @@ static int worker_block(struct td_worker *w, size_t i0, size_t k)
 				      &w->cc)) {
 			snprintf(w->err, sizeof(w->err),
 				 "time-domain: CHOLMOD solve failed (status %d)", w->cc.status);
-			return -1;
+			return w->cc.status == CHOLMOD_OUT_OF_MEMORY ? IRDM_ENOMEM : IRDM_ENUMERIC;
 		}
 		const double *d = w->x->x;
 
@@ -342,10 +336,12 @@ static int worker_block(struct td_worker *w, size_t i0, size_t k)
 			w->v[i] = 2.0 * d[i] / h - w->v[i];
 			w->u[i] += d[i];
 		}
-		if ((st + 1) % m == 0 && worker_record(w, i0, k, (size_t)((st + 1) / m - 1)))
-			return -1;
+		if ((st + 1) % m == 0)
+			ret = worker_record(w, i0, k, (size_t)((st + 1) / m - 1));
+		if (ret)
+			return ret;
 	}
-	return 0;
+	return IRDM_OK;
 }
 
 /* Columns of block b: n_in split into n_blocks near-equal runs. */
@@ -378,8 +374,10 @@ static void *worker_main(void *arg)
 		int rc = worker_block(w, i0, k);
 
 		pthread_mutex_lock(&job->lock);
-		if (rc && !job->failed)
+		if (rc && !job->failed) {
 			snprintf(job->err, job->errlen, "%s", w->err);
+			job->code = rc;
+		}
 		job->failed |= rc != 0;
 		job->done += rc ? 0 : k;
 		/* under the lock: the callback is never entered concurrently */
@@ -406,16 +404,15 @@ static unsigned thread_count(unsigned asked, size_t n_blocks)
  * blocks from the shared queue. */
 static void run_workers(struct td_worker *w, unsigned nt)
 {
-	int blas_threads = openblas_get_num_threads();
+	int blas_threads = irdm_blas_serial_begin();
 
-	openblas_set_num_threads(1);
 	for (unsigned t = 1; t < nt; t++)
 		w[t].started = !pthread_create(&w[t].tid, NULL, worker_main, &w[t]);
 	worker_main(&w[0]);
 	for (unsigned t = 1; t < nt; t++)
 		if (w[t].started)
 			pthread_join(w[t].tid, NULL);
-	openblas_set_num_threads(blas_threads);
+	irdm_blas_serial_end(blas_threads);
 }
 
 int irdm_td_responses(const struct irdm_mesh *mesh, const struct irdm_fem *fem,
@@ -430,17 +427,19 @@ int irdm_td_responses(const struct irdm_mesh *mesh, const struct irdm_fem *fem,
 	struct td_worker *w = NULL;
 	cholmod_common cc;
 	unsigned nt, n_init = 0;
-	int rc = -1;
+	int rc;
 
 	if (!mesh || !fem || !o) {
 		snprintf(err, errlen, "time-domain: NULL mesh, FEM or options");
-		return -1;
+		return IRDM_EINVAL;
 	}
-	if (check_opts(o, err, errlen) || check_model(mesh, fem, o->floating, err, errlen) ||
-	    check_io(mesh, fem, o, in_dofs, n_in, out_nodes, n_out, R, err, errlen))
-		return -1;
-	if (n_in == 0)
-		return 0;
+	rc = check_opts(o, err, errlen);
+	if (!rc)
+		rc = check_model(mesh, fem, o->floating, err, errlen);
+	if (!rc)
+		rc = check_io(mesh, fem, o, in_dofs, n_in, out_nodes, n_out, R, err, errlen);
+	if (rc || n_in == 0)
+		return rc;
 	job.h = o->dt_s / o->substeps;
 	job.rel_eps = o->kabsch_rel_eps > 0 ? o->kabsch_rel_eps : IRDM_TD_KABSCH_REL_EPS;
 
@@ -448,10 +447,12 @@ int irdm_td_responses(const struct irdm_mesh *mesh, const struct irdm_fem *fem,
 	cc.print = 0;
 	/* S = M + h/2 (a M + b K) + h^2/4 K */
 	/* S = M + h/2 C + h^2/4 K with C = a M + b K */
-	if (irdm_fem_factor(fem, 0.5 * job.h * o->damping.b_s + 0.25 * job.h * job.h,
-			    1.0 + 0.5 * job.h * o->damping.a_per_s, "time-domain", &cc, &job.L,
-			    err, errlen))
+	rc = irdm_fem_factor(fem, 0.5 * job.h * o->damping.b_s + 0.25 * job.h * job.h,
+			     1.0 + 0.5 * job.h * o->damping.a_per_s, "time-domain", &cc, &job.L,
+			     err, errlen);
+	if (rc)
 		goto out_finish;
+	rc = IRDM_ENOMEM;
 	job.n_blocks = (n_in + TD_BLOCK - 1) / TD_BLOCK;
 	nt = thread_count(o->threads, job.n_blocks);
 	w = calloc(nt, sizeof(*w));
@@ -469,11 +470,12 @@ int irdm_td_responses(const struct irdm_mesh *mesh, const struct irdm_fem *fem,
 	}
 	if (pthread_mutex_init(&job.lock, NULL)) {
 		snprintf(err, errlen, "time-domain: cannot create a mutex");
+		rc = IRDM_ETHREAD;
 		goto out_free_workers;
 	}
 	run_workers(w, nt);
 	pthread_mutex_destroy(&job.lock);
-	rc = job.failed ? -1 : 0;
+	rc = job.failed ? job.code : IRDM_OK;
 
 out_free_workers:
 	for (unsigned t = 0; t < n_init; t++)

@@ -3,9 +3,10 @@
  * Time-domain impulse-response precompute (the paper's FIR R[s]) by direct
  * integration of the FEM model  M u'' + C u' + K u = f,  C = a M + b K.
  *
- * Convention (SPEC section 2): R[s] is the displacement at (s + 1) dt caused
- * by a unit force held constant over [0, dt) (zero-order hold) and zero
- * afterwards, starting from rest; u[t] = sum_s R[s] f[t - s].
+ * Convention (docs/architecture.md, "Sample convention"): R[s] is the
+ * displacement at (s + 1) dt caused by a unit force held constant over
+ * [0, dt) (zero-order hold) and zero afterwards, starting from rest;
+ * u[t] = sum_s R[s] f[t - s].
  *
  * Integrator: Newmark average acceleration (trapezoidal rule, beta = 1/4,
  * gamma = 1/2): unconditionally stable, second order, no numerical damping.
@@ -22,12 +23,14 @@
 #include <stdint.h>
 
 #include "fem/fem.h"
+#include "irdm/error.h"
 #include "mesh/mesh.h"
 
 /*
  * How a floating object's responses lose their rigid motion.  Both are the
- * mass-weighted least-squares rigid fit (SPEC section 3); they differ in how
- * the fit meets a response that is linear in the force:
+ * mass-weighted least-squares rigid fit (docs/architecture.md, "Frames
+ * and signs"); they differ in how the fit meets a response that is linear
+ * in the force:
  *
  * LINEAR (default): the fit's exact small-motion limit, the mass-orthogonal
  *   projection off the six rigid modes (rigid_fit.h).  Linear in the force,
@@ -75,8 +78,10 @@ struct irdm_td_opts {
  * The result does not depend on `threads` (bit for bit).  While it runs,
  * OpenBLAS is switched to one thread process-wide (restored on return), so
  * do not run it concurrently with itself or with other OpenBLAS work that
- * relies on its thread setting.  Returns 0, or -1 with a one-line message
- * in err.
+ * relies on its thread setting.  A one-line reason goes to err.
+ * Return: IRDM_OK; IRDM_EINVAL if an option, the model or an index is
+ * invalid; IRDM_ENOMEM; IRDM_ENUMERIC if the factorisation, a solve or a
+ * rigid-motion fit fails; IRDM_ETHREAD if no mutex can be made.
  */
 int irdm_td_responses(const struct irdm_mesh *mesh, const struct irdm_fem *fem,
 		      const struct irdm_td_opts *o, const int64_t *in_dofs, size_t n_in,
