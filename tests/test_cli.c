@@ -26,6 +26,7 @@
 #include "image/image_response.h"
 #include "support/engine_fixture.h"
 #include "support/model_fixture.h"
+#include "support/test_files.h"
 
 extern char **environ;
 
@@ -142,17 +143,13 @@ static void write_file(const char *path, const char *text)
 static int setup(void **state)
 {
 	(void)state;
-	snprintf(dir, sizeof(dir), "/tmp/irdm-cli-XXXXXX");
-	return mkdtemp(dir) ? 0 : -1;
+	return tf_tmpdir(dir, sizeof(dir), "cli");
 }
 
 static int teardown(void **state)
 {
-	char cmd[300];
-
 	(void)state;
-	snprintf(cmd, sizeof(cmd), "rm -rf '%s'", dir);
-	return system(cmd) == 0 ? 0 : -1;
+	return tf_rmdir(dir);
 }
 
 #define SMALL "--mesh", "box:0.1,0.1,0.2", "--resolution", "2,2,4", "--representation", "modal:10"

@@ -18,6 +18,7 @@
 #include <cmocka.h>
 
 #include "mesh/mesh.h"
+#include "support/test_files.h"
 
 #define DATA "tests/data/mesh/"
 
@@ -52,24 +53,6 @@ static void assert_tmpdir_empty(void)
 	assert_int_equal(n, 0);
 }
 
-static char *load(const char *path, size_t *len)
-{
-	FILE *f = fopen(path, "rb");
-	char *p;
-	long n;
-
-	assert_non_null(f);
-	assert_int_equal(fseek(f, 0, SEEK_END), 0);
-	n = ftell(f);
-	assert_true(n > 0);
-	rewind(f);
-	p = malloc((size_t)n);
-	assert_non_null(p);
-	assert_int_equal(fread(p, 1, (size_t)n, f), (size_t)n);
-	fclose(f);
-	*len = (size_t)n;
-	return p;
-}
 
 static void assert_err(int ret, const char *err, const char *what,
 		       const char *needle)
@@ -173,7 +156,7 @@ static void test_obj(void **state)
 	size_t len;
 
 	(void)state;
-	txt = load(DATA "cube.obj", &len);
+	txt = tf_load(DATA "cube.obj", &len);
 	if (irdm_surface_parse_obj(txt, len, "cube.obj", &s, err, sizeof(err)))
 		fail_msg("%s", err);
 	free(txt);
@@ -189,7 +172,7 @@ static void test_off(void **state)
 	size_t len;
 
 	(void)state;
-	txt = load(DATA "cube.off", &len);
+	txt = tf_load(DATA "cube.off", &len);
 	if (irdm_surface_parse_off(txt, len, "cube.off", &s, err, sizeof(err)))
 		fail_msg("%s", err);
 	free(txt);
@@ -205,7 +188,7 @@ static void test_stl_ascii(void **state)
 	size_t len;
 
 	(void)state;
-	txt = load(DATA "cube_ascii.stl", &len);
+	txt = tf_load(DATA "cube_ascii.stl", &len);
 	if (irdm_surface_parse_stl(txt, len, "cube.stl", &s, err, sizeof(err)))
 		fail_msg("%s", err);
 	free(txt);
@@ -256,7 +239,7 @@ static void test_stl_binary(void **state)
 	size_t len, k;
 
 	(void)state;
-	txt = load(DATA "cube.obj", &len);
+	txt = tf_load(DATA "cube.obj", &len);
 	assert_int_equal(irdm_surface_parse_obj(txt, len, "cube.obj", &ref, err,
 						sizeof(err)), 0);
 	free(txt);
@@ -333,7 +316,7 @@ static void test_tetgen_failures(void **state)
 	irdm_surface_free(&s);
 	assert_tmpdir_empty();
 
-	txt = load(DATA "cube.obj", &len);
+	txt = tf_load(DATA "cube.obj", &len);
 	assert_int_equal(irdm_surface_parse_obj(txt, len, "cube.obj", &cube, err,
 						sizeof(err)), 0);
 	free(txt);

@@ -20,6 +20,8 @@
 
 #include <cmocka.h>
 
+#include "support/test_files.h"
+
 extern char **environ;
 
 static char dir[256];
@@ -52,24 +54,6 @@ static int run_irdm(const char *const *args)
 	return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
 }
 
-static unsigned char *slurp(const char *path, size_t *len)
-{
-	FILE *f = fopen(path, "rb");
-	unsigned char *buf;
-	long n;
-
-	assert_non_null(f);
-	assert_int_equal(fseek(f, 0, SEEK_END), 0);
-	n = ftell(f);
-	assert_true(n > 0);
-	rewind(f);
-	buf = malloc((size_t)n);
-	assert_non_null(buf);
-	assert_int_equal(fread(buf, 1, (size_t)n, f), (size_t)n);
-	fclose(f);
-	*len = (size_t)n;
-	return buf;
-}
 
 /* Precompute `scene` (options, NULL-terminated) twice; the files must match
  * byte for byte and verify. */
@@ -91,7 +75,7 @@ static void precompute_twice(const char *name, const char *const *scene)
 		args[n++] = path[k];
 		args[n] = NULL;
 		assert_int_equal(run_irdm(args), 0);
-		img[k] = slurp(path[k], &len[k]);
+		img[k] = (unsigned char *)tf_load(path[k], &len[k]);
 	}
 	assert_int_equal(len[0], len[1]);
 	for (first_diff = 0; first_diff < len[0] && img[0][first_diff] == img[1][first_diff]; first_diff++)
@@ -150,17 +134,13 @@ static void test_floating_modal(void **state)
 static int setup(void **state)
 {
 	(void)state;
-	snprintf(dir, sizeof(dir), "/tmp/irdm-repro-XXXXXX");
-	return mkdtemp(dir) ? 0 : -1;
+	return tf_tmpdir(dir, sizeof(dir), "repro");
 }
 
 static int teardown(void **state)
 {
-	char cmd[300];
-
 	(void)state;
-	snprintf(cmd, sizeof(cmd), "rm -rf '%s'", dir);
-	return system(cmd) == 0 ? 0 : -1;
+	return tf_rmdir(dir);
 }
 
 int main(void)

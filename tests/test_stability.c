@@ -23,6 +23,7 @@
 #include <cmocka.h>
 
 #include "support/engine_fixture.h"
+#include "support/test_files.h"
 
 static char dir[64];
 
@@ -121,17 +122,13 @@ static int setup(void **state)
 {
 	(void)state;
 	print_message("holding the step for %.0f s of simulated time\n", HOLD_S);
-	snprintf(dir, sizeof(dir), "/tmp/irdm-stab-XXXXXX");
-	return mkdtemp(dir) ? 0 : -1;
+	return tf_tmpdir(dir, sizeof(dir), "stab");
 }
 
 static int teardown(void **state)
 {
-	char cmd[128];
-
 	(void)state;
-	snprintf(cmd, sizeof(cmd), "rm -rf '%s'", dir);
-	return system(cmd) ? -1 : 0;
+	return tf_rmdir(dir);
 }
 
 static void test_fir_lengths_and_modal(void **state)

@@ -283,7 +283,7 @@ int irdm_opt_set(const struct irdm_opt_table *t, void *obj, const char *where, c
 	return set_entry(o, obj, where, value, err, errlen);
 }
 
-static char *trim(char *s)
+char *irdm_opt_trim(char *s)
 {
 	char *e;
 
@@ -322,7 +322,7 @@ int irdm_opt_parse_line(struct irdm_opt_file *f, char *line, char *err, size_t e
 	snprintf(where, sizeof(where), "%s:%u", f->name, f->line_no);
 	if (hash)
 		*hash = 0;
-	s = trim(line);
+	s = irdm_opt_trim(line);
 	if (!*s)
 		return IRDM_OK;
 	eq = strchr(s, '=');
@@ -331,10 +331,11 @@ int irdm_opt_parse_line(struct irdm_opt_file *f, char *line, char *err, size_t e
 		return IRDM_EFORMAT;
 	}
 	*eq = 0;
-	key = trim(s);
+	key = irdm_opt_trim(s);
 	ret = check_duplicate(f, where, key, err, errlen);
 	if (!ret)
-		ret = irdm_opt_set(f->table, f->obj, where, key, trim(eq + 1), err, errlen);
+		ret = irdm_opt_set(f->table, f->obj, where, key, irdm_opt_trim(eq + 1), err,
+				   errlen);
 	return ret;
 }
 

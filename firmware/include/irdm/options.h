@@ -106,6 +106,9 @@ int irdm_opt_parse_value(const struct irdm_opt *o, void *obj, const char *value,
 int irdm_opt_set(const struct irdm_opt_table *t, void *obj, const char *where, const char *key,
 		 const char *value, char *err, size_t errlen);
 
+/* s without its leading white space; trailing white space is cut in place. */
+char *irdm_opt_trim(char *s);
+
 /*
  * A "key = value" text being read line by line.  Set the fields, then call
  * irdm_opt_parse_line() for each line with line_no counting from 1.

@@ -1,0 +1,104 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * Board files: read the lines (from memory or, with stdio, from a file)
+ * through the option table, then check the board as a whole.  Runs once at
+ * start, never in the tick.
+ */
+#include <stdio.h>
+#include <string.h>
+
+#include "board_priv.h"
+#include "irdm/error.h"
+
+static void reader_init(struct irdm_opt_file *f, struct irdm_board *b, const char *name)
+{
+	irdm_board_default(b);
+	memset(f, 0, sizeof(*f));
+	f->table = irdm_board_options();
+	f->obj = b;
+	f->name = name;
+	f->reject_duplicates = true;
+}
+
+/* The next line: its first len characters at s (no newline). */
+static int read_line(struct irdm_opt_file *f, const char *s, size_t len, char *err,
+		     size_t errlen)
+{
+	char line[IRDM_BOARD_LINE_MAX];
+
+	f->line_no++;
+	if (len >= sizeof(line)) {
+		snprintf(err, errlen, "%s:%u: line longer than %d characters", f->name, f->line_no,
+			 IRDM_BOARD_LINE_MAX - 1);
+		return IRDM_EFORMAT;
+	}
+	memcpy(line, s, len);
+	line[len] = 0;
+	return irdm_opt_parse_line(f, line, err, errlen);
+}
+
+int irdm_board_parse(struct irdm_board *b, const char *name, const char *text,
+		     char *err, size_t errlen)
+{
+	struct irdm_opt_file f;
+	int ret = IRDM_OK;
+
+	reader_init(&f, b, name);
+	while (*text && !ret) {
+		size_t len = strcspn(text, "\n");
+		ret = read_line(&f, text, len, err, errlen);
+		text += len + (text[len] == '\n');
+	}
+	if (!ret)
+		ret = irdm_board_finish(b, &f, err, errlen);
+	return ret;
+}
+
+int irdm_board_load(struct irdm_board *b, const char *path, char *err, size_t errlen)
+{
+	/* one more than a line may hold: a line that fills it is too long */
+	char buf[IRDM_BOARD_LINE_MAX + 1];
+	struct irdm_opt_file f;
+	FILE *fp = fopen(path, "r");
+	int ret = IRDM_OK;
+
+	if (!fp) {
+		snprintf(err, errlen, "%s: cannot open", path);
+		return IRDM_EIO;
+	}
+	reader_init(&f, b, path);
+	while (!ret && fgets(buf, sizeof(buf), fp)) {
+		size_t len = strlen(buf);
+		ret = read_line(&f, buf, len - (len && buf[len - 1] == '\n'), err, errlen);
+	}
+	if (!ret && ferror(fp)) {
+		snprintf(err, errlen, "%s: read error", path);
+		ret = IRDM_EIO;
+	}
+	fclose(fp);
+	if (!ret)
+		ret = irdm_board_finish(b, &f, err, errlen);
+	return ret;
+}
+
+int irdm_board_device(const struct irdm_board *b, unsigned i, struct irdm_device_config *cfg)
+{
+	if (i >= b->devices)
+		return IRDM_EINVAL;
+	*cfg = b->device;
+	if (i == 1)
+		memcpy(cfg->base_offset_m, b->device2_base_offset_m, sizeof(cfg->base_offset_m));
+	return IRDM_OK;
+}
+
+void irdm_board_engine_config(const struct irdm_board *b, struct irdm_engine_config *cfg)
+{
+	const struct irdm_device_config *d = &b->device;
+
+	irdm_engine_config_haptic(cfg, b->period_us * 1e-6, d->k_max_n_per_m, d->b_device_ns_per_m,
+				  d->max_force_n);
+	if (!b->coupling_auto) {
+		cfg->coupling_k_n_per_m = b->coupling_k_n_per_m;
+		cfg->coupling_b_ns_per_m = b->coupling_b_ns_per_m;
+	}
+}
