@@ -28,6 +28,7 @@ static int cmd_export(int argc, char **argv)
 {
 	const char *log = NULL, *out = NULL;
 	char err[1024];
+	int rc;
 
 	for (int i = 1; i < argc; i++) {
 		if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h"))
@@ -52,8 +53,9 @@ static int cmd_export(int argc, char **argv)
 		fprintf(stderr, "irdm log export: needs LOG and -o FILE.csv (see --help)\n");
 		return 2;
 	}
-	if (irdm_log_export_csv(log, out, err, sizeof(err))) {
-		fprintf(stderr, "irdm log export: %s\n", err);
+	rc = irdm_log_export_csv(log, out, err, sizeof(err));
+	if (rc) {
+		irdm_cli_fail("log export", rc, err);
 		return 1;
 	}
 	return 0;
