@@ -97,7 +97,8 @@ static void make_record(uint64_t i, struct irdm_tick_record *r)
 			for (int k = 0; k < 3; k++)
 				vec[a][k] = any_double(&s);
 		v->proxy = (uint8_t)((i + (uint64_t)d) % IRDM_TELEM_N_PROXY);
-		v->contact_tri = (i + (uint64_t)d) % 7 == 0 ? IRDM_TELEM_NO_TRI : (uint32_t)(xorshift(&s) % 100000);
+		v->contact_tri = (i + (uint64_t)d) % 7 == 0 ? IRDM_TELEM_NO_TRI
+							   : (uint32_t)(xorshift(&s) % 100000);
 	}
 	/* values a CSV round trip must carry too */
 	if (i % 50 == 3) {
@@ -549,6 +550,25 @@ static void test_log_round_trip(void **state)
 
 #define THREAD_N 20000u
 
+/* Threads of this process at nice 19 (field 19 of /proc/self/task/TID/stat). */
+static int threads_at_nice_19(void)
+{
+	char line[512];
+	int n = 0;
+	FILE *p;
+
+	/* by pid: in the shell, /proc/self would be the shell */
+	snprintf(line, sizeof(line),
+		 "for t in /proc/%d/task/*/stat; do sed 's/.*) //' $t | cut -d' ' -f17; done",
+		 (int)getpid());
+	p = popen(line, "r");
+	assert_non_null(p);
+	while (fgets(line, sizeof(line), p))
+		n += atoi(line) == 19;
+	pclose(p);
+	return n;
+}
+
 static void test_log_writer_thread(void **state)
 {
 	const char *path = in_dir("thread.log");
@@ -556,6 +576,7 @@ static void test_log_writer_thread(void **state)
 	struct irdm_log_writer *w;
 	struct irdm_tick_record r;
 	char err[256];
+	int nice_19_before = threads_at_nice_19();
 	void *mem;
 
 	(void)state;
@@ -566,6 +587,8 @@ static void test_log_writer_thread(void **state)
 		while (irdm_telem_ring_push(ring, &r) == IRDM_EBUSY)
 			sched_yield();
 		if (i == THREAD_N / 2) {
+			/* the writer runs at the lowest priority: nice 19 */
+			assert_int_equal(threads_at_nice_19(), nice_19_before + 1);
 			/* while it is written, only the temporary name exists */
 			assert_false(exists(path));
 			assert_true(exists(in_dir("thread.log.tmp")));

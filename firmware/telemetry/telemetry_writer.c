@@ -14,7 +14,10 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
+#include <sys/syscall.h>
 #include <time.h>
+#include <unistd.h>
 
 #include "irdm/rt.h"
 #include "irdm/telemetry.h"
@@ -23,6 +26,7 @@ struct irdm_log_writer {
 	struct irdm_log_file *lf;
 	struct irdm_telem_ring *ring;
 	pthread_t tid;
+	bool lowest_nice;               /* default scheduling: nice 19 in the thread */
 	atomic_bool stop;               /* set by irdm_log_writer_stop() */
 	atomic_ullong written;
 	int error;                      /* first append error; read after the join */
@@ -48,6 +52,13 @@ static void *writer_main(void *arg)
 	struct irdm_log_writer *w = arg;
 	const struct timespec idle = { 0, IRDM_LOG_WRITER_IDLE_US * 1000L };
 
+	/*
+	 * Below a deformation thread that is itself SCHED_OTHER (at nice + 5)
+	 * too: nice is per thread on Linux.  Best effort: raising nice needs
+	 * no privilege, and the log is written either way.
+	 */
+	if (w->lowest_nice)
+		setpriority(PRIO_PROCESS, (id_t)syscall(SYS_gettid), 19);
 	for (;;) {
 		/*
 		 * Read the flag before draining: once it is seen set, the
@@ -88,6 +99,7 @@ int irdm_log_writer_start(struct irdm_log_writer **out, const char *path,
 		return IRDM_ENOMEM;
 	}
 	w->ring = ring;
+	w->lowest_nice = !sched;
 	atomic_init(&w->stop, false);
 	atomic_init(&w->written, 0);
 	ret = irdm_log_file_open(&w->lf, path, info, err, errlen);

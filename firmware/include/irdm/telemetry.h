@@ -87,7 +87,7 @@ struct irdm_tick_dev {
 	double joint_angle_rad[3];
 	double joint_torque_nm[3];      /* commanded, after clamping */
 	double force_n[3];              /* force on the object (the device renders -force_n) */
-	uint32_t contact_tri;           /* SURFACE triangle of the proxy, IRDM_TELEM_NO_TRI if none */
+	uint32_t contact_tri;           /* the proxy's SURFACE triangle, IRDM_TELEM_NO_TRI: none */
 	uint8_t proxy;                  /* enum irdm_proxy_event */
 	uint8_t reserved[3];            /* zero */
 };
@@ -190,7 +190,7 @@ uint32_t irdm_telem_ring_capacity(const struct irdm_telem_ring *ring);
 
 struct irdm_hist {
 	uint32_t edge_ns[IRDM_HIST_LOG_BINS + 1];       /* edge_ns[0] = 100 ns ... 100 ms */
-	uint64_t count[IRDM_HIST_BINS];                 /* [0] < 100 ns, [1 + i] bin i, last >= 100 ms */
+	uint64_t count[IRDM_HIST_BINS];                 /* [0] < 100 ns, [1 + i] bin i, last: more */
 	uint64_t n;
 	int64_t min_ns, max_ns;                         /* valid when n > 0 */
 	int64_t limit_ns;                               /* overrun threshold, 0 = none */
@@ -318,10 +318,16 @@ struct irdm_rt_sched;
  * Open the log (irdm_log_file_open) and start a thread that pops `ring`
  * (whose only consumer it becomes) and appends what it pops in chunks of
  * up to IRDM_LOG_WRITER_CHUNK records, sleeping IRDM_LOG_WRITER_IDLE_US
- * when the ring is empty.  sched NULL: SCHED_OTHER on any CPU, below every
- * SCHED_FIFO thread (the lowest of the controller's).  After a write error
- * the thread keeps popping (so the tick sees no difference) and discards.
- * Init-time.
+ * when the ring is empty.  sched NULL: SCHED_OTHER at nice 19 on any CPU,
+ * the lowest of the controller's threads (below SCHED_FIFO ones and below
+ * a SCHED_OTHER deformation thread).  After a write error the thread keeps
+ * popping (so the tick sees no difference) and discards.  Init-time.
+ *
+ * Size the ring for the writer's longest stall (disk, page cache): at 1 kHz
+ * 1024 records hold about a second.  In virtual time the loop can outrun
+ * any writer; for a complete, reproducible log it should not push faster
+ * than the ring drains (wait while irdm_telem_ring_used() is near the
+ * capacity), or drain the ring itself through irdm_log_file_append().
  *
  * Return: IRDM_OK;
  * IRDM_EINVAL, IRDM_ENOMEM, IRDM_EIO as irdm_log_file_open(), or if ring
