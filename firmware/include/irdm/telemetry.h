@@ -51,9 +51,10 @@ enum irdm_telem_state {
 #define IRDM_TELEM_N_STATES 5
 
 /*
- * Bits of irdm_tick_record.fault_flags: every reason the controller zeroed
- * the torque (or held the last safe force), as a set.  Part of the log
- * format: a bit never changes meaning; new reasons take new bits.
+ * Bits of irdm_tick_record.fault_flags: what the safety layer saw in the
+ * tick, as a set: a limit it enforced (CLAMP) and every reason to zero the
+ * torque or hold the last safe force.  Part of the log format: a bit never
+ * changes meaning; new reasons take new bits.
  */
 enum irdm_telem_fault {
 	IRDM_TELEM_FAULT_CLAMP = 1u << 0,          /* torque clamped to the board's limit */
