@@ -18,5 +18,6 @@ void irdm_cli_fail(const char *cmd, int code, const char *reason);
 int irdm_cmd_precompute(int argc, char **argv);
 int irdm_cmd_image(int argc, char **argv);
 int irdm_cmd_replay(int argc, char **argv);
+int irdm_cmd_log(int argc, char **argv);
 
 #endif
