@@ -21,6 +21,7 @@
 #include "irdm/hal.h"
 #include "irdm/session.h"
 #include "irdm/sim_user.h"
+#include "irdm/telemetry.h"
 
 /* Exit codes (irdm-fw --help lists them). */
 enum fw_exit {
@@ -50,7 +51,6 @@ struct fw_trace {
 	double *fz_n;                   /* its component along the contact normal */
 	double *node_u_m;               /* the watched node's displacement along its normal */
 	uint8_t *contact;               /* device 0 in contact */
-	double *latency_us, *compute_us;
 };
 
 struct fw {
@@ -67,6 +67,13 @@ struct fw {
 	struct irdm_sim_user *user;     /* NULL without --user */
 	struct irdm_clock clock;
 	struct fw_trace trace;
+	/* telemetry: per-tick records through a ring to the log (--log) */
+	struct irdm_telem_ring *ring;
+	void *ring_mem;
+	struct irdm_log_writer *writer;         /* real time: a thread drains the ring */
+	struct irdm_log_file *logf;             /* virtual time: the loop drains it */
+	struct irdm_hist latency, compute;      /* ns; compute's limit is the period */
+	struct irdm_hist compute_measured;      /* virtual time: measured, never logged */
 	uint32_t watch_row;             /* the image node whose ringing is measured */
 	bool watching;
 	double watch_normal[3];
@@ -87,6 +94,12 @@ int fw_config_from_board(struct irdm_ctrl_config *c, const struct irdm_board *b)
 /* fw_loop.c: runs until the duration is over, a fault or a signal.
  * Returns FW_EXIT_OK or FW_EXIT_FAULT. */
 int fw_loop_run(struct fw *fw, volatile sig_atomic_t *signalled);
+
+/* fw_log.c: open the log (--log) before the loop, drain and close after. */
+int fw_log_open(struct fw *fw);
+void fw_log_record(struct fw *fw, const struct irdm_ctrl_output *out, int64_t latency_ns,
+		   int64_t compute_ns);
+int fw_log_close(struct fw *fw);
 
 /* fw_summary.c */
 int fw_trace_alloc(struct fw_trace *t, uint64_t ticks);

@@ -15,7 +15,16 @@
 
 static void node_disp(const void *ctx, uint32_t row, double u_m[3])
 {
-	irdm_engine_node_disp(ctx, row, u_m);
+	const struct irdm_ctrl *c = ctx;
+	struct irdm_ctrl_disp_cache *m = (struct irdm_ctrl_disp_cache *)&c->disp;
+	uint32_t k = row % IRDM_CTRL_DISP_CACHE;
+
+	if (m->filled[k] != m->stamp || m->row[k] != row) {
+		irdm_engine_node_disp(c->s->eng, row, m->u_m[k]);
+		m->row[k] = row;
+		m->filled[k] = m->stamp;
+	}
+	memcpy(u_m, m->u_m[k], sizeof(m->u_m[k]));
 }
 
 static void proxy_out(const struct irdm_proxy *px, struct irdm_ctrl_device_output *o)
@@ -30,7 +39,7 @@ static void proxy_out(const struct irdm_proxy *px, struct irdm_ctrl_device_outpu
 /* Device i's proxy and engine command.  Return: IRDM_OK; IRDM_EFAULT. */
 static int touch(struct irdm_ctrl *c, unsigned i, struct irdm_ctrl_device_output *o)
 {
-	const struct irdm_contact_disp disp = { .fn = node_disp, .ctx = c->s->eng };
+	const struct irdm_contact_disp disp = { .fn = node_disp, .ctx = c };
 	struct irdm_ctrl_dev *d = &c->dev[i];
 	struct irdm_contact_site site;
 	int ev;
@@ -65,6 +74,7 @@ int ctrl_contacts(struct irdm_ctrl *c, struct irdm_ctrl_output *out, bool on)
 	struct irdm_contact_cmd cmd[IRDM_MAX_CONTACTS];
 
 	memset(cmd, 0, sizeof(cmd));
+	c->disp.stamp++;        /* the engine ticked since: every memo is stale */
 	for (unsigned i = 0; i < c->cfg.n_devices; i++) {
 		struct irdm_ctrl_device_output *o = &out->dev[i];
 

@@ -167,6 +167,21 @@ struct irdm_ctrl_dev {
 	struct irdm_contact_cmd cmd;
 };
 
+/*
+ * The free displacement of the surface nodes the proxies look at this tick,
+ * memoised: the closest-point query visits each candidate triangle's three
+ * nodes, and each irdm_engine_node_disp() costs O(modes); the engine's state
+ * does not change until its tick, so a node is computed once per tick.
+ * Direct-mapped by row; a collision only recomputes.
+ */
+#define IRDM_CTRL_DISP_CACHE 1024
+struct irdm_ctrl_disp_cache {
+	uint64_t stamp;                         /* this tick's; 0 is never valid */
+	uint64_t filled[IRDM_CTRL_DISP_CACHE];  /* the stamp a slot holds */
+	uint32_t row[IRDM_CTRL_DISP_CACHE];
+	double u_m[IRDM_CTRL_DISP_CACHE][3];
+};
+
 /* The controller: caller-owned, initialised by irdm_ctrl_init(). */
 struct irdm_ctrl {
 	struct irdm_ctrl_config cfg;
@@ -179,6 +194,7 @@ struct irdm_ctrl {
 	uint64_t overruns;              /* total */
 	uint64_t longest_ns;            /* longest latency + compute seen */
 	uint32_t active;                /* fault conditions that hold this tick */
+	struct irdm_ctrl_disp_cache disp;
 };
 
 /*

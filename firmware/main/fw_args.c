@@ -1,0 +1,81 @@
+/* SPDX-License-Identifier: MIT */
+/* irdm-fw's arguments: one option table drives parsing and --help. */
+#include <stddef.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "irdm/clock.h"
+#include "irdm/error.h"
+#include "irdm/options.h"
+#include "irdm/options_doc.h"
+
+#include "fw.h"
+
+#define FA(member) IRDM_OPT_FIELD(struct fw_args, member)
+#define FA_REF(member) IRDM_OPT_TEXT_REF(struct fw_args, member)
+
+static const struct irdm_opt_name clock_names[] = {
+	{ "real", IRDM_CLOCK_REAL },
+	{ "virtual", IRDM_CLOCK_VIRTUAL },
+	{ NULL, 0 },
+};
+
+static const struct irdm_opt fw_opts[] = {
+	{ .name = "board", .short_name = 'b', .type = IRDM_OPT_STRING, FA_REF(board),
+	  .metavar = "BOARD", .help = "the board file (docs/boards.md); required" },
+	{ .name = "image", .short_name = 'i', .type = IRDM_OPT_STRING, FA_REF(image),
+	  .metavar = "IMAGE", .help = "the object's image (irdm precompute); required" },
+	{ .name = "user", .type = IRDM_OPT_STRING, FA_REF(user), .metavar = "SCRIPT",
+	  .help = "virtual user script (sim boards; scenes/users/)" },
+	{ .name = "duration", .type = IRDM_OPT_DOUBLE, FA(duration_s), .metavar = "S",
+	  .unit = "s", .range = IRDM_OPT_GT | IRDM_OPT_LE, .min = 0, .max = 86400,
+	  .help = "run time (default: the user script's end + 1 s, else 5 s)" },
+	{ .name = "log", .type = IRDM_OPT_STRING, FA_REF(log), .metavar = "FILE",
+	  .help = "binary per-tick log (irdm log export FILE -o CSV)" },
+	{ .name = "clock", .type = IRDM_OPT_ENUM, FA(clock), .names = clock_names,
+	  .metavar = "real | virtual",
+	  .help = "real time paced at the board's period, or virtual time (deterministic, fast)" },
+	{ .name = "require-rt", .type = IRDM_OPT_FLAG, FA(require_rt),
+	  .help = "refuse to run without PREEMPT_RT, SCHED_FIFO and locked memory" },
+	{ .name = "quiet", .short_name = 'q', .type = IRDM_OPT_FLAG, FA(quiet),
+	  .help = "no summary" },
+	{ .name = "help", .short_name = 'h', .type = IRDM_OPT_FLAG, FA(help), .help = "this text" },
+};
+
+static const struct irdm_opt_table fw_table = {
+	.what = "option",
+	.see = "irdm-fw --help",
+	.opts = fw_opts,
+	.n_opts = sizeof(fw_opts) / sizeof(fw_opts[0]),
+};
+
+void fw_args_usage(FILE *f)
+{
+	fputs("usage: irdm-fw --board BOARD --image IMAGE [--user SCRIPT] [--duration S]\n"
+	      "               [--log FILE] [--clock real|virtual] [--require-rt]\n"
+	      "\n"
+	      "Runs the force loop on a board's device: HAL read, encoders, kinematics,\n"
+	      "proxy on the deformed surface, force engine, J^T and limits, HAL write,\n"
+	      "every period; torque off on any fault, SIGINT or SIGTERM.\n\n", f);
+	irdm_opt_print_help(f, &fw_table, IRDM_OPT_STYLE_ARG);
+	fputs("\nexit codes: 0 ran to the end; 2 bad arguments; 3 board, image or user\n"
+	      "script refused; 4 HAL, real time (--require-rt) or memory refused;\n"
+	      "5 the controller faulted (torque off, reason printed)\n", f);
+}
+
+int fw_args_parse(struct fw_args *a, int argc, char **argv, char *err, size_t errlen)
+{
+	struct irdm_opt_set set = { &fw_table, a };
+	int rc;
+
+	memset(a, 0, sizeof(*a));
+	a->clock = IRDM_CLOCK_REAL;
+	rc = irdm_opt_parse_args(&set, 1, argc, argv, NULL, NULL, err, errlen);
+	if (rc || a->help)
+		return rc;
+	if (!a->board || !a->image) {
+		snprintf(err, errlen, "%s", !a->board ? "missing --board BOARD" : "missing --image IMAGE");
+		return IRDM_EINVAL;
+	}
+	return IRDM_OK;
+}

@@ -1,0 +1,49 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * The board, as the controller's configuration.  Each arm comes from the
+ * board with its shoulder already placed in the shared device frame
+ * (irdm_board_device()), so the controller's mount offset stays zero and
+ * "each device's own frame" and the shared frame coincide.
+ */
+#include <string.h>
+
+#include "irdm/error.h"
+
+#include "fw.h"
+
+int fw_config_from_board(struct irdm_ctrl_config *c, const struct irdm_board *b)
+{
+	struct irdm_ctrl_limits *lim = &c->limits;
+	int rc;
+
+	irdm_ctrl_config_default(c);
+	c->n_devices = b->devices;
+	for (unsigned i = 0; i < b->devices; i++) {
+		rc = irdm_board_device(b, i, &c->device[i].dev);
+		if (rc)
+			return rc;
+		memset(c->device[i].mount_offset_m, 0, sizeof(c->device[i].mount_offset_m));
+		memcpy(c->device[i].calib_q_rad, b->calibration_pose_rad,
+		       sizeof(c->device[i].calib_q_rad));
+	}
+	/* the board places the object in the device frame (p_dev = R p_obj + o);
+	 * the controller maps the other way: p_obj = R^T p_dev - R^T o */
+	for (int r = 0; r < 3; r++)
+		for (int k = 0; k < 3; k++)
+			c->obj_rot[3 * r + k] = b->object_rotation[3 * k + r];
+	irdm_board_device_to_object(b, (const double[3]){ 0, 0, 0 }, c->obj_offset_m);
+	lim->max_force_n = b->device.max_force_n;
+	memcpy(lim->workspace_min_m, b->workspace_min_m, sizeof(lim->workspace_min_m));
+	memcpy(lim->workspace_max_m, b->workspace_max_m, sizeof(lim->workspace_max_m));
+	lim->max_tip_speed_m_per_s = b->max_tip_speed_m_per_s;
+	lim->overrun_fault_count = b->overrun_fault_count;
+	lim->watchdog_us = b->watchdog_us;
+	c->period_us = b->period_us;
+	irdm_board_engine_config(b, &c->engine);
+	c->engine.max_contacts = b->devices > c->engine.max_contacts ? b->devices
+								     : c->engine.max_contacts;
+	/* the controller clamps the rendered force; the engine's own limit only
+	 * guards against a runaway (it faults), so it sits well above */
+	c->engine.max_force_n = 4 * lim->max_force_n;
+	return irdm_ctrl_config_check(c);
+}

@@ -1,0 +1,188 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * The force loop around the controller's tick: wait for the period, let the
+ * virtual user push the simulated arm, read the HAL, tick, write the HAL.
+ * Nothing here allocates, prints or locks; on a fault the torque goes off
+ * (safe_off on every device) in the same period, before anything else.
+ */
+#include <math.h>
+#include <string.h>
+#include <time.h>
+
+#include "irdm/device.h"
+#include "irdm/error.h"
+#include "irdm/hal_sim.h"
+#include "irdm/rt.h"
+#include "irdm/vec3.h"
+
+#include "fw.h"
+
+/* The virtual user's hand on arm h: its force from the arm's true state. */
+static void push_hand(struct fw *fw, unsigned h, double t_s)
+{
+	struct irdm_sim_device *sim = irdm_hal_sim_device(&fw->hal[h]);
+	double q[3], qd[3], tip[3], vel[3], J[9], p_obj[3], v_obj[3], f_obj[3], f_dev[3];
+
+	if (!sim)
+		return;
+	irdm_sim_device_state(sim, q, qd);
+	irdm_device_fk(&fw->dev[h], q, tip);
+	irdm_device_jacobian(&fw->dev[h], q, J);
+	for (int r = 0; r < 3; r++)
+		vel[r] = J[3 * r] * qd[0] + J[3 * r + 1] * qd[1] + J[3 * r + 2] * qd[2];
+	irdm_board_device_to_object(&fw->board, tip, p_obj);
+	irdm_board_vector_to_object(&fw->board, vel, v_obj);
+	irdm_sim_user_hand_force(fw->user, h, t_s, p_obj, v_obj, f_obj);
+	irdm_board_vector_to_device(&fw->board, f_obj, f_dev);
+	irdm_sim_device_set_hand_force(sim, f_dev);
+}
+
+static void safe_off_all(struct fw *fw)
+{
+	for (unsigned i = 0; i < fw->board.devices; i++)
+		irdm_hal_safe_off(&fw->hal[i]);
+}
+
+/* HAL reads and polls into the controller's input; failures become flags. */
+static void read_devices(struct fw *fw, struct irdm_ctrl_input *in)
+{
+	struct irdm_hal_joint_state st;
+	uint32_t faults;
+
+	for (unsigned i = 0; i < fw->board.devices; i++) {
+		if (irdm_hal_read(&fw->hal[i], &st)) {
+			in->cmd |= IRDM_CTRL_CMD_HAL_READ_FAILED;
+			for (int j = 0; j < 3; j++)
+				in->counts[i][j] = IRDM_CTRL_COUNT_NAN;
+		} else {
+			memcpy(in->counts[i], st.counts, sizeof(in->counts[i]));
+		}
+		if (irdm_hal_poll(&fw->hal[i], &faults))
+			in->cmd |= IRDM_CTRL_CMD_HAL_FAULT;
+	}
+}
+
+static uint32_t write_devices(struct fw *fw, const struct irdm_ctrl_output *out)
+{
+	uint32_t failed = 0;
+
+	if (out->state != IRDM_SAFETY_ENABLED)
+		return 0;
+	for (unsigned i = 0; i < fw->board.devices; i++)
+		if (irdm_hal_write(&fw->hal[i], out->dev[i].torque_nm))
+			failed = IRDM_CTRL_CMD_HAL_WRITE_FAILED;
+	return failed;
+}
+
+/* The node whose motion after release is the "ringing": the vertex of the
+ * contact triangle that carries most of the contact. */
+static void watch_contact_node(struct fw *fw, const struct irdm_ctrl_device_output *d)
+{
+	unsigned best = 0;
+
+	if (!d->contact || d->tri >= fw->s->img->meta->n_tris)
+		return;
+	for (unsigned k = 1; k < 3; k++)
+		if (d->bary[k] > d->bary[best])
+			best = k;
+	fw->watch_row = fw->s->img->tris[3 * (size_t)d->tri + best];
+	memcpy(fw->watch_normal, d->normal, sizeof(fw->watch_normal));
+	fw->watching = true;
+}
+
+static void trace_tick(struct fw *fw, const struct irdm_ctrl_output *out)
+{
+	struct fw_trace *t = &fw->trace;
+	const struct irdm_ctrl_device_output *d = &out->dev[0];
+	double u[3] = { 0, 0, 0 };
+	uint64_t k = t->n;
+
+	if (k >= t->cap)
+		return;
+	watch_contact_node(fw, d);
+	if (fw->watching)
+		irdm_engine_node_disp(fw->s->eng, fw->watch_row, u);
+	t->force_n[k] = irdm_v3_norm(d->force_obj_n);
+	t->fz_n[k] = irdm_v3_dot(d->force_obj_n, fw->watch_normal);
+	t->node_u_m[k] = irdm_v3_dot(u, fw->watch_normal);
+	t->contact[k] = d->contact;
+	t->n++;
+}
+
+static double now_ns(void)
+{
+	struct timespec ts;
+
+	clock_gettime(CLOCK_MONOTONIC, &ts);
+	return (double)ts.tv_sec * 1e9 + (double)ts.tv_nsec;
+}
+
+/*
+ * Commands of the run: calibrate at the first tick (the arm starts at its
+ * calibration pose), enable at the second, shut down at the end; a signal
+ * faults (SIGNAL) and stops the run.
+ */
+static uint32_t run_commands(uint64_t tick, uint64_t last, bool signalled)
+{
+	uint32_t cmd = 0;
+
+	if (tick == 0)
+		cmd |= IRDM_CTRL_CMD_CALIBRATE;
+	if (tick == 1)
+		cmd |= IRDM_CTRL_CMD_ENABLE;
+	if (tick == last)
+		cmd |= IRDM_CTRL_CMD_SHUTDOWN;
+	if (signalled)
+		cmd |= IRDM_CTRL_CMD_SIGNAL;
+	return cmd;
+}
+
+int fw_loop_run(struct fw *fw, volatile sig_atomic_t *signalled)
+{
+	uint64_t n_ticks = fw->trace.cap, prev_lat = 0, prev_comp = 0;
+	uint32_t carry = 0;
+	struct irdm_ctrl_input in;
+	struct irdm_ctrl_output out;
+	int rc = FW_EXIT_OK;
+
+	irdm_clock_start(&fw->clock, (enum irdm_clock_mode)fw->args.clock, fw->board.period_us);
+	for (uint64_t k = 0; k < n_ticks; k++) {
+		int64_t latency_ns = irdm_clock_wait(&fw->clock);
+		double t_s = irdm_clock_time_s(&fw->clock), t0 = now_ns(), compute_ns;
+		bool sig = *signalled != 0;
+
+		memset(&in, 0, sizeof(in));
+		if (fw->user)
+			for (unsigned h = 0; h < fw->user->hands && h < fw->board.devices; h++)
+				push_hand(fw, h, t_s);
+		read_devices(fw, &in);
+		in.cmd |= carry | run_commands(k, n_ticks - 1, sig);
+		in.prev_latency_ns = prev_lat;
+		in.prev_compute_ns = prev_comp;
+		if (irdm_ctrl_tick(&fw->ctrl, &in, &out) == IRDM_EFAULT || sig)
+			safe_off_all(fw);
+		else
+			carry = write_devices(fw, &out);
+		compute_ns = now_ns() - t0;
+		/* virtual time reports no timing to the controller: its runs
+		 * (and logs) are the same every time */
+		if (fw->args.clock == IRDM_CLOCK_REAL) {
+			prev_lat = (uint64_t)(latency_ns > 0 ? latency_ns : 0);
+			prev_comp = (uint64_t)irdm_clock_elapsed_ns(&fw->clock);
+		}
+		trace_tick(fw, &out);
+		irdm_hist_add(&fw->compute_measured, (int64_t)compute_ns);
+		fw_log_record(fw, &out, fw->args.clock == IRDM_CLOCK_REAL ? latency_ns : 0,
+			      (int64_t)prev_comp);
+		fw->ticks = out.tick;
+		fw->last_state = out.state;
+		fw->last_cause = out.cause;
+		if (out.state == IRDM_SAFETY_FAULT || out.state == IRDM_SAFETY_OFF) {
+			safe_off_all(fw);
+			rc = out.state == IRDM_SAFETY_FAULT && out.cause != IRDM_FAULT_SIGNAL
+				     ? FW_EXIT_FAULT : FW_EXIT_OK;
+			break;
+		}
+	}
+	return rc;
+}

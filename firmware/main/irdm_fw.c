@@ -1,0 +1,226 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * irdm-fw: the controller.  Reads the board and the image, brings the
+ * device up through the HAL, sets up real time, runs the force loop and
+ * shuts down with the torque off first.  `irdm-fw --help` for the
+ * arguments and exit codes; docs/architecture.md for the loop.
+ */
+#include <math.h>
+#include <signal.h>
+#include <stdalign.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "irdm/error.h"
+#include "irdm/hal_sim.h"
+#include "irdm/rt.h"
+
+#include "fw.h"
+
+#define FORCE_STACK_BYTES (256u * 1024u)    /* pre-faulted for the loop */
+
+static volatile sig_atomic_t signalled;
+
+static void on_signal(int sig)
+{
+	signalled = sig;
+}
+
+/* One line on stderr, "irdm-fw: ENAME: reason", and the exit code. */
+static int fail(int exit_code, int rc, const char *fmt, const char *what, const char *why)
+{
+	fprintf(stderr, "irdm-fw: %s: ", irdm_errname(rc));
+	fprintf(stderr, fmt, what, why);
+	fputc('\n', stderr);
+	return exit_code;
+}
+
+static int open_inputs(struct fw *fw)
+{
+	struct irdm_session_config sc = { .deform = false };
+	double dt_us;
+	int rc;
+
+	rc = irdm_board_load(&fw->board, fw->args.board, fw->err, sizeof(fw->err));
+	if (rc)
+		return fail(FW_EXIT_INPUT, rc, "%s%s", "", fw->err);
+	rc = fw_config_from_board(&fw->ccfg, &fw->board);
+	if (rc)
+		return fail(FW_EXIT_INPUT, rc, "%s: %s", fw->args.board,
+			    "the controller refuses this board's arm, limits or placement");
+	sc.engine = fw->ccfg.engine;
+	rc = irdm_session_open(&fw->s, fw->args.image, &sc, fw->err, sizeof(fw->err));
+	if (rc)
+		return fail(FW_EXIT_INPUT, rc, "%s%s", "", fw->err);
+	dt_us = fw->s->img->meta->dt_s * 1e6;
+	if (fabs(dt_us - fw->board.period_us) > 1.0) {
+		snprintf(fw->err, sizeof(fw->err), "image dt is %.0f us but the board's period_us is %u",
+			 dt_us, fw->board.period_us);
+		return fail(FW_EXIT_INPUT, IRDM_EINVAL, "%s: %s", fw->args.image, fw->err);
+	}
+	if (!fw->args.user)
+		return FW_EXIT_OK;
+	if (strcmp(fw->board.hal, "sim"))
+		return fail(FW_EXIT_INPUT, IRDM_EINVAL, "--user %s: %s", fw->args.user,
+			    "a virtual user needs a simulated board (hal = sim)");
+	fw->user = calloc(1, sizeof(*fw->user));
+	if (!fw->user)
+		return fail(FW_EXIT_SETUP, IRDM_ENOMEM, "%s%s", "", "out of memory for the user script");
+	rc = irdm_sim_user_load(fw->user, fw->args.user, fw->err, sizeof(fw->err));
+	if (rc)
+		return fail(FW_EXIT_INPUT, rc, "%s%s", "", fw->err);
+	return FW_EXIT_OK;
+}
+
+static int open_devices(struct fw *fw)
+{
+	const struct irdm_hal_backend *be;
+	int rc;
+
+	irdm_hal_register(&irdm_hal_sim_backend);
+	be = irdm_hal_find(fw->board.hal);
+	if (!be)
+		return fail(FW_EXIT_SETUP, IRDM_ENOTSUP, "hal '%s': %s", fw->board.hal,
+			    "no such back-end in this build");
+	for (unsigned i = 0; i < fw->board.devices; i++) {
+		irdm_board_device(&fw->board, i, &fw->dev[i]);
+		fw->hcfg[i] = (struct irdm_hal_config){ &fw->dev[i], fw->board.hal_options,
+							fw->board.period_us * 1e-6 };
+		fw->hal_mem[i] = aligned_alloc(alignof(max_align_t),
+					       (be->data_size + alignof(max_align_t) - 1) /
+					       alignof(max_align_t) * alignof(max_align_t));
+		if (!fw->hal_mem[i])
+			return fail(FW_EXIT_SETUP, IRDM_ENOMEM, "hal '%s': %s", fw->board.hal,
+				    "out of memory");
+		rc = irdm_hal_init(&fw->hal[i], fw->board.hal, &fw->hcfg[i], fw->hal_mem[i],
+				   be->data_size);
+		if (!rc)
+			rc = irdm_hal_open(&fw->hal[i]);
+		if (rc)
+			return fail(FW_EXIT_SETUP, rc, "hal '%s': %s", fw->board.hal,
+				    "the device does not open");
+		fw->hal_open[i] = true;
+		rc = irdm_hal_start(&fw->hal[i]);
+		if (rc)
+			return fail(FW_EXIT_SETUP, rc, "hal '%s': %s", fw->board.hal,
+				    "the drives do not start");
+	}
+	return FW_EXIT_OK;
+}
+
+/*
+ * Real time as the board asks (real clock only), then report what was
+ * granted, read back; --require-rt refuses to run on less (libfranka-style:
+ * never claim real time that was not given).
+ */
+static int setup_realtime(struct fw *fw)
+{
+	struct irdm_rt_sched sched = { SCHED_FIFO, fw->board.force_priority, fw->board.cpu };
+	struct irdm_rt_report rep;
+	char line[256];
+
+	if (fw->args.clock == IRDM_CLOCK_VIRTUAL) {
+		if (fw->args.require_rt)
+			return fail(FW_EXIT_USAGE, IRDM_EINVAL, "%s%s", "",
+				    "--require-rt needs --clock real");
+		return FW_EXIT_OK;
+	}
+	irdm_rt_lock_memory();
+	irdm_rt_set_self(&sched);
+	irdm_rt_prefault_stack(FORCE_STACK_BYTES);
+	irdm_rt_report_get(&rep);
+	irdm_rt_report_format(&rep, line, sizeof(line));
+	if (!fw->args.quiet)
+		printf("%s\n", line);
+	if (fw->args.require_rt && !irdm_rt_report_realtime(&rep))
+		return fail(FW_EXIT_SETUP, IRDM_EPERM, "%s: %s", "--require-rt", line);
+	return FW_EXIT_OK;
+}
+
+static uint64_t run_ticks(const struct fw *fw)
+{
+	double s = fw->args.duration_s;
+
+	if (s <= 0)
+		s = fw->user ? fw->user->end_s + 1.0 : 5.0;
+	return (uint64_t)llround(s * 1e6 / fw->board.period_us);
+}
+
+static int start(struct fw *fw)
+{
+	struct sigaction sa;
+	int rc;
+
+	rc = open_inputs(fw);
+	if (!rc)
+		rc = open_devices(fw);
+	if (rc)
+		return rc;
+	if (irdm_ctrl_init(&fw->ctrl, &fw->ccfg, fw->s))
+		return fail(FW_EXIT_INPUT, IRDM_EINVAL, "%s: %s", fw->args.image,
+			    "the controller cannot run on this image (no contact surface?)");
+	if (fw_trace_alloc(&fw->trace, run_ticks(fw)))
+		return fail(FW_EXIT_SETUP, IRDM_ENOMEM, "%s%s", "", "out of memory for the run's trace");
+	rc = fw_log_open(fw);
+	if (rc)
+		return fail(FW_EXIT_SETUP, rc, "%s: %s", fw->args.log ? fw->args.log : "log", fw->err);
+	memset(&sa, 0, sizeof(sa));
+	sa.sa_handler = on_signal;
+	sigaction(SIGINT, &sa, NULL);
+	sigaction(SIGTERM, &sa, NULL);
+	return setup_realtime(fw);
+}
+
+/* Torque off first, then everything else. */
+static void stop(struct fw *fw)
+{
+	for (unsigned i = 0; i < IRDM_BOARD_DEVICES_MAX; i++)
+		if (fw->hal_open[i])
+			irdm_hal_safe_off(&fw->hal[i]);
+	for (unsigned i = 0; i < IRDM_BOARD_DEVICES_MAX; i++) {
+		if (fw->hal_open[i])
+			irdm_hal_close(&fw->hal[i]);
+		free(fw->hal_mem[i]);
+	}
+	if (fw->ring && fw_log_close(fw))
+		fprintf(stderr, "irdm-fw: EIO: %s\n", fw->err);
+	free(fw->user);
+	irdm_session_close(fw->s);
+}
+
+int main(int argc, char **argv)
+{
+	struct fw *fw = calloc(1, sizeof(*fw));
+	int rc;
+
+	if (!fw)
+		return fail(FW_EXIT_SETUP, IRDM_ENOMEM, "%s%s", "", "out of memory");
+	rc = fw_args_parse(&fw->args, argc - 1, argv + 1, fw->err, sizeof(fw->err));
+	if (rc || fw->args.help) {
+		if (fw->args.help) {
+			fw_args_usage(stdout);
+			free(fw);
+			return FW_EXIT_OK;
+		}
+		rc = fail(FW_EXIT_USAGE, rc, "%s%s (see irdm-fw --help)", "", fw->err);
+		free(fw);
+		return rc;
+	}
+	rc = start(fw);
+	if (!rc) {
+		rc = fw_loop_run(fw, &signalled);
+		if (signalled)
+			fprintf(stderr, "irdm-fw: stopped by signal %d: torque off\n", (int)signalled);
+		else if (rc == FW_EXIT_FAULT)
+			fprintf(stderr, "irdm-fw: EFAULT: fault %s at tick %llu: torque off\n",
+				irdm_safety_fault_name(fw->last_cause), (unsigned long long)fw->ticks);
+	}
+	stop(fw);
+	if ((rc == FW_EXIT_OK || rc == FW_EXIT_FAULT) && !fw->args.quiet)
+		fw_summary_print(fw);
+	fw_trace_free(&fw->trace);
+	free(fw);
+	return rc;
+}
