@@ -132,8 +132,9 @@ $(TICK_IMAGE): $(IRDM)
 	$(IRDM) precompute -q --mesh box:0.04,0.04,0.08 --resolution 2,2,4 --fixed 'z<=0' \
 	  --touch 'z>=0.08' --display surface --representation modal:all -o $@
 
-test: $(TESTS) $(IRDM) $(TICK_IMAGE)
-	IRDM=$(IRDM) IRDM_BUILD=$(BUILD) IRDM_TICK_IMAGE=$(TICK_IMAGE) tests/run-tests.sh $(TESTS)
+test: $(TESTS) $(IRDM) $(IRDM_FW) $(TICK_IMAGE)
+	IRDM=$(IRDM) IRDM_FW=$(IRDM_FW) IRDM_BUILD=$(BUILD) IRDM_TICK_IMAGE=$(TICK_IMAGE) \
+	  tests/run-tests.sh $(TESTS)
 
 # Generated from the scene key table (tests/test_cli.c checks it is current).
 docs: $(IRDM)
@@ -190,8 +191,8 @@ check: deps
 	$(MAKE) test
 
 run: deps
-	$(MAKE) $(IRDM)
-	tools/scripts/run-default-scene.sh $(IRDM)
+	$(MAKE) $(IRDM) $(IRDM_FW)
+	tools/scripts/run-default-scene.sh $(IRDM) $(IRDM_FW)
 
 deps:
 	tools/scripts/install-deps.sh
