@@ -8,6 +8,7 @@
 #   make check      what CI runs: fuzz, clang + sanitizer tests, then the tests
 #   make bench      benchmarks (print figures; never pass/fail on time)
 #   make run        the main job: the built-in default scene, end to end
+#   make jitter     irdm-fw's wake-up latency beside cyclictest's (JITTER_SECONDS)
 #   make docs       docs/scene-format.md from the scene key table
 #
 # CC=clang works too.  The layers point one way and the include paths
@@ -75,7 +76,7 @@ TESTS    := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 TICK_TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TICK_TEST_SRC))
 BENCHES  := $(patsubst tests/bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC))
 
-.PHONY: all test san fuzz bench bench-precompute run check deps clean docs
+.PHONY: all test san fuzz bench bench-precompute run jitter check deps clean docs
 .SECONDARY:
 all: $(IRDM) $(FW_LIB) $(HAL_LIB) $(SIM_LIB) $(if $(FWMAIN_SRC),$(IRDM_FW))
 
@@ -193,6 +194,14 @@ check: deps
 run: deps
 	$(MAKE) $(IRDM) $(IRDM_FW)
 	tools/scripts/run-default-scene.sh $(IRDM) $(IRDM_FW)
+
+# irdm-fw's wake-up latency beside cyclictest's (JITTER_SECONDS each, default 60)
+JITTER_IMAGE := $(BUILD)/data/jitter.img
+$(JITTER_IMAGE): $(IRDM) scenes/cuboid-top.scene
+	@mkdir -p $(dir $@)
+	$(IRDM) precompute -q --scene scenes/cuboid-top.scene -o $@
+jitter: deps $(IRDM) $(IRDM_FW) $(JITTER_IMAGE)
+	tools/scripts/jitter.sh $(IRDM) $(IRDM_FW) $(JITTER_IMAGE)
 
 deps:
 	tools/scripts/install-deps.sh

@@ -12,6 +12,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/prctl.h>
 
 #include "irdm/error.h"
 #include "irdm/hal_sim.h"
@@ -129,6 +130,8 @@ static int setup_realtime(struct fw *fw)
 	}
 	irdm_rt_lock_memory();
 	irdm_rt_set_self(&sched);
+	/* absolute sleeps wake on time, not up to the 50 us default slack later */
+	prctl(PR_SET_TIMERSLACK, 1UL, 0UL, 0UL, 0UL);
 	irdm_rt_prefault_stack(FORCE_STACK_BYTES);
 	irdm_rt_report_get(&rep);
 	irdm_rt_report_format(&rep, line, sizeof(line));
