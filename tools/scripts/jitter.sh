@@ -12,12 +12,14 @@ set -euo pipefail
 irdm=$1; fw=$2; image=$3
 secs=${JITTER_SECONDS:-60}
 # The simulated board, pinned to one CPU, with overruns counted rather than
-# faulting (K = 1000): on a host that is not real time the measurement must
-# reach its end; the safety policy itself is tested in tests/test_controller.c.
+# faulting (K = 1000, a 1 s watchdog): on a host that is not real time the
+# measurement must reach its end; the safety policy itself is tested in
+# tests/test_controller.c and tests/test_safety.c.
 cpu=$(( $(nproc) > 1 ? 1 : 0 ))
 mkdir -p out
 board=out/jitter.board
 sed -e "s/^cpu *=.*/cpu = $cpu/" -e 's/^overrun_fault_count *=.*/overrun_fault_count = 1000/' \
+	-e 's/^watchdog_us *=.*/watchdog_us = 1000000/' \
 	boards/sim-phantom.board > $board
 key() { awk -F= -v k="$1" '$1 ~ "^"k" *$" { sub(/#.*/, "", $2); gsub(/ /, "", $2); print $2 }' $board; }
 prio=$(key force_priority); period=$(key period_us)
