@@ -40,16 +40,6 @@ static const char *irdm_path(void)
 	return p ? p : "build/irdm";
 }
 
-static void slurp(const char *path, char *buf, size_t len)
-{
-	FILE *f = fopen(path, "r");
-	size_t n = f ? fread(buf, 1, len - 1, f) : 0;
-
-	buf[n] = 0;
-	if (f)
-		fclose(f);
-}
-
 /* Address-space cap (bytes) for the children run() starts; 0: none. */
 static rlim_t child_as_limit;
 
@@ -90,8 +80,8 @@ static int run(const char *first, ...)
 	if (pid == 0)
 		exec_child(argv, out_path, err_path);
 	assert_int_equal(waitpid(pid, &status, 0), pid);
-	slurp(out_path, out_text, sizeof(out_text));
-	slurp(err_path, err_text, sizeof(err_text));
+	tf_read_text(out_path, out_text, sizeof(out_text));
+	tf_read_text(err_path, err_text, sizeof(err_text));
 	return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
 }
 
@@ -129,15 +119,6 @@ static void expect_failure(int rc, const char *needle)
 	if (rc == 0 || strncmp(last, "irdm", 4) || !strstr(last, needle))
 		fail_msg("expected a one-line error with '%s' (exit %d): %s", needle, rc, err_text);
 	assert_true(rc > 0 && rc < 128);   /* an error exit, not a crash */
-}
-
-static void write_file(const char *path, const char *text)
-{
-	FILE *f = fopen(path, "w");
-
-	assert_non_null(f);
-	fputs(text, f);
-	fclose(f);
 }
 
 static int setup(void **state)
@@ -180,13 +161,13 @@ static void test_bad_scene_values(void **state)
 	expect_failure(run("precompute", SMALL, NULL), "-o");
 	expect_failure(run("precompute", "--scene", path_in_dir("missing.scene"), "-o", img, NULL),
 		       "missing.scene");
-	write_file(path_in_dir("bad.scene"), "young = 2000\nthis line has no equals sign\n");
+	tf_write_text(path_in_dir("bad.scene"), "young = 2000\nthis line has no equals sign\n");
 	expect_failure(run("precompute", "--scene", path_in_dir("bad.scene"), "-o", img, NULL),
 		       "bad.scene:2");
-	write_file(path_in_dir("bad.scene"), "# material\nyoung = 2000\npoisson = 0.6\n");
+	tf_write_text(path_in_dir("bad.scene"), "# material\nyoung = 2000\npoisson = 0.6\n");
 	expect_failure(run("precompute", "--scene", path_in_dir("bad.scene"), "-o", img, NULL),
 		       "bad.scene:3: poisson = 0.6: must be < 0.5");
-	write_file(path_in_dir("bad.scene"), "mass = heavy\n");
+	tf_write_text(path_in_dir("bad.scene"), "mass = heavy\n");
 	expect_failure(run("precompute", "--scene", path_in_dir("bad.scene"), "-o", img, NULL),
 		       "bad.scene:1: mass = heavy: expected lumped | consistent");
 	assert_false(exists(img));
@@ -200,21 +181,21 @@ static void test_bad_meshes(void **state)
 
 	(void)state;
 	/* element 2 lists its nodes in the inverted order */
-	write_file(path_in_dir("inv.node"), nodes);
-	write_file(path_in_dir("inv.ele"), "2 4 0\n1 1 2 3 4\n2 5 2 3 4\n");
+	tf_write_text(path_in_dir("inv.node"), nodes);
+	tf_write_text(path_in_dir("inv.ele"), "2 4 0\n1 1 2 3 4\n2 5 2 3 4\n");
 	expect_failure(run("precompute", "--mesh", path_in_dir("inv.node"), "--fixed", "z<=0",
 			   "-o", img, NULL), "element 2");
 	/* zero volume: four coplanar nodes */
-	write_file(path_in_dir("flat.node"), "4 3 0 0\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 1 1 0\n");
-	write_file(path_in_dir("flat.ele"), "1 4 0\n1 1 2 3 4\n");
+	tf_write_text(path_in_dir("flat.node"), "4 3 0 0\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 1 1 0\n");
+	tf_write_text(path_in_dir("flat.ele"), "1 4 0\n1 1 2 3 4\n");
 	expect_failure(run("precompute", "--mesh", path_in_dir("flat.ele"), "-o", img, NULL), "element 1");
 	/* NaN coordinate */
-	write_file(path_in_dir("nan.node"), "4 3 0 0\n1 0 0 0\n2 nan 0 0\n3 0 1 0\n4 0 0 1\n");
-	write_file(path_in_dir("nan.ele"), "1 4 0\n1 1 2 3 4\n");
+	tf_write_text(path_in_dir("nan.node"), "4 3 0 0\n1 0 0 0\n2 nan 0 0\n3 0 1 0\n4 0 0 1\n");
+	tf_write_text(path_in_dir("nan.ele"), "1 4 0\n1 1 2 3 4\n");
 	expect_failure(run("precompute", "--mesh", path_in_dir("nan.node"), "-o", img, NULL), "node 2");
 	/* node 5 is in no element */
-	write_file(path_in_dir("unref.node"), nodes);
-	write_file(path_in_dir("unref.ele"), "1 4 0\n1 1 2 3 4\n");
+	tf_write_text(path_in_dir("unref.node"), nodes);
+	tf_write_text(path_in_dir("unref.ele"), "1 4 0\n1 1 2 3 4\n");
 	expect_failure(run("precompute", "--mesh", path_in_dir("unref.node"), "-o", img, NULL), "node 5");
 	expect_failure(run("precompute", "--mesh", path_in_dir("nothing.msh"), "-o", img, NULL),
 		       "nothing.msh");
@@ -293,12 +274,12 @@ static void test_failure_keeps_existing_image(void **state)
 
 	(void)state;
 	assert_int_equal(run("precompute", "-q", SMALL, "-o", img, NULL), 0);
-	slurp(img, before, sizeof(before));
+	tf_read_text(img, before, sizeof(before));
 	struct stat st0, st1;
 	assert_int_equal(stat(img, &st0), 0);
 	expect_failure(run("precompute", SMALL, "--young", "-1", "-o", img, NULL), "young");
 	assert_int_equal(stat(img, &st1), 0);
-	slurp(img, after, sizeof(after));
+	tf_read_text(img, after, sizeof(after));
 	assert_int_equal(st0.st_size, st1.st_size);
 	assert_memory_equal(before, after, sizeof(before) < (size_t)st0.st_size ? sizeof(before) : (size_t)st0.st_size);
 	assert_int_equal(run("image", "verify", img, NULL), 0);
@@ -334,7 +315,7 @@ static void test_bad_images(void **state)
 	expect_failure(run("image", "verify", bad, NULL), "magic");
 	corrupt(img, bad, 2000, -1);
 	expect_failure(run("image", "info", bad, NULL), "checksum");
-	write_file(bad, "");
+	tf_write_text(bad, "");
 	expect_failure(run("image", "verify", bad, NULL), "bad.img");
 	expect_failure(run("image", "verify", path_in_dir("none.img"), NULL), "none.img");
 	expect_failure(run("image", "export", img, "--column", "99999", NULL), "99999");
@@ -370,7 +351,7 @@ static void test_export_matches_library(void **state)
 	irdm_modes_discretise(&m.modes, &m.damping, 0.002, zoh);
 	irdm_fir_from_modes(&m.modes, zoh, cd, 1, cd, 1, 50, NULL, fir, NULL, NULL);
 	char text[65536];
-	slurp(csv, text, sizeof(text));
+	tf_read_text(csv, text, sizeof(text));
 	char want[64];
 	snprintf(want, sizeof(want), "s,t_s,n%u_ux_fx,n%u_ux_fy", c, c);
 	assert_non_null(strstr(text, want));
@@ -451,7 +432,7 @@ static void test_time_domain_split_and_merge(void **state)
 	expect_failure(run("precompute", TD, "--merge", both, "-o", merged, NULL), "earlier part");
 	expect_failure(run("precompute", TD, "--young", "3000", "--merge", parts, "-o", merged, NULL),
 		       "different scene");
-	write_file(p1, "IRDMPART garbage");
+	tf_write_text(p1, "IRDMPART garbage");
 	expect_failure(run("precompute", TD, "--merge", parts, "-o", merged, NULL), "p1.part");
 #undef TD
 }
@@ -476,7 +457,7 @@ static void test_replay(void **state)
 		target[3 * t + 2] = -0.01;
 		p += sprintf(p, "%.3f,0,0,-0.01\n", t * 0.001);
 	}
-	write_file(traj, text);
+	tf_write_text(traj, text);
 	assert_int_equal(run("replay", "--image", img, "--contact", "40", "--displacement", traj, "-o", out, NULL), 0);
 	assert_int_equal(irdm_image_map(img, 0, &im, err, sizeof(err)), 0);
 	struct irdm_engine_config cfg;
@@ -487,7 +468,7 @@ static void test_replay(void **state)
 	assert_int_equal(irdm_engine_site_node(e, (uint32_t)irdm_image_node_of(&im, 40), &site), 0);
 	irdm_session_close(ses);
 	efx_reference(&im, &site, 1, 300, target, ref);
-	slurp(out, text, sizeof(text));
+	tf_read_text(out, text, sizeof(text));
 	assert_non_null(strstr(text, "t,c1_fx,c1_fy,c1_fz"));
 	p = strchr(text, '\n') + 1;
 	double got[300 * 3];
@@ -500,13 +481,13 @@ static void test_replay(void **state)
 	assert_true(efx_rel_rms(got, ref, 300 * 3) < 1e-9);
 	irdm_image_unmap(&im);
 	remove(out);
-	write_file(traj, "t,ux,uy,uz\n0,0,0,0\n0.002,0,0,0\n");
+	tf_write_text(traj, "t,ux,uy,uz\n0,0,0,0\n0.002,0,0,0\n");
 	expect_failure(run("replay", "--image", img, "--contact", "40", "--displacement", traj, "-o", out, NULL),
 		       "one row per sample");
-	write_file(traj, "0,0,0\n");
+	tf_write_text(traj, "0,0,0\n");
 	expect_failure(run("replay", "--image", img, "--contact", "40", "--displacement", traj, "-o", out, NULL),
 		       "numeric columns");
-	write_file(traj, "0,0,0,1e9\n");
+	tf_write_text(traj, "0,0,0,1e9\n");
 	expect_failure(run("replay", "--image", img, "--contact", "40", "--displacement", traj, "-o", out, NULL),
 		       "out of range");
 	expect_failure(run("replay", "--image", img, "--contact", "0", "--displacement", traj, "-o", out, NULL),
@@ -552,7 +533,7 @@ static void test_scene_docs_current(void **state)
 	const char *path = getenv("IRDM_SCENE_DOC");
 
 	(void)state;
-	slurp(path ? path : "docs/scene-format.md", committed, sizeof(committed));
+	tf_read_text(path ? path : "docs/scene-format.md", committed, sizeof(committed));
 	assert_true(strlen(committed) > 0);
 	assert_int_equal(run("precompute", "--help-markdown", NULL), 0);
 	if (strcmp(out_text, committed))

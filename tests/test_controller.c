@@ -31,6 +31,8 @@
 
 #include <cmocka.h>
 
+#include "support/tick_image.h"
+
 #include "irdm/controller.h"
 #include "irdm/sim_device.h"
 #include "irdm/vec3.h"
@@ -53,16 +55,6 @@ struct rig {
 	int rc;
 	const char *path;               /* the image; NULL: IRDM_TICK_IMAGE */
 };
-
-static const char *image_path(void)
-{
-	const char *p = getenv("IRDM_TICK_IMAGE");
-
-	if (!p || !*p)
-		fail_msg("IRDM_TICK_IMAGE is not set: it names the image this test runs on "
-			 "(make test makes it; see the head of tests/test_tick_session.c)");
-	return p;
-}
 
 /* ---- geometry helpers (the test's own, not the controller's) ---- */
 
@@ -184,7 +176,7 @@ static void rig_open(struct rig *r)
 	char err[512];
 
 	sc.engine = r->cfg.engine;
-	if (irdm_session_open(&r->s, r->path ? r->path : image_path(), &sc, err, sizeof(err)))
+	if (irdm_session_open(&r->s, r->path ? r->path : tick_image_path(), &sc, err, sizeof(err)))
 		fail_msg("session: %s", err);
 	box_of(r->s->img, r);
 	r->cfg.obj_offset_m[0] = r->cx;
@@ -1008,7 +1000,7 @@ static void test_rigid_coupling_reproduces_the_engine(void **state)
 	assert_true(r.cfg.engine.coupling_k_n_per_m == 0);
 	rig_open(&r);
 	sc.engine = r.cfg.engine;
-	if (irdm_session_open(&ref, image_path(), &sc, err, sizeof(err)))
+	if (irdm_session_open(&ref, tick_image_path(), &sc, err, sizeof(err)))
 		fail_msg("session: %s", err);
 	rig_enable(&r);
 	approach(&r, 0, -0.01, 0.003);

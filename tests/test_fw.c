@@ -49,16 +49,6 @@ static const char *env_or(const char *name, const char *dflt)
 	return p ? p : dflt;
 }
 
-static void slurp_text(const char *path, char *buf, size_t len)
-{
-	FILE *f = fopen(path, "r");
-	size_t n = f ? fread(buf, 1, len - 1, f) : 0;
-
-	buf[n] = 0;
-	if (f)
-		fclose(f);
-}
-
 /* Start prog with args (NULL-terminated); stdout/stderr to files. */
 static pid_t spawn(const char *prog, const char *const *args)
 {
@@ -89,9 +79,9 @@ static int finish(pid_t pid)
 
 	assert_int_equal(waitpid(pid, &status, 0), pid);
 	snprintf(path, sizeof(path), "%s/stdout", dir);
-	slurp_text(path, out_text, sizeof(out_text));
+	tf_read_text(path, out_text, sizeof(out_text));
 	snprintf(path, sizeof(path), "%s/stderr", dir);
-	slurp_text(path, err_text, sizeof(err_text));
+	tf_read_text(path, err_text, sizeof(err_text));
 	return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
 }
 
@@ -108,15 +98,6 @@ static void expect_error(int rc, int code, const char *needle)
 			 err_text);
 }
 
-static void write_file(const char *path, const char *text)
-{
-	FILE *f = fopen(path, "w");
-
-	assert_non_null(f);
-	fputs(text, f);
-	fclose(f);
-}
-
 static void test_bad_input(void **state)
 {
 	char bad_board[320], img2[320];
@@ -130,7 +111,7 @@ static void test_bad_input(void **state)
 	expect_error(run_fw((const char *const[]){ "--board", "/nonexistent.board", "--image", image,
 						   NULL }), 3, "/nonexistent.board");
 	snprintf(bad_board, sizeof(bad_board), "%s/bad.board", dir);
-	write_file(bad_board, "name = x\nhal = sim\nperiod_us = -5\n");
+	tf_write_text(bad_board, "name = x\nhal = sim\nperiod_us = -5\n");
 	expect_error(run_fw((const char *const[]){ "--board", bad_board, "--image", image, NULL }), 3,
 		     "bad.board:3");
 	expect_error(run_fw((const char *const[]){ "--board", BOARD, "--image", "/nonexistent.img",

@@ -27,22 +27,14 @@
 
 #include <cmocka.h>
 
+#include "support/tick_image.h"
+
 #include "irdm/engine.h"
 #include "irdm/precision.h"
 #include "irdm/session.h"
 
 #define N_TICKS 1000
 #define STEP_M 0.001
-
-static const char *image_path(void)
-{
-	const char *p = getenv("IRDM_TICK_IMAGE");
-
-	if (!p || !*p)
-		fail_msg("IRDM_TICK_IMAGE is not set: it names the image this test runs on "
-			 "(make test makes it; see the head of tests/test_tick_session.c)");
-	return p;
-}
 
 /* Mode shape k at image node row, axis i. */
 static double phi(const struct irdm_image *img, uint32_t row, int i, size_t k)
@@ -117,7 +109,7 @@ static void test_step_at_a_node(void **state)
 	(void)state;
 	irdm_engine_config_default(&sc.engine);
 	sc.engine.max_contacts = 1;
-	if (irdm_session_open(&s, image_path(), &sc, err, sizeof(err)))
+	if (irdm_session_open(&s, tick_image_path(), &sc, err, sizeof(err)))
 		fail_msg("session: %s", err);
 	assert_null(s->deform);
 	assert_true(s->img->meta->n_cols > 0);
@@ -174,7 +166,7 @@ static void test_open_errors(void **state)
 	assert_true(err[0] != '\0');
 	/* a configuration the engine refuses */
 	sc.engine.max_contacts = IRDM_MAX_CONTACTS + 1;
-	assert_int_equal(irdm_session_open(&s, image_path(), &sc, err, sizeof(err)), IRDM_EINVAL);
+	assert_int_equal(irdm_session_open(&s, tick_image_path(), &sc, err, sizeof(err)), IRDM_EINVAL);
 	assert_null(s);
 	irdm_session_close(NULL);
 }

@@ -28,6 +28,25 @@ char *tf_load(const char *path, size_t *len)
 	return p;
 }
 
+void tf_read_text(const char *path, char *buf, size_t len)
+{
+	FILE *f = fopen(path, "r");
+	size_t n = f ? fread(buf, 1, len - 1, f) : 0;
+
+	buf[n] = 0;
+	if (f)
+		fclose(f);
+}
+
+void tf_write_text(const char *path, const char *text)
+{
+	FILE *f = fopen(path, "w");
+
+	assert_non_null(f);
+	assert_true(fputs(text, f) >= 0);
+	assert_int_equal(fclose(f), 0);
+}
+
 int tf_tmpdir(char *dir, size_t len, const char *tag)
 {
 	snprintf(dir, len, "/tmp/irdm-%s-XXXXXX", tag);

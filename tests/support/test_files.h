@@ -9,6 +9,13 @@
  * fails the test if it cannot be read or is empty. */
 char *tf_load(const char *path, size_t *len);
 
+/* Up to len - 1 bytes of the text file at path, NUL-terminated ("" if it
+ * cannot be read: the caller's assertions on the text then fail). */
+void tf_read_text(const char *path, char *buf, size_t len);
+
+/* Write text to path (replacing it); fails the test if it cannot. */
+void tf_write_text(const char *path, const char *text);
+
 /* mkdtemp /tmp/irdm-TAG-XXXXXX into dir; 0 or -1 (for cmocka setups). */
 int tf_tmpdir(char *dir, size_t len, const char *tag);
 
