@@ -250,9 +250,31 @@ static void test_require_rt(void **state)
 	assert_non_null(strstr(err_text, "not PREEMPT_RT"));
 }
 
+/*
+ * The shipped board with overruns and the watchdog relaxed: on a loaded
+ * host (or under ASan) a real-time run may overrun, and this test is about
+ * the signal, not the overrun policy (tests/test_controller.c has that).
+ */
+static void relaxed_board(char *path, size_t len)
+{
+	char text[16384], out[16384] = "", *line, *save;
+
+	tf_read_text(BOARD, text, sizeof(text));
+	for (line = strtok_r(text, "\n", &save); line; line = strtok_r(NULL, "\n", &save)) {
+		if (!strncmp(line, "overrun_fault_count", 19))
+			line = "overrun_fault_count = 1000";
+		else if (!strncmp(line, "watchdog_us", 11))
+			line = "watchdog_us = 1000000";
+		strncat(out, line, sizeof(out) - strlen(out) - 2);
+		strcat(out, "\n");
+	}
+	snprintf(path, len, "%s/relaxed.board", dir);
+	tf_write_text(path, out);
+}
+
 static void test_sigterm_mid_contact_turns_torque_off(void **state)
 {
-	char log[320];
+	char log[320], board[320];
 	struct timespec t = { 1, 700000000 };    /* 1.7 s: pressed and holding */
 	struct irdm_tick_record rec, last;
 	struct irdm_log_reader *r;
@@ -262,12 +284,14 @@ static void test_sigterm_mid_contact_turns_torque_off(void **state)
 
 	(void)state;
 	snprintf(log, sizeof(log), "%s/sig.log", dir);
+	relaxed_board(board, sizeof(board));
 	pid = spawn(env_or("IRDM_FW", "build/irdm-fw"), (const char *const[]){
-		"--board", BOARD, "--image", image, "--user", PRESS, "--clock", "real",
+		"--board", board, "--image", image, "--user", PRESS, "--clock", "real",
 		"--log", log, NULL });
 	nanosleep(&t, NULL);
 	kill(pid, SIGTERM);
-	assert_int_equal(finish(pid), 0);
+	if (finish(pid) != 0)
+		fail_msg("irdm-fw did not stop cleanly on SIGTERM: %s", err_text);
 	assert_non_null(strstr(err_text, "stopped by signal 15: torque off"));
 	assert_int_equal(irdm_log_open(&r, log, err, sizeof(err)), 0);
 	memset(&last, 0, sizeof(last));
