@@ -9,7 +9,10 @@
  *    static amplitude at the touched node), not at one the loop invents;
  *  - --require-rt refuses a kernel that is not PREEMPT_RT (checked here
  *    independently) and runs on one that is;
- *  - SIGTERM mid-contact: torque off within the tick, the reason logged.
+ *  - SIGTERM mid-contact: torque off within the tick, the reason logged;
+ *  - --frame-at: the deformed surface in VTK, checked physically (a dent
+ *    at the pressed top centre, a still bottom) and byte-identical in
+ *    virtual time.
  * Needs IRDM and IRDM_FW (make test sets them); runs from the repository root.
  */
 #define _GNU_SOURCE
@@ -31,6 +34,7 @@
 #include <cmocka.h>
 
 #include "irdm/image.h"
+#include "irdm/vec3.h"
 #include "irdm/safety.h"
 #include "irdm/telemetry.h"
 #include "support/test_files.h"
@@ -132,6 +136,16 @@ static void test_bad_input(void **state)
 		     3, "/nonexistent.user");
 	expect_error(run_fw((const char *const[]){ "--board", BOARD, "--image", image, "--clock",
 						   "virtual", "--require-rt", NULL }), 2, "--require-rt");
+	expect_error(run_fw((const char *const[]){ "--board", BOARD, "--image", image,
+						   "--frame-at", "1", NULL }), 2, "--frame-out");
+	expect_error(run_fw((const char *const[]){ "--board", BOARD, "--image", image, "--clock",
+						   "virtual", "--duration", "1", "--frame-at", "2",
+						   "--frame-out", "/nonexistent/f.vtk", NULL }),
+		     2, "after the run's end");
+	expect_error(run_fw((const char *const[]){ "--board", BOARD, "--image", image, "--clock",
+						   "virtual", "--duration", "0.1", "--frame-at",
+						   "0.05", "--frame-out", "/nonexistent/f.vtk", NULL }),
+		     4, "/nonexistent/f.vtk");
 }
 
 static void test_virtual_runs_are_identical(void **state)
@@ -311,6 +325,158 @@ static void test_sigterm_mid_contact_turns_torque_off(void **state)
 		assert_true(last.dev[0].joint_torque_nm[j] == 0.0);
 }
 
+/* The numbers after the first line starting with `key` (NULL if none). */
+static const char *vtk_section(const char *text, const char *key)
+{
+	const char *p = strstr(text, key);
+
+	assert_non_null(p);
+	p = strchr(p, '\n');
+	assert_non_null(p);
+	return p + 1;
+}
+
+static void vtk_doubles(const char **p, double *v, size_t n)
+{
+	for (size_t i = 0; i < n; i++) {
+		char *end;
+		v[i] = strtod(*p, &end);
+		assert_true(end != *p);
+		*p = end;
+	}
+}
+
+struct frame_vtk {
+	uint32_t n_points, n_polys;
+	double *pos, *u, contact_m[3];
+	bool polys_in_range;
+};
+
+static void frame_parse(const char *text, struct frame_vtk *f)
+{
+	const char *p;
+	unsigned long n;
+
+	assert_non_null(strstr(text, "# vtk DataFile Version 3.0\n"));
+	assert_non_null(strstr(text, "ASCII\nDATASET POLYDATA\n"));
+	p = strstr(text, "\nPOINTS ");
+	assert_non_null(p);
+	n = strtoul(p + 8, NULL, 10);
+	f->n_points = (uint32_t)n;
+	f->pos = calloc(3 * n, sizeof(double));
+	f->u = calloc(3 * n, sizeof(double));
+	assert_true(f->pos && f->u);
+	p = vtk_section(p + 1, "POINTS");
+	vtk_doubles(&p, f->pos, 3 * n);
+	p = strstr(text, "\nPOLYGONS ");
+	assert_non_null(p);
+	f->n_polys = (uint32_t)strtoul(p + 10, NULL, 10);
+	p = vtk_section(p + 1, "POLYGONS");
+	f->polys_in_range = true;
+	for (uint32_t t = 0; t < f->n_polys; t++) {
+		double v[4];
+		vtk_doubles(&p, v, 4);
+		assert_true(v[0] == 3);
+		for (int k = 1; k < 4; k++)
+			f->polys_in_range &= v[k] >= 0 && v[k] < (double)f->n_points;
+	}
+	p = vtk_section(text, "VECTORS displacement_m double");
+	vtk_doubles(&p, f->u, 3 * n);
+	p = vtk_section(text, "contact_point_m 3 1 double");
+	vtk_doubles(&p, f->contact_m, 3);
+}
+
+static uint32_t nearest_row(const struct irdm_image *img, const double p[3])
+{
+	uint32_t best = 0;
+	double best_d = INFINITY;
+
+	for (uint32_t r = 0; r < img->meta->n_nodes; r++) {
+		const float *x = img->nodes[r].pos_m;
+		double d = pow(x[0] - p[0], 2) + pow(x[1] - p[1], 2) + pow(x[2] - p[2], 2);
+		if (d < best_d) {
+			best_d = d;
+			best = r;
+		}
+	}
+	return best;
+}
+
+/* The surface image: every face displayed, the bottom's fixed nodes too. */
+static void surface_image(char *path, size_t len)
+{
+	pid_t pid;
+
+	snprintf(path, len, "%s/surface.img", dir);
+	pid = spawn(env_or("IRDM", "build/irdm"), (const char *const[]){
+		"precompute", "-q", "--mesh", "cuboid", "--resolution", "4,4,8", "--fixed", "z<=0",
+		"--touch", "z>=0.2", "--display", "surface", "--representation", "modal:40",
+		"--static_correction", "yes", "-o", path, NULL });
+	assert_int_equal(finish(pid), 0);
+}
+
+/*
+ * Mid-hold (1.5 s) the press dents the top: the node nearest the contact
+ * point moves down by millimetres (the hand's spring pushes ~0.3 N into a
+ * cuboid of a few hundred N/m there), the fixed bottom not at all, and
+ * every position is rest + the displacement written beside it.
+ */
+static void test_frame_at_writes_the_deformed_surface(void **state)
+{
+	char img_path[320], vtk[2][320], err[256];
+	char *bytes[2];
+	size_t len[2];
+	struct irdm_image img;
+	struct frame_vtk f;
+	uint32_t row, bottom = 0;
+	double worst = 0;
+
+	(void)state;
+	surface_image(img_path, sizeof(img_path));
+	for (int k = 0; k < 2; k++) {
+		snprintf(vtk[k], sizeof(vtk[k]), "%s/frame%d.vtk", dir, k);
+		assert_int_equal(run_fw((const char *const[]){ "--board", BOARD, "--image", img_path,
+							       "--user", PRESS, "--clock", "virtual",
+							       "--frame-at", "1.5", "--frame-out",
+							       vtk[k], "-q", NULL }), 0);
+		bytes[k] = tf_load(vtk[k], &len[k]);
+	}
+	assert_int_equal(len[0], len[1]);
+	assert_memory_equal(bytes[0], bytes[1], len[0]);
+	assert_int_equal(irdm_image_map(img_path, 0, &img, err, sizeof(err)), 0);
+	frame_parse(bytes[0], &f);
+	assert_int_equal(f.n_points, img.meta->n_nodes);
+	assert_int_equal(f.n_polys, img.meta->n_tris);
+	assert_true(f.polys_in_range);
+	for (uint32_t r = 0; r < f.n_points; r++)
+		for (int a = 0; a < 3; a++)
+			assert_true(fabs(f.pos[3 * r + a] - img.nodes[r].pos_m[a] - f.u[3 * r + a]) <=
+				    1e-12);
+	/* the contact is at the pressed top centre */
+	{
+		double d[3];
+		irdm_v3_sub(d, f.contact_m, (const double[3]){ 0.05, 0.05, 0.2 });
+		assert_true(irdm_v3_norm(d) < 0.01);
+	}
+	row = nearest_row(&img, f.contact_m);
+	print_message("frame at 1.5 s: %u points, %u triangles; node %u nearest the contact "
+		      "moved %.3f mm down\n", f.n_points, f.n_polys, row, -f.u[3 * row + 2] * 1e3);
+	assert_true(f.u[3 * row + 2] <= -0.002 && f.u[3 * row + 2] >= -0.012);
+	for (uint32_t r = 0; r < f.n_points; r++) {
+		if (img.nodes[r].pos_m[2] != 0.0f)
+			continue;
+		bottom++;
+		worst = fmax(worst, irdm_v3_norm(f.u + 3 * r));
+	}
+	assert_true(bottom > 0);
+	assert_true(worst <= 1e-12);
+	irdm_image_unmap(&img);
+	free(f.pos);
+	free(f.u);
+	free(bytes[0]);
+	free(bytes[1]);
+}
+
 static int setup(void **state)
 {
 	pid_t pid;
@@ -341,6 +507,7 @@ int main(void)
 		cmocka_unit_test(test_release_ringing_is_the_dominant_mode),
 		cmocka_unit_test(test_require_rt),
 		cmocka_unit_test(test_sigterm_mid_contact_turns_torque_off),
+		cmocka_unit_test(test_frame_at_writes_the_deformed_surface),
 	};
 
 	return cmocka_run_group_tests(tests, setup, teardown);

@@ -11,9 +11,11 @@
 #define IRDM_FW_H
 
 #include <signal.h>
+#include <stdatomic.h>
 #include <stdbool.h>
 #include <stdint.h>
 #include <stdio.h>
+#include <time.h>
 
 #include "irdm/board.h"
 #include "irdm/clock.h"
@@ -37,7 +39,9 @@ struct fw_args {
 	const char *image;
 	const char *user;
 	const char *log;
+	const char *frame_out;          /* --frame-out: the VTK --frame-at writes */
 	double duration_s;              /* 0: the user script's end + 1 s, else 5 s */
+	double frame_at_s;              /* --frame-at: 0 none */
 	int clock;                      /* enum irdm_clock_mode */
 	bool require_rt;
 	bool quiet;
@@ -51,6 +55,33 @@ struct fw_trace {
 	double *fz_n;                   /* its component along the contact normal */
 	double *node_u_m;               /* the watched node's displacement along its normal */
 	uint8_t *contact;               /* device 0 in contact */
+};
+
+/*
+ * The deformation worker's side of the run (fw_frame.c).  Real time: its
+ * thread is the single writer of everything below the line until it is
+ * joined; the loop never reads it.  Virtual time: the loop runs the update
+ * itself, every every_ticks engine ticks.
+ */
+struct fw_frame {
+	struct irdm_deform_thread *th;  /* real time only */
+	unsigned every_ticks;           /* engine ticks between snapshots (publish_every) */
+	uint64_t target_tick;           /* --frame-at's engine tick, on the snapshot grid */
+	uint64_t last_update_tick;      /* virtual time: the last engine tick updated at */
+	uint32_t rows;
+	double *pos_m;                  /* 3 rows: the held frame (allocated at init) */
+	double *scratch_m;              /* 3 rows: virtual time's update target */
+	/* the contact at target_tick, written by the loop */
+	bool contact_seen, contact_on;
+	double contact_m[3], force_obj_n[3];
+	/* ---- written by the worker's thread (real) or the loop (virtual) */
+	uint64_t frames, held_tick;
+	bool held;
+	atomic_bool done;               /* the frame nearest target_tick is held */
+	double cpu_sum_ns, cpu_max_ns;
+	uint64_t cpu_n;
+	struct timespec cpu_prev;
+	bool cpu_started;
 };
 
 struct fw {
@@ -67,6 +98,7 @@ struct fw {
 	struct irdm_sim_user *user;     /* NULL without --user */
 	struct irdm_clock clock;
 	struct fw_trace trace;
+	struct fw_frame frame;
 	/* telemetry: per-tick records through a ring to the log (--log) */
 	struct irdm_telem_ring *ring;
 	void *ring_mem;
@@ -100,6 +132,20 @@ int fw_log_open(struct fw *fw);
 void fw_log_record(struct fw *fw, const struct irdm_ctrl_output *out, int64_t latency_ns,
 		   int64_t compute_ns);
 int fw_log_close(struct fw *fw);
+
+/* fw_frame.c: the deformation worker, --frame-at's frame and its VTK.
+ * fw_frame_config() before the session opens (deform channel, snapshot
+ * rate), fw_frame_open() after the controller (worker, buffers, and the
+ * thread in real time), fw_frame_tick() in the loop after each tick,
+ * fw_frame_stop() before the session closes, fw_frame_write() after. */
+void fw_frame_config(struct fw *fw, struct irdm_session_config *sc);
+int fw_frame_open(struct fw *fw, uint64_t run_ticks);
+int fw_frame_start(struct fw *fw);
+void fw_frame_tick(struct fw *fw, const struct irdm_ctrl_output *out);
+void fw_frame_stop(struct fw *fw);
+int fw_frame_write(struct fw *fw);
+void fw_frame_summary(const struct fw *fw);
+void fw_frame_free(struct fw *fw);
 
 /* fw_summary.c */
 int fw_trace_alloc(struct fw_trace *t, uint64_t ticks);

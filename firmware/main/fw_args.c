@@ -32,6 +32,12 @@ static const struct irdm_opt fw_opts[] = {
 	  .help = "run time (default: the user script's end + 1 s, else 5 s)" },
 	{ .name = "log", .type = IRDM_OPT_STRING, FA_REF(log), .metavar = "FILE",
 	  .help = "binary per-tick log (irdm log export FILE -o CSV)" },
+	{ .name = "frame-at", .type = IRDM_OPT_DOUBLE, FA(frame_at_s), .metavar = "S",
+	  .unit = "s", .range = IRDM_OPT_GT | IRDM_OPT_LE, .min = 0, .max = 86400,
+	  .help = "write the deformed surface at time S to --frame-out (VTK; needs a "
+		  "board with deform_rate_hz > 0)" },
+	{ .name = "frame-out", .type = IRDM_OPT_STRING, FA_REF(frame_out), .metavar = "FILE",
+	  .help = "where --frame-at writes (legacy VTK POLYDATA, ASCII)" },
 	{ .name = "clock", .type = IRDM_OPT_ENUM, FA(clock), .names = clock_names,
 	  .metavar = "real | virtual",
 	  .help = "real time paced at the board's period, or virtual time (deterministic, fast)" },
@@ -52,7 +58,8 @@ static const struct irdm_opt_table fw_table = {
 void fw_args_usage(FILE *f)
 {
 	fputs("usage: irdm-fw --board BOARD --image IMAGE [--user SCRIPT] [--duration S]\n"
-	      "               [--log FILE] [--clock real|virtual] [--require-rt]\n"
+	      "               [--log FILE] [--frame-at S --frame-out FILE]\n"
+	      "               [--clock real|virtual] [--require-rt]\n"
 	      "\n"
 	      "Runs the force loop on a board's device: HAL read, encoders, kinematics,\n"
 	      "proxy on the deformed surface, force engine, J^T and limits, HAL write,\n"
@@ -75,6 +82,11 @@ int fw_args_parse(struct fw_args *a, int argc, char **argv, char *err, size_t er
 		return rc;
 	if (!a->board || !a->image) {
 		snprintf(err, errlen, "%s", !a->board ? "missing --board BOARD" : "missing --image IMAGE");
+		return IRDM_EINVAL;
+	}
+	if ((a->frame_at_s > 0) != (a->frame_out != NULL)) {
+		snprintf(err, errlen, "%s", a->frame_out ? "--frame-out needs --frame-at S"
+							 : "--frame-at needs --frame-out FILE");
 		return IRDM_EINVAL;
 	}
 	return IRDM_OK;

@@ -171,6 +171,8 @@ int fw_loop_run(struct fw *fw, volatile sig_atomic_t *signalled)
 			prev_comp = (uint64_t)irdm_clock_elapsed_ns(&fw->clock);
 		}
 		trace_tick(fw, &out);
+		/* after the tick's timing: virtual time's update is not the tick's */
+		fw_frame_tick(fw, &out);
 		irdm_hist_add(&fw->compute_measured, (int64_t)compute_ns);
 		fw_log_record(fw, &out, fw->args.clock == IRDM_CLOCK_REAL ? latency_ns : 0,
 			      (int64_t)prev_comp);

@@ -105,6 +105,7 @@ void fw_summary_print(const struct fw *fw)
 	irdm_hist_summarize(&fw->compute_measured, &cs);
 	printf("overruns: %llu (longest run %llu)\n", (unsigned long long)cs.overruns,
 	       (unsigned long long)cs.longest_run);
+	fw_frame_summary(fw);
 	if (fw->last_state == IRDM_SAFETY_FAULT)
 		printf("state: fault: %s (torque off)\n", irdm_safety_fault_name(fw->last_cause));
 	else

@@ -52,6 +52,7 @@ static int open_inputs(struct fw *fw)
 		return fail(FW_EXIT_INPUT, rc, "%s: %s", fw->args.board,
 			    "the controller refuses this board's arm, limits or placement");
 	sc.engine = fw->ccfg.engine;
+	fw_frame_config(fw, &sc);
 	rc = irdm_session_open(&fw->s, fw->args.image, &sc, fw->err, sizeof(fw->err));
 	if (rc)
 		return fail(FW_EXIT_INPUT, rc, "%s%s", "", fw->err);
@@ -166,6 +167,10 @@ static int start(struct fw *fw)
 			    "the controller cannot run on this image (no contact surface?)");
 	if (fw_trace_alloc(&fw->trace, run_ticks(fw)))
 		return fail(FW_EXIT_SETUP, IRDM_ENOMEM, "%s%s", "", "out of memory for the run's trace");
+	rc = fw_frame_open(fw, run_ticks(fw));
+	if (rc)
+		return fail(rc == IRDM_EINVAL ? FW_EXIT_USAGE : FW_EXIT_SETUP, rc, "%s%s", "",
+			    fw->err);
 	rc = fw_log_open(fw);
 	if (rc)
 		return fail(FW_EXIT_SETUP, rc, "%s: %s", fw->args.log ? fw->args.log : "log", fw->err);
@@ -173,15 +178,29 @@ static int start(struct fw *fw)
 	sa.sa_handler = on_signal;
 	sigaction(SIGINT, &sa, NULL);
 	sigaction(SIGTERM, &sa, NULL);
-	return setup_realtime(fw);
+	rc = setup_realtime(fw);
+	if (rc)
+		return rc;
+	/* after the real-time set-up: the thread goes one level below it */
+	rc = fw_frame_start(fw);
+	if (rc)
+		return fail(FW_EXIT_SETUP, rc, "%s%s", "", fw->err);
+	return FW_EXIT_OK;
 }
 
-/* Torque off first, then everything else. */
-static void stop(struct fw *fw)
+/* Torque off first, then everything else.  The frame (--frame-at) is
+ * written once the worker is joined and while the image is still mapped. */
+static int stop(struct fw *fw, int rc)
 {
 	for (unsigned i = 0; i < IRDM_BOARD_DEVICES_MAX; i++)
 		if (fw->hal_open[i])
 			irdm_hal_safe_off(&fw->hal[i]);
+	fw_frame_stop(fw);
+	if (rc == FW_EXIT_OK || rc == FW_EXIT_FAULT) {
+		int wrc = fw_frame_write(fw);
+		if (wrc)
+			rc = fail(FW_EXIT_SETUP, wrc, "%s%s", "", fw->err);
+	}
 	for (unsigned i = 0; i < IRDM_BOARD_DEVICES_MAX; i++) {
 		if (fw->hal_open[i])
 			irdm_hal_close(&fw->hal[i]);
@@ -190,7 +209,9 @@ static void stop(struct fw *fw)
 	if (fw->ring && fw_log_close(fw))
 		fprintf(stderr, "irdm-fw: EIO: %s\n", fw->err);
 	free(fw->user);
+	fw_frame_free(fw);
 	irdm_session_close(fw->s);
+	return rc;
 }
 
 int main(int argc, char **argv)
@@ -220,7 +241,7 @@ int main(int argc, char **argv)
 			fprintf(stderr, "irdm-fw: EFAULT: fault %s at tick %llu: torque off\n",
 				irdm_safety_fault_name(fw->last_cause), (unsigned long long)fw->ticks);
 	}
-	stop(fw);
+	rc = stop(fw, rc);
 	if ((rc == FW_EXIT_OK || rc == FW_EXIT_FAULT) && !fw->args.quiet)
 		fw_summary_print(fw);
 	fw_trace_free(&fw->trace);

@@ -5,7 +5,8 @@
 # exported and drawn; the force engine replays the paper's Fig. 6a step;
 # then the controller, irdm-fw, runs the simulated PHANToM-like board with a
 # virtual hand that presses the top centre, holds and lets go, in virtual
-# time, and its log is exported and drawn.
+# time, and its log is exported and drawn, with a frame of the deformed
+# surface mid-hold (t = 1.5 s, the deformation worker's VTK).
 #   tools/scripts/run-default-scene.sh [IRDM] [IRDM_FW]   -> out/default.*, out/run*
 set -euo pipefail
 irdm=${1:-build/irdm}
@@ -32,7 +33,8 @@ tail -n 1 out/default-forces.csv | awk -F, '{ printf "replay: force on the objec
 
 echo "run: irdm-fw on boards/sim-phantom.board, scenes/users/press-hold-release.user, virtual time"
 "$fw" --board boards/sim-phantom.board --image out/default.img \
-	--user scenes/users/press-hold-release.user --clock virtual --log out/run.log
+	--user scenes/users/press-hold-release.user --clock virtual --log out/run.log \
+	--frame-at 1.5 --frame-out out/run-frame.vtk
 "$irdm" log export out/run.log -o out/run.csv
 
 if $py -c 'import matplotlib' 2>/dev/null; then
@@ -41,7 +43,9 @@ if $py -c 'import matplotlib' 2>/dev/null; then
 		"paper's cuboid, top node pushed 1 cm in 10 ms and held (Fig. 6a)"
 	$py tools/scripts/plot-log.py out/run.csv out/run \
 		"irdm-fw, simulated PHANToM: press the top centre, hold 2 s, release"
-	echo "run: plots out/default-response.png out/default-forces.png out/run-force.png out/run-latency.png out/run-compute.png"
+	$py tools/scripts/plot-surface.py out/run-frame.vtk out/run-frame.png \
+		"irdm-fw, simulated PHANToM: the deformed surface mid-hold"
+	echo "run: plots out/default-response.png out/default-forces.png out/run-force.png out/run-latency.png out/run-compute.png out/run-frame.png"
 else
 	echo "run: python3-matplotlib not installed; skipped the PNG plots"
 fi

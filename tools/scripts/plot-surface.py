@@ -1,0 +1,149 @@
+#!/usr/bin/python3
+"""Draw a deformed-surface frame written by `irdm-fw --frame-at S --frame-out FILE.vtk`
+(legacy VTK POLYDATA, ASCII): the shaded surface coloured by displacement
+magnitude (mm), the contact point and the force on the object as an arrow.
+The displacement is exaggerated by --scale (default: so that the largest one is
+a tenth of the object's size); the colours are the true magnitudes.
+usage: plot-surface.py FRAME.vtk OUT.png [title] [--scale K]"""
+import sys
+
+import matplotlib
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt
+import numpy as np
+from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+
+def fail(msg):
+    sys.exit(f"plot-surface: {msg}")
+
+
+def numbers(tok, i, n, kind=float):
+    if i + n > len(tok):
+        fail("file ends inside a block")
+    return np.array([kind(x) for x in tok[i:i + n]]), i + n
+
+
+def read_vtk(path):
+    """Points, triangles, per-point displacement, and the dataset's field data."""
+    with open(path) as f:
+        lines = f.read().split("\n")
+    if not lines[0].startswith("# vtk DataFile") or lines[2].strip() != "ASCII":
+        fail(f"{path}: not a legacy ASCII VTK file")
+    tok = " ".join(lines[3:]).split()
+    out, field, i = {}, {}, 0
+    while i < len(tok):
+        key = tok[i]
+        if key == "DATASET":
+            i += 2
+        elif key == "FIELD":
+            count, i = int(tok[i + 2]), i + 3
+            for _ in range(count):
+                name, comps, tuples = tok[i], int(tok[i + 1]), int(tok[i + 2])
+                v, i = numbers(tok, i + 4, comps * tuples)
+                field[name] = v.reshape(tuples, comps)
+        elif key == "POINTS":
+            n = int(tok[i + 1])
+            v, i = numbers(tok, i + 3, 3 * n)
+            out["points"] = v.reshape(n, 3)
+        elif key == "POLYGONS":
+            n = int(tok[i + 1])
+            v, i = numbers(tok, i + 3, 4 * n, int)
+            v = v.reshape(n, 4)
+            if (v[:, 0] != 3).any():
+                fail("only triangles are drawn")
+            out["tris"] = v[:, 1:]
+        elif key == "POINT_DATA":
+            i += 2
+        elif key == "VECTORS":
+            name = tok[i + 1]
+            v, i = numbers(tok, i + 3, 3 * len(out["points"]))
+            out[name] = v.reshape(-1, 3)
+        else:
+            fail(f"{path}: unexpected '{key}'")
+    for need in ("points", "tris", "displacement_m"):
+        if need not in out:
+            fail(f"{path}: no {need}")
+    out["field"] = field
+    return out
+
+
+def shaded(pts, tris, colors):
+    """Lambert shading by hand (older matplotlib has no shade= for polygons)."""
+    a, b, c = pts[tris[:, 0]], pts[tris[:, 1]], pts[tris[:, 2]]
+    n = np.cross(b - a, c - a)
+    n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-30)
+    light = np.array([-0.4, -0.6, 0.7])
+    light /= np.linalg.norm(light)
+    k = 0.45 + 0.55 * np.abs(n @ light)
+    out = colors.copy()
+    out[:, :3] *= k[:, None]
+    return out
+
+
+def main():
+    args = [a for a in sys.argv[1:] if not a.startswith("--scale")]
+    scale = None
+    for a in sys.argv[1:]:
+        if a.startswith("--scale="):
+            scale = float(a.split("=", 1)[1])
+    if len(args) < 2:
+        fail(__doc__.strip().split("\n")[-1])
+    src, dst = args[0], args[1]
+    title = args[2] if len(args) > 2 else src
+    d = read_vtk(src)
+    u = d["displacement_m"]
+    rest = d["points"] - u
+    size = np.ptp(rest, axis=0).max()
+    umax = np.linalg.norm(u, axis=1).max()
+    if scale is None:
+        scale = 0.1 * size / umax if umax > 0 else 1.0
+    shown = rest + scale * u
+    mag_mm = np.linalg.norm(u, axis=1) * 1e3
+    tri_mag = mag_mm[d["tris"]].mean(axis=1)
+
+    fig = plt.figure(figsize=(7.5, 7))
+    # drawn in call order: the arrow and the point stay on top of the surface
+    ax = fig.add_subplot(projection="3d", computed_zorder=False)
+    norm = matplotlib.colors.Normalize(0, max(mag_mm.max(), 1e-12))
+    cmap = plt.get_cmap("viridis")
+    poly = Poly3DCollection(shown[d["tris"]], facecolors=shaded(shown, d["tris"],
+                                                                cmap(norm(tri_mag))),
+                            edgecolor=(0, 0, 0, 0.15), linewidth=0.2)
+    poly.set_zorder(1)
+    ax.add_collection3d(poly)
+    f = d["field"]
+    if "contact_point_m" in f and f.get("contact", [[0]])[0][0]:
+        p = f["contact_point_m"][0]
+        # the contact point rides on the exaggerated surface like its nodes
+        near = np.argmin(np.linalg.norm(d["points"] - p, axis=1))
+        p_shown = p + (scale - 1) * u[near]
+        force = f["contact_force_n"][0]
+        fn = np.linalg.norm(force)
+        if fn > 0:
+            arrow = force / fn * 0.3 * size     # along the force, ending at the contact
+            ax.quiver(*(p_shown - arrow), *arrow, color="red", linewidth=2.5,
+                      arrow_length_ratio=0.25, zorder=10)
+        ax.scatter(*p_shown, color="red", s=30, depthshade=False, zorder=11,
+                   label=f"contact, force on the object {fn:.3f} N")
+        ax.legend(loc="upper left", fontsize=8)
+    lo, hi = shown.min(axis=0), shown.max(axis=0)
+    mid, half = (lo + hi) / 2, (hi - lo).max() / 2 * 1.05
+    for setter, c in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), mid):
+        setter(c - half, c + half)
+    ax.set_box_aspect((1, 1, 1))
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    ax.set_zlabel("z (m)")
+    ax.view_init(elev=28, azim=-55)
+    t = f.get("time_s", [[float("nan")]])[0][0]
+    ax.set_title(f"{title}\nt = {t:.3f} s, max |u| = {mag_mm.max():.2f} mm "
+                 f"(shape x{scale:.1f})", fontsize=9)
+    sm = matplotlib.cm.ScalarMappable(norm=norm, cmap=cmap)
+    fig.colorbar(sm, ax=ax, shrink=0.6, label="|displacement| (mm)")
+    fig.savefig(dst, dpi=110)
+    plt.close(fig)
+
+
+if __name__ == "__main__":
+    main()
