@@ -348,7 +348,8 @@ static void vtk_doubles(const char **p, double *v, size_t n)
 
 struct frame_vtk {
 	uint32_t n_points, n_polys;
-	double *pos, *u, contact_m[3];
+	double *pos, *u, contact_m[3], time_s;
+	uint32_t *tris;                 /* 3 n_polys */
 	bool polys_in_range;
 };
 
@@ -372,18 +373,24 @@ static void frame_parse(const char *text, struct frame_vtk *f)
 	assert_non_null(p);
 	f->n_polys = (uint32_t)strtoul(p + 10, NULL, 10);
 	p = vtk_section(p + 1, "POLYGONS");
+	f->tris = calloc(3 * (size_t)f->n_polys + 1, sizeof(uint32_t));
+	assert_non_null(f->tris);
 	f->polys_in_range = true;
 	for (uint32_t t = 0; t < f->n_polys; t++) {
 		double v[4];
 		vtk_doubles(&p, v, 4);
 		assert_true(v[0] == 3);
-		for (int k = 1; k < 4; k++)
+		for (int k = 1; k < 4; k++) {
 			f->polys_in_range &= v[k] >= 0 && v[k] < (double)f->n_points;
+			f->tris[3 * t + k - 1] = (uint32_t)v[k];
+		}
 	}
 	p = vtk_section(text, "VECTORS displacement_m double");
 	vtk_doubles(&p, f->u, 3 * n);
 	p = vtk_section(text, "contact_point_m 3 1 double");
 	vtk_doubles(&p, f->contact_m, 3);
+	p = vtk_section(text, "time_s 1 1 double");
+	vtk_doubles(&p, &f->time_s, 1);
 }
 
 static uint32_t nearest_row(const struct irdm_image *img, const double p[3])
@@ -445,9 +452,13 @@ static void test_frame_at_writes_the_deformed_surface(void **state)
 	assert_memory_equal(bytes[0], bytes[1], len[0]);
 	assert_int_equal(irdm_image_map(img_path, 0, &img, err, sizeof(err)), 0);
 	frame_parse(bytes[0], &f);
+	/* 1.5 s is on the 100 Hz snapshot grid: virtual time holds that frame */
+	assert_true(f.time_s == 1.5);
 	assert_int_equal(f.n_points, img.meta->n_nodes);
 	assert_int_equal(f.n_polys, img.meta->n_tris);
 	assert_true(f.polys_in_range);
+	/* every row is displayed here: the polygons are the SURFACE section */
+	assert_memory_equal(f.tris, img.tris, 3 * (size_t)f.n_polys * sizeof(uint32_t));
 	for (uint32_t r = 0; r < f.n_points; r++)
 		for (int a = 0; a < 3; a++)
 			assert_true(fabs(f.pos[3 * r + a] - img.nodes[r].pos_m[a] - f.u[3 * r + a]) <=
@@ -473,6 +484,7 @@ static void test_frame_at_writes_the_deformed_surface(void **state)
 	irdm_image_unmap(&img);
 	free(f.pos);
 	free(f.u);
+	free(f.tris);
 	free(bytes[0]);
 	free(bytes[1]);
 }
