@@ -135,11 +135,13 @@ int fw_log_close(struct fw *fw);
 
 /* fw_frame.c: the deformation worker, --frame-at's frame and its VTK.
  * fw_frame_config() before the session opens (deform channel, snapshot
- * rate), fw_frame_open() after the controller (worker, buffers, and the
+ * rate), fw_frame_check_args() for --frame-at against the board and the
+ * run's length, fw_frame_open() after the controller (worker, buffers, and the
  * thread in real time), fw_frame_tick() in the loop after each tick,
  * fw_frame_stop() before the session closes, fw_frame_write() after. */
 void fw_frame_config(struct fw *fw, struct irdm_session_config *sc);
-int fw_frame_open(struct fw *fw, uint64_t run_ticks);
+int fw_frame_check_args(struct fw *fw, uint64_t run_ticks);
+int fw_frame_open(struct fw *fw);
 int fw_frame_start(struct fw *fw);
 void fw_frame_tick(struct fw *fw, const struct irdm_ctrl_output *out);
 void fw_frame_stop(struct fw *fw);

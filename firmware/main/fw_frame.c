@@ -65,14 +65,26 @@ static int refuse(struct fw *fw, const char *why)
 	return IRDM_EINVAL;
 }
 
-int fw_frame_open(struct fw *fw, uint64_t run_ticks)
+int fw_frame_check_args(struct fw *fw, uint64_t run_ticks)
+{
+	if (!fw->args.frame_out)
+		return IRDM_OK;
+	if (!fw->frame.every_ticks)
+		return refuse(fw, "the board's deform_rate_hz is 0");
+	fw->frame.target_tick = target_tick(fw);
+	if (fw->frame.target_tick > run_ticks)
+		return refuse(fw, "after the run's end");
+	return IRDM_OK;
+}
+
+int fw_frame_open(struct fw *fw)
 {
 	struct fw_frame *fr = &fw->frame;
 	size_t bytes;
 	int rc;
 
 	if (!fr->every_ticks)
-		return fw->args.frame_out ? refuse(fw, "the board's deform_rate_hz is 0") : IRDM_OK;
+		return IRDM_OK;
 	rc = irdm_session_deform_open(fw->s, fw->err, sizeof(fw->err));
 	if (rc)
 		return rc;
@@ -84,12 +96,8 @@ int fw_frame_open(struct fw *fw, uint64_t run_ticks)
 		snprintf(fw->err, sizeof(fw->err), "out of memory for the deformation frames");
 		return IRDM_ENOMEM;
 	}
+	/* without --frame-at no frame is held: the frames are only counted */
 	atomic_init(&fr->done, !fw->args.frame_out);
-	if (!fw->args.frame_out)
-		return IRDM_OK;
-	fr->target_tick = target_tick(fw);
-	if (fr->target_tick > run_ticks)
-		return refuse(fw, "after the run's end");
 	return IRDM_OK;
 }
 

@@ -167,10 +167,13 @@ static int start(struct fw *fw)
 			    "the controller cannot run on this image (no contact surface?)");
 	if (fw_trace_alloc(&fw->trace, run_ticks(fw)))
 		return fail(FW_EXIT_SETUP, IRDM_ENOMEM, "%s%s", "", "out of memory for the run's trace");
-	rc = fw_frame_open(fw, run_ticks(fw));
+	rc = fw_frame_check_args(fw, run_ticks(fw));
 	if (rc)
-		return fail(rc == IRDM_EINVAL ? FW_EXIT_USAGE : FW_EXIT_SETUP, rc, "%s%s", "",
-			    fw->err);
+		return fail(FW_EXIT_USAGE, rc, "%s%s", "", fw->err);
+	rc = fw_frame_open(fw);
+	if (rc)
+		return fail(rc == IRDM_EINVAL ? FW_EXIT_INPUT : FW_EXIT_SETUP, rc, "%s: %s",
+			    fw->args.image, fw->err);
 	rc = fw_log_open(fw);
 	if (rc)
 		return fail(FW_EXIT_SETUP, rc, "%s: %s", fw->args.log ? fw->args.log : "log", fw->err);
