@@ -135,10 +135,11 @@ int fw_log_close(struct fw *fw);
 
 /* fw_frame.c: the deformation worker, --frame-at's frame and its VTK.
  * fw_frame_config() before the session opens (deform channel, snapshot
- * rate), fw_frame_check_args() for --frame-at against the board and the
- * run's length, fw_frame_open() after the controller (worker, buffers, and the
- * thread in real time), fw_frame_tick() in the loop after each tick,
- * fw_frame_stop() before the session closes, fw_frame_write() after. */
+ * rate); fw_frame_check_args() (--frame-at against the board and the run's
+ * length) and fw_frame_open() (worker, buffers) after the controller;
+ * fw_frame_start() after the real-time set-up (the thread, real time only);
+ * fw_frame_tick() in the loop after each tick; fw_frame_stop() (join) and
+ * fw_frame_write() before the session closes; fw_frame_summary() after. */
 void fw_frame_config(struct fw *fw, struct irdm_session_config *sc);
 int fw_frame_check_args(struct fw *fw, uint64_t run_ticks);
 int fw_frame_open(struct fw *fw);
