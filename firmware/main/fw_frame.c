@@ -299,7 +299,9 @@ int fw_frame_write(struct fw *fw)
 	if (!path)
 		return IRDM_OK;
 	if (!fw->frame.held) {
-		snprintf(fw->err, sizeof(fw->err), "%s: no deformation frame was computed", path);
+		snprintf(fw->err, sizeof(fw->err),
+			 "%s: no deformation frame was computed (the run stopped at tick %llu)",
+			 path, (unsigned long long)fw->ticks);
 		return IRDM_EIO;
 	}
 	if ((size_t)snprintf(tmp, sizeof(tmp), "%s.tmp", path) >= sizeof(tmp)) {
