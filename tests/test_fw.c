@@ -489,6 +489,45 @@ static void test_frame_at_writes_the_deformed_surface(void **state)
 	free(bytes[1]);
 }
 
+/*
+ * Real time: the worker's thread draws the frames (about 100 in a second at
+ * the board's 100 Hz; a loaded host may skip some) and holds the one
+ * nearest the asked time.
+ */
+static void test_frame_at_in_real_time(void **state)
+{
+	char img_path[320], vtk[320], board[320];
+	unsigned long long frames = 0;
+	struct frame_vtk f;
+	const char *p;
+	size_t len;
+	char *bytes;
+
+	(void)state;
+	snprintf(img_path, sizeof(img_path), "%s/surface.img", dir);
+	if (access(img_path, R_OK))     /* run alone: the previous test made it */
+		surface_image(img_path, sizeof(img_path));
+	snprintf(vtk, sizeof(vtk), "%s/frame-rt.vtk", dir);
+	relaxed_board(board, sizeof(board));
+	assert_int_equal(run_fw((const char *const[]){ "--board", board, "--image", img_path,
+						       "--user", PRESS, "--clock", "real",
+						       "--duration", "1", "--frame-at", "0.5",
+						       "--frame-out", vtk, NULL }), 0);
+	p = strstr(out_text, "deformation: ");
+	assert_non_null(p);
+	assert_int_equal(sscanf(p, "deformation: %llu frames", &frames), 1);
+	assert_non_null(strstr(p, "(worker thread)"));
+	print_message("real time, 1 s: %llu frames drawn by the worker thread\n", frames);
+	assert_true(frames >= 20 && frames <= 101);
+	bytes = tf_load(vtk, &len);
+	frame_parse(bytes, &f);
+	assert_true(fabs(f.time_s - 0.5) <= 0.1);
+	free(f.pos);
+	free(f.u);
+	free(f.tris);
+	free(bytes);
+}
+
 static int setup(void **state)
 {
 	pid_t pid;
@@ -520,6 +559,7 @@ int main(void)
 		cmocka_unit_test(test_require_rt),
 		cmocka_unit_test(test_sigterm_mid_contact_turns_torque_off),
 		cmocka_unit_test(test_frame_at_writes_the_deformed_surface),
+		cmocka_unit_test(test_frame_at_in_real_time),
 	};
 
 	return cmocka_run_group_tests(tests, setup, teardown);
