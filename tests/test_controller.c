@@ -37,6 +37,7 @@
 #include "irdm/sim_device.h"
 #include "irdm/vec3.h"
 #include "support/alloc_count.h"
+#include "support/device_ik.h"
 #include "support/engine_fixture.h"
 
 #define GAP_M 0.002             /* home tip above the top face */
@@ -58,37 +59,6 @@ struct rig {
 
 /* ---- geometry helpers (the test's own, not the controller's) ---- */
 
-static void solve3(const double a[9], const double b[3], double x[3])
-{
-	double d = a[0] * (a[4] * a[8] - a[5] * a[7]) - a[1] * (a[3] * a[8] - a[5] * a[6]) +
-		   a[2] * (a[3] * a[7] - a[4] * a[6]);
-
-	for (int c = 0; c < 3; c++) {
-		double m[9];
-		memcpy(m, a, sizeof(m));
-		for (int r = 0; r < 3; r++)
-			m[3 * r + c] = b[r];
-		x[c] = (m[0] * (m[4] * m[8] - m[5] * m[7]) - m[1] * (m[3] * m[8] - m[5] * m[6]) +
-			m[2] * (m[3] * m[7] - m[4] * m[6])) / d;
-	}
-}
-
-/* Joint angles that put the tip at p (device frame), by Newton from home. */
-static void ik(const struct irdm_device_config *dev, const double p[3], double q[3])
-{
-	q[0] = q[1] = q[2] = 0;
-	for (int it = 0; it < 50; it++) {
-		double tip[3], e[3], j[9], dq[3];
-		irdm_device_fk(dev, q, tip);
-		for (int a = 0; a < 3; a++)
-			e[a] = p[a] - tip[a];
-		irdm_device_jacobian(dev, q, j);
-		solve3(j, e, dq);
-		for (int a = 0; a < 3; a++)
-			q[a] += dq[a];
-	}
-}
-
 /* Device i's tip (own frame) for the object-frame point p: R^T (p - t) - mount. */
 static void dev_point(const struct rig *r, unsigned i, const double p[3], double d[3])
 {
@@ -108,7 +78,7 @@ static int put_counts(struct rig *r, unsigned i, const double p[3])
 	double d[3], q[3];
 
 	dev_point(r, i, p, d);
-	ik(&r->cfg.device[i].dev, d, q);
+	dik_angles(&r->cfg.device[i].dev, d, q);
 	return irdm_device_counts_from_angles(&r->cfg.device[i].dev, q, r->in.counts[i]);
 }
 
