@@ -38,11 +38,17 @@ static void node_disp(const void *ctx, uint32_t row, double u_m[3])
 	memcpy(u_m, m->u_m[k], sizeof(m->u_m[k]));
 }
 
-/* This tick's proxy configuration: max_disp_m from the engine's state. */
+/* This tick's proxy configuration: max_disp_m from the engine's state,
+ * needed (O(modes)) only by a proxy that is not active: its query. */
 static void proxy_cfg(const struct irdm_ctrl *c, struct irdm_proxy_config *pc)
 {
 	*pc = c->cfg.proxy;
-	pc->max_disp_m = fmin(pc->max_disp_m, irdm_engine_disp_bound(c->s->eng) + DISP_MARGIN_M);
+	for (unsigned i = 0; i < c->cfg.n_devices; i++)
+		if (!c->dev[i].px.active) {
+			pc->max_disp_m = fmin(pc->max_disp_m,
+					      irdm_engine_disp_bound(c->s->eng) + DISP_MARGIN_M);
+			return;
+		}
 }
 
 static void proxy_out(const struct irdm_proxy *px, struct irdm_ctrl_device_output *o)
