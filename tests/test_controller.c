@@ -37,6 +37,7 @@
 #include "irdm/sim_device.h"
 #include "irdm/vec3.h"
 #include "support/alloc_count.h"
+#include "support/device_ik.h"
 #include "support/engine_fixture.h"
 
 #define GAP_M 0.002             /* home tip above the top face */
@@ -58,37 +59,6 @@ struct rig {
 
 /* ---- geometry helpers (the test's own, not the controller's) ---- */
 
-static void solve3(const double a[9], const double b[3], double x[3])
-{
-	double d = a[0] * (a[4] * a[8] - a[5] * a[7]) - a[1] * (a[3] * a[8] - a[5] * a[6]) +
-		   a[2] * (a[3] * a[7] - a[4] * a[6]);
-
-	for (int c = 0; c < 3; c++) {
-		double m[9];
-		memcpy(m, a, sizeof(m));
-		for (int r = 0; r < 3; r++)
-			m[3 * r + c] = b[r];
-		x[c] = (m[0] * (m[4] * m[8] - m[5] * m[7]) - m[1] * (m[3] * m[8] - m[5] * m[6]) +
-			m[2] * (m[3] * m[7] - m[4] * m[6])) / d;
-	}
-}
-
-/* Joint angles that put the tip at p (device frame), by Newton from home. */
-static void ik(const struct irdm_device_config *dev, const double p[3], double q[3])
-{
-	q[0] = q[1] = q[2] = 0;
-	for (int it = 0; it < 50; it++) {
-		double tip[3], e[3], j[9], dq[3];
-		irdm_device_fk(dev, q, tip);
-		for (int a = 0; a < 3; a++)
-			e[a] = p[a] - tip[a];
-		irdm_device_jacobian(dev, q, j);
-		solve3(j, e, dq);
-		for (int a = 0; a < 3; a++)
-			q[a] += dq[a];
-	}
-}
-
 /* Device i's tip (own frame) for the object-frame point p: R^T (p - t) - mount. */
 static void dev_point(const struct rig *r, unsigned i, const double p[3], double d[3])
 {
@@ -108,7 +78,7 @@ static int put_counts(struct rig *r, unsigned i, const double p[3])
 	double d[3], q[3];
 
 	dev_point(r, i, p, d);
-	ik(&r->cfg.device[i].dev, d, q);
+	dik_angles(&r->cfg.device[i].dev, d, q);
 	return irdm_device_counts_from_angles(&r->cfg.device[i].dev, q, r->in.counts[i]);
 }
 
@@ -926,6 +896,67 @@ static void test_proxy_follows_and_releases(void **state)
 }
 
 /* Two devices, two contacts: each device renders its own slot's force. */
+static void engine_disp(const void *ctx, uint32_t row, double u_m[3])
+{
+	irdm_engine_node_disp(ctx, row, u_m);
+}
+
+/*
+ * The proxy's closest-point query grows the BVH boxes by the engine's
+ * per-tick bound on |u| (irdm_engine_disp_bound) instead of the configured
+ * 5 cm: every free tick must answer exactly as the configured bound does.
+ * Pressed, pulled off (the surface rings), then lowered elsewhere onto the
+ * ringing surface, bouncing: before each tick with the proxy inactive, the
+ * query with the configured bound on the same engine state is the reference.
+ */
+static void test_free_query_matches_the_configured_bound(void **state)
+{
+	struct rig r;
+	int compared = 0, touches_moving = 0;
+
+	(void)state;
+	rig_config(&r, 1);
+	rig_open(&r);
+	rig_enable(&r);
+	press(&r, 0, 0, 0.004, 300);
+	for (int k = 0; k < 2600; k++) {
+		double p[3], p_obj[3], tip[3], q[3], dz;
+		struct irdm_contact_hit hit;
+		const struct irdm_contact_disp disp = { .fn = engine_disp, .ctx = r.s->eng };
+
+		/* up 4 mm + 1 mm in 50 ticks, across 15 mm, then down 20 um a tick */
+		if (k < 50)
+			dz = -0.004 + 0.005 * (k + 1) / 50;
+		else
+			dz = fmax(0.001 - 2e-5 * (k > 300 ? k - 300 : 0), -0.003);
+		at(&r, k < 300 ? 0.015 * k / 300 : 0.015, 0, dz, p);
+		put(&r, 0, p);
+		tip_of_counts(&r, 0, p_obj, tip, q);
+		bool inactive = !r.ctrl.dev[0].px.active;
+		double bound = irdm_engine_disp_bound(r.s->eng);
+		int ref = irdm_contact_closest(&r.ctrl.cm, &disp, r.cfg.proxy.max_disp_m, p_obj,
+					       r.cfg.proxy.radius_m, &hit);
+		if (tick(&r) != IRDM_OK)
+			fail_msg("tick %d: fault 0x%x", k, r.out.cause);
+		if (!inactive || k < 50)
+			continue;
+		const struct irdm_ctrl_device_output *o = &r.out.dev[0];
+		bool touch = ref == 1 && hit.dist_m <= 0;
+		assert_int_equal(o->proxy_event, touch ? IRDM_PROXY_TOUCH : IRDM_PROXY_FREE);
+		if (touch) {
+			assert_int_equal(o->tri, hit.tri);
+			assert_memory_equal(o->bary, hit.bary, sizeof(hit.bary));
+			assert_memory_equal(o->proxy_m, hit.point_m, sizeof(hit.point_m));
+			touches_moving += bound > 1e-5;
+		}
+		compared++;
+	}
+	print_message("  %d free queries compared, %d touches of a moving surface\n", compared,
+		      touches_moving);
+	assert_true(compared > 200 && touches_moving >= 1);
+	rig_close(&r);
+}
+
 static void test_two_devices_two_contacts(void **state)
 {
 	struct rig r;
@@ -1339,6 +1370,7 @@ int main(void)
 		cmocka_unit_test(test_force_to_torque_virtual_work),
 		cmocka_unit_test(test_gravity_compensation_holds_the_arm),
 		cmocka_unit_test(test_proxy_follows_and_releases),
+		cmocka_unit_test(test_free_query_matches_the_configured_bound),
 		cmocka_unit_test(test_two_devices_two_contacts),
 		cmocka_unit_test(test_rigid_coupling_reproduces_the_engine),
 		cmocka_unit_test(test_tick_makes_no_system_call_and_no_allocation),

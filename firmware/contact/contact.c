@@ -22,6 +22,8 @@ _Static_assert(IRDM_CONTACT_STACK > IRDM_BVH_MAX_DEPTH, "stack holds a root-leaf
  * edge point seen from its two triangles differs by a few ulps). */
 #define TIE_REL 1e-13
 #define TIE_ABS 1e-30
+/* Relative slack of the rest-distance prune (tri_far): far above rounding. */
+#define FAR_SLACK 1e-9
 /* sin^2 of the smallest angle of a triangle that still has a normal */
 #define DEGENERATE_SIN2 1e-24
 
@@ -248,17 +250,36 @@ struct query {
 	const struct irdm_contact_mesh *cm;
 	const struct irdm_contact_disp *d;
 	const double *p;
+	double grow_m;                  /* max_disp_m: |u| of every node is below it */
 	double best;                    /* squared distance bound / best so far */
 	double best_cos;                /* |cos| between p - q and the normal */
 	bool found;
 	struct irdm_contact_hit *hit;
 };
 
+/*
+ * Whether triangle t cannot hold an answer, judged from its REST position
+ * alone (no displacement is asked for): every point of the displaced
+ * triangle is a point of the rest one moved by a convex combination of its
+ * vertices' u, so by at most grow_m, and its distance to p is at least the
+ * rest distance - grow_m.  The slack keeps rounding on the side of looking.
+ */
+static bool tri_far(const struct query *qr, uint32_t t)
+{
+	double v[3][3], bary[3], q[3], d;
+
+	irdm_contact_tri_pos(qr->cm, NULL, t, v);
+	d = sqrt(irdm_contact_closest_on_tri(v[0], v[1], v[2], qr->p, bary, q)) - qr->grow_m;
+	return d > 0 && d * d > (qr->best * (1 + TIE_REL) + TIE_ABS) * (1 + FAR_SLACK) + TIE_ABS;
+}
+
 static void query_tri(struct query *qr, uint32_t t)
 {
 	double v[3][3], n[3], bary[3], q[3], pq[3], d2, s, c;
 	bool better;
 
+	if (tri_far(qr, t))
+		return;
 	irdm_contact_tri_pos(qr->cm, qr->d, t, v);
 	if (!tri_normal(v, n))
 		return;
@@ -288,7 +309,7 @@ int irdm_contact_closest(const struct irdm_contact_mesh *cm, const struct irdm_c
 			 double max_disp_m, const double p[3], double radius_m,
 			 struct irdm_contact_hit *hit)
 {
-	struct query qr = { cm, d, p, radius_m * radius_m, 0, false, hit };
+	struct query qr = { cm, d, p, max_disp_m, radius_m * radius_m, 0, false, hit };
 	uint32_t stack[IRDM_CONTACT_STACK];
 	unsigned sp = 0;
 

@@ -18,7 +18,7 @@ static size_t up(size_t n)
 }
 
 struct layout {
-	size_t engine, col_of_row, phi, x, y, ring, tail, total;
+	size_t engine, col_of_row, phi, x, y, ring, tail, bound, total;
 };
 
 static int plan(const struct irdm_image *img, const struct irdm_engine_config *cfg,
@@ -40,7 +40,8 @@ static int plan(const struct irdm_image *img, const struct irdm_engine_config *c
 	l->y = l->x + up(2 * K * sizeof(double));
 	l->ring = l->y + up(2 * K * sizeof(double));
 	l->tail = l->ring + up(T * sizeof(struct irdm_force_tick));
-	l->total = l->tail + up(T * sizeof(double));
+	l->bound = l->tail + up(T * sizeof(double));
+	l->total = l->bound + up((K + T) * sizeof(double));
 	return 0;
 }
 
@@ -164,6 +165,8 @@ int irdm_engine_init(struct irdm_engine **out, const struct irdm_image *img,
 	if (e->T)
 		fir_tail(e, (double *)(base + l.tail));
 	e->tail_w = (const double *)(base + l.tail);
+	irdm_bound_init(e, (double *)(base + l.bound));
+	e->bound_w = (const double *)(base + l.bound);
 	if (img->rigid && start_rigid(e)) {
 		snprintf(err, errlen, "engine: the image's rigid-body data is not usable (mass %g kg)",
 			 img->rigid->mass_kg);

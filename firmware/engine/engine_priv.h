@@ -36,6 +36,9 @@ struct irdm_engine {
 	/* FIR */
 	struct irdm_fir_ring ring;
 	const double *tail_w;               /* T: r^s tail damping (1 when stable) */
+	/* disp_bound.c: K (modal) max |phi_k| at a column, or T (FIR) max
+	 * ||R[s]||_F over force columns and touchable rows; set at init */
+	const double *bound_w;
 	/* contacts and solve */
 	struct irdm_contact_state c[IRDM_MAX_CONTACTS];
 	struct r0_table r0, r0_next;
@@ -58,6 +61,9 @@ void irdm_modal_apply(struct irdm_engine *e, const struct irdm_force_tick *f);
 void irdm_fir_free_disp(const struct irdm_engine *e, uint32_t col, double u[3]);
 void irdm_fir_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp, double blk[9]);
 void irdm_fir_apply(struct irdm_engine *e, const struct irdm_force_tick *f);
+
+/* disp_bound.c: fill bound_w (K or T doubles) once phi or the FIR is set. */
+void irdm_bound_init(const struct irdm_engine *e, double *w);
 
 /* solve.c: (W + C) F = rhs, n = 3 m unknowns, SPD up to regularisation.
  * Returns 1 if the system had to be regularised, 0 otherwise. */

@@ -7,11 +7,22 @@
  * nodes change), the target p_obj - the site's rest point, and one engine
  * tick.  A device leaving the surface ends its push.  Device i drives
  * engine slot i.
+ *
+ * The closest-point query grows every BVH box by a bound on |u|: the
+ * configured worst case (5 cm by default) made a free tick visit most of
+ * the surface.  The engine's per-tick bound (irdm_engine_disp_bound(), a
+ * true bound) shrinks it to the device's neighbourhood; the answer is the
+ * same wherever the configured bound held, since both are valid bounds.
  */
+#include <math.h>
 #include <string.h>
 
 #include "controller_priv.h"
 #include "irdm/vec3.h"
+
+/* Added to the engine's bound: BVH boxes are floats, the nodes' rest
+ * positions too; 1 um is far above their rounding and far below a box. */
+#define DISP_MARGIN_M 1e-6
 
 static void node_disp(const void *ctx, uint32_t row, double u_m[3])
 {
@@ -27,6 +38,19 @@ static void node_disp(const void *ctx, uint32_t row, double u_m[3])
 	memcpy(u_m, m->u_m[k], sizeof(m->u_m[k]));
 }
 
+/* This tick's proxy configuration: max_disp_m from the engine's state,
+ * needed (O(modes)) only by a proxy that is not active: its query. */
+static void proxy_cfg(const struct irdm_ctrl *c, struct irdm_proxy_config *pc)
+{
+	*pc = c->cfg.proxy;
+	for (unsigned i = 0; i < c->cfg.n_devices; i++)
+		if (!c->dev[i].px.active) {
+			pc->max_disp_m = fmin(pc->max_disp_m,
+					      irdm_engine_disp_bound(c->s->eng) + DISP_MARGIN_M);
+			return;
+		}
+}
+
 static void proxy_out(const struct irdm_proxy *px, struct irdm_ctrl_device_output *o)
 {
 	o->tri = px->tri;
@@ -37,14 +61,15 @@ static void proxy_out(const struct irdm_proxy *px, struct irdm_ctrl_device_outpu
 }
 
 /* Device i's proxy and engine command.  Return: IRDM_OK; IRDM_EFAULT. */
-static int touch(struct irdm_ctrl *c, unsigned i, struct irdm_ctrl_device_output *o)
+static int touch(struct irdm_ctrl *c, unsigned i, const struct irdm_proxy_config *pc,
+		 struct irdm_ctrl_device_output *o)
 {
 	const struct irdm_contact_disp disp = { .fn = node_disp, .ctx = c };
 	struct irdm_ctrl_dev *d = &c->dev[i];
 	struct irdm_contact_site site;
 	int ev;
 
-	ev = irdm_proxy_update(&d->px, &c->cm, &disp, &c->cfg.proxy, o->tip_obj_m);
+	ev = irdm_proxy_update(&d->px, &c->cm, &disp, pc, o->tip_obj_m);
 	if (ev < 0)
 		return IRDM_EFAULT;
 	o->proxy_event = ev;
@@ -72,14 +97,16 @@ void ctrl_contacts_end(struct irdm_ctrl *c)
 int ctrl_contacts(struct irdm_ctrl *c, struct irdm_ctrl_output *out, bool on)
 {
 	struct irdm_contact_cmd cmd[IRDM_MAX_CONTACTS];
+	struct irdm_proxy_config pc;
 
 	memset(cmd, 0, sizeof(cmd));
 	c->disp.stamp++;        /* the engine ticked since: every memo is stale */
+	proxy_cfg(c, &pc);
 	for (unsigned i = 0; i < c->cfg.n_devices; i++) {
 		struct irdm_ctrl_device_output *o = &out->dev[i];
 
 		memset(&c->dev[i].cmd, 0, sizeof(c->dev[i].cmd));
-		if (on && c->dev[i].pose_ok && touch(c, i, o))
+		if (on && c->dev[i].pose_ok && touch(c, i, &pc, o))
 			return IRDM_EFAULT;
 		cmd[i] = c->dev[i].cmd;
 	}

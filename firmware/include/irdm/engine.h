@@ -189,6 +189,17 @@ const struct irdm_engine_stats *irdm_engine_stats(const struct irdm_engine *eng)
  * The surface a new contact meets.  Zero for nodes that are not columns. */
 void irdm_engine_node_disp(const struct irdm_engine *eng, uint32_t row, double u_m[3]);
 
+/*
+ * An upper bound (metres) on |u| of every touchable node for the free
+ * response irdm_engine_node_disp() returns in the engine's current state
+ * (a true bound up to rounding, which it covers): modal images
+ * sum_k max_v |phi_v,k| |yq_k|, FIR images sum_s w[s] max ||R[s]||_F
+ * sum_e |f_e[t-s]| (a bound from the force history, not a constant).
+ * O(modes), or O(FIR length x force nodes); no allocation.  A
+ * closest-point query may grow its boxes by this instead of a fixed guess.
+ */
+double irdm_engine_disp_bound(const struct irdm_engine *eng);
+
 /* Publish snapshots to a deformation context (init-time). */
 struct irdm_deform;
 void irdm_engine_attach_deform(struct irdm_engine *eng, struct irdm_deform *d);
