@@ -52,7 +52,6 @@ struct fw_args {
 struct fw_trace {
 	uint64_t n, cap;
 	double *force_n;                /* |force on the object|, device 0 */
-	double *fz_n;                   /* its component along the contact normal */
 	double *node_u_m;               /* the watched node's displacement along its normal */
 	uint8_t *contact;               /* device 0 in contact */
 };
@@ -104,8 +103,8 @@ struct fw {
 	void *ring_mem;
 	struct irdm_log_writer *writer;         /* real time: a thread drains the ring */
 	struct irdm_log_file *logf;             /* virtual time: the loop drains it */
-	struct irdm_hist latency, compute;      /* ns; compute's limit is the period */
-	struct irdm_hist compute_measured;      /* virtual time: measured, never logged */
+	struct irdm_hist latency;               /* ns, real time only (0 in virtual time) */
+	struct irdm_hist compute_measured;      /* ns, measured in both clocks; limit: the period */
 	uint32_t watch_row;             /* the image node whose ringing is measured */
 	bool watching;
 	double watch_normal[3];

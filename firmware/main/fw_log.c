@@ -53,7 +53,6 @@ void fw_log_record(struct fw *fw, const struct irdm_ctrl_output *out, int64_t la
 	struct irdm_tick_record r;
 
 	irdm_hist_add(&fw->latency, latency_ns);
-	irdm_hist_add(&fw->compute, compute_ns);
 	if (!fw->ring)
 		return;
 	memset(&r, 0, sizeof(r));
@@ -84,7 +83,6 @@ int fw_log_open(struct fw *fw)
 	int rc;
 
 	irdm_hist_init(&fw->latency, 0);
-	irdm_hist_init(&fw->compute, (int64_t)fw->board.period_us * 1000);
 	irdm_hist_init(&fw->compute_measured, (int64_t)fw->board.period_us * 1000);
 	if (!fw->args.log)
 		return IRDM_OK;

@@ -103,7 +103,6 @@ static void trace_tick(struct fw *fw, const struct irdm_ctrl_output *out)
 	if (fw->watching)
 		irdm_engine_node_disp(fw->s->eng, fw->watch_row, u);
 	t->force_n[k] = irdm_v3_norm(d->force_obj_n);
-	t->fz_n[k] = irdm_v3_dot(d->force_obj_n, fw->watch_normal);
 	t->node_u_m[k] = irdm_v3_dot(u, fw->watch_normal);
 	t->contact[k] = d->contact;
 	t->n++;

@@ -17,16 +17,14 @@ int fw_trace_alloc(struct fw_trace *t, uint64_t ticks)
 	t->n = 0;
 	t->cap = ticks;
 	t->force_n = calloc(ticks, sizeof(double));
-	t->fz_n = calloc(ticks, sizeof(double));
 	t->node_u_m = calloc(ticks, sizeof(double));
 	t->contact = calloc(ticks, 1);
-	return t->force_n && t->fz_n && t->node_u_m && t->contact ? 0 : -1;
+	return t->force_n && t->node_u_m && t->contact ? 0 : -1;
 }
 
 void fw_trace_free(struct fw_trace *t)
 {
 	free(t->force_n);
-	free(t->fz_n);
 	free(t->node_u_m);
 	free(t->contact);
 }
@@ -43,11 +41,19 @@ static uint64_t last_release(const struct fw_trace *t)
 /*
  * Dominant frequency of x[0..n) (mean removed) by a DFT scan from 0.5 to
  * 200 Hz in 0.01 Hz steps: the ringing is a few modes, and a scan finer
- * than the 1/T bins of an FFT places the peak without interpolation.
+ * than the 1/T bins of an FFT places the peak without interpolation.  Only
+ * the first RINGING_WINDOW_S are scanned: the ringing has decayed by then,
+ * and a long run (make jitter: a minute) would otherwise cost a billion
+ * sin/cos pairs.
  */
+#define RINGING_WINDOW_S 5.0
+
 static double dominant_hz(const double *x, uint64_t n, double dt_s)
 {
 	double mean = 0, best = 0, best_hz = 0;
+
+	if ((double)n * dt_s > RINGING_WINDOW_S)
+		n = (uint64_t)(RINGING_WINDOW_S / dt_s);
 
 	for (uint64_t k = 0; k < n; k++)
 		mean += x[k] / (double)n;
