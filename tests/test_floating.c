@@ -13,6 +13,7 @@
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -224,7 +225,8 @@ static void ref_tick(struct ref *r, size_t t, const double target[3], double F[3
 	rk4_tick(&r->b, F, tau, cube.meta->dt_s);
 }
 
-static void reference(const struct irdm_contact_site *site, const double *target, double *F)
+static void reference(const struct irdm_contact_site *site, const double *target, double *F,
+		      struct body *end)
 {
 	struct ref r;
 	double f[3] = { 0, 0, 0 };
@@ -248,11 +250,15 @@ static void reference(const struct irdm_contact_site *site, const double *target
 		ref_tick(&r, t, u, f);
 		memcpy(&F[3 * t], f, sizeof(f));
 	}
+	if (end)
+		*end = r.b;
 	free((void *)r.R);
 	free(r.fb);
 }
 
-static void engine_run(const struct irdm_contact_site *site, const double *target, double *F)
+/* The run; with keep, the session stays open (the caller closes it). */
+static struct irdm_session *engine_run_keep(const struct irdm_contact_site *site,
+					   const double *target, double *F, bool keep)
 {
 	struct irdm_engine_config cfg;
 	struct irdm_contact_cmd cmd[IRDM_MAX_CONTACTS];
@@ -272,7 +278,15 @@ static void engine_run(const struct irdm_contact_site *site, const double *targe
 		assert_int_equal(irdm_engine_tick(e, cmd), 0);
 		memcpy(&F[3 * t], irdm_engine_contact(e, 0)->force_n, 3 * sizeof(double));
 	}
+	if (keep)
+		return ses;
 	irdm_session_close(ses);
+	return NULL;
+}
+
+static void engine_run(const struct irdm_contact_site *site, const double *target, double *F)
+{
+	engine_run_keep(site, target, F, false);
 }
 
 static void compare(const char *what, const double *target)
@@ -288,7 +302,7 @@ static void compare(const char *what, const double *target)
 	assert_int_equal(irdm_engine_site_node(e, efx_column_row_near(&cube, top), &site), 0);
 	irdm_session_close(ses);
 	engine_run(&site, target, Fe);
-	reference(&site, target, Fr);
+	reference(&site, target, Fr, NULL);
 	double err = efx_rel_rms(Fe, Fr, N_TICKS * 3), peak = 0;
 	for (size_t k = 0; k < N_TICKS * 3; k++)
 		peak = fmax(peak, fabs(Fr[k]));
@@ -340,6 +354,59 @@ static void test_tap(void **state)
 	}
 	compare("tap", u);
 	free(u);
+}
+
+/*
+ * The engine's frames after a swirl (the cube has moved and turned): a
+ * point of the object's own frame goes to the world as the reference
+ * body carries it, x = com + R(q) (p - com0), and back to itself.  The
+ * contact proxy runs in the object's own frame (controller_contact.c).
+ */
+static void test_frames(void **state)
+{
+	const double top[3] = { 0.06, 0.06, 0.12 };
+	const double pts[4][3] = { { 0, 0, 0 }, { 0.12, 0, 0 }, { 0.12, 0.12, 0.12 }, { 0.06, 0.06, 0.12 } };
+	double *u = calloc(N_TICKS * 3, sizeof(double)), *F = malloc(N_TICKS * 3 * sizeof(double));
+	double moved = 0, worst = 0, round = 0;
+	struct irdm_engine_config cfg;
+	struct irdm_contact_site site;
+	struct body end;
+
+	(void)state;
+	for (size_t t = 0; t < N_TICKS; t++) {
+		double ph = 2 * M_PI * 1.0 * (double)(t + 1) * cube.meta->dt_s;
+		u[3 * t] = 0.03 * (cos(ph) - 1);
+		u[3 * t + 1] = 0.015 * sin(ph);
+	}
+	irdm_engine_config_default(&cfg);
+	struct irdm_session *ses = efx_session(&cube, &cfg);
+	assert_int_equal(irdm_engine_site_node(ses->eng, efx_column_row_near(&cube, top), &site), 0);
+	irdm_session_close(ses);
+	ses = engine_run_keep(&site, u, F, true);
+	reference(&site, u, F, &end);
+	for (int k = 0; k < 4; k++) {
+		double w[3], b[3], ref[3], back[3];
+
+		irdm_engine_object_to_world(ses->eng, pts[k], w);
+		irdm_engine_world_to_object(ses->eng, w, back);
+		for (int a = 0; a < 3; a++)
+			b[a] = pts[k][a] - com0[a];
+		quat_rotate(end.q, b, ref);
+		for (int a = 0; a < 3; a++) {
+			ref[a] += end.x[a];
+			moved = fmax(moved, fabs(w[a] - pts[k][a]));
+			worst = fmax(worst, fabs(w[a] - ref[a]));
+			round = fmax(round, fabs(back[a] - pts[k][a]));
+		}
+	}
+	print_message("frames: points moved up to %.2e m; object->world vs reference %.2e m; "
+		      "round trip %.2e m\n", moved, worst, round);
+	assert_true(moved > 1e-3);      /* the test means something: the cube has moved */
+	assert_true(worst <= 1e-6);
+	assert_true(round <= 1e-15);
+	irdm_session_close(ses);
+	free(u);
+	free(F);
 }
 
 static int setup(void **state)
@@ -397,6 +464,7 @@ int main(void)
 		cmocka_unit_test(test_swing),
 		cmocka_unit_test(test_tap),
 		cmocka_unit_test(test_swirl),
+		cmocka_unit_test(test_frames),
 	};
 
 	return cmocka_run_group_tests(tests, setup, teardown);

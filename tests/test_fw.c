@@ -134,6 +134,24 @@ static void test_bad_input(void **state)
 	expect_error(run_fw((const char *const[]){ "--board", BOARD, "--image", image, "--user",
 						   "/nonexistent.user", "--clock", "virtual", NULL }),
 		     3, "/nonexistent.user");
+	/* a hand that would grab the stylus 5 cm from where it rests; two
+	 * hands on a one-arm board */
+	{
+		char far_user[320], two_user[320];
+
+		snprintf(far_user, sizeof(far_user), "%s/far.user", dir);
+		tf_write_text(far_user, "place 1 at 0.05,0.05,0.26\nhold 1 for 1\n");
+		expect_error(run_fw((const char *const[]){ "--board", BOARD, "--image", image,
+							   "--user", far_user, "--clock", "virtual",
+							   NULL }),
+			     3, "far.user: hand 1: first placed 5.0 cm from where the tip rests");
+		snprintf(two_user, sizeof(two_user), "%s/two.user", dir);
+		tf_write_text(two_user, "place 1 at home\nplace 2 at home\n");
+		expect_error(run_fw((const char *const[]){ "--board", BOARD, "--image", image,
+							   "--user", two_user, "--clock", "virtual",
+							   NULL }),
+			     3, "uses 2 hands, the board has 1 device");
+	}
 	expect_error(run_fw((const char *const[]){ "--board", BOARD, "--image", image, "--clock",
 						   "virtual", "--require-rt", NULL }), 2, "--require-rt");
 	expect_error(run_fw((const char *const[]){ "--board", BOARD, "--image", image,

@@ -64,12 +64,6 @@ struct soak_case {
 	const char *script;     /* scenes/users/NAME.user */
 	enum img img;
 	const char *board;      /* boards/NAME.board */
-	/*
-	 * A known defect, not yet fixed: the run must still fail, and with
-	 * this fault (irdm-fw's message); the case turns into an error the
-	 * day it passes, so that the entry is removed with the fix.
-	 */
-	const char *known_fault;
 };
 
 struct soak_result {
@@ -215,46 +209,28 @@ static int soak_one(const struct soak_case *c, const char *seconds)
 	return rc || res.bad_tick ? -1 : 0;
 }
 
-/* Return: 0 if the case passes, or fails exactly as its known defect says. */
-static int soak_or_known(const struct soak_case *c, const char *seconds)
-{
-	int rc = soak_one(c, seconds);
-
-	if (!c->known_fault)
-		return rc;
-	if (rc && strstr(err_text, c->known_fault)) {
-		print_message("%-18s KNOWN DEFECT, still there: %s\n", c->script, c->known_fault);
-		return 0;
-	}
-	print_error("%s: the known defect '%s' is gone: remove it from the table\n", c->script,
-		    c->known_fault);
-	return -1;
-}
-
 static void test_scripts_bounded_and_passive(void **state)
 {
 	static const struct soak_case cases[] = {
-		{ "press-hold-release", IMG_CUBOID, "sim-phantom", NULL },
-		{ "pull-and-release", IMG_CUBOID, "sim-phantom", NULL },
-		{ "release", IMG_CUBOID, "sim-phantom", NULL },
-		{ "stroke", IMG_CUBOID, "sim-phantom", NULL },
+		{ "press-hold-release", IMG_CUBOID, "sim-phantom" },
+		{ "pull-and-release", IMG_CUBOID, "sim-phantom" },
+		{ "release", IMG_CUBOID, "sim-phantom" },
+		{ "stroke", IMG_CUBOID, "sim-phantom" },
 		/* the hand lets go while lifting fast: the free arm coasts up at
-		 * 0.37 m/s into the shoulder's count range (0.40 rad) at 2.5 s,
-		 * before the workspace box; the sim reports it as a read fault */
-		{ "tap", IMG_CUBOID, "sim-phantom", "fault hal-read" },
-		{ "pinch", IMG_CUBOID, "sim-phantom-pinch", NULL },
-		{ "press-hold-release", IMG_FIR, "sim-phantom", NULL },
-		{ "pull-and-release", IMG_FIR, "sim-phantom", NULL },
-		{ "release", IMG_FIR, "sim-phantom", NULL },
-		{ "stroke", IMG_FIR, "sim-phantom", NULL },
-		{ "tap", IMG_FIR, "sim-phantom", "fault hal-read" },
-		{ "pinch", IMG_FIR, "sim-phantom-pinch", NULL },
-		/* the script places the hand 5.7 cm from the tip's home pose on
-		 * this board (sim/README.md: the tip should start near it): the
-		 * spring jerks the tip past 2 m/s at tick 10 */
-		{ "swing", IMG_CUBE, "sim-phantom-cube", "fault velocity" },
-		{ "swirl", IMG_CUBE, "sim-phantom-cube", NULL },
-		{ "bunny-press", IMG_BUNNY, "sim-phantom-bunny", NULL },
+		 * 0.37 m/s to the shoulder's end stop (sim_device.h) and rests */
+		{ "tap", IMG_CUBOID, "sim-phantom" },
+		{ "pinch", IMG_CUBOID, "sim-phantom-pinch" },
+		{ "press-hold-release", IMG_FIR, "sim-phantom" },
+		{ "pull-and-release", IMG_FIR, "sim-phantom" },
+		{ "release", IMG_FIR, "sim-phantom" },
+		{ "stroke", IMG_FIR, "sim-phantom" },
+		{ "tap", IMG_FIR, "sim-phantom" },
+		{ "pinch", IMG_FIR, "sim-phantom-pinch" },
+		/* pushes the cube 2 cm and more: the proxy must follow the
+		 * cube's rigid motion (irdm_engine_world_to_object()) */
+		{ "swing", IMG_CUBE, "sim-phantom-cube" },
+		{ "swirl", IMG_CUBE, "sim-phantom-cube" },
+		{ "bunny-press", IMG_BUNNY, "sim-phantom-bunny" },
 	};
 	const char *seconds = env_or("IRDM_SOAK_SECONDS", "60");
 	int failed = 0;
@@ -268,7 +244,7 @@ static void test_scripts_bounded_and_passive(void **state)
 				      cases[k].script);
 			continue;
 		}
-		failed += soak_or_known(&cases[k], seconds) != 0;
+		failed += soak_one(&cases[k], seconds) != 0;
 	}
 	/* every case runs and prints its row before the verdict */
 	assert_int_equal(failed, 0);

@@ -25,9 +25,17 @@
 
 static struct irdm_sim_device sim, sim2;       /* big: keep them off the stack */
 
-static void frictionless(struct irdm_sim_params *p)
+/* The free arm: these tests follow motions longer than the joints' travel,
+ * so the end stops are off (test_end_stop checks them). */
+static void free_arm(struct irdm_sim_params *p)
 {
 	irdm_sim_params_default(p);
+	p->end_stops = 0;
+}
+
+static void frictionless(struct irdm_sim_params *p)
+{
+	free_arm(p);
 	for (int i = 0; i < 3; i++)
 		p->viscous_nm_s_per_rad[i] = p->coulomb_nm[i] = 0;
 }
@@ -124,7 +132,7 @@ static void test_viscous_exponential(void **state)
 	/* massless links: the joint sees its own inertia only */
 	irdm_device_config_default(&c);
 	memset(c.mass_kg, 0, sizeof(c.mass_kg));
-	irdm_sim_params_default(&p);
+	free_arm(&p);
 	memset(p.coulomb_nm, 0, sizeof(p.coulomb_nm));
 	assert_int_equal(irdm_sim_device_init(&sim, &c, &p), IRDM_OK);
 	assert_int_equal(irdm_sim_device_set_torque(&sim, (double[3]){ 0, tau, 0 }), IRDM_OK);
@@ -212,7 +220,7 @@ static void test_quantisation_floor(void **state)
 
 	irdm_device_config_default(&c);
 	c.angle_offset_rad[2] = 0.013;
-	irdm_sim_params_default(&p);
+	free_arm(&p);
 	memcpy(p.q0_rad, (double[3]){ -0.2, 0.3, 0.2 }, sizeof(p.q0_rad));
 	assert_int_equal(irdm_sim_device_init(&sim, &c, &p), IRDM_OK);
 	/* the arm falls through many counts; every sample is the floor */
@@ -379,10 +387,81 @@ static void test_limits_and_rejects(void **state)
 	REJECT(write_delay_ticks, IRDM_SIM_DELAY_MAX + 1);
 	REJECT(read_delay_ticks, IRDM_SIM_DELAY_MAX + 1);
 	REJECT(q0_rad[1], INFINITY);
+	REJECT(q0_rad[1], 0.39);                /* past the shoulder's stop (0.38) */
+	REJECT(stop_inset_rad, 0.5);            /* no travel left between the stops */
+	REJECT(stop_inset_rad, -0.01);
+	REJECT(stop_stiffness_nm_per_rad, 0);
+	REJECT(stop_damping_nm_s_per_rad, NAN);
 #undef REJECT
 	irdm_sim_params_default(&p);
 	c.l1_m = -1;
 	assert_int_equal(irdm_sim_device_init(&sim, &c, &p), IRDM_EINVAL);
+}
+
+/* ---- end stops -------------------------------------------------------------- */
+
+/*
+ * The yaw joint thrown at its stop.  With the shoulder and elbow held by
+ * Coulomb friction far above any torque they feel (they stick: Karnopp),
+ * the yaw is one degree of freedom with the constant inertia
+ *   I = joint inertia + sum_b m_b r_b^2   (r_b: body b's distance from the
+ * vertical axis, home pose: upper arm com0, forearm l1, crank 0),
+ * no gravity torque (the axis is vertical) and, frictionless, a linear
+ * spring-damper inside the stop: it leaves the stop at e times the speed
+ * it came in, e = exp(-zeta pi / sqrt(1 - zeta^2)), zeta = b / (2 sqrt(k I)),
+ * after half a damped period pi / (omega_n sqrt(1 - zeta^2)); and it
+ * enters by at most v / omega_n (the undamped bound).
+ */
+static void test_end_stop(void **state)
+{
+	struct irdm_device_config c;
+	struct irdm_sim_params p;
+	double q[3], qd[3], v_in = 0, v_out = 0, t_in = -1, t_out = -1, deepest = 0;
+	double inertia, zeta, e, wn, stop;
+	int32_t n[3];
+	(void)state;
+
+	irdm_device_config_default(&c);
+	irdm_sim_params_default(&p);
+	p.coulomb_nm[0] = p.viscous_nm_s_per_rad[0] = 0;
+	p.coulomb_nm[1] = p.coulomb_nm[2] = 5;          /* N m: >> gravity and inertia */
+	assert_int_equal(irdm_sim_device_init(&sim, &c, &p), IRDM_OK);
+	inertia = p.joint_inertia_kg_m2[0] + c.mass_kg[0] * c.com_m[0] * c.com_m[0] +
+		  c.mass_kg[1] * c.l1_m * c.l1_m;
+	zeta = p.stop_damping_nm_s_per_rad / (2 * sqrt(p.stop_stiffness_nm_per_rad * inertia));
+	e = exp(-zeta * M_PI / sqrt(1 - zeta * zeta));
+	wn = sqrt(p.stop_stiffness_nm_per_rad / inertia);
+	stop = (c.count_max[0] + 1.0) * irdm_device_rad_per_count(&c, 0) - p.stop_inset_rad;
+	/* 5 ms of 0.5 N m (about 2 rad/s), then coast 0.4 rad into the stop;
+	 * 0.1 ms steps (10 us RK4 sub-steps) time the contact */
+	for (int k = 0; k < 5000 && t_out < 0; k++) {
+		double tau[3] = { k < 50 ? 0.5 : 0, 0, 0 };
+
+		assert_int_equal(irdm_sim_device_set_torque(&sim, tau), IRDM_OK);
+		assert_int_equal(irdm_sim_device_step(&sim, DT / 10), IRDM_OK);
+		irdm_sim_device_state(&sim, q, qd);
+		assert_int_equal(irdm_sim_device_read_counts(&sim, n), IRDM_OK);
+		if (q[0] <= stop && t_in < 0)
+			v_in = qd[0];
+		else if (t_in < 0)
+			t_in = k;
+		deepest = fmax(deepest, q[0] - stop);
+		if (t_in >= 0 && q[0] <= stop) {
+			t_out = k;
+			v_out = qd[0];
+		}
+		assert_true(qd[1] == 0 && qd[2] == 0);  /* the others stick */
+	}
+	printf("end stop: in at %.4f rad/s, out at %.4f rad/s: e = %.5f (analytic %.5f), "
+	       "%g s in contact (analytic %g s), %.2e rad deep (bound %.2e)\n", v_in, -v_out,
+	       -v_out / v_in, e, (t_out - t_in) * DT / 10, M_PI / (wn * sqrt(1 - zeta * zeta)),
+	       deepest, v_in / wn);
+	assert_true(v_in > 0.5);
+	/* measured 2e-5 (the contact starts inside an RK4 sub-step) */
+	assert_true(fabs(-v_out / v_in - e) < 1e-4);
+	/* entry and exit are seen to one 0.1 ms step */
+	assert_true(fabs((t_out - t_in) * DT / 10 - M_PI / (wn * sqrt(1 - zeta * zeta))) < 1.5e-4);
+	assert_true(deepest > 0.5 * v_in / wn && deepest <= v_in / wn);
 }
 
 int main(void)
@@ -395,6 +474,7 @@ int main(void)
 		cmocka_unit_test(test_delay_exact),
 		cmocka_unit_test(test_hand_force_work),
 		cmocka_unit_test(test_limits_and_rejects),
+		cmocka_unit_test(test_end_stop),
 	};
 
 	return cmocka_run_group_tests(tests, NULL, NULL);

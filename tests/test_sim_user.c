@@ -132,12 +132,65 @@ static void test_scripts_mean_what_they_say(void **state)
 	assert_target(0, 3.3, 0.005, 0.05, 0.15, 0);
 	assert_target(1, 3.3, 0.1 - 0.005, 0.05, 0.15, 0);
 
+	/* from home: sim-phantom's tip rests 1 cm above the top centre */
 	load_shipped("stroke.user");
-	assert_target(0, 1.2, 0.02, 0.05, 0.2 - 0.005, 1);  /* 5 mm in */
-	assert_target(0, 2.7, 0.08, 0.05, 0.195, 1);        /* across the top */
+	assert_int_equal(irdm_sim_user_start(&user, 0, (double[3]){ 0.05, 0.05, 0.21 },
+					     "stroke", err, sizeof(err)), IRDM_OK);
+	assert_target(0, 0.0, 0.05, 0.05, 0.21, 1);         /* taken where it rests */
+	assert_target(0, 0.5, 0.02, 0.05, 0.21, 1);         /* carried over */
+	assert_target(0, 1.7, 0.02, 0.05, 0.2 - 0.005, 1);  /* 5 mm in */
+	assert_target(0, 3.2, 0.08, 0.05, 0.195, 1);        /* across the top */
 
+	/* sim-phantom-cube's tip rests at (0.03, 0.06, 0.13), over the top */
 	load_shipped("swirl.user");                         /* floating cube, top at 0.12 */
-	assert_target(0, 0.7, 0.06, 0.06, 0.12, 1);
+	assert_int_equal(irdm_sim_user_start(&user, 0, (double[3]){ 0.03, 0.06, 0.13 },
+					     "swirl", err, sizeof(err)), IRDM_OK);
+	assert_target(0, 1.2, 0.06, 0.06, 0.12, 1);
+	load_shipped("swing.user");
+	assert_int_equal(irdm_sim_user_start(&user, 0, (double[3]){ 0.03, 0.06, 0.13 },
+					     "swing", err, sizeof(err)), IRDM_OK);
+	assert_target(0, 0.5, -0.01, 0.06, 0.13, 1);        /* over the -x edge */
+	assert_target(0, 1.0, -0.01, 0.06, 0.09, 1);        /* beside the face */
+	assert_target(0, 2.5, 0.02, 0.06, 0.09, 1);         /* pushed 2 cm in */
+}
+
+/* 'home': unresolved, evaluation refuses; resolved, it is the given point
+ * and 'move by' stays relative to it; a far first place is refused. */
+static void test_home(void **state)
+{
+	const double home[3] = { 0.02, -0.03, 0.25 };
+	double p[3];
+	int a;
+
+	(void)state;
+	parse_ok("place 1 at home\nmove 1 by 0.01,0,-0.02 over 1\n"
+		 "move 1 to 0.1,0.1,0.1 over 1\nrelease 1\nat 2.5 place 1 at home\n");
+	assert_int_equal(irdm_sim_user_target(&user, 0, 0.5, p, &a), IRDM_EINVAL);
+	assert_int_equal(irdm_sim_user_start(&user, 0, home, "h", err, sizeof(err)), IRDM_OK);
+	assert_target(0, 0.0, home[0], home[1], home[2], 1);
+	assert_target(0, 1.0, home[0] + 0.01, home[1], home[2] - 0.02, 1);
+	assert_target(0, 2.0, 0.1, 0.1, 0.1, 0);              /* released, then placed... */
+	assert_target(0, 2.5, home[0], home[1], home[2], 1);  /* ...at home again */
+	/* idempotent: nothing left to resolve */
+	assert_int_equal(irdm_sim_user_start(&user, 0, home, "h", err, sizeof(err)), IRDM_OK);
+	assert_target(0, 2.5, home[0], home[1], home[2], 1);
+	/* a hand the script does not use passes */
+	assert_int_equal(irdm_sim_user_start(&user, 1, home, "h", err, sizeof(err)), IRDM_OK);
+
+	parse_ok("at 0.5 place 1 at 0.02,-0.03,0.2\n");
+	assert_int_equal(irdm_sim_user_start(&user, 0, home, "far", err, sizeof(err)), IRDM_EFORMAT);
+	assert_string_equal(err, "far: hand 1: first placed 5.0 cm from where the tip rests at "
+				 "the start (at most 1 cm): 'place 1 at home', then move");
+	parse_ok("at 0.5 place 1 at 0.02,-0.03,0.2405\n");          /* 9.5 mm: taken */
+	assert_int_equal(irdm_sim_user_start(&user, 0, home, "near", err, sizeof(err)), IRDM_OK);
+
+	parse_ok("place 1 at home\nmove 1 by 0.9,0,0 over 1\n");
+	assert_int_equal(irdm_sim_user_start(&user, 0, (double[3]){ 0.2, 0, 0 }, "out", err,
+					     sizeof(err)), IRDM_EFORMAT);
+	assert_string_equal(err, "out: hand 1: segment 2, from home, lies beyond +-1 m");
+	assert_int_equal(irdm_sim_user_target(&user, 0, 0.5, p, &a), IRDM_EINVAL);
+	assert_int_equal(irdm_sim_user_start(&user, 0, (double[3]){ NAN, 0, 0 }, "nan", err,
+					     sizeof(err)), IRDM_EINVAL);
 }
 
 /* ---- rules ------------------------------------------------------------------ */
@@ -662,6 +715,7 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_every_script_parses),
 		cmocka_unit_test(test_scripts_mean_what_they_say),
+		cmocka_unit_test(test_home),
 		cmocka_unit_test(test_each_rule_rejected),
 		cmocka_unit_test(test_line_length),
 		cmocka_unit_test(test_file_errors),

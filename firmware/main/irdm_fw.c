@@ -38,6 +38,34 @@ static int fail(int exit_code, int rc, const char *fmt, const char *what, const 
 	return exit_code;
 }
 
+/*
+ * The script meets the board: one device per hand, and each hand's 'home'
+ * is where its tip rests at the start, the calibration pose (checked
+ * before any device opens).
+ */
+static int meet_user(struct fw *fw)
+{
+	if (fw->user->hands > fw->board.devices) {
+		snprintf(fw->err, sizeof(fw->err), "the script uses %u hands, the board has %u device%s",
+			 fw->user->hands, fw->board.devices, fw->board.devices == 1 ? "" : "s");
+		return fail(FW_EXIT_INPUT, IRDM_EINVAL, "--user %s: %s", fw->args.user, fw->err);
+	}
+	for (unsigned h = 0; h < fw->user->hands; h++) {
+		struct irdm_device_config dev;
+		double tip[3], home[3];
+		int rc;
+
+		irdm_board_device(&fw->board, h, &dev);
+		irdm_device_fk(&dev, fw->board.calibration_pose_rad, tip);
+		irdm_board_device_to_object(&fw->board, tip, home);
+		rc = irdm_sim_user_start(fw->user, h, home, fw->args.user, fw->err,
+					 sizeof(fw->err));
+		if (rc)
+			return fail(FW_EXIT_INPUT, rc, "%s%s", "", fw->err);
+	}
+	return FW_EXIT_OK;
+}
+
 static int open_inputs(struct fw *fw)
 {
 	struct irdm_session_config sc = { .deform = false };
@@ -73,7 +101,7 @@ static int open_inputs(struct fw *fw)
 	rc = irdm_sim_user_load(fw->user, fw->args.user, fw->err, sizeof(fw->err));
 	if (rc)
 		return fail(FW_EXIT_INPUT, rc, "%s%s", "", fw->err);
-	return FW_EXIT_OK;
+	return meet_user(fw);
 }
 
 static int open_devices(struct fw *fw)

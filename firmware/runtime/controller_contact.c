@@ -51,12 +51,18 @@ static void proxy_cfg(const struct irdm_ctrl *c, struct irdm_proxy_config *pc)
 		}
 }
 
-static void proxy_out(const struct irdm_proxy *px, struct irdm_ctrl_device_output *o)
+/* The proxy, out in the world frame (it lives in the object's own). */
+static void proxy_out(const struct irdm_ctrl *c, const struct irdm_proxy *px,
+		      struct irdm_ctrl_device_output *o)
 {
+	double tip_m[3], tip_w[3];
+
 	o->tri = px->tri;
 	memcpy(o->bary, px->bary, sizeof(o->bary));
-	memcpy(o->proxy_m, px->point_m, sizeof(o->proxy_m));
-	memcpy(o->normal, px->normal, sizeof(o->normal));
+	irdm_engine_object_to_world(c->s->eng, px->point_m, o->proxy_m);
+	irdm_v3_add(tip_m, px->point_m, px->normal);
+	irdm_engine_object_to_world(c->s->eng, tip_m, tip_w);
+	irdm_v3_sub(o->normal, tip_w, o->proxy_m);
 	o->depth_m = px->depth_m;
 }
 
@@ -67,15 +73,18 @@ static int touch(struct irdm_ctrl *c, unsigned i, const struct irdm_proxy_config
 	const struct irdm_contact_disp disp = { .fn = node_disp, .ctx = c };
 	struct irdm_ctrl_dev *d = &c->dev[i];
 	struct irdm_contact_site site;
+	double tip_own_m[3];
 	int ev;
 
-	ev = irdm_proxy_update(&d->px, &c->cm, &disp, pc, o->tip_obj_m);
+	/* the proxy on the object as it is now: a floating one has moved */
+	irdm_engine_world_to_object(c->s->eng, o->tip_obj_m, tip_own_m);
+	ev = irdm_proxy_update(&d->px, &c->cm, &disp, pc, tip_own_m);
 	if (ev < 0)
 		return IRDM_EFAULT;
 	o->proxy_event = ev;
 	if (ev != IRDM_PROXY_TOUCH && ev != IRDM_PROXY_SLIDE)
 		return IRDM_OK;         /* FREE, or RELEASE: the command stays OFF */
-	proxy_out(&d->px, o);
+	proxy_out(c, &d->px, o);
 	if (irdm_proxy_site(&d->px, &c->cm, &site) ||
 	    irdm_engine_contact_begin(c->s->eng, i, &site, IRDM_CONTACT_PUSH))
 		return IRDM_EFAULT;

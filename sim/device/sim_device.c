@@ -112,14 +112,28 @@ static void solve_free(const double m[9], const double rhs[3], unsigned stuck, d
 	}
 }
 
-/* Torques held over a sub-step: motors and the hand (J^T f at q). */
-static void applied(const struct irdm_sim_device *s, const double q[3], double tau[3])
+/* The end stops' torque on joint i (zero off the stops). */
+static double stop_torque(const struct irdm_sim_device *s, int i, double q, double qd)
+{
+	double k = s->p.stop_stiffness_nm_per_rad, b = s->p.stop_damping_nm_s_per_rad;
+
+	if (q < s->stop_lo_rad[i])
+		return k * (s->stop_lo_rad[i] - q) - b * qd;
+	if (q > s->stop_hi_rad[i])
+		return -k * (q - s->stop_hi_rad[i]) - b * qd;
+	return 0;
+}
+
+/* Torques at (q, q'): motors and the hand (J^T f at q) held over the
+ * sub-step, and the end stops. */
+static void applied(const struct irdm_sim_device *s, const double q[3], const double qd[3],
+		    double tau[3])
 {
 	double th[3];
 
 	irdm_device_force_to_torque(&s->dev, q, s->hand_n, th);
 	for (int i = 0; i < 3; i++)
-		tau[i] = s->motor_nm[i] + th[i];
+		tau[i] = s->motor_nm[i] + th[i] + stop_torque(s, i, q[i], qd[i]);
 }
 
 /* x = (q, q'); friction fixed over the sub-step; stuck joints do not move. */
@@ -129,7 +143,7 @@ static void deriv(const struct irdm_sim_device *s, const double x[6], const doub
 	double m[9], bias[3], grav[3], tau[3], rhs[3];
 
 	dynamics(s, x, x + 3, m, bias, grav);
-	applied(s, x, tau);
+	applied(s, x, x + 3, tau);
 	for (int i = 0; i < 3; i++) {
 		rhs[i] = tau[i] - bias[i] - s->p.viscous_nm_s_per_rad[i] * x[3 + i] + fric[i];
 		dx[i] = x[3 + i];
@@ -144,7 +158,7 @@ static unsigned classify(struct irdm_sim_device *s, double fric[3])
 	unsigned stuck = 0;
 
 	dynamics(s, s->q_rad, s->qd_rad_per_s, m, bias, grav);
-	applied(s, s->q_rad, tau);
+	applied(s, s->q_rad, s->qd_rad_per_s, tau);
 	for (int i = 0; i < 3; i++) {
 		double c = s->p.coulomb_nm[i], v = s->qd_rad_per_s[i];
 		double hold = tau[i] - grav[i];         /* what friction must resist */
@@ -201,6 +215,10 @@ void irdm_sim_params_default(struct irdm_sim_params *p)
 		.coulomb_nm = { 5e-3, 5e-3, 5e-3 },
 		.stick_velocity_rad_per_s = 1e-3,
 		.substeps = 10,
+		.end_stops = 1,
+		.stop_inset_rad = 0.02,
+		.stop_stiffness_nm_per_rad = 50,
+		.stop_damping_nm_s_per_rad = 0.2,
 	};
 
 	*p = def;
@@ -216,6 +234,11 @@ static int params_ok(const struct irdm_sim_params *p)
 		if (!(isfinite(p->coulomb_nm[i]) && p->coulomb_nm[i] >= 0) || !isfinite(p->q0_rad[i]))
 			return 0;
 	}
+	if (p->end_stops &&
+	    !(isfinite(p->stop_inset_rad) && p->stop_inset_rad >= 0 &&
+	      isfinite(p->stop_stiffness_nm_per_rad) && p->stop_stiffness_nm_per_rad > 0 &&
+	      isfinite(p->stop_damping_nm_s_per_rad) && p->stop_damping_nm_s_per_rad >= 0))
+		return 0;
 	return isfinite(p->stick_velocity_rad_per_s) && p->stick_velocity_rad_per_s > 0 &&
 	       p->substeps >= 1 && p->substeps <= IRDM_SIM_SUBSTEPS_MAX &&
 	       p->write_delay_ticks <= IRDM_SIM_DELAY_MAX && p->read_delay_ticks <= IRDM_SIM_DELAY_MAX;
@@ -230,6 +253,33 @@ static void sample(struct irdm_sim_device *s)
 							       s->count_ring[slot]);
 }
 
+/*
+ * The stops: stop_inset_rad inside the angles the encoders can read, from
+ * the start of count_min's cell to the end of count_max's (either way
+ * round: a joint may count against its angle).
+ * Return: 0, or -1 if a range is not wider than twice the inset or the
+ * initial pose is not between the stops.
+ */
+static int place_stops(struct irdm_sim_device *s)
+{
+	for (unsigned i = 0; i < 3; i++) {
+		double c = irdm_device_rad_per_count(&s->dev, i) * s->dev.sign[i];
+		double a = s->dev.angle_offset_rad[i] + c * s->dev.count_min[i];
+		double b = s->dev.angle_offset_rad[i] + c * (s->dev.count_max[i] + 1.0);
+
+		s->stop_lo_rad[i] = -INFINITY;
+		s->stop_hi_rad[i] = INFINITY;
+		if (!s->p.end_stops)
+			continue;
+		s->stop_lo_rad[i] = fmin(a, b) + s->p.stop_inset_rad;
+		s->stop_hi_rad[i] = fmax(a, b) - s->p.stop_inset_rad;
+		if (!(s->stop_lo_rad[i] < s->stop_hi_rad[i]) ||
+		    !(s->q_rad[i] >= s->stop_lo_rad[i] && s->q_rad[i] <= s->stop_hi_rad[i]))
+			return -1;
+	}
+	return 0;
+}
+
 int irdm_sim_device_init(struct irdm_sim_device *s, const struct irdm_device_config *dev,
 			 const struct irdm_sim_params *p)
 {
@@ -239,6 +289,10 @@ int irdm_sim_device_init(struct irdm_sim_device *s, const struct irdm_device_con
 	s->dev = *dev;
 	s->p = *p;
 	memcpy(s->q_rad, p->q0_rad, sizeof(s->q_rad));
+	if (place_stops(s)) {
+		memset(s, 0, sizeof(*s));
+		return IRDM_EINVAL;
+	}
 	/* readers see the initial pose until the first delayed sample arrives */
 	sample(s);
 	for (unsigned i = 1; i < RING; i++) {

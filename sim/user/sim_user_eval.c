@@ -60,7 +60,8 @@ static void blend(const struct irdm_sim_user_seg *s, double t_s, double target_m
 static int evaluate(const struct irdm_sim_user *u, unsigned hand, double t_s, double target_m[3],
 		    const struct irdm_sim_user_seg **seg)
 {
-	if (!u || !target_m || hand >= IRDM_SIM_USER_HANDS || !isfinite(t_s))
+	if (!u || !target_m || hand >= IRDM_SIM_USER_HANDS || !isfinite(t_s) ||
+	    u->hand[hand].needs_home)
 		return IRDM_EINVAL;
 	*seg = segment_at(&u->hand[hand], t_s);
 	if (*seg)

@@ -24,6 +24,7 @@ struct hand_state {
 	double target_m[3];
 	double k_n_per_m, b_ns_per_m;
 	int active;
+	int target_home;                /* target_m is an offset from home */
 };
 
 struct parser {
@@ -162,7 +163,8 @@ static int finished(struct parser *p, const struct cmd *c)
 
 /* ---- segments -------------------------------------------------------------- */
 
-static int push(struct parser *p, const struct cmd *c, double dur_s, const double to_m[3])
+static int push(struct parser *p, const struct cmd *c, double dur_s, const double to_m[3],
+		int to_home)
 {
 	struct irdm_sim_user_hand *uh = &p->u->hand[c->hand];
 	struct hand_state *h = &p->h[c->hand];
@@ -176,6 +178,10 @@ static int push(struct parser *p, const struct cmd *c, double dur_s, const doubl
 	s->t1_s = c->start_s + dur_s;
 	memcpy(s->from_m, h->target_m, sizeof(s->from_m));
 	memcpy(s->to_m, to_m, sizeof(s->to_m));
+	s->from_home = h->target_home;
+	s->to_home = to_home;
+	h->target_home = to_home;
+	uh->needs_home |= to_home;
 	s->k_n_per_m = h->k_n_per_m;
 	s->b_ns_per_m = h->b_ns_per_m;
 	s->active = h->active;
@@ -208,21 +214,27 @@ static int need_active(struct parser *p, const struct cmd *c, int want)
 static int cmd_place(struct parser *p, struct cmd *c)
 {
 	double at_m[3];
-	int ret;
+	const char *where;
+	int ret, home;
 
 	ret = need_active(p, c, 0);
 	if (!ret)
 		ret = keyword(p, c, next(c), "at");
-	if (!ret)
-		ret = vector(p, c, next(c), at_m);
+	where = next(c);
+	home = where && !strcmp(where, "home");
+	if (home)
+		memset(at_m, 0, sizeof(at_m));
+	else if (!ret)
+		ret = vector(p, c, where, at_m);
 	if (!ret)
 		ret = finished(p, c);
 	if (ret)
 		return ret;
 	/* the target jumps while the hand is away: from == to */
 	memcpy(p->h[c->hand].target_m, at_m, sizeof(at_m));
+	p->h[c->hand].target_home = home;
 	p->h[c->hand].active = 1;
-	return push(p, c, 0, at_m);
+	return push(p, c, 0, at_m, home);
 }
 
 static int cmd_move(struct parser *p, struct cmd *c)
@@ -248,6 +260,7 @@ static int cmd_move(struct parser *p, struct cmd *c)
 		ret = finished(p, c);
 	if (ret)
 		return ret;
+	/* from home, the sum is checked again when home is known */
 	for (i = 0; relative && i < 3; i++) {
 		v[i] += cur[i];
 		if (fabs(v[i]) > IRDM_SIM_USER_COORD_MAX_M)
@@ -255,7 +268,7 @@ static int cmd_move(struct parser *p, struct cmd *c)
 				    v[i], IRDM_SIM_USER_COORD_MAX_M);
 	}
 	ret = advance(p, c, d_s);
-	return ret ? ret : push(p, c, d_s, v);
+	return ret ? ret : push(p, c, d_s, v, relative && p->h[c->hand].target_home);
 }
 
 static int cmd_hold(struct parser *p, struct cmd *c)
@@ -280,7 +293,7 @@ static int cmd_release(struct parser *p, struct cmd *c)
 	if (ret)
 		return ret;
 	p->h[c->hand].active = 0;
-	return push(p, c, 0, p->h[c->hand].target_m);
+	return push(p, c, 0, p->h[c->hand].target_m, p->h[c->hand].target_home);
 }
 
 /* stiffness and damping: a new segment only if the hand holds (else the
@@ -304,7 +317,7 @@ static int cmd_spring(struct parser *p, struct cmd *c)
 		h->k_n_per_m = v;
 	else
 		h->b_ns_per_m = v;
-	return h->active ? push(p, c, 0, h->target_m) : IRDM_OK;
+	return h->active ? push(p, c, 0, h->target_m, h->target_home) : IRDM_OK;
 }
 
 static const struct {

@@ -135,6 +135,12 @@ struct irdm_ctrl_device_output {
 	double scale;                   /* force clamp x torque saturation (1: none) */
 	int proxy_event;                /* enum irdm_proxy_event of this tick */
 	bool contact;                   /* the engine's contact is on after the tick */
+	/*
+	 * The proxy runs on the object as it is now (a floating object in its
+	 * own, moved frame: irdm_engine_world_to_object()); its point and
+	 * normal come out in the object frame as tip_obj_m is (the world
+	 * frame, the object's at the start).
+	 */
 	uint32_t tri;                   /* proxy: SURFACE triangle, barycentrics, point */
 	double bary[3];
 	double proxy_m[3];              /* object frame */

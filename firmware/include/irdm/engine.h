@@ -184,6 +184,19 @@ int irdm_engine_tick(struct irdm_engine *eng, const struct irdm_contact_cmd *cmd
 const struct irdm_contact_state *irdm_engine_contact(const struct irdm_engine *eng, unsigned i);
 const struct irdm_engine_stats *irdm_engine_stats(const struct irdm_engine *eng);
 
+/*
+ * Points between the world frame and the object's own frame (the frame of
+ * the image's rest nodes, which node displacements and sites use).  A
+ * floating object has moved and turned since the start: world_to_object
+ * undoes its rigid motion so far, object_to_world applies it; for a
+ * grounded object both copy.  A contact query (the proxy) runs in the
+ * object frame; targets stay in the world frame (above).
+ */
+void irdm_engine_world_to_object(const struct irdm_engine *eng, const double x_world_m[3],
+				 double p_obj_m[3]);
+void irdm_engine_object_to_world(const struct irdm_engine *eng, const double p_obj_m[3],
+				 double x_world_m[3]);
+
 /* Free response of image node `row` (a column): its displacement at the
  * next sample if no new force acts (object frame, without rigid motion).
  * The surface a new contact meets.  Zero for nodes that are not columns. */

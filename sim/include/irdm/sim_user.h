@@ -9,6 +9,7 @@
  * device <-> object frames.  Times and durations in seconds, hands 1 and 2.
  *
  *   [at T] place H at X,Y,Z          the hand takes hold, its target at X,Y,Z
+ *   [at T] place H at home           the same where the tip rests at the start
  *   [at T] move H to X,Y,Z over D    ease the target to X,Y,Z in D seconds
  *   [at T] move H by DX,DY,DZ over D the same, relative to the target
  *   [at T] hold H for D              keep the hand as it is for D seconds
@@ -41,6 +42,14 @@
  * (from at u = 0, to at u = 1, bit for bit) and a coordinate the move does
  * not change stays exactly constant.
  *
+ * Home.  A device starts at rest at its calibration pose and stays there
+ * until a hand takes it, so a hand first placed far from it would yank the
+ * stylus across the workspace.  'home' names that point, which only the
+ * caller knows (it depends on the board): a script that uses it is
+ * resolved by irdm_sim_user_start() before it is evaluated, and 'move by'
+ * from home stays relative to it.  irdm_sim_user_start() also refuses a
+ * hand whose first place is more than IRDM_SIM_USER_GRASP_MAX_M from home.
+ *
  * Hand.  force = K (target - tip) - B tip_vel while the hand holds, zero
  * when released or before it is first placed.  The damper acts on the
  * tip's own velocity (the hand's tissue resists motion of the stylus it
@@ -71,6 +80,7 @@
 #define IRDM_SIM_USER_B_MAX_NS_PER_M 100.0
 #define IRDM_SIM_USER_K_DEFAULT_N_PER_M 300.0
 #define IRDM_SIM_USER_B_DEFAULT_NS_PER_M 2.0
+#define IRDM_SIM_USER_GRASP_MAX_M 0.01          /* first place to home, at most */
 
 /*
  * From t0_s on the hand is `active`; its target eases from from_m (at t0_s)
@@ -81,10 +91,12 @@ struct irdm_sim_user_seg {
 	double from_m[3], to_m[3];
 	double k_n_per_m, b_ns_per_m;
 	int active;
+	int from_home, to_home;                 /* 1: that end is an offset from home */
 };
 
 struct irdm_sim_user_hand {
 	unsigned n;                             /* segments used, t0_s non-decreasing */
+	int needs_home;                         /* 'home' used, not yet resolved */
 	struct irdm_sim_user_seg seg[IRDM_SIM_USER_SEGMENTS_MAX];
 };
 
@@ -114,11 +126,27 @@ int irdm_sim_user_parse(struct irdm_sim_user *u, const char *name, const char *t
 			char *err, size_t errlen);
 
 /*
+ * Tell hand `hand` (0-based) where its device's tip rests at the start
+ * (object frame, m): 'home' in its segments becomes that point, and the
+ * hand's first place must lie within IRDM_SIM_USER_GRASP_MAX_M of it.
+ * Call once per hand the device serves, before evaluating; a hand the
+ * script does not use passes.
+ * err (may be NULL) receives one line, "NAME: hand H: reason".
+ * Return: IRDM_OK; IRDM_EINVAL if an argument is NULL, hand >=
+ * IRDM_SIM_USER_HANDS or home_m is not finite; IRDM_EFORMAT if a resolved
+ * target lies beyond +-IRDM_SIM_USER_COORD_MAX_M or the first place is
+ * too far from home (the hand is then left unresolved).
+ */
+int irdm_sim_user_start(struct irdm_sim_user *u, unsigned hand, const double home_m[3],
+			const char *name, char *err, size_t errlen);
+
+/*
  * Hand `hand` (0-based: the script's hand 1 is 0) at time t_s: its target
  * (object frame, m) and whether it holds (*active, 0 or 1).  A hand that
  * does not hold reports its last target (the origin before it was placed).
  * Return: IRDM_OK; IRDM_EINVAL if an argument is NULL, hand >=
- * IRDM_SIM_USER_HANDS or t_s is not finite.
+ * IRDM_SIM_USER_HANDS, t_s is not finite, or the hand uses 'home' and
+ * irdm_sim_user_start() has not resolved it.
  */
 int irdm_sim_user_target(const struct irdm_sim_user *u, unsigned hand, double t_s,
 			 double target_m[3], int *active);
