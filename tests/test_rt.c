@@ -175,7 +175,7 @@ static void test_attr_fifo(void **state)
 	static const struct irdm_rt_sched bad[] = {
 		{ SCHED_FIFO, 0, IRDM_RT_ANY_CPU }, { SCHED_FIFO, 100, IRDM_RT_ANY_CPU },
 		{ SCHED_OTHER, 5, IRDM_RT_ANY_CPU }, { SCHED_RR, 10, IRDM_RT_ANY_CPU },
-		{ 12345, 0, IRDM_RT_ANY_CPU }, { SCHED_FIFO, 10, -2 },
+		{ 12345, 0, IRDM_RT_ANY_CPU }, { SCHED_FIFO, 10, IRDM_RT_CPU_EXCEPT(CPU_SETSIZE) },
 		{ SCHED_FIFO, 10, CPU_SETSIZE },
 	};
 	for (size_t i = 0; i < sizeof(bad) / sizeof(bad[0]); i++)
@@ -442,6 +442,44 @@ static void test_thread_fifo(void **state)
 	assert_int_equal(irdm_rt_report_realtime(&g.r), g.r.preempt_rt && g.r.memory_locked);
 }
 
+/*
+ * A helper kept off the force thread's CPU: started by a creator pinned to
+ * one CPU (which it would inherit), with IRDM_RT_CPU_EXCEPT(that CPU) it
+ * runs on every other online CPU, and only there; alone on a one-CPU
+ * machine it keeps that CPU.
+ */
+static void *pinned_cpu_of(void *arg)
+{
+	((struct granted *)arg)->set_rc = irdm_rt_pinned_cpu();
+	return NULL;
+}
+
+static void test_cpu_except(void **state)
+{
+	const struct irdm_rt_sched pin_first = { SCHED_OTHER, 0, 0 };
+	struct granted g = { .set_self = { SCHED_OTHER, 0, IRDM_RT_CPU_EXCEPT(0) } };
+	long online = sysconf(_SC_NPROCESSORS_ONLN);
+	uint64_t want = 0;
+	pthread_t t;
+
+	(void)state;
+	for (long c = 1; c < online && c < 64; c++)
+		want |= UINT64_C(1) << c;
+	if (!want)
+		want = 1;
+	/* pinned to CPU 0 first, as a force thread would be */
+	assert_int_equal(irdm_rt_thread_start(&t, &pin_first, read_back, &g), IRDM_OK);
+	assert_int_equal(pthread_join(t, NULL), 0);
+	print_message("  CPU_EXCEPT(0) on %ld CPUs: %s\n", online, g.line);
+	assert_int_equal(g.set_rc, IRDM_OK);
+	assert_true(g.r.cpu_mask == want);
+	assert_int_equal(irdm_rt_pinned_cpu(), -1);             /* the test runs on all */
+	g = (struct granted){ .set_self = { SCHED_OTHER, 0, 0 } };
+	assert_int_equal(irdm_rt_thread_start(&t, &pin_first, pinned_cpu_of, &g), IRDM_OK);
+	assert_int_equal(pthread_join(t, NULL), 0);
+	assert_int_equal(g.set_rc, 0);                          /* pinned to CPU 0: 0 */
+}
+
 /* A thread that starts SCHED_OTHER and makes itself FIFO on the last CPU. */
 static void test_set_self(void **state)
 {
@@ -546,6 +584,7 @@ int main(void)
 		cmocka_unit_test(test_lock_memory),
 		cmocka_unit_test(test_thread_fifo),
 		cmocka_unit_test(test_set_self),
+		cmocka_unit_test(test_cpu_except),
 		cmocka_unit_test(test_refusals),
 	};
 

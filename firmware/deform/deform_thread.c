@@ -70,13 +70,16 @@ static void *deform_thread(void *arg)
 /*
  * Scheduling below the caller: SCHED_FIFO one level lower under a real-time
  * caller, else SCHED_OTHER (and nice + 5 in the thread).  Explicit in both
- * cases, so the thread never inherits the caller's real-time priority.
+ * cases, so the thread never inherits the caller's real-time priority; and
+ * off the caller's CPU when the caller is pinned to one (a force thread):
+ * inherited, that pin would put the BLAS updates on the force loop's CPU,
+ * in its caches.
  */
 static int make_attr(pthread_attr_t *a, bool rt)
 {
 	struct irdm_rt_sched s = { SCHED_OTHER, 0, IRDM_RT_ANY_CPU };
 	struct sched_param sp;
-	int policy;
+	int policy, cpu = irdm_rt_pinned_cpu();
 
 	if (rt && !pthread_getschedparam(pthread_self(), &policy, &sp) &&
 	    (policy == SCHED_FIFO || policy == SCHED_RR) &&
@@ -84,6 +87,8 @@ static int make_attr(pthread_attr_t *a, bool rt)
 		s.policy = SCHED_FIFO;
 		s.priority = sp.sched_priority - 1;
 	}
+	if (cpu >= 0)
+		s.cpu = IRDM_RT_CPU_EXCEPT(cpu);
 	return irdm_rt_thread_attr(a, &s);
 }
 

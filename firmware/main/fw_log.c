@@ -78,6 +78,7 @@ int fw_log_open(struct fw *fw)
 		.board = fw->board.name,
 		.image = fw->args.image,
 	};
+	struct irdm_rt_sched writer = { SCHED_OTHER, 0, IRDM_RT_ANY_CPU };
 	struct timespec now;
 	size_t bytes = irdm_telem_ring_mem_size(RING_RECORDS);
 	int rc;
@@ -96,7 +97,9 @@ int fw_log_open(struct fw *fw)
 		return irdm_log_file_open(&fw->logf, fw->args.log, &info, fw->err, sizeof(fw->err));
 	clock_gettime(CLOCK_REALTIME, &now);
 	info.start_time_ns = (int64_t)now.tv_sec * 1000000000 + now.tv_nsec;
-	return irdm_log_writer_start(&fw->writer, fw->args.log, &info, fw->ring, NULL, fw->err,
+	/* the lowest priority, and off the force thread's CPU when it has one */
+	writer.cpu = fw->board.cpu >= 0 ? IRDM_RT_CPU_EXCEPT(fw->board.cpu) : IRDM_RT_ANY_CPU;
+	return irdm_log_writer_start(&fw->writer, fw->args.log, &info, fw->ring, &writer, fw->err,
 				     sizeof(fw->err));
 }
 

@@ -8,6 +8,7 @@
 #include <errno.h>
 #include <pthread.h>
 #include <sched.h>
+#include <unistd.h>
 
 #include "irdm/rt.h"
 
@@ -35,13 +36,32 @@ static bool sched_valid(const struct irdm_rt_sched *s)
 	if (s->priority < sched_get_priority_min(s->policy) ||
 	    s->priority > sched_get_priority_max(s->policy))
 		return false;
-	return s->cpu == IRDM_RT_ANY_CPU || (s->cpu >= 0 && s->cpu < CPU_SETSIZE);
+	return (s->cpu >= IRDM_RT_CPU_EXCEPT(CPU_SETSIZE - 1) && s->cpu < CPU_SETSIZE);
 }
 
-static void one_cpu(cpu_set_t *set, int cpu)
+/*
+ * The CPUs s->cpu names; false for "any" (the thread keeps the mask it
+ * would inherit, which is every CPU unless its creator was pinned).  With
+ * EXCEPT: the online CPUs but that one, or "any" if none is left.
+ */
+static bool cpu_mask(const struct irdm_rt_sched *s, cpu_set_t *set)
 {
+	long online;
+	int avoid;
+
 	CPU_ZERO(set);
-	CPU_SET(cpu, set);
+	if (s->cpu >= 0) {
+		CPU_SET(s->cpu, set);
+		return true;
+	}
+	if (s->cpu == IRDM_RT_ANY_CPU)
+		return false;
+	avoid = -2 - s->cpu;
+	online = sysconf(_SC_NPROCESSORS_ONLN);
+	for (long c = 0; c < online && c < CPU_SETSIZE; c++)
+		if (c != avoid)
+			CPU_SET((int)c, set);
+	return CPU_COUNT(set) > 0;
 }
 
 int irdm_rt_thread_attr(pthread_attr_t *attr, const struct irdm_rt_sched *s)
@@ -60,10 +80,8 @@ int irdm_rt_thread_attr(pthread_attr_t *attr, const struct irdm_rt_sched *s)
 		rc = pthread_attr_setschedpolicy(attr, s->policy);
 	if (!rc)
 		rc = pthread_attr_setschedparam(attr, &sp);
-	if (!rc && s->cpu != IRDM_RT_ANY_CPU) {
-		one_cpu(&set, s->cpu);
+	if (!rc && cpu_mask(s, &set))
 		rc = pthread_attr_setaffinity_np(attr, sizeof(set), &set);
-	}
 	if (rc)
 		goto destroy;
 	return IRDM_OK;
@@ -95,12 +113,23 @@ int irdm_rt_set_self(const struct irdm_rt_sched *s)
 
 	if (!sched_valid(s))
 		return IRDM_EINVAL;
-	if (s->cpu != IRDM_RT_ANY_CPU) {
-		one_cpu(&set, s->cpu);
+	if (cpu_mask(s, &set)) {
 		rc = pthread_setaffinity_np(pthread_self(), sizeof(set), &set);
 		if (rc)
 			return from_errno(rc, IRDM_EINVAL);
 	}
 	rc = pthread_setschedparam(pthread_self(), s->policy, &sp);
 	return from_errno(rc, IRDM_EINVAL);
+}
+
+int irdm_rt_pinned_cpu(void)
+{
+	cpu_set_t set;
+
+	if (pthread_getaffinity_np(pthread_self(), sizeof(set), &set) || CPU_COUNT(&set) != 1)
+		return -1;
+	for (int c = 0; c < CPU_SETSIZE; c++)
+		if (CPU_ISSET(c, &set))
+			return c;
+	return -1;
 }

@@ -25,6 +25,13 @@
 #include "irdm/error.h"
 
 #define IRDM_RT_ANY_CPU (-1)
+/*
+ * Every online CPU but n: where a helper thread (deformation, log writer)
+ * goes when the force thread owns CPU n, so that it neither shares that
+ * CPU's caches nor needs it to run.  On a one-CPU machine it is any CPU.
+ * Encoded below -1 (n >= 0): IRDM_RT_CPU_EXCEPT(0) is -2.
+ */
+#define IRDM_RT_CPU_EXCEPT(n) (-2 - (n))
 
 /*
  * 1 in a build with AddressSanitizer, whose mlockall() locks nothing (so
@@ -46,7 +53,7 @@
 struct irdm_rt_sched {
 	int policy;     /* SCHED_FIFO or SCHED_OTHER */
 	int priority;   /* SCHED_FIFO: 1..99; SCHED_OTHER: 0 */
-	int cpu;        /* the one CPU it may run on, or IRDM_RT_ANY_CPU */
+	int cpu;        /* the one CPU it may run on, IRDM_RT_ANY_CPU or IRDM_RT_CPU_EXCEPT(n) */
 };
 
 /* What the system granted, read back by irdm_rt_report_get(). */
@@ -102,7 +109,8 @@ int irdm_rt_prefault_stack(size_t depth_bytes);
  *
  * Return: IRDM_OK; IRDM_EINVAL if the policy is not SCHED_FIFO or
  * SCHED_OTHER, the priority is out of the policy's range or the CPU is
- * negative (other than IRDM_RT_ANY_CPU) or too large; IRDM_ENOMEM if the
+ * neither IRDM_RT_ANY_CPU nor a CPU or IRDM_RT_CPU_EXCEPT() of one below
+ * CPU_SETSIZE; IRDM_ENOMEM if the
  * attributes cannot be allocated.
  */
 int irdm_rt_thread_attr(pthread_attr_t *attr, const struct irdm_rt_sched *s);
@@ -128,6 +136,9 @@ int irdm_rt_thread_start(pthread_t *tid, const struct irdm_rt_sched *s,
  * not available; IRDM_EPERM if the system refused the policy or priority.
  */
 int irdm_rt_set_self(const struct irdm_rt_sched *s);
+
+/* The one CPU the calling thread may run on, or -1 if it may run on more. */
+int irdm_rt_pinned_cpu(void);
 
 /* ---- report ---- */
 
