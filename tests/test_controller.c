@@ -38,6 +38,7 @@
 #include "irdm/vec3.h"
 #include "support/alloc_count.h"
 #include "support/device_ik.h"
+#include "support/strict_mode.h"
 #include "support/engine_fixture.h"
 
 #define GAP_M 0.002             /* home tip above the top face */
@@ -1187,32 +1188,30 @@ static void rt_stop(struct rig *r, struct rt_result *res)
 	res->bad += r->out.state != IRDM_SAFETY_OFF;
 }
 
+struct strict_job {
+	struct rig *r;
+	bool slip;              /* make one system call: the control */
+};
+
 /* Exit status 0, or killed by SIGKILL if it made a system call. */
-static __attribute__((noreturn)) void strict_child(struct rig *r, int fd, bool slip)
+static void strict_child(void *arg, int fd)
 {
+	const struct strict_job *job = arg;
 	struct rt_result res = { .magic = RT_MAGIC }, warm = { 0 };
 
-	signal(SIGABRT, SIG_DFL);       /* a crash must not look like a kill */
-	rt_cycle(r, &warm);             /* every path once: first touches done */
-	if (prctl(PR_SET_SECCOMP, SECCOMP_MODE_STRICT, 0, 0, 0)) {
-		res.prctl_errno = errno;
-		if (write(fd, &res, sizeof(res)) < 0)
-			_exit(3);
-		_exit(2);
-	}
+	rt_cycle(job->r, &warm);        /* every path once: first touches done */
+	res.prctl_errno = strict_enter();
+	if (res.prctl_errno)
+		strict_exit(fd, &res, sizeof(res), STRICT_UNAVAILABLE);
 	alloc_arm();
 	for (int c = 0; c < RT_CYCLES; c++) {
-		rt_cycle(r, &res);
-		if (slip && c == 1)
+		rt_cycle(job->r, &res);
+		if (job->slip && c == 1)
 			syscall(SYS_getppid);
 	}
-	rt_stop(r, &res);
+	rt_stop(job->r, &res);
 	res.allocs = alloc_calls();
-	if (write(fd, &res, sizeof(res)) != (ssize_t)sizeof(res))
-		syscall(SYS_exit, 4);
-	syscall(SYS_exit, 0);
-	for (;;)
-		;
+	strict_exit(fd, &res, sizeof(res), 0);
 }
 
 /* An image and an engine configuration the strict-mode run covers. */
@@ -1238,9 +1237,9 @@ static struct rt_variant variants[] = {
 static int run_strict(bool slip, struct rt_result *res, const struct rt_variant *v)
 {
 	struct rig r;
-	int fd[2], status;
-	size_t got = 0;
-	pid_t pid;
+	struct strict_job job = { &r, slip };
+	size_t got;
+	int status;
 
 	rig_config(&r, 1);
 	r.path = v->path;
@@ -1249,29 +1248,9 @@ static int run_strict(bool slip, struct rt_result *res, const struct rt_variant 
 		irdm_engine_config_default(&r.cfg.engine);
 	rig_open(&r);
 	rig_enable(&r);
-	assert_int_equal(pipe(fd), 0);
-	fflush(NULL);
-	pid = fork();
-	assert_true(pid >= 0);
-	if (pid == 0) {
-		close(fd[0]);
-		strict_child(&r, fd[1], slip);
-	}
-	close(fd[1]);
-	memset(res, 0, sizeof(*res));
-	while (got < sizeof(*res)) {
-		ssize_t k = read(fd[0], (char *)res + got, sizeof(*res) - got);
-		if (k < 0 && errno == EINTR)
-			continue;
-		if (k <= 0)
-			break;
-		got += (size_t)k;
-	}
-	close(fd[0]);
-	while (waitpid(pid, &status, 0) < 0)
-		assert_int_equal(errno, EINTR);
+	status = strict_run(strict_child, &job, res, sizeof(*res), &got);
 	rig_close(&r);
-	if (WIFEXITED(status) && WEXITSTATUS(status) == 2) {
+	if (WIFEXITED(status) && WEXITSTATUS(status) == STRICT_UNAVAILABLE) {
 		print_message("  seccomp strict mode not available (errno %d): skipped\n",
 			      res->prctl_errno);
 		skip();

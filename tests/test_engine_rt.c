@@ -55,6 +55,7 @@
 #include "irdm/rt.h"
 #include "irdm/session.h"
 #include "support/engine_fixture.h"
+#include "support/strict_mode.h"
 
 /*
  * AddressSanitizer (make san) replaces malloc and friends and mmap with
@@ -636,71 +637,34 @@ static void test_fir_alloc_and_fault_free(void **state)
 
 /* ---- proof 3: no system call ---- */
 
-/*
- * The forked child is single-threaded (fork copies the calling thread
- * only), and seccomp strict mode applies to the thread that enters it: from
- * prctl() on, the child can only read, write, _exit and sigreturn.  It
- * reports through the pipe and leaves with SYS_exit (exit() would run
- * atexit handlers and exit_group, both forbidden).
- */
-static __attribute__((noreturn)) void strict_child(struct rig *r, int fd)
+/* The ticks in seccomp strict mode (support/strict_mode.h). */
+static void strict_child(void *arg, int fd)
 {
+	struct rig *r = arg;
 	struct run_result res = { .magic = RESULT_MAGIC, .all_finite = true };
 
-	/* a crash must not look like a system call: no cmocka handler here */
-	static const int sigs[] = { SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT };
-	for (size_t i = 0; i < sizeof(sigs) / sizeof(sigs[0]); i++)
-		signal(sigs[i], SIG_DFL);
 	/* faults are not system calls, but keep the measured part clean */
 	warm_up(r);
-	if (prctl(PR_SET_SECCOMP, SECCOMP_MODE_STRICT, 0, 0, 0)) {
-		res.prctl_errno = errno;
-		if (write(fd, &res, sizeof(res)) < 0)
-			_exit(3);
-		_exit(2);
-	}
+	res.prctl_errno = strict_enter();
+	if (res.prctl_errno)
+		strict_exit(fd, &res, sizeof(res), STRICT_UNAVAILABLE);
 	arm();
 	run(r, N_TICKS, &res);
 	nan_target(r, &res);
 	disarm();
 	res.alloc_calls = calls_total();
-	if (write(fd, &res, sizeof(res)) != (ssize_t)sizeof(res))
-		syscall(SYS_exit, 4);
-	syscall(SYS_exit, 0);
-	for (;;)
-		;
+	strict_exit(fd, &res, sizeof(res), 0);
 }
 
 static void no_system_call(const struct irdm_image *img)
 {
 	struct run_result res;
 	struct rig r;
-	int fd[2], status;
-	size_t got = 0;
-	pid_t pid;
+	size_t got;
+	int status;
 
 	rig_init(&r, img);
-	assert_int_equal(pipe(fd), 0);
-	fflush(NULL);
-	pid = fork();
-	assert_true(pid >= 0);
-	if (pid == 0) {
-		close(fd[0]);
-		strict_child(&r, fd[1]);
-	}
-	close(fd[1]);
-	memset(&res, 0, sizeof(res));
-	while (got < sizeof(res)) {
-		ssize_t k = read(fd[0], (char *)&res + got, sizeof(res) - got);
-		if (k < 0 && errno == EINTR)
-			continue;
-		if (k <= 0)
-			break;
-		got += (size_t)k;
-	}
-	close(fd[0]);
-	while (waitpid(pid, &status, 0) < 0)
-		assert_int_equal(errno, EINTR);
+	status = strict_run(strict_child, &r, &res, sizeof(res), &got);
 	rig_free(&r);
 
 	if (WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL)
@@ -739,28 +703,26 @@ static void test_fir_no_system_call(void **state)
 }
 
 /* The harness can fail: a system call in strict mode does kill the child. */
+static void slip_child(void *arg, int fd)
+{
+	int e = strict_enter();
+
+	(void)arg;
+	if (e)
+		strict_exit(fd, &e, sizeof(e), STRICT_UNAVAILABLE);
+	syscall(SYS_getppid);
+	strict_exit(fd, &e, sizeof(e), 0);
+}
+
 static void test_strict_mode_catches_a_system_call(void **state)
 {
-	int status;
-	pid_t pid;
+	int status, e;
+	size_t got;
 
 	(void)state;
-	fflush(NULL);
-	pid = fork();
-	assert_true(pid >= 0);
-	if (pid == 0) {
-		signal(SIGABRT, SIG_DFL);
-		if (prctl(PR_SET_SECCOMP, SECCOMP_MODE_STRICT, 0, 0, 0))
-			_exit(errno == EINVAL ? 2 : 3);
-		syscall(SYS_getppid);
-		syscall(SYS_exit, 0);
-		for (;;)
-			;
-	}
-	while (waitpid(pid, &status, 0) < 0)
-		assert_int_equal(errno, EINTR);
-	if (WIFEXITED(status) && WEXITSTATUS(status) == 2) {
-		print_message("  seccomp strict mode not available in this kernel: skipped\n");
+	status = strict_run(slip_child, NULL, &e, sizeof(e), &got);
+	if (WIFEXITED(status) && WEXITSTATUS(status) == STRICT_UNAVAILABLE) {
+		print_message("  seccomp strict mode not available (errno %d): skipped\n", e);
 		skip();
 	}
 	assert_true(WIFSIGNALED(status));
