@@ -508,6 +508,95 @@ static void test_frame_at_writes_the_deformed_surface(void **state)
 }
 
 /*
+ * --frames-every: a frame every 0.5 s of the 6.2 s press run into a
+ * directory, with the JSON index ParaView reads.  Each frame's time is on
+ * its line of the index and in its file; the one at 1.5 s is --frame-at's
+ * frame byte for byte (checked physically above); before the touch
+ * (1.04 s) the surface is at rest, and through the hold the node nearest
+ * the contact is dented; a second run replaces the whole directory.
+ */
+static void test_frames_series(void **state)
+{
+	char img_path[320], out[320], single[320], path[400], stray[400], line[256];
+	char *a, *b;
+	size_t la, lb;
+	unsigned n = 0;
+	FILE *idx;
+
+	(void)state;
+	surface_image(img_path, sizeof(img_path));
+	snprintf(out, sizeof(out), "%s/series", dir);
+	snprintf(single, sizeof(single), "%s/single.vtk", dir);
+	snprintf(stray, sizeof(stray), "%s/stray.txt", out);
+	for (int run = 0; run < 2; run++) {
+		assert_int_equal(run_fw((const char *const[]){
+			"--board", BOARD, "--image", img_path, "--user", PRESS, "--clock", "virtual",
+			"--frames-every", "0.5", "--frames-out", out, "--frame-at", "1.5",
+			"--frame-out", single, "-q", NULL }), 0);
+		if (run == 0)
+			tf_write_text(stray, "left from an older series\n");
+	}
+	assert_int_equal(access(stray, F_OK), -1);         /* replaced as a whole */
+	snprintf(path, sizeof(path), "%s.tmp", out);
+	assert_int_equal(access(path, F_OK), -1);
+	snprintf(path, sizeof(path), "%s.old", out);
+	assert_int_equal(access(path, F_OK), -1);
+	snprintf(path, sizeof(path), "%s/frames.vtk.series", out);
+	idx = fopen(path, "r");
+	assert_non_null(idx);
+	while (fgets(line, sizeof(line), idx)) {
+		unsigned k;
+		double t;
+		struct frame_vtk f;
+		char *text;
+		size_t len;
+		double du = 0;
+
+		if (sscanf(line, " { \"name\" : \"frame_%5u.vtk\", \"time\" : %lf }", &k, &t) != 2)
+			continue;
+		n++;
+		assert_int_equal(k, n);
+		assert_true(t == 0.5 * n);
+		snprintf(path, sizeof(path), "%s/frame_%05u.vtk", out, k);
+		text = tf_load(path, &len);
+		frame_parse(text, &f);
+		assert_true(f.time_s == t);
+		for (uint32_t r = 0; r < f.n_points; r++)
+			du = fmax(du, fabs(f.u[3 * r + 2]));
+		if (t < 1.0)
+			assert_true(du <= 1e-12);               /* not touched yet */
+		if (t >= 1.5 && t <= 3.0)
+			assert_true(du >= 0.002);               /* the press holds its dent */
+		free(f.pos);
+		free(f.u);
+		free(f.tris);
+		free(text);
+	}
+	fclose(idx);
+	print_message("series: %u frames every 0.5 s\n", n);
+	assert_int_equal(n, 12);
+	snprintf(path, sizeof(path), "%s/frame_00003.vtk", out);
+	a = tf_load(path, &la);
+	b = tf_load(single, &lb);
+	assert_int_equal(la, lb);
+	assert_memory_equal(a, b, la);
+	free(a);
+	free(b);
+	/* refused before the run: too many frames, a directory that cannot be made */
+	expect_error(run_fw((const char *const[]){ "--board", BOARD, "--image", img_path, "--clock",
+						   "virtual", "--duration", "5", "--frames-every",
+						   "0.001", "--frames-out", out, NULL }),
+		     2, "more than 1000 frames");
+	expect_error(run_fw((const char *const[]){ "--board", BOARD, "--image", img_path, "--clock",
+						   "virtual", "--duration", "0.5", "--frames-every",
+						   "0.1", "--frames-out", "/nonexistent/series", NULL }),
+		     4, "/nonexistent/series.tmp");
+	expect_error(run_fw((const char *const[]){ "--board", BOARD, "--image", img_path,
+						   "--frames-every", "0.1", NULL }),
+		     2, "--frames-every needs --frames-out DIR");
+}
+
+/*
  * Real time: the worker's thread draws the frames (about 100 in a second at
  * the board's 100 Hz; a loaded host may skip some) and holds the one
  * nearest the asked time.
@@ -577,6 +666,7 @@ int main(void)
 		cmocka_unit_test(test_require_rt),
 		cmocka_unit_test(test_sigterm_mid_contact_turns_torque_off),
 		cmocka_unit_test(test_frame_at_writes_the_deformed_surface),
+		cmocka_unit_test(test_frames_series),
 		cmocka_unit_test(test_frame_at_in_real_time),
 	};
 

@@ -40,8 +40,10 @@ struct fw_args {
 	const char *user;
 	const char *log;
 	const char *frame_out;          /* --frame-out: the VTK --frame-at writes */
+	const char *frames_out;         /* --frames-out: the directory of the series */
 	double duration_s;              /* 0: the user script's end + 1 s, else 5 s */
 	double frame_at_s;              /* --frame-at: 0 none */
+	double frames_every_s;          /* --frames-every: 0 none */
 	int clock;                      /* enum irdm_clock_mode */
 	bool require_rt;
 	bool quiet;
@@ -57,26 +59,40 @@ struct fw_trace {
 };
 
 /*
+ * A frame to keep: the snapshot nearest target_tick (engine ticks).  The
+ * worker (real time) or the loop (virtual) fills the frame; the loop fills
+ * the contact at target_tick.
+ */
+struct fw_frame_slot {
+	uint64_t target_tick, held_tick;
+	double *pos_m;                  /* 3 rows, allocated at open */
+	bool held;
+	bool contact_seen, contact_on;
+	double contact_m[3], force_obj_n[3];
+};
+
+#define FW_FRAMES_MAX 1000              /* --frames-every's series, at most */
+
+/*
  * The deformation worker's side of the run (fw_frame.c).  Real time: its
- * thread is the single writer of everything below the line until it is
- * joined; the loop never reads it.  Virtual time: the loop runs the update
- * itself, every every_ticks engine ticks.
+ * thread is the single writer of the frames (pos_m, held*) and of the
+ * counters below until it is joined; the loop never reads them.  Virtual
+ * time: the loop runs the update itself, every every_ticks engine ticks.
+ * Slots are in target order: the --frames-every series (if any), and
+ * --frame-at's slot among them at single_slot.
  */
 struct fw_frame {
 	struct irdm_deform_thread *th;  /* real time only */
 	unsigned every_ticks;           /* engine ticks between snapshots (publish_every) */
-	uint64_t target_tick;           /* --frame-at's engine tick, on the snapshot grid */
 	uint64_t last_update_tick;      /* virtual time: the last engine tick updated at */
 	uint32_t rows;
-	double *pos_m;                  /* 3 rows: the held frame (allocated at init) */
+	struct fw_frame_slot *slot;
+	unsigned n_slots, single_slot;  /* single_slot: n_slots if no --frame-at */
+	unsigned contact_next;          /* the loop's: the next slot to take a contact */
 	double *scratch_m;              /* 3 rows: virtual time's update target */
-	/* the contact at target_tick, written by the loop */
-	bool contact_seen, contact_on;
-	double contact_m[3], force_obj_n[3];
 	/* ---- written by the worker's thread (real) or the loop (virtual) */
-	uint64_t frames, held_tick;
-	bool held;
-	atomic_bool done;               /* the frame nearest target_tick is held */
+	unsigned next;                  /* the first slot still looking for its frame */
+	uint64_t frames;
 	double cpu_sum_ns, cpu_max_ns;
 	uint64_t cpu_n;
 	struct timespec cpu_prev;
@@ -132,7 +148,8 @@ void fw_log_record(struct fw *fw, const struct irdm_ctrl_output *out, int64_t la
 		   int64_t compute_ns);
 int fw_log_close(struct fw *fw);
 
-/* fw_frame.c: the deformation worker, --frame-at's frame and its VTK.
+/* fw_frame.c: the deformation worker and the frames it keeps;
+ * fw_frame_vtk.c: writing them (--frame-at's file, --frames-every's series).
  * fw_frame_config() before the session opens (deform channel, snapshot
  * rate); fw_frame_check_args() (--frame-at against the board and the run's
  * length) and fw_frame_open() (worker, buffers) after the controller;
@@ -146,6 +163,7 @@ int fw_frame_start(struct fw *fw);
 void fw_frame_tick(struct fw *fw, const struct irdm_ctrl_output *out);
 void fw_frame_stop(struct fw *fw);
 int fw_frame_write(struct fw *fw);
+int fw_frame_write_series(struct fw *fw);
 void fw_frame_summary(const struct fw *fw);
 void fw_frame_free(struct fw *fw);
 

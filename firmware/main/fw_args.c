@@ -38,6 +38,13 @@ static const struct irdm_opt fw_opts[] = {
 		  "board with deform_rate_hz > 0)" },
 	{ .name = "frame-out", .type = IRDM_OPT_STRING, FA_REF(frame_out), .metavar = "FILE",
 	  .help = "where --frame-at writes (legacy VTK POLYDATA, ASCII)" },
+	{ .name = "frames-every", .type = IRDM_OPT_DOUBLE, FA(frames_every_s), .metavar = "S",
+	  .unit = "s", .range = IRDM_OPT_GT | IRDM_OPT_LE, .min = 0, .max = 86400,
+	  .help = "a deformed-surface frame every S seconds of the run into --frames-out "
+		  "(at most 1000 frames)" },
+	{ .name = "frames-out", .type = IRDM_OPT_STRING, FA_REF(frames_out), .metavar = "DIR",
+	  .help = "where --frames-every writes: frame_NNNNN.vtk and frames.vtk.series (ParaView "
+		  "opens the series with time); replaced as a whole" },
 	{ .name = "clock", .type = IRDM_OPT_ENUM, FA(clock), .names = clock_names,
 	  .metavar = "real | virtual",
 	  .help = "real time paced at the board's period, or virtual time (deterministic, fast)" },
@@ -59,6 +66,7 @@ void fw_args_usage(FILE *f)
 {
 	fputs("usage: irdm-fw --board BOARD --image IMAGE [--user SCRIPT] [--duration S]\n"
 	      "               [--log FILE] [--frame-at S --frame-out FILE]\n"
+	      "               [--frames-every S --frames-out DIR]\n"
 	      "               [--clock real|virtual] [--require-rt]\n"
 	      "\n"
 	      "Runs the force loop on a board's device: HAL read, encoders, kinematics,\n"
@@ -87,6 +95,11 @@ int fw_args_parse(struct fw_args *a, int argc, char **argv, char *err, size_t er
 	if ((a->frame_at_s > 0) != (a->frame_out != NULL)) {
 		snprintf(err, errlen, "%s", a->frame_out ? "--frame-out needs --frame-at S"
 							 : "--frame-at needs --frame-out FILE");
+		return IRDM_EINVAL;
+	}
+	if ((a->frames_every_s > 0) != (a->frames_out != NULL)) {
+		snprintf(err, errlen, "%s", a->frames_out ? "--frames-out needs --frames-every S"
+							  : "--frames-every needs --frames-out DIR");
 		return IRDM_EINVAL;
 	}
 	return IRDM_OK;

@@ -1,20 +1,21 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * The deformation worker in irdm-fw, and --frame-at's picture of the
- * deformed surface.
+ * The deformation worker in irdm-fw, and the frames of the deformed surface
+ * it keeps (--frame-at's one, --frames-every's series; fw_frame_vtk.c
+ * writes them).
  *
  * Real time: the worker's thread (irdm/deform_worker.h) runs one priority
  * level below the force loop at the board's deform_rate_hz; its frame
- * callback counts frames, measures its own CPU time and holds the frame
- * nearest --frame-at.  It is the only writer of that state until it is
- * joined, so nothing is locked.  Virtual time: no thread; the loop runs
+ * callback counts frames, measures its own CPU time and holds, for each
+ * slot, the frame nearest the slot's time.  It is the only writer of that
+ * state until it is joined, so nothing is locked.  Virtual time: no thread; the loop runs
  * irdm_deform_update() itself on the snapshot grid, so the frames (and the
  * VTK) are the same every run.
  *
  * Frame times are engine ticks: the snapshot after engine tick k is the
  * surface at t = k * period.  The engine publishes every every_ticks ticks
- * (at least the worker's rate) and --frame-at is rounded onto that grid, so
- * in virtual time the frame is exactly the one at the target tick.
+ * (at least the worker's rate) and frame times are rounded onto that grid,
+ * so in virtual time a frame is exactly the one at its target tick.
  */
 #include <errno.h>
 #include <math.h>
@@ -50,31 +51,76 @@ void fw_frame_config(struct fw *fw, struct irdm_session_config *sc)
 	sc->engine.publish_every = fw->frame.every_ticks;
 }
 
-/* --frame-at on the snapshot grid, never tick 0 (no snapshot there). */
-static uint64_t target_tick(const struct fw *fw)
+/* Time t_s on the snapshot grid, never tick 0 (no snapshot there). */
+static uint64_t grid_tick(const struct fw *fw, double t_s)
 {
-	double ticks = fw->args.frame_at_s * 1e6 / fw->board.period_us;
+	double ticks = t_s * 1e6 / fw->board.period_us;
 	uint64_t k = (uint64_t)llround(ticks / fw->frame.every_ticks) * fw->frame.every_ticks;
 
 	return k ? k : fw->frame.every_ticks;
 }
 
-static int refuse(struct fw *fw, const char *why)
+static int refuse(struct fw *fw, const char *opt, double v, const char *why)
 {
-	snprintf(fw->err, sizeof(fw->err), "--frame-at %g: %s", fw->args.frame_at_s, why);
+	snprintf(fw->err, sizeof(fw->err), "%s %g: %s", opt, v, why);
 	return IRDM_EINVAL;
+}
+
+/* How many frames --frames-every asks of a run of run_ticks. */
+static uint64_t series_frames(const struct fw *fw, uint64_t run_ticks)
+{
+	double n = floor(run_ticks * fw->board.period_us * 1e-6 / fw->args.frames_every_s + 1e-9);
+
+	return n < 1e9 ? (uint64_t)n : UINT64_MAX;
 }
 
 int fw_frame_check_args(struct fw *fw, uint64_t run_ticks)
 {
-	if (!fw->args.frame_out)
+	struct fw_frame *fr = &fw->frame;
+	uint64_t n = 0;
+
+	if (!fw->args.frame_out && !fw->args.frames_out)
 		return IRDM_OK;
-	if (!fw->frame.every_ticks)
-		return refuse(fw, "the board's deform_rate_hz is 0");
-	fw->frame.target_tick = target_tick(fw);
-	if (fw->frame.target_tick > run_ticks)
-		return refuse(fw, "after the run's end");
+	if (!fr->every_ticks)
+		return refuse(fw, fw->args.frame_out ? "--frame-at" : "--frames-every",
+			      fw->args.frame_out ? fw->args.frame_at_s : fw->args.frames_every_s,
+			      "the board's deform_rate_hz is 0");
+	if (fw->args.frame_out && grid_tick(fw, fw->args.frame_at_s) > run_ticks)
+		return refuse(fw, "--frame-at", fw->args.frame_at_s, "after the run's end");
+	if (fw->args.frames_out) {
+		n = series_frames(fw, run_ticks);
+		if (n == 0)
+			return refuse(fw, "--frames-every", fw->args.frames_every_s,
+				      "longer than the run");
+		if (n > FW_FRAMES_MAX)
+			return refuse(fw, "--frames-every", fw->args.frames_every_s,
+				      "more than 1000 frames in this run");
+	}
+	fr->n_slots = (unsigned)n + (fw->args.frame_out != NULL);
 	return IRDM_OK;
+}
+
+/* The slots' targets, in order: the series, and --frame-at's among them. */
+static void place_targets(struct fw *fw)
+{
+	struct fw_frame *fr = &fw->frame;
+	unsigned n_series = fr->n_slots - (fw->args.frame_out != NULL), k = 0;
+	uint64_t single = fw->args.frame_out ? grid_tick(fw, fw->args.frame_at_s) : 0;
+
+	fr->single_slot = fr->n_slots;
+	for (unsigned i = 0; i < n_series; i++) {
+		uint64_t t = grid_tick(fw, (i + 1) * fw->args.frames_every_s);
+
+		if (fr->single_slot == fr->n_slots && fw->args.frame_out && single <= t) {
+			fr->single_slot = k;
+			fr->slot[k++].target_tick = single;
+		}
+		fr->slot[k++].target_tick = t;
+	}
+	if (fw->args.frame_out && fr->single_slot == fr->n_slots) {
+		fr->single_slot = k;
+		fr->slot[k].target_tick = single;
+	}
 }
 
 int fw_frame_open(struct fw *fw)
@@ -90,15 +136,22 @@ int fw_frame_open(struct fw *fw)
 		return rc;
 	fr->rows = irdm_deform_rows(fw->s->worker);
 	bytes = 3 * (size_t)fr->rows * sizeof(double);
-	fr->pos_m = calloc(1, bytes);
 	fr->scratch_m = calloc(1, bytes);
-	if (!fr->pos_m || !fr->scratch_m) {
-		snprintf(fw->err, sizeof(fw->err), "out of memory for the deformation frames");
-		return IRDM_ENOMEM;
+	fr->slot = calloc(fr->n_slots ? fr->n_slots : 1, sizeof(*fr->slot));
+	if (!fr->scratch_m || !fr->slot)
+		goto out_of_memory;
+	for (unsigned k = 0; k < fr->n_slots; k++) {
+		fr->slot[k].pos_m = calloc(1, bytes);
+		if (!fr->slot[k].pos_m)
+			goto out_of_memory;
 	}
-	/* without --frame-at no frame is held: the frames are only counted */
-	atomic_init(&fr->done, !fw->args.frame_out);
+	/* without slots no frame is held: the frames are only counted */
+	place_targets(fw);
 	return IRDM_OK;
+out_of_memory:
+	snprintf(fw->err, sizeof(fw->err), "out of memory for %u deformation frames of %u nodes",
+		 fr->n_slots, fr->rows);
+	return IRDM_ENOMEM;
 }
 
 /* Distance in ticks. */
@@ -107,19 +160,27 @@ static uint64_t tick_gap(uint64_t a, uint64_t b)
 	return a > b ? a - b : b - a;
 }
 
-/* Hold the frame nearest the target: a frame at or past it ends the search. */
+/*
+ * Each slot holds the frame nearest its target; a frame at or past the
+ * target ends that slot's search, and the same frame is then offered to
+ * the next slot (two targets may share a snapshot).
+ */
 static void frame_offer(struct fw_frame *fr, const double *pos_m, uint64_t tick)
 {
 	fr->frames++;
-	if (atomic_load_explicit(&fr->done, memory_order_relaxed))
-		return;
-	if (!fr->held || tick_gap(tick, fr->target_tick) < tick_gap(fr->held_tick, fr->target_tick)) {
-		memcpy(fr->pos_m, pos_m, 3 * (size_t)fr->rows * sizeof(double));
-		fr->held_tick = tick;
-		fr->held = true;
+	while (fr->next < fr->n_slots) {
+		struct fw_frame_slot *sl = &fr->slot[fr->next];
+
+		if (!sl->held || tick_gap(tick, sl->target_tick) < tick_gap(sl->held_tick,
+									     sl->target_tick)) {
+			memcpy(sl->pos_m, pos_m, 3 * (size_t)fr->rows * sizeof(double));
+			sl->held_tick = tick;
+			sl->held = true;
+		}
+		if (tick < sl->target_tick)
+			return;
+		fr->next++;
 	}
-	if (tick >= fr->target_tick)
-		atomic_store_explicit(&fr->done, true, memory_order_release);
 }
 
 static void cpu_add(struct fw_frame *fr, double ns)
@@ -169,14 +230,14 @@ int fw_frame_start(struct fw *fw)
 	return rc;
 }
 
-static void contact_capture(struct fw_frame *fr, const struct irdm_ctrl_output *out)
+static void contact_capture(struct fw_frame_slot *sl, const struct irdm_ctrl_output *out)
 {
 	const struct irdm_ctrl_device_output *d = &out->dev[0];
 
-	fr->contact_seen = true;
-	fr->contact_on = d->contact;
-	memcpy(fr->contact_m, d->proxy_m, sizeof(fr->contact_m));
-	memcpy(fr->force_obj_n, d->force_obj_n, sizeof(fr->force_obj_n));
+	sl->contact_seen = true;
+	sl->contact_on = d->contact;
+	memcpy(sl->contact_m, d->proxy_m, sizeof(sl->contact_m));
+	memcpy(sl->force_obj_n, d->force_obj_n, sizeof(sl->force_obj_n));
 }
 
 /* Virtual time: the update on the snapshot grid, timed outside the tick. */
@@ -205,8 +266,12 @@ void fw_frame_tick(struct fw *fw, const struct irdm_ctrl_output *out)
 	if (!fr->every_ticks)
 		return;
 	eng_tick = irdm_engine_stats(fw->s->eng)->ticks;
-	if (fw->args.frame_out && eng_tick == fr->target_tick && !fr->contact_seen)
-		contact_capture(fr, out);
+	while (fr->contact_next < fr->n_slots &&
+	       fr->slot[fr->contact_next].target_tick <= eng_tick) {
+		if (fr->slot[fr->contact_next].target_tick == eng_tick)
+			contact_capture(&fr->slot[fr->contact_next], out);
+		fr->contact_next++;
+	}
 	if (fw->args.clock != IRDM_CLOCK_REAL)
 		virtual_update(fw, eng_tick);
 }
@@ -219,112 +284,10 @@ void fw_frame_stop(struct fw *fw)
 
 void fw_frame_free(struct fw *fw)
 {
-	free(fw->frame.pos_m);
+	for (unsigned k = 0; fw->frame.slot && k < fw->frame.n_slots; k++)
+		free(fw->frame.slot[k].pos_m);
+	free(fw->frame.slot);
 	free(fw->frame.scratch_m);
-}
-
-/* Three doubles a line, %.17g: the file holds every bit the run had. */
-static void put_vec(FILE *f, const double *v)
-{
-	fprintf(f, "%.17g %.17g %.17g\n", v[0], v[1], v[2]);
-}
-
-static bool tri_shown(const uint32_t *t, uint32_t rows)
-{
-	return t[0] < rows && t[1] < rows && t[2] < rows;
-}
-
-static void write_polys(FILE *f, const struct irdm_image *img, uint32_t rows)
-{
-	uint32_t n = 0;
-
-	for (uint32_t t = 0; t < img->meta->n_tris; t++)
-		n += tri_shown(img->tris + 3 * (size_t)t, rows);
-	fprintf(f, "POLYGONS %u %u\n", n, 4 * n);
-	for (uint32_t t = 0; t < img->meta->n_tris; t++) {
-		const uint32_t *v = img->tris + 3 * (size_t)t;
-		if (tri_shown(v, rows))
-			fprintf(f, "3 %u %u %u\n", v[0], v[1], v[2]);
-	}
-}
-
-/*
- * Legacy VTK: the displayed nodes' world positions and the surface; the
- * contact as dataset field data; per point the displacement and the rest
- * position (what plot-surface.py colours by).
- */
-static void write_vtk(FILE *f, const struct fw *fw)
-{
-	const struct fw_frame *fr = &fw->frame;
-	const struct irdm_image *img = fw->s->img;
-	double dt_s = fw->board.period_us * 1e-6;
-
-	fprintf(f, "# vtk DataFile Version 3.0\n");
-	fprintf(f, "irdm-fw frame: tick %llu (t %.6f s), contact at tick %llu\n",
-		(unsigned long long)fr->held_tick, (double)fr->held_tick * dt_s,
-		(unsigned long long)(fr->contact_seen ? fr->target_tick : 0));
-	fprintf(f, "ASCII\nDATASET POLYDATA\nFIELD FieldData 4\n");
-	fprintf(f, "time_s 1 1 double\n%.17g\n", (double)fr->held_tick * dt_s);
-	fprintf(f, "contact 1 1 int\n%d\n", fr->contact_on ? 1 : 0);
-	fprintf(f, "contact_point_m 3 1 double\n");
-	put_vec(f, fr->contact_m);
-	fprintf(f, "contact_force_n 3 1 double\n");
-	put_vec(f, fr->force_obj_n);
-	fprintf(f, "POINTS %u double\n", fr->rows);
-	for (uint32_t r = 0; r < fr->rows; r++)
-		put_vec(f, fr->pos_m + 3 * (size_t)r);
-	write_polys(f, img, fr->rows);
-	fprintf(f, "POINT_DATA %u\nVECTORS displacement_m double\n", fr->rows);
-	for (uint32_t r = 0; r < fr->rows; r++) {
-		const float *rest = img->nodes[r].pos_m;
-		const double *p = fr->pos_m + 3 * (size_t)r;
-		double u[3] = { p[0] - rest[0], p[1] - rest[1], p[2] - rest[2] };
-		put_vec(f, u);
-	}
-	fprintf(f, "FIELD FieldData 1\nrest_m 3 %u double\n", fr->rows);
-	for (uint32_t r = 0; r < fr->rows; r++) {
-		const float *rest = img->nodes[r].pos_m;
-		put_vec(f, (const double[3]){ rest[0], rest[1], rest[2] });
-	}
-}
-
-/* Written to FILE.tmp and renamed: a reader never sees half a frame. */
-int fw_frame_write(struct fw *fw)
-{
-	const char *path = fw->args.frame_out;
-	char tmp[4096];
-	FILE *f;
-	int bad;
-
-	if (!path)
-		return IRDM_OK;
-	if (!fw->frame.held) {
-		snprintf(fw->err, sizeof(fw->err),
-			 "%s: no deformation frame was computed (the run stopped at tick %llu)",
-			 path, (unsigned long long)fw->ticks);
-		return IRDM_EIO;
-	}
-	if ((size_t)snprintf(tmp, sizeof(tmp), "%s.tmp", path) >= sizeof(tmp)) {
-		snprintf(fw->err, sizeof(fw->err), "%s: path too long", path);
-		return IRDM_EINVAL;
-	}
-	f = fopen(tmp, "w");
-	if (!f)
-		goto fail;
-	write_vtk(f, fw);
-	bad = ferror(f);
-	if (fclose(f) || bad)
-		goto fail_unlink;
-	if (rename(tmp, path))
-		goto fail_unlink;
-	return IRDM_OK;
-fail_unlink:
-	bad = errno;
-	remove(tmp);
-	errno = bad;
-fail:
-	snprintf(fw->err, sizeof(fw->err), "%s: %s", path, strerror(errno));
-	return IRDM_EIO;
 }
 
 void fw_frame_summary(const struct fw *fw)
@@ -339,8 +302,12 @@ void fw_frame_summary(const struct fw *fw)
 	       (unsigned long long)fr->frames, fw->board.deform_rate_hz,
 	       fw->args.clock == IRDM_CLOCK_REAL ? "worker thread" : "in the loop",
 	       fr->cpu_n ? fr->cpu_sum_ns / (double)fr->cpu_n * 1e-3 : 0.0, fr->cpu_max_ns * 1e-3);
-	if (fw->args.frame_out)
+	if (fw->args.frame_out && fr->slot[fr->single_slot].held)
 		printf("frame: t %.3f s (tick %llu) -> %s\n",
-		       (double)fr->held_tick * fw->board.period_us * 1e-6,
-		       (unsigned long long)fr->held_tick, fw->args.frame_out);
+		       (double)fr->slot[fr->single_slot].held_tick * fw->board.period_us * 1e-6,
+		       (unsigned long long)fr->slot[fr->single_slot].held_tick, fw->args.frame_out);
+	if (fw->args.frames_out)
+		printf("frames: %u every %g s -> %s/frames.vtk.series\n",
+		       fr->n_slots - (fw->args.frame_out != NULL), fw->args.frames_every_s,
+		       fw->args.frames_out);
 }

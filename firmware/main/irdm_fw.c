@@ -232,6 +232,9 @@ static int stop(struct fw *fw, int rc)
 		/* a fault's exit code says more than the frame it cut short */
 		if (wrc && fail(FW_EXIT_SETUP, wrc, "%s%s", "", fw->err) && rc == FW_EXIT_OK)
 			rc = FW_EXIT_SETUP;
+		wrc = fw_frame_write_series(fw);
+		if (wrc && fail(FW_EXIT_SETUP, wrc, "%s%s", "", fw->err) && rc == FW_EXIT_OK)
+			rc = FW_EXIT_SETUP;
 	}
 	for (unsigned i = 0; i < IRDM_BOARD_DEVICES_MAX; i++) {
 		if (fw->hal_open[i])

@@ -1,10 +1,11 @@
 #!/usr/bin/python3
-"""Draw a deformed-surface frame written by `irdm-fw --frame-at S --frame-out FILE.vtk`
-(legacy VTK POLYDATA, ASCII): the shaded surface coloured by displacement
-magnitude (mm), the contact point and the force on the object as an arrow.
+"""Draw deformed-surface frames written by `irdm-fw --frame-at S --frame-out FILE.vtk`
+or `--frames-every S --frames-out DIR` (legacy VTK POLYDATA, ASCII): the shaded
+surface coloured by displacement magnitude (mm), the contact point and the force
+on the object as an arrow.  Several frames make a strip with one colour range.
 The displacement is exaggerated by --scale (default: so that the largest one is
 a tenth of the object's size); the colours are the true magnitudes.
-usage: plot-surface.py FRAME.vtk OUT.png [title] [--scale K]"""
+usage: plot-surface.py FRAME.vtk [FRAME.vtk ...] OUT.png [title] [--scale K]"""
 import sys
 
 import matplotlib
@@ -81,32 +82,12 @@ def shaded(pts, tris, colors):
     return out
 
 
-def main():
-    args = [a for a in sys.argv[1:] if not a.startswith("--scale")]
-    scale = None
-    for a in sys.argv[1:]:
-        if a.startswith("--scale="):
-            scale = float(a.split("=", 1)[1])
-    if len(args) < 2:
-        fail(__doc__.strip().split("\n")[-1])
-    src, dst = args[0], args[1]
-    title = args[2] if len(args) > 2 else src
-    d = read_vtk(src)
+def draw(ax, d, scale, norm, cmap, size):
+    """One frame on ax: the exaggerated surface, its contact and force."""
     u = d["displacement_m"]
     rest = d["points"] - u
-    size = np.ptp(rest, axis=0).max()
-    umax = np.linalg.norm(u, axis=1).max()
-    if scale is None:
-        scale = 0.1 * size / umax if umax > 0 else 1.0
     shown = rest + scale * u
-    mag_mm = np.linalg.norm(u, axis=1) * 1e3
-    tri_mag = mag_mm[d["tris"]].mean(axis=1)
-
-    fig = plt.figure(figsize=(7.5, 7))
-    # drawn in call order: the arrow and the point stay on top of the surface
-    ax = fig.add_subplot(projection="3d", computed_zorder=False)
-    norm = matplotlib.colors.Normalize(0, max(mag_mm.max(), 1e-12))
-    cmap = plt.get_cmap("viridis")
+    tri_mag = (np.linalg.norm(u, axis=1) * 1e3)[d["tris"]].mean(axis=1)
     poly = Poly3DCollection(shown[d["tris"]], facecolors=shaded(shown, d["tris"],
                                                                 cmap(norm(tri_mag))),
                             edgecolor=(0, 0, 0, 0.15), linewidth=0.2)
@@ -136,11 +117,45 @@ def main():
     ax.set_ylabel("y (m)")
     ax.set_zlabel("z (m)")
     ax.view_init(elev=28, azim=-55)
-    t = f.get("time_s", [[float("nan")]])[0][0]
-    ax.set_title(f"{title}\nt = {t:.3f} s, max |u| = {mag_mm.max():.2f} mm "
-                 f"(shape x{scale:.1f})", fontsize=9)
+    return f.get("time_s", [[float("nan")]])[0][0]
+
+
+def main():
+    args = [a for a in sys.argv[1:] if not a.startswith("--scale")]
+    scale = None
+    for a in sys.argv[1:]:
+        if a.startswith("--scale="):
+            scale = float(a.split("=", 1)[1])
+    srcs = [a for a in args if a.endswith(".vtk")]
+    rest_args = [a for a in args if not a.endswith(".vtk")]
+    if not srcs or not rest_args:
+        fail(__doc__.strip().split("\n")[-1])
+    dst = rest_args[0]
+    title = rest_args[1] if len(rest_args) > 1 else srcs[0]
+    frames = [read_vtk(src) for src in srcs]
+    # one scale and one colour range for every frame: they compare
+    size = max(np.ptp(d["points"] - d["displacement_m"], axis=0).max() for d in frames)
+    umax = max(np.linalg.norm(d["displacement_m"], axis=1).max() for d in frames)
+    if scale is None:
+        scale = 0.1 * size / umax if umax > 0 else 1.0
+    norm = matplotlib.colors.Normalize(0, max(umax * 1e3, 1e-12))
+    cmap = plt.get_cmap("viridis")
+    n = len(frames)
+    fig = plt.figure(figsize=(7.5 if n == 1 else 4.2 * n, 7 if n == 1 else 4.8))
+    for k, d in enumerate(frames):
+        # drawn in call order: the arrow and the point stay on top of the surface
+        ax = fig.add_subplot(1, n, k + 1, projection="3d", computed_zorder=False)
+        t = draw(ax, d, scale, norm, cmap, size)
+        mag = np.linalg.norm(d["displacement_m"], axis=1).max() * 1e3
+        if n == 1:
+            ax.set_title(f"{title}\nt = {t:.3f} s, max |u| = {mag:.2f} mm "
+                         f"(shape x{scale:.1f})", fontsize=9)
+        else:
+            ax.set_title(f"t = {t:.2f} s, max |u| = {mag:.2f} mm", fontsize=9)
+    if n > 1:
+        fig.suptitle(f"{title} (shape x{scale:.1f})", fontsize=10)
     sm = matplotlib.cm.ScalarMappable(norm=norm, cmap=cmap)
-    fig.colorbar(sm, ax=ax, shrink=0.6, label="|displacement| (mm)")
+    fig.colorbar(sm, ax=fig.axes, shrink=0.6, label="|displacement| (mm)")
     fig.savefig(dst, dpi=110)
     plt.close(fig)
 

@@ -34,7 +34,7 @@ tail -n 1 out/default-forces.csv | awk -F, '{ printf "replay: force on the objec
 echo "run: irdm-fw on boards/sim-phantom.board, scenes/users/press-hold-release.user, virtual time"
 "$fw" --board boards/sim-phantom.board --image out/default.img \
 	--user scenes/users/press-hold-release.user --clock virtual --log out/run.log \
-	--frame-at 1.5 --frame-out out/run-frame.vtk
+	--frame-at 1.5 --frame-out out/run-frame.vtk --frames-every 0.1 --frames-out out/run-frames
 "$irdm" log export out/run.log -o out/run.csv
 
 if $py -c 'import matplotlib' 2>/dev/null; then
@@ -45,7 +45,10 @@ if $py -c 'import matplotlib' 2>/dev/null; then
 		"irdm-fw, simulated PHANToM: press the top centre, hold 2 s, release"
 	$py tools/scripts/plot-surface.py out/run-frame.vtk out/run-frame.png \
 		"irdm-fw, simulated PHANToM: the deformed surface mid-hold"
-	echo "run: plots out/default-response.png out/default-forces.png out/run-force.png out/run-latency.png out/run-compute.png out/run-frame.png"
+	# pressing in, holding, and ringing after the release at 3.2 s
+	$py tools/scripts/plot-surface.py out/run-frames/frame_000{11,13,30,33}.vtk \
+		out/run-frames.png "irdm-fw: press, hold, release"
+	echo "run: plots out/default-response.png out/default-forces.png out/run-force.png out/run-latency.png out/run-compute.png out/run-frame.png out/run-frames.png"
 else
 	echo "run: python3-matplotlib not installed; skipped the PNG plots"
 fi
