@@ -12,6 +12,7 @@
 #ifndef IRDM_TOOLS_MESH_H
 #define IRDM_TOOLS_MESH_H
 
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -105,6 +106,16 @@ int irdm_surface_tetrahedralize(const struct irdm_surface *s, const char *switch
  * Return: IRDM_OK; IRDM_EFORMAT if the mesh is invalid; IRDM_ENOMEM.
  */
 int irdm_mesh_finish(struct irdm_mesh *m, const char *what, char *err, size_t errlen);
+
+/*
+ * Whether only straining moves the mesh (grounded: anchored by the fixed
+ * nodes, fixed[i] per node) or it moves only as one rigid body (floating);
+ * mesh_rigidity.c says how, without a tolerance on eigenvalues.
+ * Return: 0; -1 with a "model: ..." message naming a node of a loose part
+ * (or of running out of memory).
+ */
+int irdm_mesh_check_rigidity(const struct irdm_mesh *m, const bool *fixed, bool floating,
+			     char *err, size_t errlen);
 
 /*
  * Built-in generators: an axis-aligned box [0,lx]x[0,ly]x[0,lz] (metres)

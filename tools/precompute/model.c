@@ -113,6 +113,10 @@ int irdm_model_build(const struct irdm_scene *sc, size_t n_modes_needed,
 	ret = mark_nodes(sc, m, err, errlen);
 	if (ret)
 		goto out_fail;
+	ret = irdm_mesh_check_rigidity(&m->mesh, m->fixed, sc->floating, err, errlen) ? IRDM_EINVAL
+										       : IRDM_OK;
+	if (ret)
+		goto out_fail;
 	m->seconds_mesh = now_s() - t0;
 	t0 = now_s();
 	ret = irdm_fem_assemble(&m->mesh, &sc->mat, sc->mass, m->fixed, &m->fem, err, errlen);
