@@ -257,11 +257,17 @@ static void test_stl_binary(void **state)
 
 		assert_err(ret, err, "cut.stl", "");
 	}
-	/* without the "solid" lure, trailing bytes are tolerated */
-	memcpy(bin, "BINARY", 6);
+	/* trailing bytes are tolerated, after a "solid" header too (CAD
+	 * exporters write both) */
 	bin = realloc(bin, len + 10);
 	assert_non_null(bin);
 	memset(bin + len, 0, 10);
+	memcpy(bin, "solid part exported", 19);
+	if (irdm_surface_parse_stl(bin, len + 10, "cad.stl", &s, err, sizeof(err)))
+		fail_msg("%s", err);
+	assert_cube_surface(&s);
+	irdm_surface_free(&s);
+	memcpy(bin, "BINARY", 6);
 	assert_int_equal(irdm_surface_parse_stl(bin, len + 10, "x.stl", &s, err,
 						sizeof(err)), 0);
 	assert_cube_surface(&s);
@@ -305,16 +311,32 @@ static void test_tetgen_failures(void **state)
 	size_t len;
 
 	(void)state;
-	/* open surface: tetgen does not produce a mesh */
+	/* open surface (the box misses its x = 1 face): refused before tetgen,
+	 * with the 4 edges of the hole counted and the first one named */
 	assert_int_equal(irdm_surface_parse_obj(open_box_obj, strlen(open_box_obj),
 						"open.obj", &s, err, sizeof(err)), 0);
 	assert_err(irdm_surface_tetrahedralize(&s, NULL, "open.obj", &m, err,
 					       sizeof(err)), err, "open.obj",
-		   "tetgen");
+		   "surface is not closed: 4 open (one triangle) edges, the first from (1, 0, 0) "
+		   "to (1, 1, 0)");
 	print_message("open surface: %s\n", err);
 	assert_null(m.tets);
 	irdm_surface_free(&s);
 	assert_tmpdir_empty();
+	/* two tetrahedra sharing an edge: closed, but that edge has 4 triangles */
+	{
+		static const char bowtie[] =
+			"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 0 -1 0\nv 0 0 -1\n"
+			"f 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\n"
+			"f 1 2 5\nf 1 6 2\nf 2 6 5\nf 1 5 6\n";
+		assert_int_equal(irdm_surface_parse_obj(bowtie, strlen(bowtie), "bowtie.obj", &s,
+							err, sizeof(err)), 0);
+		assert_err(irdm_surface_tetrahedralize(&s, NULL, "bowtie.obj", &m, err,
+						       sizeof(err)), err, "bowtie.obj",
+			   "1 non-manifold (three or more triangles) edge, the first from (0, 0, 0) "
+			   "to (1, 0, 0)");
+		irdm_surface_free(&s);
+	}
 
 	txt = tf_load(DATA "cube.obj", &len);
 	assert_int_equal(irdm_surface_parse_obj(txt, len, "cube.obj", &cube, err,

@@ -113,6 +113,11 @@ int mesh_read_file(const char *path, char **buf, size_t *len,
 int surface_check(const struct irdm_surface *s, const char *what,
 		  char *err, size_t errlen);
 
+/* Every edge in exactly two triangles (surface_closed.c); else
+ * IRDM_EFORMAT naming the count and the first bad edge. */
+int surface_check_closed(const struct irdm_surface *s, const char *what, char *err,
+			 size_t errlen);
+
 /* Growing a surface while parsing; 0 or -1 (out of memory / too many). */
 struct surface_build {
 	struct irdm_surface *s;

@@ -5,8 +5,10 @@
  * equality, +0 and -0 alike) to recover the connectivity tetgen needs.
  *
  * Binary is recognised by its size (84 + 50 * count bytes), because
- * plenty of binary files also begin with the word "solid"; a file that
- * does not start with "solid" is binary, trailing bytes allowed.
+ * plenty of binary files also begin with the word "solid", or by bytes
+ * no text has after the 80-byte header (CAD tools also append bytes after
+ * the last triangle); a file that does not start with "solid" is binary,
+ * trailing bytes allowed.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -218,6 +220,24 @@ out_free:
 	return ret;
 }
 
+/*
+ * Text: no control byte but whitespace (a binary STL's floats have NULs
+ * and control bytes; bytes >= 0x80 may be UTF-8 in a solid's name).
+ */
+static bool all_text(const unsigned char *p, size_t len)
+{
+	for (size_t i = 0; i < len; i++)
+		if ((p[i] < 0x20 && p[i] != '\t' && p[i] != '\r' && p[i] != '\n') ||
+		    p[i] == 0x7f)
+			return false;
+	return true;
+}
+
+/*
+ * Starts with "solid" AND is text throughout: CAD tools write binary
+ * files whose 80-byte header starts with "solid", and some append bytes
+ * after the last triangle, so neither the word nor an inexact size tells.
+ */
 static bool looks_ascii(const char *p, size_t len)
 {
 	size_t i = 0;
@@ -225,7 +245,9 @@ static bool looks_ascii(const char *p, size_t len)
 	while (i < len && (p[i] == ' ' || p[i] == '\t' || p[i] == '\r' ||
 			   p[i] == '\n'))
 		i++;
-	return len - i >= 5 && !memcmp(p + i, "solid", 5);
+	return len - i >= 5 && !memcmp(p + i, "solid", 5) &&
+	       all_text((const unsigned char *)p + STL_HEADER * (len > STL_HEADER),
+			len > STL_HEADER ? len - STL_HEADER : 0);
 }
 
 int irdm_surface_parse_stl(const void *buf, size_t len, const char *what,

@@ -303,6 +303,8 @@ int irdm_surface_tetrahedralize(const struct irdm_surface *s, const char *switch
 	if (!what)
 		what = "surface";
 	ret = surface_check(s, what, err, errlen);
+	if (!ret)
+		ret = surface_check_closed(s, what, err, errlen);
 	if (ret)
 		return ret;
 	r = calloc(1, sizeof(*r));
