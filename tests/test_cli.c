@@ -497,6 +497,33 @@ static void test_replay(void **state)
 	expect_failure(run("replay", "--image", img, "--contact", "40", "--displacement", path_in_dir("no.csv"),
 			   "-o", out, NULL), "no.csv");
 	expect_failure(run("replay", "--image", img, "--contact", "40", NULL), "needs");
+	/* --sites: each row's site checked, named by file and row */
+	{
+		const char *sites = path_in_dir("rps.csv");
+
+		tf_write_text(traj, "t,ux,uy,uz\n0,0,0,-0.001\n0.001,nan,nan,nan\n");
+		tf_write_text(sites, "t,tri,b0,b1,b2\n0,99999,0.2,0.3,0.5\n0.001,-1,0,0,0\n");
+		expect_failure(run("replay", "--image", img, "--sites", sites, "--displacement", traj,
+				   "-o", out, NULL), "rps.csv: row 1, contact 1: triangle is not -1");
+		tf_write_text(sites, "t,tri,b0,b1,b2\n0,0,0.2,0.3,0.6\n0.001,-1,0,0,0\n");
+		expect_failure(run("replay", "--image", img, "--sites", sites, "--displacement", traj,
+				   "-o", out, NULL), "row 1, contact 1: barycentrics must sum to 1");
+		tf_write_text(sites, "t,tri,b0,b1,b2\n0,0,-0.2,0.7,0.5\n0.001,-1,0,0,0\n");
+		expect_failure(run("replay", "--image", img, "--sites", sites, "--displacement", traj,
+				   "-o", out, NULL), "finite and >= 0");
+		tf_write_text(sites, "t,tri,b0,b1,b2\n0,-1,0,0,0\n0.001,-1,0,0,0\n");
+		expect_failure(run("replay", "--image", img, "--sites", sites, "--displacement", traj,
+				   "-o", out, NULL), "row 1: contact 1 has a displacement but no site");
+		tf_write_text(sites, "t,tri,b0,b1,b2\n0,0,0.2,0.3,0.5\n");
+		expect_failure(run("replay", "--image", img, "--sites", sites, "--displacement", traj,
+				   "-o", out, NULL), "1 rows, but");
+		expect_failure(run("replay", "--image", img, "--sites", sites, "--contact", "40",
+				   "--displacement", traj, "-o", out, NULL), "exclude each other");
+		tf_write_text(sites, "t,tri,b0,b1,b2\n0,0,0.2,0.3,0.5\n0.001,-1,0,0,0\n");
+		assert_int_equal(run("replay", "--image", img, "--sites", sites, "--displacement",
+				     traj, "-o", out, NULL), 0);
+		remove(out);
+	}
 	assert_false(exists(out));
 }
 

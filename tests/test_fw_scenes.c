@@ -19,10 +19,10 @@
  * about 20 s of wall time here; make san sets 10 s).
  *
  * And irdm-fw against irdm replay with a rigid coupling (coupling = 0,0:
- * the engine's target is the contact's displacement): the press's first
- * contact tick, rebuilt from the log as a contact point and a displacement
- * trajectory, gives the same force to 1e-9; the rest of the first
- * triangle's window is measured and bounded loosely (why: at the test).
+ * the engine's target is the contact's displacement): the whole press run,
+ * every tick in and out of contact, rebuilt from the log as per-tick sites
+ * (the proxy slides across triangles) and targets, gives the same forces
+ * (to 1e-12 of the peak; measured: identical).
  * Needs IRDM and IRDM_FW (make test sets them); runs from the repository root.
  */
 #define _GNU_SOURCE
@@ -252,7 +252,7 @@ static void test_scripts_bounded_and_passive(void **state)
 
 /* ---- irdm-fw against irdm replay, rigid coupling ---- */
 
-#define RIGID_TICKS 3100        /* press-hold-release: touch 1.04 s, release 3.2 s */
+#define RIGID_TICKS 6200        /* press-hold-release: touch 1.04 s, release 3.2 s */
 
 /* The shipped board with the coupling made rigid (coupling = 0,0). */
 static void rigid_board(char *path, size_t len)
@@ -270,13 +270,12 @@ static void rigid_board(char *path, size_t len)
 	tf_write_text(path, out);
 }
 
-struct contact_window {
+struct rigid_run {
 	struct irdm_tick_record rec[RIGID_TICKS];
-	size_t n, first, last;          /* records; the window [first, last] */
+	size_t n, touched, sites;       /* records; ticks with a site; distinct sites */
 };
 
-/* The first contact episode on one triangle: [first, last]. */
-static void find_window(struct contact_window *w, const char *log)
+static void read_log(struct rigid_run *w, const char *log)
 {
 	struct irdm_log_reader *r;
 	char err[256];
@@ -285,56 +284,56 @@ static void find_window(struct contact_window *w, const char *log)
 	while (w->n < RIGID_TICKS && irdm_log_next(r, &w->rec[w->n], err, sizeof(err)) == 1)
 		w->n++;
 	irdm_log_close(r);
-	for (w->first = 0; w->first < w->n; w->first++)
-		if (w->rec[w->first].dev[0].contact_tri != IRDM_TELEM_NO_TRI)
-			break;
-	assert_true(w->first < w->n);
-	for (w->last = w->first; w->last + 1 < w->n; w->last++)
-		if (w->rec[w->last + 1].dev[0].contact_tri != w->rec[w->first].dev[0].contact_tri)
-			break;
 }
 
 /*
- * The trajectory replay imposes: from the touch on, one row a tick, the
- * tip (object frame) less the site's rest point (the controller's target,
- * controller_contact.c).  rest_m is the touch tick's tip on the rest top
- * face, z = (float)0.2 as the image stores its nodes (0.2 itself moves the
- * target by 3e-9 m of 1.8e-5: 1.7e-4 of the force); replay's x,y,z form
- * finds the same point as the nearest of the rest surface.
+ * What the controller commanded, tick by tick, as irdm replay reads it:
+ * the site (triangle, barycentrics; -1 when none) and the target (nan
+ * when none), both as the log holds them (%.17g: bit for bit).
  */
-static void write_trajectory(const struct irdm_board *b, const struct contact_window *w,
-			     const double rest_m[3], const char *path)
+static void write_inputs(struct rigid_run *w, const char *sites, const char *traj)
 {
-	FILE *f = fopen(path, "w");
+	FILE *fs = fopen(sites, "w"), *ft = fopen(traj, "w");
+	const struct irdm_tick_dev *prev = NULL;
 
-	assert_non_null(f);
-	fprintf(f, "t,ux,uy,uz\n");
-	for (size_t k = w->first; k <= w->last; k++) {
-		double p[3];
+	assert_true(fs && ft);
+	fprintf(fs, "t,tri,b0,b1,b2\n");
+	fprintf(ft, "t,ux,uy,uz\n");
+	for (size_t k = 0; k < w->n; k++) {
+		const struct irdm_tick_dev *d = &w->rec[k].dev[0];
+		double t = (double)k * 1e-3;
 
-		irdm_board_device_to_object(b, w->rec[k].dev[0].tip_pos_m, p);
-		fprintf(f, "%.17g,%.17g,%.17g,%.17g\n", (double)(k - w->first) * 1e-3,
-			p[0] - rest_m[0], p[1] - rest_m[1], p[2] - rest_m[2]);
+		if (d->site_tri == IRDM_TELEM_NO_TRI) {
+			fprintf(fs, "%.3f,-1,0,0,0\n", t);
+			fprintf(ft, "%.3f,nan,nan,nan\n", t);
+			continue;
+		}
+		w->touched++;
+		if (!prev || memcmp(prev->site_bary, d->site_bary, sizeof(d->site_bary)) ||
+		    prev->site_tri != d->site_tri)
+			w->sites++;
+		prev = d;
+		fprintf(fs, "%.3f,%u,%.17g,%.17g,%.17g\n", t, d->site_tri, d->site_bary[0],
+			d->site_bary[1], d->site_bary[2]);
+		fprintf(ft, "%.3f,%.17g,%.17g,%.17g\n", t, d->target_m[0], d->target_m[1],
+			d->target_m[2]);
 	}
-	assert_int_equal(fclose(f), 0);
+	assert_int_equal(fclose(fs), 0);
+	assert_int_equal(fclose(ft), 0);
 }
 
-/*
- * Largest |F_fw - F_replay| over the window, relative to the peak force;
- * *touch_rel: the same at the touch tick, relative to its force.
- */
-static double compare_forces(const struct contact_window *w, const char *forces, double *peak,
-			     double *touch_rel)
+/* Largest |F_fw - F_replay| over every tick, relative to the peak force. */
+static double compare_forces(const struct rigid_run *w, const char *forces, double *peak)
 {
 	FILE *f = fopen(forces, "r");
 	char line[512];
 	double worst = 0;
-	size_t k = w->first;
+	size_t k = 0;
 
 	assert_non_null(f);
 	assert_non_null(fgets(line, sizeof(line), f));         /* header */
 	*peak = 0;
-	while (fgets(line, sizeof(line), f) && k <= w->last) {
+	while (fgets(line, sizeof(line), f) && k < w->n) {
 		const double *fw = w->rec[k++].dev[0].force_n;
 		double t, fr[3], d = 0, n = 0;
 
@@ -343,62 +342,48 @@ static double compare_forces(const struct contact_window *w, const char *forces,
 			d += pow(fw[a] - fr[a], 2);
 			n += fr[a] * fr[a];
 		}
-		if (k == w->first + 1)
-			*touch_rel = sqrt(d / n);
 		worst = fmax(worst, sqrt(d));
 		*peak = fmax(*peak, sqrt(n));
 	}
 	fclose(f);
-	assert_int_equal(k, w->last + 1);
+	assert_int_equal(k, w->n);
 	return worst / *peak;
 }
 
 static void test_rigid_matches_replay(void **state)
 {
-	static struct contact_window w;
-	char board_path[320], log[320], traj[320], forces[320], at[128], err[256];
-	struct irdm_board b;
-	double p[3], rest_m[3], peak, rel, touch_rel = INFINITY;
+	static struct rigid_run w;
+	char board_path[320], log[320], traj[320], sites[320], forces[320];
+	double peak, rel;
 
 	(void)state;
 	rigid_board(board_path, sizeof(board_path));
-	assert_int_equal(irdm_board_load(&b, board_path, err, sizeof(err)), 0);
 	snprintf(log, sizeof(log), "%s/rigid.log", dir);
 	if (run(env_or("IRDM_FW", "build/irdm-fw"), (const char *const[]){
 		"--board", board_path, "--image", images[IMG_CUBOID], "--user",
-		"scenes/users/press-hold-release.user", "--clock", "virtual", "--duration", "3.1",
+		"scenes/users/press-hold-release.user", "--clock", "virtual", "--duration", "6.2",
 		"--log", log, "-q", NULL }))
 		fail_msg("irdm-fw, rigid: %s", err_text);
 	memset(&w, 0, sizeof(w));
-	find_window(&w, log);
-	irdm_board_device_to_object(&b, w.rec[w.first].dev[0].tip_pos_m, p);
-	rest_m[0] = p[0];
-	rest_m[1] = p[1];
-	rest_m[2] = 0.2f;
+	read_log(&w, log);
+	assert_int_equal(w.n, RIGID_TICKS);
 	snprintf(traj, sizeof(traj), "%s/traj.csv", dir);
+	snprintf(sites, sizeof(sites), "%s/sites.csv", dir);
 	snprintf(forces, sizeof(forces), "%s/forces.csv", dir);
-	snprintf(at, sizeof(at), "%.17g,%.17g,%.17g", rest_m[0], rest_m[1], rest_m[2]);
-	write_trajectory(&b, &w, rest_m, traj);
+	write_inputs(&w, sites, traj);
+	/* the board's engine: pushes only, passivity control on */
 	if (run(env_or("IRDM", "build/irdm"), (const char *const[]){
-		"replay", "--image", images[IMG_CUBOID], "--contact", at, "--push",
-		"--displacement", traj, "-o", forces, NULL }))
+		"replay", "--image", images[IMG_CUBOID], "--sites", sites, "--displacement", traj,
+		"--push", "--passivity", "-o", forces, NULL }))
 		fail_msg("irdm replay: %s", err_text);
-	rel = compare_forces(&w, forces, &peak, &touch_rel);
-	print_message("rigid: touch tick %zu: |F_fw - F_replay| / |F| = %.3e\n", w.first,
-		      touch_rel);
-	print_message("rigid: ticks %zu..%zu on triangle %u, peak %.4f N: "
-		      "max |F_fw - F_replay| / peak = %.3e\n", w.first, w.last,
-		      w.rec[w.first].dev[0].contact_tri, peak, rel);
-	/* the touch tick: the same site, target and (rest) state */
-	assert_true(touch_rel <= 1e-9);
-	/*
-	 * After it, not 1e-9: replay holds one material point, while the
-	 * controller's proxy re-projects the tip on the displaced triangle
-	 * every tick (new barycentrics, target = tip - their rest point), a
-	 * frictionless slide replay cannot express; measured 2.9e-2.  This
-	 * bound catches a frame or sign slip.
-	 */
-	assert_true(rel <= 5e-2);
+	rel = compare_forces(&w, forces, &peak);
+	print_message("rigid: %zu ticks, %zu in contact over %zu distinct sites (the proxy "
+		      "slides), peak %.4f N: max |F_fw - F_replay| / peak = %.3e\n", w.n, w.touched,
+		      w.sites, peak, rel);
+	/* the test means something: contact, and the site moved */
+	assert_true(w.touched > 1000 && w.sites > 100);
+	/* the same arithmetic on the same inputs: measured identical */
+	assert_true(rel <= 1e-12);
 }
 
 static int precompute(enum img k, const char *name, const char *const *args)

@@ -99,6 +99,12 @@ static void make_record(uint64_t i, struct irdm_tick_record *r)
 		v->proxy = (uint8_t)((i + (uint64_t)d) % IRDM_TELEM_N_PROXY);
 		v->contact_tri = (i + (uint64_t)d) % 7 == 0 ? IRDM_TELEM_NO_TRI
 							   : (uint32_t)(xorshift(&s) % 100000);
+		v->site_tri = (i + (uint64_t)d) % 5 == 0 ? IRDM_TELEM_NO_TRI
+							: (uint32_t)(xorshift(&s) % 100000);
+		for (int k = 0; k < 3; k++) {
+			v->site_bary[k] = any_double(&s);
+			v->target_m[k] = any_double(&s);
+		}
 	}
 	/* values a CSV round trip must carry too */
 	if (i % 50 == 3) {
@@ -700,7 +706,7 @@ static void test_log_reader_refuses_bad_logs(void **state)
 {
 	const char *good = in_dir("ten.log"), *bad = in_dir("bad.log");
 	const long full = IRDM_LOG_HEADER_SIZE + 10 * IRDM_TICK_RECORD_SIZE;
-	const uint32_t v2 = 2, rs = 200;
+	const uint32_t v1 = 1, rs = 200;     /* v1: the log before the engine command */
 	const char wrong_magic[8] = "IRDMIMG";
 
 	(void)state;
@@ -711,15 +717,21 @@ static void test_log_reader_refuses_bad_logs(void **state)
 	copy_patched(good, bad, full - IRDM_TICK_RECORD_SIZE * 5, 0, NULL, 0);
 	expect_refused(bad, IRDM_ETRUNC, "truncated: the header says 10 records, the file holds 5 and 0 bytes");
 	copy_patched(good, bad, full - 100, 0, NULL, 0);
-	expect_refused(bad, IRDM_ETRUNC, "the file holds 9 and 180 bytes");
+	{
+		char want[64];
+
+		snprintf(want, sizeof(want), "the file holds 9 and %u bytes",
+			 IRDM_TICK_RECORD_SIZE - 100);
+		expect_refused(bad, IRDM_ETRUNC, want);
+	}
 	copy_patched(good, bad, 100, 0, NULL, 0);
 	expect_refused(bad, IRDM_ETRUNC, "truncated: 100 bytes");
 	copy_patched(good, bad, 0, 0, NULL, 0);
 	expect_refused(bad, IRDM_EMAGIC, "too short");
 	copy_patched(good, bad, full + 10, 0, NULL, 0);
 	expect_refused(bad, IRDM_EFORMAT, "holds more");
-	copy_patched(good, bad, full, offsetof(struct irdm_log_header, version), &v2, sizeof(v2));
-	expect_refused(bad, IRDM_EVERSION, "log version 2");
+	copy_patched(good, bad, full, offsetof(struct irdm_log_header, version), &v1, sizeof(v1));
+	expect_refused(bad, IRDM_EVERSION, "log version 1, this build reads version 2");
 	copy_patched(good, bad, full, offsetof(struct irdm_log_header, record_size), &rs, sizeof(rs));
 	expect_refused(bad, IRDM_EFORMAT, "record size 200");
 	copy_patched(good, bad, full, 0, wrong_magic, sizeof(wrong_magic));
@@ -844,6 +856,13 @@ static void check_csv_row(char *line, uint64_t i)
 		snprintf(want, sizeof(want), "%lld",
 			 v->contact_tri == IRDM_TELEM_NO_TRI ? -1LL : (long long)v->contact_tri);
 		expect_text(&p, want, i, "tri");
+		snprintf(want, sizeof(want), "%lld",
+			 v->site_tri == IRDM_TELEM_NO_TRI ? -1LL : (long long)v->site_tri);
+		expect_text(&p, want, i, "site_tri");
+		for (int k = 0; k < 3; k++)
+			expect_double(&p, v->site_bary[k], i, "site barycentric");
+		for (int k = 0; k < 3; k++)
+			expect_double(&p, v->target_m[k], i, "target");
 	}
 	assert_int_equal(*p, 0);        /* no column left over */
 }
@@ -866,7 +885,8 @@ static void test_cli_export_matches_records(void **state)
 	assert_non_null(f);
 	assert_non_null(fgets(line, sizeof(line), f));
 	assert_true(!strncmp(line, head, strlen(head)));
-	assert_non_null(strstr(line, ",d1_fz_n,d1_proxy,d1_tri\n"));
+	assert_non_null(strstr(line, ",d1_fz_n,d1_proxy,d1_tri,d1_site_tri,d1_b0,d1_b1,d1_b2,"
+				     "d1_tx_m,d1_ty_m,d1_tz_m\n"));
 	while (fgets(line, sizeof(line), f))
 		check_csv_row(line, rows++);
 	fclose(f);

@@ -33,7 +33,10 @@ _Static_assert(offsetof(struct irdm_tick_dev, joint_torque_nm) == 72, "dev layou
 _Static_assert(offsetof(struct irdm_tick_dev, force_n) == 96, "dev layout");
 _Static_assert(offsetof(struct irdm_tick_dev, contact_tri) == 120, "dev layout");
 _Static_assert(offsetof(struct irdm_tick_dev, proxy) == 124, "dev layout");
-_Static_assert(sizeof(struct irdm_tick_dev) == 128, "dev layout");
+_Static_assert(offsetof(struct irdm_tick_dev, site_tri) == 128, "dev layout");
+_Static_assert(offsetof(struct irdm_tick_dev, site_bary) == 136, "dev layout");
+_Static_assert(offsetof(struct irdm_tick_dev, target_m) == 160, "dev layout");
+_Static_assert(sizeof(struct irdm_tick_dev) == 184, "dev layout");
 
 _Static_assert(offsetof(struct irdm_tick_record, tick) == 0, "record layout");
 _Static_assert(offsetof(struct irdm_tick_record, wake_latency_ns) == 8, "record layout");

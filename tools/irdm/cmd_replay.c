@@ -18,6 +18,8 @@ static const char usage[] =
 	"usage: irdm replay --image IMAGE --contact NODE|x,y,z [--contact NODE|x,y,z]\n"
 	"                   --displacement TRAJ.csv -o FORCES.csv [--nodes N,...]\n"
 	"                   [--push] [--solve coupled|per-vertex] [--coupling K,B]\n"
+	"       irdm replay --image IMAGE --sites SITES.csv --displacement TRAJ.csv\n"
+	"                   -o FORCES.csv [--push] [--passivity] ...\n"
 	"\n"
 	"TRAJ.csv: one row per sample (t = 0, dt, 2 dt, ...): t, then ux, uy, uz (m)\n"
 	"for each contact: the displacement imposed on the contact point (eq. 8;\n"
@@ -30,7 +32,13 @@ static const char usage[] =
 	"displacement u[t] of each --nodes node (any node of the image; for a\n"
 	"floating object the world displacement, rigid motion included).\n"
 	"--push releases a contact when the object would pull (default: held).\n"
-	"--coupling K,B couples through a spring-damper (N/m, N s/m) instead.\n";
+	"--coupling K,B couples through a spring-damper (N/m, N s/m) instead.\n"
+	"SITES.csv (instead of --contact): one row per sample as TRAJ.csv: t, then\n"
+	"tri, b0, b1, b2 per contact: the contact's site that sample, a surface\n"
+	"triangle and barycentrics (tri -1: none; its displacement must be nan), as\n"
+	"irdm-fw logs them (irdm log export: dN_site_tri, dN_b0..2, and the targets\n"
+	"dN_tx_m.. for TRAJ.csv): a sliding contact replayed tick by tick.\n"
+	"--passivity turns on the engine's passivity control (a haptic board's).\n";
 
 static int parse_contact(const char *s, struct irdm_replay_contact *c)
 {
@@ -72,6 +80,10 @@ int irdm_cmd_replay(int argc, char **argv)
 			o.mode = IRDM_CONTACT_PUSH;
 			continue;
 		}
+		if (!strcmp(a, "--passivity")) {
+			o.passivity = true;
+			continue;
+		}
 		if (i + 1 >= argc) {
 			fprintf(stderr, "irdm replay: %s needs a value\n", a);
 			return 2;
@@ -79,6 +91,8 @@ int irdm_cmd_replay(int argc, char **argv)
 		const char *v = argv[++i];
 		if (!strcmp(a, "--image")) {
 			o.image = v;
+		} else if (!strcmp(a, "--sites")) {
+			o.sites = v;
 		} else if (!strcmp(a, "--displacement")) {
 			o.trajectory = v;
 		} else if (!strcmp(a, "-o")) {
@@ -119,8 +133,12 @@ int irdm_cmd_replay(int argc, char **argv)
 			return 2;
 		}
 	}
-	if (!o.image || !o.trajectory || !o.out || !o.n_contacts) {
-		fprintf(stderr, "irdm replay: needs --image, --contact, --displacement and -o (see --help)\n");
+	if (o.sites && o.n_contacts) {
+		fprintf(stderr, "irdm replay: --sites and --contact exclude each other (see --help)\n");
+		return 2;
+	}
+	if (!o.image || !o.trajectory || !o.out || (!o.n_contacts && !o.sites)) {
+		fprintf(stderr, "irdm replay: needs --image, --contact (or --sites), --displacement and -o (see --help)\n");
 		return 2;
 	}
 	int rc = irdm_replay_run(&o, err, sizeof(err));

@@ -28,7 +28,11 @@ const char irdm_log_csv_columns_help[] =
 	"  dN_tau1_nm dN_tau2_nm dN_tau3_nm  joint torques commanded\n"
 	"  dN_fx_n dN_fy_n dN_fz_n         force on the object (the device renders its negative)\n"
 	"  dN_proxy         free, touch, slide or release\n"
-	"  dN_tri           the proxy's surface triangle, -1 if none\n";
+	"  dN_tri           the proxy's surface triangle, -1 if none\n"
+	"  dN_site_tri      the engine's contact site this tick: surface triangle,\n"
+	"                   -1 if no contact was commanded\n"
+	"  dN_b0 dN_b1 dN_b2                its barycentrics\n"
+	"  dN_tx_m dN_ty_m dN_tz_m          the engine's target: tip less the site's rest point\n";
 
 static const char *const vec_cols[5][3] = {
 	{ "x_m", "y_m", "z_m" },
@@ -45,7 +49,8 @@ static void write_header_row(FILE *f, unsigned n_devices)
 		for (int v = 0; v < 5; v++)
 			for (int k = 0; k < 3; k++)
 				fprintf(f, ",d%u_%s", d, vec_cols[v][k]);
-		fprintf(f, ",d%u_proxy,d%u_tri", d, d);
+		fprintf(f, ",d%u_proxy,d%u_tri,d%u_site_tri,d%u_b0,d%u_b1,d%u_b2,d%u_tx_m,d%u_ty_m,"
+			"d%u_tz_m", d, d, d, d, d, d, d, d, d);
 	}
 	fputc('\n', f);
 }
@@ -78,6 +83,14 @@ static void write_device(FILE *f, const struct irdm_tick_dev *d)
 		fputs("-1", f);
 	else
 		fprintf(f, "%u", d->contact_tri);
+	if (d->site_tri == IRDM_TELEM_NO_TRI)
+		fputs(",-1", f);
+	else
+		fprintf(f, ",%u", d->site_tri);
+	for (int k = 0; k < 3; k++)
+		fprintf(f, ",%.17g", d->site_bary[k]);
+	for (int k = 0; k < 3; k++)
+		fprintf(f, ",%.17g", d->target_m[k]);
 }
 
 static void write_row(FILE *f, const struct irdm_tick_record *r, const struct irdm_log_header *h)

@@ -10,6 +10,7 @@
 #include "irdm/deform_worker.h"
 #include "irdm/session.h"
 #include "replay/replay.h"
+#include "replay/replay_priv.h"
 
 #define MAX_NODES_OUT 256
 
@@ -34,115 +35,6 @@ int irdm_replay_locate(const struct irdm_image *img, const double p[3], uint32_t
 	*tri = hit.tri;
 	memcpy(bary, hit.bary, sizeof(hit.bary));
 	return 0;
-}
-
-/* ---- trajectory CSV ---- */
-
-struct trajectory {
-	size_t n_rows, n_cols;
-	double *v;          /* n_rows x n_cols */
-};
-
-static int parse_line(char *line, double *v, size_t want, size_t *got)
-{
-	char *p = line;
-	size_t k = 0;
-
-	for (;;) {
-		while (*p == ' ' || *p == '\t')
-			p++;
-		if (k == want)
-			return -1;
-		if (*p == ',' || *p == '\n' || *p == '\r' || *p == 0) {
-			v[k++] = NAN;   /* empty: released */
-		} else {
-			char *end;
-			v[k++] = strtod(p, &end);
-			if (end == p)
-				return -2;   /* not a number */
-			p = end;
-			while (*p == ' ' || *p == '\t')
-				p++;
-		}
-		if (*p == ',') {
-			p++;
-			continue;
-		}
-		if (*p == '\n' || *p == '\r' || *p == 0)
-			break;
-		return -2;
-	}
-	*got = k;
-	return 0;
-}
-
-static int read_trajectory(const char *path, size_t n_cols, double dt, struct trajectory *tr,
-			   char *err, size_t errlen)
-{
-	FILE *f = fopen(path, "r");
-	char line[4096];
-	size_t cap = 0, lineno = 0;
-	int ret = IRDM_EFORMAT;
-
-	memset(tr, 0, sizeof(*tr));
-	tr->n_cols = n_cols;
-	if (!f) {
-		snprintf(err, errlen, "%s: cannot open: %s", path, strerror(errno));
-		return IRDM_EIO;
-	}
-	while (fgets(line, sizeof(line), f)) {
-		double v[1 + 3 * IRDM_MAX_CONTACTS];
-		size_t got = 0;
-		lineno++;
-		int rc = parse_line(line, v, n_cols, &got);
-		if (rc == -2 && lineno == 1 && tr->n_rows == 0)
-			continue;   /* header */
-		if (rc || got != n_cols) {
-			snprintf(err, errlen, "%s:%zu: expected %zu numeric columns (t and 3 per contact)",
-				 path, lineno, n_cols);
-			goto out_fail;
-		}
-		double t_expect = (double)tr->n_rows * dt;
-		if (!isfinite(v[0]) || fabs(v[0] - t_expect) > 1e-6 * dt + 1e-9 * fabs(t_expect)) {
-			snprintf(err, errlen, "%s:%zu: t = %g, expected %g: one row per sample of the image's dt = %g s",
-				 path, lineno, v[0], t_expect, dt);
-			goto out_fail;
-		}
-		for (size_t k = 1; k < n_cols; k++)
-			if (isinf(v[k]) || fabs(v[k]) > 10.0) {
-				snprintf(err, errlen, "%s:%zu: displacement %g m is out of range (|u| <= 10 m)",
-					 path, lineno, v[k]);
-				goto out_fail;
-			}
-		if (tr->n_rows == cap) {
-			cap = cap ? 2 * cap : 1024;
-			double *nv = realloc(tr->v, cap * n_cols * sizeof(double));
-			if (!nv) {
-				snprintf(err, errlen, "%s: out of memory", path);
-				ret = IRDM_ENOMEM;
-				goto out_fail;
-			}
-			tr->v = nv;
-		}
-		memcpy(&tr->v[tr->n_rows * n_cols], v, n_cols * sizeof(double));
-		tr->n_rows++;
-	}
-	if (ferror(f)) {
-		snprintf(err, errlen, "%s: read failed: %s", path, strerror(errno));
-		ret = IRDM_EIO;
-		goto out_fail;
-	}
-	fclose(f);
-	if (!tr->n_rows) {
-		snprintf(err, errlen, "%s: no samples", path);
-		return IRDM_EFORMAT;
-	}
-	return IRDM_OK;
-out_fail:
-	fclose(f);
-	free(tr->v);
-	tr->v = NULL;
-	return ret;
 }
 
 /* ---- sites and output nodes ---- */
@@ -206,6 +98,7 @@ struct run {
 	const struct irdm_image *img;   /* the session's */
 	struct irdm_engine *eng;        /* the session's */
 	struct trajectory tr;
+	struct trajectory sites;        /* --sites: per-sample sites, else none */
 	double *pos;                    /* every image node's position */
 	struct irdm_contact_site site[IRDM_MAX_CONTACTS];
 	uint32_t rows[MAX_NODES_OUT], mesh[MAX_NODES_OUT];
@@ -231,6 +124,7 @@ static int start(const struct irdm_replay_opts *o, struct run *r, char *err, siz
 	int ret;
 
 	irdm_engine_config_default(&sc.engine);
+	sc.engine.passivity_control = o->passivity;
 	sc.engine.max_contacts = o->n_contacts;
 	sc.engine.solve = o->solve;
 	sc.engine.coupling_k_n_per_m = o->coupling_k;
@@ -241,7 +135,7 @@ static int start(const struct irdm_replay_opts *o, struct run *r, char *err, siz
 		return ret;
 	r->img = r->s->img;
 	r->eng = r->s->eng;
-	ret = make_sites(o, r->img, r->eng, r->site, err, errlen);
+	ret = o->sites ? IRDM_OK : make_sites(o, r->img, r->eng, r->site, err, errlen);
 	if (ret)
 		return ret;
 	if (o->nodes) {
@@ -251,8 +145,18 @@ static int start(const struct irdm_replay_opts *o, struct run *r, char *err, siz
 		if (ret)
 			return ret;
 	}
-	return read_trajectory(o->trajectory, 1 + 3 * (size_t)o->n_contacts, r->img->meta->dt_s,
-			       &r->tr, err, errlen);
+	ret = read_trajectory(o->trajectory, o->n_contacts, r->img->meta->dt_s, &r->tr, err,
+			      errlen);
+	if (ret || !o->sites)
+		return ret;
+	ret = read_sites(o->sites, o->n_contacts, r->img->meta->dt_s, r->img->meta->n_tris,
+			 &r->sites, err, errlen);
+	if (!ret && r->sites.n_rows != r->tr.n_rows) {
+		snprintf(err, errlen, "%s: %zu rows, but %s has %zu", o->sites, r->sites.n_rows,
+			 o->trajectory, r->tr.n_rows);
+		ret = IRDM_EFORMAT;
+	}
+	return ret;
 }
 
 static void header(const struct irdm_replay_opts *o, struct run *r)
@@ -276,8 +180,20 @@ static int step(const struct irdm_replay_opts *o, struct run *r, size_t row, cha
 		const double *u = &v[1 + 3 * i];
 		if (isnan(u[0]) || isnan(u[1]) || isnan(u[2]))
 			continue;   /* released this sample */
-		if (irdm_engine_contact(r->eng, i)->mode == IRDM_CONTACT_OFF)
+		if (r->sites.v) {
+			/* the site of this sample, handed over every sample as the
+			 * controller does (a slide keeps the contact's past) */
+			const double *st = &r->sites.v[row * r->sites.n_cols + 1 + 4 * i];
+			if (st[0] < 0 || irdm_engine_site_point(r->eng, (uint32_t)st[0], st + 1,
+								&r->site[i])) {
+				snprintf(err, errlen, "%s: row %zu: contact %u has a displacement but "
+					 "no site", o->sites, row + 1, i + 1);
+				return IRDM_EINVAL;
+			}
 			irdm_engine_contact_begin(r->eng, i, &r->site[i], o->mode);
+		} else if (irdm_engine_contact(r->eng, i)->mode == IRDM_CONTACT_OFF) {
+			irdm_engine_contact_begin(r->eng, i, &r->site[i], o->mode);
+		}
 		cmd[i].mode = o->mode;
 		memcpy(cmd[i].target_m, u, sizeof(cmd[i].target_m));
 	}
@@ -288,7 +204,7 @@ static int step(const struct irdm_replay_opts *o, struct run *r, size_t row, cha
 	fprintf(r->out, "%.9g", v[0]);
 	for (unsigned i = 0; i < o->n_contacts; i++) {
 		const double *f = irdm_engine_contact(r->eng, i)->force_n;
-		fprintf(r->out, ",%.12g,%.12g,%.12g", f[0], f[1], f[2]);
+		fprintf(r->out, ",%.17g,%.17g,%.17g", f[0], f[1], f[2]);
 	}
 	uint64_t tick;
 	if (r->n_nodes && !irdm_deform_update(r->s->worker, r->pos, &tick)) {
@@ -304,11 +220,20 @@ static int step(const struct irdm_replay_opts *o, struct run *r, size_t row, cha
 	return 0;
 }
 
-int irdm_replay_run(const struct irdm_replay_opts *o, char *err, size_t errlen)
+int irdm_replay_run(const struct irdm_replay_opts *opts, char *err, size_t errlen)
 {
 	struct run *r = calloc(1, sizeof(*r));
+	struct irdm_replay_opts with_sites = *opts;
+	const struct irdm_replay_opts *o = &with_sites;
 	int ret;
 
+	if (opts->sites) {
+		ret = sites_contacts(opts->sites, &with_sites.n_contacts, err, errlen);
+		if (ret) {
+			free(r);
+			return ret;
+		}
+	}
 	if (!r) {
 		snprintf(err, errlen, "out of memory");
 		return IRDM_ENOMEM;
@@ -347,7 +272,8 @@ out_remove:
 		fclose(r->out);
 	remove(r->tmp);
 out_free:
-	free(r->tr.v);
+	irdm_trajectory_free(&r->tr);
+	irdm_trajectory_free(&r->sites);
 	free(r->pos);
 	irdm_session_close(r->s);
 	free(r);

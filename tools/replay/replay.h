@@ -17,11 +17,13 @@ struct irdm_replay_contact {
 
 struct irdm_replay_opts {
 	const char *image, *trajectory, *out, *nodes;
+	const char *sites;              /* per-sample sites (irdm replay --sites), or NULL */
 	unsigned n_contacts;
 	struct irdm_replay_contact contact[IRDM_MAX_CONTACTS];
 	enum irdm_contact_mode mode;
 	enum irdm_solve_mode solve;
 	double coupling_k, coupling_b;
+	bool passivity;                 /* the engine's passivity control (a haptic board's) */
 };
 
 void irdm_replay_opts_default(struct irdm_replay_opts *o);

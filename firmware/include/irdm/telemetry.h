@@ -91,6 +91,16 @@ struct irdm_tick_dev {
 	uint32_t contact_tri;           /* the proxy's SURFACE triangle, IRDM_TELEM_NO_TRI: none */
 	uint8_t proxy;                  /* enum irdm_proxy_event */
 	uint8_t reserved[3];            /* zero */
+	/*
+	 * The engine's command this tick, all that `irdm replay --sites`
+	 * needs to repeat it: the site (SURFACE triangle and barycentrics;
+	 * site_tri IRDM_TELEM_NO_TRI when no contact was commanded) and the
+	 * target (the tip less the site's rest point, object frame).
+	 */
+	uint32_t site_tri;
+	uint32_t reserved2;             /* zero */
+	double site_bary[3];
+	double target_m[3];
 };
 
 /*
@@ -110,7 +120,7 @@ struct irdm_tick_record {
 	struct irdm_tick_dev dev[IRDM_TELEM_MAX_DEVICES];
 };
 
-#define IRDM_TICK_RECORD_SIZE 280u
+#define IRDM_TICK_RECORD_SIZE 392u
 
 /* ---- the ring: tick -> writer, lock-free, one producer, one consumer ---- */
 
@@ -234,7 +244,7 @@ void irdm_hist_summarize(const struct irdm_hist *h, struct irdm_hist_summary *s)
 /* ---- the log file ---- */
 
 #define IRDM_LOG_MAGIC "IRDMLOG"        /* 8 bytes with its NUL */
-#define IRDM_LOG_VERSION 1u
+#define IRDM_LOG_VERSION 2u      /* 2: the engine's command (site, target) per device */
 #define IRDM_LOG_HEADER_SIZE 256u
 #define IRDM_LOG_COUNT_OPEN UINT64_MAX  /* record_count of a log never closed */
 #define IRDM_LOG_NAME_LEN 64
