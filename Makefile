@@ -10,6 +10,7 @@
 #   make run        the main job: the built-in default scene, end to end
 #   make jitter     irdm-fw's wake-up latency beside cyclictest's (JITTER_SECONDS)
 #   make docs       docs/scene-format.md from the scene key table
+#   make sizes      irdm-fw built with each configs/*.config (CONFIG=FILE: one)
 #
 # CC=clang works too.  The layers point one way and the include paths
 # enforce it (docs/architecture.md):
@@ -29,15 +30,36 @@
 SHELL   := bash
 .SHELLFLAGS := -o pipefail -ec
 
+# Build configuration (docs/build-config.md): CONFIG=configs/NAME.config
+# leaves out of the firmware each feature whose CONFIG_IRDM_X is not y, and
+# builds the firmware alone (irdm-fw and its libraries) into build/cfg-NAME.
+CONFIG  ?=
+FEATURES := MODAL FIR FLOATING DEFORM
+ifneq ($(CONFIG),)
+include $(CONFIG)
+BUILD   ?= build/cfg-$(basename $(notdir $(CONFIG)))
+$(foreach f,$(FEATURES),$(if $(filter y n,$(CONFIG_IRDM_$(f))),,\
+  $(error $(CONFIG): CONFIG_IRDM_$(f) must be y or n, got '$(CONFIG_IRDM_$(f))')))
+$(if $(filter y,$(CONFIG_IRDM_MODAL) $(CONFIG_IRDM_FIR)),,\
+  $(error $(CONFIG): CONFIG_IRDM_MODAL and CONFIG_IRDM_FIR are both n: the engine needs one))
+endif
+feature = $(if $(CONFIG),$(filter y,$(CONFIG_IRDM_$(1))),y)
+FEATURE_SRC_MODAL    = firmware/engine/engine_modal.c
+FEATURE_SRC_FIR      = firmware/engine/engine_fir.c
+FEATURE_SRC_FLOATING = firmware/engine/floating.c $(wildcard firmware/rigid/*.c)
+FEATURE_SRC_DEFORM   = $(wildcard firmware/deform/*.c) firmware/session/session_deform.c
+FEATURE_OFF_SRC := $(foreach f,$(FEATURES),$(if $(call feature,$(f)),,$(FEATURE_SRC_$(f))))
+
 CC      ?= cc
 BUILD   ?= build
 SAN     ?=
 FUZZ_SECONDS ?= 30
 
 CSTD     = -std=c11 -D_POSIX_C_SOURCE=200809L -D_DEFAULT_SOURCE
-WARN     = -Wall -Wextra -Werror -Wshadow -Wstrict-prototypes -Wvla
+WARN     = -Wall -Wextra -Werror -Wshadow -Wstrict-prototypes -Wvla -Wundef
 OPT     ?= -O2 -g
 CFLAGS  += $(CSTD) $(WARN) $(OPT) -MMD -MP
+CFLAGS  += $(foreach f,$(FEATURES),-DIRDM_CONFIG_$(f)=$(if $(call feature,$(f)),1,0))
 LDLIBS   = -lcholmod -larpack -lopenblas -lpthread -lm
 
 # Include paths, one set per layer (target-specific: an object sees only its own).
@@ -52,7 +74,7 @@ CFLAGS  += -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-re
 LDFLAGS += -fsanitize=address,undefined
 endif
 
-FW_SRC    := $(filter-out firmware/main/%,$(wildcard firmware/*/*.c))
+FW_SRC    := $(filter-out firmware/main/% $(FEATURE_OFF_SRC),$(wildcard firmware/*/*.c))
 FWMAIN_SRC := $(wildcard firmware/main/*.c)
 HAL_SRC   := $(wildcard hal/*/*.c)
 SIM_SRC   := $(wildcard sim/*/*.c)
@@ -76,9 +98,9 @@ TESTS    := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 TICK_TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TICK_TEST_SRC))
 BENCHES  := $(patsubst tests/bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC))
 
-.PHONY: all test san fuzz bench bench-precompute run jitter check deps clean docs
+.PHONY: all test san fuzz bench bench-precompute run jitter check deps clean docs cfg-fws sizes
 .SECONDARY:
-all: $(IRDM) $(FW_LIB) $(HAL_LIB) $(SIM_LIB) $(if $(FWMAIN_SRC),$(IRDM_FW))
+all: $(if $(CONFIG),,$(IRDM)) $(FW_LIB) $(HAL_LIB) $(SIM_LIB) $(if $(FWMAIN_SRC),$(IRDM_FW))
 
 $(BUILD)/obj/firmware/%.o: LAYER_INC = $(FW_INC)
 # irdm-fw's main() is the composition root: it alone sees every layer below
@@ -109,8 +131,9 @@ $(IRDM): $(call obj,$(CLI_SRC)) $(TOOL_LIB) $(FW_LIB)
 
 TEST_LIBS := $(TOOL_LIB) $(SIM_LIB) $(HAL_LIB) $(FW_LIB)
 
+# BLAS only for the deformation worker
 $(IRDM_FW): $(call obj,$(FWMAIN_SRC)) $(SIM_LIB) $(HAL_LIB) $(FW_LIB)
-	$(CC) $(LDFLAGS) $^ -o $@ -lopenblas -lpthread -lm
+	$(CC) $(LDFLAGS) $^ -o $@ $(if $(call feature,DEFORM),-lopenblas) -lpthread -lm
 
 # The force tick alone: the firmware library, libm and cmocka, nothing else.
 $(TICK_TESTS): $(BUILD)/tests/test_tick_%: $(BUILD)/obj/tests/test_tick_%.o $(FW_LIB)
@@ -133,9 +156,24 @@ $(TICK_IMAGE): $(IRDM)
 	$(IRDM) precompute -q --mesh box:0.04,0.04,0.08 --resolution 2,2,4 --fixed 'z<=0' \
 	  --touch 'z>=0.08' --display surface --representation modal:all -o $@
 
-test: $(TESTS) $(IRDM) $(IRDM_FW) $(TICK_IMAGE) $(BUILD)/data/bunny.off
+test: $(TESTS) $(IRDM) $(IRDM_FW) $(TICK_IMAGE) $(BUILD)/data/bunny.off cfg-fws
 	IRDM=$(IRDM) IRDM_FW=$(IRDM_FW) IRDM_BUILD=$(BUILD) IRDM_TICK_IMAGE=$(TICK_IMAGE) \
 	  tests/run-tests.sh $(TESTS)
+
+# The firmware built with the shipped trimmed configurations, beside the
+# full one (test_build_config checks what they leave out and refuse).
+CFG_NAMES := default minimal
+cfg-fws:
+	$(foreach c,$(CFG_NAMES),$(MAKE) --no-print-directory CONFIG=configs/$(c).config \
+	  BUILD=$(BUILD)/cfg-$(c) all;)
+
+# What each configuration costs: irdm-fw's sections and its libraries.
+sizes: all cfg-fws
+	@for b in $(IRDM_FW) $(foreach c,$(CFG_NAMES),$(BUILD)/cfg-$(c)/irdm-fw); do \
+	  size $$b | tail -n 1; \
+	  echo "  firmware library text: $$(size -t $$(dirname $$b)/libirdmfw.a | tail -n 1 | awk '{print $$1}') bytes"; \
+	  echo "  needs: $$(readelf -d $$b | sed -n 's/.*Shared library: \[\(.*\)\]/\1/p' | tr '\n' ' ')"; \
+	done
 
 # Generated from the scene key table (tests/test_cli.c checks it is current).
 docs: $(IRDM)

@@ -26,16 +26,13 @@
  * Needs IRDM and IRDM_FW (make test sets them); runs from the repository root.
  */
 #define _GNU_SOURCE
-#include <fcntl.h>
 #include <math.h>
 #include <setjmp.h>
-#include <spawn.h>
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cmocka.h>
@@ -43,9 +40,8 @@
 #include "irdm/board.h"
 #include "irdm/safety.h"
 #include "irdm/telemetry.h"
+#include "support/run_prog.h"
 #include "support/test_files.h"
-
-extern char **environ;
 
 /*
  * Passivity tolerance: the encoders quantise the tip to ~18 um, so the
@@ -79,30 +75,10 @@ static const char *env_or(const char *name, const char *dflt)
 	return p ? p : dflt;
 }
 
-/* Run prog with args (NULL-terminated), stdout to /dev/null, stderr kept. */
+/* Run prog with args (NULL-terminated); its stderr kept in err_text. */
 static int run(const char *prog, const char *const *args)
 {
-	const char *argv[40];
-	char err_path[300];
-	posix_spawn_file_actions_t fa;
-	int n = 0, status = 0;
-	pid_t pid;
-
-	argv[n++] = prog;
-	for (; *args && n < 39; args++)
-		argv[n++] = *args;
-	argv[n] = NULL;
-	snprintf(err_path, sizeof(err_path), "%s/stderr", dir);
-	posix_spawn_file_actions_init(&fa);
-	posix_spawn_file_actions_addopen(&fa, 1, "/dev/null", O_WRONLY, 0);
-	posix_spawn_file_actions_addopen(&fa, 2, err_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-	if (posix_spawn(&pid, argv[0], &fa, NULL, (char *const *)argv, environ))
-		return -1;
-	posix_spawn_file_actions_destroy(&fa);
-	if (waitpid(pid, &status, 0) != pid)
-		return -1;
-	tf_read_text(err_path, err_text, sizeof(err_text));
-	return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+	return rp_run(dir, prog, args, NULL, 0, err_text, sizeof(err_text));
 }
 
 /* Return: 0, or -1 (said why) on the first bad tick of a run. */

@@ -7,6 +7,7 @@
  */
 #include <string.h>
 
+#include "repr.h"
 #include "tick_priv.h"
 
 void tick_free_disp(const struct irdm_engine *e, uint32_t col, double u[3])
@@ -15,10 +16,7 @@ void tick_free_disp(const struct irdm_engine *e, uint32_t col, double u[3])
 		irdm_v3_zero(u);
 		return;
 	}
-	if (e->repr == IRDM_REPR_MODAL)
-		irdm_modal_free_disp(e, col, u);
-	else
-		irdm_fir_free_disp(e, col, u);
+	repr_free_disp(e, col, u);
 }
 
 /* W_ij = sum_vw a_iv a_jw R0(v <- w) for contacts i (displacement), j (force). */
@@ -69,7 +67,7 @@ void tick_assemble(struct irdm_engine *e, struct system *s)
 
 	tick_r0_refresh(e, s->idx, s->m);
 	build_w(e, s);
-	if (e->floating) {
+	if (FLOATING(e)) {
 		tick_to_world(e, s);
 		return;
 	}

@@ -106,6 +106,7 @@ static void convert_shapes(struct irdm_engine *e, double *phi)
 	}
 }
 
+#if IRDM_CONFIG_FLOATING
 /* A floating object starts at rest with its object frame on the world frame. */
 static int start_rigid(struct irdm_engine *e)
 {
@@ -120,6 +121,34 @@ static int start_rigid(struct irdm_engine *e)
 	e->floating = true;
 	return irdm_rigid_init(&e->rb, &p, &s0);
 }
+#else
+static int start_rigid(struct irdm_engine *e)
+{
+	(void)e;
+	return IRDM_ENOTSUP;        /* refused before, by unsupported() */
+}
+#endif
+
+/*
+ * An image this build cannot run (irdm/build_config.h): say which feature
+ * it needs.  Return: 0, or IRDM_ENOTSUP with the message.
+ */
+static int unsupported(const struct irdm_image *img, char *err, size_t errlen)
+{
+	const char *need = NULL, *config = NULL;
+
+	if (!IRDM_CONFIG_FIR && img->meta->representation == IRDM_REPR_FIR)
+		need = "FIR responses", config = "CONFIG_IRDM_FIR";
+	else if (!IRDM_CONFIG_MODAL && img->meta->representation == IRDM_REPR_MODAL)
+		need = "modal responses", config = "CONFIG_IRDM_MODAL";
+	else if (!IRDM_CONFIG_FLOATING && img->rigid)
+		need = "a floating object", config = "CONFIG_IRDM_FLOATING";
+	if (!need)
+		return 0;
+	snprintf(err, errlen, "engine: the image holds %s; this build has %s off "
+		 "(docs/build-config.md)", need, config);
+	return IRDM_ENOTSUP;
+}
 
 int irdm_engine_init(struct irdm_engine **out, const struct irdm_image *img,
 		     const struct irdm_engine_config *cfg, void *mem, size_t mem_size,
@@ -130,6 +159,8 @@ int irdm_engine_init(struct irdm_engine **out, const struct irdm_image *img,
 	uint8_t *base = mem;
 
 	*out = NULL;
+	if (img && img->meta && unsupported(img, err, errlen))
+		return IRDM_ENOTSUP;
 	if (!img || !img->meta || plan(img, cfg, &l)) {
 		snprintf(err, errlen, "engine: invalid configuration (contacts 1..%d, coupling >= 0, stable radius in [0, 1), force limit >= 0)",
 			 IRDM_MAX_CONTACTS);
@@ -308,4 +339,36 @@ const struct irdm_engine_stats *irdm_engine_stats(const struct irdm_engine *e)
 void irdm_engine_attach_deform(struct irdm_engine *e, struct irdm_deform *d)
 {
 	e->deform = d;
+}
+
+/* ---- frames (irdm/engine.h) ---- */
+
+void irdm_engine_world_to_object(const struct irdm_engine *e, const double x[3], double p[3])
+{
+	double b[3];
+
+	(void)e;
+#if IRDM_CONFIG_FLOATING
+	if (e->floating) {
+		irdm_rigid_world_to_body(&e->rb, x, b);
+		irdm_v3_add(p, b, e->com_rest_m);
+		return;
+	}
+#endif
+	memcpy(p, x, sizeof(b));
+}
+
+void irdm_engine_object_to_world(const struct irdm_engine *e, const double p[3], double x[3])
+{
+	double b[3];
+
+	(void)e;
+#if IRDM_CONFIG_FLOATING
+	if (e->floating) {
+		irdm_v3_sub(b, p, e->com_rest_m);
+		irdm_rigid_body_to_world(&e->rb, b, x);
+		return;
+	}
+#endif
+	memcpy(x, p, sizeof(b));
 }

@@ -3,6 +3,7 @@
 #ifndef IRDM_ENGINE_PRIV_H
 #define IRDM_ENGINE_PRIV_H
 
+#include "irdm/build_config.h"
 #include "irdm/deform.h"
 #include "irdm/engine.h"
 #include "irdm/history.h"

@@ -151,27 +151,3 @@ int tick_move_rigid(struct irdm_engine *e, const struct system *s)
 		irdm_rigid_accumulate(&e->rb, &s->f[3 * i], s->x_now[i]);
 	return irdm_rigid_step(&e->rb, e->dt_s);
 }
-
-void irdm_engine_world_to_object(const struct irdm_engine *e, const double x[3], double p[3])
-{
-	double b[3];
-
-	if (!e->floating) {
-		memcpy(p, x, sizeof(b));
-		return;
-	}
-	irdm_rigid_world_to_body(&e->rb, x, b);
-	irdm_v3_add(p, b, e->com_rest_m);
-}
-
-void irdm_engine_object_to_world(const struct irdm_engine *e, const double p[3], double x[3])
-{
-	double b[3];
-
-	if (!e->floating) {
-		memcpy(x, p, sizeof(b));
-		return;
-	}
-	irdm_v3_sub(b, p, e->com_rest_m);
-	irdm_rigid_body_to_world(&e->rb, b, x);
-}

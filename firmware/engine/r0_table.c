@@ -6,6 +6,7 @@
  */
 #include <string.h>
 
+#include "repr.h"
 #include "tick_priv.h"
 
 static int r0_index(const struct r0_table *t, uint32_t col)
@@ -43,10 +44,8 @@ void tick_r0_refresh(struct irdm_engine *e, const unsigned *idx, int m)
 			double *blk = nt->blk[a][b];
 			if (oa >= 0 && ob >= 0)
 				memcpy(blk, old->blk[oa][ob], 9 * sizeof(double));
-			else if (e->repr == IRDM_REPR_MODAL)
-				irdm_modal_r0(e, nt->col[b], nt->col[a], blk);
 			else
-				irdm_fir_r0(e, nt->col[b], nt->col[a], blk);
+				repr_r0(e, nt->col[b], nt->col[a], blk);
 		}
 	old->n = nt->n;
 	memcpy(old->col, nt->col, nt->n * sizeof(uint32_t));

@@ -18,6 +18,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "repr.h"
 #include "tick_priv.h"
 
 /* Spread contact forces over their nodes, merging shared columns. */
@@ -54,7 +55,7 @@ static int fault(struct irdm_engine *e)
 static void body_forces(struct irdm_engine *e, struct system *s)
 {
 	for (int i = 0; i < s->m; i++) {
-		if (e->floating)
+		if (FLOATING(e))
 			irdm_rigid_rotate_inverse(&e->rb, &s->f[3 * i], &s->f_body[3 * i]);
 		else
 			memcpy(&s->f_body[3 * i], &s->f[3 * i], 3 * sizeof(double));
@@ -84,12 +85,28 @@ static void record(struct irdm_engine *e, struct system *s, const struct irdm_co
 	for (int i = 0; i < s->m; i++) {
 		struct irdm_contact_state *c = &e->c[s->idx[i]];
 		tick_contact_disp(s, i, c->disp_m);
-		if (e->floating)
+		if (FLOATING(e))
 			tick_floating_disp(e, s, i, c->disp_m);
 		memcpy(c->force_n, &s->f[3 * i], sizeof(c->force_n));
 		memcpy(c->disp_prev_m, c->disp_m, sizeof(c->disp_m));
 		memcpy(c->target_prev_m, cmd[s->idx[i]].target_m, sizeof(c->target_prev_m));
 	}
+}
+
+/* A snapshot for the deformation worker (irdm/deform.h). */
+static void publish(struct irdm_engine *e)
+{
+#if IRDM_CONFIG_DEFORM
+	struct irdm_pose pose;
+	const struct irdm_pose *pp = tick_pose(e, &pose) ? &pose : NULL;
+
+	if (repr_is_modal(e))
+		irdm_deform_publish_modal(e->deform, e->tick, e->x, &e->last, pp);
+	else
+		irdm_deform_publish_fir(e->deform, e->tick, &e->ring, pp);
+#else
+	(void)e;
+#endif
 }
 
 int irdm_engine_tick(struct irdm_engine *e, const struct irdm_contact_cmd *cmd)
@@ -108,8 +125,7 @@ int irdm_engine_tick(struct irdm_engine *e, const struct irdm_contact_cmd *cmd)
 			return fault(e);
 		s.idx[s.m++] = i;
 	}
-	if (e->repr == IRDM_REPR_MODAL)
-		irdm_modal_begin_tick(e);
+	repr_begin_tick(e);
 	if (s.m) {
 		tick_history_terms(e, &s);
 		tick_assemble(e, &s);
@@ -124,27 +140,15 @@ int irdm_engine_tick(struct irdm_engine *e, const struct irdm_contact_cmd *cmd)
 		    (e->cfg.max_force_n > 0 && fabs(s.f[i]) > e->cfg.max_force_n))
 			return fault(e);
 	body_forces(e, &s);
-	if (e->floating && tick_move_rigid(e, &s))
+	if (FLOATING(e) && tick_move_rigid(e, &s))
 		return fault(e);
 	record(e, &s, cmd);
 	gather_forces(e, &s, &e->last);
-	if (e->repr == IRDM_REPR_MODAL)
-		irdm_modal_apply(e, &e->last);
-	else
-		irdm_fir_apply(e, &e->last);
+	repr_apply(e, &e->last);
 	e->tick++;
 	e->stats.ticks++;
-	if (e->deform && e->cfg.publish_every && e->tick % e->cfg.publish_every == 0) {
-		struct irdm_pose pose, *pp = NULL;
-		if (e->floating) {
-			irdm_rigid_pose(&e->rb, &pose);
-			pp = &pose;
-		}
-		if (e->repr == IRDM_REPR_MODAL)
-			irdm_deform_publish_modal(e->deform, e->tick, e->x, &e->last, pp);
-		else
-			irdm_deform_publish_fir(e->deform, e->tick, &e->ring, pp);
-	}
+	if (e->deform && e->cfg.publish_every && e->tick % e->cfg.publish_every == 0)
+		publish(e);
 	return IRDM_OK;
 }
 
@@ -159,8 +163,8 @@ void irdm_engine_node_disp(const struct irdm_engine *e, uint32_t row, double u[3
 	irdm_v3_zero(u);
 	if (col == NO_COL)
 		return;
-	if (e->repr == IRDM_REPR_FIR) {
-		irdm_fir_free_disp(e, col, u);
+	if (!repr_is_modal(e)) {
+		repr_free_disp(e, col, u);
 		return;
 	}
 	const struct irdm_mode *m = e->img->modes;

@@ -7,6 +7,8 @@
 #ifndef IRDM_TICK_PRIV_H
 #define IRDM_TICK_PRIV_H
 
+#include "irdm/build_config.h"
+
 #include "engine_priv.h"
 
 struct system {
@@ -33,11 +35,54 @@ void tick_history_terms(struct irdm_engine *e, struct system *s);
 void tick_assemble(struct irdm_engine *e, struct system *s);
 void tick_contact_disp(const struct system *s, int i, double u[3]);
 
-/* floating.c */
+/* floating.c; a build without floating objects (irdm/build_config.h) has
+ * none: the engine refuses their images, and these are never reached */
+#if IRDM_CONFIG_FLOATING
+#define FLOATING(e) ((e)->floating)
 void tick_to_world(struct irdm_engine *e, struct system *s);
 void tick_floating_disp(const struct irdm_engine *e, const struct system *s, int i, double d[3]);
 void tick_newton_floating(struct irdm_engine *e, struct system *s, const struct irdm_contact_cmd *cmd);
 int tick_move_rigid(struct irdm_engine *e, const struct system *s);
+
+/* The floating object's pose; false for a grounded one. */
+static inline bool tick_pose(const struct irdm_engine *e, struct irdm_pose *pose)
+{
+	if (!e->floating)
+		return false;
+	irdm_rigid_pose(&e->rb, pose);
+	return true;
+}
+#else
+static inline bool tick_pose(const struct irdm_engine *e, struct irdm_pose *pose)
+{
+	(void)e, (void)pose;
+	return false;
+}
+
+#define FLOATING(e) ((void)(e), false)
+static inline void tick_to_world(struct irdm_engine *e, struct system *s)
+{
+	(void)e, (void)s;
+}
+
+static inline void tick_floating_disp(const struct irdm_engine *e, const struct system *s, int i,
+				      double d[3])
+{
+	(void)e, (void)s, (void)i, (void)d;
+}
+
+static inline void tick_newton_floating(struct irdm_engine *e, struct system *s,
+					const struct irdm_contact_cmd *cmd)
+{
+	(void)e, (void)s, (void)cmd;
+}
+
+static inline int tick_move_rigid(struct irdm_engine *e, const struct system *s)
+{
+	(void)e, (void)s;
+	return 0;
+}
+#endif
 
 /* contact_solve.c */
 void tick_solve(struct irdm_engine *e, struct system *s, const struct irdm_contact_cmd *cmd);

@@ -24,6 +24,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "irdm/build_config.h"
 #include "irdm/deform_worker.h"
 #include "irdm/error.h"
 
@@ -131,10 +132,15 @@ int fw_frame_open(struct fw *fw)
 
 	if (!fr->every_ticks)
 		return IRDM_OK;
+#if IRDM_CONFIG_DEFORM
 	rc = irdm_session_deform_open(fw->s, fw->err, sizeof(fw->err));
 	if (rc)
 		return rc;
 	fr->rows = irdm_deform_rows(fw->s->worker);
+#else
+	(void)rc;       /* the session refused the board before (session.c) */
+	return IRDM_ENOTSUP;
+#endif
 	bytes = 3 * (size_t)fr->rows * sizeof(double);
 	fr->scratch_m = calloc(1, bytes);
 	fr->slot = calloc(fr->n_slots ? fr->n_slots : 1, sizeof(*fr->slot));
@@ -191,6 +197,7 @@ static void cpu_add(struct fw_frame *fr, double ns)
 		fr->cpu_max_ns = ns;
 }
 
+#if IRDM_CONFIG_DEFORM
 /*
  * The worker thread's callback.  Its compute time is the thread's CPU time
  * since the previous frame: the update (and the empty polls between
@@ -209,9 +216,11 @@ static void on_frame(void *ctx, const double *pos_m, uint64_t tick)
 	fr->cpu_prev = now;
 	fr->cpu_started = true;
 }
+#endif
 
 int fw_frame_start(struct fw *fw)
 {
+#if IRDM_CONFIG_DEFORM
 	int rc;
 
 	if (!fw->frame.every_ticks || fw->args.clock != IRDM_CLOCK_REAL) {
@@ -228,6 +237,10 @@ int fw_frame_start(struct fw *fw)
 	if (!rc && fw->err[0] && !fw->args.quiet)
 		fprintf(stderr, "irdm-fw: %s\n", fw->err);
 	return rc;
+#else
+	(void)fw;
+	return IRDM_OK;
+#endif
 }
 
 static void contact_capture(struct fw_frame_slot *sl, const struct irdm_ctrl_output *out)
@@ -251,8 +264,12 @@ static void virtual_update(struct fw *fw, uint64_t eng_tick)
 		return;
 	fr->last_update_tick = eng_tick;
 	clock_gettime(CLOCK_MONOTONIC, &t0);
+#if IRDM_CONFIG_DEFORM
 	if (!irdm_deform_update(fw->s->worker, fr->scratch_m, &tick))
 		return;
+#else
+	return;
+#endif
 	clock_gettime(CLOCK_MONOTONIC, &t1);
 	cpu_add(fr, ts_ns(&t1) - ts_ns(&t0));
 	frame_offer(fr, fr->scratch_m, tick);
@@ -278,7 +295,9 @@ void fw_frame_tick(struct fw *fw, const struct irdm_ctrl_output *out)
 
 void fw_frame_stop(struct fw *fw)
 {
+#if IRDM_CONFIG_DEFORM
 	irdm_deform_thread_stop(fw->frame.th);
+#endif
 	fw->frame.th = NULL;
 }
 

@@ -7,6 +7,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 
+#include "irdm/build_config.h"
+
 #include "session_priv.h"
 
 #define SESSION_ALIGN 64u
@@ -37,6 +39,7 @@ static int open_engine(struct irdm_session *s, const struct irdm_engine_config *
 
 static int open_deform(struct irdm_session *s, char *err, size_t errlen)
 {
+#if IRDM_CONFIG_DEFORM
 	size_t n = irdm_deform_mem_size(s->img);
 	int rc = session_part_mem(&s->deform_mem, n, "deform", err, errlen);
 
@@ -45,6 +48,12 @@ static int open_deform(struct irdm_session *s, char *err, size_t errlen)
 	if (!rc)
 		irdm_engine_attach_deform(s->eng, s->deform);
 	return rc;
+#else
+	(void)s;
+	snprintf(err, errlen, "session: the deformed surface is asked for (a board's "
+		 "deform_rate_hz > 0); this build has CONFIG_IRDM_DEFORM off (docs/build-config.md)");
+	return IRDM_ENOTSUP;
+#endif
 }
 
 /*

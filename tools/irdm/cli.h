@@ -17,6 +17,7 @@ void irdm_cli_fail(const char *cmd, int code, const char *reason);
 
 int irdm_cmd_precompute(int argc, char **argv);
 int irdm_cmd_image(int argc, char **argv);
+int irdm_cmd_image_config(int argc, char **argv);
 int irdm_cmd_replay(int argc, char **argv);
 int irdm_cmd_log(int argc, char **argv);
 

@@ -17,6 +17,7 @@ static const char usage[] =
 	"usage: irdm image info IMAGE\n"
 	"       irdm image verify [--require-stable] IMAGE\n"
 	"       irdm image export IMAGE --column NODE [--rows NODE,...] [--samples N] [-o FILE.csv]\n"
+	"       irdm image config IMAGE [--board BOARD]   # the build configuration it needs\n"
 	"\n"
 	"NODE is a mesh node index (0-based), as 'image info' lists for the columns.\n"
 	"export writes one CSV row per sample s: s, t_s (= (s+1) dt, when the\n"
@@ -445,6 +446,9 @@ int irdm_cmd_image(int argc, char **argv)
 		return cmd_verify(argc - 2, argv + 2);
 	if (!strcmp(argv[1], "export"))
 		return cmd_export(argc - 2, argv + 2);
-	fprintf(stderr, "irdm image: unknown subcommand '%s' (info, verify, export)\n", argv[1]);
+	if (!strcmp(argv[1], "config"))
+		return irdm_cmd_image_config(argc - 2, argv + 2);
+	fprintf(stderr, "irdm image: unknown subcommand '%s' (info, verify, export, config)\n",
+		argv[1]);
 	return 2;
 }
