@@ -36,6 +36,7 @@ void bench_stats(double *t, size_t n, struct bench_stats *st)
 	qsort(t, n, sizeof(*t), cmp_double);
 	st->median = t[n / 2];
 	st->p99 = t[n * 99 / 100];
+	st->p999 = t[n * 999 / 1000];
 	st->max = t[n - 1];
 }
 

@@ -17,9 +17,10 @@ double bench_now_us(void);
 /* b - a in nanoseconds. */
 double bench_elapsed_ns(const struct timespec *a, const struct timespec *b);
 
-/* Median, 99th percentile and maximum of n > 0 samples (sorted in place). */
+/* Median, 99th and 99.9th percentiles and maximum of n > 0 samples
+ * (sorted in place). */
 struct bench_stats {
-	double median, p99, max;
+	double median, p99, p999, max;
 };
 void bench_stats(double *samples, size_t n, struct bench_stats *st);
 
