@@ -213,6 +213,8 @@ fuzz:
 
 bench: $(BENCHES) $(IRDM) bench-precompute
 	for b in $(BENCHES); do echo "== $$b"; IRDM=$(IRDM) $$b; done
+	@echo "== ticks paced at 1 kHz, deformation thread running (make jitter, 10 s)"
+	$(MAKE) --no-print-directory jitter JITTER_SECONDS=10
 
 # Paper-scale images (cuboid, bunny): time and size beside the paper's.
 bench-precompute: $(IRDM) $(BUILD)/data/bunny.off
