@@ -37,6 +37,7 @@
 #include "irdm/vec3.h"
 #include "irdm/safety.h"
 #include "irdm/telemetry.h"
+#include "support/run_prog.h"
 #include "support/test_files.h"
 
 extern char **environ;
@@ -56,37 +57,12 @@ static const char *env_or(const char *name, const char *dflt)
 /* Start prog with args (NULL-terminated); stdout/stderr to files. */
 static pid_t spawn(const char *prog, const char *const *args)
 {
-	const char *argv[40];
-	char out_path[300], err_path[300];
-	posix_spawn_file_actions_t fa;
-	int n = 0;
-	pid_t pid;
-
-	argv[n++] = prog;
-	for (; *args && n < 39; args++)
-		argv[n++] = *args;
-	argv[n] = NULL;
-	snprintf(out_path, sizeof(out_path), "%s/stdout", dir);
-	snprintf(err_path, sizeof(err_path), "%s/stderr", dir);
-	posix_spawn_file_actions_init(&fa);
-	posix_spawn_file_actions_addopen(&fa, 1, out_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-	posix_spawn_file_actions_addopen(&fa, 2, err_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-	assert_int_equal(posix_spawn(&pid, argv[0], &fa, NULL, (char *const *)argv, environ), 0);
-	posix_spawn_file_actions_destroy(&fa);
-	return pid;
+	return rp_spawn(dir, prog, args);
 }
 
 static int finish(pid_t pid)
 {
-	char path[300];
-	int status = 0;
-
-	assert_int_equal(waitpid(pid, &status, 0), pid);
-	snprintf(path, sizeof(path), "%s/stdout", dir);
-	tf_read_text(path, out_text, sizeof(out_text));
-	snprintf(path, sizeof(path), "%s/stderr", dir);
-	tf_read_text(path, err_text, sizeof(err_text));
-	return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+	return rp_finish(dir, pid, out_text, sizeof(out_text), err_text, sizeof(err_text));
 }
 
 static int run_fw(const char *const *args)

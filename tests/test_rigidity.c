@@ -31,6 +31,7 @@
 #include "fem/fem.h"
 #include "mesh/mesh.h"
 #include "modal/modal.h"
+#include "support/model_fixture.h"
 #include "support/test_files.h"
 
 static char dir[256], off_path[320];
@@ -152,39 +153,10 @@ static void test_graded_floating_has_six_rigid_modes(void **state)
 	(void)state;
 	solve(&s, 1.0, true, 10);
 	assert_int_equal(s.modes.n_rigid, 6);
-	size_t n = s.modes.n, nn = s.mesh.n_nodes;
-	double *v = malloc(n * sizeof(double)), *mv = malloc(n * sizeof(double));
-	assert_true(v && mv);
-	for (int f = 0; f < 6; f++) {
-		double vv = 0, proj = 0;
-		for (size_t i = 0; i < nn; i++) {
-			const double *p = &s.mesh.pos_m[3 * i];
-			double r[3] = { p[0] - 0.05, p[1] - 0.05, p[2] - 0.05 }, u[3] = { 0, 0, 0 };
-			if (f < 3) {
-				u[f] = 1;
-			} else {
-				int a = f - 3;           /* e_a x r */
-				u[(a + 1) % 3] = -r[(a + 2) % 3];
-				u[(a + 2) % 3] = r[(a + 1) % 3];
-			}
-			memcpy(&v[3 * i], u, sizeof(u));
-		}
-		irdm_csc_matvec(&s.fem.M, v, mv);
-		for (size_t i = 0; i < n; i++)
-			vv += v[i] * mv[i];
-		for (size_t r = 0; r < 6; r++) {
-			double d = 0;
-			for (size_t i = 0; i < n; i++)
-				d += s.modes.rigid_phi[r * n + i] * mv[i];
-			proj += d * d;
-		}
-		worst = fmax(worst, fabs(proj - vv) / vv);
-	}
+	worst = fixture_rigid_outside(&s.mesh, &s.fem, &s.modes, (const double[3]){ 0.05, 0.05, 0.05 });
 	print_message("floating graded mesh: 6 rigid modes, first elastic %.4f Hz; rigid fields "
 		      "outside their span: %.1e\n", sqrt(s.modes.omega2[0]) / (2 * M_PI), worst);
 	assert_true(worst <= 1e-8);
-	free(v);
-	free(mv);
 	solved_free(&s);
 }
 

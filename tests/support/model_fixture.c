@@ -1,4 +1,5 @@
 /* SPDX-License-Identifier: MIT */
+#include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -78,4 +79,44 @@ void fixture_dense_compliance(const struct irdm_fem *fem, int64_t j, double *x)
 	dpotrs_("L", &n, &one, a, &n, x, &n, &info);
 	assert_int_equal(info, 0);
 	free(a);
+}
+
+double fixture_rigid_outside(const struct irdm_mesh *mesh, const struct irdm_fem *fem,
+			     const struct irdm_modes *modes, const double centre[3])
+{
+	size_t n = modes->n, nn = mesh->n_nodes;
+	double *v = malloc(n * sizeof(double)), *mv = malloc(n * sizeof(double)), worst = 0;
+
+	assert_true(v && mv && n == 3 * nn);
+	for (int f = 0; f < 6; f++) {
+		double vv = 0, proj = 0;
+
+		for (size_t i = 0; i < nn; i++) {
+			const double *p = &mesh->pos_m[3 * i];
+			double r[3] = { p[0] - centre[0], p[1] - centre[1], p[2] - centre[2] };
+			double u[3] = { 0, 0, 0 };
+
+			if (f < 3) {
+				u[f] = 1;
+			} else {
+				int a = f - 3;          /* e_a x r */
+				u[(a + 1) % 3] = -r[(a + 2) % 3];
+				u[(a + 2) % 3] = r[(a + 1) % 3];
+			}
+			memcpy(&v[3 * i], u, sizeof(u));
+		}
+		irdm_csc_matvec(&fem->M, v, mv);
+		for (size_t i = 0; i < n; i++)
+			vv += v[i] * mv[i];
+		for (size_t r = 0; r < modes->n_rigid; r++) {
+			double d = 0;
+			for (size_t i = 0; i < n; i++)
+				d += modes->rigid_phi[r * n + i] * mv[i];
+			proj += d * d;
+		}
+		worst = fmax(worst, fabs(proj - vv) / vv);
+	}
+	free(v);
+	free(mv);
+	return worst;
 }

@@ -17,6 +17,15 @@ int64_t fixture_free_dof(const struct irdm_model *m, uint32_t node, int axis);
 /* Mesh node nearest to p. */
 uint32_t fixture_nearest_node(const struct irdm_mesh *mesh, const double p[3]);
 
+/*
+ * How far the six rigid fields about centre (3 translations, 3
+ * infinitesimal rotations, built here from the node positions) lie outside
+ * the span of modes->rigid_phi: the largest | |P v|_M^2 - |v|_M^2 | /
+ * |v|_M^2 over the six (0: inside).  Every node free (a floating mesh).
+ */
+double fixture_rigid_outside(const struct irdm_mesh *mesh, const struct irdm_fem *fem,
+			     const struct irdm_modes *modes, const double centre[3]);
+
 /* Dense K^-1 column j by LAPACK (dpotrf/dpotrs): an independent solve. */
 void fixture_dense_compliance(const struct irdm_fem *fem, int64_t j, double *x);
 

@@ -15,13 +15,12 @@
 
 extern char **environ;
 
-int rp_run(const char *dir, const char *prog, const char *const *args, char *out,
-	   size_t outlen, char *err, size_t errlen)
+pid_t rp_spawn(const char *dir, const char *prog, const char *const *args)
 {
 	const char *argv[40];
 	char out_path[300], err_path[300];
 	posix_spawn_file_actions_t fa;
-	int n = 0, status = 0;
+	int n = 0;
 	pid_t pid;
 
 	argv[n++] = prog;
@@ -35,10 +34,26 @@ int rp_run(const char *dir, const char *prog, const char *const *args, char *out
 	posix_spawn_file_actions_addopen(&fa, 2, err_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
 	assert_int_equal(posix_spawn(&pid, argv[0], &fa, NULL, (char *const *)argv, environ), 0);
 	posix_spawn_file_actions_destroy(&fa);
+	return pid;
+}
+
+int rp_finish(const char *dir, pid_t pid, char *out, size_t outlen, char *err, size_t errlen)
+{
+	char path[300];
+	int status = 0;
+
 	assert_int_equal(waitpid(pid, &status, 0), pid);
+	snprintf(path, sizeof(path), "%s/stdout", dir);
 	if (out)
-		tf_read_text(out_path, out, outlen);
+		tf_read_text(path, out, outlen);
+	snprintf(path, sizeof(path), "%s/stderr", dir);
 	if (err)
-		tf_read_text(err_path, err, errlen);
+		tf_read_text(path, err, errlen);
 	return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+int rp_run(const char *dir, const char *prog, const char *const *args, char *out,
+	   size_t outlen, char *err, size_t errlen)
+{
+	return rp_finish(dir, rp_spawn(dir, prog, args), out, outlen, err, errlen);
 }

@@ -4,6 +4,7 @@
 #define IRDM_TESTS_RUN_PROG_H
 
 #include <stddef.h>
+#include <sys/types.h>
 
 /*
  * prog with args (NULL-terminated, at most 38), its stdout and stderr kept
@@ -12,5 +13,9 @@
  */
 int rp_run(const char *dir, const char *prog, const char *const *args, char *out,
 	   size_t outlen, char *err, size_t errlen);
+
+/* The same in two steps, for a caller that acts while it runs (a signal). */
+pid_t rp_spawn(const char *dir, const char *prog, const char *const *args);
+int rp_finish(const char *dir, pid_t pid, char *out, size_t outlen, char *err, size_t errlen);
 
 #endif
