@@ -302,3 +302,52 @@ void irdm_mass_properties(const struct irdm_mesh *mesh, const double *m_kg,
 	}
 	*mass_kg = m;
 }
+
+int irdm_mass_properties_of_matrix(const struct irdm_mesh *mesh, const struct irdm_fem *fem,
+				   double *mass_kg, double com_m[3], double inertia_kg_m2[9])
+{
+	const struct irdm_csc *M = &fem->M;
+	const struct irdm_dofmap *map = &fem->map;
+	double m = 0, s[3] = { 0, 0, 0 };
+
+	if (map->n_free != 3 * mesh->n_nodes)
+		return -1;
+	/* x-x entries: free DoF 3 i (node i, axis 0) for every node */
+	for (size_t j = 0; j < mesh->n_nodes; j++) {
+		int64_t c = map->free_of[3 * j];
+		for (int64_t p = M->colptr[c]; p < M->colptr[c + 1]; p++) {
+			int64_t g = map->global_of[M->rowind[p]];
+			if (g % 3)
+				continue;
+			m += M->val[p];
+			for (int k = 0; k < 3; k++)
+				s[k] += M->val[p] * mesh->pos_m[3 * j + k];
+		}
+	}
+	for (int k = 0; k < 3; k++)
+		com_m[k] = s[k] / m;
+	memset(inertia_kg_m2, 0, 9 * sizeof(double));
+	for (size_t j = 0; j < mesh->n_nodes; j++) {
+		int64_t c = map->free_of[3 * j];
+		double rj[3];
+
+		for (int k = 0; k < 3; k++)
+			rj[k] = mesh->pos_m[3 * j + k] - com_m[k];
+		for (int64_t p = M->colptr[c]; p < M->colptr[c + 1]; p++) {
+			int64_t g = map->global_of[M->rowind[p]];
+			double ri[3], dot = 0;
+			if (g % 3)
+				continue;
+			for (int k = 0; k < 3; k++) {
+				ri[k] = mesh->pos_m[g + k] - com_m[k];
+				dot += ri[k] * rj[k];
+			}
+			for (int a = 0; a < 3; a++)
+				for (int b = 0; b < 3; b++)
+					inertia_kg_m2[3 * a + b] += M->val[p] *
+						((a == b ? dot : 0) - 0.5 * (ri[a] * rj[b] + rj[a] * ri[b]));
+		}
+	}
+	*mass_kg = m;
+	return 0;
+}

@@ -84,4 +84,16 @@ double irdm_rayleigh_ratio(const struct irdm_rayleigh *r, double w_rad_s);
 void irdm_mass_properties(const struct irdm_mesh *mesh, const double *node_mass_kg,
 			  double *mass_kg, double com_m[3], double inertia_kg_m2[9]);
 
+/*
+ * Mass properties of the mass matrix the model uses (fem->M, lumped or
+ * consistent; every node free: a floating object): with m_ij its x-x
+ * entry between nodes i and j (M is isotropic per node pair),
+ *   m = sum m_ij,  m c = sum m_ij x_j,  I = sum m_ij ((r_i . r_j) 1 - r_i r_j^T)
+ * (r = x - c, symmetrised), the rigid body's kinetic energy under the
+ * same M the modes are separated with; for a consistent M of linear tets
+ * the continuum's exact values.  Return: 0; -1 if a node is fixed.
+ */
+int irdm_mass_properties_of_matrix(const struct irdm_mesh *mesh, const struct irdm_fem *fem,
+				   double *mass_kg, double com_m[3], double inertia_kg_m2[9]);
+
 #endif /* IRDM_TOOLS_FEM_H */

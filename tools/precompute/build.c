@@ -457,8 +457,18 @@ static int fill_nodes_rigid(struct build *b)
 			b->nodes[r].pos_m[a] = (float)m->mesh.pos_m[3 * (size_t)m->rows[r] + (size_t)a];
 		b->nodes[r].mesh_node = m->rows[r];
 	}
-	irdm_mass_properties(&m->mesh, m->fem.lumped_mass_kg, &b->rigid.mass_kg, b->rigid.com_m,
-			     b->rigid.inertia_kg_m2);
+	/*
+	 * A floating body's mass, centre and inertia from the mass matrix
+	 * the modes were separated with (consistent or lumped): from the
+	 * lumped masses under a consistent M, an off-centre push spun the
+	 * cube 2 % too slowly (24 % on a flat 6x6x1 mesh).
+	 */
+	if (m->fem.map.n_free == 3 * m->mesh.n_nodes)
+		irdm_mass_properties_of_matrix(&m->mesh, &m->fem, &b->rigid.mass_kg,
+					       b->rigid.com_m, b->rigid.inertia_kg_m2);
+	else
+		irdm_mass_properties(&m->mesh, m->fem.lumped_mass_kg, &b->rigid.mass_kg,
+				     b->rigid.com_m, b->rigid.inertia_kg_m2);
 	return IRDM_OK;
 }
 
