@@ -748,12 +748,63 @@ static void test_finish_large(void **state)
 	irdm_mesh_free(&m);
 }
 
+/*
+ * Mesh statistics: a regular tetrahedron has quality 1 and its volume
+ * a^3 / (6 sqrt 2); a Kuhn box (6 equal tets a hex) spans no volume ratio;
+ * a box 1000 times too large, and one graded by a tiny tet, are warned of.
+ */
+static void test_mesh_stats(void **state)
+{
+	const double a = 0.03;
+	double pos[12] = { 0, 0, 0, a, 0, 0, a / 2, a * sqrt(3) / 2, 0,
+			   a / 2, a * sqrt(3) / 6, a * sqrt(2.0 / 3.0) };
+	uint32_t tet[4] = { 0, 1, 2, 3 };
+	struct irdm_mesh m = { .n_nodes = 4, .pos_m = pos, .n_tets = 1, .tets = tet };
+	struct irdm_mesh_stats st;
+	char lines[3][256], err[256];
+
+	(void)state;
+	irdm_mesh_stats(&m, &st);
+	assert_true(fabs(st.quality_min - 1) < 1e-12 && fabs(st.quality_max - 1) < 1e-12);
+	assert_true(fabs(st.vol_min_m3 - a * a * a / (6 * sqrt(2))) < 1e-12 * a * a * a);
+	assert_int_equal(irdm_mesh_stats_text(&m, &st, lines), 1);
+	assert_non_null(strstr(lines[0], "mesh stats: 4 nodes, 1 tets, 0.03 m across"));
+
+	assert_int_equal(irdm_mesh_gen_box(0.1, 0.1, 0.2, 2, 2, 4, 6, &m, err, sizeof(err)), 0);
+	irdm_mesh_stats(&m, &st);
+	assert_true(fabs(st.vol_max_m3 / st.vol_min_m3 - 1) < 1e-12);
+	assert_true(fabs(st.vol_min_m3 - 0.05 * 0.05 * 0.05 / 6) < 1e-15);
+	assert_int_equal(irdm_mesh_stats_text(&m, &st, lines), 1);
+	for (size_t i = 0; i < 3 * m.n_nodes; i++)
+		m.pos_m[i] *= 1000;                     /* drawn in mm, read as m */
+	irdm_mesh_stats(&m, &st);
+	assert_int_equal(irdm_mesh_stats_text(&m, &st, lines), 2);
+	assert_non_null(strstr(lines[1], "warning: the object is 200 m across: is mesh_scale right?"));
+	irdm_mesh_free(&m);
+	/* the regular tet beside one 1000 times smaller in size: graded */
+	{
+		double p2[24];
+		uint32_t t2[8] = { 0, 1, 2, 3, 4, 5, 6, 7 };
+		struct irdm_mesh g = { .n_nodes = 8, .pos_m = p2, .n_tets = 2, .tets = t2 };
+
+		for (int i = 0; i < 12; i++) {
+			p2[i] = pos[i];
+			p2[12 + i] = pos[i] * 1e-3 + (i % 3 == 0 ? 0.05 : 0);
+		}
+		irdm_mesh_stats(&g, &st);
+		assert_true(fabs(st.vol_max_m3 / st.vol_min_m3 / 1e9 - 1) < 1e-9);
+		assert_int_equal(irdm_mesh_stats_text(&g, &st, lines), 2);
+		assert_non_null(strstr(lines[1], "warning: tet volumes span a factor 1e+09"));
+	}
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_box_paper_cuboid),
 		cmocka_unit_test(test_box_cubes),
 		cmocka_unit_test(test_box_bad_args),
+		cmocka_unit_test(test_mesh_stats),
 		cmocka_unit_test(test_hash),
 		cmocka_unit_test(test_tetgen_cube),
 		cmocka_unit_test(test_tetgen_ten_node),

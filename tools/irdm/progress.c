@@ -22,6 +22,13 @@ void irdm_cli_progress(void *ctx, const char *stage, double fraction)
 	int tty = isatty(STDERR_FILENO);
 	int pct = (int)(fraction * 100.0 + 0.5);
 
+	/* a line of its own: warnings even when quiet */
+	if (fraction < 0) {
+		if (!p->quiet || !strncmp(stage, "warning:", 8))
+			fprintf(stderr, "%s%s\n", tty && p->stage[0] ? "\n" : "", stage);
+		p->stage[0] = 0;
+		return;
+	}
 	if (p->quiet)
 		return;
 	if (p->t0 == 0)

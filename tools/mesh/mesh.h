@@ -107,6 +107,23 @@ int irdm_surface_tetrahedralize(const struct irdm_surface *s, const char *switch
  */
 int irdm_mesh_finish(struct irdm_mesh *m, const char *what, char *err, size_t errlen);
 
+/* What a mesh is made of (mesh_stats.c). */
+struct irdm_mesh_stats {
+	size_t n_nodes, n_tets, worst_tet;
+	double size_m;                          /* the largest bounding-box side */
+	double vol_min_m3, vol_max_m3;
+	double quality_min, quality_max;        /* 1: regular tet, 0: flat */
+};
+#define IRDM_MESH_VOL_SPAN_WARN 1e6     /* tet volumes spanning more: graded */
+#define IRDM_MESH_SIZE_WARN_M 5.0       /* a desktop object larger: units? */
+#define IRDM_MESH_SIZE_SMALL_M 1e-3     /* or smaller */
+
+void irdm_mesh_stats(const struct irdm_mesh *m, struct irdm_mesh_stats *st);
+
+/* The stats as a line, then a line per warning; returns how many (1-3). */
+int irdm_mesh_stats_text(const struct irdm_mesh *m, const struct irdm_mesh_stats *st,
+			 char lines[3][256]);
+
 /*
  * Whether only straining moves the mesh (grounded: anchored by the fixed
  * nodes, fixed[i] per node) or it moves only as one rigid body (floating);

@@ -31,6 +31,8 @@ struct irdm_modes {
 	double *rigid_phi;      /* n x n_rigid (floating only) */
 };
 
+/* Progress of a stage in [0, 1]; a negative fraction: `stage` is a line to
+ * show as it is (mesh statistics, warnings). */
 typedef void (*irdm_progress_fn)(void *ctx, const char *stage, double fraction);
 
 /*

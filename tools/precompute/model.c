@@ -94,6 +94,21 @@ static int pick_damping(const struct irdm_scene *sc, struct irdm_model *m, char 
 					 2 * M_PI * sc->damp_hz[1], &m->damping, err, errlen);
 }
 
+/* The mesh's statistics and warnings, before the eigensolve spends on it. */
+static void say_stats(const struct irdm_mesh *mesh, irdm_progress_fn progress, void *ctx)
+{
+	struct irdm_mesh_stats st;
+	char lines[3][256];
+	int n;
+
+	if (!progress)
+		return;
+	irdm_mesh_stats(mesh, &st);
+	n = irdm_mesh_stats_text(mesh, &st, lines);
+	for (int i = 0; i < n; i++)
+		progress(ctx, lines[i], -1.0);
+}
+
 int irdm_model_build(const struct irdm_scene *sc, size_t n_modes_needed,
 		     irdm_progress_fn progress, void *ctx, struct irdm_model *m,
 		     char *err, size_t errlen)
@@ -117,6 +132,7 @@ int irdm_model_build(const struct irdm_scene *sc, size_t n_modes_needed,
 										       : IRDM_OK;
 	if (ret)
 		goto out_fail;
+	say_stats(&m->mesh, progress, ctx);
 	m->seconds_mesh = now_s() - t0;
 	t0 = now_s();
 	ret = irdm_fem_assemble(&m->mesh, &sc->mat, sc->mass, m->fixed, &m->fem, err, errlen);
