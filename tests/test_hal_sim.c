@@ -256,9 +256,13 @@ static void test_encoder_out_of_range(void **state)
 	int rc = IRDM_OK, k;
 	(void)state;
 
-	/* no compensation: the arm falls out of the encoders' range; the read
-	 * then says so */
+	/* no compensation and no end stops: the arm falls out of the encoders'
+	 * range; the read then says so.  With its stops it rests on one. */
 	open_sim(NULL);
+	for (k = 0; k < 2000; k++)
+		assert_int_equal(irdm_hal_read(&dev, &st), IRDM_OK);
+	irdm_hal_close(&dev);
+	open_sim("end_stops=0");
 	for (k = 0; k < 5000 && rc == IRDM_OK; k++)
 		rc = irdm_hal_read(&dev, &st);
 	printf("unpowered arm left the encoder range after %d ticks\n", k);

@@ -217,8 +217,8 @@ void irdm_sim_params_default(struct irdm_sim_params *p)
 		.substeps = 10,
 		.end_stops = 1,
 		.stop_inset_rad = 0.02,
-		.stop_stiffness_nm_per_rad = 50,
-		.stop_damping_nm_s_per_rad = 0.2,
+		.stop_stiffness_nm_per_rad = 500,
+		.stop_damping_nm_s_per_rad = 0.6,
 	};
 
 	*p = def;

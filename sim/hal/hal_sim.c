@@ -54,6 +54,13 @@ static int parse_token(const char *tok, size_t len, struct irdm_sim_params *p)
 	if (rc == IRDM_OK && !matched)
 		rc = option_uint(tok, len, "substeps", IRDM_SIM_SUBSTEPS_MAX, &p->substeps,
 				 &matched);
+	if (rc == IRDM_OK && !matched) {
+		unsigned stops = 1;
+
+		rc = option_uint(tok, len, "end_stops", 1, &stops, &matched);
+		if (matched)
+			p->end_stops = (int)stops;
+	}
 	if (rc == IRDM_OK && !matched)
 		rc = IRDM_EINVAL;               /* unknown option */
 	return rc;

@@ -9,6 +9,7 @@
  * over the next.  Options (config->options, space or comma separated):
  *   write_delay=K  read_delay=K   bus delay in ticks, 0..IRDM_SIM_DELAY_MAX
  *   substeps=N                    integration steps per tick
+ *   end_stops=0|1                 the arm's mechanical stops (default 1)
  * everything else from irdm_sim_params_default(), starting at rest in the
  * home pose.  No I/O and no system call: the tick stays free of them.
  */

@@ -86,11 +86,12 @@ struct irdm_sim_device {
  * 2e-3 N m s/rad, Coulomb 5e-3 N m (figures of the right order for a
  * desktop arm, not measured), stick below 1e-3 rad/s, 10 sub-steps, no
  * delay, the home pose; end stops 0.02 rad (about 150 counts of the
- * default encoders) inside the count range, 50 N m/rad and 0.2 N m s/rad:
- * with the default arm's yaw inertia (about 1.3e-3 kg m^2) a 32 Hz contact,
- * damping ratio 0.4, which a 1.4 rad/s impact (a stylus flung at 0.37 m/s)
- * enters by about 0.006 rad, well inside the inset, and which 10 RK4
- * sub-steps of a 1 ms tick resolve (omega h = 0.02).
+ * default encoders) inside the count range, 500 N m/rad and 0.6 N m s/rad:
+ * with the default arm's yaw inertia (about 1.3e-3 kg m^2) a 100 Hz
+ * contact, damping ratio 0.38, stiff enough that the upper arm falling
+ * 0.38 rad under gravity with the torque off (0.037 J) enters the stop by
+ * 0.012 rad, inside the inset, and soft enough for 10 RK4 sub-steps of a
+ * 1 ms tick (omega h = 0.06).
  */
 void irdm_sim_params_default(struct irdm_sim_params *p);
 

@@ -1,0 +1,70 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * CiA 402 drives in emulation: one node per joint of the simulated arm
+ * (irdm/sim_device.h), on a CAN port (docs/canopen.md).  Each answers NMT
+ * and expedited SDOs for the objects the master configures, takes its
+ * RPDO1 (controlword + target torque; latest wins), and at every SYNC
+ * sends its TPDO1 (statusword + position counts sampled then), applies
+ * the set-point and moves the arm one period: a one-period bus delay, as
+ * real synchronous PDOs have.  Heartbeats at the configured producer time
+ * on the emulated clock (which SYNCs advance).  Faults a test injects:
+ * stop the heartbeat, drop TPDOs, answer SDOs wrongly, raise an EMCY and
+ * fault.  No allocation after init; the caller owns the struct.
+ */
+#ifndef IRDM_CAN_DRIVES_H
+#define IRDM_CAN_DRIVES_H
+
+#include <stdbool.h>
+#include <stdint.h>
+
+#include "irdm/can_port.h"
+#include "irdm/cia402.h"
+#include "irdm/sim_device.h"
+
+#define IRDM_CAN_DRIVES_MAX 3
+
+struct irdm_can_drive {
+	unsigned node;
+	enum irdm_co_nmt_state nmt;
+	struct irdm_cia402_drive fsa;
+	int8_t mode;                    /* 0x6060: 10 = cyclic synchronous torque */
+	uint16_t heartbeat_ms;          /* 0x1017: 0 = none */
+	uint32_t rated_torque_mnm;      /* 0x6076: motor side, mN m */
+	uint16_t rpdo_cw;               /* the latest RPDO1 */
+	int16_t rpdo_torque_permille;
+	uint64_t heartbeat_next_us;
+	/* injected faults */
+	bool no_heartbeat;
+	unsigned drop_tpdos;            /* the next k TPDOs are not sent */
+	bool sdo_wrong;                 /* SDO answers name another object */
+};
+
+struct irdm_can_drives {
+	struct irdm_can_port port;
+	struct irdm_sim_device arm;
+	unsigned n;
+	struct irdm_can_drive d[IRDM_CAN_DRIVES_MAX];
+	double period_s;
+	uint64_t now_us;
+	uint8_t sync_counter;           /* the last SYNC's counter byte (0: none) */
+	uint64_t syncs, bad_frames;
+};
+
+/*
+ * n drives (1..3) on nodes first_node.., the arm dev with parameters p,
+ * one SYNC = period_s.  Each drive starts pre-operational, switch on
+ * disabled, and sends its boot-up heartbeat.
+ * Return: IRDM_OK; IRDM_EINVAL (bad count, node range, period, or the arm
+ * refused, irdm_sim_device_init()).
+ */
+int irdm_can_drives_init(struct irdm_can_drives *dr, const struct irdm_can_port *port,
+			 const struct irdm_device_config *dev, const struct irdm_sim_params *p,
+			 unsigned n, unsigned first_node, double period_s);
+
+/* Everything waiting on the bus, answered.  Return: frames handled. */
+int irdm_can_drives_poll(struct irdm_can_drives *dr);
+
+/* Injected: drive k raises EMCY code (error register 0x01) and faults. */
+void irdm_can_drives_fault(struct irdm_can_drives *dr, unsigned k, uint16_t code);
+
+#endif /* IRDM_CAN_DRIVES_H */
