@@ -89,6 +89,10 @@ struct fw_frame {
 	struct fw_frame_slot *slot;
 	unsigned n_slots, single_slot;  /* single_slot: n_slots if no --frame-at */
 	unsigned contact_next;          /* the loop's: the next slot to take a contact */
+	/* --frame-at's frame for the summary, copied at stop (the slots are
+	 * freed before the summary prints) */
+	bool single_held;
+	uint64_t single_held_tick;
 	double *scratch_m;              /* 3 rows: virtual time's update target */
 	/* ---- written by the worker's thread (real) or the loop (virtual) */
 	unsigned next;                  /* the first slot still looking for its frame */

@@ -295,10 +295,17 @@ void fw_frame_tick(struct fw *fw, const struct irdm_ctrl_output *out)
 
 void fw_frame_stop(struct fw *fw)
 {
+	struct fw_frame *fr = &fw->frame;
+
 #if IRDM_CONFIG_DEFORM
-	irdm_deform_thread_stop(fw->frame.th);
+	irdm_deform_thread_stop(fr->th);
 #endif
-	fw->frame.th = NULL;
+	fr->th = NULL;
+	/* joined: the slots are the loop's again */
+	if (fr->slot && fr->single_slot < fr->n_slots) {
+		fr->single_held = fr->slot[fr->single_slot].held;
+		fr->single_held_tick = fr->slot[fr->single_slot].held_tick;
+	}
 }
 
 void fw_frame_free(struct fw *fw)
@@ -321,10 +328,10 @@ void fw_frame_summary(const struct fw *fw)
 	       (unsigned long long)fr->frames, fw->board.deform_rate_hz,
 	       fw->args.clock == IRDM_CLOCK_REAL ? "worker thread" : "in the loop",
 	       fr->cpu_n ? fr->cpu_sum_ns / (double)fr->cpu_n * 1e-3 : 0.0, fr->cpu_max_ns * 1e-3);
-	if (fw->args.frame_out && fr->slot[fr->single_slot].held)
+	if (fw->args.frame_out && fr->single_held)
 		printf("frame: t %.3f s (tick %llu) -> %s\n",
-		       (double)fr->slot[fr->single_slot].held_tick * fw->board.period_us * 1e-6,
-		       (unsigned long long)fr->slot[fr->single_slot].held_tick, fw->args.frame_out);
+		       (double)fr->single_held_tick * fw->board.period_us * 1e-6,
+		       (unsigned long long)fr->single_held_tick, fw->args.frame_out);
 	if (fw->args.frames_out)
 		printf("frames: %u every %g s -> %s/frames.vtk.series\n",
 		       fr->n_slots - (fw->args.frame_out != NULL), fw->args.frames_every_s,
