@@ -4,11 +4,16 @@
  * convolution of responses read back from the image) on the paper's cuboid
  * (10 x 10 x 20 cm, E 2000 Pa, nu 0.49, rho 110, bottom fixed; a coarse
  * 4 x 4 x 8 mesh so the reference stays quick): step, release, two points,
- * stroking.  Must-show 1 of issue 3: relative RMS force error <= 1e-4.
+ * stroking; and FIR images (f64, f32, f16) whose tail the engine damps by
+ * r^s, against the same convolution with that tail.  Each tolerance is
+ * about 5x the largest error measured with gcc -O2, clang and ASan builds,
+ * so a regression of ten times fails (dropping the FIR's oldest tap costs
+ * 1e-3).
  */
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -23,8 +28,21 @@
 
 static char dir[64];
 static struct irdm_image exact, trunc32;     /* modal:all f64; modal:40 + static corr, f32 */
+static struct irdm_image fir[3];                /* fir:200 f64, f32, f16 */
+static const char *const fir_prec[3] = { "f64", "f32", "f16" };
 
 #define N_STEP 2000
+
+/*
+ * Limits, about 5x the largest relative RMS error measured (gcc -O2, clang
+ * -O2, ASan -O1; 2026-11-24): modal f64 3.6e-13, modal 40 f32 5.3e-15,
+ * stroke 1.7e-12, FIR 200 (f64, f32, f16) 5.6e-14.  All are rounding: the engine and the
+ * reference read the same numbers from the image.
+ */
+#define TOL_MODAL_F64 2e-12
+#define TOL_MODAL_F32 3e-14
+#define TOL_STROKE 1e-11
+#define TOL_FIR 3e-13
 
 static int setup(void **state)
 {
@@ -40,6 +58,11 @@ static int setup(void **state)
 		  "precision", "f64", "touch", "z>=0.2", NULL);
 	efx_image(&trunc32, p2, "resolution", "4,4,8", "representation", "modal:40",
 		  "precision", "f32", "touch", "z>=0.2", NULL);
+	for (int k = 0; k < 3; k++) {
+		snprintf(p1, sizeof(p1), "%s/fir-%s.img", dir, fir_prec[k]);
+		efx_image(&fir[k], p1, "resolution", "4,4,8", "representation", "fir:200",
+			  "precision", fir_prec[k], "touch", "z>=0.2", "display", "z>=0.2", NULL);
+	}
 	return 0;
 }
 
@@ -50,39 +73,64 @@ static int teardown(void **state)
 	(void)state;
 	irdm_image_unmap(&exact);
 	irdm_image_unmap(&trunc32);
+	for (int k = 0; k < 3; k++)
+		irdm_image_unmap(&fir[k]);
 	snprintf(cmd, sizeof(cmd), "rm -rf '%s'", dir);
 	return system(cmd) ? -1 : 0;
 }
 
-/* Run the engine (rigid coupling: displacements imposed) on fixed sites. */
-static void run_engine(const struct irdm_image *img, const struct irdm_contact_site *sites, int m,
-		       size_t N, const double *target, double *F)
+/*
+ * Run the engine on fixed sites with cfg (its max_contacts set to m here):
+ * GRAB contacts begin when their target is first finite; PUSH contacts
+ * begin at tick 0, and once the engine lets one go it stays off
+ * (*release_tick: the first tick it was off, or N).
+ */
+static void run_engine_cfg(const struct irdm_image *img, struct irdm_engine_config cfg,
+			   const struct irdm_contact_site *sites, int m, size_t N,
+			   const double *target, enum irdm_contact_mode mode, double *F,
+			   size_t *release_tick)
 {
-	struct irdm_engine_config cfg;
 	struct irdm_contact_cmd cmd[IRDM_MAX_CONTACTS];
+	bool begun[IRDM_MAX_CONTACTS] = { false };
 
-	irdm_engine_config_default(&cfg);
 	cfg.max_contacts = (unsigned)m;
 	struct irdm_session *ses = efx_session(img, &cfg);
 	struct irdm_engine *e = ses->eng;
+	if (release_tick)
+		*release_tick = N;
 	for (size_t t = 0; t < N; t++) {
 		memset(cmd, 0, sizeof(cmd));
 		for (int i = 0; i < m; i++) {
 			const double *u = &target[t * 3 * (size_t)m + 3 * (size_t)i];
-			if (isnan(u[0]))
+			bool off = irdm_engine_contact(e, (unsigned)i)->mode == IRDM_CONTACT_OFF;
+			if (isnan(u[0]) || (mode == IRDM_CONTACT_PUSH && begun[i] && off))
 				continue;
-			if (irdm_engine_contact(e, (unsigned)i)->mode == IRDM_CONTACT_OFF)
-				assert_int_equal(irdm_engine_contact_begin(e, (unsigned)i, &sites[i],
-									   IRDM_CONTACT_GRAB), 0);
-			cmd[i].mode = IRDM_CONTACT_GRAB;
+			if (off)
+				assert_int_equal(irdm_engine_contact_begin(e, (unsigned)i, &sites[i], mode), 0);
+			begun[i] = true;
+			cmd[i].mode = mode;
 			memcpy(cmd[i].target_m, u, 3 * sizeof(double));
 		}
 		assert_int_equal(irdm_engine_tick(e, cmd), 0);
-		for (int i = 0; i < m; i++)
+		for (int i = 0; i < m; i++) {
 			memcpy(&F[t * 3 * (size_t)m + 3 * (size_t)i], irdm_engine_contact(e, (unsigned)i)->force_n,
 			       3 * sizeof(double));
+			if (release_tick && *release_tick == N && begun[i] &&
+			    irdm_engine_contact(e, (unsigned)i)->mode == IRDM_CONTACT_OFF)
+				*release_tick = t;
+		}
 	}
 	irdm_session_close(ses);
+}
+
+/* Rigid coupling (displacements imposed), coupled solve, grabbed. */
+static void run_engine(const struct irdm_image *img, const struct irdm_contact_site *sites, int m,
+		       size_t N, const double *target, double *F)
+{
+	struct irdm_engine_config cfg;
+
+	irdm_engine_config_default(&cfg);
+	run_engine_cfg(img, cfg, sites, m, N, target, IRDM_CONTACT_GRAB, F, NULL);
 }
 
 static void node_site(const struct irdm_image *img, const double p[3], struct irdm_contact_site *s)
@@ -96,17 +144,28 @@ static void node_site(const struct irdm_image *img, const double p[3], struct ir
 	irdm_session_close(ses);
 }
 
+/* The tail weight the engine gives an FIR image (engine.h: the recorded
+ * radius brought to 0.999 when it is not below), written out again here. */
+static double fir_tail_r(const struct irdm_image *img)
+{
+	double rho = img->meta->max_spectral_radius;
+
+	return rho >= 0.999 ? 0.999 / rho : 1.0;
+}
+
 static void compare(const char *what, const struct irdm_image *img,
-		    const struct irdm_contact_site *sites, int m, size_t N, const double *target)
+		    const struct irdm_contact_site *sites, int m, size_t N, const double *target,
+		    double tol)
 {
 	double *F = malloc(N * 3 * (size_t)m * sizeof(double));
 	double *R = malloc(N * 3 * (size_t)m * sizeof(double));
+	double tail_r = img->meta->representation == IRDM_REPR_FIR ? fir_tail_r(img) : 1.0;
 
 	run_engine(img, sites, m, N, target, F);
-	efx_reference(img, sites, m, N, target, R);
+	efx_reference_tail(img, sites, m, N, target, tail_r, R);
 	double err = efx_rel_rms(F, R, N * 3 * (size_t)m);
-	print_message("%-34s relative RMS force error %.2e\n", what, err);
-	assert_true(err <= 1e-4);
+	print_message("%-34s relative RMS force error %.2e (limit %.0e)\n", what, err, tol);
+	assert_true(err <= tol);
 	free(F);
 	free(R);
 }
@@ -122,9 +181,9 @@ static void test_step(void **state)
 	for (size_t t = 0; t < N_STEP; t++)
 		u[3 * t + 2] = -0.01;
 	node_site(&exact, top, &s);
-	compare("step, modal all modes f64", &exact, &s, 1, N_STEP, u);
+	compare("step, modal all modes f64", &exact, &s, 1, N_STEP, u, TOL_MODAL_F64);
 	node_site(&trunc32, top, &s);
-	compare("step, modal 40 + static corr f32", &trunc32, &s, 1, N_STEP, u);
+	compare("step, modal 40 + static corr f32", &trunc32, &s, 1, N_STEP, u, TOL_MODAL_F32);
 	free(u);
 }
 
@@ -140,7 +199,7 @@ static void test_release(void **state)
 		for (int a = 0; a < 3; a++)
 			u[3 * t + (size_t)a] = t < 700 ? (a == 2 ? -0.01 : 0) : NAN;
 	node_site(&exact, top, &s);
-	compare("release, modal f64", &exact, &s, 1, N_STEP, u);
+	compare("release, modal f64", &exact, &s, 1, N_STEP, u, TOL_MODAL_F64);
 	free(u);
 }
 
@@ -159,7 +218,8 @@ static void test_two_points(void **state)
 		const struct irdm_image *img = pass ? &trunc32 : &exact;
 		node_site(img, a, &s[0]);
 		node_site(img, b, &s[1]);
-		compare(pass ? "two points, modal 40 f32" : "two points, modal f64", img, s, 2, N, u);
+		compare(pass ? "two points, modal 40 f32" : "two points, modal f64", img, s, 2, N, u,
+			pass ? TOL_MODAL_F32 : TOL_MODAL_F64);
 	}
 	/* the held point's force grows as the other is pushed (the ring-down
 	 * wobbles, so compare averages) */
@@ -176,6 +236,156 @@ static void test_two_points(void **state)
 	assert_true(late > 2 * early);
 	free(F);
 	free(u);
+}
+
+/*
+ * FIR images, the paper's representation (T = 200 here, so the ring wraps
+ * many times): pushed 1 cm for 0.5 s, then let go.  Every truncated FIR
+ * tried on this cuboid is unstable (radius 1.009-1.021 for 5-50 %
+ * damping), so the engine damps its tail by r^s; the reference convolves
+ * with the same weighted tail, read back from the image independently of
+ * the engine's ring.
+ */
+static void test_fir(void **state)
+{
+	const double top[3] = { 0.05, 0.05, 0.2 };
+	const size_t N = 900;
+	struct irdm_contact_site s;
+	double *u = calloc(N * 3, sizeof(double));
+	char what[64];
+
+	(void)state;
+	for (size_t t = 0; t < N; t++)
+		for (int a = 0; a < 3; a++)
+			u[3 * t + (size_t)a] = t < 500 ? (a == 2 ? -0.01 : 0) : NAN;
+	for (int k = 0; k < 3; k++) {
+		assert_int_equal(fir[k].meta->representation, IRDM_REPR_FIR);
+		assert_true(fir_tail_r(&fir[k]) < 1.0);        /* the damped path runs */
+		node_site(&fir[k], top, &s);
+		snprintf(what, sizeof(what), "step + release, FIR 200 %s", fir_prec[k]);
+		compare(what, &fir[k], &s, 1, N, u, TOL_FIR);
+	}
+	free(u);
+}
+
+/*
+ * The engine in a non-default mode against efx_reference_opts (the same
+ * mode written from its physics); returns the error, prints it.
+ */
+static double compare_mode(const char *what, struct irdm_engine_config cfg,
+			   const struct irdm_contact_site *sites, int m, size_t N,
+			   const double *target, enum irdm_contact_mode mode,
+			   const struct efx_ref_opts *o, double *F, double *R, size_t *rel)
+{
+	run_engine_cfg(&exact, cfg, sites, m, N, target, mode, F, rel);
+	efx_reference_opts(&exact, sites, m, N, target, o, R);
+	double err = efx_rel_rms(F, R, N * 3 * (size_t)m);
+	print_message("%-34s relative RMS force error %.2e\n", what, err);
+	return err;
+}
+
+/* Fig. 6b's two points with the paper's per-vertex solve (eq. 10-11). */
+static void test_per_vertex(void **state)
+{
+	const double a[3] = { 0.025, 0.05, 0.2 }, b[3] = { 0.075, 0.05, 0.2 };
+	const size_t N = 1200;
+	struct irdm_contact_site s[2];
+	struct irdm_engine_config cfg;
+	struct efx_ref_opts pv = { .tail_r = 1.0, .per_vertex = 1 }, co = { .tail_r = 1.0 };
+	double *u = calloc(N * 6, sizeof(double)), *F = malloc(N * 6 * sizeof(double));
+	double *R = malloc(N * 6 * sizeof(double)), *Rc = malloc(N * 6 * sizeof(double));
+
+	(void)state;
+	for (size_t t = 0; t < N; t++)
+		u[6 * t + 5] = -0.01 * fmin(1.0, (double)t / 600.0);
+	node_site(&exact, a, &s[0]);
+	node_site(&exact, b, &s[1]);
+	irdm_engine_config_default(&cfg);
+	cfg.solve = IRDM_SOLVE_PER_VERTEX;
+	double err = compare_mode("two points, per-vertex solve", cfg, s, 2, N, u,
+				  IRDM_CONTACT_GRAB, &pv, F, R, NULL);
+	/* the two solves must differ here, or this test could not tell them apart */
+	efx_reference_opts(&exact, s, 2, N, u, &co, Rc);
+	double apart = efx_rel_rms(R, Rc, N * 6);
+	print_message("per-vertex vs coupled solve: %.2e apart\n", apart);
+	assert_true(err <= TOL_MODAL_F64);
+	assert_true(apart > 1e3 * TOL_MODAL_F64);
+	free(u);
+	free(F);
+	free(R);
+	free(Rc);
+}
+
+/* A device pushes the top 1 cm through the haptic coupling (K, B). */
+static void test_coupling(void **state)
+{
+	const double top[3] = { 0.05, 0.05, 0.2 };
+	const size_t N = 1500;
+	struct irdm_contact_site s;
+	struct irdm_engine_config cfg;
+	double *u = calloc(N * 3, sizeof(double)), *F = malloc(N * 3 * sizeof(double));
+	double *R = malloc(N * 3 * sizeof(double));
+
+	(void)state;
+	for (size_t t = 0; t < N; t++)
+		u[3 * t + 2] = -0.01 * fmin(1.0, (double)t / 100.0);
+	node_site(&exact, top, &s);
+	irdm_engine_config_default(&cfg);
+	cfg.coupling_k_n_per_m = 1000;
+	cfg.coupling_b_ns_per_m = 2.25;
+	struct efx_ref_opts o = { .tail_r = 1.0, .k_n_per_m = 1000, .b_ns_per_m = 2.25,
+				  .dt_s = exact.meta->dt_s };
+	double err = compare_mode("step through the coupling", cfg, &s, 1, N, u,
+				  IRDM_CONTACT_GRAB, &o, F, R, NULL);
+	print_message("coupled force after 1.5 s: %.4f N\n", F[3 * (N - 1) + 2]);
+	assert_true(err <= TOL_MODAL_F64);
+	free(u);
+	free(F);
+	free(R);
+}
+
+/*
+ * A push contact lets go when holding the surface would pull the tool:
+ * pressed 1 cm through the haptic coupling (a rigid one rings every tick,
+ * docs/architecture.md, and lets go at once), held, then the tool lifts at
+ * 0.1 m/s; the reference decides the release tick on its own force.
+ */
+static void test_push_release(void **state)
+{
+	const double top[3] = { 0.05, 0.05, 0.2 };
+	const size_t N = 1200;
+	struct irdm_contact_site s;
+	struct irdm_engine_config cfg;
+	double *u = calloc(N * 3, sizeof(double)), *F = malloc(N * 3 * sizeof(double));
+	double *R = malloc(N * 3 * sizeof(double));
+	size_t rel, ref_rel = N;
+
+	(void)state;
+	for (size_t t = 0; t < N; t++) {
+		double z = -0.01 * fmin(1.0, (double)t / 200.0);
+		if (t > 600)
+			z = fmin(0.0, -0.01 + 1e-4 * (double)(t - 600));
+		u[3 * t + 2] = z;
+	}
+	node_site(&exact, top, &s);
+	irdm_engine_config_default(&cfg);
+	cfg.coupling_k_n_per_m = 1000;
+	cfg.coupling_b_ns_per_m = 2.25;
+	struct efx_ref_opts o = { .tail_r = 1.0, .push = 1, .normal = s.normal, .k_n_per_m = 1000,
+				  .b_ns_per_m = 2.25, .dt_s = exact.meta->dt_s };
+	double err = compare_mode("push, lifted off", cfg, &s, 1, N, u, IRDM_CONTACT_PUSH, &o, F,
+				  R, &rel);
+	for (size_t t = 0; t < N && ref_rel == N; t++)
+		if (t > 0 && R[3 * t] == 0 && R[3 * t + 1] == 0 && R[3 * t + 2] == 0)
+			ref_rel = t;
+	print_message("released at tick %zu (reference: %zu), the tool at z = %.2f mm\n", rel,
+		      ref_rel, 1e3 * u[3 * rel + 2]);
+	assert_true(rel > 600 && rel < N);
+	assert_int_equal(rel, ref_rel);
+	assert_true(err <= TOL_MODAL_F64);
+	free(u);
+	free(F);
+	free(R);
 }
 
 /* ---- stroking: a contact sliding across triangles ---- */
@@ -310,7 +520,7 @@ static void test_stroke(void **state)
 	print_message("stroke: %u triangle changes, relative RMS force error %.2e; largest tick-to-tick |dFz| %.2e N at a crossing, %.2e N elsewhere (mean |Fz| %.3f N)\n",
 		      changes, err, at_cross, elsewhere, mean);
 	assert_true(changes >= 4);
-	assert_true(err <= 1e-4);
+	assert_true(err <= TOL_STROKE);
 	assert_true(at_cross <= elsewhere);
 	free(sites);
 	free(u);
@@ -375,6 +585,10 @@ int main(void)
 		cmocka_unit_test(test_step),
 		cmocka_unit_test(test_release),
 		cmocka_unit_test(test_two_points),
+		cmocka_unit_test(test_fir),
+		cmocka_unit_test(test_per_vertex),
+		cmocka_unit_test(test_coupling),
+		cmocka_unit_test(test_push_release),
 		cmocka_unit_test(test_stroke),
 		cmocka_unit_test(test_errors),
 	};

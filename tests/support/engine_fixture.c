@@ -1,5 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 #include <math.h>
+#include <stdbool.h>
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -64,9 +65,9 @@ uint32_t efx_column_row_near(const struct irdm_image *img, const double p[3])
 	return br;
 }
 
-/* W[s] (3m x 3m, row-major per s) of the contact points. */
+/* W[s] (3m x 3m, row-major per s) of the contact points, times tail_r^s. */
 static double *contact_responses(const struct irdm_image *img, const struct irdm_contact_site *st,
-				 int m, size_t N)
+				 int m, size_t N, double tail_r)
 {
 	int n = 3 * m;
 	double *W = calloc(N * (size_t)n * n, sizeof(double));
@@ -83,11 +84,12 @@ static double *contact_responses(const struct irdm_image *img, const struct irdm
 						continue;
 					/* displacement at v (row) per force at w (column) */
 					assert_int_equal(irdm_image_response(img, st[j].col[w], st[i].row[v], N, R), 0);
-					for (size_t s = 0; s < N; s++)
+					double ws = a;
+					for (size_t s = 0; s < N; s++, ws *= tail_r)
 						for (int r = 0; r < 3; r++)
 							for (int c = 0; c < 3; c++)
 								W[s * n * n + (size_t)(3 * i + r) * n + 3 * j + c] +=
-									a * R[9 * s + 3 * (size_t)r + (size_t)c];
+									ws * R[9 * s + 3 * (size_t)r + (size_t)c];
 				}
 	free(R);
 	return W;
@@ -126,33 +128,127 @@ static void dense_solve(double *a, double *b, int n)
 void efx_reference(const struct irdm_image *img, const struct irdm_contact_site *sites, int m,
 		   size_t N, const double *target, double *F)
 {
-	int n = 3 * m;
-	double *W = contact_responses(img, sites, m, N);
+	struct efx_ref_opts o = { .tail_r = 1.0 };
 
+	efx_reference_opts(img, sites, m, N, target, &o, F);
+}
+
+void efx_reference_tail(const struct irdm_image *img, const struct irdm_contact_site *sites, int m,
+			size_t N, const double *target, double tail_r, double *F)
+{
+	struct efx_ref_opts o = { .tail_r = tail_r };
+
+	efx_reference_opts(img, sites, m, N, target, &o, F);
+}
+
+/* u_k[t] = sum_{s=0}^{t} W[s](k, :) F[t-s]: the contact points' displacement. */
+static double disp_at(const double *W, const double *F, int n, size_t t, int k)
+{
+	double u = 0;
+
+	for (size_t s = 0; s <= t; s++)
+		for (int j = 0; j < n; j++)
+			u += W[s * n * n + (size_t)k * n + j] * F[(t - s) * n + j];
+	return u;
+}
+
+/*
+ * One tick's system over the active unknowns act[0..na), written from the
+ * physics rather than from the engine's algebra: u = W0 F + U~ and, with a
+ * coupling, F = k (p - u) + (b/dt) ((p - p') - (u - u')); rigid: u = p.
+ * Per vertex: no W0 cross terms between different contacts.
+ */
+static void tick_system(const double *W, const double *F, const double *target, int n, size_t t,
+			const int *act, int na, const struct efx_ref_opts *o, const double *prev,
+			double *a, double *rhs)
+{
+	double bdt = o->b_ns_per_m / (o->dt_s > 0 ? o->dt_s : 1);
+
+	for (int q = 0; q < na; q++) {
+		int k = act[q];
+		double u = 0, p = target[t * n + k];
+
+		for (size_t s = 1; s <= t; s++)
+			for (int j = 0; j < n; j++)
+				u += W[s * n * n + (size_t)k * n + j] * F[(t - s) * n + j];
+		for (int c = 0; c < na; c++) {
+			double w0 = W[(size_t)k * n + act[c]];
+
+			if (o->per_vertex && k / 3 != act[c] / 3)
+				w0 = 0;
+			a[q * na + c] = o->k_n_per_m > 0 ? (o->k_n_per_m + bdt) * w0 : w0;
+		}
+		if (o->k_n_per_m > 0) {
+			a[q * na + q] += 1.0;
+			rhs[q] = o->k_n_per_m * (p - u) + bdt * (p - prev[2 * k] - u + prev[2 * k + 1]);
+		} else {
+			rhs[q] = p - u;
+		}
+	}
+}
+
+void efx_reference_opts(const struct irdm_image *img, const struct irdm_contact_site *sites, int m,
+			size_t N, const double *target, const struct efx_ref_opts *o, double *F)
+{
+	int n = 3 * m;
+	double *W = contact_responses(img, sites, m, N, o->tail_r);
+	double prev[24];                /* per unknown: the target and displacement of t-1 */
+	bool on[4] = { false }, released[4] = { false };
+
+	assert_true(m <= 4);
 	for (size_t t = 0; t < N; t++) {
 		double rhs[12], a[144];
 		int act[12], na = 0;
-		/* active unknowns this tick (released contacts carry no force) */
-		for (int i = 0; i < m; i++)
-			if (!isnan(target[t * n + 3 * i]))
-				for (int r = 0; r < 3; r++)
-					act[na++] = 3 * i + r;
+
 		for (int k = 0; k < n; k++)
 			F[t * n + k] = 0;
-		for (int q = 0; q < na; q++) {
-			int k = act[q];
-			double u = 0;
-			for (size_t s = 1; s <= t; s++)
-				for (int j = 0; j < n; j++)
-					u += W[s * n * n + (size_t)k * n + j] * F[(t - s) * n + j];
-			rhs[q] = target[t * n + k] - u;
-			for (int p = 0; p < na; p++)
-				a[q * na + p] = W[(size_t)k * n + act[p]];
+		for (int i = 0; i < m; i++) {
+			bool want = !isnan(target[t * n + 3 * i]) && !released[i];
+			if (want && !on[i])             /* fresh: no coupling damping yet */
+				for (int r = 0; r < 3; r++) {
+					int k = 3 * i + r;
+					double u = 0;
+					for (size_t s = 1; s <= t; s++)
+						for (int j = 0; j < n; j++)
+							u += W[s * n * n + (size_t)k * n + j] * F[(t - s) * n + j];
+					prev[2 * k] = prev[2 * k + 1] = u;
+				}
+			on[i] = want;
 		}
-		if (na)
+		for (int pass = 0; pass <= m; pass++) {
+			int dropped = 0;
+
+			na = 0;
+			for (int i = 0; i < m; i++)
+				if (on[i])
+					for (int r = 0; r < 3; r++)
+						act[na++] = 3 * i + r;
+			if (!na)
+				break;
+			tick_system(W, F, target, n, t, act, na, o, prev, a, rhs);
 			dense_solve(a, rhs, na);
-		for (int q = 0; q < na; q++)
-			F[t * n + act[q]] = rhs[q];
+			for (int q = 0; q < na; q++)
+				F[t * n + act[q]] = rhs[q];
+			/* a push contact that would pull the tool lets go */
+			for (int i = 0; i < m && o->push; i++) {
+				const double *f = &F[t * n + 3 * i], *nr = &o->normal[3 * i];
+				if (on[i] && f[0] * nr[0] + f[1] * nr[1] + f[2] * nr[2] > 0) {
+					on[i] = false;
+					released[i] = true;
+					dropped = 1;
+				}
+			}
+			if (!dropped)
+				break;
+			for (int k = 0; k < n; k++)
+				F[t * n + k] = 0;
+		}
+		for (int i = 0; i < m; i++)
+			for (int r = 0; on[i] && r < 3; r++) {
+				int k = 3 * i + r;
+				prev[2 * k] = target[t * n + k];
+				prev[2 * k + 1] = disp_at(W, F, n, t, k);
+			}
 	}
 	free(W);
 }

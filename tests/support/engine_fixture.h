@@ -25,6 +25,29 @@ struct irdm_session *efx_session(const struct irdm_image *img, const struct irdm
 void efx_reference(const struct irdm_image *img, const struct irdm_contact_site *sites, int m,
 		   size_t N, const double *target, double *F_out);
 
+/* The same with every R[s] weighted by tail_r^s (an FIR image's tail as a
+ * stabilised engine uses it; tail_r = 1: as recorded). */
+void efx_reference_tail(const struct irdm_image *img, const struct irdm_contact_site *sites, int m,
+			size_t N, const double *target, double tail_r, double *F);
+
+/*
+ * The reference with the engine's other modes, each restated from its
+ * physics: a virtual coupling k, b (F = k (p - u) + b (dp - du) / dt; k = 0:
+ * rigid), the paper's per-vertex solve (no R[0] cross terms between
+ * contacts: node sites only), push contacts (normal[3 i..]: outward; a
+ * contact whose force would pull the tool, F . n > 0, lets go for good),
+ * and the FIR tail weight.
+ */
+struct efx_ref_opts {
+	double tail_r;
+	int per_vertex;
+	double k_n_per_m, b_ns_per_m, dt_s;
+	int push;
+	const double *normal;
+};
+void efx_reference_opts(const struct irdm_image *img, const struct irdm_contact_site *sites, int m,
+			size_t N, const double *target, const struct efx_ref_opts *o, double *F);
+
 /* Relative RMS of a - b over n values: |a - b|_2 / |b|_2. */
 double efx_rel_rms(const double *a, const double *b, size_t n);
 
