@@ -188,7 +188,9 @@ static bool judge_axis(struct irdm_can_master *m, unsigned k)
 			 (unsigned long long)silent_ms, (unsigned)m->cfg.heartbeat_timeout_ms);
 	} else if (a->nmt != IRDM_CO_STATE_OPERATIONAL) {
 		snprintf(reason, sizeof(reason), "heartbeat says NMT %s", nmt_name(a->nmt));
-	} else if (a->state == IRDM_CIA402_FAULT || a->state == IRDM_CIA402_FAULT_REACTION_ACTIVE) {
+	} else if ((a->state == IRDM_CIA402_FAULT && !m->reset_request) ||
+		   a->state == IRDM_CIA402_FAULT_REACTION_ACTIVE) {
+		/* (a fault being reset on request is expected until it clears) */
 		snprintf(reason, sizeof(reason), "drive fault (statusword 0x%04X, %s)", a->sw,
 			 irdm_cia402_name(a->state));
 	} else if (m->enable && a->was_enabled && a->state != IRDM_CIA402_OPERATION_ENABLED) {

@@ -106,6 +106,7 @@ static int receive(struct irdm_hal_dev *dev)
 
 	if (c->link->check)
 		c->link->check(dev, &c->m);
+	pump(dev);              /* a fault just found sent the torque off: heard now */
 	return c->m.faulted ? faulted(dev) : rc;
 }
 
@@ -185,8 +186,12 @@ int irdm_hal_can_write(struct irdm_hal_dev *dev, const double tau_nm[IRDM_HAL_JO
 
 	if (c->state != HAL_CAN_RUNNING)
 		return IRDM_EINVAL;
-	if (c->m.faulted)
+	if (c->m.faulted) {
+		(void)irdm_can_master_send(&c->m, NULL);        /* off again, with the SYNC */
+		pump(dev);
+		c->written = true;
 		return faulted(dev);
+	}
 	for (unsigned a = 0; a < IRDM_HAL_JOINTS; a++) {
 		tau[a] = isfinite(tau_nm[a]) ? tau_nm[a] : 0.0;
 		if (!isfinite(tau_nm[a]))
