@@ -150,6 +150,11 @@ static void test_canemu_runs_and_faults(void **state)
 	irdm_can_drives_fault(irdm_hal_canemu_drives(&dev), 1, 0x4210);
 	assert_int_equal(irdm_hal_write(&dev, tau), IRDM_OK);   /* the EMCY is not read yet */
 	assert_int_equal(irdm_hal_read(&dev, &st), IRDM_EHW);
+	/* in the same tick, before any write: every emulated drive was told off */
+	for (unsigned k = 0; k < 3; k++) {
+		assert_int_equal(irdm_hal_canemu_drives(&dev)->d[k].rpdo_cw, 0);
+		assert_int_equal(irdm_hal_canemu_drives(&dev)->d[k].rpdo_torque_permille, 0);
+	}
 	assert_int_equal(irdm_hal_poll(&dev, &faults), IRDM_EHW);
 	assert_int_equal(faults, IRDM_HAL_FAULT_DRIVE);
 	assert_string_equal(dev.why, "drive 2 (node 2): EMCY 0x4210 (temperature), error register 0x01");
