@@ -161,6 +161,35 @@ static void test_bad_options_one_line(void **state)
 			    "rated_torque_xxx: unknown option for this back-end\n");
 }
 
+/* A drive faulting mid-run: torque off, the run ends in fault, and the
+ * reason names the drive in one line (stderr and the summary). */
+static void test_fault_reason_one_line(void **state)
+{
+	static char text[16384];
+	char board[320];
+	char *at;
+	int rc;
+
+	(void)state;
+	tf_read_text("boards/canemu-3dof.board", text, sizeof(text));
+	at = strstr(text, "substeps=10\n");
+	assert_non_null(at);
+	memmove(at + 2, at, strlen(at) + 1);    /* 2 more bytes: "emcy_at=2:500" */
+	memcpy(at, "emcy_at=2:500", strlen("emcy_at=2:500"));
+	snprintf(board, sizeof(board), "%s/emcy.board", dir);
+	tf_write_text(board, text);
+	rc = run(env_or("IRDM_FW", "build/irdm-fw"), (const char *const[]){
+		"--board", board, "--image", image, "--user", "scenes/users/press-hold-release.user",
+		"--clock", "virtual", NULL });
+	print_message("exit %d; stderr: %s", rc, err_text);
+	assert_int_not_equal(rc, 0);
+	assert_non_null(strstr(err_text, "irdm-fw: EFAULT: fault "));
+	assert_non_null(strstr(err_text, ": torque off: drive 2 (node 2): EMCY 0x2310 (current), "
+				   "error register 0x01\n"));
+	assert_non_null(strstr(out_text, "(torque off): drive 2 (node 2): EMCY 0x2310 (current), "
+				   "error register 0x01\n"));
+}
+
 static int setup(void **state)
 {
 	(void)state;
@@ -183,6 +212,7 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_canemu_matches_delayed_sim),
 		cmocka_unit_test(test_bad_options_one_line),
+		cmocka_unit_test(test_fault_reason_one_line),
 	};
 
 	return cmocka_run_group_tests(tests, setup, teardown);

@@ -45,12 +45,15 @@ struct irdm_hal_can_opts {
 	uint32_t sdo_timeout_ms;
 	uint32_t enable_timeout_ms;
 	unsigned substeps;              /* canemu only: the emulated arm's steps a period */
+	unsigned emcy_drive;            /* canemu only: drive (1..) that faults, 0: none */
+	uint32_t emcy_at_ms;            /*   at this virtual time, with EMCY 0x2310 */
 };
 
 /* Which options a back-end takes beyond the common ones. */
 enum irdm_hal_can_extra {
 	IRDM_HAL_CAN_IFACE = 1u << 0,   /* iface= (required) */
 	IRDM_HAL_CAN_SUBSTEPS = 1u << 1,
+	IRDM_HAL_CAN_EMCY_AT = 1u << 2, /* emcy_at=DRIVE:MS (an injected fault) */
 };
 
 /*
