@@ -87,19 +87,29 @@ static void run_board(const char *board, const char *log)
 		fail_msg("irdm-fw on %s: %s", board, err_text);
 }
 
+/* dir/name: boards/from with the first `find` replaced by `repl`. */
+static void edited_board(const char *from, const char *find, const char *repl, const char *name,
+			 char *path, size_t len)
+{
+	static char text[16384];
+	size_t flen = strlen(find), rlen = strlen(repl);
+	char *at;
+
+	tf_read_text(from, text, sizeof(text));
+	at = strstr(text, find);
+	assert_non_null(at);
+	assert_true(strlen(text) - flen + rlen < sizeof(text));
+	memmove(at + rlen, at + flen, strlen(at + flen) + 1);
+	memcpy(at, repl, rlen);
+	snprintf(path, len, "%s/%s", dir, name);
+	tf_write_text(path, text);
+}
+
 /* sim-phantom.board with the sim back-end's write_delay=1. */
 static void sim_delayed_board(char *path, size_t len)
 {
-	static char text[16384];
-	const char *from = "write_delay=0,read_delay=0";
-	char *at;
-
-	tf_read_text("boards/sim-phantom.board", text, sizeof(text));
-	at = strstr(text, from);
-	assert_non_null(at);
-	at[strlen("write_delay=")] = '1';
-	snprintf(path, len, "%s/sim-delayed.board", dir);
-	tf_write_text(path, text);
+	edited_board("boards/sim-phantom.board", "write_delay=0", "write_delay=1",
+		     "sim-delayed.board", path, len);
 }
 
 static void test_canemu_matches_delayed_sim(void **state)
@@ -141,18 +151,12 @@ static void test_canemu_matches_delayed_sim(void **state)
 
 static void test_bad_options_one_line(void **state)
 {
-	static char text[16384];
 	char board[320];
-	char *at;
 	int rc;
 
 	(void)state;
-	tf_read_text("boards/canemu-3dof.board", text, sizeof(text));
-	at = strstr(text, "rated_torque_mnm=100");
-	assert_non_null(at);
-	memcpy(at, "rated_torque_xxx", strlen("rated_torque_xxx"));
-	snprintf(board, sizeof(board), "%s/bad.board", dir);
-	tf_write_text(board, text);
+	edited_board("boards/canemu-3dof.board", "rated_torque_mnm=100", "rated_torque_xxx=100",
+		     "bad.board", board, sizeof(board));
 	rc = run(env_or("IRDM_FW", "build/irdm-fw"), (const char *const[]){
 		"--board", board, "--image", image, "--clock", "virtual", "--duration", "0.1",
 		"-q", NULL });
@@ -165,19 +169,12 @@ static void test_bad_options_one_line(void **state)
  * reason names the drive in one line (stderr and the summary). */
 static void test_fault_reason_one_line(void **state)
 {
-	static char text[16384];
 	char board[320];
-	char *at;
 	int rc;
 
 	(void)state;
-	tf_read_text("boards/canemu-3dof.board", text, sizeof(text));
-	at = strstr(text, "substeps=10\n");
-	assert_non_null(at);
-	memmove(at + 2, at, strlen(at) + 1);    /* 2 more bytes: "emcy_at=2:500" */
-	memcpy(at, "emcy_at=2:500", strlen("emcy_at=2:500"));
-	snprintf(board, sizeof(board), "%s/emcy.board", dir);
-	tf_write_text(board, text);
+	edited_board("boards/canemu-3dof.board", "substeps=10", "substeps=10 emcy_at=2:500",
+		     "emcy.board", board, sizeof(board));
 	rc = run(env_or("IRDM_FW", "build/irdm-fw"), (const char *const[]){
 		"--board", board, "--image", image, "--user", "scenes/users/press-hold-release.user",
 		"--clock", "virtual", NULL });

@@ -66,15 +66,7 @@ static int socketcan_open(struct irdm_hal_dev *dev)
 	return irdm_hal_can_open(dev, &socketcan_link, IRDM_HAL_CAN_IFACE);
 }
 
-static const struct irdm_hal_ops socketcan_ops = {
-	.open = socketcan_open,
-	.start = irdm_hal_can_start,
-	.read = irdm_hal_can_read,
-	.write = irdm_hal_can_write,
-	.safe_off = irdm_hal_can_safe_off,
-	.poll = irdm_hal_can_poll,
-	.close = irdm_hal_can_close,
-};
+static const struct irdm_hal_ops socketcan_ops = IRDM_HAL_CAN_OPS(socketcan_open);
 
 const struct irdm_hal_backend irdm_hal_socketcan_backend = {
 	.name = "socketcan",

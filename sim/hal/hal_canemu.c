@@ -83,15 +83,7 @@ static int canemu_open(struct irdm_hal_dev *dev)
 	return irdm_hal_can_open(dev, &canemu_link, IRDM_HAL_CAN_SUBSTEPS | IRDM_HAL_CAN_EMCY_AT);
 }
 
-static const struct irdm_hal_ops canemu_ops = {
-	.open = canemu_open,
-	.start = irdm_hal_can_start,
-	.read = irdm_hal_can_read,
-	.write = irdm_hal_can_write,
-	.safe_off = irdm_hal_can_safe_off,
-	.poll = irdm_hal_can_poll,
-	.close = irdm_hal_can_close,
-};
+static const struct irdm_hal_ops canemu_ops = IRDM_HAL_CAN_OPS(canemu_open);
 
 const struct irdm_hal_backend irdm_hal_canemu_backend = {
 	.name = "canemu",

@@ -102,6 +102,14 @@ int irdm_hal_can_safe_off(struct irdm_hal_dev *dev);
 int irdm_hal_can_poll(struct irdm_hal_dev *dev, uint32_t *faults);
 void irdm_hal_can_close(struct irdm_hal_dev *dev);
 
+/* A CAN back-end's ops table: its own open, the shared rest. */
+#define IRDM_HAL_CAN_OPS(open_fn)                                                              \
+	{                                                                                      \
+		.open = (open_fn), .start = irdm_hal_can_start, .read = irdm_hal_can_read,     \
+		.write = irdm_hal_can_write, .safe_off = irdm_hal_can_safe_off,                \
+		.poll = irdm_hal_can_poll, .close = irdm_hal_can_close,                        \
+	}
+
 /* The operator's fault reset (tests; the controller has no such command yet). */
 void irdm_hal_can_reset_faults(struct irdm_hal_dev *dev);
 
