@@ -316,6 +316,11 @@ static void test_torque_scaling(void **state)
 	expect_frame(1, 0x202, 4, n2);
 	assert_int_equal(dr.d[0].rpdo_torque_permille, 86);
 	assert_int_equal(dr.d[1].rpdo_torque_permille, -86);
+	/* rounded, clamped to int16, not finite -> 0 */
+	assert_int_equal(irdm_can_torque_permille(&c.axis[0], 0.5 * 86.5 / 86.2), 87);
+	assert_int_equal(irdm_can_torque_permille(&c.axis[0], 1e9), 32767);
+	assert_int_equal(irdm_can_torque_permille(&c.axis[0], -1e9), -32767);
+	assert_int_equal(irdm_can_torque_permille(&c.axis[0], 0.0 / 0.0), 0);
 }
 
 /* Every axis got disable voltage + zero torque within two periods of

@@ -143,8 +143,18 @@ static void test_canemu_runs_and_faults(void **state)
 	assert_int_equal(irdm_hal_start(&dev), IRDM_OK);
 	run_ticks(100, tau, &bad);
 	assert_int_equal(bad, 0);
+	{       /* a torque that is not a number: refused, zero sent instead */
+		double nan_tau[3] = { 0.0, 0.0 / 0.0, 0.0 };
+
+		assert_int_equal(irdm_hal_write(&dev, nan_tau), IRDM_EFAULT);
+		assert_int_equal(irdm_hal_canemu_drives(&dev)->d[1].rpdo_torque_permille, 0);
+		assert_int_equal(irdm_hal_read(&dev, &st), IRDM_OK);
+		assert_int_equal(irdm_hal_write(&dev, tau), IRDM_OK);
+		/* 0.098 N m / 11.6 = 8.45 mN m = 84.5 per mille of 100 mN m -> 84 */
+		assert_int_equal(irdm_hal_canemu_drives(&dev)->d[1].rpdo_torque_permille, 84);
+	}
 	assert_int_equal(irdm_hal_read(&dev, &st), IRDM_OK);
-	assert_int_equal(st.seq, 101);
+	assert_int_equal(st.seq, 102);
 	/* drive 2 raises EMCY 0x4210 (temperature) and faults */
 	mark = n_log;
 	irdm_can_drives_fault(irdm_hal_canemu_drives(&dev), 1, 0x4210);

@@ -66,8 +66,10 @@ int irdm_hal_can_open(struct irdm_hal_dev *dev, const struct irdm_hal_can_link *
 
 	if (c->state != HAL_CAN_CLOSED)
 		return IRDM_EBUSY;
-	if (!cfg->device || !(isfinite(cfg->period_s) && cfg->period_s >= 1e-4 && cfg->period_s <= 1))
-		return say(dev, "period: 100 us to 1 s"), IRDM_EINVAL;
+	if (!cfg->device || !(isfinite(cfg->period_s) && cfg->period_s >= 1e-4 && cfg->period_s <= 1)) {
+		say(dev, "period: 100 us to 1 s, and an arm");
+		return IRDM_EINVAL;
+	}
 	c->link = link;
 	rc = irdm_hal_can_parse(cfg->options, extra, &c->opts, dev->why, sizeof(dev->why));
 	if (!rc)
