@@ -192,6 +192,45 @@ static void test_canemu_runs_and_faults(void **state)
 	assert_null(irdm_hal_canemu_drives(&dev));
 }
 
+/* One SYNC per tick and one RPDO per axis before each, also in ticks the
+ * loop does not write (the read closes the period), counter +1 each. */
+static void test_one_sync_per_tick(void **state)
+{
+	double tau[3] = { 0.0, 0.098, 0.0 };
+	struct irdm_hal_joint_state st;
+	unsigned rpdos[3] = { 0, 0, 0 }, syncs = 0, last = 0;
+
+	(void)state;
+	assert_int_equal(open_as("canemu", OPTS), IRDM_OK);
+	assert_int_equal(irdm_hal_start(&dev), IRDM_OK);
+	n_log = 0;
+	for (int k = 0; k < 300; k++) {
+		assert_int_equal(irdm_hal_read(&dev, &st), IRDM_OK);
+		if (k % 3)      /* every third tick writes nothing */
+			assert_int_equal(irdm_hal_write(&dev, tau), IRDM_OK);
+	}
+	for (unsigned i = 0; i < n_log; i++) {
+		const struct irdm_can_frame *f = &bus_log[i].f;
+
+		if (bus_log[i].from != 0)
+			continue;
+		if (f->id == 0x080) {
+			for (int a = 0; a < 3; a++)
+				assert_int_equal(rpdos[a], 1);
+			memset(rpdos, 0, sizeof(rpdos));
+			if (syncs++)
+				assert_int_equal(f->data[0], last % 240 + 1);
+			last = f->data[0];
+		} else {
+			assert_true(f->id >= 0x201 && f->id <= 0x203);
+			rpdos[f->id - 0x201]++;
+		}
+	}
+	/* start's last SYNC was before the log; then one per tick */
+	assert_int_equal(syncs, 300);
+	irdm_hal_close(&dev);
+}
+
 static void test_canemu_start_times_out(void **state)
 {
 	(void)state;
@@ -292,6 +331,7 @@ int main(void)
 		cmocka_unit_test(test_options_refused_by_name),
 		cmocka_unit_test(test_socketcan_without_interface),
 		cmocka_unit_test(test_canemu_runs_and_faults),
+		cmocka_unit_test(test_one_sync_per_tick),
 		cmocka_unit_test(test_canemu_start_times_out),
 		cmocka_unit_test(test_tick_ops_no_system_call_no_allocation),
 	};
