@@ -114,6 +114,36 @@ static void test_socketcan_without_interface(void **state)
 	assert_non_null(strstr(dev.why, "nosuchcan7"));
 }
 
+/* The SocketCAN port's flags into a master running on emulated drives. */
+static void test_socketcan_bus_off_loses_link(void **state)
+{
+	struct irdm_socketcan sock = { .fd = -1 };
+	struct irdm_hal_joint_state st;
+	struct irdm_can_master *m;
+
+	(void)state;
+	assert_int_equal(open_as("canemu", OPTS), IRDM_OK);
+	assert_int_equal(irdm_hal_start(&dev), IRDM_OK);
+	m = &((struct irdm_hal_can *)dev.data)->m;
+	sock.error_passive = true;
+	irdm_hal_socketcan_judge(&sock, m);
+	assert_false(m->faulted);
+	assert_int_equal(irdm_hal_read(&dev, &st), IRDM_OK);
+	sock.bus_off = true;
+	n_log = 0;
+	irdm_hal_socketcan_judge(&sock, m);
+	assert_true(m->faulted && m->link_lost);
+	assert_string_equal(m->why, "CAN link: bus-off (the controller left the bus)");
+	assert_int_equal(n_log, 4);     /* off to 0x201..0x203, then the SYNC */
+	for (unsigned i = 0; i < 3; i++) {
+		assert_int_equal(bus_log[i].f.id, 0x201 + i);
+		assert_int_equal(bus_log[i].f.data[0] | bus_log[i].f.data[1] | bus_log[i].f.data[2] |
+					 bus_log[i].f.data[3], 0);
+	}
+	assert_int_equal(bus_log[3].f.id, 0x080);
+	irdm_hal_close(&dev);
+}
+
 static void run_ticks(int n, const double tau[3], int *bad)
 {
 	struct irdm_hal_joint_state st;
@@ -330,6 +360,7 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_options_refused_by_name),
 		cmocka_unit_test(test_socketcan_without_interface),
+		cmocka_unit_test(test_socketcan_bus_off_loses_link),
 		cmocka_unit_test(test_canemu_runs_and_faults),
 		cmocka_unit_test(test_one_sync_per_tick),
 		cmocka_unit_test(test_canemu_start_times_out),

@@ -41,10 +41,15 @@ static void link_idle(void *ctx)
 	nanosleep(&ts, NULL);
 }
 
+void irdm_hal_socketcan_judge(const struct irdm_socketcan *s, struct irdm_can_master *m)
+{
+	if (s->bus_off)
+		irdm_can_master_lose(m, -1, "bus-off (the controller left the bus)");
+}
+
 static void link_check(struct irdm_hal_dev *dev, struct irdm_can_master *m)
 {
-	if (data_of(dev)->sock.bus_off)
-		irdm_can_master_lose(m, -1, "bus-off (the controller left the bus)");
+	irdm_hal_socketcan_judge(&data_of(dev)->sock, m);
 }
 
 static void link_close(struct irdm_hal_dev *dev)
