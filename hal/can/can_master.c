@@ -205,7 +205,7 @@ static bool judge_axis(struct irdm_can_master *m, unsigned k)
 	return false;
 }
 
-static int irdm_can_master_first_fault(const struct irdm_can_master *m)
+static int first_fault(const struct irdm_can_master *m)
 {
 	for (unsigned k = 0; k < m->cfg.n_axes; k++)
 		if (m->ax[k].state == IRDM_CIA402_FAULT)
@@ -253,7 +253,7 @@ int irdm_can_master_receive(struct irdm_can_master *m)
 	}
 	if (m->faulted)
 		return IRDM_EHW;
-	if (irdm_can_master_first_fault(m) < 0)
+	if (first_fault(m) < 0)
 		m->reset_request = false;       /* every fault reset: asked once, done */
 	return stale ? IRDM_ETIMEDOUT : IRDM_OK;
 }
