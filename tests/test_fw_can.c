@@ -8,14 +8,26 @@
  * have).  Also: the bus load printed at start, and a bad hal_options line
  * refused in one line naming the option.
  *
- * What differs, and so the tolerance (measured, then a margin): the CAN
- * run's enable sequence runs 5 SYNCs, so 5 periods of the emulated arm
- * at zero torque, before the first tick (the arm has started to fall when
- * calibrated); its TPDO position is sampled at the SYNC, before the step
- * (the sim back-end samples after its step); the torque is quantised to
- * 1 per mille of 100 mN m (1.16 mN m at the joint).  Measured: peak
- * force 0.4660 N vs 0.4667 N, at 1.245 s vs 1.241 s; the largest
- * per-tick force difference 0.021 N (4.5 % of the peak, near release).
+ * What differs, and so the tolerance (measured, then a margin).  Per
+ * tick |F_can - F_sim| against write_delay=1: max 0.021 N (4.5 % of the
+ * 0.467 N peak, at release, 3.246 s), p99 0.012 N; peaks 0.4660 vs
+ * 0.4667 N at 1.245 vs 1.241 s.  Where it comes from, measured by
+ * changing one thing at a time (not kept in the tree):
+ *  - timing: in sim back-end terms the emulated bus is closest to
+ *    write_delay=0, read_delay=1 (max 0.015 N, p99 0.008 N): an RPDO's
+ *    torque acts from the SYNC right after it, and the TPDO carries the
+ *    position sampled at that SYNC, before the period's step.  The brief's
+ *    reference (write_delay=1) is one of the neighbours, not the match;
+ *    it is kept, and the closer model is checked beside it.
+ *  - start-up: enabling the drives takes 5 SYNCs, 5 periods of the
+ *    emulated arm at zero torque before the first tick (it has started to
+ *    fall when calibrated); without them the first ticks' angles match
+ *    the sim run exactly, but the largest difference stays (p99 0.008 ->
+ *    0.005 N against write_delay=0/read_delay=1).
+ *  - torque quantisation (1 per mille of 100 mN m rated: 1.16 mN m at the
+ *    joint) is not a factor: 10 mN m rated gives the same numbers.
+ * Tolerances: 0.03 N per tick against write_delay=1, 0.02 N against
+ * write_delay=0/read_delay=1; peak within 1 %, its time within 20 ms.
  *
  * Needs IRDM and IRDM_FW (make test sets them); runs from the repository root.
  */
@@ -105,48 +117,60 @@ static void edited_board(const char *from, const char *find, const char *repl, c
 	tf_write_text(path, text);
 }
 
-/* sim-phantom.board with the sim back-end's write_delay=1. */
-static void sim_delayed_board(char *path, size_t len)
+/* The largest per-tick |F| difference of two runs; where. */
+static double worst_diff(const struct trace *a, const struct trace *b, size_t *at)
 {
-	edited_board("boards/sim-phantom.board", "write_delay=0", "write_delay=1",
-		     "sim-delayed.board", path, len);
+	double worst = 0;
+
+	for (size_t k = 0; k < TICKS; k++)
+		if (fabs(a->f_n[k] - b->f_n[k]) > worst)
+			worst = fabs(a->f_n[k] - b->f_n[k]), *at = k;
+	return worst;
 }
 
 static void test_canemu_matches_delayed_sim(void **state)
 {
-	static struct trace can, sim;
-	char sim_board[320], can_log[320], sim_log[320];
-	double worst = 0;
-	size_t worst_at = 0;
+	static struct trace can, sim, sim_rd;
+	char board[320], can_log[320], sim_log[320], rd_log[320];
+	double worst, worst_rd;
+	size_t worst_at = 0, rd_at = 0;
 
 	(void)state;
 	snprintf(can_log, sizeof(can_log), "%s/can.log", dir);
 	snprintf(sim_log, sizeof(sim_log), "%s/sim.log", dir);
+	snprintf(rd_log, sizeof(rd_log), "%s/sim-rd.log", dir);
 	run_board("boards/canemu-3dof.board", can_log);
 	assert_non_null(strstr(out_text, "hal 'canemu': CAN bus load: SYNC + 3 x RPDO1 (4 B) + 3 x "
 				   "TPDO1 (6 B) = 695 bits worst case in 1000 us at 1000000 "
 				   "bit/s: 69.5 %"));
 	assert_non_null(strstr(out_text, "state: off"));
-	sim_delayed_board(sim_board, sizeof(sim_board));
-	run_board(sim_board, sim_log);
+	edited_board("boards/sim-phantom.board", "write_delay=0", "write_delay=1",
+		     "sim-delayed.board", board, sizeof(board));
+	run_board(board, sim_log);
+	edited_board("boards/sim-phantom.board", "read_delay=0", "read_delay=1", "sim-rd.board",
+		     board, sizeof(board));
+	run_board(board, rd_log);
 	read_trace(can_log, &can);
 	read_trace(sim_log, &sim);
+	read_trace(rd_log, &sim_rd);
 	assert_int_equal(can.n, TICKS);
 	assert_int_equal(sim.n, TICKS);
+	assert_int_equal(sim_rd.n, TICKS);
 	assert_false(can.faulted);
-	for (size_t k = 0; k < TICKS; k++)
-		if (fabs(can.f_n[k] - sim.f_n[k]) > worst)
-			worst = fabs(can.f_n[k] - sim.f_n[k]), worst_at = k;
+	worst = worst_diff(&can, &sim, &worst_at);
+	worst_rd = worst_diff(&can, &sim_rd, &rd_at);
 	print_message("canemu: peak %.4f N at %.3f s, %zu contact ticks; sim write_delay=1: peak "
-		      "%.4f N at %.3f s, %zu contact ticks; max |dF| %.4f N at %.3f s\n",
+		      "%.4f N at %.3f s, %zu contact ticks; max |dF| %.4f N at %.3f s; against "
+		      "write_delay=0 read_delay=1: %.4f N at %.3f s\n",
 		      can.peak_n, can.peak_at * 1e-3, can.contact, sim.peak_n, sim.peak_at * 1e-3,
-		      sim.contact, worst, worst_at * 1e-3);
+		      sim.contact, worst, worst_at * 1e-3, worst_rd, rd_at * 1e-3);
 	/* the run means something: a press of a few tenths of a newton */
 	assert_true(sim.peak_n > 0.3 && sim.contact > 1000);
 	assert_true(fabs(can.peak_n - sim.peak_n) <= 0.01 * sim.peak_n);
 	assert_true(can.peak_at >= sim.peak_at - 20 && can.peak_at <= sim.peak_at + 20);
 	assert_true(labs((long)can.contact - (long)sim.contact) <= (long)sim.contact / 50);
 	assert_true(worst <= 0.03);
+	assert_true(worst_rd <= 0.02);
 }
 
 static void test_bad_options_one_line(void **state)
