@@ -114,6 +114,8 @@ static void test_socketcan_without_interface(void **state)
 	assert_non_null(strstr(dev.why, "nosuchcan7"));
 }
 
+static const double NULL_TAU[3] = { 0, 0, 0 };
+
 /* The SocketCAN port's flags into a master running on emulated drives. */
 static void test_socketcan_bus_off_loses_link(void **state)
 {
@@ -129,6 +131,14 @@ static void test_socketcan_bus_off_loses_link(void **state)
 	irdm_hal_socketcan_judge(&sock, m);
 	assert_false(m->faulted);
 	assert_int_equal(irdm_hal_read(&dev, &st), IRDM_OK);
+	/* one period without a TPDO: a time-out naming the drive, gone at the next */
+	irdm_hal_canemu_drives(&dev)->d[2].drop_tpdos = 1;
+	assert_int_equal(irdm_hal_write(&dev, NULL_TAU), IRDM_OK);
+	assert_int_equal(irdm_hal_read(&dev, &st), IRDM_ETIMEDOUT);
+	assert_string_equal(dev.why, "drive 3 (node 3): no TPDO1 this period");
+	assert_int_equal(irdm_hal_write(&dev, NULL_TAU), IRDM_OK);
+	assert_int_equal(irdm_hal_read(&dev, &st), IRDM_OK);
+	assert_string_equal(dev.why, "");
 	sock.bus_off = true;
 	n_log = 0;
 	irdm_hal_socketcan_judge(&sock, m);

@@ -174,6 +174,7 @@ int irdm_hal_can_read(struct irdm_hal_dev *dev, struct irdm_hal_joint_state *st)
 	}
 	if (rc)
 		return rc;
+	dev->why[0] = '\0';    /* a late TPDO's line is not the reason of a later fault */
 	for (unsigned a = 0; a < IRDM_HAL_JOINTS; a++)
 		st->counts[a] = c->m.ax[a].counts;
 	st->seq = ++c->seq;
