@@ -140,7 +140,7 @@ static void test_cantilever_matches_euler_bernoulli(void **state)
 	const double bl[2] = { 1.87510407, 4.69409113 };
 
 	(void)state;
-	/* linear tets lock in bending: 8 cells across are needed for < 3 % */
+	/* linear tets lock in bending: 8 cells across are needed for < 2 % */
 	fixture_model(&m, w, w, L, 8, 8, 160, 5, 0.0, false, 4, IRDM_EIG_LANCZOS, 0.001);
 	double EI = E * pow(w, 4) / 12, rhoA = rho * w * w;
 	/* bending modes come in degenerate x/y pairs: modes 0,1 and the second pair */
@@ -153,7 +153,8 @@ static void test_cantilever_matches_euler_bernoulli(void **state)
 		double rel = fabs(f - f_eb) / f_eb;
 		print_message("cantilever bending %d: FEM %.5f Hz, Euler-Bernoulli %.5f Hz (%.2f %%)\n",
 			      i + 1, f, f_eb, 100 * rel);
-		assert_true(rel <= 0.03);
+		/* measured 1.57 % and 0.58 % (the second pair locks less) */
+		assert_true(rel <= (i == 0 ? 0.02 : 0.008));
 		/* the pair is degenerate by symmetry */
 		assert_true(fabs(m.modes.omega2[idx + 1] - m.modes.omega2[idx]) <= 1e-6 * m.modes.omega2[idx]);
 	}

@@ -102,7 +102,7 @@ static void test_modal_equals_time_domain_grounded_cuboid(void **state)
 	pick_columns(&m, 0.1, 0.1, 0.2, cols);
 	double rel = modal_vs_time_domain(&m, cols, 3, false, 0.002, 250, 32);
 	print_message("grounded cuboid: max |R_modal - R_td| / max |R| = %.3g\n", rel);
-	assert_true(rel <= 1e-3);
+	assert_true(rel <= 3e-4);       /* measured 1.03e-4 at 32 sub-steps */
 	irdm_model_free(&m);
 }
 
@@ -116,7 +116,7 @@ static void test_modal_equals_time_domain_floating_cube(void **state)
 	pick_columns(&m, 0.12, 0.12, 0.12, cols);
 	double rel = modal_vs_time_domain(&m, cols, 3, true, 0.002, 250, 32);
 	print_message("floating cube: max |R_modal - R_td| / max |R| = %.3g\n", rel);
-	assert_true(rel <= 1e-3);
+	assert_true(rel <= 5e-4);       /* measured 1.77e-4 */
 	irdm_model_free(&m);
 }
 

@@ -50,21 +50,42 @@ static char dir[64];
 #define DEVICE_F 7.9
 
 struct outcome {
-	double max_f, first_rms, last_rms, min_work, max_work, rho;
+	double max_f, min_work, max_work, rho;
+	double first_osc, last_osc;     /* |F|'s standard deviation in the 2nd and last tenth */
+	double held_f, coupling_b;      /* mean |F| of the last window; the coupling's B */
 	unsigned touches;
 };
+
+/* Mean and spread in one pass without cancellation (Welford): a ripple of
+ * 1e-9 N on a 10 N force would vanish in E[f^2] - E[f]^2. */
+struct welford {
+	size_t n;
+	double mean, m2;
+};
+
+static void welford_add(struct welford *w, double x)
+{
+	double d = x - w->mean;
+
+	w->n++;
+	w->mean += d / (double)w->n;
+	w->m2 += d * (x - w->mean);
+}
 
 static struct outcome hold_step(const struct irdm_image *img, double seconds)
 {
 	struct irdm_engine_config cfg;
 	struct irdm_contact_cmd cmd[IRDM_MAX_CONTACTS];
 	struct irdm_contact_site site;
-	struct outcome o = { 0, 0, 0, INFINITY, -INFINITY, img->meta->max_spectral_radius, 0 };
+	struct outcome o = { .min_work = INFINITY, .max_work = -INFINITY,
+			     .rho = img->meta->max_spectral_radius };
+	struct welford first = { 0 }, last = { 0 };
 	const double top[3] = { 0.05, 0.05, 0.2 };
 	size_t N = (size_t)(seconds / img->meta->dt_s), tenth = N / 10;
 	double work = 0;
 
 	irdm_engine_config_haptic(&cfg, img->meta->dt_s, DEVICE_K, DEVICE_B, 0 /* observe, no fault */);
+	o.coupling_b = cfg.coupling_b_ns_per_m;
 	struct irdm_session *ses = efx_session(img, &cfg);
 	struct irdm_engine *e = ses->eng;
 	assert_int_equal(irdm_engine_site_node(e, efx_column_row_near(img, top), &site), 0);
@@ -94,26 +115,35 @@ static struct outcome hold_step(const struct irdm_image *img, double seconds)
 		}
 		o.max_f = fmax(o.max_f, sqrt(f2));
 		if (t >= tenth && t < 2 * tenth)
-			o.first_rms += f2;
+			welford_add(&first, sqrt(f2));
 		if (t >= N - tenth)
-			o.last_rms += f2;
+			welford_add(&last, sqrt(f2));
 		o.min_work = fmin(o.min_work, work);
 		o.max_work = fmax(o.max_work, work);
 	}
-	o.first_rms = sqrt(o.first_rms / (double)tenth);
-	o.last_rms = sqrt(o.last_rms / (double)tenth);
+	o.held_f = last.mean;
+	o.first_osc = sqrt(first.m2 / (double)first.n);
+	o.last_osc = sqrt(last.m2 / (double)last.n);
 	irdm_session_close(ses);
 	return o;
 }
 
 static void check(const char *what, struct outcome o)
 {
-	print_message("%-26s radius %.4f touches %3u max|F| %6.3f N rms 6-12 s %.4f, last 6 s %.4f N work min %.1e max %.1e J\n",
-		      what, o.rho, o.touches, o.max_f, o.first_rms, o.last_rms, o.min_work, o.max_work);
-	/* bounded: within the coupling's spring and damper forces at 1 cm, 0.2 m/s */
-	assert_true(o.max_f <= 1.5 * (DEVICE_K * 0.01 + DEVICE_B * 0.2));
-	/* not growing */
-	assert_true(o.last_rms <= 1.05 * o.first_rms + 1e-9);
+	print_message("%-26s radius %.4f touches %3u max|F| %6.3f N held %.4f N, oscillation 6-12 s %.1e, last 6 s %.1e N work min %.1e max %.1e J\n",
+		      what, o.rho, o.touches, o.max_f, o.held_f, o.first_osc, o.last_osc, o.min_work,
+		      o.max_work);
+	/*
+	 * Bounded: the held force is at most the coupling spring's at 1 cm,
+	 * and the peak exceeds it by no more than the coupling damper's force
+	 * at the approach speed (0.2 m/s) plus 0.05 N (measured overshoots
+	 * 0.09-0.45 N, the stiffest cases at exactly B x 0.2).
+	 */
+	assert_true(o.held_f <= DEVICE_K * 0.01);
+	assert_true(o.max_f - o.held_f <= o.coupling_b * 0.2 + 0.05);
+	/* not growing: the oscillation about the held force, not the force
+	 * itself (a growing ripple would hide under the static 0.5-10 N) */
+	assert_true(o.last_osc <= 1.05 * o.first_osc + 1e-9);
 	/* passive: energy never created beyond 1e-9 of what went in */
 	assert_true(o.min_work >= -1e-9 * fmax(o.max_work, 1e-12));
 }
