@@ -7,6 +7,16 @@
  * Opening and closing are system calls made at start and end; send and
  * recv are one non-blocking system call each (the HAL back-end's own I/O,
  * the only system calls the force tick may make).
+ *
+ * Through the port: send returns IRDM_OK, IRDM_EBUSY when the interface's
+ * queue is full (ENOBUFS/EAGAIN, counted in tx_dropped), IRDM_EINVAL for a
+ * frame no classical controller sends (id > 0x7FF, dlc > 8), IRDM_EIO when
+ * the link is gone (bus-off latched, ENETDOWN, ENODEV).  recv returns 1
+ * with a frame, IRDM_EIO as send, or 0: nothing waiting, or the one frame
+ * its system call read was not data (an error frame, counted and latched;
+ * an RTR or extended-id frame or a wrong size, counted in rx_rejected), so
+ * a caller that drains until 0 may leave frames for its next call.
+ * bus_off stays latched until the socket is closed and opened again.
  */
 #ifndef IRDM_SOCKETCAN_H
 #define IRDM_SOCKETCAN_H
@@ -26,6 +36,7 @@ struct irdm_socketcan {
 	bool error_passive;             /* latched: an error frame said error passive */
 	uint64_t error_frames;          /* error frames seen */
 	uint64_t tx_dropped;            /* sends refused: queue full (ENOBUFS/EAGAIN) */
+	uint64_t rx_rejected;           /* frames read but not data: RTR, extended id, size */
 };
 
 /*
