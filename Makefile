@@ -18,6 +18,7 @@
 #   firmware/*/*.c  -> libirdmfw.a     sees firmware/include only
 #   hal/*/*.c       -> libirdmhal.a    sees firmware/include, hal/include
 #   sim/*/*.c       -> libirdmsim.a    sees firmware/include, hal/include, sim/include
+#   sim/main/*.c    -> irdm-candrives (the CAN drive emulator; not in the library)
 #   tools/*/*.c     -> libirdmtools.a  sees firmware/include, tools/ (not tools/irdm)
 #   tools/irdm/*.c  -> irdm
 #   firmware/main/*.c -> irdm-fw (the controller; sees firmware, hal and sim headers)
@@ -77,7 +78,8 @@ endif
 FW_SRC    := $(filter-out firmware/main/% $(FEATURE_OFF_SRC),$(wildcard firmware/*/*.c))
 FWMAIN_SRC := $(wildcard firmware/main/*.c)
 HAL_SRC   := $(wildcard hal/*/*.c)
-SIM_SRC   := $(wildcard sim/*/*.c)
+SIM_SRC   := $(filter-out sim/main/%,$(wildcard sim/*/*.c))
+CDMAIN_SRC := $(wildcard sim/main/*.c)
 TOOL_SRC  := $(filter-out tools/irdm/%,$(wildcard tools/*/*.c))
 CLI_SRC   := $(wildcard tools/irdm/*.c)
 TEST_SRC  := $(wildcard tests/test_*.c)
@@ -94,13 +96,15 @@ SIM_LIB  := $(BUILD)/libirdmsim.a
 TOOL_LIB := $(BUILD)/libirdmtools.a
 IRDM     := $(BUILD)/irdm
 IRDM_FW  := $(BUILD)/irdm-fw
+IRDM_CD  := $(BUILD)/irdm-candrives
 TESTS    := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 TICK_TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TICK_TEST_SRC))
 BENCHES  := $(patsubst tests/bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC))
 
 .PHONY: all test san fuzz bench bench-precompute run jitter check deps clean docs cfg-fws sizes
 .SECONDARY:
-all: $(if $(CONFIG),,$(IRDM)) $(FW_LIB) $(HAL_LIB) $(SIM_LIB) $(if $(FWMAIN_SRC),$(IRDM_FW))
+all: $(if $(CONFIG),,$(IRDM)) $(FW_LIB) $(HAL_LIB) $(SIM_LIB) $(if $(FWMAIN_SRC),$(IRDM_FW)) \
+  $(if $(CDMAIN_SRC),$(IRDM_CD))
 
 $(BUILD)/obj/firmware/%.o: LAYER_INC = $(FW_INC)
 # irdm-fw's main() is the composition root: it alone sees every layer below
@@ -134,6 +138,10 @@ TEST_LIBS := $(TOOL_LIB) $(SIM_LIB) $(HAL_LIB) $(FW_LIB)
 # BLAS only for the deformation worker
 $(IRDM_FW): $(call obj,$(FWMAIN_SRC)) $(SIM_LIB) $(HAL_LIB) $(FW_LIB)
 	$(CC) $(LDFLAGS) $^ -o $@ $(if $(call feature,DEFORM),-lopenblas) -lpthread -lm
+
+# The drive emulator: the simulator, the HAL's CAN code, the firmware's arm.
+$(IRDM_CD): $(call obj,$(CDMAIN_SRC)) $(SIM_LIB) $(HAL_LIB) $(FW_LIB)
+	$(CC) $(LDFLAGS) $^ -o $@ -lm
 
 # The force tick alone: the firmware library, libm and cmocka, nothing else.
 $(TICK_TESTS): $(BUILD)/tests/test_tick_%: $(BUILD)/obj/tests/test_tick_%.o $(FW_LIB)
