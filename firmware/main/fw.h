@@ -175,5 +175,7 @@ void fw_frame_free(struct fw *fw);
 int fw_trace_alloc(struct fw_trace *t, uint64_t ticks);
 void fw_trace_free(struct fw_trace *t);
 void fw_summary_print(const struct fw *fw);
+/* The first open device's one-line reason (struct irdm_hal_dev's why), or "". */
+const char *fw_hal_why(const struct fw *fw);
 
 #endif /* IRDM_FW_H */

@@ -81,6 +81,14 @@ static void print_hist(const char *what, const struct irdm_hist *h)
 	       (unsigned long long)s.n);
 }
 
+const char *fw_hal_why(const struct fw *fw)
+{
+	for (unsigned i = 0; i < IRDM_BOARD_DEVICES_MAX; i++)
+		if (fw->hal_open[i] && fw->hal[i].why[0])
+			return fw->hal[i].why;
+	return "";
+}
+
 void fw_summary_print(const struct fw *fw)
 {
 	const struct fw_trace *t = &fw->trace;
@@ -113,7 +121,8 @@ void fw_summary_print(const struct fw *fw)
 	       (unsigned long long)cs.longest_run);
 	fw_frame_summary(fw);
 	if (fw->last_state == IRDM_SAFETY_FAULT)
-		printf("state: fault: %s (torque off)\n", irdm_safety_fault_name(fw->last_cause));
+		printf("state: fault: %s (torque off)%s%s\n", irdm_safety_fault_name(fw->last_cause),
+		       fw_hal_why(fw)[0] ? ": " : "", fw_hal_why(fw));
 	else
 		printf("state: %s\n", irdm_safety_state_name(fw->last_state));
 }

@@ -15,7 +15,9 @@
 #include <sys/prctl.h>
 
 #include "irdm/error.h"
+#include "irdm/hal_canemu.h"
 #include "irdm/hal_sim.h"
+#include "irdm/hal_socketcan.h"
 #include "irdm/rt.h"
 
 #include "fw.h"
@@ -66,6 +68,12 @@ static int meet_user(struct fw *fw)
 	return FW_EXIT_OK;
 }
 
+/* The back-ends whose arm the virtual user can push (irdm_hal_sim_device). */
+static bool has_simulated_arm(const char *hal)
+{
+	return !strcmp(hal, irdm_hal_sim_backend.name) || !strcmp(hal, irdm_hal_canemu_backend.name);
+}
+
 static int open_inputs(struct fw *fw)
 {
 	struct irdm_session_config sc = { .deform = false };
@@ -92,9 +100,9 @@ static int open_inputs(struct fw *fw)
 	}
 	if (!fw->args.user)
 		return FW_EXIT_OK;
-	if (strcmp(fw->board.hal, "sim"))
+	if (!has_simulated_arm(fw->board.hal))
 		return fail(FW_EXIT_INPUT, IRDM_EINVAL, "--user %s: %s", fw->args.user,
-			    "a virtual user needs a simulated board (hal = sim)");
+			    "a virtual user needs a back-end with a simulated arm (hal = sim or canemu)");
 	fw->user = calloc(1, sizeof(*fw->user));
 	if (!fw->user)
 		return fail(FW_EXIT_SETUP, IRDM_ENOMEM, "%s%s", "", "out of memory for the user script");
@@ -110,6 +118,8 @@ static int open_devices(struct fw *fw)
 	int rc;
 
 	irdm_hal_register(&irdm_hal_sim_backend);
+	irdm_hal_register(&irdm_hal_canemu_backend);
+	irdm_hal_register(&irdm_hal_socketcan_backend);
 	be = irdm_hal_find(fw->board.hal);
 	if (!be)
 		return fail(FW_EXIT_SETUP, IRDM_ENOTSUP, "hal '%s': %s", fw->board.hal,
@@ -130,12 +140,14 @@ static int open_devices(struct fw *fw)
 			rc = irdm_hal_open(&fw->hal[i]);
 		if (rc)
 			return fail(FW_EXIT_SETUP, rc, "hal '%s': %s", fw->board.hal,
-				    "the device does not open");
+				    fw->hal[i].why[0] ? fw->hal[i].why : "the device does not open");
 		fw->hal_open[i] = true;
+		if (fw->hal[i].info[0] && !fw->args.quiet)
+			printf("hal '%s': %s\n", fw->board.hal, fw->hal[i].info);
 		rc = irdm_hal_start(&fw->hal[i]);
 		if (rc)
 			return fail(FW_EXIT_SETUP, rc, "hal '%s': %s", fw->board.hal,
-				    "the drives do not start");
+				    fw->hal[i].why[0] ? fw->hal[i].why : "the drives do not start");
 	}
 	return FW_EXIT_OK;
 }
@@ -273,8 +285,9 @@ int main(int argc, char **argv)
 		if (signalled)
 			fprintf(stderr, "irdm-fw: stopped by signal %d: torque off\n", (int)signalled);
 		else if (rc == FW_EXIT_FAULT)
-			fprintf(stderr, "irdm-fw: EFAULT: fault %s at tick %llu: torque off\n",
-				irdm_safety_fault_name(fw->last_cause), (unsigned long long)fw->ticks);
+			fprintf(stderr, "irdm-fw: EFAULT: fault %s at tick %llu: torque off%s%s\n",
+				irdm_safety_fault_name(fw->last_cause), (unsigned long long)fw->ticks,
+				fw_hal_why(fw)[0] ? ": " : "", fw_hal_why(fw));
 	}
 	rc = stop(fw, rc);
 	if ((rc == FW_EXIT_OK || rc == FW_EXIT_FAULT) && !fw->args.quiet)

@@ -60,5 +60,7 @@ int irdm_hal_init(struct irdm_hal_dev *dev, const char *name, const struct irdm_
 	dev->backend = b;
 	dev->config = cfg;
 	dev->data = mem;
+	dev->why[0] = '\0';
+	dev->info[0] = '\0';
 	return IRDM_OK;
 }

@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "irdm/error.h"
+#include "irdm/hal_canemu.h"
 #include "irdm/hal_sim.h"
 
 enum sim_state { SIM_CLOSED = 0, SIM_OPEN, SIM_RUNNING, SIM_OFF };
@@ -208,5 +209,9 @@ int irdm_hal_sim_inject_fault(struct irdm_hal_dev *dev, uint32_t faults)
 
 struct irdm_sim_device *irdm_hal_sim_device(struct irdm_hal_dev *dev)
 {
+	struct irdm_can_drives *emulated = irdm_hal_canemu_drives(dev);
+
+	if (emulated)
+		return &emulated->arm;  /* the arm behind the emulated CAN drives */
 	return is_open_sim(dev) ? &data_of(dev)->arm : NULL;
 }

@@ -45,6 +45,7 @@
 
 #define IRDM_HAL_JOINTS IRDM_DEVICE_JOINTS
 #define IRDM_HAL_BACKENDS_MAX 8
+#define IRDM_HAL_WHY_MAX 192    /* bytes of a back-end's one-line reason */
 
 /* Asynchronous fault bits (poll); a back-end sets the ones it can detect. */
 enum irdm_hal_fault {
@@ -136,6 +137,16 @@ struct irdm_hal_dev {
 	const struct irdm_hal_backend *backend;
 	const struct irdm_hal_config *config;
 	void *data;             /* backend->data_size bytes, max_align_t aligned */
+	/*
+	 * Written by the back-end, read by the caller (both may stay empty):
+	 * why   the reason of the last error or of the latched fault, one line
+	 *       naming the part and the cause ("drive 2 (node 2): SDO abort
+	 *       0x06020000 ... writing 0x6060:00"); set where the error is
+	 *       returned (open, start) or the fault latched (poll, read).
+	 * info  what the caller should print once after open (e.g. a bus load).
+	 */
+	char why[IRDM_HAL_WHY_MAX];
+	char info[IRDM_HAL_WHY_MAX];
 };
 
 /*

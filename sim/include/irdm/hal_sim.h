@@ -30,8 +30,8 @@ extern const struct irdm_hal_backend irdm_hal_sim_backend;
  */
 int irdm_hal_sim_inject_fault(struct irdm_hal_dev *dev, uint32_t faults);
 
-/* The simulated arm behind an open sim instance (true state, the hand's
- * force), or NULL if dev is not one. */
+/* The simulated arm behind an open sim or canemu instance (true state, the
+ * hand's force), or NULL if dev is neither. */
 struct irdm_sim_device *irdm_hal_sim_device(struct irdm_hal_dev *dev);
 
 #endif /* IRDM_HAL_SIM_H */

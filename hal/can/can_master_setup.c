@@ -1,0 +1,227 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * The CANopen master's set-up (irdm/can_master.h): the configuration's
+ * checks and bus load, then each drive's SDO configuration and NMT start.
+ * Set-up may wait (through cfg->idle, a bounded number of times); the
+ * cycle (can_master.c) never does.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "irdm/can_master.h"
+#include "irdm/error.h"
+
+#define MODE_CST 10
+#define BITRATE_MIN 10000u
+#define BITRATE_MAX 1000000u
+
+/* The CST mapping: RPDO1 = controlword 0x6040 (16 bit) + target torque 0x6071
+ * (16 bit); TPDO1 = statusword 0x6041 (16 bit) + position actual 0x6064 (32 bit). */
+#define RPDO1_BYTES 4
+#define TPDO1_BYTES 6
+static const uint32_t rpdo1_map[2] = { 0x60400010, 0x60710010 };
+static const uint32_t tpdo1_map[2] = { 0x60410010, 0x60640020 };
+
+unsigned irdm_can_master_cycle_bits(const struct irdm_can_master_cfg *cfg)
+{
+	unsigned per_axis = irdm_can_frame_bits(RPDO1_BYTES, true) +
+			    irdm_can_frame_bits(TPDO1_BYTES, true);
+
+	return irdm_can_frame_bits(cfg->sync_counter ? 1 : 0, true) + cfg->n_axes * per_axis;
+}
+
+void irdm_can_master_load_line(const struct irdm_can_master_cfg *cfg, char *line, size_t len)
+{
+	unsigned bits = irdm_can_master_cycle_bits(cfg);
+	double budget_bits = (double)cfg->bitrate * cfg->period_us * 1e-6;
+
+	snprintf(line, len,
+		 "CAN bus load: SYNC + %u x RPDO1 (%d B) + %u x TPDO1 (%d B) = %u bits worst case "
+		 "in %u us at %u bit/s: %.1f %%",
+		 cfg->n_axes, RPDO1_BYTES, cfg->n_axes, TPDO1_BYTES, bits, (unsigned)cfg->period_us,
+		 (unsigned)cfg->bitrate, budget_bits > 0 ? 100.0 * bits / budget_bits : INFINITY);
+}
+
+static int refuse(char *err, size_t errlen, const char *field, const char *why)
+{
+	snprintf(err, errlen, "%s: %s", field, why);
+	return IRDM_EINVAL;
+}
+
+static int check_axes(const struct irdm_can_master_cfg *cfg, char *err, size_t errlen)
+{
+	if (cfg->n_axes < 1 || cfg->n_axes > IRDM_CAN_AXES_MAX)
+		return refuse(err, errlen, "nodes", "1 to 3 drives");
+	for (unsigned k = 0; k < cfg->n_axes; k++) {
+		const struct irdm_can_axis_cfg *a = &cfg->axis[k];
+
+		if (a->node < IRDM_CO_NODE_MIN || a->node > IRDM_CO_NODE_MAX)
+			return refuse(err, errlen, "nodes", "a node id is 1..127");
+		for (unsigned j = 0; j < k; j++)
+			if (cfg->axis[j].node == a->node)
+				return refuse(err, errlen, "nodes", "a node id appears twice");
+		if (a->rated_torque_mnm == 0)
+			return refuse(err, errlen, "rated_torque_mnm", "must be > 0");
+		if (!(isfinite(a->gear_ratio) && a->gear_ratio > 0))
+			return refuse(err, errlen, "gear_ratio", "must be finite and > 0");
+	}
+	return IRDM_OK;
+}
+
+int irdm_can_master_check(const struct irdm_can_master_cfg *cfg, char *err, size_t errlen)
+{
+	double budget_bits = (double)cfg->bitrate * cfg->period_us * 1e-6;
+	unsigned bits;
+	int rc = check_axes(cfg, err, errlen);
+
+	if (rc)
+		return rc;
+	if (cfg->bitrate < BITRATE_MIN || cfg->bitrate > BITRATE_MAX)
+		return refuse(err, errlen, "bitrate", "10000..1000000 bit/s");
+	if (cfg->period_us == 0)
+		return refuse(err, errlen, "period_us", "must be > 0");
+	if (cfg->heartbeat_ms == 0)
+		return refuse(err, errlen, "heartbeat_ms", "must be > 0 (the drives' liveness)");
+	if (cfg->heartbeat_timeout_ms <= cfg->heartbeat_ms)
+		return refuse(err, errlen, "heartbeat_timeout_ms", "must exceed heartbeat_ms");
+	if (cfg->tpdo_missing_periods == 0)
+		return refuse(err, errlen, "tpdo_missing_periods", "must be > 0");
+	if (cfg->sdo_timeout_polls == 0 || !cfg->idle)
+		return refuse(err, errlen, "sdo_timeout", "must be > 0, with a wait");
+	bits = irdm_can_master_cycle_bits(cfg);
+	if (bits > budget_bits) {
+		snprintf(err, errlen,
+			 "bitrate: one cycle needs %u bits worst case, %u us at %u bit/s carries %.0f",
+			 bits, (unsigned)cfg->period_us, (unsigned)cfg->bitrate, budget_bits);
+		return IRDM_EINVAL;
+	}
+	return IRDM_OK;
+}
+
+/* One object to write during set-up. */
+struct sdo_item {
+	uint16_t index;
+	uint8_t sub;
+	uint8_t size;
+	uint32_t value;
+};
+
+static void say_drive(const struct irdm_can_master *m, unsigned k, const struct sdo_item *it,
+		      char *err, size_t errlen, const char *what)
+{
+	snprintf(err, errlen, "drive %u (node %u): %s writing 0x%04X:%02X", k + 1,
+		 m->cfg.axis[k].node, what, it->index, it->sub);
+}
+
+/* The answer to it from drive k, or an error (err says which). */
+static int sdo_answer(struct irdm_can_master *m, unsigned k, const struct sdo_item *it,
+		      const struct irdm_can_frame *f, char *err, size_t errlen)
+{
+	uint32_t value, abort_code = 0;
+	unsigned size;
+	char what[IRDM_CAN_WHY_MAX];
+	int rc = irdm_co_sdo_answer(f, m->cfg.axis[k].node, it->index, it->sub, &value, &size,
+				    &abort_code);
+
+	if (rc == IRDM_OK && size == 0)
+		return IRDM_OK;
+	if (rc == IRDM_EHW) {
+		snprintf(what, sizeof(what), "SDO abort 0x%08X %s", (unsigned)abort_code,
+			 irdm_co_abort_name(abort_code));
+	} else {
+		rc = IRDM_EFORMAT;
+		snprintf(what, sizeof(what),
+			 "malformed SDO answer %02X %02X %02X %02X (not a confirmation)", f->data[0],
+			 f->data[1], f->data[2], f->data[3]);
+	}
+	say_drive(m, k, it, err, errlen, what);
+	return rc;
+}
+
+/* Write one object to drive k and wait (bounded) for its confirmation. */
+static int sdo_write(struct irdm_can_master *m, unsigned k, const struct sdo_item *it, char *err,
+		     size_t errlen)
+{
+	unsigned node = m->cfg.axis[k].node;
+	struct irdm_can_frame f;
+	int rc;
+
+	irdm_co_sdo_write(&f, node, it->index, it->sub, it->value, it->size);
+	if (irdm_can_send(&m->port, &f) != IRDM_OK) {
+		say_drive(m, k, it, err, errlen, "CAN link down or queue full");
+		return IRDM_EIO;
+	}
+	for (unsigned poll = 0; poll < m->cfg.sdo_timeout_polls; poll++) {
+		m->cfg.idle(m->cfg.idle_ctx);
+		while ((rc = irdm_can_recv(&m->port, &f)) == 1)
+			if (f.id == IRDM_CO_SDO_TX + node)
+				return sdo_answer(m, k, it, &f, err, errlen);
+			else
+				(void)irdm_can_master_take(m, &f);
+		if (rc < 0) {
+			say_drive(m, k, it, err, errlen, "CAN link down");
+			return IRDM_EIO;
+		}
+	}
+	say_drive(m, k, it, err, errlen, "no SDO answer (time-out)");
+	return IRDM_ETIMEDOUT;
+}
+
+static int configure_drive(struct irdm_can_master *m, unsigned k, char *err, size_t errlen)
+{
+	const struct sdo_item items[] = {
+		{ 0x6060, 0, 1, MODE_CST },
+		{ 0x1017, 0, 2, m->cfg.heartbeat_ms },
+		{ 0x6076, 0, 4, m->cfg.axis[k].rated_torque_mnm },
+		{ 0x1600, 1, 4, rpdo1_map[0] },
+		{ 0x1600, 2, 4, rpdo1_map[1] },
+		{ 0x1600, 0, 1, 2 },
+		{ 0x1A00, 1, 4, tpdo1_map[0] },
+		{ 0x1A00, 2, 4, tpdo1_map[1] },
+		{ 0x1A00, 0, 1, 2 },
+	};
+
+	for (size_t i = 0; i < sizeof(items) / sizeof(items[0]); i++) {
+		int rc = sdo_write(m, k, &items[i], err, errlen);
+
+		if (rc)
+			return rc;
+	}
+	return IRDM_OK;
+}
+
+int irdm_can_master_init(struct irdm_can_master *m, const struct irdm_can_port *port,
+			 const struct irdm_can_master_cfg *cfg, char *err, size_t errlen)
+{
+	struct irdm_can_frame f;
+	int rc;
+
+	memset(m, 0, sizeof(*m));
+	rc = irdm_can_master_check(cfg, err, errlen);
+	if (rc)
+		return rc;
+	m->cfg = *cfg;
+	m->port = *port;
+	for (unsigned k = 0; k < cfg->n_axes; k++)
+		m->ax[k].state = IRDM_CIA402_UNKNOWN;
+	for (unsigned k = 0; k < cfg->n_axes; k++) {
+		rc = configure_drive(m, k, err, errlen);
+		if (rc)
+			return rc;
+	}
+	for (unsigned k = 0; k < cfg->n_axes; k++) {
+		irdm_co_nmt(&f, IRDM_CO_NMT_START, cfg->axis[k].node);
+		if (irdm_can_send(&m->port, &f) != IRDM_OK) {
+			snprintf(err, errlen, "drive %u (node %u): NMT start not sent: CAN link down",
+				 k + 1, cfg->axis[k].node);
+			return IRDM_EIO;
+		}
+	}
+	/* heartbeats count from here: the producer time was just written */
+	for (unsigned k = 0; k < cfg->n_axes; k++) {
+		m->ax[k].heartbeat_period = 0;
+		m->ax[k].nmt = IRDM_CO_STATE_OPERATIONAL;
+	}
+	return IRDM_OK;
+}

@@ -1,0 +1,249 @@
+/* SPDX-License-Identifier: MIT */
+/* The HAL ops on the CANopen master, shared by the CAN back-ends (irdm/hal_can.h). */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "irdm/error.h"
+#include "irdm/hal_can.h"
+
+static struct irdm_hal_can *can_of(struct irdm_hal_dev *dev)
+{
+	return dev->data;
+}
+
+static void pump(struct irdm_hal_dev *dev)
+{
+	struct irdm_hal_can *c = can_of(dev);
+
+	if (c->link->pump)
+		c->link->pump(dev);
+}
+
+static void say(struct irdm_hal_dev *dev, const char *line)
+{
+	snprintf(dev->why, sizeof(dev->why), "%s", line);
+}
+
+/* The master's configuration from the options, the arm and the period. */
+static int master_cfg(struct irdm_hal_dev *dev, const struct irdm_hal_can_opts *o,
+		      struct irdm_can_master_cfg *mc)
+{
+	const struct irdm_hal_config *cfg = dev->config;
+	uint32_t period_us = (uint32_t)lround(cfg->period_s * 1e6);
+
+	if (o->n_nodes != IRDM_HAL_JOINTS) {
+		snprintf(dev->why, sizeof(dev->why),
+			 "hal_options nodes: %u node(s) given, the arm has %d joints", o->n_nodes,
+			 IRDM_HAL_JOINTS);
+		return IRDM_EINVAL;
+	}
+	memset(mc, 0, sizeof(*mc));
+	mc->n_axes = o->n_nodes;
+	for (unsigned k = 0; k < o->n_nodes; k++)
+		mc->axis[k] = (struct irdm_can_axis_cfg){ o->nodes[k], o->rated_torque_mnm[k],
+							  cfg->device->gear_ratio[k] };
+	mc->period_us = period_us;
+	mc->bitrate = o->bitrate;
+	mc->sync_counter = o->sync_counter;
+	mc->heartbeat_ms = o->heartbeat_ms;
+	mc->heartbeat_timeout_ms = o->heartbeat_timeout_ms;
+	mc->tpdo_missing_periods = o->tpdo_missing_periods;
+	mc->sdo_timeout_polls = (unsigned)((o->sdo_timeout_ms * 1000ull + period_us - 1) / period_us);
+	mc->idle = can_of(dev)->link->idle;
+	mc->idle_ctx = dev;
+	return IRDM_OK;
+}
+
+int irdm_hal_can_open(struct irdm_hal_dev *dev, const struct irdm_hal_can_link *link,
+		      unsigned extra)
+{
+	struct irdm_hal_can *c = can_of(dev);
+	const struct irdm_hal_config *cfg = dev->config;
+	struct irdm_can_master_cfg mc;
+	struct irdm_can_port port;
+	int rc;
+
+	if (c->state != HAL_CAN_CLOSED)
+		return IRDM_EBUSY;
+	if (!cfg->device || !(isfinite(cfg->period_s) && cfg->period_s >= 1e-4 && cfg->period_s <= 1))
+		return say(dev, "period: 100 us to 1 s"), IRDM_EINVAL;
+	c->link = link;
+	rc = irdm_hal_can_parse(cfg->options, extra, &c->opts, dev->why, sizeof(dev->why));
+	if (!rc)
+		rc = master_cfg(dev, &c->opts, &mc);
+	if (!rc)
+		rc = irdm_can_master_check(&mc, dev->why, sizeof(dev->why));
+	if (rc)
+		return rc;
+	irdm_can_master_load_line(&mc, dev->info, sizeof(dev->info));
+	rc = link->open(dev, &port, dev->why, sizeof(dev->why));
+	if (rc)
+		return rc;
+	rc = irdm_can_master_init(&c->m, &port, &mc, dev->why, sizeof(dev->why));
+	if (rc) {
+		link->close(dev);
+		return rc;
+	}
+	c->written = false;
+	c->seq = 0;
+	c->state = HAL_CAN_OPEN;
+	return IRDM_OK;
+}
+
+/* Faulted: the master already sent the torque off; the reason to the caller. */
+static int faulted(struct irdm_hal_dev *dev)
+{
+	say(dev, can_of(dev)->m.why);
+	return IRDM_EHW;
+}
+
+/* The link's flags, then the master's verdict on this period. */
+static int receive(struct irdm_hal_dev *dev)
+{
+	struct irdm_hal_can *c = can_of(dev);
+	int rc = irdm_can_master_receive(&c->m);
+
+	if (c->link->check)
+		c->link->check(dev, &c->m);
+	return c->m.faulted ? faulted(dev) : rc;
+}
+
+static void send_hold(struct irdm_hal_dev *dev)
+{
+	(void)irdm_can_master_send(&can_of(dev)->m, NULL);
+	pump(dev);
+}
+
+int irdm_hal_can_start(struct irdm_hal_dev *dev)
+{
+	struct irdm_hal_can *c = can_of(dev);
+	unsigned periods = (unsigned)((c->opts.enable_timeout_ms * 1000ull + c->m.cfg.period_us - 1) /
+				      c->m.cfg.period_us);
+	int k;
+
+	if (c->state == HAL_CAN_CLOSED)
+		return IRDM_EINVAL;
+	if (c->m.faulted)
+		return faulted(dev);
+	irdm_can_master_enable(&c->m, true);
+	for (unsigned p = 0; p < periods && !irdm_can_master_all_enabled(&c->m); p++) {
+		send_hold(dev);
+		c->link->idle(dev);
+		if (receive(dev) == IRDM_EHW)
+			return IRDM_EHW;
+	}
+	k = irdm_can_master_first_not_enabled(&c->m);
+	if (k >= 0) {
+		irdm_can_master_safe_off(&c->m);
+		pump(dev);
+		snprintf(dev->why, sizeof(dev->why),
+			 "drive %d (node %u): not operation enabled after %u ms (%s)", k + 1,
+			 c->m.cfg.axis[k].node, (unsigned)c->opts.enable_timeout_ms,
+			 irdm_cia402_name(c->m.ax[k].state));
+		return IRDM_ETIMEDOUT;
+	}
+	send_hold(dev);         /* the first read's TPDO is on its way */
+	c->written = true;
+	c->state = HAL_CAN_RUNNING;
+	return IRDM_OK;
+}
+
+int irdm_hal_can_read(struct irdm_hal_dev *dev, struct irdm_hal_joint_state *st)
+{
+	struct irdm_hal_can *c = can_of(dev);
+	int rc;
+
+	if (c->state == HAL_CAN_CLOSED)
+		return IRDM_EINVAL;
+	if (!c->written)
+		send_hold(dev); /* nobody wrote last period: its SYNC, zero torque */
+	c->written = false;
+	rc = receive(dev);
+	if (rc == IRDM_ETIMEDOUT) {
+		int k = -1;
+
+		for (unsigned a = 0; a < c->m.cfg.n_axes && k < 0; a++)
+			if (!c->m.ax[a].fresh)
+				k = (int)a;
+		snprintf(dev->why, sizeof(dev->why), "drive %d (node %u): no TPDO1 this period",
+			 k + 1, c->m.cfg.axis[k < 0 ? 0 : k].node);
+	}
+	if (rc)
+		return rc;
+	for (unsigned a = 0; a < IRDM_HAL_JOINTS; a++)
+		st->counts[a] = c->m.ax[a].counts;
+	st->seq = ++c->seq;
+	return IRDM_OK;
+}
+
+int irdm_hal_can_write(struct irdm_hal_dev *dev, const double tau_nm[IRDM_HAL_JOINTS])
+{
+	struct irdm_hal_can *c = can_of(dev);
+	double tau[IRDM_HAL_JOINTS];
+	int rc = IRDM_OK;
+
+	if (c->state != HAL_CAN_RUNNING)
+		return IRDM_EINVAL;
+	if (c->m.faulted)
+		return faulted(dev);
+	for (unsigned a = 0; a < IRDM_HAL_JOINTS; a++) {
+		tau[a] = isfinite(tau_nm[a]) ? tau_nm[a] : 0.0;
+		if (!isfinite(tau_nm[a]))
+			rc = IRDM_EFAULT;
+	}
+	if (irdm_can_master_send(&c->m, tau) == IRDM_EHW)
+		rc = faulted(dev);
+	pump(dev);
+	c->written = true;
+	return rc;
+}
+
+int irdm_hal_can_safe_off(struct irdm_hal_dev *dev)
+{
+	struct irdm_hal_can *c = can_of(dev);
+	int rc;
+
+	if (c->state == HAL_CAN_CLOSED)
+		return IRDM_OK;         /* nothing open: nothing can apply torque */
+	rc = irdm_can_master_safe_off(&c->m);
+	pump(dev);
+	c->written = true;
+	if (c->state == HAL_CAN_RUNNING)
+		c->state = HAL_CAN_OFF;
+	if (rc)
+		say(dev, "CAN link: torque off not sent (link down): cut the power");
+	return rc;
+}
+
+int irdm_hal_can_poll(struct irdm_hal_dev *dev, uint32_t *faults)
+{
+	struct irdm_hal_can *c = can_of(dev);
+
+	if (c->state == HAL_CAN_CLOSED)
+		return IRDM_EINVAL;
+	*faults = 0;
+	if (!c->m.faulted)
+		return IRDM_OK;
+	*faults = c->m.link_lost ? IRDM_HAL_FAULT_LINK : IRDM_HAL_FAULT_DRIVE;
+	return faulted(dev);
+}
+
+void irdm_hal_can_close(struct irdm_hal_dev *dev)
+{
+	struct irdm_hal_can *c = can_of(dev);
+
+	if (c->state == HAL_CAN_CLOSED)
+		return;
+	irdm_can_master_safe_off(&c->m);
+	irdm_can_master_stop(&c->m);
+	pump(dev);
+	c->link->close(dev);
+	c->state = HAL_CAN_CLOSED;
+}
+
+void irdm_hal_can_reset_faults(struct irdm_hal_dev *dev)
+{
+	irdm_can_master_reset_faults(&can_of(dev)->m);
+	dev->why[0] = '\0';
+}

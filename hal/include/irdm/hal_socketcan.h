@@ -1,0 +1,16 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * The "socketcan" HAL back-end: CiA 402 drives in cyclic synchronous
+ * torque mode on a Linux SocketCAN interface, through the CANopen master
+ * (irdm/hal_can.h says how the HAL ops map onto it; docs/canopen.md lists
+ * the board's hal_options: iface=, nodes=, rated_torque_mnm=, ...).
+ * Register it with irdm_hal_register(&irdm_hal_socketcan_backend).
+ */
+#ifndef IRDM_HAL_SOCKETCAN_H
+#define IRDM_HAL_SOCKETCAN_H
+
+#include "irdm/hal.h"
+
+extern const struct irdm_hal_backend irdm_hal_socketcan_backend;
+
+#endif /* IRDM_HAL_SOCKETCAN_H */

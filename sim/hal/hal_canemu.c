@@ -1,0 +1,112 @@
+/* SPDX-License-Identifier: MIT */
+/* The "canemu" HAL back-end (irdm/hal_canemu.h). */
+#include <stdio.h>
+
+#include "irdm/error.h"
+#include "irdm/hal_can.h"
+#include "irdm/hal_canemu.h"
+
+struct canemu_data {
+	struct irdm_hal_can can;        /* first: the shared code's view */
+	struct irdm_can_membus bus;
+	struct irdm_can_drives drives;
+};
+
+static struct canemu_data *data_of(struct irdm_hal_dev *dev)
+{
+	return dev->data;
+}
+
+static int link_open(struct irdm_hal_dev *dev, struct irdm_can_port *port, char *err,
+		     size_t errlen)
+{
+	struct canemu_data *d = data_of(dev);
+	const struct irdm_hal_can_opts *o = &d->can.opts;
+	struct irdm_can_port drives_port;
+	struct irdm_sim_params p;
+
+	for (unsigned k = 1; k < o->n_nodes; k++)
+		if (o->nodes[k] != o->nodes[0] + k) {
+			snprintf(err, errlen, "hal_options nodes: the emulator's nodes are "
+				 "consecutive (e.g. 1,2,3)");
+			return IRDM_EINVAL;
+		}
+	irdm_can_membus_init(&d->bus);
+	irdm_can_membus_port(&d->bus, port);
+	irdm_can_membus_port(&d->bus, &drives_port);
+	irdm_sim_params_default(&p);
+	p.substeps = o->substeps;
+	if (irdm_can_drives_init(&d->drives, &drives_port, dev->config->device, &p, o->n_nodes,
+				 o->nodes[0], dev->config->period_s) != IRDM_OK) {
+		snprintf(err, errlen, "canemu: the emulated arm refuses this board's arm");
+		return IRDM_EINVAL;
+	}
+	return IRDM_OK;
+}
+
+/* The emulator's turn: it answers what the master just sent. */
+static void link_pump(struct irdm_hal_dev *dev)
+{
+	irdm_can_drives_poll(&data_of(dev)->drives);
+}
+
+static void link_idle(void *ctx)
+{
+	link_pump(ctx);
+}
+
+static void link_close(struct irdm_hal_dev *dev)
+{
+	(void)dev;              /* memory only: nothing to release */
+}
+
+static const struct irdm_hal_can_link canemu_link = {
+	.open = link_open,
+	.pump = link_pump,
+	.idle = link_idle,
+	.check = NULL,
+	.close = link_close,
+};
+
+static int canemu_open(struct irdm_hal_dev *dev)
+{
+	return irdm_hal_can_open(dev, &canemu_link, IRDM_HAL_CAN_SUBSTEPS);
+}
+
+static const struct irdm_hal_ops canemu_ops = {
+	.open = canemu_open,
+	.start = irdm_hal_can_start,
+	.read = irdm_hal_can_read,
+	.write = irdm_hal_can_write,
+	.safe_off = irdm_hal_can_safe_off,
+	.poll = irdm_hal_can_poll,
+	.close = irdm_hal_can_close,
+};
+
+const struct irdm_hal_backend irdm_hal_canemu_backend = {
+	.name = "canemu",
+	.ops = &canemu_ops,
+	.data_size = sizeof(struct canemu_data),
+};
+
+static struct canemu_data *open_canemu(struct irdm_hal_dev *dev)
+{
+	return dev && dev->backend == &irdm_hal_canemu_backend &&
+			       data_of(dev)->can.state != HAL_CAN_CLOSED
+		       ? data_of(dev)
+		       : NULL;
+}
+
+struct irdm_can_drives *irdm_hal_canemu_drives(struct irdm_hal_dev *dev)
+{
+	struct canemu_data *d = open_canemu(dev);
+
+	return d ? &d->drives : NULL;
+}
+
+struct irdm_can_membus *irdm_hal_canemu_bus(struct irdm_hal_dev *dev)
+{
+	struct canemu_data *d = open_canemu(dev);
+
+	return d ? &d->bus : NULL;
+}
