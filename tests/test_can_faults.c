@@ -44,6 +44,10 @@ static void test_parse_each_kind(void **state)
 	assert_int_equal(irdm_can_fault_parse("emcy:1:100:0x2310", &f, err, sizeof(err)), IRDM_OK);
 	assert_int_equal(f.kind, IRDM_CAN_FAULT_EMCY);
 	assert_int_equal(f.code, 0x2310);
+	assert_int_equal(irdm_can_fault_parse("fault:3:12", &f, err, sizeof(err)), IRDM_OK);
+	assert_int_equal(f.kind, IRDM_CAN_FAULT_STATE);
+	assert_int_equal(f.node, 3);
+	assert_int_equal(f.at_sync, 12);
 	assert_int_equal(irdm_can_fault_parse("sdo-wrong:2", &f, err, sizeof(err)), IRDM_OK);
 	assert_int_equal(f.kind, IRDM_CAN_FAULT_SDO_WRONG);
 	assert_int_equal(f.at_sync, 0);
@@ -84,6 +88,7 @@ static void test_parse_refuses(void **state)
 	refused("flood:5:10001", "out of range");
 	refused("flood:5:0", "COUNT must be >= 1");
 	refused("sdo-wrong", "too few fields");
+	refused("fault:1", "too few fields");
 	refused("heartbeat-stop:1:0", "SYNC counts from 1");
 }
 
@@ -205,16 +210,16 @@ static void test_heartbeat_wall_and_stop(void **state)
 	assert_int_equal(count_id(0x701), 10);          /* the others beat on */
 }
 
-static void test_emcy_and_fault_at_n(void **state)
+/* word makes node 2 fault at SYNC 4; the EMCY frames heard. */
+static unsigned fault_at_4(const char *word)
 {
 	struct irdm_can_frame f;
 	uint16_t sw;
 	int32_t pos;
 	unsigned emcy = 0;
 
-	(void)state;
 	bring_up();
-	schedule("emcy:2:4:0x2310");
+	schedule(word);
 	for (unsigned s = 1; s <= 4; s++) {
 		assert_int_equal(irdm_co_sync(&f, 0), IRDM_OK);
 		assert_int_equal(irdm_can_send(&master, &f), IRDM_OK);
@@ -234,7 +239,19 @@ static void test_emcy_and_fault_at_n(void **state)
 			}
 		}
 	}
-	assert_int_equal(emcy, 1);
+	return emcy;
+}
+
+static void test_emcy_and_fault_at_n(void **state)
+{
+	(void)state;
+	assert_int_equal(fault_at_4("emcy:2:4:0x2310"), 1);
+}
+
+static void test_fault_without_emcy(void **state)
+{
+	(void)state;
+	assert_int_equal(fault_at_4("fault:2:4"), 0);
 }
 
 static void test_sdo_wrong_from_start(void **state)
@@ -301,6 +318,7 @@ int main(void)
 		cmocka_unit_test(test_delay_on_the_wall_clock),
 		cmocka_unit_test(test_heartbeat_wall_and_stop),
 		cmocka_unit_test(test_emcy_and_fault_at_n),
+		cmocka_unit_test(test_fault_without_emcy),
 		cmocka_unit_test(test_sdo_wrong_from_start),
 		cmocka_unit_test(test_flood_bounded),
 		cmocka_unit_test(test_schedule_refuses),

@@ -248,6 +248,9 @@ static void fire(struct irdm_can_drives *dr, const struct irdm_can_fault *f)
 	case IRDM_CAN_FAULT_EMCY:
 		irdm_can_drives_fault(dr, (unsigned)(d - dr->d), f->code);
 		break;
+	case IRDM_CAN_FAULT_STATE:
+		irdm_cia402_drive_fault(&d->fsa);
+		break;
 	case IRDM_CAN_FAULT_SDO_WRONG:
 		d->sdo_wrong = true;
 		break;

@@ -21,6 +21,7 @@ static const struct {
 	{ "delay", IRDM_CAN_FAULT_DELAY, 4, "delay:NODE:SYNC:K:US" },
 	{ "heartbeat-stop", IRDM_CAN_FAULT_HEARTBEAT_STOP, 2, "heartbeat-stop:NODE:SYNC" },
 	{ "emcy", IRDM_CAN_FAULT_EMCY, 3, "emcy:NODE:SYNC:CODE" },
+	{ "fault", IRDM_CAN_FAULT_STATE, 2, "fault:NODE:SYNC" },
 	{ "sdo-wrong", IRDM_CAN_FAULT_SDO_WRONG, 1, "sdo-wrong:NODE" },
 	{ "flood", IRDM_CAN_FAULT_FLOOD, 2, "flood:SYNC:COUNT" },
 };
@@ -107,5 +108,5 @@ int irdm_can_fault_parse(const char *word, struct irdm_can_fault *f, char *err, 
 		return IRDM_OK;
 	}
 	return bad(err, errlen, word, "unknown kind, expected one of drop, delay, heartbeat-stop, "
-		   "emcy, sdo-wrong, flood", NULL);
+		   "emcy, fault, sdo-wrong, flood", NULL);
 }

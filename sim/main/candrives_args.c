@@ -52,6 +52,7 @@ static const struct irdm_opt cd_opts[] = {
 	  .metavar = "KIND:...",
 	  .help = "inject a fault (repeatable, up to 16): drop:NODE:SYNC:K, "
 		  "delay:NODE:SYNC:K:US, heartbeat-stop:NODE:SYNC, emcy:NODE:SYNC:CODE, "
+		  "fault:NODE:SYNC, "
 		  "sdo-wrong:NODE, flood:SYNC:COUNT" },
 	{ .name = "quiet", .short_name = 'q', .type = IRDM_OPT_FLAG, CA(quiet),
 	  .help = "no state changes or summary" },

@@ -8,6 +8,7 @@
  *   delay:NODE:SYNC:K:US        those TPDOs are sent US microseconds late (wall clock)
  *   heartbeat-stop:NODE:SYNC    NODE sends no heartbeat from SYNC on
  *   emcy:NODE:SYNC:CODE         NODE sends EMCY CODE (0x.. or decimal) and faults
+ *   fault:NODE:SYNC             NODE faults without an EMCY (its statusword says so)
  *   sdo-wrong:NODE              NODE's SDO answers name another object (from start)
  *   flood:SYNC:COUNT            COUNT 8-byte frames of id 0x001 at SYNC (bounded)
  *
@@ -30,6 +31,7 @@ enum irdm_can_fault_kind {
 	IRDM_CAN_FAULT_DELAY,
 	IRDM_CAN_FAULT_HEARTBEAT_STOP,
 	IRDM_CAN_FAULT_EMCY,
+	IRDM_CAN_FAULT_STATE,
 	IRDM_CAN_FAULT_SDO_WRONG,
 	IRDM_CAN_FAULT_FLOOD,
 };

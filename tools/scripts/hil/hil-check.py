@@ -1,0 +1,1 @@
+import sys, os; print(sorted(os.listdir(sys.argv[1])))
