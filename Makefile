@@ -9,6 +9,7 @@
 #   make bench      benchmarks (print figures; never pass/fail on time)
 #   make run        the main job: the built-in default scene, end to end
 #   make jitter     irdm-fw's wake-up latency beside cyclictest's (JITTER_SECONDS)
+#   make hil        the CAN back-end end to end in a PREEMPT_RT VM (docs/hil.md)
 #   make docs       docs/scene-format.md from the scene key table
 #   make sizes      irdm-fw built with each configs/*.config (CONFIG=FILE: one)
 #
@@ -101,7 +102,7 @@ TESTS    := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 TICK_TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TICK_TEST_SRC))
 BENCHES  := $(patsubst tests/bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC))
 
-.PHONY: all test san fuzz bench bench-precompute run jitter check deps clean docs cfg-fws sizes
+.PHONY: all test san fuzz bench bench-precompute run jitter check deps clean docs cfg-fws sizes hil
 .SECONDARY:
 all: $(if $(CONFIG),,$(IRDM)) $(FW_LIB) $(HAL_LIB) $(SIM_LIB) $(if $(FWMAIN_SRC),$(IRDM_FW)) \
   $(if $(CDMAIN_SRC),$(IRDM_CD))
@@ -232,12 +233,14 @@ $(BUILD)/data/bunny.off:
 	@mkdir -p $(dir $@)
 	tools/scripts/bunny-off.sh $@
 
-# The gcc run comes last so its summary line closes the output.
+# The gcc run comes last of the tests so its summary line closes them; then
+# the CAN back-end end to end in the VM (make hil).
 check: deps
 	$(MAKE) fuzz FUZZ_SECONDS=$(FUZZ_SECONDS)
 	$(MAKE) CC=clang BUILD=build-clang test
 	$(MAKE) san
 	$(MAKE) test
+	$(MAKE) hil
 
 run: deps
 	$(MAKE) $(IRDM) $(IRDM_FW)
@@ -250,6 +253,14 @@ $(JITTER_IMAGE): $(IRDM) scenes/cuboid-top.scene
 	$(IRDM) precompute -q --scene scenes/cuboid-top.scene -o $@
 jitter: deps $(IRDM) $(IRDM_FW) $(JITTER_IMAGE)
 	tools/scripts/jitter.sh $(IRDM) $(IRDM_FW) $(JITTER_IMAGE)
+
+# Hardware in the loop without the hardware: Debian's PREEMPT_RT kernel
+# under qemu (TCG), vcan0, irdm-candrives and irdm-fw (the minimal build)
+# on it, candump's log checked on the host (tools/scripts/hil/, docs/hil.md)
+hil: deps $(IRDM) $(IRDM_FW) $(BUILD)/tests/test_socketcan
+	$(MAKE) --no-print-directory CONFIG=configs/minimal.config BUILD=$(BUILD)/cfg-minimal all
+	tools/scripts/hil/hil.sh $(BUILD) $(IRDM) $(BUILD)/cfg-minimal/irdm-fw \
+	  $(BUILD)/cfg-minimal/irdm-candrives $(BUILD)/tests/test_socketcan $(IRDM_FW)
 
 deps:
 	tools/scripts/install-deps.sh
