@@ -295,6 +295,44 @@ static void test_flood_bounded(void **state)
 	assert_int_equal(ids[IRDM_CAN_FLOOD_ID], 0);
 }
 
+/* Docked, the arm does not move (gravity pulls on it) until a drive
+ * applies torque; then it does. */
+static void test_dock_until_torque(void **state)
+{
+	unsigned ids[0x800];
+	double q0[3], q[3], qd[3];
+	struct irdm_can_frame f;
+
+	(void)state;
+	bring_up();
+	dr.docked = true;
+	for (unsigned k = 0; k < 3; k++)
+		dr.d[k].mode = 10;                      /* cyclic synchronous torque */
+	irdm_sim_device_state(&dr.arm, q0, qd);
+	for (int s = 0; s < 50; s++)
+		sync_count(ids, 0x800);
+	irdm_sim_device_state(&dr.arm, q, qd);
+	assert_memory_equal(q, q0, sizeof(q));
+	for (unsigned r = 0; r < 6; r++) {              /* shutdown, switch on, enable, hold */
+		static const uint16_t cw[6] = { 0x06, 0x07, 0x0F, 0x0F, 0x0F, 0x0F };
+
+		for (unsigned node = 1; node <= 3; node++) {
+			assert_int_equal(irdm_co_rpdo_cst(&f, node, cw[r], node == 2 ? 10 : 0),
+					 IRDM_OK);
+			assert_int_equal(irdm_can_send(&master, &f), IRDM_OK);
+		}
+		irdm_can_drives_poll(&dr);
+		sync_count(ids, 0x800);
+	}
+	for (int s = 0; s < 20 && dr.docked; s++)
+		sync_count(ids, 0x800);
+	assert_false(dr.docked);
+	for (int s = 0; s < 50; s++)
+		sync_count(ids, 0x800);
+	irdm_sim_device_state(&dr.arm, q, qd);
+	assert_true(q[1] != q0[1]);
+}
+
 static void test_schedule_refuses(void **state)
 {
 	struct irdm_can_fault f = { .kind = IRDM_CAN_FAULT_DROP, .node = 4, .at_sync = 1,
@@ -321,6 +359,7 @@ int main(void)
 		cmocka_unit_test(test_fault_without_emcy),
 		cmocka_unit_test(test_sdo_wrong_from_start),
 		cmocka_unit_test(test_flood_bounded),
+		cmocka_unit_test(test_dock_until_torque),
 		cmocka_unit_test(test_schedule_refuses),
 	};
 

@@ -316,7 +316,10 @@ static void sync(struct irdm_can_drives *dr)
 	irdm_sim_device_set_torque(&dr->arm, tau);
 	if (dr->before_step)
 		dr->before_step(dr->hook_ctx, dr);
-	irdm_sim_device_step(&dr->arm, dr->period_s);
+	if (dr->docked && (tau[0] != 0 || tau[1] != 0 || tau[2] != 0))
+		dr->docked = false;
+	if (!dr->docked)
+		irdm_sim_device_step(&dr->arm, dr->period_s);
 	dr->now_us += (uint64_t)llround(dr->period_s * 1e6);
 	for (unsigned k = 0; k < dr->n && !dr->wall_heartbeat; k++)
 		if (dr->d[k].heartbeat_ms && dr->now_us >= dr->d[k].heartbeat_next_us)

@@ -132,6 +132,9 @@ static int set_up(struct cd *cd)
 				 cd->board.period_us * 1e-6))
 		return fail(CD_EXIT_INPUT, "the board's arm or period is refused by the drives");
 	cd->dr.wall_heartbeat = true;
+	/* a real arm rests in its dock at the calibration pose until the
+	 * controller drives it; the process starts long before that */
+	cd->dr.docked = true;
 	if (cd->user) {
 		cd->dr.before_step = push;
 		cd->dr.hook_ctx = cd;

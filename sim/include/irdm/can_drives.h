@@ -65,6 +65,8 @@ struct irdm_can_drives {
 	uint64_t syncs, bad_frames;
 	uint64_t tpdos_sent, tpdos_dropped, tpdos_delayed, flood_sent, faults_fired;
 	bool wall_heartbeat;            /* heartbeats on irdm_can_drives_wall()'s clock */
+	bool docked;                    /* the arm rests in its calibration dock (no
+					 * steps) until a drive first applies torque */
 	uint64_t wall_us;               /* the last wall time given */
 	irdm_can_drives_hook before_step;
 	void *hook_ctx;

@@ -6,7 +6,8 @@
 # /out/NAME.* for the host's checks (hil-check.py).
 H=/hil
 B=$H/can-3dof-vm.board
-. $H/params.sh          # FAULT_AT: the SYNC of 1.5 s, mid-hold (the press ends at 1.2 s)
+. $H/params.sh          # FAULT_AT: the SYNC of 1.5 s, mid-hold (the press ends at 1.2 s);
+			# TPDO_MISSING: the board's tpdo_missing_periods
 
 echo "hil-guest: SocketCAN port tests on vcan0"
 IRDM_SOCKETCAN_TEST_IF=vcan0 $H/test_socketcan > /out/test_socketcan.txt 2>&1
@@ -47,8 +48,8 @@ scenario base 4
 scenario heartbeat 2.5 heartbeat-stop:2:$FAULT_AT
 scenario emcy 2.5 emcy:3:$FAULT_AT:0x2310
 scenario fault 2.5 fault:1:$FAULT_AT
-scenario drop 2.5 drop:2:$FAULT_AT:5
-scenario drop-short 2.5 drop:2:$FAULT_AT:2
+scenario drop 2.5 drop:2:$FAULT_AT:$((TPDO_MISSING + 5))
+scenario drop-short 2.5 drop:2:$FAULT_AT:$((TPDO_MISSING / 2))
 scenario sdo 2.5 sdo-wrong:2
 # bus-off: the interface goes away under both ends 1.5 s into the run
 ( sleep 1.8; ip link set vcan0 down; echo "hil-guest: vcan0 down" ) &

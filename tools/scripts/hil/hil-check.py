@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """make hil's checks, on the host, of what the VM sent back (docs/hil.md).
 
-    hil-check.py RESULTS_DIR PERIOD_US TPDO_MISSING HEARTBEAT_TIMEOUT_MS
+    hil-check.py RESULTS_DIR PERIOD_US TPDO_MISSING HEARTBEAT_TIMEOUT_MS FAULT_AT
 
 RESULTS_DIR holds, per scenario NAME: NAME.candump (candump -L of vcan0),
 NAME.fw.txt / NAME.fw.rc (irdm-fw's output and exit code), NAME.cd.txt /
@@ -21,6 +21,8 @@ Checked (a failure makes the exit code 1):
                drive; every axis gets disable voltage and zero torque
                (RPDO1 00 00 00 00) within two periods of the fault being
                detectable, and nothing else after it
+  drop-short   TPDO_MISSING / 2 TPDOs dropped: tolerated, ran to the end (half:
+               TCG delays a TPDO now and then, which counts as missing too)
   sdo          start-up refused: non-zero exit, the drive and object named
 Reported, not checked: the SYNC period's distribution (TCG's timing).
 """
@@ -30,7 +32,7 @@ import os
 import re
 import sys
 
-FORCE_TOL_N = 0.35      # measured: docs/hil.md ("forces")
+FORCE_TOL_N = 0.12      # measured: docs/hil.md ("Forces")
 ALIGN_MAX = 25          # ticks either way
 AXES = (1, 2, 3)
 SYNC = 0x080
@@ -198,7 +200,7 @@ def fault_scenario(d, name, kind, args):
           re.search(r"drive \d \(node \d\)|link", reason) is not None,
           f"{name}: non-zero exit with a one-line reason naming the drive or the link")
     print(f"  frames: {len(fr)}; states: {states_reached(fr)}")
-    period_ms, missing, hb_timeout_ms = args
+    period_ms, missing, hb_timeout_ms, fault_at = args
     if kind == "emcy":
         onset = first_sync_after(fr, lambda f: 0x081 <= f[1] <= 0x0FF)
         check(onset is not None, f"{name}: the EMCY is on the bus")
@@ -211,15 +213,14 @@ def fault_scenario(d, name, kind, args):
         if onset is not None:
             torque_off_checks(name, fr, onset, 2)
     elif kind == "drop":
+        # the TPDO1 of SYNC fault_at is the first one dropped; its answer
+        # would be in window fault_at (after that SYNC), a late one later
         ws, _ = windows(fr)
-        onset = None
-        for i in range(1, len(ws)):
-            if any(f[1] == 0x181 for f in ws[i][1]) and not any(f[1] == 0x182 for f in ws[i][1]):
-                onset = i
-                break
-        check(onset is not None, f"{name}: node 2's TPDO1 goes missing")
-        if onset is not None:
-            torque_off_checks(name, fr, onset, missing - 1 + 2)
+        gone = len(ws) > fault_at + 5 and not any(
+            f[1] == 0x182 for w in ws[fault_at + 1:fault_at + 6] for f in w[1])
+        check(gone, f"{name}: node 2's TPDO1 goes missing at SYNC {fault_at}")
+        if gone:
+            torque_off_checks(name, fr, fault_at - 1, missing + 2)
     elif kind == "heartbeat":
         hb = [i for i, f in enumerate(fr) if f[1] == 0x702]
         onset = sum(1 for f in fr[:hb[-1]] if f[1] == SYNC) if hb else None
@@ -235,11 +236,12 @@ def fault_scenario(d, name, kind, args):
 
 
 def main():
-    if len(sys.argv) != 5:
-        sys.exit("usage: hil-check.py RESULTS_DIR PERIOD_US TPDO_MISSING HEARTBEAT_TIMEOUT_MS")
+    if len(sys.argv) != 6:
+        sys.exit("usage: hil-check.py RESULTS_DIR PERIOD_US TPDO_MISSING HEARTBEAT_TIMEOUT_MS "
+                 "FAULT_AT")
     d = sys.argv[1]
     period_ms = int(sys.argv[2]) / 1000
-    args = (period_ms, int(sys.argv[3]), int(sys.argv[4]))
+    args = (period_ms, int(sys.argv[3]), int(sys.argv[4]), int(sys.argv[5]))
 
     kernel = dict(l.split("=", 1) for l in read(os.path.join(d, "kernel.txt")).splitlines()
                   if "=" in l)
@@ -278,8 +280,9 @@ def main():
 
     rc = read(os.path.join(d, "drop-short.fw.rc"), "?").strip()
     reason = (read(os.path.join(d, "drop-short.fw.txt")).splitlines() or [""])[0]
-    print(f"== drop-short (2 TPDOs < tpdo_missing_periods): irdm-fw exit {rc} "
-          f"(reported, not checked: {reason or 'no fault'})")
+    print(f"== drop-short ({args[1] // 2} TPDO1 dropped, < tpdo_missing_periods): "
+          f"irdm-fw exit {rc}: {reason}")
+    check(rc == "0", "drop-short: tolerated, ran to the end")
 
     fw = (read(os.path.join(d, "sdo.fw.txt")).splitlines() or [""])[0]
     rc = read(os.path.join(d, "sdo.fw.rc"), "?").strip()

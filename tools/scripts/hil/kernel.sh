@@ -4,7 +4,8 @@
 # (no hooks run) into DIR and cached there: DIR/vmlinux (the uncompressed
 # kernel, booted through its PVH entry: about 2.5 s faster under TCG than
 # the bzImage's decompressor), DIR/VERSION and DIR/modules/ (the .ko files
-# make hil loads, with their dependencies).
+# make hil loads: CAN and vcan; virtio-blk for the results disk; each
+# after its dependencies, which their .modinfo lists).
 #   tools/scripts/hil/kernel.sh DIR
 set -euo pipefail
 dir=$1
@@ -14,7 +15,8 @@ if [ -z "$pkg" ]; then
 	echo "hil: apt-cache knows no linux-image-rt-amd64 (apt-get update?)" >&2
 	exit 1
 fi
-if [ -f "$dir/vmlinux" ] && [ "$(cat "$dir/PACKAGE" 2>/dev/null)" = "$pkg" ]; then
+if [ -f "$dir/vmlinux" ] && [ "$(cat "$dir/PACKAGE" 2>/dev/null)" = "$pkg" ] &&
+	[ -f "$dir/modules/virtio_blk.ko" ]; then
 	echo "hil: kernel $pkg cached in $dir"
 	exit 0
 fi
@@ -31,7 +33,8 @@ off=$(grep -abo $'\xfd7zXZ\x00' "$bz" | head -n 1 | cut -d: -f1)
 xz -dc --single-stream < <(tail -c +"$((off + 1))" "$bz" 2>/dev/null || true) > "$dir/vmlinux.tmp"
 mv "$dir/vmlinux.tmp" "$dir/vmlinux"
 mkdir -p "$dir/modules"
-for m in can can-raw can-dev vcan; do
+for m in can can-raw can-dev vcan virtio_ring virtio virtio_pci_modern_dev virtio_pci_legacy_dev \
+	virtio_pci virtio_blk; do
 	find "$dir/x/lib/modules/$version" -name "$m.ko" -exec cp {} "$dir/modules/" \;
 	[ -f "$dir/modules/$m.ko" ] || { echo "hil: $pkg has no $m.ko" >&2; exit 1; }
 done
