@@ -41,8 +41,10 @@ static struct logged sent[LOG_MAX];     /* what the master sent */
 static unsigned n_sent;
 static char err[256];
 
-/* A port in front of the master's endpoint that can go down (bus-off). */
-static bool rx_down, tx_down;
+/* A port in front of the master's endpoint that can go down (bus-off),
+ * or say "nothing" once before every frame (as SocketCAN does after an
+ * error frame). */
+static bool rx_down, tx_down, rx_hiccup, hiccup_said;
 
 static int wrap_send(void *ctx, const struct irdm_can_frame *f)
 {
@@ -53,6 +55,11 @@ static int wrap_send(void *ctx, const struct irdm_can_frame *f)
 static int wrap_recv(void *ctx, struct irdm_can_frame *f)
 {
 	(void)ctx;
+	if (rx_hiccup && !hiccup_said) {
+		hiccup_said = true;
+		return 0;
+	}
+	hiccup_said = false;
 	return rx_down ? IRDM_EIO : irdm_can_recv(&master_port, f);
 }
 
@@ -95,7 +102,7 @@ static struct irdm_can_master_cfg cfg_3axes(void)
 static void bus_up(void)
 {
 	memset(&m, 0, sizeof(m));
-	rx_down = tx_down = false;
+	rx_down = tx_down = rx_hiccup = hiccup_said = false;
 	irdm_can_membus_init(&bus);
 	assert_int_equal(irdm_can_membus_port(&bus, &master_port), IRDM_OK);
 	assert_int_equal(irdm_can_membus_port(&bus, &drives_port), IRDM_OK);
@@ -309,6 +316,11 @@ static void test_torque_scaling(void **state)
 	expect_frame(1, 0x202, 4, n2);
 	assert_int_equal(dr.d[0].rpdo_torque_permille, 86);
 	assert_int_equal(dr.d[1].rpdo_torque_permille, -86);
+	/* rounded, clamped to int16, not finite -> 0 */
+	assert_int_equal(irdm_can_torque_permille(&c.axis[0], 0.5 * 86.5 / 86.2), 87);
+	assert_int_equal(irdm_can_torque_permille(&c.axis[0], 1e9), 32767);
+	assert_int_equal(irdm_can_torque_permille(&c.axis[0], -1e9), -32767);
+	assert_int_equal(irdm_can_torque_permille(&c.axis[0], 0.0 / 0.0), 0);
 }
 
 /* Every axis got disable voltage + zero torque within two periods of
@@ -541,6 +553,29 @@ static void test_latest_wins(void **state)
 	assert_int_equal(m.ax[0].counts, -2);
 }
 
+/* A port that says "nothing" between frames still hands over all of them;
+ * a flood is taken at most IRDM_CAN_RX_MAX frames a period. */
+static void test_drain_hiccups_and_flood(void **state)
+{
+	struct irdm_can_master_cfg c = cfg_3axes();
+	static const uint8_t junk[8] = { 0 };
+
+	(void)state;
+	run_up(&c);
+	rx_hiccup = true;
+	for (int p = 0; p < 20; p++)
+		assert_int_equal(period(NULL), IRDM_OK);
+	rx_hiccup = false;
+	irdm_can_master_send(&m, NULL);
+	irdm_can_drives_poll(&dr);
+	for (int k = 0; k < 600; k++)
+		rogue_send(0x123, 8, junk);
+	assert_int_equal(irdm_can_master_receive(&m), IRDM_OK);  /* the TPDOs came first */
+	assert_int_equal(m.unknown_frames, IRDM_CAN_RX_MAX - 3);
+	irdm_can_master_receive(&m);
+	assert_int_equal(m.unknown_frames, 2 * IRDM_CAN_RX_MAX - 3);
+}
+
 static void test_bus_load(void **state)
 {
 	struct irdm_can_master_cfg c = cfg_3axes();
@@ -649,6 +684,7 @@ int main(void)
 		cmocka_unit_test(test_fault_link_down),
 		cmocka_unit_test(test_malformed_counted),
 		cmocka_unit_test(test_latest_wins),
+		cmocka_unit_test(test_drain_hiccups_and_flood),
 		cmocka_unit_test(test_bus_load),
 		cmocka_unit_test(test_config_refused),
 		cmocka_unit_test(test_one_rpdo_per_sync_and_counter),

@@ -194,7 +194,9 @@ static bool judge_axis(struct irdm_can_master *m, unsigned k)
 			 (unsigned long long)silent_ms, (unsigned)m->cfg.heartbeat_timeout_ms);
 	} else if (a->nmt != IRDM_CO_STATE_OPERATIONAL) {
 		snprintf(reason, sizeof(reason), "heartbeat says NMT %s", nmt_name(a->nmt));
-	} else if (a->state == IRDM_CIA402_FAULT || a->state == IRDM_CIA402_FAULT_REACTION_ACTIVE) {
+	} else if ((a->state == IRDM_CIA402_FAULT && !m->reset_request) ||
+		   a->state == IRDM_CIA402_FAULT_REACTION_ACTIVE) {
+		/* (a fault being reset on request is expected until it clears) */
 		snprintf(reason, sizeof(reason), "drive fault (statusword 0x%04X, %s)", a->sw,
 			 irdm_cia402_name(a->state));
 	} else if (m->enable && a->was_enabled && a->state != IRDM_CIA402_OPERATION_ENABLED) {
@@ -209,7 +211,7 @@ static bool judge_axis(struct irdm_can_master *m, unsigned k)
 	return false;
 }
 
-static int irdm_can_master_first_fault(const struct irdm_can_master *m)
+static int first_fault(const struct irdm_can_master *m)
 {
 	for (unsigned k = 0; k < m->cfg.n_axes; k++)
 		if (m->ax[k].state == IRDM_CIA402_FAULT)
@@ -217,16 +219,38 @@ static int irdm_can_master_first_fault(const struct irdm_can_master *m)
 	return -1;
 }
 
-int irdm_can_master_receive(struct irdm_can_master *m)
+/*
+ * Take what is waiting, at most IRDM_CAN_RX_MAX frames (the cycle stays
+ * bounded under a flood; the rest waits for the next period).  A port may
+ * say "nothing" (0) after reading a frame that was not data (SocketCAN's
+ * error frames), so only a second 0 in a row ends the drain.
+ * Return: 0, or the port's error (IRDM_EIO).
+ */
+static int drain(struct irdm_can_master *m)
 {
 	struct irdm_can_frame f;
+	unsigned zeros = 0;
+
+	for (unsigned n = 0; n < IRDM_CAN_RX_MAX && zeros < 2; n++) {
+		int rc = irdm_can_recv(&m->port, &f);
+
+		if (rc < 0)
+			return rc;
+		if (rc == 1)
+			(void)irdm_can_master_take(m, &f);
+		zeros = rc == 1 ? 0 : zeros + 1;
+	}
+	return 0;
+}
+
+int irdm_can_master_receive(struct irdm_can_master *m)
+{
 	bool stale = false;
 	int rc;
 
 	for (unsigned k = 0; k < m->cfg.n_axes; k++)
 		m->ax[k].fresh = false;
-	while ((rc = irdm_can_recv(&m->port, &f)) == 1)
-		(void)irdm_can_master_take(m, &f);
+	rc = drain(m);
 	if (rc < 0)
 		irdm_can_master_lose(m, -1, "link down (bus-off or interface gone) on receive");
 	for (unsigned k = 0; k < m->cfg.n_axes && !m->faulted; k++) {
@@ -235,7 +259,7 @@ int irdm_can_master_receive(struct irdm_can_master *m)
 	}
 	if (m->faulted)
 		return IRDM_EHW;
-	if (irdm_can_master_first_fault(m) < 0)
+	if (first_fault(m) < 0)
 		m->reset_request = false;       /* every fault reset: asked once, done */
 	return stale ? IRDM_ETIMEDOUT : IRDM_OK;
 }

@@ -66,8 +66,10 @@ int irdm_hal_can_open(struct irdm_hal_dev *dev, const struct irdm_hal_can_link *
 
 	if (c->state != HAL_CAN_CLOSED)
 		return IRDM_EBUSY;
-	if (!cfg->device || !(isfinite(cfg->period_s) && cfg->period_s >= 1e-4 && cfg->period_s <= 1))
-		return say(dev, "period: 100 us to 1 s"), IRDM_EINVAL;
+	if (!cfg->device || !(isfinite(cfg->period_s) && cfg->period_s >= 1e-4 && cfg->period_s <= 1)) {
+		say(dev, "period: 100 us to 1 s, and an arm");
+		return IRDM_EINVAL;
+	}
 	c->link = link;
 	rc = irdm_hal_can_parse(cfg->options, extra, &c->opts, dev->why, sizeof(dev->why));
 	if (!rc)
@@ -106,6 +108,7 @@ static int receive(struct irdm_hal_dev *dev)
 
 	if (c->link->check)
 		c->link->check(dev, &c->m);
+	pump(dev);              /* a fault just found sent the torque off: heard now */
 	return c->m.faulted ? faulted(dev) : rc;
 }
 
@@ -170,6 +173,7 @@ int irdm_hal_can_read(struct irdm_hal_dev *dev, struct irdm_hal_joint_state *st)
 		rc = IRDM_OK;
 	if (rc)
 		return rc;
+	dev->why[0] = '\0';    /* a late TPDO's line is not the reason of a later fault */
 	for (unsigned a = 0; a < IRDM_HAL_JOINTS; a++)
 		st->counts[a] = c->m.ax[a].counts;
 	st->seq = ++c->seq;
@@ -184,8 +188,12 @@ int irdm_hal_can_write(struct irdm_hal_dev *dev, const double tau_nm[IRDM_HAL_JO
 
 	if (c->state != HAL_CAN_RUNNING)
 		return IRDM_EINVAL;
-	if (c->m.faulted)
+	if (c->m.faulted) {
+		(void)irdm_can_master_send(&c->m, NULL);        /* off again, with the SYNC */
+		pump(dev);
+		c->written = true;
 		return faulted(dev);
+	}
 	for (unsigned a = 0; a < IRDM_HAL_JOINTS; a++) {
 		tau[a] = isfinite(tau_nm[a]) ? tau_nm[a] : 0.0;
 		if (!isfinite(tau_nm[a]))

@@ -117,6 +117,20 @@ static int list_option(const char *key, const char *v, size_t vlen, struct irdm_
 	return IRDM_OK;
 }
 
+/* emcy_at=DRIVE:MS: drive 1..3 raises EMCY 0x2310 and faults at MS ms. */
+static int emcy_at(const char *v, size_t vlen, struct irdm_hal_can_opts *o, char *err,
+		   size_t errlen)
+{
+	const char *colon = memchr(v, ':', vlen);
+	uint32_t drive;
+
+	if (!colon || number(v, (size_t)(colon - v), 1, IRDM_CAN_AXES_MAX, &drive) ||
+	    number(colon + 1, vlen - (size_t)(colon - v) - 1, 0, 3600000, &o->emcy_at_ms))
+		return bad(err, errlen, "emcy_at", "expected DRIVE:MS, drive 1..3, 0..3600000 ms");
+	o->emcy_drive = drive;
+	return IRDM_OK;
+}
+
 static int option(const char *tok, size_t len, unsigned extra, struct irdm_hal_can_opts *o,
 		  char *err, size_t errlen)
 {
@@ -133,6 +147,8 @@ static int option(const char *tok, size_t len, unsigned extra, struct irdm_hal_c
 		snprintf(o->iface, sizeof(o->iface), "%.*s", (int)vlen, eq + 1);
 		return IRDM_OK;
 	}
+	if (!strcmp(key, "emcy_at") && (extra & IRDM_HAL_CAN_EMCY_AT))
+		return emcy_at(eq + 1, vlen, o, err, errlen);
 	if (!strcmp(key, "sync_counter")) {
 		if (vlen == 3 && !strncmp(eq + 1, "yes", 3))
 			o->sync_counter = true;

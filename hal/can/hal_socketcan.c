@@ -41,10 +41,15 @@ static void link_idle(void *ctx)
 	nanosleep(&ts, NULL);
 }
 
+void irdm_hal_socketcan_judge(const struct irdm_socketcan *s, struct irdm_can_master *m)
+{
+	if (s->bus_off)
+		irdm_can_master_lose(m, -1, "bus-off (the controller left the bus)");
+}
+
 static void link_check(struct irdm_hal_dev *dev, struct irdm_can_master *m)
 {
-	if (data_of(dev)->sock.bus_off)
-		irdm_can_master_lose(m, -1, "bus-off (the controller left the bus)");
+	irdm_hal_socketcan_judge(&data_of(dev)->sock, m);
 }
 
 static void link_close(struct irdm_hal_dev *dev)
@@ -66,15 +71,7 @@ static int socketcan_open(struct irdm_hal_dev *dev)
 	return irdm_hal_can_open(dev, &socketcan_link, IRDM_HAL_CAN_IFACE);
 }
 
-static const struct irdm_hal_ops socketcan_ops = {
-	.open = socketcan_open,
-	.start = irdm_hal_can_start,
-	.read = irdm_hal_can_read,
-	.write = irdm_hal_can_write,
-	.safe_off = irdm_hal_can_safe_off,
-	.poll = irdm_hal_can_poll,
-	.close = irdm_hal_can_close,
-};
+static const struct irdm_hal_ops socketcan_ops = IRDM_HAL_CAN_OPS(socketcan_open);
 
 const struct irdm_hal_backend irdm_hal_socketcan_backend = {
 	.name = "socketcan",

@@ -10,6 +10,7 @@ struct canemu_data {
 	struct irdm_hal_can can;        /* first: the shared code's view */
 	struct irdm_can_membus bus;
 	struct irdm_can_drives drives;
+	bool emcy_done;                 /* the injected emcy_at fault happened */
 };
 
 static struct canemu_data *data_of(struct irdm_hal_dev *dev)
@@ -47,7 +48,15 @@ static int link_open(struct irdm_hal_dev *dev, struct irdm_can_port *port, char 
 /* The emulator's turn: it answers what the master just sent. */
 static void link_pump(struct irdm_hal_dev *dev)
 {
-	irdm_can_drives_poll(&data_of(dev)->drives);
+	struct canemu_data *d = data_of(dev);
+	const struct irdm_hal_can_opts *o = &d->can.opts;
+
+	irdm_can_drives_poll(&d->drives);
+	if (o->emcy_drive && o->emcy_drive <= d->drives.n && !d->emcy_done &&
+	    d->drives.now_us >= 1000ull * o->emcy_at_ms) {
+		irdm_can_drives_fault(&d->drives, o->emcy_drive - 1, 0x2310);
+		d->emcy_done = true;
+	}
 }
 
 static void link_idle(void *ctx)
@@ -70,18 +79,11 @@ static const struct irdm_hal_can_link canemu_link = {
 
 static int canemu_open(struct irdm_hal_dev *dev)
 {
-	return irdm_hal_can_open(dev, &canemu_link, IRDM_HAL_CAN_SUBSTEPS);
+	data_of(dev)->emcy_done = false;
+	return irdm_hal_can_open(dev, &canemu_link, IRDM_HAL_CAN_SUBSTEPS | IRDM_HAL_CAN_EMCY_AT);
 }
 
-static const struct irdm_hal_ops canemu_ops = {
-	.open = canemu_open,
-	.start = irdm_hal_can_start,
-	.read = irdm_hal_can_read,
-	.write = irdm_hal_can_write,
-	.safe_off = irdm_hal_can_safe_off,
-	.poll = irdm_hal_can_poll,
-	.close = irdm_hal_can_close,
-};
+static const struct irdm_hal_ops canemu_ops = IRDM_HAL_CAN_OPS(canemu_open);
 
 const struct irdm_hal_backend irdm_hal_canemu_backend = {
 	.name = "canemu",

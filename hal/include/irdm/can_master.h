@@ -25,7 +25,8 @@
 
 #define IRDM_CAN_AXES_MAX 3
 #define IRDM_CAN_WHY_MAX 160
-#define IRDM_CAN_SYNC_COUNTER_MAX 240   /* the counter runs 1..240, then 1 again */
+#define IRDM_CAN_SYNC_COUNTER_MAX 240
+#define IRDM_CAN_RX_MAX 256             /* frames one receive takes at most */   /* the counter runs 1..240, then 1 again */
 
 struct irdm_can_axis_cfg {
 	unsigned node;                  /* 1..127 */

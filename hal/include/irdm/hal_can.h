@@ -45,12 +45,15 @@ struct irdm_hal_can_opts {
 	uint32_t sdo_timeout_ms;
 	uint32_t enable_timeout_ms;
 	unsigned substeps;              /* canemu only: the emulated arm's steps a period */
+	unsigned emcy_drive;            /* canemu only: drive (1..) that faults, 0: none */
+	uint32_t emcy_at_ms;            /*   at this virtual time, with EMCY 0x2310 */
 };
 
 /* Which options a back-end takes beyond the common ones. */
 enum irdm_hal_can_extra {
 	IRDM_HAL_CAN_IFACE = 1u << 0,   /* iface= (required) */
 	IRDM_HAL_CAN_SUBSTEPS = 1u << 1,
+	IRDM_HAL_CAN_EMCY_AT = 1u << 2, /* emcy_at=DRIVE:MS (an injected fault) */
 };
 
 /*
@@ -98,6 +101,14 @@ int irdm_hal_can_write(struct irdm_hal_dev *dev, const double tau_nm[IRDM_HAL_JO
 int irdm_hal_can_safe_off(struct irdm_hal_dev *dev);
 int irdm_hal_can_poll(struct irdm_hal_dev *dev, uint32_t *faults);
 void irdm_hal_can_close(struct irdm_hal_dev *dev);
+
+/* A CAN back-end's ops table: its own open, the shared rest. */
+#define IRDM_HAL_CAN_OPS(open_fn)                                                              \
+	{                                                                                      \
+		.open = (open_fn), .start = irdm_hal_can_start, .read = irdm_hal_can_read,     \
+		.write = irdm_hal_can_write, .safe_off = irdm_hal_can_safe_off,                \
+		.poll = irdm_hal_can_poll, .close = irdm_hal_can_close,                        \
+	}
 
 /* The operator's fault reset (tests; the controller has no such command yet). */
 void irdm_hal_can_reset_faults(struct irdm_hal_dev *dev);

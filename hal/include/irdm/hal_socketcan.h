@@ -9,8 +9,18 @@
 #ifndef IRDM_HAL_SOCKETCAN_H
 #define IRDM_HAL_SOCKETCAN_H
 
+#include "irdm/can_master.h"
 #include "irdm/hal.h"
+#include "irdm/socketcan.h"
 
 extern const struct irdm_hal_backend irdm_hal_socketcan_backend;
+
+/*
+ * The port's latched flags into the master, after each receive: bus-off
+ * loses the link (every axis off, "CAN link: bus-off ..."); error passive
+ * alone does not (frames still pass: the TPDO and heartbeat checks judge
+ * what it costs).
+ */
+void irdm_hal_socketcan_judge(const struct irdm_socketcan *s, struct irdm_can_master *m);
 
 #endif /* IRDM_HAL_SOCKETCAN_H */

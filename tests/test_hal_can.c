@@ -1,0 +1,382 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * The CAN back-ends through the HAL ops (irdm/hal.h): "canemu" (the master
+ * on the in-memory bus with emulated drives) end to end - open, start,
+ * read, write, a drive fault turning every axis off with one line naming
+ * the drive, safe_off - with the bus log from the membus tap; the board
+ * options refused by name; "socketcan" on an interface that does not
+ * exist; and the tick's ops (read, write, poll, safe_off) over many ticks,
+ * a fault among them, in seccomp strict mode with the allocator counted:
+ * no system call, no allocation.
+ */
+#include <setjmp.h>
+#include <signal.h>
+#include <stdalign.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+#include <sys/syscall.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmocka.h>
+
+#include "irdm/error.h"
+#include "irdm/hal_can.h"
+#include "irdm/hal_canemu.h"
+#include "irdm/hal_socketcan.h"
+
+#include "support/alloc_count.h"
+#include "support/strict_mode.h"
+
+#define OPTS "nodes=1,2,3 rated_torque_mnm=100 heartbeat_ms=10 heartbeat_timeout_ms=50 " \
+	     "tpdo_missing_periods=3 sync_counter=yes"
+
+static struct irdm_device_config arm;
+static struct irdm_hal_config cfg;
+static struct irdm_hal_dev dev;
+static alignas(max_align_t) unsigned char mem[1 << 16];
+
+struct logged {
+	struct irdm_can_frame f;
+	unsigned from;
+};
+static struct logged bus_log[4096];
+static unsigned n_log;
+
+static void tap(void *ctx, const struct irdm_can_frame *f, unsigned from)
+{
+	(void)ctx;
+	if (n_log < sizeof(bus_log) / sizeof(bus_log[0]))
+		bus_log[n_log++] = (struct logged){ *f, from };
+}
+
+static int open_as(const char *backend, const char *options)
+{
+	int rc;
+
+	irdm_device_config_default(&arm);
+	cfg = (struct irdm_hal_config){ &arm, options, 1e-3 };
+	assert_int_equal(irdm_hal_register(&irdm_hal_canemu_backend), IRDM_OK);
+	assert_int_equal(irdm_hal_register(&irdm_hal_socketcan_backend), IRDM_OK);
+	assert_int_equal(irdm_hal_init(&dev, backend, &cfg, mem, sizeof(mem)), IRDM_OK);
+	rc = irdm_hal_open(&dev);
+	if (rc == IRDM_OK && !strcmp(backend, "canemu")) {
+		n_log = 0;
+		irdm_hal_canemu_bus(&dev)->tap = tap;
+	}
+	return rc;
+}
+
+static void test_options_refused_by_name(void **state)
+{
+	static const struct {
+		const char *options, *why;
+	} cases[] = {
+		{ "nodes=1,2,3", "hal_options rated_torque_mnm: missing (the drives' rated torque)" },
+		{ "rated_torque_mnm=100", "hal_options nodes: missing (one node id per joint, e.g. "
+					  "nodes=1,2,3)" },
+		{ "nodes=1,2 rated_torque_mnm=100", "hal_options nodes: 2 node(s) given, the arm has 3 joints" },
+		{ "nodes=1,2,300 rated_torque_mnm=100", "hal_options nodes: expected 1 to 3 node ids "
+							"1..127, e.g. 1,2,3" },
+		{ "nodes=1,2,3, rated_torque_mnm=100", "hal_options nodes: expected 1 to 3 node ids "
+						       "1..127, e.g. 1,2,3" },
+		{ OPTS " bitrate=2000000", "hal_options bitrate: 10000..1000000 bit/s" },
+		{ OPTS " bitrate=500000", "bitrate: one cycle needs 695 bits worst case, 1000 us at "
+					  "500000 bit/s carries 500" },
+		{ OPTS " sync_counter=maybe", "hal_options sync_counter: expected yes or no" },
+		{ OPTS " iface=can0", "hal_options iface: unknown option for this back-end" },
+		{ OPTS " speed", "hal_options speed: expected key=value" },
+		{ OPTS " heartbeat_timeout_ms=5", "hal_options heartbeat_timeout_ms: must exceed "
+						  "heartbeat_ms" },
+		{ "nodes=1,3,4 rated_torque_mnm=100", "hal_options nodes: the emulator's nodes are "
+						      "consecutive (e.g. 1,2,3)" },
+	};
+
+	(void)state;
+	for (size_t i = 0; i < sizeof(cases) / sizeof(cases[0]); i++) {
+		assert_int_equal(open_as("canemu", cases[i].options), IRDM_EINVAL);
+		assert_string_equal(dev.why, cases[i].why);
+	}
+	assert_int_equal(open_as("socketcan", OPTS), IRDM_EINVAL);
+	assert_string_equal(dev.why, "hal_options iface: missing (the CAN interface, e.g. iface=can0)");
+}
+
+static void test_socketcan_without_interface(void **state)
+{
+	int rc;
+
+	(void)state;
+	rc = open_as("socketcan", "iface=nosuchcan7 " OPTS);
+	print_message("socketcan on nosuchcan7: %s: %s\n", irdm_errname(rc), dev.why);
+	assert_true(rc == IRDM_EIO || rc == IRDM_ENOTSUP);
+	assert_non_null(strstr(dev.why, "nosuchcan7"));
+}
+
+static const double NULL_TAU[3] = { 0, 0, 0 };
+
+/* The SocketCAN port's flags into a master running on emulated drives. */
+static void test_socketcan_bus_off_loses_link(void **state)
+{
+	struct irdm_socketcan sock = { .fd = -1 };
+	struct irdm_hal_joint_state st;
+	struct irdm_can_master *m;
+
+	(void)state;
+	assert_int_equal(open_as("canemu", OPTS), IRDM_OK);
+	assert_int_equal(irdm_hal_start(&dev), IRDM_OK);
+	m = &((struct irdm_hal_can *)dev.data)->m;
+	sock.error_passive = true;
+	irdm_hal_socketcan_judge(&sock, m);
+	assert_false(m->faulted);
+	assert_int_equal(irdm_hal_read(&dev, &st), IRDM_OK);
+	/* one period without a TPDO: the latest counts stand (the master loses
+	 * the drive after tpdo_missing_periods; test_hal_can_wire) */
+	irdm_hal_canemu_drives(&dev)->d[2].drop_tpdos = 1;
+	assert_int_equal(irdm_hal_write(&dev, NULL_TAU), IRDM_OK);
+	assert_int_equal(irdm_hal_read(&dev, &st), IRDM_OK);
+	assert_int_equal(m->ax[2].missing, 1);
+	assert_int_equal(irdm_hal_write(&dev, NULL_TAU), IRDM_OK);
+	assert_int_equal(irdm_hal_read(&dev, &st), IRDM_OK);
+	assert_string_equal(dev.why, "");
+	sock.bus_off = true;
+	n_log = 0;
+	irdm_hal_socketcan_judge(&sock, m);
+	assert_true(m->faulted && m->link_lost);
+	assert_string_equal(m->why, "CAN link: bus-off (the controller left the bus)");
+	assert_int_equal(n_log, 4);     /* off to 0x201..0x203, then the SYNC */
+	for (unsigned i = 0; i < 3; i++) {
+		assert_int_equal(bus_log[i].f.id, 0x201 + i);
+		assert_int_equal(bus_log[i].f.data[0] | bus_log[i].f.data[1] | bus_log[i].f.data[2] |
+					 bus_log[i].f.data[3], 0);
+	}
+	assert_int_equal(bus_log[3].f.id, 0x080);
+	irdm_hal_close(&dev);
+}
+
+static void run_ticks(int n, const double tau[3], int *bad)
+{
+	struct irdm_hal_joint_state st;
+	uint32_t faults;
+
+	for (int k = 0; k < n; k++) {
+		*bad += irdm_hal_read(&dev, &st) != IRDM_OK;
+		*bad += irdm_hal_poll(&dev, &faults) != IRDM_OK;
+		*bad += irdm_hal_write(&dev, tau) != IRDM_OK;
+	}
+}
+
+static void test_canemu_runs_and_faults(void **state)
+{
+	double tau[3] = { 0.0, 0.098, 0.0 };    /* about the shoulder's gravity torque */
+	struct irdm_hal_joint_state st;
+	uint32_t faults;
+	unsigned mark;
+	bool off[3] = { false, false, false };
+	int bad = 0;
+
+	(void)state;
+	assert_int_equal(open_as("canemu", OPTS), IRDM_OK);
+	assert_string_equal(dev.info, "CAN bus load: SYNC + 3 x RPDO1 (4 B) + 3 x TPDO1 (6 B) = "
+			    "695 bits worst case in 1000 us at 1000000 bit/s: 69.5 %");
+	assert_int_equal(irdm_hal_write(&dev, tau), IRDM_EINVAL);      /* not started */
+	assert_int_equal(irdm_hal_start(&dev), IRDM_OK);
+	run_ticks(100, tau, &bad);
+	assert_int_equal(bad, 0);
+	{       /* a torque that is not a number: refused, zero sent instead */
+		double nan_tau[3] = { 0.0, 0.0 / 0.0, 0.0 };
+
+		assert_int_equal(irdm_hal_write(&dev, nan_tau), IRDM_EFAULT);
+		assert_int_equal(irdm_hal_canemu_drives(&dev)->d[1].rpdo_torque_permille, 0);
+		assert_int_equal(irdm_hal_read(&dev, &st), IRDM_OK);
+		assert_int_equal(irdm_hal_write(&dev, tau), IRDM_OK);
+		/* 0.098 N m / 11.6 = 8.45 mN m = 84.5 per mille of 100 mN m -> 84 */
+		assert_int_equal(irdm_hal_canemu_drives(&dev)->d[1].rpdo_torque_permille, 84);
+	}
+	assert_int_equal(irdm_hal_read(&dev, &st), IRDM_OK);
+	assert_int_equal(st.seq, 102);
+	/* drive 2 raises EMCY 0x4210 (temperature) and faults */
+	mark = n_log;
+	irdm_can_drives_fault(irdm_hal_canemu_drives(&dev), 1, 0x4210);
+	assert_int_equal(irdm_hal_write(&dev, tau), IRDM_OK);   /* the EMCY is not read yet */
+	assert_int_equal(irdm_hal_read(&dev, &st), IRDM_EHW);
+	/* in the same tick, before any write: every emulated drive was told off */
+	for (unsigned k = 0; k < 3; k++) {
+		assert_int_equal(irdm_hal_canemu_drives(&dev)->d[k].rpdo_cw, 0);
+		assert_int_equal(irdm_hal_canemu_drives(&dev)->d[k].rpdo_torque_permille, 0);
+	}
+	assert_int_equal(irdm_hal_poll(&dev, &faults), IRDM_EHW);
+	assert_int_equal(faults, IRDM_HAL_FAULT_DRIVE);
+	assert_string_equal(dev.why, "drive 2 (node 2): EMCY 0x4210 (temperature), error register 0x01");
+	assert_int_equal(irdm_hal_write(&dev, tau), IRDM_EHW);
+	/* from the master (endpoint 0), after the EMCY: 0x00 00 00 00 to 0x201..0x203 */
+	for (unsigned i = mark; i < n_log; i++) {
+		const struct irdm_can_frame *f = &bus_log[i].f;
+
+		if (bus_log[i].from == 0 && f->id >= 0x201 && f->id <= 0x203 && f->dlc == 4 &&
+		    !f->data[0] && !f->data[1] && !f->data[2] && !f->data[3])
+			off[f->id - 0x201] = true;
+	}
+	assert_true(off[0] && off[1] && off[2]);
+	for (unsigned k = 0; k < 3; k++)
+		assert_int_not_equal(irdm_hal_canemu_drives(&dev)->d[k].fsa.state,
+				     IRDM_CIA402_OPERATION_ENABLED);
+	assert_int_equal(irdm_hal_safe_off(&dev), IRDM_OK);
+	assert_int_equal(irdm_hal_start(&dev), IRDM_EHW);       /* latched */
+	/* the operator's reset: the drive leaves fault, and enables again */
+	irdm_hal_can_reset_faults(&dev);
+	for (int k = 0; k < 5; k++)
+		irdm_hal_read(&dev, &st);
+	assert_int_equal(irdm_hal_start(&dev), IRDM_OK);
+	irdm_hal_close(&dev);
+	assert_null(irdm_hal_canemu_drives(&dev));
+}
+
+/* One SYNC per tick and one RPDO per axis before each, also in ticks the
+ * loop does not write (the read closes the period), counter +1 each. */
+static void test_one_sync_per_tick(void **state)
+{
+	double tau[3] = { 0.0, 0.098, 0.0 };
+	struct irdm_hal_joint_state st;
+	unsigned rpdos[3] = { 0, 0, 0 }, syncs = 0, last = 0;
+
+	(void)state;
+	assert_int_equal(open_as("canemu", OPTS), IRDM_OK);
+	assert_int_equal(irdm_hal_start(&dev), IRDM_OK);
+	n_log = 0;
+	for (int k = 0; k < 300; k++) {
+		assert_int_equal(irdm_hal_read(&dev, &st), IRDM_OK);
+		if (k % 3)      /* every third tick writes nothing */
+			assert_int_equal(irdm_hal_write(&dev, tau), IRDM_OK);
+	}
+	for (unsigned i = 0; i < n_log; i++) {
+		const struct irdm_can_frame *f = &bus_log[i].f;
+
+		if (bus_log[i].from != 0)
+			continue;
+		if (f->id == 0x080) {
+			for (int a = 0; a < 3; a++)
+				assert_int_equal(rpdos[a], 1);
+			memset(rpdos, 0, sizeof(rpdos));
+			if (syncs++)
+				assert_int_equal(f->data[0], last % 240 + 1);
+			last = f->data[0];
+		} else {
+			assert_true(f->id >= 0x201 && f->id <= 0x203);
+			rpdos[f->id - 0x201]++;
+		}
+	}
+	/* start's last SYNC was before the log; then one per tick */
+	assert_int_equal(syncs, 300);
+	irdm_hal_close(&dev);
+}
+
+static void test_canemu_start_times_out(void **state)
+{
+	(void)state;
+	assert_int_equal(open_as("canemu", OPTS " enable_timeout_ms=2"), IRDM_OK);
+	assert_int_equal(irdm_hal_start(&dev), IRDM_ETIMEDOUT);
+	assert_non_null(strstr(dev.why, "drive 1 (node 1): not operation enabled after 2 ms ("));
+	irdm_hal_close(&dev);
+}
+
+/* ---- the tick's ops in seccomp strict mode ---- */
+
+#define STRICT_TICKS 2000
+#define STRICT_MAGIC 0x43414e53u
+
+struct strict_result {
+	uint32_t magic;
+	int prctl_errno;
+	unsigned long allocs;
+	int bad, faults_seen;
+};
+
+static void strict_child(void *arg, int fd)
+{
+	double tau[3] = { 0.0, 0.098, 0.0 };
+	struct strict_result res = { .magic = STRICT_MAGIC };
+	struct irdm_hal_joint_state st;
+	uint32_t faults;
+	bool slip = arg != NULL;
+
+	run_ticks(10, tau, &res.bad);           /* every path once before the filter */
+	res.prctl_errno = strict_enter();
+	if (res.prctl_errno)
+		strict_exit(fd, &res, sizeof(res), STRICT_UNAVAILABLE);
+	alloc_arm();
+	run_ticks(STRICT_TICKS, tau, &res.bad);
+	if (slip)
+		syscall(SYS_getppid);
+	/* a drive drops its TPDOs: lost after 3 periods, every axis off */
+	irdm_hal_canemu_drives(&dev)->d[2].drop_tpdos = 1000;
+	for (int k = 0; k < 10; k++) {
+		irdm_hal_read(&dev, &st);
+		if (irdm_hal_poll(&dev, &faults) == IRDM_EHW)
+			res.faults_seen++;
+		irdm_hal_write(&dev, tau);
+	}
+	res.bad += irdm_hal_safe_off(&dev) != IRDM_OK;
+	res.bad += irdm_hal_safe_off(&dev) != IRDM_OK;
+	res.allocs = alloc_calls();
+	strict_exit(fd, &res, sizeof(res), 0);
+}
+
+static int run_strict(bool slip, struct strict_result *res)
+{
+	size_t got;
+	int status;
+
+	assert_int_equal(open_as("canemu", OPTS), IRDM_OK);
+	assert_int_equal(irdm_hal_start(&dev), IRDM_OK);
+	status = strict_run(strict_child, slip ? (void *)1 : NULL, res, sizeof(*res), &got);
+	irdm_hal_close(&dev);
+	if (WIFEXITED(status) && WEXITSTATUS(status) == STRICT_UNAVAILABLE) {
+		print_message("  seccomp strict mode not available (errno %d): skipped\n",
+			      res->prctl_errno);
+		skip();
+	}
+	return status;
+}
+
+static void test_tick_ops_no_system_call_no_allocation(void **state)
+{
+	struct strict_result res;
+	int status;
+
+	(void)state;
+	status = run_strict(false, &res);
+	if (WIFSIGNALED(status))
+		fail_msg("strict-mode child died of signal %d (SIGKILL: a system call in the tick)",
+			 WTERMSIG(status));
+	assert_int_equal(WEXITSTATUS(status), 0);
+	assert_int_equal(res.magic, STRICT_MAGIC);
+	print_message("  %d ticks + 10 with a drive lost: %d failed ops, %d polls with the fault, "
+		      "%lu allocator calls%s\n", STRICT_TICKS, res.bad, res.faults_seen, res.allocs,
+		      alloc_counting() ? "" : " (not counted: ASan owns the allocator)");
+	assert_int_equal(res.bad, 0);
+	/* tick 1 still reads the TPDO of the SYNC before the drop; ticks 2, 3, 4
+	 * miss it; lost at the third: ticks 4..10 poll the fault */
+	assert_int_equal(res.faults_seen, 7);
+	assert_int_equal(res.allocs, 0);
+	/* the control: one system call is caught */
+	status = run_strict(true, &res);
+	assert_true(WIFSIGNALED(status));
+	assert_int_equal(WTERMSIG(status), SIGKILL);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_options_refused_by_name),
+		cmocka_unit_test(test_socketcan_without_interface),
+		cmocka_unit_test(test_socketcan_bus_off_loses_link),
+		cmocka_unit_test(test_canemu_runs_and_faults),
+		cmocka_unit_test(test_one_sync_per_tick),
+		cmocka_unit_test(test_canemu_start_times_out),
+		cmocka_unit_test(test_tick_ops_no_system_call_no_allocation),
+	};
+
+	return cmocka_run_group_tests(tests, NULL, NULL);
+}
