@@ -165,7 +165,7 @@ $(TICK_IMAGE): $(IRDM)
 	$(IRDM) precompute -q --mesh box:0.04,0.04,0.08 --resolution 2,2,4 --fixed 'z<=0' \
 	  --touch 'z>=0.08' --display surface --representation modal:all -o $@
 
-test: $(TESTS) $(IRDM) $(IRDM_FW) $(TICK_IMAGE) $(BUILD)/data/bunny.off cfg-fws
+test: $(TESTS) $(IRDM) $(IRDM_FW) $(IRDM_CD) $(TICK_IMAGE) $(BUILD)/data/bunny.off cfg-fws
 	IRDM=$(IRDM) IRDM_FW=$(IRDM_FW) IRDM_BUILD=$(BUILD) IRDM_TICK_IMAGE=$(TICK_IMAGE) \
 	  tests/run-tests.sh $(TESTS)
 

@@ -1,6 +1,7 @@
 #!/bin/sh
 # The HIL scenarios, run inside the VM by /init (busybox sh; vcan0 is up).
-# Each: candump logs the bus, irdm-candrives emulates the drives (the
+# Each: candump logs the bus (a 4 MB receive buffer: the flood overran its
+# default one), irdm-candrives emulates the drives (the
 # press-hold-release hand pushing its arm; the scenario's faults), irdm-fw
 # runs the board in real time; their outputs, exit codes and logs go to
 # /out/NAME.* for the host's checks (hil-check.py).
@@ -21,7 +22,7 @@ scenario() {
 	faults=""
 	for f in "$@"; do faults="$faults --fault $f"; done
 	echo "hil-guest: scenario $name ($secs s of irdm-fw${faults:+,$faults})"
-	candump -L vcan0 > /out/$name.candump 2>/dev/null &
+	candump -r 4194304 -L vcan0 > /out/$name.candump 2>/dev/null &
 	dump=$!
 	$H/irdm-candrives --board $B --if vcan0 --user $H/press-hold-release.user $faults \
 		> /out/$name.cd.txt 2>&1 &
@@ -50,6 +51,8 @@ scenario emcy 2.5 emcy:3:$FAULT_AT:0x2310
 scenario fault 2.5 fault:1:$FAULT_AT
 scenario drop 2.5 drop:2:$FAULT_AT:$((TPDO_MISSING + 5))
 scenario drop-short 2.5 drop:2:$FAULT_AT:$((TPDO_MISSING / 2))
+scenario delay 2.5 delay:2:$FAULT_AT:5:30000
+scenario flood 2.5 flood:$FAULT_AT:1000
 scenario sdo 2.5 sdo-wrong:2
 # bus-off: the interface goes away under both ends 1.5 s into the run
 ( sleep 1.8; ip link set vcan0 down; echo "hil-guest: vcan0 down" ) &

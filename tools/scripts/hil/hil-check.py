@@ -23,6 +23,10 @@ Checked (a failure makes the exit code 1):
                detectable, and nothing else after it
   drop-short   TPDO_MISSING / 2 TPDOs dropped: tolerated, ran to the end (half:
                TCG delays a TPDO now and then, which counts as missing too)
+  delay        5 of node 2's TPDO1 sent 30 ms (3 periods) late: every one
+               on the bus, tolerated, ran to the end
+  flood        1000 frames of id 0x001 at once: all on the bus, as many as
+               the emulator says it sent; tolerated, ran to the end
   sdo          start-up refused: non-zero exit, the drive and object named
 Reported, not checked: the SYNC period's distribution (TCG's timing).
 """
@@ -235,6 +239,25 @@ def fault_scenario(d, name, kind, args):
         check("link" in reason, f"{name}: the reason says the link")
 
 
+def tolerated_scenarios(d):
+    """Faults below the master's limits: the run goes on to its end."""
+    fr = frames(os.path.join(d, "delay.candump"))
+    rc = read(os.path.join(d, "delay.fw.rc"), "?").strip()
+    print(f"== delay: irdm-fw exit {rc}")
+    n1, n2 = (sum(1 for f in fr if f[1] == i) for i in (0x181, 0x182))
+    check(rc == "0", "delay: tolerated, ran to the end")
+    check(n1 > 0 and n1 == n2, f"delay: every delayed TPDO1 on the bus ({n2} of node 2, "
+                               f"{n1} of node 1)")
+    fr = frames(os.path.join(d, "flood.candump"))
+    rc = read(os.path.join(d, "flood.fw.rc"), "?").strip()
+    m = re.search(r"(\d+) flood frames", read(os.path.join(d, "flood.cd.txt")))
+    n = sum(1 for f in fr if f[1] == 0x001)
+    print(f"== flood: irdm-fw exit {rc}, {n} flood frames on the bus")
+    check(rc == "0", "flood: tolerated, ran to the end")
+    check(m is not None and int(m.group(1)) == n and n > 0,
+          f"flood: the {m.group(1) if m else '?'} frames the emulator sent are on the bus")
+
+
 def main():
     if len(sys.argv) != 6:
         sys.exit("usage: hil-check.py RESULTS_DIR PERIOD_US TPDO_MISSING HEARTBEAT_TIMEOUT_MS "
@@ -283,6 +306,8 @@ def main():
     print(f"== drop-short ({args[1] // 2} TPDO1 dropped, < tpdo_missing_periods): "
           f"irdm-fw exit {rc}: {reason}")
     check(rc == "0", "drop-short: tolerated, ran to the end")
+
+    tolerated_scenarios(d)
 
     fw = (read(os.path.join(d, "sdo.fw.txt")).splitlines() or [""])[0]
     rc = read(os.path.join(d, "sdo.fw.rc"), "?").strip()
