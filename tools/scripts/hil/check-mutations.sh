@@ -43,7 +43,7 @@ mutate() {
 mutate "a SYNC skipped" "counter +1 each time" skip_sync
 mutate "two RPDO1 for one axis" "exactly one RPDO1 per axis" two_rpdos
 mutate "the torque-off delayed 3 periods" "emcy: every axis RPDO1 00 00 00 00" late_off
-mutate "forces 1.5 times the reference's" "forces: max" weak_force
+mutate "forces 1.5 times the reference's" "forces: hold means" weak_force
 mutate "a kernel without PREEMPT_RT" "PREEMPT_RT" no_rt
 mutate "the start-up failure unnamed" "sdo: start-up refused" no_reason
 exit $failed

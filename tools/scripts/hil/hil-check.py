@@ -14,9 +14,12 @@ Checked (a failure makes the exit code 1):
   base         irdm-fw ran to the end; the SYNC counter advanced by one
                each time (1..240, then 1) with none missing; exactly one
                RPDO1 per axis before each SYNC; every drive reached
-               operation enabled; the forces match the reference run
-               within FORCE_TOL_N after the best alignment of at most
-               ALIGN_MAX ticks
+               operation enabled; the forces match the reference run:
+               the mean over the hold (1.5-3.0 s) within HOLD_TOL_N, the
+               rms difference after the best alignment (at most ALIGN_MAX
+               ticks) within RMS_TOL_N, the peaks within PEAK_TOL_N (the
+               largest per-tick difference is reported: it falls on the
+               press's steep rise, where TCG's late TPDOs decide it)
   faults       irdm-fw exits non-zero with a one-line reason naming the
                drive; every axis gets disable voltage and zero torque
                (RPDO1 00 00 00 00) within two periods of the fault being
@@ -36,7 +39,10 @@ import os
 import re
 import sys
 
-FORCE_TOL_N = 0.12      # measured: docs/hil.md ("Forces")
+HOLD_TOL_N = 0.04       # measured: docs/hil.md ("Forces")
+RMS_TOL_N = 0.04
+PEAK_TOL_N = 0.12
+HOLD_S = (1.5, 3.0)
 ALIGN_MAX = 25          # ticks either way
 AXES = (1, 2, 3)
 SYNC = 0x080
@@ -143,7 +149,7 @@ def load_force(path):
     return [math.sqrt(sum(float(r[f"d0_f{a}_n"]) ** 2 for a in "xyz")) for r in rows]
 
 
-def force_checks(vm_csv, ref_csv):
+def force_checks(vm_csv, ref_csv, period_ms):
     if not (os.path.exists(vm_csv) and os.path.exists(ref_csv)):
         return check(False, "forces: base.csv and reference.csv present")
     vm, ref = load_force(vm_csv), load_force(ref_csv)
@@ -155,12 +161,18 @@ def force_checks(vm_csv, ref_csv):
         if best is None or rms < best[1]:
             best = (lag, rms, max(err), len(pairs))
     lag, rms, worst, n = best
+    k0, k1 = (int(round(t * 1e3 / period_ms)) for t in HOLD_S)
+    hold_vm = sum(vm[k0:k1]) / max(1, len(vm[k0:k1]))
+    hold_ref = sum(ref[k0:k1]) / max(1, len(ref[k0:k1]))
     print(f"  forces: VM peak {max(vm):.3f} N over {len(vm)} ticks, reference peak "
-          f"{max(ref):.3f} N over {len(ref)} ticks; best alignment: VM tick k = reference "
-          f"tick k{lag:+d}; |difference| rms {rms:.4f} N, max {worst:.4f} N over {n} ticks")
-    check(worst <= FORCE_TOL_N, f"forces: max |VM - reference| {worst:.3f} N <= {FORCE_TOL_N} N")
-    check(abs(max(vm) - max(ref)) <= FORCE_TOL_N,
-          f"forces: peaks {max(vm):.3f} N and {max(ref):.3f} N within {FORCE_TOL_N} N")
+          f"{max(ref):.3f} N over {len(ref)} ticks; hold mean {hold_vm:.4f} N against "
+          f"{hold_ref:.4f} N; best alignment: VM tick k = reference tick k{lag:+d}; "
+          f"|difference| rms {rms:.4f} N, max {worst:.4f} N (reported) over {n} ticks")
+    check(len(vm[k0:k1]) == k1 - k0 and abs(hold_vm - hold_ref) <= HOLD_TOL_N,
+          f"forces: hold means {hold_vm:.3f} N and {hold_ref:.3f} N within {HOLD_TOL_N} N")
+    check(rms <= RMS_TOL_N, f"forces: rms |VM - reference| {rms:.4f} N <= {RMS_TOL_N} N")
+    check(abs(max(vm) - max(ref)) <= PEAK_TOL_N,
+          f"forces: peaks {max(vm):.3f} N and {max(ref):.3f} N within {PEAK_TOL_N} N")
 
 
 def torque_off_checks(name, fr, onset_sync, allowed):
@@ -295,7 +307,7 @@ def main():
         kind = "EMCY" if 0x081 <= f[1] <= 0x0FF else kind
         counts[kind] = counts.get(kind, 0) + 1
     print(f"  frame counts: {counts}")
-    force_checks(os.path.join(d, "base.csv"), os.path.join(d, "reference.csv"))
+    force_checks(os.path.join(d, "base.csv"), os.path.join(d, "reference.csv"), period_ms)
 
     for name, kind in (("heartbeat", "heartbeat"), ("emcy", "emcy"), ("fault", "fault"),
                        ("drop", "drop"), ("busoff", "busoff")):
