@@ -19,6 +19,8 @@
 #include "irdm/can_faults.h"
 #include "irdm/can_membus.h"
 
+#include "support/can_drain.h"
+
 static struct irdm_can_membus bus;
 static struct irdm_can_drives dr;
 static struct irdm_can_port master, drives_port;
@@ -155,12 +157,7 @@ static void test_drop_exactly_k_from_n(void **state)
 /* Drain what the master hears; how many frames had this id. */
 static unsigned count_id(uint32_t id)
 {
-	struct irdm_can_frame f;
-	unsigned n = 0;
-
-	while (irdm_can_recv(&master, &f) == 1)
-		n += f.id == id;
-	return n;
+	return can_drain_count(&master, id);
 }
 
 static void test_delay_on_the_wall_clock(void **state)

@@ -71,15 +71,7 @@ static int wire_open(struct irdm_hal_dev *dev)
 	return irdm_hal_can_open(dev, &wire_link, 0);
 }
 
-static const struct irdm_hal_ops wire_ops = {
-	.open = wire_open,
-	.start = irdm_hal_can_start,
-	.read = irdm_hal_can_read,
-	.write = irdm_hal_can_write,
-	.safe_off = irdm_hal_can_safe_off,
-	.poll = irdm_hal_can_poll,
-	.close = irdm_hal_can_close,
-};
+static const struct irdm_hal_ops wire_ops = IRDM_HAL_CAN_OPS(wire_open);
 
 static const struct irdm_hal_backend wire_backend = {
 	.name = "test-wire",
