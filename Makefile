@@ -9,6 +9,7 @@
 #   make bench      benchmarks (print figures; never pass/fail on time)
 #   make run        the main job: the built-in default scene, end to end
 #   make jitter     irdm-fw's wake-up latency beside cyclictest's (JITTER_SECONDS)
+#   make hil        the CAN back-end end to end in a PREEMPT_RT VM (docs/hil.md)
 #   make docs       docs/scene-format.md from the scene key table
 #   make sizes      irdm-fw built with each configs/*.config (CONFIG=FILE: one)
 #
@@ -18,6 +19,7 @@
 #   firmware/*/*.c  -> libirdmfw.a     sees firmware/include only
 #   hal/*/*.c       -> libirdmhal.a    sees firmware/include, hal/include
 #   sim/*/*.c       -> libirdmsim.a    sees firmware/include, hal/include, sim/include
+#   sim/main/*.c    -> irdm-candrives (the CAN drive emulator; not in the library)
 #   tools/*/*.c     -> libirdmtools.a  sees firmware/include, tools/ (not tools/irdm)
 #   tools/irdm/*.c  -> irdm
 #   firmware/main/*.c -> irdm-fw (the controller; sees firmware, hal and sim headers)
@@ -77,7 +79,8 @@ endif
 FW_SRC    := $(filter-out firmware/main/% $(FEATURE_OFF_SRC),$(wildcard firmware/*/*.c))
 FWMAIN_SRC := $(wildcard firmware/main/*.c)
 HAL_SRC   := $(wildcard hal/*/*.c)
-SIM_SRC   := $(wildcard sim/*/*.c)
+SIM_SRC   := $(filter-out sim/main/%,$(wildcard sim/*/*.c))
+CDMAIN_SRC := $(wildcard sim/main/*.c)
 TOOL_SRC  := $(filter-out tools/irdm/%,$(wildcard tools/*/*.c))
 CLI_SRC   := $(wildcard tools/irdm/*.c)
 TEST_SRC  := $(wildcard tests/test_*.c)
@@ -94,13 +97,15 @@ SIM_LIB  := $(BUILD)/libirdmsim.a
 TOOL_LIB := $(BUILD)/libirdmtools.a
 IRDM     := $(BUILD)/irdm
 IRDM_FW  := $(BUILD)/irdm-fw
+IRDM_CD  := $(BUILD)/irdm-candrives
 TESTS    := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 TICK_TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TICK_TEST_SRC))
 BENCHES  := $(patsubst tests/bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC))
 
-.PHONY: all test san fuzz bench bench-precompute run jitter check deps clean docs cfg-fws sizes
+.PHONY: all test san fuzz bench bench-precompute run jitter check deps clean docs cfg-fws sizes hil
 .SECONDARY:
-all: $(if $(CONFIG),,$(IRDM)) $(FW_LIB) $(HAL_LIB) $(SIM_LIB) $(if $(FWMAIN_SRC),$(IRDM_FW))
+all: $(if $(CONFIG),,$(IRDM)) $(FW_LIB) $(HAL_LIB) $(SIM_LIB) $(if $(FWMAIN_SRC),$(IRDM_FW)) \
+  $(if $(CDMAIN_SRC),$(IRDM_CD))
 
 $(BUILD)/obj/firmware/%.o: LAYER_INC = $(FW_INC)
 # irdm-fw's main() is the composition root: it alone sees every layer below
@@ -135,6 +140,10 @@ TEST_LIBS := $(TOOL_LIB) $(SIM_LIB) $(HAL_LIB) $(FW_LIB)
 $(IRDM_FW): $(call obj,$(FWMAIN_SRC)) $(SIM_LIB) $(HAL_LIB) $(FW_LIB)
 	$(CC) $(LDFLAGS) $^ -o $@ $(if $(call feature,DEFORM),-lopenblas) -lpthread -lm
 
+# The drive emulator: the simulator, the HAL's CAN code, the firmware's arm.
+$(IRDM_CD): $(call obj,$(CDMAIN_SRC)) $(SIM_LIB) $(HAL_LIB) $(FW_LIB)
+	$(CC) $(LDFLAGS) $^ -o $@ -lm
+
 # The force tick alone: the firmware library, libm and cmocka, nothing else.
 $(TICK_TESTS): $(BUILD)/tests/test_tick_%: $(BUILD)/obj/tests/test_tick_%.o $(FW_LIB)
 	@mkdir -p $(dir $@)
@@ -156,7 +165,7 @@ $(TICK_IMAGE): $(IRDM)
 	$(IRDM) precompute -q --mesh box:0.04,0.04,0.08 --resolution 2,2,4 --fixed 'z<=0' \
 	  --touch 'z>=0.08' --display surface --representation modal:all -o $@
 
-test: $(TESTS) $(IRDM) $(IRDM_FW) $(TICK_IMAGE) $(BUILD)/data/bunny.off cfg-fws
+test: $(TESTS) $(IRDM) $(IRDM_FW) $(IRDM_CD) $(TICK_IMAGE) $(BUILD)/data/bunny.off cfg-fws
 	IRDM=$(IRDM) IRDM_FW=$(IRDM_FW) IRDM_BUILD=$(BUILD) IRDM_TICK_IMAGE=$(TICK_IMAGE) \
 	  tests/run-tests.sh $(TESTS)
 
@@ -224,12 +233,14 @@ $(BUILD)/data/bunny.off:
 	@mkdir -p $(dir $@)
 	tools/scripts/bunny-off.sh $@
 
-# The gcc run comes last so its summary line closes the output.
+# The gcc run comes last of the tests so its summary line closes them; then
+# the CAN back-end end to end in the VM (make hil).
 check: deps
 	$(MAKE) fuzz FUZZ_SECONDS=$(FUZZ_SECONDS)
 	$(MAKE) CC=clang BUILD=build-clang test
 	$(MAKE) san
 	$(MAKE) test
+	$(MAKE) hil
 
 run: deps
 	$(MAKE) $(IRDM) $(IRDM_FW)
@@ -242,6 +253,14 @@ $(JITTER_IMAGE): $(IRDM) scenes/cuboid-top.scene
 	$(IRDM) precompute -q --scene scenes/cuboid-top.scene -o $@
 jitter: deps $(IRDM) $(IRDM_FW) $(JITTER_IMAGE)
 	tools/scripts/jitter.sh $(IRDM) $(IRDM_FW) $(JITTER_IMAGE)
+
+# Hardware in the loop without the hardware: Debian's PREEMPT_RT kernel
+# under qemu (TCG), vcan0, irdm-candrives and irdm-fw (the minimal build)
+# on it, candump's log checked on the host (tools/scripts/hil/, docs/hil.md)
+hil: deps $(IRDM) $(IRDM_FW) $(BUILD)/tests/test_socketcan
+	$(MAKE) --no-print-directory CONFIG=configs/minimal.config BUILD=$(BUILD)/cfg-minimal all
+	tools/scripts/hil/hil.sh $(BUILD) $(IRDM) $(BUILD)/cfg-minimal/irdm-fw \
+	  $(BUILD)/cfg-minimal/irdm-candrives $(BUILD)/tests/test_socketcan $(IRDM_FW)
 
 deps:
 	tools/scripts/install-deps.sh

@@ -18,6 +18,8 @@
 #include "irdm/can_drives.h"
 #include "irdm/can_membus.h"
 
+#include "support/can_drain.h"
+
 #define PERIOD_S 1e-3
 
 static struct irdm_can_membus bus;
@@ -57,12 +59,7 @@ static struct irdm_can_frame rx_id(uint32_t id)
 
 static int count_id(uint32_t id)
 {
-	struct irdm_can_frame f;
-	int n = 0;
-
-	while (irdm_can_recv(&master, &f) == 1)
-		n += f.id == id;
-	return n;
+	return (int)can_drain_count(&master, id);
 }
 
 /* An SDO write to node; the answer's verdict and abort code. */

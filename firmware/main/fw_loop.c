@@ -13,6 +13,7 @@
 #include "irdm/error.h"
 #include "irdm/hal_sim.h"
 #include "irdm/rt.h"
+#include "irdm/sim_user_push.h"
 #include "irdm/vec3.h"
 
 #include "fw.h"
@@ -21,20 +22,9 @@
 static void push_hand(struct fw *fw, unsigned h, double t_s)
 {
 	struct irdm_sim_device *sim = irdm_hal_sim_device(&fw->hal[h]);
-	double q[3], qd[3], tip[3], vel[3], J[9], p_obj[3], v_obj[3], f_obj[3], f_dev[3];
 
-	if (!sim)
-		return;
-	irdm_sim_device_state(sim, q, qd);
-	irdm_device_fk(&fw->dev[h], q, tip);
-	irdm_device_jacobian(&fw->dev[h], q, J);
-	for (int r = 0; r < 3; r++)
-		vel[r] = J[3 * r] * qd[0] + J[3 * r + 1] * qd[1] + J[3 * r + 2] * qd[2];
-	irdm_board_device_to_object(&fw->board, tip, p_obj);
-	irdm_board_vector_to_object(&fw->board, vel, v_obj);
-	irdm_sim_user_hand_force(fw->user, h, t_s, p_obj, v_obj, f_obj);
-	irdm_board_vector_to_device(&fw->board, f_obj, f_dev);
-	irdm_sim_device_set_hand_force(sim, f_dev);
+	if (sim)
+		irdm_sim_user_push(fw->user, h, &fw->board, sim, t_s);
 }
 
 static void safe_off_all(struct fw *fw)

@@ -133,6 +133,12 @@ static int take_heartbeat(struct irdm_can_master *m, int k, const struct irdm_ca
 		return IRDM_EFORMAT;
 	}
 	m->ax[k].heartbeat_period = m->period;
+	/* A pre-operational beat from a drive that has sent no PDO yet was on
+	 * the bus while our NMT start was (drives beat on their own clock):
+	 * it is not news.  A drive that never starts sends no TPDO1 and is
+	 * lost by that check within tpdo_missing_periods. */
+	if (s == IRDM_CO_STATE_PRE_OPERATIONAL && !m->ax[k].seen)
+		return IRDM_OK;
 	m->ax[k].nmt = s;
 	return IRDM_OK;
 }

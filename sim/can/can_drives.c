@@ -23,7 +23,8 @@ static void heartbeat(struct irdm_can_drives *dr, struct irdm_can_drive *d)
 	f.data[0] = (uint8_t)d->nmt;
 	if (!d->no_heartbeat)
 		send(dr, &f);
-	d->heartbeat_next_us = dr->now_us + 1000ull * d->heartbeat_ms;
+	d->heartbeat_next_us = (dr->wall_heartbeat ? dr->wall_us : dr->now_us) +
+			       1000ull * d->heartbeat_ms;
 }
 
 static void boot(struct irdm_can_drives *dr, struct irdm_can_drive *d)
@@ -217,6 +218,73 @@ static double joint_torque(const struct irdm_can_drives *dr, unsigned k)
 	       dr->arm.dev.gear_ratio[k];
 }
 
+/* The flood: count frames of the highest priority but NMT's. */
+static void flood(struct irdm_can_drives *dr, uint32_t count)
+{
+	struct irdm_can_frame f = { .id = IRDM_CAN_FLOOD_ID, .dlc = 8 };
+
+	memset(f.data, 0xFF, sizeof(f.data));
+	for (uint32_t k = 0; k < count; k++)
+		if (irdm_can_send(&dr->port, &f) == IRDM_OK)
+			dr->flood_sent++;
+}
+
+static void fire(struct irdm_can_drives *dr, const struct irdm_can_fault *f)
+{
+	struct irdm_can_drive *d = drive_of(dr, f->node);
+
+	dr->faults_fired++;
+	switch (f->kind) {
+	case IRDM_CAN_FAULT_DROP:
+		d->drop_tpdos = f->count;
+		break;
+	case IRDM_CAN_FAULT_DELAY:
+		d->delay_tpdos = f->count;
+		d->delay_us = f->delay_us;
+		break;
+	case IRDM_CAN_FAULT_HEARTBEAT_STOP:
+		d->no_heartbeat = true;
+		break;
+	case IRDM_CAN_FAULT_EMCY:
+		irdm_can_drives_fault(dr, (unsigned)(d - dr->d), f->code);
+		break;
+	case IRDM_CAN_FAULT_STATE:
+		irdm_cia402_drive_fault(&d->fsa);
+		break;
+	case IRDM_CAN_FAULT_SDO_WRONG:
+		d->sdo_wrong = true;
+		break;
+	case IRDM_CAN_FAULT_FLOOD:
+		flood(dr, f->count);
+		break;
+	}
+}
+
+/* A TPDO out, unless a fault drops or holds it. */
+static void tpdo_out(struct irdm_can_drives *dr, struct irdm_can_drive *d,
+		     const struct irdm_can_frame *f)
+{
+	if (d->drop_tpdos) {
+		d->drop_tpdos--;
+		dr->tpdos_dropped++;
+		return;
+	}
+	if (d->held) {                                  /* the older one first: order kept */
+		send(dr, &d->held_frame);
+		d->held = false;
+	}
+	if (d->delay_tpdos) {
+		d->delay_tpdos--;
+		d->held = true;
+		d->held_frame = *f;
+		d->held_due_us = dr->wall_us + d->delay_us;
+		dr->tpdos_delayed++;
+		return;
+	}
+	send(dr, f);
+	dr->tpdos_sent++;
+}
+
 /* SYNC: sample and send TPDOs, apply the set-points, move the arm a period. */
 static void sync(struct irdm_can_drives *dr)
 {
@@ -224,6 +292,9 @@ static void sync(struct irdm_can_drives *dr)
 	double tau[3] = { 0, 0, 0 };
 
 	dr->syncs++;
+	for (unsigned k = 0; k < dr->n_faults; k++)
+		if (dr->fault[k].at_sync == dr->syncs)
+			fire(dr, &dr->fault[k]);
 	irdm_sim_device_read_counts(&dr->arm, counts);
 	for (unsigned k = 0; k < dr->n; k++) {
 		struct irdm_can_drive *d = &dr->d[k];
@@ -238,18 +309,19 @@ static void sync(struct irdm_can_drives *dr)
 		f.data[1] = (uint8_t)(sw >> 8);
 		for (int b = 0; b < 4; b++)
 			f.data[2 + b] = (uint8_t)((uint32_t)counts[k] >> (8 * b));
-		if (d->nmt == IRDM_CO_STATE_OPERATIONAL) {
-			if (d->drop_tpdos)
-				d->drop_tpdos--;
-			else
-				send(dr, &f);
-		}
+		if (d->nmt == IRDM_CO_STATE_OPERATIONAL)
+			tpdo_out(dr, d, &f);
 		tau[k] = joint_torque(dr, k);
 	}
 	irdm_sim_device_set_torque(&dr->arm, tau);
-	irdm_sim_device_step(&dr->arm, dr->period_s);
+	if (dr->before_step)
+		dr->before_step(dr->hook_ctx, dr);
+	if (dr->docked && (tau[0] != 0 || tau[1] != 0 || tau[2] != 0))
+		dr->docked = false;
+	if (!dr->docked)
+		irdm_sim_device_step(&dr->arm, dr->period_s);
 	dr->now_us += (uint64_t)llround(dr->period_s * 1e6);
-	for (unsigned k = 0; k < dr->n; k++)
+	for (unsigned k = 0; k < dr->n && !dr->wall_heartbeat; k++)
 		if (dr->d[k].heartbeat_ms && dr->now_us >= dr->d[k].heartbeat_next_us)
 			heartbeat(dr, &dr->d[k]);
 }
@@ -279,13 +351,50 @@ static void frame_in(struct irdm_can_drives *dr, const struct irdm_can_frame *f)
 int irdm_can_drives_poll(struct irdm_can_drives *dr)
 {
 	struct irdm_can_frame f;
-	int n = 0;
+	int n = 0, rc;
 
-	while (irdm_can_recv(&dr->port, &f) == 1) {
+	while ((rc = irdm_can_recv(&dr->port, &f)) == 1) {
 		frame_in(dr, &f);
 		n++;
 	}
-	return n;
+	return rc == IRDM_EIO ? IRDM_EIO : n;
+}
+
+uint64_t irdm_can_drives_wall(struct irdm_can_drives *dr, uint64_t now_us)
+{
+	uint64_t next = UINT64_MAX;
+
+	dr->wall_us = now_us;
+	for (unsigned k = 0; k < dr->n; k++) {
+		struct irdm_can_drive *d = &dr->d[k];
+
+		if (d->held && now_us >= d->held_due_us) {
+			send(dr, &d->held_frame);
+			d->held = false;
+		}
+		if (d->held && d->held_due_us < next)
+			next = d->held_due_us;
+		if (!dr->wall_heartbeat || !d->heartbeat_ms)
+			continue;
+		if (now_us >= d->heartbeat_next_us)
+			heartbeat(dr, d);
+		if (d->heartbeat_next_us < next)
+			next = d->heartbeat_next_us;
+	}
+	return next;
+}
+
+int irdm_can_drives_schedule(struct irdm_can_drives *dr, const struct irdm_can_fault *f)
+{
+	if (f->kind != IRDM_CAN_FAULT_FLOOD && !drive_of(dr, f->node))
+		return IRDM_EINVAL;
+	if (dr->n_faults == IRDM_CAN_FAULTS_MAX)
+		return IRDM_ENOMEM;
+	if (f->at_sync == 0)
+		fire(dr, f);
+	else
+		dr->fault[dr->n_faults++] = *f;
+	return IRDM_OK;
 }
 
 void irdm_can_drives_fault(struct irdm_can_drives *dr, unsigned k, uint16_t code)

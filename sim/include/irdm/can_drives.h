@@ -7,9 +7,14 @@
  * sends its TPDO1 (statusword + position counts sampled then), applies
  * the set-point and moves the arm one period: a one-period bus delay, as
  * real synchronous PDOs have.  Heartbeats at the configured producer time
- * on the emulated clock (which SYNCs advance).  Faults a test injects:
- * stop the heartbeat, drop TPDOs, answer SDOs wrongly, raise an EMCY and
- * fault.  No allocation after init; the caller owns the struct.
+ * on the emulated clock (which SYNCs advance), or, with wall_heartbeat, on
+ * the wall clock the caller gives irdm_can_drives_wall() (a process on a
+ * real bus: a master that stops sending SYNC still hears heartbeats).
+ * Faults a test injects: stop the heartbeat, drop or delay TPDOs, answer
+ * SDOs wrongly, raise an EMCY and fault, flood the bus; set by hand or on
+ * a schedule counted in SYNCs (irdm/can_faults.h).  A hook may act on the
+ * arm before each SYNC's step (the virtual user's hand).  No allocation
+ * after init; the caller owns the struct.
  */
 #ifndef IRDM_CAN_DRIVES_H
 #define IRDM_CAN_DRIVES_H
@@ -17,6 +22,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "irdm/can_faults.h"
 #include "irdm/can_port.h"
 #include "irdm/cia402.h"
 #include "irdm/sim_device.h"
@@ -37,7 +43,16 @@ struct irdm_can_drive {
 	bool no_heartbeat;
 	unsigned drop_tpdos;            /* the next k TPDOs are not sent */
 	bool sdo_wrong;                 /* SDO answers name another object */
+	unsigned delay_tpdos;           /* the next k TPDOs are held delay_us (wall) */
+	uint32_t delay_us;
+	bool held;                      /* a delayed TPDO waits for held_due_us */
+	struct irdm_can_frame held_frame;
+	uint64_t held_due_us;
 };
+
+struct irdm_can_drives;
+/* Called at each SYNC before the arm steps; syncs counts this one (1..). */
+typedef void (*irdm_can_drives_hook)(void *ctx, struct irdm_can_drives *dr);
 
 struct irdm_can_drives {
 	struct irdm_can_port port;
@@ -48,6 +63,15 @@ struct irdm_can_drives {
 	uint64_t now_us;
 	uint8_t sync_counter;           /* the last SYNC's counter byte (0: none) */
 	uint64_t syncs, bad_frames;
+	uint64_t tpdos_sent, tpdos_dropped, tpdos_delayed, flood_sent, faults_fired;
+	bool wall_heartbeat;            /* heartbeats on irdm_can_drives_wall()'s clock */
+	bool docked;                    /* the arm rests in its calibration dock (no
+					 * steps) until a drive first applies torque */
+	uint64_t wall_us;               /* the last wall time given */
+	irdm_can_drives_hook before_step;
+	void *hook_ctx;
+	struct irdm_can_fault fault[IRDM_CAN_FAULTS_MAX];
+	unsigned n_faults;
 };
 
 /*
@@ -61,8 +85,23 @@ int irdm_can_drives_init(struct irdm_can_drives *dr, const struct irdm_can_port 
 			 const struct irdm_device_config *dev, const struct irdm_sim_params *p,
 			 unsigned n, unsigned first_node, double period_s);
 
-/* Everything waiting on the bus, answered.  Return: frames handled. */
+/* Everything waiting on the bus, answered.
+ * Return: frames handled; IRDM_EIO if the port says the link is gone. */
 int irdm_can_drives_poll(struct irdm_can_drives *dr);
+
+/*
+ * The wall clock moved to now_us (monotonic, microseconds): send the
+ * heartbeats due on it (with wall_heartbeat) and the delayed TPDOs due.
+ * Return: the wall time of the next thing due (UINT64_MAX: none).
+ */
+uint64_t irdm_can_drives_wall(struct irdm_can_drives *dr, uint64_t now_us);
+
+/*
+ * Schedule fault f (irdm/can_faults.h); one with at_sync 0 applies now.
+ * Return: IRDM_OK; IRDM_EINVAL if its node is not one of these drives;
+ * IRDM_ENOMEM if IRDM_CAN_FAULTS_MAX are scheduled.
+ */
+int irdm_can_drives_schedule(struct irdm_can_drives *dr, const struct irdm_can_fault *f);
 
 /* Injected: drive k raises EMCY code (error register 0x01) and faults. */
 void irdm_can_drives_fault(struct irdm_can_drives *dr, unsigned k, uint16_t code);
