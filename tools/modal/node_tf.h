@@ -23,10 +23,11 @@
 
 struct irdm_node_tf {
 	size_t K;
+	size_t n_pad;                /* length of the mode arrays: even, > K */
 	double r0[9];                /* R[0], row-major */
 	double *t, *d;               /* den_k(z) = z^2 - t z + d */
 	double *beta1, *beta0;
-	double *p;                   /* 6 per mode: phi phi^T, xx xy xz yy yz zz */
+	double *p;                   /* phi phi^T: xx, xy, xz, yy, yz, zz arrays */
 	double complex *pole;        /* 2 per mode */
 };
 
@@ -35,7 +36,7 @@ int irdm_node_tf_init(struct irdm_node_tf *tf, const struct irdm_mode *zoh, size
 		      const double *phi_c, const double *D);
 void irdm_node_tf_free(struct irdm_node_tf *tf);
 
-/* H(z) (row-major) and, if dH is not NULL, H'(z). */
+/* H(z) and H'(z), row-major. */
 void irdm_node_tf_eval(const struct irdm_node_tf *tf, double complex z, double complex H[9],
 		       double complex dH[9]);
 

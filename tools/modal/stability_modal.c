@@ -118,7 +118,7 @@ static void track_peaks(struct walk *w, double complex z, const struct point *b)
  * MAX_LOG_STEP: a zero, pole or cluster within about one arc length of the
  * ends makes the latter large, so the walk slows down next to it. */
 #define MAX_TURN (M_PI / 4)
-#define MAX_LOG_STEP 0.5
+#define MAX_LOG_STEP 1.0
 
 static bool arc_ok(double r, double step, const struct point *a, const struct point *b)
 {
@@ -162,20 +162,31 @@ static int winding(const struct irdm_node_tf *tf, double r, struct walk *w)
 	return (int)lround(n);
 }
 
-/* Newton on det H: z -= det H / (det H)' = 1 / tr(H^-1 H'). */
-static int newton(const struct irdm_node_tf *tf, double complex z, double complex *root)
+/*
+ * Newton on F = det H den_m (den_m the denominator of mode m, or 1 when
+ * m == NO_MODE): z -= F / F' = 1 / ((log det H)' + den_m' / den_m).
+ * Taking out mode m's poles lets Newton started next to them reach a zero
+ * of det H that nearly cancels one (a mode the node barely sees).
+ */
+#define NO_MODE ((size_t)-1)
+
+static int newton(const struct irdm_node_tf *tf, double complex z, size_t m, double complex *root)
 {
 	for (int it = 0; it < 50; it++) {
-		double complex H[9], dH[9], adj[9], tr = 0;
-		irdm_node_tf_eval(tf, z, H, dH);
-		irdm_adj3c(H, adj);
-		for (int i = 0; i < 3; i++)
-			for (int j = 0; j < 3; j++)
-				tr += adj[3 * i + j] * dH[3 * j + i];
-		double complex det = irdm_det3c(H), step = det / tr;
+		struct point p;
+		if (point_at(tf, z, &p)) {
+			*root = z;      /* det H exactly 0 (or not finite: checked below) */
+			return isfinite(cabs(z)) ? 0 : -1;
+		}
+		double complex ld = p.ld;
+		if (m != NO_MODE)
+			ld += (2 * z - tf->t[m]) / ((z - tf->t[m]) * z + tf->d[m]);
+		double complex step = 1 / ld;
 		if (!isfinite(cabs(step)))
 			return -1;
 		z -= step;
+		if (!(cabs(z) < 2 * IRDM_STAB_RHO_MAX))
+			return -1;      /* diverging: no root of interest there */
 		if (cabs(step) <= 1e-14 * cabs(z)) {
 			*root = z;
 			return 0;
@@ -184,14 +195,20 @@ static int newton(const struct irdm_node_tf *tf, double complex z, double comple
 	return -1;
 }
 
+/* Newton starts beside the open-loop poles of largest modulus */
+#define N_POLE_STARTS 4
+
 struct search {
 	const struct irdm_node_tf *tf;
 	long n_all;                /* 2K closed-loop poles */
 	double lo, hi;
-	bool lo_certified;
+	bool lo_certified, lo_newton;
 	bool fresh;                /* hi moved: its peaks not tried yet */
 	double complex peak[N_PEAKS];   /* of the last hi circle */
 	double peak_v[N_PEAKS];
+	/* candidate radii: the top open-loop poles themselves (a mode the node
+	 * does not see keeps its poles) and the roots Newton found beside them */
+	double pole_cand[2 * N_POLE_STARTS];
 	struct irdm_stab_cert *out;
 };
 
@@ -210,6 +227,7 @@ static void probe(struct search *s, double r)
 	if (n != s->n_all) {
 		s->lo = r;
 		s->lo_certified = n >= 0;
+		s->lo_newton = false;
 		return;
 	}
 	s->hi = r;
@@ -218,28 +236,83 @@ static void probe(struct search *s, double r)
 	memcpy(s->peak_v, w.peak_v, sizeof(s->peak_v));
 }
 
-/* Newton from the hi circle's peaks; the largest root found in the
- * bracket is then bracketed by circles just either side of it. */
+/* The modes of the N_POLE_STARTS open-loop poles of largest modulus. */
+static void top_pole_modes(const struct irdm_node_tf *tf, size_t mode[N_POLE_STARTS])
+{
+	double mod[N_POLE_STARTS];
+
+	for (int i = 0; i < N_POLE_STARTS; i++) {
+		mode[i] = NO_MODE;
+		mod[i] = -1;
+	}
+	for (size_t k = 0; k < 2 * tf->K; k += 2) {
+		double m = cabs(tf->pole[k]);
+		int low = 0;
+		for (int i = 1; i < N_POLE_STARTS; i++)
+			if (mod[i] < mod[low])
+				low = i;
+		if (m > mod[low]) {
+			mod[low] = m;
+			mode[low] = k / 2;
+		}
+	}
+}
+
+static void pole_roots(struct search *s)
+{
+	size_t mode[N_POLE_STARTS];
+
+	top_pole_modes(s->tf, mode);
+	for (int i = 0; i < N_POLE_STARTS; i++) {
+		double complex root, l = mode[i] == NO_MODE ? 0 : s->tf->pole[2 * mode[i]];
+		s->pole_cand[2 * i] = cabs(l);
+		s->pole_cand[2 * i + 1] = 0;
+		if (mode[i] != NO_MODE && !newton(s->tf, l * (1 + 1e-7), mode[i], &root)) {
+			s->out->newton++;
+			s->pole_cand[2 * i + 1] = cabs(root);
+			TRACE("newton beside pole %.12f%+.12fi -> %.12f%+.12fi |z| %.12f\n", creal(l), cimag(l), creal(root), cimag(root), cabs(root));
+		}
+	}
+}
+
+/* Newton from the hi circle's peaks (and the pole roots); the largest root
+ * in the bracket is then bracketed by circles just either side of it. */
 static bool try_root(struct search *s)
 {
 	double best = 0;
+	bool best_root = false;   /* a converged Newton root (else a bare pole) */
 
-	if (!s->fresh)
-		return false;
-	s->fresh = false;
-	for (int i = 0; i < N_PEAKS; i++) {
+	for (int i = 0; i < 2 * N_POLE_STARTS; i++)
+		if (s->pole_cand[i] > s->lo && s->pole_cand[i] < s->hi && s->pole_cand[i] > best) {
+			best = s->pole_cand[i];
+			best_root = i % 2 == 1;
+		}
+	for (int i = 0; s->fresh && i < N_PEAKS; i++) {
 		double complex root;
-		if (s->peak_v[i] == -INFINITY || newton(s->tf, s->peak[i], &root))
+		if (s->peak_v[i] == -INFINITY || newton(s->tf, s->peak[i], NO_MODE, &root))
 			continue;
 		s->out->newton++;
 		TRACE("newton from %g%+gi (%g) -> %.12f%+.12fi |z| %.12f\n", creal(s->peak[i]), cimag(s->peak[i]), s->peak_v[i], creal(root), cimag(root), cabs(root));
-		if (cabs(root) > s->lo && cabs(root) < s->hi)
-			best = fmax(best, cabs(root));
+		if (cabs(root) > s->lo && cabs(root) < s->hi && cabs(root) > best) {
+			best = cabs(root);
+			best_root = true;
+		}
 	}
+	s->fresh = false;
 	if (best == 0)
 		return false;
 	probe(s, best * (1 + REL_TOL / 4));
-	probe(s, best * (1 - REL_TOL / 4));
+	if (s->hi != best * (1 + REL_TOL / 4))
+		return true;
+	if (!best_root) {
+		probe(s, best * (1 - REL_TOL / 4));
+		return true;
+	}
+	/* a closed-loop pole at |root| to Newton's 1e-14: the lower bound,
+	 * without a circle next to it */
+	s->lo = best;
+	s->lo_certified = false;
+	s->lo_newton = true;
 	return true;
 }
 
@@ -273,12 +346,15 @@ int irdm_stability_modal_cert(const struct irdm_mode *zoh, size_t K, const doubl
 	probe(&s, IRDM_STAB_RHO_MAX);
 	if (s.hi == IRDM_STAB_RHO_MAX) {
 		probe(&s, IRDM_STAB_RHO_MIN);
-		if (s.hi != IRDM_STAB_RHO_MIN)
+		if (s.hi != IRDM_STAB_RHO_MIN) {
+			pole_roots(&s);
 			bracket(&s);
+		}
 	}
 	out->rho = fmin(s.hi, IRDM_STAB_RHO_MAX);
 	out->rho_lo = s.hi == IRDM_STAB_RHO_MIN ? 0 : fmin(s.lo, IRDM_STAB_RHO_MAX);
 	out->lo_certified = s.hi == IRDM_STAB_RHO_MIN || s.lo_certified;
+	out->lo_newton = s.lo_newton;
 	irdm_node_tf_free(&tf);
 	return 0;
 }
