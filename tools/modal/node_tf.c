@@ -1,5 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 #include <math.h>
+#include <stdbool.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -30,7 +31,7 @@ static int alloc_modes(struct irdm_node_tf *tf, size_t K)
 	memset(tf, 0, sizeof(*tf));
 	tf->K = K;
 	tf->n_pad = n;
-	tf->t = calloc(10 * n, sizeof(double));
+	tf->t = calloc(14 * n, sizeof(double));
 	tf->pole = malloc(2 * (K > 0 ? K : 1) * sizeof(double complex));
 	if (!tf->t || !tf->pole) {
 		irdm_node_tf_free(tf);
@@ -40,6 +41,7 @@ static int alloc_modes(struct irdm_node_tf *tf, size_t K)
 	tf->beta1 = tf->t + 2 * n;
 	tf->beta0 = tf->t + 3 * n;
 	tf->p = tf->t + 4 * n;
+	tf->pole_xy = tf->t + 10 * n;
 	return 0;
 }
 
@@ -50,6 +52,7 @@ int irdm_node_tf_init(struct irdm_node_tf *tf, const struct irdm_mode *zoh, size
 
 	if (alloc_modes(tf, K))
 		return -1;
+	size_t n = tf->n_pad;
 	for (size_t k = 0; k < K; k++) {
 		const double *a = zoh[k].a, *b = zoh[k].b;
 		double phi[3] = { phi_c[k], phi_c[K + k], phi_c[2 * K + k] };
@@ -59,8 +62,14 @@ int irdm_node_tf_init(struct irdm_node_tf *tf, const struct irdm_mode *zoh, size
 		tf->beta1[k] = a[0] * b[0] + a[1] * b[1];
 		tf->beta0[k] = -b[0] * tf->d[k];
 		for (int e = 0; e < 6; e++)
-			tf->p[(size_t)e * tf->n_pad + k] = phi[row[e]] * phi[col[e]];
+			tf->p[(size_t)e * n + k] = phi[row[e]] * phi[col[e]];
 		mode_poles(tf->t[k], tf->d[k], &tf->pole[2 * k]);
+		/* a mode the node does not see is no pole of H: far away */
+		bool seen = phi[0] != 0 || phi[1] != 0 || phi[2] != 0;
+		for (int j = 0; j < 2; j++) {
+			tf->pole_xy[(size_t)(2 * j) * n + k] = seen ? creal(tf->pole[2 * k + j]) : 1e150;
+			tf->pole_xy[(size_t)(2 * j + 1) * n + k] = seen ? cimag(tf->pole[2 * k + j]) : 0;
+		}
 		/* R0 summed in the same order as irdm_stability_modal */
 		for (int i = 0; i < 3; i++)
 			for (int j = 0; j < 3; j++)
@@ -90,6 +99,7 @@ static void unpack_sym(const double complex s[6], const double *c, double comple
 
 /* two modes at a time (GNU vector extension, gcc and clang; SSE2 on x86-64) */
 typedef double v2d __attribute__((vector_size(16)));
+typedef long long v2di __attribute__((vector_size(16)));
 
 static inline v2d load2(const double *p)
 {
@@ -105,12 +115,14 @@ static inline double sum2(v2d v)
 }
 
 void irdm_node_tf_eval(const struct irdm_node_tf *tf, double complex z, double complex H[9],
-		       double complex dH[9])
+		       double complex dH[9], double *pole_dist)
 {
 	const v2d x = { creal(z), creal(z) }, y = { cimag(z), cimag(z) }, one = { 1, 1 };
 	const v2d x2y2 = x * x - y * y, y2 = y + y;
 	v2d sr[6] = { 0 }, si[6] = { 0 }, dr[6] = { 0 }, di[6] = { 0 };
+	v2d near2 = { INFINITY, INFINITY };
 	size_t n = tf->n_pad;
+	const double *pl = tf->pole_xy;
 
 	/* the whole cost of the certificate: real arithmetic, 2 modes a step */
 	for (size_t k = 0; k < n; k += 2) {
@@ -129,7 +141,14 @@ void irdm_node_tf_eval(const struct irdm_node_tf *tf, double complex z, double c
 			dr[e] += p * dg_r;
 			di[e] += p * dg_i;
 		}
+		for (int j = 0; j < 2; j++) {
+			v2d ex = x - load2(&pl[(size_t)(2 * j) * n + k]), ey = y - load2(&pl[(size_t)(2 * j + 1) * n + k]);
+			v2d q = ex * ex + ey * ey;
+			v2di less = q < near2;
+			near2 = (v2d)((less & (v2di)q) | (~less & (v2di)near2));
+		}
 	}
+	*pole_dist = sqrt(fmin(near2[0], near2[1]));
 	double complex s[6], ds[6];
 	for (int e = 0; e < 6; e++) {
 		s[e] = CMPLX(sum2(sr[e]), sum2(si[e]));

@@ -29,6 +29,7 @@ struct irdm_node_tf {
 	double *beta1, *beta0;
 	double *p;                   /* phi phi^T: xx, xy, xz, yy, yz, zz arrays */
 	double complex *pole;        /* 2 per mode */
+	double *pole_xy;             /* the poles of H: re, im of the first, of the second */
 };
 
 /* phi_c: 3 x K row-major; D: 3x3 or NULL.  0, or -1 out of memory. */
@@ -36,9 +37,9 @@ int irdm_node_tf_init(struct irdm_node_tf *tf, const struct irdm_mode *zoh, size
 		      const double *phi_c, const double *D);
 void irdm_node_tf_free(struct irdm_node_tf *tf);
 
-/* H(z) and H'(z), row-major. */
+/* H(z) and H'(z), row-major; the distance from z to the nearest pole of H. */
 void irdm_node_tf_eval(const struct irdm_node_tf *tf, double complex z, double complex H[9],
-		       double complex dH[9]);
+		       double complex dH[9], double *pole_dist);
 
 /* Open-loop poles (both of every mode) with |l| < r. */
 size_t irdm_node_tf_poles_inside(const struct irdm_node_tf *tf, double r);

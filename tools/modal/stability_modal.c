@@ -52,13 +52,14 @@
 struct point {
 	double complex det;
 	double complex ld;   /* (det H)' / det H = tr(H^-1 H') */
+	double pole_dist;    /* to the nearest pole of H */
 };
 
 static int point_at(const struct irdm_node_tf *tf, double complex z, struct point *p)
 {
 	double complex H[9], dH[9], adj[9], tr = 0;
 
-	irdm_node_tf_eval(tf, z, H, dH);
+	irdm_node_tf_eval(tf, z, H, dH, &p->pole_dist);
 	irdm_adj3c(H, adj);
 	p->det = irdm_det3c(H);
 	for (int i = 0; i < 3; i++)
@@ -113,18 +114,31 @@ static void track_peaks(struct walk *w, double complex z, const struct point *b)
 	w->prev_z = z;
 }
 
-/* An arc is accepted when det H turns by less than MAX_TURN between its
- * ends and its length times |(log det H)'| at either end is at most
- * MAX_LOG_STEP: a zero, pole or cluster within about one arc length of the
- * ends makes the latter large, so the walk slows down next to it. */
+/*
+ * An arc is accepted when det H turns by less than MAX_TURN between its
+ * ends, its length times |(log det H)'| at either end is at most
+ * MAX_LOG_STEP, and it is at most MAX_POLE_STEP times the distance of
+ * either end to the nearest pole of H.  Zeros near the arc, alone or in
+ * clusters (near-double roots), make |(log det H)'| large: their terms
+ * 1 / (z - z_j) add.  A pole next to a zero (a mode the node barely sees)
+ * cancels that far from the pair, and a pair straddling the circle turns
+ * det H by 2 pi over a stretch the size of the pair, invisible to both
+ * tests above; the pole rule resolves every pole, so every such pair, at
+ * its own scale.
+ */
 #define MAX_TURN (M_PI / 4)
 #define MAX_LOG_STEP 1.0
+#define MAX_POLE_STEP 0.5
+
+static double step_limit(double r, const struct point *a)
+{
+	return fmin(MAX_LOG_STEP / cabs(a->ld), MAX_POLE_STEP * a->pole_dist) / r;
+}
 
 static bool arc_ok(double r, double step, const struct point *a, const struct point *b)
 {
-	double ld = fmax(cabs(a->ld), cabs(b->ld));
-
-	return fabs(carg(b->det / a->det)) < MAX_TURN && r * step * ld <= MAX_LOG_STEP;
+	return fabs(carg(b->det / a->det)) < MAX_TURN && step <= step_limit(r, a)
+	       && step <= step_limit(r, b);
 }
 
 /* Winding number of det H on |z| = r, or INT_MIN if unresolved. */
@@ -139,7 +153,7 @@ static int winding(const struct irdm_node_tf *tf, double r, struct walk *w)
 	if (point_at(tf, r, &a))
 		return INT_MIN;
 	while (theta < M_PI) {
-		step = fmin(fmin(step, M_PI - theta), MAX_LOG_STEP / (r * cabs(a.ld)));
+		step = fmin(fmin(step, M_PI - theta), step_limit(r, &a));
 		double next = theta + step >= M_PI * (1 - 1e-15) ? M_PI : theta + step;
 		double complex z = next == M_PI ? -r : r * cexp(I * next);
 		if (step < ARC_MIN_RAD || ++w->points > WALK_MAX_POINTS || point_at(tf, z, &b))
