@@ -220,9 +220,9 @@ struct search {
 	bool fresh;                /* hi moved: its peaks not tried yet */
 	double complex peak[N_PEAKS];   /* of the last hi circle */
 	double peak_v[N_PEAKS];
-	/* candidate radii: the top open-loop poles themselves (a mode the node
-	 * does not see keeps its poles) and the roots Newton found beside them */
-	double pole_cand[2 * N_POLE_STARTS];
+	/* moduli of the roots Newton found beside the top open-loop poles
+	 * (the pole itself when the node does not see the mode), or 0 */
+	double pole_root[N_POLE_STARTS];
 	struct irdm_stab_cert *out;
 };
 
@@ -279,11 +279,10 @@ static void pole_roots(struct search *s)
 	top_pole_modes(s->tf, mode);
 	for (int i = 0; i < N_POLE_STARTS; i++) {
 		double complex root, l = mode[i] == NO_MODE ? 0 : s->tf->pole[2 * mode[i]];
-		s->pole_cand[2 * i] = cabs(l);
-		s->pole_cand[2 * i + 1] = 0;
+		s->pole_root[i] = 0;
 		if (mode[i] != NO_MODE && !newton(s->tf, l * (1 + 1e-7), mode[i], &root)) {
 			s->out->newton++;
-			s->pole_cand[2 * i + 1] = cabs(root);
+			s->pole_root[i] = cabs(root);
 			TRACE("newton beside pole %.12f%+.12fi -> %.12f%+.12fi |z| %.12f\n", creal(l), cimag(l), creal(root), cimag(root), cabs(root));
 		}
 	}
@@ -294,23 +293,18 @@ static void pole_roots(struct search *s)
 static bool try_root(struct search *s)
 {
 	double best = 0;
-	bool best_root = false;   /* a converged Newton root (else a bare pole) */
 
-	for (int i = 0; i < 2 * N_POLE_STARTS; i++)
-		if (s->pole_cand[i] > s->lo && s->pole_cand[i] < s->hi && s->pole_cand[i] > best) {
-			best = s->pole_cand[i];
-			best_root = i % 2 == 1;
-		}
+	for (int i = 0; i < N_POLE_STARTS; i++)
+		if (s->pole_root[i] > s->lo && s->pole_root[i] < s->hi)
+			best = fmax(best, s->pole_root[i]);
 	for (int i = 0; s->fresh && i < N_PEAKS; i++) {
 		double complex root;
 		if (s->peak_v[i] == -INFINITY || newton(s->tf, s->peak[i], NO_MODE, &root))
 			continue;
 		s->out->newton++;
 		TRACE("newton from %g%+gi (%g) -> %.12f%+.12fi |z| %.12f\n", creal(s->peak[i]), cimag(s->peak[i]), s->peak_v[i], creal(root), cimag(root), cabs(root));
-		if (cabs(root) > s->lo && cabs(root) < s->hi && cabs(root) > best) {
-			best = cabs(root);
-			best_root = true;
-		}
+		if (cabs(root) > s->lo && cabs(root) < s->hi)
+			best = fmax(best, cabs(root));
 	}
 	s->fresh = false;
 	if (best == 0)
@@ -318,10 +312,6 @@ static bool try_root(struct search *s)
 	probe(s, best * (1 + REL_TOL / 4));
 	if (s->hi != best * (1 + REL_TOL / 4))
 		return true;
-	if (!best_root) {
-		probe(s, best * (1 - REL_TOL / 4));
-		return true;
-	}
 	/* a closed-loop pole at |root| to Newton's 1e-14: the lower bound,
 	 * without a circle next to it */
 	s->lo = best;
