@@ -32,7 +32,6 @@
 #include <math.h>
 #include <stdbool.h>
 #include <stdio.h>
-#include <string.h>
 
 #include "modal/mat3c.h"
 #include "modal/node_tf.h"
@@ -74,41 +73,50 @@ static int point_at(const struct irdm_node_tf *tf, double complex z, struct poin
 
 /*
  * On a circle outside every closed-loop pole, the phase velocity of det H,
- * d arg / d theta = Re(z (log det H)'), peaks by about r / delta at the
- * angle of a zero delta inside: the highest peaks are the zeros nearest
- * the circle, the largest first.  The walk keeps its N_PEAKS highest local
- * maxima as Newton starts.
+ * v = d arg / d theta = Re(z (log det H)'), peaks by about r / delta at
+ * the angle of a zero delta inside: the highest peaks are the zeros nearest
+ * the circle, the largest first.  On a circle with poles outside, v dips
+ * by about r / delta next to a zero delta outside.  The walk keeps the
+ * N_PEAKS highest local maxima and deepest local minima as Newton starts.
  */
 #define N_PEAKS 4
 
+struct peaks {
+	double complex z[N_PEAKS];
+	double v[N_PEAKS];      /* -INFINITY: none */
+};
+
+enum { SIDE_HI, SIDE_LO };      /* peaks (all poles inside), dips */
+
 struct walk {
-	double complex peak[N_PEAKS];
-	double peak_v[N_PEAKS];
+	struct peaks side[2];
 	double complex prev_z;
 	double prev_v, prev2_v;
 	size_t points;
 };
 
-static void keep_peak(struct walk *w, double complex z, double v)
+static void keep_peak(struct peaks *p, double complex z, double v)
 {
 	int low = 0;
 
 	for (int i = 1; i < N_PEAKS; i++)
-		if (w->peak_v[i] < w->peak_v[low])
+		if (p->v[i] < p->v[low])
 			low = i;
-	if (v > w->peak_v[low]) {
-		w->peak_v[low] = v;
-		w->peak[low] = z;
+	if (v > p->v[low]) {
+		p->v[low] = v;
+		p->z[low] = z;
 	}
 }
 
-/* the walk's last three points' velocities: the middle one a local max? */
+/* the walk's last three velocities: the middle one a local max or min? */
 static void track_peaks(struct walk *w, double complex z, const struct point *b)
 {
 	double v = creal(z * b->ld);
 
 	if (w->prev_v >= w->prev2_v && w->prev_v >= v)
-		keep_peak(w, w->prev_z, w->prev_v);
+		keep_peak(&w->side[SIDE_HI], w->prev_z, w->prev_v);
+	if (w->prev_v <= w->prev2_v && w->prev_v <= v)
+		keep_peak(&w->side[SIDE_LO], w->prev_z, -w->prev_v);
 	w->prev2_v = w->prev_v;
 	w->prev_v = v;
 	w->prev_z = z;
@@ -147,9 +155,9 @@ static int winding(const struct irdm_node_tf *tf, double r, struct walk *w)
 	struct point a, b;
 	double theta = 0, step = M_PI / 64, turn = 0;
 
-	*w = (struct walk){ .points = 1, .prev_v = -INFINITY, .prev2_v = -INFINITY };
+	*w = (struct walk){ .points = 1, .prev_v = NAN, .prev2_v = NAN };
 	for (int i = 0; i < N_PEAKS; i++)
-		w->peak_v[i] = -INFINITY;
+		w->side[SIDE_HI].v[i] = w->side[SIDE_LO].v[i] = -INFINITY;
 	if (point_at(tf, r, &a))
 		return INT_MIN;
 	while (theta < M_PI) {
@@ -183,6 +191,10 @@ static int winding(const struct irdm_node_tf *tf, double r, struct walk *w)
  * of det H that nearly cancels one (a mode the node barely sees).
  */
 #define NO_MODE ((size_t)-1)
+/* Newton's last step, relative: 1e-10 is reached at a double root too
+ * (linear convergence, and rounding limits it to ~1e-8 anyway): degenerate
+ * modes of a symmetric body give double closed-loop poles */
+#define NEWTON_TOL 1e-10
 
 static int newton(const struct irdm_node_tf *tf, double complex z, size_t m, double complex *root)
 {
@@ -201,7 +213,7 @@ static int newton(const struct irdm_node_tf *tf, double complex z, size_t m, dou
 		z -= step;
 		if (!(cabs(z) < 2 * IRDM_STAB_RHO_MAX))
 			return -1;      /* diverging: no root of interest there */
-		if (cabs(step) <= 1e-14 * cabs(z)) {
+		if (cabs(step) <= NEWTON_TOL * cabs(z)) {
 			*root = z;
 			return 0;
 		}
@@ -217,9 +229,9 @@ struct search {
 	long n_all;                /* 2K closed-loop poles */
 	double lo, hi;
 	bool lo_certified, lo_newton;
-	bool fresh;                /* hi moved: its peaks not tried yet */
-	double complex peak[N_PEAKS];   /* of the last hi circle */
-	double peak_v[N_PEAKS];
+	/* the last hi circle's peaks, the last lo circle's dips; fresh until tried */
+	struct peaks start[2];
+	bool fresh[2];
 	/* moduli of the roots Newton found beside the top open-loop poles
 	 * (the pole itself when the node does not see the mode), or 0 */
 	double pole_root[N_POLE_STARTS];
@@ -238,16 +250,16 @@ static void probe(struct search *s, double r)
 	s->out->circles++;
 	s->out->points += w.points;
 	TRACE("r %.12f n %ld / %ld points %zu lo %.12f hi %.12f\n", r, n, s->n_all, w.points, s->lo, s->hi);
-	if (n != s->n_all) {
+	int side = n == s->n_all ? SIDE_HI : SIDE_LO;
+	if (side == SIDE_HI)
+		s->hi = r;
+	else {
 		s->lo = r;
 		s->lo_certified = n >= 0;
 		s->lo_newton = false;
-		return;
 	}
-	s->hi = r;
-	s->fresh = true;
-	memcpy(s->peak, w.peak, sizeof(s->peak));
-	memcpy(s->peak_v, w.peak_v, sizeof(s->peak_v));
+	s->start[side] = w.side[side];
+	s->fresh[side] = n >= 0;
 }
 
 /* The modes of the N_POLE_STARTS open-loop poles of largest modulus. */
@@ -288,8 +300,8 @@ static void pole_roots(struct search *s)
 	}
 }
 
-/* Newton from the hi circle's peaks (and the pole roots); the largest root
- * in the bracket is then bracketed by circles just either side of it. */
+/* Newton from the fresh peaks and dips (and the pole roots); the largest
+ * root in the bracket is then tested by a circle just outside it. */
 static bool try_root(struct search *s)
 {
 	double best = 0;
@@ -297,22 +309,24 @@ static bool try_root(struct search *s)
 	for (int i = 0; i < N_POLE_STARTS; i++)
 		if (s->pole_root[i] > s->lo && s->pole_root[i] < s->hi)
 			best = fmax(best, s->pole_root[i]);
-	for (int i = 0; s->fresh && i < N_PEAKS; i++) {
-		double complex root;
-		if (s->peak_v[i] == -INFINITY || newton(s->tf, s->peak[i], NO_MODE, &root))
-			continue;
-		s->out->newton++;
-		TRACE("newton from %g%+gi (%g) -> %.12f%+.12fi |z| %.12f\n", creal(s->peak[i]), cimag(s->peak[i]), s->peak_v[i], creal(root), cimag(root), cabs(root));
-		if (cabs(root) > s->lo && cabs(root) < s->hi)
-			best = fmax(best, cabs(root));
-	}
-	s->fresh = false;
+	for (int side = SIDE_HI; side <= SIDE_LO; side++)
+		for (int i = 0; s->fresh[side] && i < N_PEAKS; i++) {
+			const struct peaks *p = &s->start[side];
+			double complex root;
+			if (p->v[i] == -INFINITY || newton(s->tf, p->z[i], NO_MODE, &root))
+				continue;
+			s->out->newton++;
+			TRACE("newton from %g%+gi (%g) -> %.12f%+.12fi |z| %.12f\n", creal(p->z[i]), cimag(p->z[i]), p->v[i], creal(root), cimag(root), cabs(root));
+			if (cabs(root) > s->lo && cabs(root) < s->hi)
+				best = fmax(best, cabs(root));
+		}
+	s->fresh[SIDE_HI] = s->fresh[SIDE_LO] = false;
 	if (best == 0)
 		return false;
 	probe(s, best * (1 + REL_TOL / 4));
 	if (s->hi != best * (1 + REL_TOL / 4))
 		return true;
-	/* a closed-loop pole at |root| to Newton's 1e-14: the lower bound,
+	/* a closed-loop pole at |root| to about Newton's last step: the lower bound,
 	 * without a circle next to it */
 	s->lo = best;
 	s->lo_certified = false;
