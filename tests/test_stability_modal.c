@@ -22,6 +22,7 @@
 
 #include "irdm/image.h"
 #include "irdm/precision.h"
+#include "modal/modal.h"
 #include "modal/stability.h"
 #include "support/engine_fixture.h"
 #include "support/test_files.h"
@@ -145,6 +146,37 @@ static void test_floating_cube(void **state)
 			    "precision", "f32", "touch", "surface", NULL);
 }
 
+/*
+ * A mode the node barely sees (phi 1e-1 .. 1e-4 of the others) and the
+ * least damped: its closed-loop pole sits just beside its open-loop pole,
+ * and the circle that certifies the radius passes between the two.  The
+ * winding number must resolve that pair (the walk's pole rule); skipping
+ * it counts poles outside that are not there.  Synthetic modes, 1 ms.
+ */
+static void test_mode_the_node_barely_sees(void **state)
+{
+	enum { K = 40 };
+	struct irdm_mode zoh[K];
+	double phi[3 * K];
+
+	(void)state;
+	for (int scale = 1; scale <= 4; scale++) {
+		for (int k = 0; k < K; k++) {
+			/* 2 .. 80 Hz, the first mode least damped */
+			irdm_zoh_mode(2 * M_PI * 2.0 * (k + 1), k == 0 ? 0.002 : 0.02, 1e-3, &zoh[k]);
+			for (int i = 0; i < 3; i++)
+				phi[i * K + k] = cos(1.0 + 0.7 * k * (i + 1) + i) / (k + 1)
+						 * (k == 0 ? pow(10, -scale) : 1);
+		}
+		struct irdm_stab_cert cert;
+		double dense = irdm_stability_modal(zoh, K, phi, NULL);
+		assert_int_equal(irdm_stability_modal_cert(zoh, K, phi, NULL, &cert), 0);
+		print_message("phi scale 1e-%d: dense %.12f, certificate [%.12f, %.12f]\n", scale, dense,
+			      cert.rho_lo, cert.rho);
+		assert_true(cert.rho >= dense * (1 - DENSE_TOL) && cert.rho <= dense * (1 + CERT_WIDTH));
+	}
+}
+
 static int setup(void **state)
 {
 	(void)state;
@@ -162,6 +194,7 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_grounded_cuboid),
 		cmocka_unit_test(test_floating_cube),
+		cmocka_unit_test(test_mode_the_node_barely_sees),
 	};
 
 	return cmocka_run_group_tests(tests, setup, teardown);

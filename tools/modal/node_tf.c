@@ -13,7 +13,7 @@ static void mode_poles(double t, double d, double complex l[2])
 	double disc = t * t - 4 * d;
 
 	if (disc < 0) {
-		l[0] = CMPLX(t / 2, sqrt(-disc) / 2);
+		l[0] = t / 2 + I * (sqrt(-disc) / 2);   /* finite: I * x is exact */
 		l[1] = conj(l[0]);
 		return;
 	}
@@ -151,8 +151,8 @@ void irdm_node_tf_eval(const struct irdm_node_tf *tf, double complex z, double c
 	*pole_dist = sqrt(fmin(near2[0], near2[1]));
 	double complex s[6], ds[6];
 	for (int e = 0; e < 6; e++) {
-		s[e] = CMPLX(sum2(sr[e]), sum2(si[e]));
-		ds[e] = CMPLX(sum2(dr[e]), sum2(di[e]));
+		s[e] = sum2(sr[e]) + I * sum2(si[e]);
+		ds[e] = sum2(dr[e]) + I * sum2(di[e]);
 	}
 	unpack_sym(s, tf->r0, H);
 	unpack_sym(ds, NULL, dH);
