@@ -92,7 +92,8 @@ static void compare_all_columns(const char *what, const char *path, ...)
 		/* the search's bounds are reported as such */
 		dense = fmin(fmax(dense, IRDM_STAB_RHO_MIN), IRDM_STAB_RHO_MAX);
 		if ((dense < 1) != (cert.rho < 1))
-			fail_msg("%s column %zu: dense %.12f, certificate %.12f: verdicts differ", what, c, dense, cert.rho);
+			fail_msg("%s column %zu: dense %.12f, certificate %.12f: verdicts differ", what, c,
+				 dense, cert.rho);
 		assert_true(cert.lo_certified || cert.lo_newton);
 		double lo_tol = cert.lo_certified ? DENSE_TOL : NEWTON_LO_TOL;
 		if (!(cert.rho >= dense * (1 - DENSE_TOL) && cert.rho_lo <= dense * (1 + lo_tol)

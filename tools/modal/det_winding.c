@@ -1,8 +1,9 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * The winding number of det H on |z| = r: a walk along the upper half circle (H(conj z) = conj H(z);
- * det H is real at +-r, so the half turns by a multiple of pi) summing the
- * principal phase steps of det H between its points.  A step is exact when
+ * The winding number of det H on |z| = r: a walk along the upper half
+ * circle (H(conj z) = conj H(z); det H is real at +-r, so the half turns
+ * by a multiple of pi) summing the principal phase steps of det H between
+ * its points.  A step is exact when
  * det H turns by less than pi along the arc; the walk cannot see the turn
  * between its points, so it accepts an arc only when (arc_ok) the sampled
  * turn is below pi/4, the arc is at most 1 / |(log det H)'| at both ends
@@ -91,7 +92,8 @@ static double step_limit(double r, const struct irdm_tf_point *a)
 	return fmin(MAX_LOG_STEP / cabs(a->ld), MAX_POLE_STEP * a->pole_dist) / r;
 }
 
-static bool arc_ok(double r, double step, const struct irdm_tf_point *a, const struct irdm_tf_point *b)
+static bool arc_ok(double r, double step, const struct irdm_tf_point *a,
+		   const struct irdm_tf_point *b)
 {
 	return fabs(carg(b->det / a->det)) < MAX_TURN && step <= step_limit(r, a)
 	       && step <= step_limit(r, b);

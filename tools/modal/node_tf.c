@@ -142,7 +142,8 @@ void irdm_node_tf_eval(const struct irdm_node_tf *tf, double complex z, double c
 			di[e] += p * dg_i;
 		}
 		for (int j = 0; j < 2; j++) {
-			v2d ex = x - load2(&pl[(size_t)(2 * j) * n + k]), ey = y - load2(&pl[(size_t)(2 * j + 1) * n + k]);
+			v2d ex = x - load2(&pl[(size_t)(2 * j) * n + k]);
+			v2d ey = y - load2(&pl[(size_t)(2 * j + 1) * n + k]);
 			v2d q = ex * ex + ey * ey;
 			v2di less = q < near2;
 			near2 = (v2d)((less & (v2di)q) | (~less & (v2di)near2));

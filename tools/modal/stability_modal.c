@@ -9,13 +9,14 @@
  * cancellations cancel in the sum.  The spectral radius is the least r
  * with N(r) = 2K.
  *
- * Radius (the winding number: det_winding.c): Newton on det H from the phase-velocity peaks of the last circle
- * with every pole inside and the dips of the last one with poles outside,
- * and on det H times one mode's denominator from beside the top open-loop
- * poles; the largest root in the bracket gets a circle at |z*| (1 +
- * REL_TOL / 4): all poles inside makes that the upper bound rho and |z*|
- * (a closed-loop pole, to Newton's tolerance) the lower bound.  Without a
- * root in the bracket: bisection on r.
+ * Radius (the winding number is det_winding.c's): Newton on det H from
+ * the phase-velocity peaks of the last circle with every pole inside and
+ * the dips of the last one with poles outside, and on det H times one
+ * mode's denominator from beside the top open-loop poles.  The largest
+ * root z* in the bracket gets a circle at |z*| (1 + REL_TOL / 4): all
+ * poles inside makes that the upper bound rho, and |z*| (a closed-loop
+ * pole, to Newton's tolerance) the lower bound.  Without a root in the
+ * bracket: bisection on r.
  */
 #include <limits.h>
 #include <math.h>
@@ -101,7 +102,8 @@ static void probe(struct search *s, double r)
 	long n = wind == INT_MIN ? -1 : (long)irdm_node_tf_poles_inside(s->tf, r) + wind;
 	s->out->circles++;
 	s->out->points += w.points;
-	TRACE("r %.12f n %ld / %ld points %zu lo %.12f hi %.12f\n", r, n, s->n_all, w.points, s->lo, s->hi);
+	TRACE("r %.12f n %ld / %ld points %zu lo %.12f hi %.12f\n", r, n, s->n_all, w.points,
+	      s->lo, s->hi);
 	int side = n == s->n_all ? IRDM_SIDE_HI : IRDM_SIDE_LO;
 	if (side == IRDM_SIDE_HI)
 		s->hi = r;
@@ -147,7 +149,8 @@ static void pole_roots(struct search *s)
 		if (mode[i] != NO_MODE && !newton(s->tf, l * (1 + 1e-7), mode[i], &root)) {
 			s->out->newton++;
 			s->pole_root[i] = cabs(root);
-			TRACE("newton beside pole %.12f%+.12fi -> %.12f%+.12fi |z| %.12f\n", creal(l), cimag(l), creal(root), cimag(root), cabs(root));
+			TRACE("newton beside pole %.12f%+.12fi -> %.12f%+.12fi\n", creal(l), cimag(l),
+			      creal(root), cimag(root));
 		}
 	}
 }
@@ -168,7 +171,8 @@ static bool try_root(struct search *s)
 			if (p->v[i] == -INFINITY || newton(s->tf, p->z[i], NO_MODE, &root))
 				continue;
 			s->out->newton++;
-			TRACE("newton from %g%+gi (%g) -> %.12f%+.12fi |z| %.12f\n", creal(p->z[i]), cimag(p->z[i]), p->v[i], creal(root), cimag(root), cabs(root));
+			TRACE("newton from %g%+gi -> %.12f%+.12fi\n", creal(p->z[i]), cimag(p->z[i]),
+			      creal(root), cimag(root));
 			if (cabs(root) > s->lo && cabs(root) < s->hi)
 				best = fmax(best, cabs(root));
 		}
