@@ -8,15 +8,10 @@
 
 #include "modal/fft.h"
 #include "modal/lapack.h"
+#include "modal/mat3c.h"
 #include "modal/stability.h"
 
 #define MAX_FFT (1u << 19)
-
-static double complex det3(const double complex a[9])
-{
-	return a[0] * (a[4] * a[8] - a[5] * a[7]) - a[1] * (a[3] * a[8] - a[5] * a[6])
-	       + a[2] * (a[3] * a[7] - a[4] * a[6]);
-}
 
 /* Winding number of det Q on |w| = r sampled at n points, or INT_MIN if det
  * vanishes at a sample; *worst: the largest phase step seen. */
@@ -39,7 +34,7 @@ static int winding(const double *R, size_t T, double r, size_t n, double complex
 		double complex a[9];
 		for (int e = 0; e < 9; e++)
 			a[e] = q[(size_t)e * n + m % n];
-		double complex d = det3(a);
+		double complex d = irdm_det3c(a);
 		if (cabs(d) == 0.0)
 			return INT_MIN;
 		if (m > 0) {

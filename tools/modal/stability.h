@@ -40,4 +40,31 @@ double irdm_stability_fir_companion(const double *R, size_t T);
 double irdm_stability_modal(const struct irdm_mode *zoh, size_t K, const double *phi_c,
 			    const double *D);
 
+/*
+ * Modal, by the argument principle on det H(z), H the node's 3x3
+ * force-to-displacement transfer function (stability_modal.c): O(modes)
+ * per point of a circle, no eigenproblem.  rho is an upper bound of the
+ * spectral radius by a winding number, within REL_TOL = 1e-8 relative of
+ * rho_lo.  rho_lo is a lower bound by a winding number (lo_certified), or
+ * the modulus of a closed-loop pole Newton converged to (lo_newton), or,
+ * with neither, only where the count was unresolved (a root too close to
+ * the circle for ARC_MIN_RAD).  Radii
+ * outside [IRDM_STAB_RHO_MIN, IRDM_STAB_RHO_MAX] are reported as the bound
+ * (rho_lo 0 below it).  -1 if R0 is singular or out of memory.
+ */
+struct irdm_stab_cert {
+	double rho, rho_lo;
+	int lo_certified;           /* rho_lo by a winding number */
+	int lo_newton;              /* rho_lo = |a closed-loop pole| found by Newton */
+	unsigned circles, newton;   /* circles walked, Newton roots found */
+	size_t points;              /* transfer-function evaluations on circles */
+};
+
+int irdm_stability_modal_cert(const struct irdm_mode *zoh, size_t K, const double *phi_c,
+			      const double *D, struct irdm_stab_cert *out);
+
+/* The same, rho only (-1 on failure). */
+double irdm_stability_modal_ap(const struct irdm_mode *zoh, size_t K, const double *phi_c,
+			       const double *D);
+
 #endif
