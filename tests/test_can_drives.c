@@ -99,6 +99,22 @@ static void tpdo(unsigned node, uint16_t *sw, int32_t *pos)
 	assert_int_equal(irdm_co_tpdo_cst(&f, node, sw, pos), IRDM_OK);
 }
 
+/* One PDO's mapping by CiA 301's procedure, each step confirmed: off,
+ * emptied, the entries, their number, every SYNC, on. */
+static void map_pdo(unsigned node, uint16_t comm, uint16_t map_index, uint32_t cob_id,
+		    uint32_t e1, uint32_t e2)
+{
+	uint32_t abort_code;
+
+	assert_int_equal(sdo_write(node, comm, 1, cob_id | 0x80000000u, 4, &abort_code), IRDM_OK);
+	assert_int_equal(sdo_write(node, map_index, 0, 0, 1, &abort_code), IRDM_OK);
+	assert_int_equal(sdo_write(node, map_index, 1, e1, 4, &abort_code), IRDM_OK);
+	assert_int_equal(sdo_write(node, map_index, 2, e2, 4, &abort_code), IRDM_OK);
+	assert_int_equal(sdo_write(node, map_index, 0, 2, 1, &abort_code), IRDM_OK);
+	assert_int_equal(sdo_write(node, comm, 2, 1, 1, &abort_code), IRDM_OK);
+	assert_int_equal(sdo_write(node, comm, 1, cob_id, 4, &abort_code), IRDM_OK);
+}
+
 static void configure_and_start(void)
 {
 	uint32_t abort_code;
@@ -107,8 +123,8 @@ static void configure_and_start(void)
 		assert_int_equal(sdo_write(node, 0x6060, 0, 10, 1, &abort_code), IRDM_OK);
 		assert_int_equal(sdo_write(node, 0x1017, 0, 100, 2, &abort_code), IRDM_OK);
 		assert_int_equal(sdo_write(node, 0x6076, 0, 500, 4, &abort_code), IRDM_OK);
-		assert_int_equal(sdo_write(node, 0x1600, 1, 0x60400010, 4, &abort_code), IRDM_OK);
-		assert_int_equal(sdo_write(node, 0x1A00, 2, 0x60640020, 4, &abort_code), IRDM_OK);
+		map_pdo(node, 0x1400, 0x1600, 0x200 + node, 0x60400010, 0x60710010);
+		map_pdo(node, 0x1800, 0x1A00, 0x180 + node, 0x60410010, 0x60640020);
 	}
 	{
 		struct irdm_can_frame f;
@@ -163,8 +179,6 @@ static void test_boot_and_sdo(void **state)
 	assert_int_equal(abort_code, 0x06010002);
 	assert_int_equal(sdo_write(2, 0x6060, 0, 10, 2, &abort_code), IRDM_EHW);
 	assert_int_equal(abort_code, 0x06070010);
-	assert_int_equal(sdo_write(2, 0x1600, 2, 0x60710020, 4, &abort_code), IRDM_EHW);
-	assert_int_equal(abort_code, 0x06040041);
 	/* an upload: the statusword of switch on disabled, 2 bytes */
 	assert_int_equal(irdm_co_sdo_read(&f, 2, 0x6041, 0), IRDM_OK);
 	tx(&f);
@@ -175,6 +189,87 @@ static void test_boot_and_sdo(void **state)
 	/* a drive that answers about another object is not believed */
 	dr.d[2].sdo_wrong = true;
 	assert_int_equal(sdo_write(3, 0x6060, 0, 10, 1, &abort_code), IRDM_EFORMAT);
+}
+
+/* The verdict and abort code of one SDO write: IRDM_OK wants abort 0. */
+static void expect_write(unsigned node, uint16_t index, uint8_t sub, uint32_t v, unsigned size,
+			 uint32_t want_abort)
+{
+	uint32_t abort_code = 0;
+	int rc = sdo_write(node, index, sub, v, size, &abort_code);
+
+	if (rc != (want_abort ? IRDM_EHW : IRDM_OK) || (want_abort && abort_code != want_abort))
+		fail_msg("0x%04X:%02X = 0x%X: rc %d abort 0x%08X, expected abort 0x%08X", index, sub,
+			 (unsigned)v, rc, (unsigned)abort_code, (unsigned)want_abort);
+}
+
+/*
+ * A strict drive (CiA 301): each step of the PDO mapping procedure
+ * skipped is refused with its abort, and a PDO left off is not run.
+ */
+static void test_pdo_mapping_strict(void **state)
+{
+	(void)state;
+	bring_up();
+	/* valid as booted: the mapping may not change (0x06010000 unsupported access) */
+	expect_write(1, 0x1600, 0, 0, 1, 0x06010000);
+	expect_write(1, 0x1600, 1, 0x60400010, 4, 0x06010000);
+	expect_write(1, 0x1A00, 0, 0, 1, 0x06010000);
+	/* off, but sub 0 still 2: the entries may not change */
+	expect_write(1, 0x1400, 1, 0x80000201, 4, 0);
+	expect_write(1, 0x1600, 2, 0x60710010, 4, 0x06010000);
+	/* emptied: the CST entries are taken, another one is not mappable */
+	expect_write(1, 0x1600, 0, 0, 1, 0);
+	expect_write(1, 0x1600, 1, 0x60400010, 4, 0);
+	expect_write(1, 0x1600, 2, 0x60710020, 4, 0x06040041);
+	expect_write(1, 0x1600, 2, 0x60710010, 4, 0);
+	expect_write(1, 0x1600, 3, 0x60600008, 4, 0x06090011);
+	expect_write(1, 0x1600, 0, 3, 1, 0x06090030);
+	expect_write(1, 0x1600, 0, 2, 1, 0);
+	/* transmission type: only 1, synchronous every SYNC */
+	expect_write(1, 0x1400, 2, 0xFF, 1, 0x06090030);
+	expect_write(1, 0x1400, 2, 0, 1, 0x06090030);
+	expect_write(1, 0x1400, 2, 1, 1, 0);
+	/* the identifier is fixed; sub 0 read-only; lengths checked */
+	expect_write(1, 0x1400, 1, 0x80000202, 4, 0x06090030);
+	expect_write(1, 0x1400, 0, 2, 1, 0x06010002);
+	expect_write(1, 0x1400, 1, 0x201, 2, 0x06070010);
+	expect_write(1, 0x1600, 0, 2, 4, 0x06070010);
+	/* RPDO1 off (left so): node 1's set-point is not taken; TPDO1 off: not sent */
+	expect_write(1, 0x1800, 1, 0x80000181, 4, 0);
+	{
+		struct irdm_can_frame f;
+
+		assert_int_equal(irdm_co_nmt(&f, IRDM_CO_NMT_START, 0), IRDM_OK);
+		tx(&f);
+	}
+	rpdo(1, 0x06, 0);
+	rpdo(2, 0x06, 0);
+	assert_int_equal(dr.d[0].rpdo_cw, 0);
+	assert_int_equal(dr.d[1].rpdo_cw, 0x06);
+	count_id(0);
+	sync_once();
+	assert_int_equal(count_id(0x181), 0);
+	sync_once();
+	assert_int_equal(count_id(0x182), 1);
+	/* on again: both run */
+	expect_write(1, 0x1400, 1, 0x201, 4, 0);
+	expect_write(1, 0x1800, 1, 0x181, 4, 0);
+	expect_write(1, 0x1600, 1, 0x60400010, 4, 0x06010000);          /* valid again */
+	rpdo(1, 0x06, 0);
+	assert_int_equal(dr.d[0].rpdo_cw, 0x06);
+	sync_once();
+	assert_int_equal(count_id(0x181), 1);
+	/* a reset restores the stored configuration: valid, mapped */
+	expect_write(1, 0x1800, 1, 0x80000181, 4, 0);
+	{
+		struct irdm_can_frame f;
+
+		assert_int_equal(irdm_co_nmt(&f, IRDM_CO_NMT_RESET_NODE, 1), IRDM_OK);
+		tx(&f);
+	}
+	assert_int_equal(dr.d[0].tpdo1.cob_id, 0x181);
+	assert_int_equal(dr.d[0].tpdo1.n_mapped, 2);
 }
 
 static void test_enable_and_move(void **state)
@@ -314,6 +409,7 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_boot_and_sdo),
+		cmocka_unit_test(test_pdo_mapping_strict),
 		cmocka_unit_test(test_enable_and_move),
 		cmocka_unit_test(test_latest_wins_and_bad_frames),
 		cmocka_unit_test(test_faults),

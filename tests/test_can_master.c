@@ -158,33 +158,61 @@ static void expect_frame(unsigned i, uint32_t id, unsigned dlc, const uint8_t *b
 			 sent[i].f.data[5], sent[i].f.data[6], sent[i].f.data[7], (unsigned)id, dlc);
 }
 
+/*
+ * One drive's set-up, as CiA 301 lays the expedited download out: the
+ * command byte (0x2F / 0x2B / 0x23: 1 / 2 / 4 bytes, expedited, size
+ * given), the index little endian, the sub-index, the value little endian
+ * in the 4 data bytes.  A PDO's COB-ID carries the node: the rows marked
+ * add it to data byte 4 (0x200 + n is 0x00 + n, 0x02; 0x180 + n is
+ * 0x80 + n, 0x01; bit 31, not valid, is 0x80 in byte 7).
+ */
+#define SETUP_SDOS 17
+static const struct {
+	uint8_t bytes[8];
+	bool plus_node;
+} setup_sdo[SETUP_SDOS] = {
+	{ { 0x2F, 0x60, 0x60, 0x00, 0x0A, 0, 0, 0 }, false },     /* 0x6060 = 10 (CST), 1 B */
+	{ { 0x2B, 0x17, 0x10, 0x00, 0x0A, 0, 0, 0 }, false },     /* 0x1017 = 10 ms, 2 B */
+	{ { 0x23, 0x76, 0x60, 0x00, 0xF4, 0x01, 0, 0 }, false },     /* 0x6076 = 500 mN m */
+	/* RPDO1 */
+	{ { 0x23, 0x00, 0x14, 0x01, 0x00, 0x02, 0x00, 0x80 }, true },      /* 0x1400:01 off */
+	{ { 0x2F, 0x00, 0x16, 0x00, 0x00, 0, 0, 0 }, false },     /* 0x1600:00 = 0 */
+	{ { 0x23, 0x00, 0x16, 0x01, 0x10, 0x00, 0x40, 0x60 }, false },     /* 0x6040, 16 bit */
+	{ { 0x23, 0x00, 0x16, 0x02, 0x10, 0x00, 0x71, 0x60 }, false },     /* 0x6071, 16 bit */
+	{ { 0x2F, 0x00, 0x16, 0x00, 0x02, 0, 0, 0 }, false },     /* two entries */
+	{ { 0x2F, 0x00, 0x14, 0x02, 0x01, 0, 0, 0 }, false },     /* every SYNC */
+	{ { 0x23, 0x00, 0x14, 0x01, 0x00, 0x02, 0x00, 0x00 }, true },      /* 0x1400:01 on */
+	/* TPDO1 */
+	{ { 0x23, 0x00, 0x18, 0x01, 0x80, 0x01, 0x00, 0x80 }, true },      /* 0x1800:01 off */
+	{ { 0x2F, 0x00, 0x1A, 0x00, 0x00, 0, 0, 0 }, false },     /* 0x1A00:00 = 0 */
+	{ { 0x23, 0x00, 0x1A, 0x01, 0x10, 0x00, 0x41, 0x60 }, false },     /* 0x6041, 16 bit */
+	{ { 0x23, 0x00, 0x1A, 0x02, 0x20, 0x00, 0x64, 0x60 }, false },     /* 0x6064, 32 bit */
+	{ { 0x2F, 0x00, 0x1A, 0x00, 0x02, 0, 0, 0 }, false },     /* two entries */
+	{ { 0x2F, 0x00, 0x18, 0x02, 0x01, 0, 0, 0 }, false },     /* every SYNC */
+	{ { 0x23, 0x00, 0x18, 0x01, 0x80, 0x01, 0x00, 0x00 }, true },      /* 0x1800:01 on */
+};
+
 static void test_setup_sequence(void **state)
 {
 	struct irdm_can_master_cfg c = cfg_3axes();
-	/* per node: index and sub little endian, then the value little endian */
-	static const uint8_t sdo[9][8] = {
-		{ 0x2F, 0x60, 0x60, 0x00, 0x0A, 0, 0, 0 },              /* 0x6060 = 10 (CST), 1 B */
-		{ 0x2B, 0x17, 0x10, 0x00, 0x0A, 0, 0, 0 },              /* 0x1017 = 10 ms, 2 B */
-		{ 0x23, 0x76, 0x60, 0x00, 0xF4, 0x01, 0, 0 },           /* 0x6076 = 500 mN m */
-		{ 0x23, 0x00, 0x16, 0x01, 0x10, 0x00, 0x40, 0x60 },     /* 0x6040, 16 bit */
-		{ 0x23, 0x00, 0x16, 0x02, 0x10, 0x00, 0x71, 0x60 },     /* 0x6071, 16 bit */
-		{ 0x2F, 0x00, 0x16, 0x00, 0x02, 0, 0, 0 },              /* two entries */
-		{ 0x23, 0x00, 0x1A, 0x01, 0x10, 0x00, 0x41, 0x60 },     /* 0x6041, 16 bit */
-		{ 0x23, 0x00, 0x1A, 0x02, 0x20, 0x00, 0x64, 0x60 },     /* 0x6064, 32 bit */
-		{ 0x2F, 0x00, 0x1A, 0x00, 0x02, 0, 0, 0 },
-	};
 
 	(void)state;
 	bus_up();
 	master_up(&c);
-	assert_int_equal(n_sent, 3 * 9 + 3);
+	assert_int_equal(n_sent, 3 * SETUP_SDOS + 3);
 	for (unsigned node = 1; node <= 3; node++)
-		for (unsigned i = 0; i < 9; i++)
-			expect_frame((node - 1) * 9 + i, 0x600 + node, 8, sdo[i]);
+		for (unsigned i = 0; i < SETUP_SDOS; i++) {
+			uint8_t want[8];
+
+			memcpy(want, setup_sdo[i].bytes, 8);
+			if (setup_sdo[i].plus_node)
+				want[4] = (uint8_t)(want[4] + node);
+			expect_frame((node - 1) * SETUP_SDOS + i, 0x600 + node, 8, want);
+		}
 	for (unsigned node = 1; node <= 3; node++) {
 		uint8_t nmt[2] = { 0x01, (uint8_t)node };       /* start remote node */
 
-		expect_frame(27 + node - 1, 0x000, 2, nmt);
+		expect_frame(3 * SETUP_SDOS + node - 1, 0x000, 2, nmt);
 	}
 	irdm_can_drives_poll(&dr);
 	for (unsigned k = 0; k < 3; k++) {
@@ -192,6 +220,12 @@ static void test_setup_sequence(void **state)
 		assert_int_equal(dr.d[k].heartbeat_ms, 10);
 		assert_int_equal(dr.d[k].rated_torque_mnm, 500);
 		assert_int_equal(dr.d[k].nmt, IRDM_CO_STATE_OPERATIONAL);
+		assert_int_equal(dr.d[k].rpdo1.cob_id, 0x200 + k + 1);
+		assert_int_equal(dr.d[k].tpdo1.cob_id, 0x180 + k + 1);
+		assert_int_equal(dr.d[k].rpdo1.n_mapped, 2);
+		assert_int_equal(dr.d[k].tpdo1.n_mapped, 2);
+		assert_int_equal(dr.d[k].rpdo1.transmission, 1);
+		assert_int_equal(dr.d[k].tpdo1.transmission, 1);
 	}
 }
 
@@ -268,6 +302,68 @@ static void test_setup_aborts_named(void **state)
 		assert_int_equal(irdm_can_master_init(&m, &wrapped, &c, err, sizeof(err)),
 				 IRDM_EFORMAT);
 		assert_non_null(strstr(err, "drive 2 (node 2): malformed SDO answer"));
+	}
+}
+
+/* A drive that confirms every SDO but refuses writes to picky_index with
+ * picky_abort (a drive whose PDO stays valid, say). */
+static uint16_t picky_index;
+static uint32_t picky_abort;
+
+static void picky_turn(void *ctx)
+{
+	struct irdm_can_frame f, a = { .id = 0x581, .dlc = 8 };
+
+	(void)ctx;
+	while (irdm_can_recv(&rogue, &f) == 1) {
+		if (f.id != 0x601)
+			continue;
+		memset(a.data, 0, 8);
+		a.data[0] = 0x60;                       /* download confirmed */
+		memcpy(a.data + 1, f.data + 1, 3);
+		if ((f.data[1] | f.data[2] << 8) == picky_index) {
+			a.data[0] = 0x80;               /* abort, the code little endian */
+			for (int b = 0; b < 4; b++)
+				a.data[4 + b] = (uint8_t)(picky_abort >> (8 * b));
+		}
+		irdm_can_send(&rogue, &a);
+	}
+}
+
+/* A drive refusing the master's mapping: the one-line error names the
+ * drive, the abort and the object, and nothing after it is sent. */
+static void test_setup_pdo_refused_named(void **state)
+{
+	static const uint32_t other_map[2] = { 0x60400010, 0x60710020 };
+	static const struct {
+		uint16_t index;
+		uint32_t abort_code;
+		const char *line;
+	} cases[] = {
+		{ 0x1600, 0x06010000, "drive 1 (node 1): SDO abort 0x06010000 unsupported access to "
+				      "an object writing 0x1600:00" },
+		{ 0x1A00, 0x08000022, "drive 1 (node 1): SDO abort 0x08000022 data cannot be stored: "
+				      "present device state writing 0x1A00:00" },
+		{ 0x1800, 0x06090030, "drive 1 (node 1): SDO abort 0x06090030 invalid value for "
+				      "parameter writing 0x1800:01" },
+	};
+	struct irdm_can_master_cfg c = cfg_3axes();
+
+	(void)state;
+	bus_up();
+	dr.d[1].rpdo1.map = other_map;          /* drive 2 maps 0x6071 as 32 bit */
+	assert_int_equal(irdm_can_master_init(&m, &wrapped, &c, err, sizeof(err)), IRDM_EHW);
+	assert_string_equal(err, "drive 2 (node 2): SDO abort 0x06040041 object cannot be mapped "
+				 "to the PDO writing 0x1600:02");
+	assert_int_equal(n_sent, SETUP_SDOS + 7);       /* drive 1, then drive 2 up to 0x1600:02 */
+	c.n_axes = 1;
+	c.idle = picky_turn;
+	for (size_t i = 0; i < sizeof(cases) / sizeof(cases[0]); i++) {
+		picky_index = cases[i].index;
+		picky_abort = cases[i].abort_code;
+		bus_up();
+		assert_int_equal(irdm_can_master_init(&m, &wrapped, &c, err, sizeof(err)), IRDM_EHW);
+		assert_string_equal(err, cases[i].line);
 	}
 }
 
@@ -673,6 +769,7 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_setup_sequence),
+		cmocka_unit_test(test_setup_pdo_refused_named),
 		cmocka_unit_test(test_setup_aborts_named),
 		cmocka_unit_test(test_every_axis_enabled),
 		cmocka_unit_test(test_torque_scaling),

@@ -20,8 +20,11 @@
  * (16 bit); TPDO1 = statusword 0x6041 (16 bit) + position actual 0x6064 (32 bit). */
 #define RPDO1_BYTES 4
 #define TPDO1_BYTES 6
-static const uint32_t rpdo1_map[2] = { 0x60400010, 0x60710010 };
-static const uint32_t tpdo1_map[2] = { 0x60410010, 0x60640020 };
+#define PDO_ENTRIES 2
+static const uint32_t rpdo1_map[PDO_ENTRIES] = { 0x60400010, 0x60710010 };
+static const uint32_t tpdo1_map[PDO_ENTRIES] = { 0x60410010, 0x60640020 };
+#define PDO_NOT_VALID 0x80000000u       /* COB-ID bit 31 */
+#define PDO_SYNC_EVERY 1                /* transmission type: synchronous, every SYNC */
 
 unsigned irdm_can_master_cycle_bits(const struct irdm_can_master_cfg *cfg)
 {
@@ -168,21 +171,43 @@ static int sdo_write(struct irdm_can_master *m, unsigned k, const struct sdo_ite
 	return IRDM_ETIMEDOUT;
 }
 
+/*
+ * A PDO's mapping the way CiA 301 lets it change (most drives refuse a
+ * mapping write otherwise): switch the PDO off (COB-ID bit 31), empty the
+ * mapping (sub 0 = 0), write the entries, set their number, make it
+ * synchronous (transmission type 1: every SYNC), switch it on again.
+ * Return: the items written into it (PDO_ITEMS).
+ */
+#define PDO_ITEMS (5 + PDO_ENTRIES)
+
+static size_t pdo_items(struct sdo_item *it, uint16_t comm_index, uint16_t map_index,
+			uint32_t cob_id, const uint32_t map[PDO_ENTRIES])
+{
+	size_t n = 0;
+
+	it[n++] = (struct sdo_item){ comm_index, 1, 4, cob_id | PDO_NOT_VALID };
+	it[n++] = (struct sdo_item){ map_index, 0, 1, 0 };
+	for (uint8_t e = 0; e < PDO_ENTRIES; e++)
+		it[n++] = (struct sdo_item){ map_index, (uint8_t)(e + 1), 4, map[e] };
+	it[n++] = (struct sdo_item){ map_index, 0, 1, PDO_ENTRIES };
+	it[n++] = (struct sdo_item){ comm_index, 2, 1, PDO_SYNC_EVERY };
+	it[n++] = (struct sdo_item){ comm_index, 1, 4, cob_id };
+	return n;
+}
+
 static int configure_drive(struct irdm_can_master *m, unsigned k, char *err, size_t errlen)
 {
-	const struct sdo_item items[] = {
+	unsigned node = m->cfg.axis[k].node;
+	struct sdo_item items[3 + 2 * PDO_ITEMS] = {
 		{ 0x6060, 0, 1, MODE_CST },
 		{ 0x1017, 0, 2, m->cfg.heartbeat_ms },
 		{ 0x6076, 0, 4, m->cfg.axis[k].rated_torque_mnm },
-		{ 0x1600, 1, 4, rpdo1_map[0] },
-		{ 0x1600, 2, 4, rpdo1_map[1] },
-		{ 0x1600, 0, 1, 2 },
-		{ 0x1A00, 1, 4, tpdo1_map[0] },
-		{ 0x1A00, 2, 4, tpdo1_map[1] },
-		{ 0x1A00, 0, 1, 2 },
 	};
+	size_t n = 3;
 
-	for (size_t i = 0; i < sizeof(items) / sizeof(items[0]); i++) {
+	n += pdo_items(items + n, 0x1400, 0x1600, IRDM_CO_RPDO1 + node, rpdo1_map);
+	n += pdo_items(items + n, 0x1800, 0x1A00, IRDM_CO_TPDO1 + node, tpdo1_map);
+	for (size_t i = 0; i < n; i++) {
 		int rc = sdo_write(m, k, &items[i], err, errlen);
 
 		if (rc)

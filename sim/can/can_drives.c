@@ -8,8 +8,8 @@
 
 #define MODE_CST 10
 /* the CST mapping the master writes: RPDO1 0x6040 + 0x6071, TPDO1 0x6041 + 0x6064 */
-static const uint32_t rpdo_map[3] = { 2, 0x60400010, 0x60710010 };
-static const uint32_t tpdo_map[3] = { 2, 0x60410010, 0x60640020 };
+static const uint32_t rpdo_map[IRDM_CAN_PDO_ENTRIES] = { 0x60400010, 0x60710010 };
+static const uint32_t tpdo_map[IRDM_CAN_PDO_ENTRIES] = { 0x60410010, 0x60640020 };
 
 static void send(struct irdm_can_drives *dr, const struct irdm_can_frame *f)
 {
@@ -33,6 +33,9 @@ static void boot(struct irdm_can_drives *dr, struct irdm_can_drive *d)
 	heartbeat(dr, d);
 	d->nmt = IRDM_CO_STATE_PRE_OPERATIONAL;
 	irdm_cia402_drive_init(&d->fsa);
+	/* a reset restores the communication objects from the stored configuration */
+	irdm_can_pdo_boot(&d->rpdo1, IRDM_CO_RPDO1 + d->node, rpdo_map);
+	irdm_can_pdo_boot(&d->tpdo1, IRDM_CO_TPDO1 + d->node, tpdo_map);
 	d->rpdo_cw = 0;
 	d->rpdo_torque_permille = 0;
 }
@@ -141,8 +144,16 @@ static uint32_t object_read(struct irdm_can_drives *dr, struct irdm_can_drive *d
 static uint32_t object_write(struct irdm_can_drive *d, uint16_t index, uint8_t sub, uint32_t v,
 			     unsigned size)
 {
-	if ((index == 0x1600 || index == 0x1A00) && sub <= 2)
-		return v == (index == 0x1600 ? rpdo_map : tpdo_map)[sub] ? 0 : 0x06040041;
+	switch (index) {
+	case 0x1400:
+		return irdm_can_pdo_write_comm(&d->rpdo1, sub, v, size);
+	case 0x1800:
+		return irdm_can_pdo_write_comm(&d->tpdo1, sub, v, size);
+	case 0x1600:
+		return irdm_can_pdo_write_map(&d->rpdo1, sub, v, size);
+	case 0x1A00:
+		return irdm_can_pdo_write_map(&d->tpdo1, sub, v, size);
+	}
 	if (sub != 0)
 		return index == 0x6060 || index == 0x1017 || index == 0x6076 ? 0x06090011
 									      : 0x06020000;
@@ -309,7 +320,7 @@ static void sync(struct irdm_can_drives *dr)
 		f.data[1] = (uint8_t)(sw >> 8);
 		for (int b = 0; b < 4; b++)
 			f.data[2 + b] = (uint8_t)((uint32_t)counts[k] >> (8 * b));
-		if (d->nmt == IRDM_CO_STATE_OPERATIONAL)
+		if (d->nmt == IRDM_CO_STATE_OPERATIONAL && irdm_can_pdo_live(&d->tpdo1))
 			tpdo_out(dr, d, &f);
 		tau[k] = joint_torque(dr, k);
 	}
@@ -338,7 +349,8 @@ static void frame_in(struct irdm_can_drives *dr, const struct irdm_can_frame *f)
 	} else if ((d = drive_of(dr, irdm_co_node_of(f, IRDM_CO_SDO_RX)))) {
 		sdo(dr, d, f);
 	} else if ((d = drive_of(dr, irdm_co_node_of(f, IRDM_CO_RPDO1))) && f->dlc == 4) {
-		if (d->nmt == IRDM_CO_STATE_OPERATIONAL) {      /* latest wins */
+		/* latest wins; a PDO not valid is not listened to */
+		if (d->nmt == IRDM_CO_STATE_OPERATIONAL && irdm_can_pdo_live(&d->rpdo1)) {
 			d->rpdo_cw = (uint16_t)(f->data[0] | (f->data[1] << 8));
 			d->rpdo_torque_permille = (int16_t)(f->data[2] | (f->data[3] << 8));
 		}

@@ -103,8 +103,10 @@ int irdm_can_master_check(const struct irdm_can_master_cfg *cfg, char *err, size
 
 /*
  * Check cfg, configure every drive by expedited SDO (mode of operation
- * 0x6060 = 10 CST, heartbeat producer 0x1017, rated torque 0x6076, the
- * RPDO1 0x1600 and TPDO1 0x1A00 mappings), then NMT start each node.
+ * 0x6060 = 10 CST, heartbeat producer 0x1017, rated torque 0x6076, then
+ * RPDO1 and TPDO1 by CiA 301's procedure: PDO off (0x1400 / 0x1800:01 bit
+ * 31), mapping 0x1600 / 0x1A00 emptied, its entries, their number, the
+ * transmission type 1 (every SYNC), PDO on), then NMT start each node.
  * Return: IRDM_OK; IRDM_EINVAL (cfg; err says which field); IRDM_ETIMEDOUT
  * (a drive did not answer: err names the drive and the object);
  * IRDM_EHW (an SDO abort: err names the code); IRDM_EFORMAT (an answer

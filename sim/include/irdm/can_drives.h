@@ -2,9 +2,11 @@
 /*
  * CiA 402 drives in emulation: one node per joint of the simulated arm
  * (irdm/sim_device.h), on a CAN port (docs/canopen.md).  Each answers NMT
- * and expedited SDOs for the objects the master configures, takes its
- * RPDO1 (controlword + target torque; latest wins), and at every SYNC
- * sends its TPDO1 (statusword + position counts sampled then), applies
+ * and expedited SDOs for the objects the master configures, strictly as
+ * a real drive does for the PDOs (irdm/can_drive_pdo.h: a mapping changes
+ * only with its PDO switched off), takes its RPDO1 (controlword + target
+ * torque; latest wins) while that PDO is valid, and at every SYNC sends
+ * its TPDO1 while valid (statusword + position counts sampled then), applies
  * the set-point and moves the arm one period: a one-period bus delay, as
  * real synchronous PDOs have.  Heartbeats at the configured producer time
  * on the emulated clock (which SYNCs advance), or, with wall_heartbeat, on
@@ -22,6 +24,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "irdm/can_drive_pdo.h"
 #include "irdm/can_faults.h"
 #include "irdm/can_port.h"
 #include "irdm/cia402.h"
@@ -36,6 +39,8 @@ struct irdm_can_drive {
 	int8_t mode;                    /* 0x6060: 10 = cyclic synchronous torque */
 	uint16_t heartbeat_ms;          /* 0x1017: 0 = none */
 	uint32_t rated_torque_mnm;      /* 0x6076: motor side, mN m */
+	struct irdm_can_pdo rpdo1;      /* 0x1400, 0x1600: controlword + target torque */
+	struct irdm_can_pdo tpdo1;      /* 0x1800, 0x1A00: statusword + position */
 	uint16_t rpdo_cw;               /* the latest RPDO1 */
 	int16_t rpdo_torque_permille;
 	uint64_t heartbeat_next_us;
