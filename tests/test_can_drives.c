@@ -235,6 +235,9 @@ static void test_pdo_mapping_strict(void **state)
 	expect_write(1, 0x1400, 0, 2, 1, 0x06010002);
 	expect_write(1, 0x1400, 1, 0x201, 2, 0x06070010);
 	expect_write(1, 0x1600, 0, 2, 4, 0x06070010);
+	/* node 2: its PDOs as booted (valid, event-driven) made synchronous */
+	expect_write(2, 0x1400, 2, 1, 1, 0);
+	expect_write(2, 0x1800, 2, 1, 1, 0);
 	/* RPDO1 off (left so): node 1's set-point is not taken; TPDO1 off: not sent */
 	expect_write(1, 0x1800, 1, 0x80000181, 4, 0);
 	{
@@ -259,6 +262,13 @@ static void test_pdo_mapping_strict(void **state)
 	rpdo(1, 0x06, 0);
 	assert_int_equal(dr.d[0].rpdo_cw, 0x06);
 	sync_once();
+	assert_int_equal(count_id(0x181), 0);           /* TPDO1 still event-driven */
+	expect_write(1, 0x1800, 1, 0x80000181, 4, 0);
+	expect_write(1, 0x1800, 2, 1, 1, 0);            /* the type may change while valid, too */
+	sync_once();
+	assert_int_equal(count_id(0x181), 0);           /* now synchronous but off */
+	expect_write(1, 0x1800, 1, 0x181, 4, 0);
+	sync_once();
 	assert_int_equal(count_id(0x181), 1);
 	/* a reset restores the stored configuration: valid, mapped */
 	expect_write(1, 0x1800, 1, 0x80000181, 4, 0);
@@ -270,6 +280,7 @@ static void test_pdo_mapping_strict(void **state)
 	}
 	assert_int_equal(dr.d[0].tpdo1.cob_id, 0x181);
 	assert_int_equal(dr.d[0].tpdo1.n_mapped, 2);
+	assert_int_equal(dr.d[0].tpdo1.transmission, 0xFF);
 }
 
 static void test_enable_and_move(void **state)

@@ -107,6 +107,10 @@ static void bring_up(void)
 	irdm_sim_params_default(&params);
 	assert_int_equal(irdm_can_drives_init(&dr, &drives_port, &dev, &params, 3, 1, 1e-3),
 			 IRDM_OK);
+	/* the PDOs synchronous, as the master's set-up leaves them (its SDOs:
+	 * test_can_master, test_can_drives) */
+	for (unsigned k = 0; k < 3; k++)
+		dr.d[k].rpdo1.transmission = dr.d[k].tpdo1.transmission = 1;
 	assert_int_equal(irdm_co_nmt(&f, IRDM_CO_NMT_START, 0), IRDM_OK);
 	assert_int_equal(irdm_can_send(&master, &f), IRDM_OK);
 	irdm_can_drives_poll(&dr);

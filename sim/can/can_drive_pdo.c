@@ -14,14 +14,15 @@
 void irdm_can_pdo_boot(struct irdm_can_pdo *p, uint32_t id, const uint32_t *map)
 {
 	p->cob_id = id;
-	p->transmission = IRDM_CAN_PDO_SYNC_EVERY;
+	p->transmission = IRDM_CAN_PDO_ASYNC;
 	p->n_mapped = IRDM_CAN_PDO_ENTRIES;
 	p->map = map;
 }
 
 bool irdm_can_pdo_live(const struct irdm_can_pdo *p)
 {
-	return !(p->cob_id & IRDM_CAN_PDO_INVALID) && p->n_mapped == IRDM_CAN_PDO_ENTRIES;
+	return !(p->cob_id & IRDM_CAN_PDO_INVALID) && p->n_mapped == IRDM_CAN_PDO_ENTRIES &&
+	       p->transmission == IRDM_CAN_PDO_SYNC_EVERY;
 }
 
 uint32_t irdm_can_pdo_write_comm(struct irdm_can_pdo *p, uint8_t sub, uint32_t v, unsigned size)
