@@ -2,7 +2,7 @@
 /*
  * The CiA 402 drive emulator (sim/can) on an in-memory bus, driven from
  * here with frames written by hand: boot-up, SDO configuration (and its
- * aborts), NMT, the state machine to operation enabled over PDOs, the
+ * aborts; the PDO mapping procedure, each skipped step refused), NMT, the state machine to operation enabled over PDOs, the
  * arm moving under torque exactly as the simulated device does with the
  * same one-period delay (a second, independent run of irdm/sim_device.h),
  * latest-value-wins, malformed frames counted, and the injected faults.

@@ -4,12 +4,13 @@
  * emulator (sim/can) on the in-memory bus, every frame the master sends
  * logged through the bus's tap.  The expected bytes are the standard's
  * layouts written out here by hand (docs/canopen.md), not produced by the
- * frame builders the master uses.  Checked: the set-up SDO sequence and
- * each abort named; every axis reaching operation enabled; the fault runs
- * (heartbeat stops, EMCY, drive fault, TPDOs dropped, link down) each
- * ending with disable voltage + zero torque to every axis within two
- * periods and one line naming the drive; malformed and unknown frames
- * counted, never trusted; the bus load against a hand computation; one
+ * frame builders the master uses.  Checked: the set-up SDO sequence (CiA
+ * 301's PDO mapping procedure included, byte by byte) and each abort
+ * named, on a PDO object too; every axis reaching operation enabled; the
+ * fault runs (heartbeat stops, EMCY, drive fault, TPDOs dropped, link
+ * down) each ending with disable voltage + zero torque to every axis
+ * within two periods and one line naming the drive; malformed and
+ * unknown frames counted, never trusted; the bus load against a hand computation; one
  * RPDO per axis per SYNC and the SYNC counter.
  */
 #include <setjmp.h>
