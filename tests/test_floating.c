@@ -137,31 +137,43 @@ struct ref {
 	double rest[3];         /* contact rest point */
 };
 
-/* end-of-tick world position of the point for world force F at tick t */
-static void end_position(const struct ref *r, size_t t, const double F[3], double x[3])
+/*
+ * The body-frame deformation of the point at the end of tick t under world
+ * force F (body-frame fb) with the history so far, and the tick's rigid
+ * step of b: the force acts where the point is deformed to at the end of
+ * the tick (this tick's force included), in the pose at the start.
+ */
+static void step_with(const struct ref *r, size_t t, const double F[3], struct body *b, double u[3])
 {
-	struct body b = r->b;
-	double fb[3], u[3] = { 0, 0, 0 }, p[3], xn[3], arm[3], tau[3];
+	double fb[3], p[3], xn[3], arm[3], tau[3];
 
-	quat_rotate_inv(b.q, F, fb);
+	quat_rotate_inv(b->q, F, fb);
+	memset(u, 0, 3 * sizeof(double));
 	for (size_t s = 1; s <= t; s++)
 		for (int i = 0; i < 3; i++)
 			for (int j = 0; j < 3; j++)
 				u[i] += r->R[9 * s + 3 * (size_t)i + (size_t)j] * r->fb[3 * (t - s) + (size_t)j];
-	double u_start[3] = { u[0], u[1], u[2] };
 	for (int i = 0; i < 3; i++)
 		for (int j = 0; j < 3; j++)
 			u[i] += r->R[3 * i + j] * fb[j];
-	/* the force acts at the point where it is at the start of the tick */
 	for (int a = 0; a < 3; a++)
-		p[a] = r->rest[a] - com0[a] + u_start[a];
-	world_of(&b, p, xn);
+		p[a] = r->rest[a] - com0[a] + u[a];
+	world_of(b, p, xn);
 	for (int a = 0; a < 3; a++)
-		arm[a] = xn[a] - b.x[a];
+		arm[a] = xn[a] - b->x[a];
 	tau[0] = arm[1] * F[2] - arm[2] * F[1];
 	tau[1] = arm[2] * F[0] - arm[0] * F[2];
 	tau[2] = arm[0] * F[1] - arm[1] * F[0];
-	rk4_tick(&b, F, tau, cube.meta->dt_s);
+	rk4_tick(b, F, tau, cube.meta->dt_s);
+}
+
+/* end-of-tick world position of the point for world force F at tick t */
+static void end_position(const struct ref *r, size_t t, const double F[3], double x[3])
+{
+	struct body b = r->b;
+	double u[3], p[3];
+
+	step_with(r, t, F, &b, u);
 	for (int a = 0; a < 3; a++)
 		p[a] = r->rest[a] - com0[a] + u[a];
 	world_of(&b, p, x);
@@ -206,23 +218,9 @@ static void ref_tick(struct ref *r, size_t t, const double target[3], double F[3
 			F[a] += g[a];
 	}
 	/* commit the tick */
-	double fb[3];
-	double u_start[3] = { 0, 0, 0 }, p[3], xn[3], arm[3], tau[3];
-	for (size_t s = 1; s <= t; s++)
-		for (int i = 0; i < 3; i++)
-			for (int j = 0; j < 3; j++)
-				u_start[i] += r->R[9 * s + 3 * (size_t)i + (size_t)j] * r->fb[3 * (t - s) + (size_t)j];
-	for (int a = 0; a < 3; a++)
-		p[a] = r->rest[a] - com0[a] + u_start[a];
-	world_of(&r->b, p, xn);
-	for (int a = 0; a < 3; a++)
-		arm[a] = xn[a] - r->b.x[a];
-	tau[0] = arm[1] * F[2] - arm[2] * F[1];
-	tau[1] = arm[2] * F[0] - arm[0] * F[2];
-	tau[2] = arm[0] * F[1] - arm[1] * F[0];
-	quat_rotate_inv(r->b.q, F, fb);
-	memcpy(&r->fb[3 * t], fb, sizeof(fb));
-	rk4_tick(&r->b, F, tau, cube.meta->dt_s);
+	double u[3];
+	quat_rotate_inv(r->b.q, F, &r->fb[3 * t]);
+	step_with(r, t, F, &r->b, u);
 }
 
 static void reference(const struct irdm_contact_site *site, const double *target, double *F,

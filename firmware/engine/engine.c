@@ -343,6 +343,16 @@ void irdm_engine_attach_deform(struct irdm_engine *e, struct irdm_deform *d)
 
 /* ---- frames (irdm/engine.h) ---- */
 
+const struct irdm_rigid_body *irdm_engine_rigid_body(const struct irdm_engine *e)
+{
+#if IRDM_CONFIG_FLOATING
+	if (e->floating)
+		return &e->rb;
+#endif
+	(void)e;
+	return NULL;
+}
+
 void irdm_engine_world_to_object(const struct irdm_engine *e, const double x[3], double p[3])
 {
 	double b[3];

@@ -67,24 +67,36 @@ void tick_to_world(struct irdm_engine *e, struct system *s)
 }
 
 /*
- * Where a floating contact point really is after the step: its body-frame
- * deformation u_body + W_body F_body, carried by the new pose (the solve
- * used the linearised rigid motion).
+ * The body-frame material point of contact i at the end of the tick under
+ * the body-frame forces fb: its free response u_body plus W_body fb (which
+ * holds R[0], and the static correction of a truncated model).
  */
-void tick_floating_disp(const struct irdm_engine *e, const struct system *s, int i, double d[3])
+static void deformed_point(const struct irdm_engine *e, const struct system *s, int i,
+			   const double *fb, double b[3])
 {
-	const struct irdm_contact_site *st = &e->c[s->idx[i]].site;
 	int n = 3 * s->m;
-	double u[3], b[3], x[3];
+	double u[3];
 
 	for (int r = 0; r < 3; r++) {
 		u[r] = s->u_body[i][r];
 		for (int k = 0; k < n; k++)
-			u[r] += s->w_body[(3 * i + r) * n + k] * s->f_body[k];
+			u[r] += s->w_body[(3 * i + r) * n + k] * fb[k];
 	}
-	body_point(e, st, u, b);
+	body_point(e, &e->c[s->idx[i]].site, u, b);
+}
+
+/*
+ * Where a floating contact point really is after the step: its deformed
+ * body point carried by the new pose (the solve used the linearised rigid
+ * motion).
+ */
+void tick_floating_disp(const struct irdm_engine *e, const struct system *s, int i, double d[3])
+{
+	double b[3], x[3];
+
+	deformed_point(e, s, i, s->f_body, b);
 	irdm_rigid_body_to_world(&e->rb, b, x);
-	irdm_v3_sub(d, x, st->rest_m);
+	irdm_v3_sub(d, x, e->c[s->idx[i]].site.rest_m);
 }
 
 /*
@@ -95,26 +107,35 @@ void tick_floating_disp(const struct irdm_engine *e, const struct system *s, int
  */
 #define NEWTON_STEPS 3
 
+/*
+ * The forces f (world; fb in the body frame) push rb, each at its contact
+ * point's actual position: the deformed point, static-correction part
+ * included, in the pose at the start of the tick (the lever arm; the free
+ * response alone would leave out W_body fb and tilt the torque).
+ */
+static void push_body(const struct irdm_engine *e, const struct system *s, const double *f,
+		      const double *fb, struct irdm_rigid_body *rb)
+{
+	for (int i = 0; i < s->m; i++) {
+		double b[3], x[3];
+		deformed_point(e, s, i, fb, b);
+		irdm_rigid_body_to_world(&e->rb, b, x);
+		irdm_rigid_accumulate(rb, &f[3 * i], x);
+	}
+}
+
 static void trial_positions(const struct irdm_engine *e, const struct system *s, double *x)
 {
 	struct irdm_rigid_body trial = e->rb;
-	int n = 3 * s->m;
 	double fb[MAX_SOLVE];
 
-	for (int i = 0; i < s->m; i++) {
-		irdm_rigid_accumulate(&trial, &s->f[3 * i], s->x_now[i]);
+	for (int i = 0; i < s->m; i++)
 		irdm_rigid_rotate_inverse(&e->rb, &s->f[3 * i], &fb[3 * i]);
-	}
+	push_body(e, s, s->f, fb, &trial);
 	irdm_rigid_step(&trial, e->dt_s);
 	for (int i = 0; i < s->m; i++) {
-		const struct irdm_contact_site *st = &e->c[s->idx[i]].site;
-		double u[3], b[3];
-		for (int r = 0; r < 3; r++) {
-			u[r] = s->u_body[i][r];
-			for (int k = 0; k < n; k++)
-				u[r] += s->w_body[(3 * i + r) * n + k] * fb[k];
-		}
-		body_point(e, st, u, b);
+		double b[3];
+		deformed_point(e, s, i, fb, b);
 		irdm_rigid_body_to_world(&trial, b, &x[3 * i]);
 	}
 }
@@ -147,7 +168,6 @@ void tick_newton_floating(struct irdm_engine *e, struct system *s,
 /* The contact forces push the rigid body for one tick. */
 int tick_move_rigid(struct irdm_engine *e, const struct system *s)
 {
-	for (int i = 0; i < s->m; i++)
-		irdm_rigid_accumulate(&e->rb, &s->f[3 * i], s->x_now[i]);
+	push_body(e, s, s->f, s->f_body, &e->rb);
 	return irdm_rigid_step(&e->rb, e->dt_s);
 }

@@ -116,7 +116,7 @@ static int read_gmsh(const char *path, double scale, struct irdm_mesh *m,
  * as "a0.5" mean what the author of the file would expect; the scale is
  * applied afterwards and the mesh checked again.
  */
-static int read_surface(const char *path, double scale, const char *switches,
+static int read_surface(const char *path, double scale, struct irdm_mesh_sizing *sz,
 			struct irdm_mesh *m, char *err, size_t errlen)
 {
 	struct irdm_surface s = { 0, NULL, 0, NULL };
@@ -136,7 +136,7 @@ static int read_surface(const char *path, double scale, const char *switches,
 	free(txt);
 	if (ret)
 		return ret;
-	ret = irdm_surface_tetrahedralize(&s, switches, path, m, err, errlen);
+	ret = irdm_surface_tetrahedralize_sized(&s, sz, path, m, err, errlen);
 	irdm_surface_free(&s);
 	if (ret || scale == 1.0)
 		return ret;
@@ -146,6 +146,14 @@ static int read_surface(const char *path, double scale, const char *switches,
 
 int irdm_mesh_read(const char *path, double scale, const char *tetgen_switches,
 		   struct irdm_mesh *m, char *err, size_t errlen)
+{
+	struct irdm_mesh_sizing sz = { tetgen_switches, 0, 0, "" };
+
+	return irdm_mesh_read_sized(path, scale, &sz, m, err, errlen);
+}
+
+int irdm_mesh_read_sized(const char *path, double scale, struct irdm_mesh_sizing *sz,
+			 struct irdm_mesh *m, char *err, size_t errlen)
 {
 	int ret;
 
@@ -164,7 +172,10 @@ int irdm_mesh_read(const char *path, double scale, const char *tetgen_switches,
 		ret = read_gmsh(path, scale, m, err, errlen);
 	} else if (has_ext(path, ".obj") || has_ext(path, ".off") ||
 		   has_ext(path, ".stl")) {
-		ret = read_surface(path, scale, tetgen_switches, m, err, errlen);
+		struct irdm_mesh_sizing file_sz = *sz;
+		file_sz.max_tet_volume = sz->max_tet_volume / (scale * scale * scale);
+		ret = read_surface(path, scale, &file_sz, m, err, errlen);
+		memcpy(sz->note, file_sz.note, sizeof(sz->note));
 	} else {
 		mesh_err(err, errlen, path,
 			 "unknown mesh format (expected .node, .ele, .msh, .obj, .off or .stl)");

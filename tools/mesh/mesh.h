@@ -95,6 +95,34 @@ int irdm_surface_tetrahedralize(const struct irdm_surface *s, const char *switch
 				char *err, size_t errlen);
 
 /*
+ * How big a surface's tetrahedralisation should be (surface_sizing.c).
+ * switches, when set, win: tetgen runs once with them.  Otherwise
+ * target_nodes (0: none) picks tetgen's -a bound from the enclosed volume
+ * and re-runs tetgen (at most 6 times, loosening the radius-edge bound -q
+ * while there are too many nodes) until the count is within a factor 2,
+ * keeping the closest; max_tet_volume (file units^3, 0: none) caps the -a
+ * bound, or alone is it.  note says what was done ("" if nothing).
+ */
+struct irdm_mesh_sizing {
+	const char *switches;
+	unsigned target_nodes;
+	double max_tet_volume;
+	char note[256];
+};
+
+int irdm_surface_tetrahedralize_sized(const struct irdm_surface *s, struct irdm_mesh_sizing *sz,
+				      const char *what, struct irdm_mesh *m, char *err,
+				      size_t errlen);
+
+/* The volume a closed surface encloses (its units cubed). */
+double irdm_surface_volume(const struct irdm_surface *s);
+
+/* irdm_mesh_read() with a sizing for surfaces (sz->max_tet_volume in m^3:
+ * converted to the file's units by the scale). */
+int irdm_mesh_read_sized(const char *path, double scale, struct irdm_mesh_sizing *sz,
+			 struct irdm_mesh *m, char *err, size_t errlen);
+
+/*
  * Validate and finish a parsed mesh: finite coordinates, indices in range,
  * no repeated node in a tet, no zero-volume or inverted tet, no
  * unreferenced node; then compute the outward boundary triangles (a face

@@ -15,12 +15,40 @@ static double now_s(void)
 	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-int irdm_model_mesh(const struct irdm_scene *sc, struct irdm_mesh *mesh, char *err, size_t errlen)
+/*
+ * A mesh file; a surface is sized (target_nodes, max_tet_volume) unless the
+ * scene gives tetgen switches, which win: then a note says the size keys
+ * were overridden.
+ */
+static int read_file_mesh(const struct irdm_scene *sc, struct irdm_mesh *mesh, char note[256],
+			  char *err, size_t errlen)
+{
+	struct irdm_mesh_sizing sz = { NULL, 0, 0, "" };
+	bool sized = sc->target_nodes || sc->max_tet_volume_m3 > 0;
+
+	if (sc->tetgen_given) {
+		sz.switches = sc->tetgen;
+	} else {
+		sz.target_nodes = irdm_scene_target_nodes(sc);
+		sz.max_tet_volume = sc->max_tet_volume_m3;
+	}
+	int ret = irdm_mesh_read_sized(sc->mesh, sc->mesh_scale, &sz, mesh, err, errlen);
+	if (!ret && sc->tetgen_given && sized)
+		snprintf(sz.note, sizeof(sz.note),
+			 "mesh sizing: note: tetgen = %s given, it overrides target_nodes and "
+			 "max_tet_volume", sc->tetgen);
+	memcpy(note, sz.note, sizeof(sz.note));
+	return ret;
+}
+
+int irdm_model_mesh(const struct irdm_scene *sc, struct irdm_mesh *mesh, char note[256],
+		    char *err, size_t errlen)
 {
 	unsigned r[3] = { sc->res[0], sc->res[1], sc->res[2] };
 	double l[3];
 	int ret;
 
+	note[0] = '\0';
 	if (!strcmp(sc->mesh, "cuboid")) {
 		/* the paper's cuboid: 10 x 10 x 20 cm, 11 x 11 x 22 hexes of 5 tets */
 		l[0] = l[1] = 0.1;
@@ -40,7 +68,7 @@ int irdm_model_mesh(const struct irdm_scene *sc, struct irdm_mesh *mesh, char *e
 		if (!r[0])
 			r[0] = r[1] = r[2] = 4;
 	} else {
-		return irdm_mesh_read(sc->mesh, sc->mesh_scale, sc->tetgen, mesh, err, errlen);
+		return read_file_mesh(sc, mesh, note, err, errlen);
 	}
 	ret = irdm_mesh_gen_box(l[0], l[1], l[2], r[0], r[1], r[2], sc->tets_per_hex, mesh,
 				err, errlen);
@@ -122,9 +150,12 @@ int irdm_model_build(const struct irdm_scene *sc, size_t n_modes_needed,
 		return ret;
 	if (progress)
 		progress(ctx, "mesh", 0.0);
-	ret = irdm_model_mesh(sc, &m->mesh, err, errlen);
+	char note[256] = "";
+	ret = irdm_model_mesh(sc, &m->mesh, note, err, errlen);
 	if (ret)
 		goto out_fail;
+	if (progress && note[0])
+		progress(ctx, note, -1.0);
 	ret = mark_nodes(sc, m, err, errlen);
 	if (ret)
 		goto out_fail;

@@ -30,8 +30,10 @@ struct irdm_model {
 	double seconds_mesh, seconds_fem, seconds_eig;
 };
 
-/* Builtin or file mesh of the scene (validated, boundary computed). */
-int irdm_model_mesh(const struct irdm_scene *sc, struct irdm_mesh *mesh, char *err, size_t errlen);
+/* Builtin or file mesh of the scene (validated, boundary computed); note:
+ * what the sizing of a surface did, "" if nothing. */
+int irdm_model_mesh(const struct irdm_scene *sc, struct irdm_mesh *mesh, char note[256],
+		    char *err, size_t errlen);
 
 /* Everything up to modes and selection.  n_modes_needed: modes to solve
  * (0: all).  Return: IRDM_OK; IRDM_EINVAL (scene, constraints, damping);

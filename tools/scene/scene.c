@@ -247,6 +247,7 @@ static int set_tetgen(const struct irdm_opt *o, void *obj, const char *v, char *
 		return IRDM_EFORMAT;
 	}
 	snprintf(sc->tetgen, sizeof(sc->tetgen), "%s", v);
+	sc->tetgen_given = true;
 	return IRDM_OK;
 }
 
@@ -352,7 +353,15 @@ static const struct irdm_opt scene_opts[] = {
 	  .range = IRDM_OPT_GT, .min = 0,
 	  .help = "multiply file coordinates by S (0.001 for mm)" },
 	{ .name = "tetgen", .type = IRDM_OPT_CUSTOM, .parse = set_tetgen, .metavar = "SWITCHES",
-	  .help = "tetgen quality switches for surface meshes (default pq1.414)" },
+	  .help = "tetgen switches for surface meshes; when given they override target_nodes "
+		  "and max_tet_volume (default: sized by target_nodes)" },
+	{ .name = "target_nodes", .type = IRDM_OPT_UNSIGNED, SC(target_nodes), .metavar = "N",
+	  .range = IRDM_OPT_GE | IRDM_OPT_LE, .min = 100, .max = 10000000,
+	  .help = "surface meshes: about N nodes (within a factor 2; tetgen re-run up to 6 "
+		  "times; default 3000 unless max_tet_volume or tetgen is given)" },
+	{ .name = "max_tet_volume", .type = IRDM_OPT_DOUBLE, SC(max_tet_volume_m3),
+	  .metavar = "M3", .unit = "m^3", .range = IRDM_OPT_GT, .min = 0,
+	  .help = "surface meshes: largest tetrahedron (tetgen -a, after mesh_scale)" },
 	{ .name = "young", .type = IRDM_OPT_DOUBLE, SC(mat.young_pa), .metavar = "PA", .unit = "Pa",
 	  .range = IRDM_OPT_GT, .min = 0,
 	  .help = "Young's modulus (default 2000: the paper)" },
@@ -511,7 +520,26 @@ int irdm_scene_format(const struct irdm_scene *sc, char *buf, size_t len)
 		region_text(&sc->touch), region_text(&sc->display),
 		sc->method == IRDM_METHOD_MODAL ? "modal" : "time-domain", sc->substeps,
 		eig[sc->eigensolver], sc->modes);
-	return (n < 0 || (size_t)n >= len) ? -1 : 0;
+	if (n < 0 || (size_t)n >= len)
+		return -1;
+	if (sc->tetgen_given || irdm_scene_builtin_mesh(sc))
+		return 0;       /* as before sizing existed: the same images */
+	int k = snprintf(buf + n, len - (size_t)n, "target_nodes=%u\nmax_tet_volume=%.17g\n",
+			 irdm_scene_target_nodes(sc), sc->max_tet_volume_m3);
+	return (k < 0 || (size_t)k >= len - (size_t)n) ? -1 : 0;
+}
+
+bool irdm_scene_builtin_mesh(const struct irdm_scene *sc)
+{
+	return !strcmp(sc->mesh, "cuboid") || !strcmp(sc->mesh, "cube") ||
+	       !strncmp(sc->mesh, "box:", 4);
+}
+
+unsigned irdm_scene_target_nodes(const struct irdm_scene *sc)
+{
+	if (sc->target_nodes || sc->max_tet_volume_m3 > 0)
+		return sc->target_nodes;
+	return IRDM_SCENE_TARGET_NODES;
 }
 
 bool irdm_region_contains(const struct irdm_region *r, uint32_t node, const double p[3],

@@ -50,6 +50,9 @@ struct irdm_scene {
 	unsigned tets_per_hex;   /* 5 or 6 */
 	double mesh_scale;       /* multiplies file coordinates */
 	char tetgen[32];         /* tetgen switches for surface meshes */
+	bool tetgen_given;       /* set by the scene: then they win over the sizes */
+	unsigned target_nodes;   /* surface meshes: about this many nodes (0: default) */
+	double max_tet_volume_m3; /* surface meshes: largest tet (0: none) */
 	struct irdm_material mat;
 	enum irdm_mass_kind mass;
 	enum irdm_damping_kind damping;
@@ -98,6 +101,17 @@ int irdm_scene_load(struct irdm_scene *sc, const char *path, char *err, size_t e
 /* Cross-field checks (after all keys are set).  Return: IRDM_OK;
  * IRDM_EINVAL naming the first conflict. */
 int irdm_scene_check(const struct irdm_scene *sc, char *err, size_t errlen);
+
+/* A surface mesh's node target when the scene names none (and no
+ * max_tet_volume): a CAD part becomes a model of a few thousand nodes. */
+#define IRDM_SCENE_TARGET_NODES 3000
+
+/* cuboid, cube or box:...: generated, not read (no tetgen, no sizing). */
+bool irdm_scene_builtin_mesh(const struct irdm_scene *sc);
+
+/* The node target for a surface mesh: the scene's, or the default unless
+ * the scene gives max_tet_volume (0: no target). */
+unsigned irdm_scene_target_nodes(const struct irdm_scene *sc);
 
 /* Canonical text of every key (provenance, scene hash). */
 int irdm_scene_format(const struct irdm_scene *sc, char *buf, size_t len);

@@ -197,6 +197,12 @@ void irdm_engine_world_to_object(const struct irdm_engine *eng, const double x_w
 void irdm_engine_object_to_world(const struct irdm_engine *eng, const double p_obj_m[3],
 				 double x_world_m[3]);
 
+/* The floating object's rigid body (its pose, velocities, momentum:
+ * irdm/rigid.h), read-only; NULL for a grounded object or a build without
+ * floating objects. */
+struct irdm_rigid_body;
+const struct irdm_rigid_body *irdm_engine_rigid_body(const struct irdm_engine *eng);
+
 /* Free response of image node `row` (a column): its displacement at the
  * next sample if no new force acts (object frame, without rigid motion).
  * The surface a new contact meets.  Zero for nodes that are not columns. */
