@@ -24,6 +24,7 @@
 #include "mesh/mesh.h"
 #include "precompute/model.h"
 #include "scene/scene.h"
+#include "support/test_files.h"
 
 #define FACTOR 2.0      /* the sizing's promise: target / 2 .. target * 2 */
 
@@ -272,8 +273,7 @@ static void test_bad_values(void **state)
 static int setup(void **state)
 {
 	(void)state;
-	snprintf(dir, sizeof(dir), "/tmp/irdm-sizing-XXXXXX");
-	if (!mkdtemp(dir))
+	if (tf_tmpdir(dir, sizeof(dir), "sizing"))
 		return -1;
 	snprintf(off_path, sizeof(off_path), "%s/notch.off", dir);
 	snprintf(stl_path, sizeof(stl_path), "%s/part.stl", dir);
@@ -282,11 +282,8 @@ static int setup(void **state)
 
 static int teardown(void **state)
 {
-	char cmd[128];
-
 	(void)state;
-	snprintf(cmd, sizeof(cmd), "rm -rf '%s'", dir);
-	return system(cmd) ? -1 : 0;
+	return tf_rmdir(dir);
 }
 
 int main(void)

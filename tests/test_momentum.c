@@ -31,6 +31,7 @@
 #include "irdm/rigid.h"
 #include "irdm/vec3.h"
 #include "support/engine_fixture.h"
+#include "support/test_files.h"
 
 #define PUSH_S 0.15     /* the push, then the contact ends */
 #define FREE_TICKS 20   /* free flight: momentum must stay put */
@@ -235,17 +236,13 @@ static void test_plate(void **state)
 static int setup(void **state)
 {
 	(void)state;
-	snprintf(dir, sizeof(dir), "/tmp/irdm-momentum-XXXXXX");
-	return mkdtemp(dir) ? 0 : -1;
+	return tf_tmpdir(dir, sizeof(dir), "momentum");
 }
 
 static int teardown(void **state)
 {
-	char cmd[128];
-
 	(void)state;
-	snprintf(cmd, sizeof(cmd), "rm -rf '%s'", dir);
-	return system(cmd) ? -1 : 0;
+	return tf_rmdir(dir);
 }
 
 int main(void)
