@@ -144,6 +144,40 @@ static void node_site(const struct irdm_image *img, const double p[3], struct ir
 	irdm_session_close(ses);
 }
 
+/* The surface point above p on its triangle: a site of three nodes. */
+static void point_site(const struct irdm_image *img, const double p[3],
+		       struct irdm_contact_site *s)
+{
+	struct irdm_engine_config cfg;
+	double bary[3];
+	uint32_t tri;
+
+	irdm_engine_config_default(&cfg);
+	struct irdm_session *ses = efx_session(img, &cfg);
+	assert_int_equal(irdm_replay_locate(img, p, &tri, bary), 0);
+	assert_int_equal(irdm_engine_site_point(ses->eng, tri, bary, s), 0);
+	assert_int_equal(s->n_nodes, 3);
+	irdm_session_close(ses);
+}
+
+/* How many distinct nodes the sites have (a node they share counts once). */
+static unsigned distinct_rows(const struct irdm_contact_site *s, int m)
+{
+	uint32_t seen[3 * IRDM_MAX_CONTACTS];
+	unsigned n = 0;
+
+	for (int i = 0; i < m; i++)
+		for (uint32_t v = 0; v < s[i].n_nodes; v++) {
+			unsigned k = 0;
+			while (k < n && seen[k] != s[i].row[v])
+				k++;
+			if (k == n)
+				seen[n++] = s[i].row[v];
+		}
+	print_message("%d sites, %u distinct nodes\n", m, n);
+	return n;
+}
+
 /* The tail weight the engine gives an FIR image (engine.h: the recorded
  * radius brought to 0.999 when it is not below), written out again here. */
 static double fir_tail_r(const struct irdm_image *img)
@@ -244,28 +278,41 @@ static void test_two_points(void **state)
  * tried on this cuboid is unstable (radius 1.009-1.021 for 5-50 %
  * damping), so the engine damps its tail by r^s; the reference convolves
  * with the same weighted tail, read back from the image independently of
- * the engine's ring.
+ * the engine's ring.  Then two points on triangles, their nodes summed
+ * several rows a pass (fir_sum.c), against the same reference.
  */
 static void test_fir(void **state)
 {
 	const double top[3] = { 0.05, 0.05, 0.2 };
+	const double pa[3] = { 0.03, 0.043, 0.2 }, pb[3] = { 0.068, 0.058, 0.2 };
 	const size_t N = 900;
-	struct irdm_contact_site s;
-	double *u = calloc(N * 3, sizeof(double));
+	struct irdm_contact_site s, tri[2];
+	double *u = calloc(N * 3, sizeof(double)), *u2 = calloc(N * 6, sizeof(double));
 	char what[64];
 
 	(void)state;
 	for (size_t t = 0; t < N; t++)
 		for (int a = 0; a < 3; a++)
 			u[3 * t + (size_t)a] = t < 500 ? (a == 2 ? -0.01 : 0) : NAN;
+	for (size_t t = 0; t < N; t++)
+		for (int a = 0; a < 6; a++)
+			u2[6 * t + (size_t)a] = t < 500 ? (a == 2 ? -0.01 : a == 5 ? -0.006 : 0) : NAN;
 	for (int k = 0; k < 3; k++) {
 		assert_int_equal(fir[k].meta->representation, IRDM_REPR_FIR);
 		assert_true(fir_tail_r(&fir[k]) < 1.0);        /* the damped path runs */
 		node_site(&fir[k], top, &s);
 		snprintf(what, sizeof(what), "step + release, FIR 200 %s", fir_prec[k]);
 		compare(what, &fir[k], &s, 1, N, u, TOL_FIR);
+		/* six site nodes: the history summed several rows a pass
+		 * (fir_sum.c: a pass of four, then one of two) */
+		point_site(&fir[k], pa, &tri[0]);
+		point_site(&fir[k], pb, &tri[1]);
+		assert_true(distinct_rows(tri, 2) > 4);         /* more than one pass */
+		snprintf(what, sizeof(what), "two triangle points, FIR 200 %s", fir_prec[k]);
+		compare(what, &fir[k], tri, 2, N, u2, TOL_FIR);
 	}
 	free(u);
+	free(u2);
 }
 
 /*

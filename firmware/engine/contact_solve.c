@@ -64,7 +64,7 @@ static void solve_per_vertex(struct irdm_engine *e, struct system *s,
 			if (!isinf(kappa))
 				for (int r = 0; r < 3; r++)
 					a[4 * r] += 1.0 / kappa;
-			tick_free_disp(e, st->col[v], uv);
+			tick_free_disp(e, s, st->col[v], uv);
 			irdm_v3_sub(rhs, p, uv);
 			if (irdm_solve_spd(a, rhs, 3))
 				e->stats.singular_solves++;

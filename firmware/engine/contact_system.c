@@ -10,13 +10,36 @@
 #include "repr.h"
 #include "tick_priv.h"
 
-void tick_free_disp(const struct irdm_engine *e, uint32_t col, double u[3])
+/* The free displacement at a site node: from this tick's memo (filled by
+ * tick_history_terms), summed afresh only for a node it lacks. */
+void tick_free_disp(const struct irdm_engine *e, const struct system *s, uint32_t col,
+		    double u[3])
 {
 	if (col == NO_COL) {
 		irdm_v3_zero(u);
 		return;
 	}
+	for (uint32_t k = 0; k < s->n_free; k++)
+		if (s->free_col[k] == col) {
+			memcpy(u, s->free_u[k], sizeof(s->free_u[k]));
+			return;
+		}
 	repr_free_disp(e, col, u);
+}
+
+/* The distinct weighted site nodes of the active contacts, summed in one
+ * call (one pass over the FIR ring for all of them). */
+static void free_disp_memo(const struct irdm_engine *e, struct system *s)
+{
+	s->n_free = 0;
+	for (int i = 0; i < s->m; i++) {
+		const struct irdm_contact_site *st = &e->c[s->idx[i]].site;
+		for (uint32_t v = 0; v < st->n_nodes; v++) {
+			if (st->col[v] != NO_COL && st->weight[v] != 0)
+				tick_col_slot(s->free_col, &s->n_free, st->col[v]);
+		}
+	}
+	repr_free_disps(e, s->n_free, s->free_col, s->free_u);
 }
 
 /* W_ij = sum_vw a_iv a_jw R0(v <- w) for contacts i (displacement), j (force). */
@@ -46,6 +69,7 @@ static void build_w(struct irdm_engine *e, struct system *s)
 
 void tick_history_terms(struct irdm_engine *e, struct system *s)
 {
+	free_disp_memo(e, s);
 	for (int i = 0; i < s->m; i++) {
 		const struct irdm_contact_site *st = &e->c[s->idx[i]].site;
 		double *u = s->u_body[i];
@@ -54,7 +78,7 @@ void tick_history_terms(struct irdm_engine *e, struct system *s)
 			double uv[3];
 			if (st->weight[v] == 0)
 				continue;
-			tick_free_disp(e, st->col[v], uv);
+			tick_free_disp(e, s, st->col[v], uv);
 			irdm_v3_axpy(u, st->weight[v], uv);
 		}
 	}

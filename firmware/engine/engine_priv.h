@@ -60,6 +60,10 @@ void irdm_modal_free_disp(const struct irdm_engine *e, uint32_t col, double u[3]
 void irdm_modal_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp, double blk[9]);
 void irdm_modal_apply(struct irdm_engine *e, const struct irdm_force_tick *f);
 void irdm_fir_free_disp(const struct irdm_engine *e, uint32_t col, double u[3]);
+/* fir_sum.c: the free displacement at n <= IRDM_MAX_FORCE_NODES columns,
+ * one pass over the ring for all of them. */
+void irdm_fir_free_disps(const struct irdm_engine *e, uint32_t n, const uint32_t *cols,
+			 double (*u)[3]);
 void irdm_fir_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp, double blk[9]);
 void irdm_fir_apply(struct irdm_engine *e, const struct irdm_force_tick *f);
 

@@ -42,6 +42,25 @@ static inline void repr_free_disp(const struct irdm_engine *e, uint32_t col, dou
 #endif
 }
 
+/* The free displacement at n distinct columns: FIR images sum them in one
+ * pass over the ring (fir_sum.c), modal ones column by column. */
+static inline void repr_free_disps(const struct irdm_engine *e, uint32_t n, const uint32_t *cols,
+				   double (*u)[3])
+{
+#if IRDM_CONFIG_MODAL
+	if (repr_is_modal(e)) {
+		for (uint32_t v = 0; v < n; v++)
+			irdm_modal_free_disp(e, cols[v], u[v]);
+		return;
+	}
+#endif
+#if IRDM_CONFIG_FIR
+	irdm_fir_free_disps(e, n, cols, u);
+#else
+	(void)e, (void)n, (void)cols, (void)u;
+#endif
+}
+
 static inline void repr_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp,
 			   double blk[9])
 {

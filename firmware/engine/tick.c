@@ -28,16 +28,12 @@ static void gather_forces(struct irdm_engine *e, const struct system *s, struct 
 	for (int i = 0; i < s->m; i++) {
 		const struct irdm_contact_site *st = &e->c[s->idx[i]].site;
 		for (uint32_t v = 0; v < st->n_nodes; v++) {
-			uint32_t col = st->col[v], k;
+			uint32_t col = st->col[v], n0 = t->n, k;
 			if (col == NO_COL || st->weight[v] == 0)
 				continue;           /* a fixed node takes its share to ground */
-			for (k = 0; k < t->n && t->col[k] != col; k++)
-				;
-			if (k == t->n) {
-				t->col[t->n] = col;
-				memset(t->f_n[t->n], 0, sizeof(t->f_n[t->n]));
-				t->n++;
-			}
+			k = tick_col_slot(t->col, &t->n, col);
+			if (t->n != n0)
+				memset(t->f_n[k], 0, sizeof(t->f_n[k]));
 			irdm_v3_axpy(t->f_n[k], st->weight[v], &s->f_body[3 * i]);
 		}
 	}

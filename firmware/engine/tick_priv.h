@@ -23,14 +23,35 @@ struct system {
 	double f[MAX_SOLVE];
 	double f_body[MAX_SOLVE];
 	double x_now[IRDM_MAX_CONTACTS][3];     /* floating: world position of each point */
+	/* The free displacement of each distinct site node this tick, summed
+	 * once (the history does not change within a tick; a node two
+	 * contacts share is summed once) and read by the history terms and
+	 * the per-vertex solve. */
+	uint32_t n_free;
+	uint32_t free_col[IRDM_MAX_FORCE_NODES];
+	double free_u[IRDM_MAX_FORCE_NODES][3];
 };
+
+/* The index of col among cols[0 .. *n), appended (and *n grown) if missing:
+ * the distinct columns of the contact sites. */
+static inline uint32_t tick_col_slot(uint32_t *cols, uint32_t *n, uint32_t col)
+{
+	uint32_t k = 0;
+
+	while (k < *n && cols[k] != col)
+		k++;
+	if (k == *n)
+		cols[(*n)++] = col;
+	return k;
+}
 
 /* r0_table.c */
 void tick_r0_refresh(struct irdm_engine *e, const unsigned *idx, int m);
 const double *tick_r0_block(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp);
 
 /* contact_system.c */
-void tick_free_disp(const struct irdm_engine *e, uint32_t col, double u[3]);
+void tick_free_disp(const struct irdm_engine *e, const struct system *s, uint32_t col,
+		    double u[3]);
 void tick_history_terms(struct irdm_engine *e, struct system *s);
 void tick_assemble(struct irdm_engine *e, struct system *s);
 void tick_contact_disp(const struct system *s, int i, double u[3]);
