@@ -68,6 +68,7 @@ static void start_fresh(struct irdm_engine *e, struct system *s)
 		if (!c->fresh)
 			continue;
 		memcpy(c->disp_prev_m, s->u_free[i], sizeof(c->disp_prev_m));
+		memcpy(c->port_disp_prev_m, s->u_free[i], sizeof(c->port_disp_prev_m));
 		memcpy(c->target_prev_m, s->u_free[i], sizeof(c->target_prev_m));
 		c->fresh = 0;
 	}

@@ -77,6 +77,8 @@ struct irdm_contact_state {
 	double target_prev_m[3];
 	double disp_prev_m[3];
 	double port_energy_j;           /* passivity observer: work done on the object */
+	double port_disp_prev_m[3];     /* the observer's last displacement: before
+					 * its controller's force, like this tick's */
 	double pc_damping_ns_per_m;     /* passivity controller's damping this tick */
 	uint32_t fresh;                 /* began since the last tick */
 };
