@@ -67,17 +67,20 @@ static int send_off(struct irdm_can_master *m)
 
 void irdm_can_master_lose(struct irdm_can_master *m, int axis, const char *reason)
 {
-	if (!m->faulted) {
-		if (axis < 0)
-			snprintf(m->why, sizeof(m->why), "CAN link: %s", reason);
-		else
-			snprintf(m->why, sizeof(m->why), "drive %d (node %u): %s", axis + 1,
-				 m->cfg.axis[axis].node, reason);
-		m->link_lost = axis < 0;
-	}
+	bool first = !m->faulted;
+
+	/* torque off first, then say why */
 	m->faulted = true;
 	m->enable = false;
 	(void)send_off(m);      /* the link may be the fault: nothing more to do */
+	if (!first)
+		return;
+	if (axis < 0)
+		snprintf(m->why, sizeof(m->why), "CAN link: %s", reason);
+	else
+		snprintf(m->why, sizeof(m->why), "drive %d (node %u): %s", axis + 1,
+			 m->cfg.axis[axis].node, reason);
+	m->link_lost = axis < 0;
 }
 
 /* The configured axis of node, or -1. */
