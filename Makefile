@@ -47,7 +47,7 @@ $(if $(filter y,$(CONFIG_IRDM_MODAL) $(CONFIG_IRDM_FIR)),,\
 endif
 feature = $(if $(CONFIG),$(filter y,$(CONFIG_IRDM_$(1))),y)
 FEATURE_SRC_MODAL    = firmware/engine/engine_modal.c
-FEATURE_SRC_FIR      = firmware/engine/engine_fir.c firmware/engine/fir_sum.c
+FEATURE_SRC_FIR      = firmware/engine/engine_fir.c firmware/engine/fir_sum.c firmware/engine/fir_sum_avx2.c
 FEATURE_SRC_FLOATING = firmware/engine/floating.c $(wildcard firmware/rigid/*.c)
 FEATURE_SRC_DEFORM   = $(wildcard firmware/deform/*.c) firmware/session/session_deform.c
 FEATURE_OFF_SRC := $(foreach f,$(FEATURES),$(if $(call feature,$(f)),,$(FEATURE_SRC_$(f))))

@@ -58,6 +58,9 @@ struct irdm_engine_config {
 	 */
 	double stable_radius;
 	double max_force_n;             /* > 0: a larger force faults the engine (torque off) */
+	/* sum an FIR history with the portable code even on a processor with
+	 * AVX2 and FMA (the two agree to rounding; tests compare them) */
+	bool fir_portable_sum;
 	unsigned publish_every;         /* deformation snapshot every N ticks (0: never) */
 };
 
