@@ -30,7 +30,9 @@ static const char usage[] =
 	"  frames.csv       frame, t_s, file, per contact on, point (m), force on\n"
 	"                   the object (N), and the largest displacement (m)\n"
 	"  forces.csv       every sample's forces, as irdm replay -o writes them\n"
-	"A frame's time is its sample's (the surface after that sample's tick).\n"
+	"A frame after sample t (forces held over [t dt, (t+1) dt)) is the surface\n"
+	"at (t+1) dt, where the contact stands at sample t's displacement; frames\n"
+	"fall on S, 2 S, ... as irdm-fw --frames-every's do.\n"
 	"Pictures: tools/scripts/plot-surface.py DIR/frames.pvd --each PNGDIR and\n"
 	"tools/scripts/plot-forces.py DIR/forces.csv OUT.png.\n";
 

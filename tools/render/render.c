@@ -1,9 +1,12 @@
 /* SPDX-License-Identifier: MIT */
 /*
  * irdm render's run: irdm replay's (replay.c) with a hook that keeps a
- * frame every so many samples.  Frame times are the samples' times, as in
- * the forces CSV: the surface after that sample's tick, when the contact
- * point stands at that sample's commanded displacement.
+ * frame every so many samples.  Times follow the sample convention
+ * (docs/architecture.md): sample t's force acts over [t dt, (t+1) dt) and
+ * its displacement u[t], the commanded one at the contact, is the surface
+ * at (t+1) dt.  So the frame after sample t is at (t+1) dt, as irdm-fw's
+ * frames are (the snapshot after engine tick k is the surface at k dt), and
+ * a frame every n samples falls on n dt, 2 n dt, ..., as --frames-every's.
  */
 #include <errno.h>
 #include <math.h>
@@ -22,6 +25,11 @@ struct render {
 	FILE *pvd, *csv;
 	bool started;
 };
+
+static double frame_time(const struct irdm_replay *r)
+{
+	return (double)(irdm_replay_row(r) + 1) * irdm_replay_session(r)->img->meta->dt_s;
+}
 
 static int io_error(const char *path, int e, char *err, size_t errlen)
 {
@@ -52,7 +60,7 @@ static int first_tick(struct render *rd, struct irdm_replay *r, char *err, size_
 		return IRDM_EINVAL;
 	}
 	rd->sum->every_rows = (size_t)llround(every);
-	if ((rows - 1) / rd->sum->every_rows + 1 > IRDM_RENDER_MAX_FRAMES) {
+	if (rows / rd->sum->every_rows > IRDM_RENDER_MAX_FRAMES) {
 		snprintf(err, errlen, "--every %g: more than %d frames in this run of %zu samples",
 			 rd->o->every_s, IRDM_RENDER_MAX_FRAMES, rows);
 		return IRDM_EINVAL;
@@ -78,7 +86,7 @@ static void csv_row(struct render *rd, struct irdm_replay *r, const char *file, 
 {
 	const struct irdm_engine *eng = irdm_replay_session(r)->eng;
 
-	fprintf(rd->csv, "%zu,%.9g,%s", rd->sum->frames, irdm_replay_time(r), file);
+	fprintf(rd->csv, "%zu,%.9g,%s", rd->sum->frames, frame_time(r), file);
 	for (unsigned i = 0; i < irdm_replay_contacts(r); i++) {
 		const struct irdm_contact_state *c = irdm_engine_contact(eng, i);
 		fprintf(rd->csv, ",%d", c->mode != IRDM_CONTACT_OFF);
@@ -100,20 +108,20 @@ static int frame(struct render *rd, struct irdm_replay *r, char *err, size_t err
 
 	if (!pos) {
 		snprintf(err, errlen, "internal: no deformation snapshot at t = %g s",
-			 irdm_replay_time(r));
+			 frame_time(r));
 		return IRDM_EINVAL;
 	}
 	snprintf(file, sizeof(file), "frame_%05zu.vtu", rd->sum->frames);
 	snprintf(rd->path, sizeof(rd->path), "%s/%s", rd->tmp, file);
-	e = irdm_render_write_vtu(rd->path, r, pos);
+	e = irdm_render_write_vtu(rd->path, r, frame_time(r), pos);
 	if (e)
 		return io_error(rd->path, e, err, errlen);
-	irdm_render_pvd_entry(rd->pvd, irdm_replay_time(r), file);
+	irdm_render_pvd_entry(rd->pvd, frame_time(r), file);
 	umax = max_disp(img, pos);
 	csv_row(rd, r, file, umax);
 	if (umax > rd->sum->max_disp_m) {
 		rd->sum->max_disp_m = umax;
-		rd->sum->max_disp_t_s = irdm_replay_time(r);
+		rd->sum->max_disp_t_s = frame_time(r);
 	}
 	rd->sum->frames++;
 	return IRDM_OK;
@@ -124,7 +132,7 @@ static int on_tick(void *ctx, struct irdm_replay *r, char *err, size_t errlen)
 	struct render *rd = ctx;
 	int ret = rd->started ? IRDM_OK : first_tick(rd, r, err, errlen);
 
-	if (ret || irdm_replay_row(r) % rd->sum->every_rows)
+	if (ret || (irdm_replay_row(r) + 1) % rd->sum->every_rows)
 		return ret;
 	return frame(rd, r, err, errlen);
 }

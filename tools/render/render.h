@@ -42,9 +42,9 @@ int irdm_render_run(const struct irdm_render_opts *o, struct irdm_render_summary
 
 void irdm_render_surface(const struct irdm_image *img, struct irdm_render_surface *s);
 
-/* render_vtu.c: one frame (the replay's current sample) as .vtu at path;
- * the collection's head, one entry, tail.  Return 0 or errno. */
-int irdm_render_write_vtu(const char *path, struct irdm_replay *r, const double *pos_m);
+/* render_vtu.c: one frame (the replay's current sample, at t_s) as .vtu at
+ * path (0 or errno); the collection's head, one entry, tail. */
+int irdm_render_write_vtu(const char *path, struct irdm_replay *r, double t_s, const double *pos_m);
 void irdm_render_pvd_begin(FILE *f);
 void irdm_render_pvd_entry(FILE *f, double t_s, const char *file);
 void irdm_render_pvd_end(FILE *f);

@@ -10,14 +10,14 @@
 
 #include "render/render.h"
 
-static void field_data(FILE *f, struct irdm_replay *r)
+static void field_data(FILE *f, struct irdm_replay *r, double t_s)
 {
 	const struct irdm_engine *eng = irdm_replay_session(r)->eng;
 	unsigned nc = irdm_replay_contacts(r);
 
 	fprintf(f, "    <FieldData>\n"
 		"      <DataArray type=\"Float64\" Name=\"time_s\" NumberOfTuples=\"1\" format=\"ascii\">%.9g</DataArray>\n",
-		irdm_replay_time(r));
+		t_s);
 	fprintf(f, "      <DataArray type=\"Int32\" Name=\"contact\" NumberOfTuples=\"%u\" format=\"ascii\">",
 		nc);
 	for (unsigned i = 0; i < nc; i++)
@@ -84,7 +84,7 @@ static void cells(FILE *f, const struct irdm_image *img)
 	fprintf(f, "        </DataArray>\n      </Cells>\n");
 }
 
-int irdm_render_write_vtu(const char *path, struct irdm_replay *r, const double *pos_m)
+int irdm_render_write_vtu(const char *path, struct irdm_replay *r, double t_s, const double *pos_m)
 {
 	const struct irdm_image *img = irdm_replay_session(r)->img;
 	FILE *f = fopen(path, "w");
@@ -95,7 +95,7 @@ int irdm_render_write_vtu(const char *path, struct irdm_replay *r, const double 
 	fprintf(f, "<?xml version=\"1.0\"?>\n"
 		"<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">\n"
 		"  <UnstructuredGrid>\n");
-	field_data(f, r);
+	field_data(f, r, t_s);
 	fprintf(f, "    <Piece NumberOfPoints=\"%u\" NumberOfCells=\"%u\">\n", img->meta->n_nodes,
 		img->meta->n_tris);
 	point_data(f, img, pos_m);

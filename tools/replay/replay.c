@@ -11,6 +11,7 @@
 #include "irdm/contact.h"
 #include "irdm/deform_worker.h"
 #include "irdm/session.h"
+#include "modal/lapack.h"           /* openblas_set_num_threads */
 #include "replay/replay.h"
 #include "replay/replay_priv.h"
 
@@ -72,11 +73,6 @@ size_t irdm_replay_row(const struct irdm_replay *r)
 size_t irdm_replay_rows(const struct irdm_replay *r)
 {
 	return r->tr.n_rows;
-}
-
-double irdm_replay_time(const struct irdm_replay *r)
-{
-	return r->tr.v[r->row * r->tr.n_cols];
 }
 
 unsigned irdm_replay_contacts(const struct irdm_replay *r)
@@ -264,6 +260,9 @@ static int start(struct irdm_replay *r, char *err, size_t errlen)
 		snprintf(err, errlen, "%s: out of memory for the deformed surface", o->image);
 		return IRDM_ENOMEM;
 	}
+	/* the product irdm-fw's worker computes, summed in the same order:
+	 * its frames and these agree bit for bit */
+	openblas_set_num_threads(IRDM_DEFORM_BLAS_THREADS);
 	ret = irdm_session_deform_open(r->s, err, errlen);
 	if (!ret && o->nodes)
 		ret = parse_nodes(r, o->nodes, err, errlen);

@@ -55,12 +55,11 @@ void irdm_replay_opts_default(struct irdm_replay_opts *o);
 int irdm_replay_run(const struct irdm_replay_opts *o, struct irdm_replay_summary *sum, char *err,
 		    size_t errlen);
 
-/* For on_tick: the session (image, engine), the sample (row, its time t,
- * the rows in all), the contacts the run drives. */
+/* For on_tick: the session (image, engine), the sample (row; the rows in
+ * all), the contacts the run drives. */
 const struct irdm_session *irdm_replay_session(const struct irdm_replay *r);
 size_t irdm_replay_row(const struct irdm_replay *r);
 size_t irdm_replay_rows(const struct irdm_replay *r);
-double irdm_replay_time(const struct irdm_replay *r);
 unsigned irdm_replay_contacts(const struct irdm_replay *r);
 /* Every image node's world position after this sample's tick (3 n_nodes),
  * computed once per sample; NULL without the deformation channel. */
