@@ -13,7 +13,8 @@
 
 static const char usage[] =
 	"usage: irdm render --image IMAGE --contact NODE|x,y,z [--contact ...]\n"
-	"                   --displacement TRAJ.csv -o DIR [--every S] [--push] ...\n"
+	"                   --displacement TRAJ.csv -o DIR [--every S] [--nodes N,...|all]\n"
+	"                   [--push] ...\n"
 	"       irdm render --image IMAGE --sites SITES.csv --displacement TRAJ.csv -o DIR ...\n"
 	"       irdm render --image IMAGE --log RUN.log --board BOARD -o DIR [--every S]\n"
 	"\n"
@@ -29,7 +30,8 @@ static const char usage[] =
 	"  frames.pvd       the frames with their times (open it in ParaView)\n"
 	"  frames.csv       frame, t_s, file, per contact on, point (m), force on\n"
 	"                   the object (N), and the largest displacement (m)\n"
-	"  forces.csv       every sample's forces, as irdm replay -o writes them\n"
+	"  forces.csv       every sample's forces, as irdm replay -o writes them, and\n"
+	"                   the displacement of the --nodes (mesh nodes) every sample\n"
 	"A frame after sample t (forces held over [t dt, (t+1) dt)) is the surface\n"
 	"at (t+1) dt, where the contact stands at sample t's displacement; frames\n"
 	"fall on S, 2 S, ... as irdm-fw --frames-every's do.\n"
@@ -53,14 +55,14 @@ static int render_option(struct irdm_render_opts *o, int argc, char **argv, int 
 {
 	const char *a = argv[*i];
 
-	if (strcmp(a, "-o") && strcmp(a, "--every"))
+	if (strcmp(a, "-o") && strcmp(a, "--every") && strcmp(a, "--nodes"))
 		return 0;
 	if (*i + 1 >= argc) {
 		fprintf(stderr, "irdm render: %s needs a value\n", a);
 		return -1;
 	}
-	if (!strcmp(a, "-o")) {
-		o->out_dir = argv[++*i];
+	if (strcmp(a, "--every")) {
+		*(!strcmp(a, "-o") ? &o->out_dir : &o->in.nodes) = argv[++*i];
 		return 1;
 	}
 	return parse_every(argv[++*i], &o->every_s) ? -1 : 1;

@@ -169,7 +169,6 @@ static int run_into_tmp(struct render *rd, char *err, size_t errlen)
 	irdm_render_pvd_begin(rd->pvd);
 	snprintf(rd->forces, sizeof(rd->forces), "%s/forces.csv", rd->tmp);
 	in.out = rd->forces;
-	in.nodes = NULL;
 	in.deform = true;
 	in.on_tick = on_tick;
 	in.ctx = rd;

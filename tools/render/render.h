@@ -18,7 +18,7 @@
 #define IRDM_RENDER_MAX_FRAMES 5000
 
 struct irdm_render_opts {
-	struct irdm_replay_opts in;     /* the inputs as irdm replay's (its out, nodes unused) */
+	struct irdm_replay_opts in;     /* the inputs as irdm replay's (its out unused) */
 	const char *out_dir;
 	double every_s;                 /* a frame every every_s, rounded to samples (> 0) */
 };
