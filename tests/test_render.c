@@ -521,7 +521,7 @@ static void test_pictures(void **state)
 	write_step(traj);
 	if (run_irdm((const char *const[]){ "render", "--image", image, "--contact", "212",
 					    "--displacement", traj, "-o", outdir, "--every", "1",
-					    NULL }))
+					    "--nodes", "212", NULL }))
 		fail_msg("irdm render: %s", err_text);
 	/* frames at 1..6 s: every other one, 1, 3, 5 s */
 	if (rp_run(dir, "/usr/bin/python3", (const char *const[]){ "tools/scripts/plot-surface.py",
@@ -539,7 +539,8 @@ static void test_pictures(void **state)
 		else
 			check_png(png, 400, 400, 30000);
 	}
-	check_png(fpng, 600, 500, 30000);
+	/* three panels: the --nodes displacement below the forces */
+	check_png(fpng, 600, 900, 30000);
 }
 
 /* ---- an irdm-fw run, rendered from its log ---- */
