@@ -102,7 +102,7 @@ TESTS    := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 TICK_TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TICK_TEST_SRC))
 BENCHES  := $(patsubst tests/bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC))
 
-.PHONY: all test san fuzz bench bench-precompute run jitter check deps clean docs cfg-fws sizes hil
+.PHONY: all test san fuzz bench bench-precompute run render jitter check deps clean docs cfg-fws sizes hil
 .SECONDARY:
 all: $(if $(CONFIG),,$(IRDM)) $(FW_LIB) $(HAL_LIB) $(SIM_LIB) $(if $(FWMAIN_SRC),$(IRDM_FW)) \
   $(if $(CDMAIN_SRC),$(IRDM_CD))
@@ -245,6 +245,12 @@ check: deps
 run: deps
 	$(MAKE) $(IRDM) $(IRDM_FW)
 	tools/scripts/run-default-scene.sh $(IRDM) $(IRDM_FW)
+
+# The default scene's deformed surface as VTK frames, PNGs and force plots
+# (irdm render; out/render-*; after make run it also renders that run's log)
+render: deps
+	$(MAKE) $(IRDM)
+	tools/scripts/render-default-scene.sh $(IRDM)
 
 # irdm-fw's wake-up latency beside cyclictest's (JITTER_SECONDS each, default 60)
 JITTER_IMAGE := $(BUILD)/data/jitter.img
