@@ -99,40 +99,6 @@ void stab_poison(const struct stab_case *c, unsigned long t, double dt_s,
 
 /* ---- the static force an independent sum of the responses predicts ---- */
 
-/* Solve the n x n system a x = b in place (Gauss, partial pivoting);
- * -1 if a pivot vanishes. */
-static int small_solve(double *a, double *b, int n)
-{
-	for (int k = 0; k < n; k++) {
-		int p = k;
-		for (int i = k + 1; i < n; i++)
-			if (fabs(a[i * n + k]) > fabs(a[p * n + k]))
-				p = i;
-		if (fabs(a[p * n + k]) < 1e-300)
-			return -1;
-		for (int j = 0; j < n; j++) {
-			double t = a[k * n + j];
-			a[k * n + j] = a[p * n + j];
-			a[p * n + j] = t;
-		}
-		double t = b[k];
-		b[k] = b[p];
-		b[p] = t;
-		for (int i = k + 1; i < n; i++) {
-			double f = a[i * n + k] / a[k * n + k];
-			for (int j = k; j < n; j++)
-				a[i * n + j] -= f * a[k * n + j];
-			b[i] -= f * b[k];
-		}
-	}
-	for (int i = n - 1; i >= 0; i--) {
-		for (int j = i + 1; j < n; j++)
-			b[i] -= a[i * n + j] * b[j];
-		b[i] /= a[i * n + i];
-	}
-	return 0;
-}
-
 /*
  * Static compliance between node sites: sum over s of R[s] (weighted by
  * the engine's FIR tail r^s, restated from docs/architecture.md: r =
@@ -190,7 +156,7 @@ static double static_force(const struct irdm_image *img, const struct irdm_conta
 		}
 	for (int i = 0; i < n; i++)
 		f[i] = k > 0 ? k * target[i] : target[i];
-	if (small_solve(a, f, n))
+	if (efx_dense_solve(a, f, n))
 		return NAN;
 
 	for (int i = 0; i < m; i++)
