@@ -179,7 +179,7 @@ void irdm_engine_contact_end(struct irdm_engine *eng, unsigned i);
  * contact forces, advances the history, optionally publishes a snapshot.
  *
  * Return: IRDM_OK;
- * IRDM_EFAULT if a target is not finite, a force is not finite or over
+ * IRDM_EFAULT if a target is not finite or beyond IRDM_MAX_TARGET_M, a force is not finite or over
  * max_force_n, or a floating object's rigid step failed, or the engine had
  * already faulted: it then holds zero force until irdm_engine_reset().
  */
