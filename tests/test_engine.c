@@ -329,8 +329,7 @@ static void test_fir_sum_paths(void **state)
 	const double top[3] = { 0.05, 0.05, 0.2 };
 	const double pa[3] = { 0.03, 0.043, 0.2 }, pb[3] = { 0.068, 0.058, 0.2 };
 	const size_t N = 700;
-	bool wide = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") &&
-		    __builtin_cpu_supports("f16c");
+	bool wide;
 	double *u = calloc(N * 6, sizeof(double));
 	double *F[2] = { malloc(N * 6 * sizeof(double)), malloc(N * 6 * sizeof(double)) };
 	double *R = malloc(N * 6 * sizeof(double));
@@ -338,7 +337,16 @@ static void test_fir_sum_paths(void **state)
 	struct irdm_engine_config cfg;
 
 	(void)state;
-	print_message("this processor %s AVX2 + FMA + F16C\n", wide ? "has" : "lacks");
+	irdm_engine_config_default(&cfg);
+	struct irdm_session *ses = efx_session(&fir[0], &cfg);
+	wide = !strcmp(irdm_engine_fir_sum_name(ses->eng), "avx2");
+	print_message("FIR history sum by default on this processor: %s\n",
+		      irdm_engine_fir_sum_name(ses->eng));
+	irdm_session_close(ses);
+	cfg.fir_portable_sum = true;
+	ses = efx_session(&fir[0], &cfg);
+	assert_string_equal(irdm_engine_fir_sum_name(ses->eng), "portable");
+	irdm_session_close(ses);
 	for (size_t t = 0; t < N; t++)
 		for (int a = 0; a < 6; a++)
 			u[6 * t + (size_t)a] = t < 400 ? (a == 2 ? -0.01 : a == 5 ? -0.006 : 0) : NAN;

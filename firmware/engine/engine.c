@@ -334,6 +334,11 @@ const struct irdm_contact_state *irdm_engine_contact(const struct irdm_engine *e
 	return i < IRDM_MAX_CONTACTS ? &e->c[i] : NULL;
 }
 
+const char *irdm_engine_fir_sum_name(const struct irdm_engine *e)
+{
+	return !e->T ? "none" : e->fir_wide ? "avx2" : "portable";
+}
+
 const struct irdm_engine_stats *irdm_engine_stats(const struct irdm_engine *e)
 {
 	return &e->stats;

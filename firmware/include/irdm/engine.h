@@ -189,6 +189,11 @@ int irdm_engine_tick(struct irdm_engine *eng, const struct irdm_contact_cmd *cmd
 const struct irdm_contact_state *irdm_engine_contact(const struct irdm_engine *eng, unsigned i);
 const struct irdm_engine_stats *irdm_engine_stats(const struct irdm_engine *eng);
 
+/* Which FIR history sum the engine runs: "avx2" (fir_sum_avx2.c, chosen at
+ * init where the processor has AVX2, FMA and F16C), "portable", or "none"
+ * (not an FIR image). */
+const char *irdm_engine_fir_sum_name(const struct irdm_engine *eng);
+
 /*
  * Points between the world frame and the object's own frame (the frame of
  * the image's rest nodes, which node displacements and sites use).  A
