@@ -178,8 +178,8 @@ static unsigned distinct_rows(const struct irdm_contact_site *s, int m)
 	return n;
 }
 
-/* The tail weight the engine gives an FIR image (engine.h: the recorded
- * radius brought to 0.999 when it is not below), written out again here. */
+/* The tail weight the engine gives an FIR image (engine.h: an image whose
+ * largest recorded radius is >= 1 brought to 0.999), written out again here. */
 static double fir_tail_r(const struct irdm_image *img)
 {
 	double rho = img->meta->max_spectral_radius;

@@ -52,9 +52,13 @@ struct irdm_engine_config {
 	/* Hannaford-Ryu passivity observer/controller at each contact port. */
 	bool passivity_control;
 	/*
-	 * Unstable recursions are never run unprotected: an image column whose
-	 * recorded spectral radius is >= 1 gets its FIR tail damped by r^s so
-	 * that the radius becomes <= stable_radius (<1).  0 = 0.999.
+	 * Unstable recursions are never run unprotected: an FIR image whose
+	 * largest recorded spectral radius (meta max_spectral_radius) is >= 1
+	 * gets the tail of every column damped by w[s] = r^s, r =
+	 * stable_radius / that radius, so that its radius becomes <=
+	 * stable_radius (<1).  This distorts the response from the first
+	 * sample; an image made with fir_tail = window:L is stable as stored
+	 * and runs undamped.  0 = 0.999.
 	 */
 	double stable_radius;
 	double max_force_n;             /* > 0: a larger force faults the engine (torque off) */
