@@ -20,5 +20,6 @@ int irdm_cmd_image(int argc, char **argv);
 int irdm_cmd_image_config(int argc, char **argv);
 int irdm_cmd_replay(int argc, char **argv);
 int irdm_cmd_log(int argc, char **argv);
+int irdm_cmd_report(int argc, char **argv);
 
 #endif
