@@ -36,6 +36,7 @@ struct row {
 	int cert_stable, bounded;
 	double growth;
 	size_t ticks;
+	int paper;
 };
 
 static struct row rows[8];
@@ -49,7 +50,7 @@ static const char *irdm_path(void)
 }
 
 /* config,repr,dt_ms,scenario,force_err,first10,after100,disp_err,median,p99,
- * bytes,radius,cert_stable,run_bounded,raw_growth,ticks,keys */
+ * bytes,radius,cert_stable,run_bounded,raw_growth,ticks,paper,keys */
 static void read_csv(const char *path)
 {
 	char text[8192], *save = NULL;
@@ -64,10 +65,10 @@ static void read_csv(const char *path)
 		if (!line)
 			continue;
 		assert_true(n_rows < 8);
-		assert_int_equal(sscanf(l, "tiny,%47[^,],%lf,%31[^,],%lf,%lf,%lf,%lf,%lf,%lf,%zu,%lf,%d,%d,%lf,%zu,",
+		assert_int_equal(sscanf(l, "tiny,%47[^,],%lf,%31[^,],%lf,%lf,%lf,%lf,%lf,%lf,%zu,%lf,%d,%d,%lf,%zu,%d,",
 					r->repr, &dt, scen, &r->force_err, &r->first10, &r->after100,
 					&r->disp_err, &r->median_us, &r->p99_us, &r->bytes, &r->radius,
-					&r->cert_stable, &r->bounded, &r->growth, &r->ticks), 15);
+					&r->cert_stable, &r->bounded, &r->growth, &r->ticks, &r->paper), 16);
 		assert_float_equal(dt, 2.0, 0);
 		assert_string_equal(scen, "step");
 		n_rows++;
@@ -143,6 +144,7 @@ static void test_truncated_fir_unstable(void **state)
 	(void)state;
 	printf("fir:100: radius %.6f, raw growth %.3e (rate %.6f per tick, log radius %.6f), force error %.3g\n",
 	       r->radius, r->growth, rate, log(r->radius), r->force_err);
+	assert_int_equal(r->paper, 1);
 	assert_int_equal(r->cert_stable, 0);
 	assert_true(r->radius > 1.01);
 	assert_true(isfinite(r->growth) && r->growth > 1e50);

@@ -129,8 +129,8 @@ static void header(FILE *f, const double load[3], const double load_end[3], doub
 		"move when a contact slides), each tick timed, pinned to the last CPU, after a\n"
 		"first untimed run of the same scenario; median and p99 of the run, worst\n"
 		"scenario.  Stable: every column's recorded spectral radius below 1 (the\n"
-		"image's certificate) and the run bounded (no fault, |F| <= 10 x the\n"
-		"reference's peak).  Raw FIR growth: the recorded FIR recursion run without the\n"
+		"image's certificate) and the run bounded (no fault, finite, the last\n"
+		"tenth's largest force at most 10 x that of ticks 40-60 %%).  Raw FIR growth: the recorded FIR recursion run without the\n"
 		"tail damping on the step for %.0f s (our own convolution), max |F| of its last\n"
 		"second over the exact held force; about 1 if it is stable.  Bytes: the image\n"
 		"file.  The paper's setting is in bold.\n\n",

@@ -48,6 +48,7 @@ struct irdm_report_config {
 	/* the paper's setting, marked in tables and plots: a repr name and dt */
 	const char *paper_repr;
 	double paper_dt_s;
+	double check_s;         /* the reference check's length (report_check.h) */
 };
 
 /* The shipped configurations by name ("sweep", "paper", "tiny"), or NULL. */
@@ -68,12 +69,13 @@ struct irdm_report_row {
 	size_t image_bytes;
 	double spectral_radius;         /* largest recorded radius of the columns used */
 	bool cert_stable;               /* every column used certified stable */
-	bool run_bounded;               /* finite, no fault, |F| <= 10 max |Fref| */
+	bool run_bounded;               /* finite, no fault, not growing (report.c) */
 	/* FIR: the recorded recursion run without the engine's tail damping
 	 * (the step node, RAW_SECONDS): max |F| of its last second over the
 	 * reference's; NAN for modal images */
 	double raw_growth;
 	size_t ticks;
+	bool paper;                     /* the configuration's paper setting */
 };
 
 #define IRDM_REPORT_DISP_EVERY 10
@@ -92,7 +94,8 @@ struct irdm_report_opts {
 };
 
 /* The reference checked against a second, independent method: the
- * time-domain (Newmark) responses of the step node (report_check.c). */
+ * time-domain (Newmark) responses of the step node over the step's first
+ * second (report_check.c). */
 struct irdm_report_check {
 	double dt_s;
 	unsigned substeps;

@@ -24,7 +24,7 @@ const struct irdm_report_scenario irdm_report_release = {
 /* Fig. 6b: one point held, a second pushed beside it. */
 const struct irdm_report_scenario irdm_report_two_points = {
 	.name = "two-points",
-	.what = "top centre held 5 mm down; a node 2.5 cm away diagonally pushed to 1 cm over 0.5 s, both held to 2 s",
+	.what = "top centre node held 5 mm down; the node one cell away diagonally (2.5 cm on the 4x4x8 mesh) pushed to 1 cm over 0.5 s from 0.2 s, both held to 2 s",
 	.duration_s = 2.0, .n_contacts = 2,
 	.path = { { .on_node = true, .on_s = 0, .off_s = 1e9, .depth_m = 0.005 },
 		  { .on_node = true, .from_m = { 0.025, 0.025 }, .on_s = 0.2, .off_s = 1e9,
@@ -34,9 +34,9 @@ const struct irdm_report_scenario irdm_report_two_points = {
 /* Fig. 6c: a point pressed and stroked across the top's triangles. */
 const struct irdm_report_scenario irdm_report_stroke = {
 	.name = "stroke",
-	.what = "a point pressed 5 mm over 0.1 s, stroked 4 cm across the top's triangles in 1 s, held to 2 s",
+	.what = "a point pressed 5 mm over 0.1 s, stroked 2.1 cm across the top's triangles (beside the centre) in 1 s, held to 2 s",
 	.duration_s = 2.0, .n_contacts = 1,
-	.path = { { .on_node = false, .from_m = { -0.02, -0.004 }, .to_m = { 0.02, 0.004 },
+	.path = { { .on_node = false, .from_m = { 0.002, 0.011 }, .to_m = { 0.023, 0.014 },
 		    .slide_begin_s = 0.2, .slide_end_s = 1.2, .on_s = 0, .off_s = 1e9,
 		    .depth_m = 0.005, .ramp_s = 0.1 } },
 };

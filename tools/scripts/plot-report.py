@@ -3,7 +3,7 @@
 relative RMS force error over the scenarios against its tick time (median,
 worst scenario) and against its image bytes; the stable ones' Pareto front
 drawn, the unstable ones as crosses, the paper's setting starred.
-usage: plot-report.py REPORT-NAME.csv OUT-PREFIX [PAPER_REPR PAPER_DT_MS]
+usage: plot-report.py REPORT-NAME.csv OUT-PREFIX
 writes OUT-PREFIX-tick.png and OUT-PREFIX-bytes.png"""
 import csv
 import sys
@@ -15,7 +15,7 @@ import matplotlib.pyplot as plt
 
 def load(path):
     """One entry per (repr, dt): worst force error, worst tick median, bytes, stable."""
-    reps = {}
+    reps, paper = {}, None
     with open(path) as f:
         for r in csv.DictReader(f):
             key = (r["repr"], float(r["dt_ms"]))
@@ -24,7 +24,9 @@ def load(path):
             e["err"] = max(e["err"], float(r["force_err"]))
             e["tick"] = max(e["tick"], float(r["tick_median_us"]))
             e["stable"] &= r["cert_stable"] == "1" and r["run_bounded"] == "1"
-    return reps
+            if r["paper"] == "1":
+                paper = key
+    return reps, paper
 
 
 def pareto(points):
@@ -76,12 +78,11 @@ def plot(reps, xkey, xlabel, out, paper):
 
 
 def main():
-    if len(sys.argv) not in (3, 5):
+    if len(sys.argv) != 3:
         sys.exit(__doc__)
-    reps = load(sys.argv[1])
+    reps, paper = load(sys.argv[1])
     if not reps:
         sys.exit("plot-report.py: %s: no rows" % sys.argv[1])
-    paper = (sys.argv[3], float(sys.argv[4])) if len(sys.argv) == 5 else None
     plot(reps, "tick", "force tick, median (us, worst scenario)", sys.argv[2] + "-tick.png", paper)
     plot(reps, "bytes", "image bytes", sys.argv[2] + "-bytes.png", paper)
 
