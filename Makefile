@@ -230,11 +230,15 @@ bench: $(BENCHES) $(IRDM) bench-precompute
 # Accuracy, tick time and image size of every representation against the
 # exact full model (irdm report --help); CSVs in out/report/, the report
 # and its Pareto plots in docs/ (committed).
+# The paper's cuboid at full resolution (its all-mode reference takes the
+# 9504-mode eigensolve, minutes): make report REPORT_CONFIGS=paper
+# REPORT_MD=docs/report-paper.md
 REPORT_CONFIGS ?= sweep
+REPORT_MD ?= docs/report.md
 report: $(IRDM)
 	@mkdir -p out/report docs/report
 	$(IRDM) report $(foreach c,$(REPORT_CONFIGS),--config $(c)) -o out/report \
-	  --md docs/report.md --plots report/report
+	  --md $(REPORT_MD) --plots report/report
 	for c in $(REPORT_CONFIGS); do \
 	  /usr/bin/python3 tools/scripts/plot-report.py out/report/report-$$c.csv docs/report/report-$$c; \
 	done

@@ -10,7 +10,11 @@
  *     recursion the report runs for 20 s grows like radius^ticks: the
  *     growth's per-tick rate matches the certificate's radius (to 2.5e-4
  *     in log, measured);
- *   - every row's bytes are its image file's size.
+ *   - every row's bytes are its image file's size;
+ *   - the force errors of the truncated representations, recomputed here
+ *     from the kept images with the engine tests' own brute-force
+ *     reference (tests/support/engine_fixture.c) and their own engine
+ *     loop, agree with the report's to 1e-6.
  */
 #include <math.h>
 #include <setjmp.h>
@@ -23,6 +27,9 @@
 
 #include <cmocka.h>
 
+#include "irdm/image.h"
+#include "irdm/session.h"
+#include "support/engine_fixture.h"
 #include "support/run_prog.h"
 #include "support/test_files.h"
 
@@ -184,6 +191,83 @@ static void test_bytes_are_file_sizes(void **state)
 	}
 }
 
+/* The step (1 cm down at the top centre, held) on image path, in the
+ * engine; F: N x 3. */
+static void engine_step(const char *path, const struct irdm_contact_site *site, size_t N,
+			double *F)
+{
+	struct irdm_image img;
+	struct irdm_engine_config cfg;
+	struct irdm_session *ses;
+	struct irdm_contact_cmd cmd = { .mode = IRDM_CONTACT_GRAB, .target_m = { 0, 0, -0.01 } };
+	char err[512];
+
+	assert_int_equal(irdm_image_map(path, 0, &img, err, sizeof(err)), 0);
+	irdm_engine_config_default(&cfg);
+	cfg.max_contacts = 1;
+	ses = efx_session(&img, &cfg);
+	assert_int_equal(irdm_engine_contact_begin(ses->eng, 0, site, IRDM_CONTACT_GRAB), 0);
+	for (size_t t = 0; t < N; t++) {
+		assert_int_equal(irdm_engine_tick(ses->eng, &cmd), 0);
+		memcpy(&F[3 * t], irdm_engine_contact(ses->eng, 0)->force_n, 3 * sizeof(double));
+	}
+	irdm_session_close(ses);
+	irdm_image_unmap(&img);
+}
+
+/* The report's error figures against the same figures computed here. */
+static void test_errors_recomputed(void **state)
+{
+	static const char *const reprs[][2] = {
+		{ "modal:20+sc", "tiny-modal_20+sc-2ms.img" },
+		{ "fir:100", "tiny-fir_100-2ms.img" },
+	};
+	const size_t N = 1500;
+	const double top[3] = { 0.05, 0.05, 0.2 };
+	double *F = malloc(N * 3 * sizeof(double)), *Fref = malloc(N * 3 * sizeof(double));
+	double *target = malloc(N * 3 * sizeof(double));
+	struct irdm_image ref;
+	struct irdm_contact_site site;
+	struct irdm_engine_config cfg;
+	struct irdm_session *ses;
+	char path[512], err[512];
+
+	(void)state;
+	assert_non_null(F);
+	assert_non_null(Fref);
+	assert_non_null(target);
+	for (size_t t = 0; t < N; t++) {
+		target[3 * t] = target[3 * t + 1] = 0;
+		target[3 * t + 2] = -0.01;
+	}
+	snprintf(path, sizeof(path), "%s/tmp/tiny-reference-2ms.img", dir);
+	assert_int_equal(irdm_image_map(path, 0, &ref, err, sizeof(err)), 0);
+	irdm_engine_config_default(&cfg);
+	ses = efx_session(&ref, &cfg);
+	assert_int_equal(irdm_engine_site_node(ses->eng, efx_column_row_near(&ref, top), &site), 0);
+	irdm_session_close(ses);
+	efx_reference(&ref, &site, 1, N, target, Fref);
+	for (size_t i = 0; i < sizeof(reprs) / sizeof(reprs[0]); i++) {
+		const struct row *r = row_of(reprs[i][0]);
+		double whole, first, after;
+
+		snprintf(path, sizeof(path), "%s/tmp/%s", dir, reprs[i][1]);
+		engine_step(path, &site, N, F);
+		whole = efx_rel_rms(F, Fref, 3 * N);
+		first = efx_rel_rms(F, Fref, 30);
+		after = efx_rel_rms(F + 300, Fref + 300, 3 * (N - 100));
+		printf("%s: force error %.6e (report %.6e), first 10 %.6e (%.6e), from 100 %.6e (%.6e)\n",
+		       reprs[i][0], whole, r->force_err, first, r->first10, after, r->after100);
+		assert_true(fabs(whole / r->force_err - 1) < 1e-6);
+		assert_true(fabs(first / r->first10 - 1) < 1e-6);
+		assert_true(fabs(after / r->after100 - 1) < 1e-6);
+	}
+	irdm_image_unmap(&ref);
+	free(F);
+	free(Fref);
+	free(target);
+}
+
 /* The Markdown names the paper's setting of this configuration unstable. */
 static void test_markdown(void **state)
 {
@@ -215,6 +299,7 @@ int main(void)
 		cmocka_unit_test(test_truncated_fir_unstable),
 		cmocka_unit_test(test_truncated_modal),
 		cmocka_unit_test(test_bytes_are_file_sizes),
+		cmocka_unit_test(test_errors_recomputed),
 		cmocka_unit_test(test_markdown),
 		cmocka_unit_test(test_bad_config),
 	};
