@@ -291,6 +291,16 @@ static void test_bad_config(void **state)
 	assert_non_null(strstr(err, "--config nope: not one of sweep, paper, tiny"));
 }
 
+static void test_bad_repr(void **state)
+{
+	const char *args[] = { "report", "--config", "tiny", "--repr", "fir:7", "-o", dir, NULL };
+	char err[1024];
+
+	(void)state;
+	assert_int_equal(rp_run(dir, irdm_path(), args, NULL, 0, err, sizeof(err)), 2);
+	assert_non_null(strstr(err, "--repr fir:7: not a representation of configuration tiny"));
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -302,6 +312,7 @@ int main(void)
 		cmocka_unit_test(test_errors_recomputed),
 		cmocka_unit_test(test_markdown),
 		cmocka_unit_test(test_bad_config),
+		cmocka_unit_test(test_bad_repr),
 	};
 
 	return cmocka_run_group_tests(tests, setup, teardown);

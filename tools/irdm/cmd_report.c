@@ -81,6 +81,14 @@ static int parse(struct report_args *a, int argc, char **argv)
 	return 0;
 }
 
+static int has_repr(const struct irdm_report_config *cfg, const char *name)
+{
+	for (size_t i = 0; i < cfg->n_reprs; i++)
+		if (!strcmp(cfg->reprs[i].name, name))
+			return 1;
+	return 0;
+}
+
 static void csv_row(void *ctx, const struct irdm_report_row *r)
 {
 	irdm_report_csv_row(ctx, r);
@@ -200,6 +208,12 @@ int irdm_cmd_report(int argc, char **argv)
 		return rc;
 	if (!a.n_cfg)
 		a.cfg[a.n_cfg++] = irdm_report_config_find("sweep");
+	for (size_t i = 0; a.repr && i < a.n_cfg; i++)
+		if (!has_repr(a.cfg[i], a.repr)) {
+			fprintf(stderr, "irdm report: --repr %s: not a representation of configuration %s\n",
+				a.repr, a.cfg[i]->name);
+			return 2;
+		}
 	snprintf(md, sizeof(md), "%s/report.md", a.dir);
 	snprintf(tmp, sizeof(tmp), "%s/tmp", a.dir);
 	if (!a.md)
