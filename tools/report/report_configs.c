@@ -64,10 +64,12 @@ static const struct irdm_report_model paper_model = {
 		"touch=box:0.0445,0.0445,0.1999,0.0555,0.0555,0.2001 display=touch",
 };
 
+/* The default scene's 300 of 9504 modes, with and without the static
+ * correction.  (1000 modes: a Lanczos run of many minutes on this shared
+ * machine, beyond the report's budget; add the hybrid FIR head + modal
+ * tail here when its scene keys exist.) */
 static const struct irdm_report_repr paper_reprs[] = {
-	/* the default scene's: 300 of 9504 modes */
 	MODAL(300),
-	{ "modal:1000+sc", "representation=modal:1000 static_correction=yes precision=f32" },
 };
 
 static const struct irdm_report_scenario *const paper_scenarios[] = {
