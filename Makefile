@@ -235,7 +235,7 @@ stability: $(BUILD)/tests/test_stability_cases $(BUILD)/tests/test_stability_soa
 	IRDM_STAB_OUT=$(STAB_OUT) $(BUILD)/tests/test_stability_cases
 	IRDM_STAB_OUT=$(STAB_OUT) $(BUILD)/tests/test_stability_spin
 	IRDM_STAB_OUT=$(STAB_OUT) IRDM_SOAK_SECONDS=$(STAB_SOAK_SECONDS) $(BUILD)/tests/test_stability_soak
-	python3 tools/scripts/stability-report.py $(STAB_OUT)
+	/usr/bin/python3 tools/scripts/stability-report.py $(STAB_OUT)
 
 bench: $(BENCHES) $(IRDM) bench-precompute
 	for b in $(BENCHES); do echo "== $$b"; IRDM=$(IRDM) $$b; done
