@@ -66,59 +66,110 @@ static void elastic_load(const struct irdm_fem *fem, const struct irdm_modes *m,
 	free(mt);
 }
 
-int irdm_compliance_solve(const struct irdm_fem *fem, const struct irdm_modes *m,
-			  bool floating, const int64_t *in, size_t n_in, double *X,
-			  char *err, size_t errlen)
-{
-	size_t n = fem->K.n;
-	double eps = floating ? 1e-2 * m->omega2[0] : 0.0;
+/* A factor of K (+ eps M) kept for batches of compliance columns. */
+struct irdm_compliance {
+	const struct irdm_fem *fem;
+	const struct irdm_modes *m;
+	bool floating;
+	double eps;
 	cholmod_common cc;
-	cholmod_factor *f = NULL;
-	cholmod_dense *rhs = NULL, *sol = NULL;
-	double *tmp = malloc(n * sizeof(double)), *load = NULL;
+	cholmod_factor *f;
+	double *tmp;
+};
+
+int irdm_compliance_open(const struct irdm_fem *fem, const struct irdm_modes *m,
+			 bool floating, struct irdm_compliance **out, char *err, size_t errlen)
+{
+	struct irdm_compliance *c = calloc(1, sizeof(*c));
 	int ret;
 
-	cholmod_l_start(&cc);
-	cc.print = 0;
-	rhs = cholmod_l_allocate_dense(n, n_in, n, CHOLMOD_REAL, &cc);
-	load = malloc(n * n_in * sizeof(double));
-	if (!rhs || !tmp || !load) {
+	*out = NULL;
+	if (!c || !(c->tmp = malloc(fem->K.n * sizeof(double)))) {
+		free(c);
+		snprintf(err, errlen, "static compliance: out of memory");
+		return IRDM_ENOMEM;
+	}
+	c->fem = fem;
+	c->m = m;
+	c->floating = floating;
+	c->eps = floating ? 1e-2 * m->omega2[0] : 0.0;
+	cholmod_l_start(&c->cc);
+	c->cc.print = 0;
+	ret = irdm_fem_factor(fem, 1.0, c->eps, "static compliance", &c->cc, &c->f, err, errlen);
+	if (ret) {
+		irdm_compliance_close(c);
+		return ret;
+	}
+	*out = c;
+	return IRDM_OK;
+}
+
+void irdm_compliance_close(struct irdm_compliance *c)
+{
+	if (!c)
+		return;
+	cholmod_l_free_factor(&c->f, &c->cc);
+	cholmod_l_finish(&c->cc);
+	free(c->tmp);
+	free(c);
+}
+
+int irdm_compliance_columns(struct irdm_compliance *c, const int64_t *in, size_t n_in,
+			    double *X, char *err, size_t errlen)
+{
+	const struct irdm_fem *fem = c->fem;
+	size_t n = fem->K.n;
+	cholmod_dense *rhs, *sol = NULL;
+	double *load = malloc(n * n_in * sizeof(double)), *tmp = c->tmp;
+	int ret;
+
+	rhs = cholmod_l_allocate_dense(n, n_in, n, CHOLMOD_REAL, &c->cc);
+	if (!rhs || !load) {
 		snprintf(err, errlen, "static compliance: out of memory");
 		ret = IRDM_ENOMEM;
 		goto out_free;
 	}
-	ret = irdm_fem_factor(fem, 1.0, eps, "static compliance", &cc, &f, err, errlen);
-	if (ret)
-		goto out_free;
-	for (size_t c = 0; c < n_in; c++)
-		elastic_load(fem, m, in[c], &load[c * n], tmp);
+	for (size_t k = 0; k < n_in; k++)
+		elastic_load(fem, c->m, in[k], &load[k * n], tmp);
 	memset(X, 0, n * n_in * sizeof(double));
-	for (int step = 0; step < (floating ? REFINE_STEPS : 1); step++) {
+	for (int step = 0; step < (c->floating ? REFINE_STEPS : 1); step++) {
 		double *b = rhs->x;
-		for (size_t c = 0; c < n_in; c++) {
-			irdm_csc_matvec(&fem->M, &X[c * n], tmp);
+		for (size_t k = 0; k < n_in; k++) {
+			irdm_csc_matvec(&fem->M, &X[k * n], tmp);
 			for (size_t i = 0; i < n; i++)
-				b[c * n + i] = load[c * n + i] + eps * tmp[i];
+				b[k * n + i] = load[k * n + i] + c->eps * tmp[i];
 		}
-		cholmod_l_free_dense(&sol, &cc);
-		sol = cholmod_l_solve(CHOLMOD_A, f, rhs, &cc);
+		cholmod_l_free_dense(&sol, &c->cc);
+		sol = cholmod_l_solve(CHOLMOD_A, c->f, rhs, &c->cc);
 		if (!sol) {
 			snprintf(err, errlen, "static compliance: sparse solve failed");
-			ret = cc.status == CHOLMOD_OUT_OF_MEMORY ? IRDM_ENOMEM : IRDM_ENUMERIC;
+			ret = c->cc.status == CHOLMOD_OUT_OF_MEMORY ? IRDM_ENOMEM : IRDM_ENUMERIC;
 			goto out_free;
 		}
 		memcpy(X, sol->x, n * n_in * sizeof(double));
-		if (floating)
-			remove_rigid(fem, m, X, n_in, tmp);
+		if (c->floating)
+			remove_rigid(fem, c->m, X, n_in, tmp);
 	}
 	ret = IRDM_OK;
 out_free:
-	free(tmp);
 	free(load);
-	cholmod_l_free_dense(&sol, &cc);
-	cholmod_l_free_dense(&rhs, &cc);
-	cholmod_l_free_factor(&f, &cc);
-	cholmod_l_finish(&cc);
+	cholmod_l_free_dense(&sol, &c->cc);
+	cholmod_l_free_dense(&rhs, &c->cc);
+	return ret;
+}
+
+int irdm_compliance_solve(const struct irdm_fem *fem, const struct irdm_modes *m,
+			  bool floating, const int64_t *in, size_t n_in, double *X,
+			  char *err, size_t errlen)
+{
+	struct irdm_compliance *c;
+	int ret;
+
+	ret = irdm_compliance_open(fem, m, floating, &c, err, errlen);
+	if (ret)
+		return ret;
+	ret = irdm_compliance_columns(c, in, n_in, X, err, errlen);
+	irdm_compliance_close(c);
 	return ret;
 }
 
