@@ -366,7 +366,7 @@ static void test_writer_layout(void **state)
 	fixture_buffer(&fx, &buf, &size);
 	h = get_header(buf);
 	assert_memory_equal(h.magic, "IRDMIMG", 8);
-	assert_int_equal(h.version_major, 1);
+	assert_int_equal(h.version_major, IRDM_IMAGE_VERSION_MAJOR);
 	assert_int_equal(h.version_minor, 0);
 	assert_int_equal(h.header_size, 64);
 	assert_int_equal(h.file_size, size);
@@ -707,17 +707,21 @@ static void test_bad_magic_and_version(void **state)
 	buf[7] = 0;
 
 	h = get_header(buf);
-	h.version_major = 2;
+	h.version_major = 3;
 	put_header(buf, &h);
 	img_fixture_reseal(buf, size);
-	expect_parse(buf, size, IRDM_EVERSION, "version 2.0");
+	expect_parse(buf, size, IRDM_EVERSION, "version 3.0");
+	h.version_major = 1;            /* the dense STATIC_CORR of before */
+	put_header(buf, &h);
+	img_fixture_reseal(buf, size);
+	expect_parse(buf, size, IRDM_EVERSION, "1.x kept the static correction dense; re-run irdm precompute");
 	h.version_major = 0;
 	put_header(buf, &h);
 	img_fixture_reseal(buf, size);
 	expect_parse(buf, size, IRDM_EVERSION, "not supported");
 
 	/* A newer minor is compatible, and may use reserved header fields. */
-	h.version_major = 1;
+	h.version_major = IRDM_IMAGE_VERSION_MAJOR;
 	h.version_minor = 3;
 	h.flags = 0x10;
 	h.reserved[5] = 7;

@@ -41,9 +41,18 @@ int irdm_static_correction(const struct irdm_fem *fem, const struct irdm_modes *
  * columns of many batches share it. */
 struct irdm_compliance;
 
+/* How a floating object's singular K is solved (static.c): K + eps M with
+ * eight refinement steps, or K with springs at six pinned DoFs, one solve.
+ * Both give the elastic compliance; grounded objects solve K once. */
+enum irdm_compliance_method {
+	IRDM_COMPLIANCE_SHIFTED,
+	IRDM_COMPLIANCE_PINNED,
+};
+
 /* Return: IRDM_OK; IRDM_ENOMEM; IRDM_ENUMERIC (as irdm_fem_factor). */
 int irdm_compliance_open(const struct irdm_fem *fem, const struct irdm_modes *m,
-			 bool floating, struct irdm_compliance **c, char *err, size_t errlen);
+			 bool floating, enum irdm_compliance_method method,
+			 struct irdm_compliance **c, char *err, size_t errlen);
 
 /* Compliance columns X (n x n_in) of the free DoFs in[] with c's factor.
  * Return: IRDM_OK; IRDM_ENOMEM; IRDM_ENUMERIC if a solve fails. */

@@ -9,6 +9,14 @@
  * and refine: x <- (K + eps M)^-1 (P f + eps M x), which converges by
  * eps / (w1^2 + eps) per step on elastic modes; eps = 1e-2 w1^2 keeps the
  * factor well conditioned and reaches double precision in 8 steps.
+ *
+ * Pinned (the batched static correction): one solve instead of eight.  Six
+ * DoFs chosen so that the rigid modes restricted to them are well
+ * conditioned (a statically determinate support) get a spring to ground.
+ * A self-equilibrated load P f needs no reaction from such a support, so
+ * the solution of (K + springs) x = P f is an exact solution of K x = P f
+ * (for any spring stiffness) and differs from the elastic one by rigid
+ * motion only, which remove_rigid takes out.
  */
 #include <math.h>
 #include <stdio.h>
@@ -66,19 +74,99 @@ static void elastic_load(const struct irdm_fem *fem, const struct irdm_modes *m,
 	free(mt);
 }
 
-/* A factor of K (+ eps M) kept for batches of compliance columns. */
+/* A factor of K (+ eps M, or + pin springs) kept for batches of columns. */
 struct irdm_compliance {
 	const struct irdm_fem *fem;
 	const struct irdm_modes *m;
 	bool floating;
+	int steps;                      /* solves per batch */
 	double eps;
 	cholmod_common cc;
 	cholmod_factor *f;
 	double *tmp;
 };
 
+/* Diagonal entry j of the CSC matrix a (0 if not stored). */
+static double csc_diag(const struct irdm_csc *a, size_t j)
+{
+	for (int64_t p = a->colptr[j]; p < a->colptr[j + 1]; p++)
+		if (a->rowind[p] == (int64_t)j)
+			return a->val[p];
+	return 0.0;
+}
+
+/*
+ * Springs at n_rigid DoFs picked greedily (pivoted Gram-Schmidt on the rows
+ * of the rigid modes): each next DoF is the one whose rigid-mode row is
+ * largest outside the span of those already picked, so the rigid modes
+ * restricted to the pins are as well conditioned as the mesh allows.  Each
+ * spring is as stiff as K's own diagonal there.  diag: n, zeroed here.
+ */
+static void pin_springs(const struct irdm_fem *fem, const struct irdm_modes *m, double *diag)
+{
+	size_t n = m->n, nr = m->n_rigid;
+	double q[6][6];
+
+	memset(diag, 0, n * sizeof(double));
+	for (size_t s = 0; s < nr && s < 6; s++) {
+		double best = -1, v[6], bv[6];
+		size_t bi = 0;
+		for (size_t i = 0; i < n; i++) {
+			double nrm = 0;
+			for (size_t r = 0; r < nr; r++)
+				v[r] = m->rigid_phi[r * n + i];
+			for (size_t t = 0; t < s; t++) {
+				double d = 0;
+				for (size_t r = 0; r < nr; r++)
+					d += v[r] * q[t][r];
+				for (size_t r = 0; r < nr; r++)
+					v[r] -= d * q[t][r];
+			}
+			for (size_t r = 0; r < nr; r++)
+				nrm += v[r] * v[r];
+			if (nrm > best && diag[i] == 0) {
+				best = nrm;
+				bi = i;
+				memcpy(bv, v, sizeof(v));
+			}
+		}
+		for (size_t r = 0; r < nr; r++)
+			q[s][r] = bv[r] / sqrt(best);
+		diag[bi] = csc_diag(&fem->K, bi);
+	}
+}
+
+static int factor(struct irdm_compliance *c, enum irdm_compliance_method method, char *err,
+		  size_t errlen)
+{
+	double *diag;
+	int ret;
+
+	c->steps = 1;
+	if (!c->floating)
+		return irdm_fem_factor(c->fem, 1.0, 0.0, "static compliance", &c->cc, &c->f,
+				       err, errlen);
+	if (method == IRDM_COMPLIANCE_SHIFTED) {
+		c->eps = 1e-2 * c->m->omega2[0];
+		c->steps = REFINE_STEPS;
+		return irdm_fem_factor(c->fem, 1.0, c->eps, "static compliance", &c->cc, &c->f,
+				       err, errlen);
+	}
+	diag = malloc(c->m->n * sizeof(double));
+	if (!diag) {
+		snprintf(err, errlen, "static compliance: out of memory");
+		return IRDM_ENOMEM;
+	}
+	pin_springs(c->fem, c->m, diag);
+	ret = irdm_fem_factor_diag(c->fem, 1.0, 0.0, diag, "static compliance (pinned)", &c->cc,
+				   &c->f, err, errlen);
+	free(diag);
+	return ret;
+}
+
 int irdm_compliance_open(const struct irdm_fem *fem, const struct irdm_modes *m,
-			 bool floating, struct irdm_compliance **out, char *err, size_t errlen)
+			 bool floating, enum irdm_compliance_method method,
+			 struct irdm_compliance **out, char *err, size_t errlen)
 {
 	struct irdm_compliance *c = calloc(1, sizeof(*c));
 	int ret;
@@ -92,10 +180,9 @@ int irdm_compliance_open(const struct irdm_fem *fem, const struct irdm_modes *m,
 	c->fem = fem;
 	c->m = m;
 	c->floating = floating;
-	c->eps = floating ? 1e-2 * m->omega2[0] : 0.0;
 	cholmod_l_start(&c->cc);
 	c->cc.print = 0;
-	ret = irdm_fem_factor(fem, 1.0, c->eps, "static compliance", &c->cc, &c->f, err, errlen);
+	ret = factor(c, method, err, errlen);
 	if (ret) {
 		irdm_compliance_close(c);
 		return ret;
@@ -132,12 +219,13 @@ int irdm_compliance_columns(struct irdm_compliance *c, const int64_t *in, size_t
 	for (size_t k = 0; k < n_in; k++)
 		elastic_load(fem, c->m, in[k], &load[k * n], tmp);
 	memset(X, 0, n * n_in * sizeof(double));
-	for (int step = 0; step < (c->floating ? REFINE_STEPS : 1); step++) {
+	for (int step = 0; step < c->steps; step++) {
 		double *b = rhs->x;
 		for (size_t k = 0; k < n_in; k++) {
-			irdm_csc_matvec(&fem->M, &X[k * n], tmp);
+			if (c->eps > 0)
+				irdm_csc_matvec(&fem->M, &X[k * n], tmp);
 			for (size_t i = 0; i < n; i++)
-				b[k * n + i] = load[k * n + i] + c->eps * tmp[i];
+				b[k * n + i] = load[k * n + i] + (c->eps > 0 ? c->eps * tmp[i] : 0.0);
 		}
 		cholmod_l_free_dense(&sol, &c->cc);
 		sol = cholmod_l_solve(CHOLMOD_A, c->f, rhs, &c->cc);
@@ -165,7 +253,7 @@ int irdm_compliance_solve(const struct irdm_fem *fem, const struct irdm_modes *m
 	struct irdm_compliance *c;
 	int ret;
 
-	ret = irdm_compliance_open(fem, m, floating, &c, err, errlen);
+	ret = irdm_compliance_open(fem, m, floating, IRDM_COMPLIANCE_SHIFTED, &c, err, errlen);
 	if (ret)
 		return ret;
 	ret = irdm_compliance_columns(c, in, n_in, X, err, errlen);

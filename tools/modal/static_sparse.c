@@ -114,6 +114,14 @@ static double frob(const double b[9])
 	return sqrt(s);
 }
 
+/* S is symmetric: its diagonal blocks too, exactly (R[0] is then). */
+static void symmetrise(double b[9])
+{
+	for (int i = 0; i < 3; i++)
+		for (int j = 0; j < i; j++)
+			b[3 * i + j] = b[3 * j + i] = 0.5 * (b[3 * i + j] + b[3 * j + i]);
+}
+
 /* Judge every pair (c in the batch, r <= c); keep the diagonal always. */
 static int judge_batch(const struct batch *bt, double tol, struct lower *l, double *max_rel)
 {
@@ -127,6 +135,8 @@ static int judge_batch(const struct batch *bt, double tol, struct lower *l, doub
 		for (size_t r = 0; r <= c; r++) {
 			double scale = sqrt(bt->diag_norm[c] * bt->diag_norm[r]), nrm;
 			block(bt, c, r, b);
+			if (r == c)
+				symmetrise(b);
 			nrm = frob(b);
 			if (r != c && (nrm == 0 || nrm < tol * scale)) {
 				if (scale > 0 && nrm / scale > *max_rel)
@@ -212,7 +222,7 @@ int irdm_static_correction_sparse(const struct irdm_fem *fem, const struct irdm_
 	out->n_cols = n_cols;
 	if (!X || !mod || !diag_norm || !in || !slot || modal_basis(m, col_dofs, n_cols, &P, &Ps))
 		goto out_nomem;
-	ret = irdm_compliance_open(fem, m, floating, &comp, err, errlen);
+	ret = irdm_compliance_open(fem, m, floating, IRDM_COMPLIANCE_PINNED, &comp, err, errlen);
 	if (ret)
 		goto out_free;
 	for (size_t c0 = 0; c0 < n_cols; c0 += B) {

@@ -69,6 +69,7 @@ static int modal_data(struct build *b, char *err, size_t errlen)
 {
 	struct irdm_model *m = &b->m;
 	size_t K = m->modes.n_modes, n = m->modes.n;
+	int ret;
 
 	b->n_modes = K;
 	b->zoh = malloc(K * sizeof(*b->zoh));
@@ -93,8 +94,13 @@ static int modal_data(struct build *b, char *err, size_t errlen)
 	b->corr = malloc(m->n_cols * m->n_rows * 9 * sizeof(double));
 	if (!b->corr)
 		goto out_nomem;
-	return irdm_static_correction(&m->fem, &m->modes, b->sc->floating, m->col_dofs,
-				      m->n_cols, m->row_dofs, m->n_rows, b->corr, err, errlen);
+	if (b->o->progress)
+		b->o->progress(b->o->ctx, "static correction", 0.0);
+	ret = irdm_static_correction(&m->fem, &m->modes, b->sc->floating, m->col_dofs,
+				     m->n_cols, m->row_dofs, m->n_rows, b->corr, err, errlen);
+	if (!ret && b->o->progress)
+		b->o->progress(b->o->ctx, "static correction", 1.0);
+	return ret;
 out_nomem:
 	snprintf(err, errlen, "precompute: out of memory for the modal data");
 	return IRDM_ENOMEM;

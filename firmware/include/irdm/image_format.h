@@ -15,7 +15,7 @@
 #include <stdint.h>
 
 #define IRDM_IMAGE_MAGIC "IRDMIMG"          /* 7 chars + NUL = 8 bytes */
-#define IRDM_IMAGE_VERSION_MAJOR 1u         /* incompatible layout change */
+#define IRDM_IMAGE_VERSION_MAJOR 2u         /* incompatible layout change */
 #define IRDM_IMAGE_VERSION_MINOR 0u         /* compatible additions */
 #define IRDM_IMAGE_ALIGN 64u                /* payload alignment, bytes */
 #define IRDM_IMAGE_MAX_SECTIONS 32u
