@@ -12,7 +12,7 @@
 #include "modal/modal.h"
 
 /* Default drop tolerance (scene key static_correction_tol). */
-#define IRDM_STATIC_CORR_TOL_DEFAULT 1e-3
+#define IRDM_STATIC_CORR_TOL_DEFAULT 0.02
 
 /*
  * Column c's kept blocks are k in [start[c], start[c+1]): row rows[k] (a

@@ -395,7 +395,7 @@ static const struct irdm_opt scene_opts[] = {
 	  .help = "residual compliance of dropped modes (modal; default yes)" },
 	{ .name = "static_correction_tol", .type = IRDM_OPT_DOUBLE, SC(static_corr_tol),
 	  .metavar = "TOL", .range = IRDM_OPT_GE | IRDM_OPT_LT, .min = 0, .max = 1,
-	  .help = "modal: drop the static correction's block between touchable nodes a and b when its norm is below TOL sqrt(|S_aa| |S_bb|), the diagonal blocks' norms: a relative force error of about TOL per dropped neighbour (default 0.001; 0 keeps every block)" },
+	  .help = "modal: drop the static correction's block between touchable nodes a and b when its norm is below TOL sqrt(|S_aa| |S_bb|), the diagonal blocks' norms: the force error at a contact is of about that order (default 0.02; 0 keeps every block)" },
 	{ .name = "precision", .type = IRDM_OPT_ENUM, SC(precision), .names = precision_names,
 	  .help = "storage of the responses (default f32)" },
 	{ .name = "touch", .type = IRDM_OPT_CUSTOM, .parse = set_region, SC(touch),
