@@ -1178,7 +1178,8 @@ FX(m_fir_len5, fx->meta.fir_length = 5)
 FX(m_fir_modes, fx->meta.n_modes = 1)
 FX(m_fir_corr_flag, fx->meta.flags |= IRDM_META_STATIC_CORR)
 FX(m_unknown_flag, fx->meta.flags |= 1u << 9)
-FX(m_reserved0, fx->meta.reserved0 = 1)
+FX(m_fir_exact, fx->meta.fir_exact = 1)
+FX(m_fir_window_flag, fx->meta.flags |= IRDM_META_FIR_TAIL_WINDOW)
 FX(m_reserved, fx->meta.reserved[7] = 1)
 FX(m_tool_nul, memset(fx->meta.tool_version, 'x', 32))
 FX(m_name_nul, memset(fx->meta.mesh_name, 'x', 64))
@@ -1249,7 +1250,9 @@ static const struct sem_case sem_cases[] = {
 	{ "FIR n_modes", FIR, m_fir_modes, NULL, IRDM_EFORMAT, "n_modes 1" },
 	{ "FIR corr flag", FIR, m_fir_corr_flag, NULL, IRDM_EFORMAT, "STATIC_CORR" },
 	{ "meta flag", FIR, m_unknown_flag, NULL, IRDM_EFORMAT, "unknown flags" },
-	{ "meta reserved0", FIR, m_reserved0, NULL, IRDM_EFORMAT, "reserved" },
+	{ "meta fir_exact without its flag", FIR, m_fir_exact, NULL, IRDM_EFORMAT, "fir_exact 1" },
+	{ "meta tail window without fir_exact", FIR, m_fir_window_flag, NULL, IRDM_EFORMAT,
+	  "FIR_TAIL_WINDOW set" },
 	{ "meta reserved", FIR, m_reserved, NULL, IRDM_EFORMAT, "reserved" },
 	{ "tool_version", FIR, m_tool_nul, NULL, IRDM_EFORMAT, "NUL-terminated" },
 	{ "mesh_name", FIR, m_name_nul, NULL, IRDM_EFORMAT, "NUL-terminated" },

@@ -68,7 +68,11 @@ static int cmd_info(const char *path)
 		printf("responses     FIR, T = %u samples (%.3f s), %s%s\n", m->fir_length,
 		       m->fir_length * m->dt_s, elem_name(m->precision),
 		       m->flags & IRDM_META_TIME_DOMAIN ? ", time-domain" : ", from modes");
-	else
+	if (m->flags & IRDM_META_FIR_TAIL_WINDOW)
+		printf("tail          samples 0..%u exact, %u past them windowed (fir_tail = window:%u), "
+		       "sum = static compliance\n", m->fir_exact - 1, m->fir_length - m->fir_exact,
+		       m->fir_length - m->fir_exact);
+	if (m->representation != IRDM_REPR_FIR)
 		printf("responses     modal, %u of %u modes%s, %s\n", m->n_modes, m->n_modes_total,
 		       m->flags & IRDM_META_STATIC_CORR ? " + static correction" : "",
 		       elem_name(m->precision));

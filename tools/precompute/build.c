@@ -17,6 +17,7 @@
 #include "modal/response.h"
 #include "modal/stability.h"
 #include "modal/static_sparse.h"
+#include "precompute/fir_tail.h"
 #include "precompute/precompute.h"
 #include "precompute/td_part.h"
 #include "timedomain/timedomain.h"
@@ -58,6 +59,12 @@ static size_t modes_needed(const struct irdm_scene *sc)
 	if (sc->method == IRDM_METHOD_TIME_DOMAIN)
 		return 1;       /* only the first mode, for the default damping */
 	return sc->modes;       /* FIR synthesised from modes */
+}
+
+/* FIR samples the image holds: T, plus a windowed tail (fir_tail.h). */
+static size_t fir_taps(const struct build *b)
+{
+	return (size_t)b->sc->fir_length + b->sc->fir_tail;
 }
 
 static bool truncated(const struct build *b)
@@ -109,7 +116,7 @@ out_nomem:
 static int fir_from_modes(struct build *b, char *err, size_t errlen)
 {
 	struct irdm_model *m = &b->m;
-	size_t T = b->sc->fir_length;
+	size_t T = fir_taps(b);
 	int ret;
 
 	ret = modal_data(b, err, errlen);
@@ -165,7 +172,7 @@ static int td_run(struct build *b, size_t begin, size_t end, double *R, char *er
 	int64_t *global = malloc(n_in * sizeof(int64_t));
 	struct td_progress tp = { b->o->progress, b->o->ctx };
 	struct irdm_td_opts o = {
-		.dt_s = b->sc->dt_s, .n_samples = b->sc->fir_length, .substeps = b->sc->substeps,
+		.dt_s = b->sc->dt_s, .n_samples = fir_taps(b), .substeps = b->sc->substeps,
 		.damping = m->damping, .floating = b->sc->floating, .threads = b->sc->threads,
 		.progress = td_progress, .progress_ctx = &tp,
 		/* rigid motion removed by a mass-weighted best fit (Kabsch):
@@ -192,7 +199,7 @@ static int td_scatter(struct build *b, const double *R, size_t begin, size_t end
 		      char *err, size_t errlen)
 {
 	struct irdm_model *m = &b->m;
-	size_t T = b->sc->fir_length, n_out = 3 * m->n_rows;
+	size_t T = fir_taps(b), n_out = 3 * m->n_rows;
 	size_t *slot = malloc(3 * m->n_cols * sizeof(size_t));
 
 	if (!slot) {
@@ -216,7 +223,7 @@ static int td_scatter(struct build *b, const double *R, size_t begin, size_t end
 static int td_part(struct build *b, size_t n_in, char *err, size_t errlen)
 {
 	const struct irdm_precompute_opts *o = b->o;
-	size_t T = b->sc->fir_length, n_out = 3 * b->m.n_rows;
+	size_t T = fir_taps(b), n_out = 3 * b->m.n_rows;
 	size_t e = o->part_end < n_in ? o->part_end : n_in;
 	int ret;
 
@@ -242,7 +249,7 @@ static int td_part(struct build *b, size_t n_in, char *err, size_t errlen)
 static int td_merge(struct build *b, size_t n_in, char *err, size_t errlen)
 {
 	const struct irdm_precompute_opts *o = b->o;
-	size_t T = b->sc->fir_length, n_out = 3 * b->m.n_rows;
+	size_t T = fir_taps(b), n_out = 3 * b->m.n_rows;
 	unsigned char *seen = calloc(n_in ? n_in : 1, 1);
 	int ret = IRDM_EINVAL;
 
@@ -288,7 +295,7 @@ out_seen:
 static int fir_time_domain(struct build *b, char *err, size_t errlen)
 {
 	struct irdm_model *m = &b->m;
-	size_t T = b->sc->fir_length, n_out = 3 * m->n_rows, n_in = list_inputs(m, NULL, NULL);
+	size_t T = fir_taps(b), n_out = 3 * m->n_rows, n_in = list_inputs(m, NULL, NULL);
 	size_t fir_n = m->n_cols * m->n_rows * T * 9;
 	double *R;
 	int ret;
@@ -341,7 +348,7 @@ static void stab_one(struct build *b, size_t c)
 	double rho;
 
 	if (b->sc->representation == IRDM_REPR_FIR) {
-		size_t T = b->sc->fir_length;
+		size_t T = fir_taps(b);
 		const double *R = &b->fir[(c * m->n_rows + row) * T * 9];
 		/* exact eigenvalues while the companion matrix is cheap (3(T-1)
 		 * <= 480), the argument-principle upper bound beyond */
@@ -430,12 +437,14 @@ static void fill_meta(struct build *b)
 	mt->n_nodes = (uint32_t)m->n_rows;
 	mt->n_cols = (uint32_t)m->n_cols;
 	mt->n_tris = (uint32_t)m->n_tris;
-	mt->fir_length = sc->representation == IRDM_REPR_FIR ? sc->fir_length : 0;
+	mt->fir_length = sc->representation == IRDM_REPR_FIR ? (uint32_t)fir_taps(b) : 0;
+	mt->fir_exact = sc->representation == IRDM_REPR_FIR && sc->fir_tail ? sc->fir_length : 0;
 	mt->n_modes = sc->representation == IRDM_REPR_MODAL ? (uint32_t)b->n_modes : 0;
 	mt->flags = (sc->floating ? IRDM_META_FLOATING : 0) |
 		    (b->sparse.start ? IRDM_META_STATIC_CORR : 0) |
 		    (sc->mass == IRDM_MASS_CONSISTENT ? IRDM_META_CONSISTENT_MASS : 0) |
-		    (sc->method == IRDM_METHOD_TIME_DOMAIN ? IRDM_META_TIME_DOMAIN : 0);
+		    (sc->method == IRDM_METHOD_TIME_DOMAIN ? IRDM_META_TIME_DOMAIN : 0) |
+		    (mt->fir_exact ? IRDM_META_FIR_TAIL_WINDOW : 0);
 	mt->dt_s = sc->dt_s;
 	mt->young_pa = sc->mat.young_pa;
 	mt->poisson = sc->mat.poisson;
@@ -586,8 +595,14 @@ static int responses(struct build *b, char *err, size_t errlen)
 		ret = fir_from_modes(b, err, errlen);
 	if (ret || b->o->part_out)
 		return ret;
+	if (b->fir && b->sc->fir_tail) {
+		ret = irdm_fir_tail_window(m, b->sc->floating, b->sc->fir_length, b->sc->fir_tail,
+					   b->fir, err, errlen);
+		if (ret)
+			return ret;
+	}
 	if (b->fir)
-		b->stored[0] = store(b->fir, m->n_cols * m->n_rows * b->sc->fir_length * 9,
+		b->stored[0] = store(b->fir, m->n_cols * m->n_rows * fir_taps(b) * 9,
 				     b->sc->precision, &b->stored_bytes[0]);
 	if (b->shapes && b->sc->representation == IRDM_REPR_MODAL)
 		b->stored[1] = store(b->shapes, m->n_rows * 3 * b->n_modes, b->sc->precision,

@@ -307,6 +307,25 @@ static int set_representation(const struct irdm_opt *o, void *obj, const char *v
 	return parse_representation(obj, v) ? IRDM_EFORMAT : IRDM_OK;
 }
 
+/* "none", or "window:L": L samples past T, tapered (precompute/fir_tail.c). */
+static int set_fir_tail(const struct irdm_opt *o, void *obj, const char *v, char *why, size_t len)
+{
+	static const struct irdm_opt count = { .name = "fir_tail", .type = IRDM_OPT_UNSIGNED,
+		.size = sizeof(unsigned), .range = IRDM_OPT_GE | IRDM_OPT_LE, .min = 1, .max = 1000000 };
+	struct irdm_scene *sc = obj;
+
+	(void)o;
+	if (!strcmp(v, "none")) {
+		sc->fir_tail = 0;
+		return IRDM_OK;
+	}
+	if (strncmp(v, "window:", 7)) {
+		snprintf(why, len, "expected none or window:L");
+		return IRDM_EFORMAT;
+	}
+	return irdm_opt_parse_value(&count, &sc->fir_tail, v + 7, why, len);
+}
+
 /* "all" or "0": every mode; otherwise 1 to 1000000. */
 static int set_modes(const struct irdm_opt *o, void *obj, const char *v, char *why, size_t len)
 {
@@ -391,6 +410,11 @@ static const struct irdm_opt scene_opts[] = {
 	  .help = "K modes (1 to 1000000) or all, or an FIR of T samples (1 to 1000000) (default modal:300)" },
 	{ .name = "modes", .type = IRDM_OPT_CUSTOM, .parse = set_modes, .metavar = "K | all",
 	  .help = "modes that synthesise a modal-method FIR, 1 to 1000000 (default 300)" },
+	{ .name = "fir_tail", .type = IRDM_OPT_CUSTOM, .parse = set_fir_tail,
+	  .metavar = "none | window:L",
+	  .help = "FIR stabilisation: window:L appends L samples past T tapered to zero (Hann), "
+		  "the taps' sum restored to the static compliance; the first T stay exact "
+		  "(default none: the engine damps an unstable FIR's tail by r^s)" },
 	{ .name = "static_correction", .type = IRDM_OPT_BOOL, SC(static_correction),
 	  .help = "residual compliance of dropped modes (modal; default yes)" },
 	{ .name = "static_correction_tol", .type = IRDM_OPT_DOUBLE, SC(static_corr_tol),
@@ -478,6 +502,16 @@ int irdm_scene_check(const struct irdm_scene *sc, char *err, size_t errlen)
 		snprintf(err, errlen, "scene: method = time-domain makes FIR responses: use representation = fir:T");
 		return IRDM_EINVAL;
 	}
+	if (sc->fir_tail && sc->representation != IRDM_REPR_FIR) {
+		snprintf(err, errlen, "scene: fir_tail = window:%u windows an FIR's tail: use representation = fir:T",
+			 sc->fir_tail);
+		return IRDM_EINVAL;
+	}
+	if (sc->fir_tail && (uint64_t)sc->fir_tail + sc->fir_length > 1000000) {
+		snprintf(err, errlen, "scene: fir:%u with fir_tail = window:%u makes more than 1000000 samples",
+			 sc->fir_length, sc->fir_tail);
+		return IRDM_EINVAL;
+	}
 	if (sc->damping == IRDM_DAMP_RATIOS && sc->damp_hz[0] > 0 &&
 	    fabs(sc->damp_hz[0] - sc->damp_hz[1]) < 1e-9) {
 		snprintf(err, errlen, "scene: damping needs two different frequencies");
@@ -528,6 +562,12 @@ int irdm_scene_format(const struct irdm_scene *sc, char *buf, size_t len)
 		eig[sc->eigensolver], sc->modes);
 	if (n < 0 || (size_t)n >= len)
 		return -1;
+	if (sc->fir_tail) {         /* only when set: older scenes keep their text */
+		int t = snprintf(buf + n, len - (size_t)n, "fir_tail=window:%u\n", sc->fir_tail);
+		if (t < 0 || (size_t)t >= len - (size_t)n)
+			return -1;
+		n += t;
+	}
 	if (sc->tetgen_given || irdm_scene_builtin_mesh(sc))
 		return 0;       /* as before sizing existed: the same images */
 	int k = snprintf(buf + n, len - (size_t)n, "target_nodes=%u\nmax_tet_volume=%.17g\n",

@@ -79,6 +79,9 @@ enum irdm_meta_flags {
 	IRDM_META_STATIC_CORR = 1u << 1,    /* STATIC_CORR present */
 	IRDM_META_CONSISTENT_MASS = 1u << 2,
 	IRDM_META_TIME_DOMAIN = 1u << 3,    /* FIR computed by time integration */
+	/* FIR: samples [fir_exact, fir_length) are the response tapered to
+	 * zero, the taps' sum restored to the static compliance */
+	IRDM_META_FIR_TAIL_WINDOW = 1u << 4,
 };
 
 struct irdm_meta {                          /* 256 bytes */
@@ -103,7 +106,7 @@ struct irdm_meta {                          /* 256 bytes */
 	uint32_t mesh_nodes;                /* of the whole source mesh */
 	uint32_t mesh_tets;
 	uint32_t n_modes_total;             /* elastic modes of the whole model */
-	uint32_t reserved0;
+	uint32_t fir_exact;                 /* FIR_TAIL_WINDOW: samples kept exact, 1..T-1; else 0 */
 	uint64_t mesh_hash;                 /* FNV-1a 64 of positions and tets */
 	char     tool_version[32];          /* NUL-terminated */
 	char     mesh_name[64];             /* NUL-terminated */
