@@ -194,7 +194,7 @@ docs: $(IRDM)
 	mv docs/scene-format.md.tmp docs/scene-format.md
 
 san:
-	$(MAKE) BUILD=build-san SAN=1 OPT="-O1 -g" IRDM_SOAK_SECONDS=10 test
+	$(MAKE) BUILD=build-san SAN=1 OPT="-O1 -g" IRDM_SOAK_SECONDS=10 IRDM_TORUS=small test
 
 # libFuzzer needs clang.  Each target gets its own corpus directory; a
 # finding (crash, leak, sanitizer report: none recovers) stops the build and

@@ -240,7 +240,7 @@ static void bench_image(const char *scene, const char *repr, const char *path,
 	       img.meta->n_nodes, img.meta->n_cols,
 	       img.meta->representation == IRDM_REPR_MODAL ? img.meta->n_modes : img.meta->fir_length,
 	       img.meta->representation == IRDM_REPR_MODAL ? "modes" : "taps", img.meta->dt_s * 1e3,
-	       img.static_corr ? ", static correction" : "",
+	       img.corr_start ? ", static correction" : "",
 	       img.locked ? ", locked" : "");
 	for (int k = 0; k < K_COUNT; k++)
 		fig[k] = bench_case(scene, repr, &img, &st, (enum kase)k);

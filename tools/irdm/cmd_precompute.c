@@ -4,6 +4,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 
 #include "cli.h"
 #include "irdm/error.h"
@@ -142,6 +143,15 @@ static const struct irdm_opt_table irdm_precompute_options = {
 	.n_opts = sizeof(precompute_opts) / sizeof(precompute_opts[0]),
 };
 
+/* Peak resident memory of the whole run (Linux: ru_maxrss in KiB). */
+static void print_peak_memory(void)
+{
+	struct rusage ru;
+
+	if (!getrusage(RUSAGE_SELF, &ru))
+		printf("memory        peak %.1f MiB resident\n", (double)ru.ru_maxrss / 1024.0);
+}
+
 static void print_report(const struct irdm_scene *sc, const struct irdm_precompute_opts *o,
 			 const struct irdm_precompute_report *r)
 {
@@ -161,9 +171,15 @@ static void print_report(const struct irdm_scene *sc, const struct irdm_precompu
 		       (double)r->image_bytes / (1 << 20),
 		       sc->representation == IRDM_REPR_FIR ? "FIR" : "modal");
 	}
+	if (r->corr_blocks)
+		printf("static corr   %zu of %zu blocks kept (%.2f %%), tol %g, largest dropped %.3g\n",
+		       r->corr_blocks, r->cols * r->cols,
+		       100.0 * (double)r->corr_blocks / ((double)r->cols * (double)r->cols),
+		       r->corr_tol, r->corr_max_dropped_rel);
 	printf("time          %.2f s total: mesh %.2f, FEM %.2f, eigen %.2f, responses %.2f, stability %.2f\n",
 	       r->seconds_total, r->seconds_mesh, r->seconds_fem, r->seconds_eig,
 	       r->seconds_responses, r->seconds_stability);
+	print_peak_memory();
 }
 
 static void print_help(void)

@@ -15,7 +15,7 @@
 #include <stdint.h>
 
 #define IRDM_IMAGE_MAGIC "IRDMIMG"          /* 7 chars + NUL = 8 bytes */
-#define IRDM_IMAGE_VERSION_MAJOR 1u         /* incompatible layout change */
+#define IRDM_IMAGE_VERSION_MAJOR 2u         /* incompatible layout change */
 #define IRDM_IMAGE_VERSION_MINOR 0u         /* compatible additions */
 #define IRDM_IMAGE_ALIGN 64u                /* payload alignment, bytes */
 #define IRDM_IMAGE_MAX_SECTIONS 32u
@@ -62,10 +62,11 @@ enum irdm_section_kind {
 	IRDM_SEC_FIR = 6,          /* FIR only: R[s] blocks [col][row][s][3][3], elem = precision */
 	IRDM_SEC_MODES = 7,        /* modal only: n_modes x struct irdm_mode */
 	IRDM_SEC_MODE_SHAPES = 8,  /* modal only: [row][3][mode], elem = precision */
-	IRDM_SEC_STATIC_CORR = 9,  /* modal, optional: residual compliance [col][col'][3][3] */
+	IRDM_SEC_STATIC_CORR = 9,  /* modal, optional: kept residual-compliance blocks [k][3][3] */
 	IRDM_SEC_RIGID = 10,       /* floating only: struct irdm_rigid */
 	IRDM_SEC_STABILITY = 11,   /* n_cols x struct irdm_stability */
 	IRDM_SEC_CONTACT_BVH = 12, /* optional: contact BVH + adjacency, struct irdm_bvh_header */
+	IRDM_SEC_STATIC_CORR_INDEX = 13, /* with STATIC_CORR: u32 column starts + rows of its blocks */
 };
 
 enum irdm_repr {
