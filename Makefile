@@ -64,12 +64,25 @@ CFLAGS  += $(CSTD) $(WARN) $(OPT) -MMD -MP
 CFLAGS  += $(foreach f,$(FEATURES),-DIRDM_CONFIG_$(f)=$(if $(call feature,$(f)),1,0))
 LDLIBS   = -lcholmod -larpack -lopenblas -lpthread -lm
 
+# The distributed eigensolver (eigensolver = slepc, tools/dist/): PETSc and
+# SLEPc over MPI when pkg-config finds them (Debian: petsc-dev slepc-dev);
+# SLEPC=0 builds without them (the option then says it is not built in).
+# Their headers are -isystem: our warnings are not theirs to pass.
+MPI_PC  ?= ompi
+SLEPC   ?= $(shell pkg-config --exists slepc PETSc $(MPI_PC) 2>/dev/null && echo 1 || echo 0)
+ifeq ($(SLEPC),1)
+SLEPC_CFLAGS := -DIRDM_HAVE_SLEPC=1 $(patsubst -I%,-isystem %,$(filter -I%,$(shell pkg-config --cflags slepc PETSc $(MPI_PC))))
+LDLIBS  += $(shell pkg-config --libs slepc PETSc $(MPI_PC))
+else
+SLEPC_CFLAGS := -DIRDM_HAVE_SLEPC=0
+endif
+
 # Include paths, one set per layer (target-specific: an object sees only its own).
 FW_INC    = -Ifirmware/include
 HAL_INC   = $(FW_INC) -Ihal/include
 SIM_INC   = $(HAL_INC) -Isim/include
-TOOL_INC  = $(FW_INC) -Itools -I/usr/include/suitesparse
-TEST_INC  = $(SIM_INC) -Itools -I/usr/include/suitesparse
+TOOL_INC  = $(FW_INC) -Itools -I/usr/include/suitesparse $(SLEPC_CFLAGS)
+TEST_INC  = $(SIM_INC) -Itools -I/usr/include/suitesparse $(SLEPC_CFLAGS)
 
 ifneq ($(SAN),)
 CFLAGS  += -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "dist/dist.h"
 #include "irdm/error.h"
 #include "irdm/options.h"
 #include "irdm/options_doc.h"
@@ -243,12 +244,50 @@ static int output_opts(const struct irdm_scene *sc, const struct precompute_args
 	return 0;
 }
 
+static int run(const struct irdm_scene *sc, const struct irdm_precompute_opts *o,
+	       struct irdm_cli_progress *prog)
+{
+	struct irdm_precompute_report rep;
+	char err[1024];
+	int rc = irdm_precompute(sc, o, &rep, err, sizeof(err));
+
+	if (rc) {
+		/* over MPI: every rank stops, with this one's number and reason */
+		irdm_dist_abort("precompute", rc, err);
+		irdm_cli_fail("precompute", rc, err);
+		return 1;
+	}
+	if (!prog->quiet)
+		print_report(sc, o, &rep);
+	return 0;
+}
+
+/* eigensolver = slepc: the same run on every MPI rank (a single one without
+ * mpirun); rank 0 alone shows progress and writes. */
+static int run_distributed(const struct irdm_scene *sc, const struct irdm_precompute_opts *o,
+			   struct irdm_cli_progress *prog)
+{
+	char err[1024];
+	int rc = irdm_dist_begin(err, sizeof(err));
+
+	if (rc) {
+		irdm_cli_fail("precompute", rc, err);
+		return 1;
+	}
+	if (irdm_dist_rank() != 0)
+		prog->quiet = 1;
+	rc = run(sc, o, prog);
+	if (!rc)
+		irdm_dist_wait_all();
+	irdm_dist_end();
+	return rc;
+}
+
 int irdm_cmd_precompute(int argc, char **argv)
 {
 	struct irdm_scene sc;
 	struct precompute_args args = { 0 };
 	struct irdm_precompute_opts o = { 0 };
-	struct irdm_precompute_report rep;
 	struct irdm_cli_progress prog = { 0 };
 	const char *parts[MAX_PARTS];
 	char err[1024];
@@ -284,12 +323,6 @@ int irdm_cmd_precompute(int argc, char **argv)
 		return rc;
 	o.progress = irdm_cli_progress;
 	o.ctx = &prog;
-	rc = irdm_precompute(&sc, &o, &rep, err, sizeof(err));
-	if (rc) {
-		irdm_cli_fail("precompute", rc, err);
-		return 1;
-	}
-	if (!prog.quiet)
-		print_report(&sc, &o, &rep);
-	return 0;
+	return sc.eigensolver == IRDM_EIG_SLEPC ? run_distributed(&sc, &o, &prog)
+					       : run(&sc, &o, &prog);
 }

@@ -19,6 +19,7 @@ enum irdm_eig_method {
 	IRDM_EIG_AUTO = 0,      /* dense when small or all modes wanted, else Lanczos */
 	IRDM_EIG_DENSE = 1,
 	IRDM_EIG_LANCZOS = 2,
+	IRDM_EIG_SLEPC = 3,     /* SLEPc over MPI ranks (tools/dist/), if built in */
 };
 
 struct irdm_modes {
@@ -27,8 +28,9 @@ struct irdm_modes {
 	size_t  n_rigid;        /* rigid modes found and excluded */
 	size_t  n_elastic_total;/* elastic modes of the model: n - n_rigid */
 	double *omega2;         /* n_modes eigenvalues w^2 (rad^2/s^2) */
-	double *phi;            /* n x n_modes, column-major, Phi^T M Phi = I */
-	double *rigid_phi;      /* n x n_rigid (floating only) */
+	double *phi;            /* n x n_modes, column-major, Phi^T M Phi = I
+				 * (NULL on an MPI rank other than 0) */
+	double *rigid_phi;      /* n x n_rigid (floating only; NULL as phi) */
 };
 
 /* Progress of a stage in [0, 1]; a negative fraction: `stage` is a line to
@@ -52,6 +54,12 @@ int irdm_eig_dense(const struct irdm_fem *fem, size_t n_lowest, double *w2, doub
 int irdm_eig_lanczos(const struct irdm_fem *fem, size_t n_lowest, double sigma,
 		     irdm_progress_fn progress, void *ctx, double *w2, double *phi,
 		     char *err, size_t errlen);
+/* The same by SLEPc (Krylov-Schur, shift-invert through MUMPS) over the
+ * MPI ranks (started here if the caller did not): every rank gets w2,
+ * rank 0 alone phi (NULL elsewhere).  Collective: every rank calls it. */
+int irdm_eig_slepc(const struct irdm_fem *fem, size_t n_lowest, double sigma,
+		   irdm_progress_fn progress, void *ctx, double *w2, double *phi,
+		   char *err, size_t errlen);
 
 /*
  * Exact zero-order-hold discretisation of q'' + 2 z w q' + w^2 q = g:

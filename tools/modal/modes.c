@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "dist/dist.h"
 #include "modal/modal.h"
 
 /* Dense is cheaper than Lanczos below this many DoFs, and always used when
@@ -102,13 +103,19 @@ static int split_rigid(struct irdm_modes *out, size_t n_req, const double *w2,
 	out->n_rigid = r;
 	out->n_modes = n_req - r;
 	out->omega2 = malloc(out->n_modes * sizeof(double));
-	out->phi = malloc(n * out->n_modes * sizeof(double));
-	out->rigid_phi = malloc(n * (r ? r : 1) * sizeof(double));
-	if (!out->omega2 || !out->phi || !out->rigid_phi) {
+	if (!out->omega2) {
 		snprintf(err, errlen, "modes: out of memory");
 		return IRDM_ENOMEM;
 	}
 	memcpy(out->omega2, w2 + r, out->n_modes * sizeof(double));
+	if (!phi)       /* an MPI rank other than 0: eigenvalues only */
+		return 0;
+	out->phi = malloc(n * out->n_modes * sizeof(double));
+	out->rigid_phi = malloc(n * (r ? r : 1) * sizeof(double));
+	if (!out->phi || !out->rigid_phi) {
+		snprintf(err, errlen, "modes: out of memory");
+		return IRDM_ENOMEM;
+	}
 	memcpy(out->phi, phi + n * r, n * out->n_modes * sizeof(double));
 	memcpy(out->rigid_phi, phi, n * r * sizeof(double));
 	return 0;
@@ -143,17 +150,29 @@ int irdm_modes_solve(const struct irdm_fem *fem, size_t n_wanted, bool floating,
 				 ? IRDM_EIG_DENSE : IRDM_EIG_LANCZOS;
 	if (method == IRDM_EIG_LANCZOS && n_req * 2 + 20 > n)
 		method = IRDM_EIG_DENSE;
+	if (method == IRDM_EIG_SLEPC && n_req * 2 + 20 > n) {
+		/* every rank would hold the whole Krylov basis: no gain */
+		snprintf(err, errlen, "slepc: %zu modes of %zu DoFs are too many for a Krylov solver: "
+			 "use eigensolver = dense", n_req, n);
+		return IRDM_EINVAL;
+	}
 	w2 = malloc(n_req * sizeof(double));
-	phi = malloc(n * n_req * sizeof(double));
-	if (!w2 || !phi) {
+	/* the eigenvectors are gathered on rank 0 only */
+	if (method != IRDM_EIG_SLEPC || irdm_dist_rank() == 0)
+		phi = malloc(n * n_req * sizeof(double));
+	if (!w2 || (!phi && (method != IRDM_EIG_SLEPC || irdm_dist_rank() == 0))) {
 		snprintf(err, errlen, "modes: out of memory for %zu modes of %zu DoFs", n_req, n);
 		ret = IRDM_ENOMEM;
 		goto out_free;
 	}
 	if (progress)
-		progress(ctx, method == IRDM_EIG_DENSE ? "dense eigensolve" : "Lanczos eigensolve", 0.0);
+		progress(ctx, method == IRDM_EIG_DENSE ? "dense eigensolve"
+			 : method == IRDM_EIG_SLEPC ? "SLEPc eigensolve" : "Lanczos eigensolve", 0.0);
 	if (method == IRDM_EIG_DENSE)
 		ret = irdm_eig_dense(fem, n_req, w2, phi, err, errlen);
+	else if (method == IRDM_EIG_SLEPC)
+		ret = irdm_eig_slepc(fem, n_req, floating ? -1e-6 * scale : 0.0, progress, ctx,
+				     w2, phi, err, errlen);
 	else    /* a negative shift keeps K - sigma M definite for floating bodies */
 		ret = irdm_eig_lanczos(fem, n_req, floating ? -1e-6 * scale : 0.0, progress, ctx,
 				       w2, phi, err, errlen);

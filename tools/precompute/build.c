@@ -8,6 +8,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "dist/dist.h"
 #include "image/bvh_build.h"
 #include "image/elem_store.h"
 #include "image/image_writer.h"
@@ -647,6 +648,10 @@ int irdm_precompute(const struct irdm_scene *sc, const struct irdm_precompute_op
 	if (ret)
 		return ret;
 	b.scene_hash = irdm_fnv1a(b.scene_hash, &b.m.damping, sizeof(b.m.damping));
+	/* over MPI the ranks other than 0 are done once the eigenvectors are
+	 * gathered: rank 0 alone holds them and makes the image */
+	if (irdm_dist_rank() != 0)
+		goto out_report;
 	t1 = now_s();
 	ret = responses(&b, err, errlen);
 	if (ret)

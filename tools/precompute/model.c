@@ -5,6 +5,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "dist/dist.h"
 #include "precompute/model.h"
 
 static double now_s(void)
@@ -49,6 +50,10 @@ int irdm_model_mesh(const struct irdm_scene *sc, struct irdm_mesh *mesh, char no
 	int ret;
 
 	note[0] = '\0';
+	if (irdm_dist_fault("mesh")) {  /* the failure tests: one rank cannot read it */
+		snprintf(err, errlen, "%s: cannot read the mesh (IRDM_TEST_FAULT)", sc->mesh);
+		return IRDM_EIO;
+	}
 	if (!strcmp(sc->mesh, "cuboid")) {
 		/* the paper's cuboid: 10 x 10 x 20 cm, 11 x 11 x 22 hexes of 5 tets */
 		l[0] = l[1] = 0.1;

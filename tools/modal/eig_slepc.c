@@ -1,0 +1,290 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * Distributed shift-invert Krylov-Schur for the lowest modes (SLEPc over
+ * MPI): K and M in PETSc matrices, each rank holding its block of rows;
+ * (K - sigma M)^-1 applied through one MUMPS factorisation spread over the
+ * ranks; the eigenvectors M-normalised and gathered on rank 0 only (the
+ * other ranks get the eigenvalues).  The same problem as eig_lanczos.c's,
+ * solved by a second method: the two agree to rounding (test_slepc).
+ */
+#include <math.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "dist/dist.h"
+#include "modal/modal.h"
+
+#if IRDM_HAVE_SLEPC
+#include <slepceps.h>
+
+/* Tolerance of the eigensolve's relative residual: the serial solvers'
+ * eigenvalues are rounding-exact, this keeps SLEPc's within 1e-9. */
+#define SLEPC_TOL 1e-12
+#define SLEPC_MAX_IT 1000
+
+struct monitor_ctx {
+	irdm_progress_fn progress;
+	void *pctx;
+	PetscInt nev;
+};
+
+static PetscErrorCode monitor(EPS eps, PetscInt its, PetscInt nconv, PetscScalar *er,
+			      PetscScalar *ei, PetscReal *errest, PetscInt nest, void *ctx)
+{
+	struct monitor_ctx *m = ctx;
+
+	(void)eps;
+	(void)its;
+	(void)er;
+	(void)ei;
+	(void)errest;
+	(void)nest;
+	if (m->progress && irdm_dist_rank() == 0)
+		m->progress(m->pctx, "SLEPc Krylov-Schur", fmin(0.99, (double)nconv / (double)m->nev));
+	return 0;
+}
+
+/*
+ * This rank's rows [lo, hi) of the symmetric CSC a (both triangles stored:
+ * column j is row j) into a PETSc AIJ matrix, preallocated exactly.
+ */
+static int csc_rows_to_petsc(const struct irdm_csc *a, PetscInt lo, PetscInt hi, Mat *out,
+			     char *err, size_t errlen)
+{
+	PetscInt nloc = hi - lo, *d_nnz, *o_nnz, *cols;
+	size_t max_row = 0;
+	PetscErrorCode perr = 0;
+
+	for (PetscInt i = lo; i < hi; i++)
+		if ((size_t)(a->colptr[i + 1] - a->colptr[i]) > max_row)
+			max_row = (size_t)(a->colptr[i + 1] - a->colptr[i]);
+	d_nnz = irdm_dist_fault("oom") ? NULL : malloc(((size_t)nloc + 1) * sizeof(PetscInt));
+	o_nnz = malloc(((size_t)nloc + 1) * sizeof(PetscInt));
+	cols = malloc((max_row + 1) * sizeof(PetscInt));
+	if (!d_nnz || !o_nnz || !cols) {
+		snprintf(err, errlen, "slepc: out of memory for %ld matrix rows", (long)nloc);
+		free(d_nnz);
+		free(o_nnz);
+		free(cols);
+		return IRDM_ENOMEM;
+	}
+	for (PetscInt i = lo; i < hi; i++) {
+		d_nnz[i - lo] = o_nnz[i - lo] = 0;
+		for (int64_t p = a->colptr[i]; p < a->colptr[i + 1]; p++)
+			if (a->rowind[p] >= lo && a->rowind[p] < hi)
+				d_nnz[i - lo]++;
+			else
+				o_nnz[i - lo]++;
+	}
+	perr = MatCreateAIJ(PETSC_COMM_WORLD, nloc, nloc, (PetscInt)a->n, (PetscInt)a->n, 0, d_nnz,
+			    0, o_nnz, out);
+	for (PetscInt i = lo; i < hi && !perr; i++) {
+		PetscInt len = (PetscInt)(a->colptr[i + 1] - a->colptr[i]);
+		for (PetscInt k = 0; k < len; k++)
+			cols[k] = (PetscInt)a->rowind[a->colptr[i] + k];
+		perr = MatSetValues(*out, 1, &i, len, cols, &a->val[a->colptr[i]], INSERT_VALUES);
+	}
+	if (!perr)
+		perr = MatAssemblyBegin(*out, MAT_FINAL_ASSEMBLY);
+	if (!perr)
+		perr = MatAssemblyEnd(*out, MAT_FINAL_ASSEMBLY);
+	free(d_nnz);
+	free(o_nnz);
+	free(cols);
+	if (perr) {
+		snprintf(err, errlen, "slepc: PETSc error %d assembling a matrix", (int)perr);
+		return IRDM_ENUMERIC;
+	}
+	return IRDM_OK;
+}
+
+/* Krylov-Schur, shift-and-invert at sigma, the factorisation by MUMPS. */
+static PetscErrorCode setup_eps(EPS eps, Mat K, Mat M, PetscInt nev, double sigma,
+				struct monitor_ctx *mon)
+{
+	ST st;
+	KSP ksp;
+	PC pc;
+
+	PetscCall(EPSSetOperators(eps, K, M));
+	PetscCall(EPSSetProblemType(eps, EPS_GHEP));
+	PetscCall(EPSSetType(eps, EPSKRYLOVSCHUR));
+	PetscCall(EPSSetDimensions(eps, nev, PETSC_DEFAULT, PETSC_DEFAULT));
+	PetscCall(EPSSetTolerances(eps, SLEPC_TOL, SLEPC_MAX_IT));
+	PetscCall(EPSSetTarget(eps, sigma));
+	PetscCall(EPSSetWhichEigenpairs(eps, EPS_TARGET_MAGNITUDE));
+	PetscCall(EPSGetST(eps, &st));
+	PetscCall(STSetType(st, STSINVERT));
+	PetscCall(STGetKSP(st, &ksp));
+	PetscCall(KSPSetType(ksp, KSPPREONLY));
+	PetscCall(KSPGetPC(ksp, &pc));
+	/* K - sigma M is definite (sigma below the lowest eigenvalue) */
+	PetscCall(PCSetType(pc, PCCHOLESKY));
+	PetscCall(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
+	PetscCall(EPSMonitorSet(eps, monitor, mon, NULL));
+	/* PETSC_OPTIONS (-eps_ncv, -mat_mumps_icntl_14, ...) still tune it */
+	PetscCall(EPSSetFromOptions(eps));
+	return 0;
+}
+
+/* Sort order: ascending eigenvalue (SLEPc orders by distance to sigma). */
+struct eig_idx {
+	double w2;
+	PetscInt i;
+};
+
+static int cmp_eig(const void *a, const void *b)
+{
+	double x = ((const struct eig_idx *)a)->w2, y = ((const struct eig_idx *)b)->w2;
+
+	return (x > y) - (x < y);
+}
+
+/* Eigenpairs in ascending order: every rank the eigenvalues, rank 0 the
+ * M-normalised vectors (phi may be NULL elsewhere). */
+static PetscErrorCode extract(EPS eps, Mat M, PetscInt nev, struct eig_idx *ix, double *w2,
+			      double *phi)
+{
+	Vec x, mx, x0;
+	VecScatter to0;
+	PetscInt n;
+
+	for (PetscInt k = 0; k < nev; k++) {
+		PetscScalar kr;
+		PetscCall(EPSGetEigenvalue(eps, k, &kr, NULL));
+		ix[k] = (struct eig_idx){ PetscRealPart(kr), k };
+	}
+	qsort(ix, (size_t)nev, sizeof(*ix), cmp_eig);
+	PetscCall(MatCreateVecs(M, &x, &mx));
+	PetscCall(VecGetSize(x, &n));
+	PetscCall(VecScatterCreateToZero(x, &to0, &x0));
+	for (PetscInt k = 0; k < nev; k++) {
+		PetscScalar kr, xmx;
+		PetscCall(EPSGetEigenpair(eps, ix[k].i, &kr, NULL, x, NULL));
+		w2[k] = PetscRealPart(kr);
+		/* M-normalise here rather than rely on the solver's choice */
+		PetscCall(MatMult(M, x, mx));
+		PetscCall(VecDot(x, mx, &xmx));
+		PetscCall(VecScale(x, 1.0 / sqrt(PetscRealPart(xmx))));
+		PetscCall(VecScatterBegin(to0, x, x0, INSERT_VALUES, SCATTER_FORWARD));
+		PetscCall(VecScatterEnd(to0, x, x0, INSERT_VALUES, SCATTER_FORWARD));
+		if (phi) {
+			const PetscScalar *a;
+			PetscCall(VecGetArrayRead(x0, &a));
+			memcpy(&phi[(size_t)k * (size_t)n], a, (size_t)n * sizeof(double));
+			PetscCall(VecRestoreArrayRead(x0, &a));
+		}
+	}
+	PetscCall(VecScatterDestroy(&to0));
+	PetscCall(VecDestroy(&x0));
+	PetscCall(VecDestroy(&x));
+	PetscCall(VecDestroy(&mx));
+	return 0;
+}
+
+/* This rank's share of the n rows (PETSc's split: contiguous blocks). */
+static int my_rows(PetscInt n, PetscInt *lo, PetscInt *hi)
+{
+	PetscInt nloc = PETSC_DECIDE, end = 0;
+
+	if (PetscSplitOwnership(PETSC_COMM_WORLD, &nloc, &n))
+		return -1;
+	if (MPI_Scan(&nloc, &end, 1, MPIU_INT, MPI_SUM, PETSC_COMM_WORLD))
+		return -1;
+	*lo = end - nloc;
+	*hi = end;
+	return 0;
+}
+
+static int solve(Mat K, Mat M, PetscInt nev, double sigma, irdm_progress_fn progress, void *pctx,
+		 double *w2, double *phi, char *err, size_t errlen)
+{
+	struct monitor_ctx mon = { progress, pctx, nev };
+	struct eig_idx *ix = malloc((size_t)nev * sizeof(*ix));
+	PetscInt nconv = 0;
+	EPS eps = NULL;
+	PetscErrorCode perr;
+	int ret = IRDM_ENUMERIC;
+
+	if (!ix) {
+		snprintf(err, errlen, "slepc: out of memory");
+		return IRDM_ENOMEM;
+	}
+	perr = EPSCreate(PETSC_COMM_WORLD, &eps);
+	if (!perr)
+		perr = setup_eps(eps, K, M, nev, sigma, &mon);
+	if (irdm_dist_fault("kill"))
+		raise(SIGKILL);
+	if (!perr)
+		perr = EPSSolve(eps);
+	if (perr) {
+		const char *text = NULL;
+		PetscErrorMessage(perr, &text, NULL);
+		snprintf(err, errlen, "slepc: the eigensolve failed: %s (PETSc error %d)",
+			 text ? text : "?", (int)perr);
+		goto out_free;
+	}
+	EPSGetConverged(eps, &nconv);
+	if (nconv < nev) {
+		snprintf(err, errlen, "slepc: %ld of %ld eigenpairs converged", (long)nconv, (long)nev);
+		goto out_free;
+	}
+	if (extract(eps, M, nev, ix, w2, phi)) {
+		snprintf(err, errlen, "slepc: gathering the eigenvectors failed");
+		goto out_free;
+	}
+	ret = IRDM_OK;
+out_free:
+	EPSDestroy(&eps);
+	free(ix);
+	return ret;
+}
+
+int irdm_eig_slepc(const struct irdm_fem *fem, size_t n_lowest, double sigma,
+		   irdm_progress_fn progress, void *pctx, double *w2, double *phi,
+		   char *err, size_t errlen)
+{
+	Mat K = NULL, M = NULL;
+	PetscInt lo, hi;
+	int ret;
+
+	/* a no-op when the command started it (a singleton for a library caller) */
+	ret = irdm_dist_begin(err, errlen);
+	if (ret)
+		return ret;
+	if (my_rows((PetscInt)fem->K.n, &lo, &hi)) {
+		snprintf(err, errlen, "slepc: cannot split %zu rows over the ranks", fem->K.n);
+		return IRDM_ENUMERIC;
+	}
+	if (progress && irdm_dist_rank() == 0)
+		progress(pctx, "distributed assembly", 0.0);
+	ret = csc_rows_to_petsc(&fem->K, lo, hi, &K, err, errlen);
+	if (!ret)
+		ret = csc_rows_to_petsc(&fem->M, lo, hi, &M, err, errlen);
+	if (!ret)
+		ret = solve(K, M, (PetscInt)n_lowest, sigma, progress, pctx, w2, phi, err, errlen);
+	MatDestroy(&K);
+	MatDestroy(&M);
+	return ret;
+}
+
+#else   /* !IRDM_HAVE_SLEPC */
+
+int irdm_eig_slepc(const struct irdm_fem *fem, size_t n_lowest, double sigma,
+		   irdm_progress_fn progress, void *pctx, double *w2, double *phi,
+		   char *err, size_t errlen)
+{
+	(void)fem;
+	(void)n_lowest;
+	(void)sigma;
+	(void)progress;
+	(void)pctx;
+	(void)w2;
+	(void)phi;
+	snprintf(err, errlen, "slepc: not built in (install petsc-dev slepc-dev and rebuild)");
+	return IRDM_EINVAL;
+}
+
+#endif
