@@ -79,6 +79,10 @@ static int teardown(void **state)
 #define FIR "--mesh", "box:0.03,0.04,0.06", "--resolution", "2,3,4", "--fixed", "z<=0", \
 	"--touch", "z>=0.06", "--precision", "f64", "--representation", "fir:48", "--modes", "30"
 
+#define TIME_DOMAIN "--mesh", "box:0.03,0.04,0.06", "--resolution", "2,3,4", "--fixed", "z<=0", \
+	"--touch", "z>=0.06", "--precision", "f64", "--representation", "fir:32", \
+	"--method", "time-domain", "--substeps", "4"
+
 /* irdm precompute ARGS... -o OUT, under mpirun -np np (np 0: no mpirun). */
 static int precompute(int np, const char *out, const char *const *scene)
 {
@@ -233,6 +237,17 @@ static void test_fir_matches_dense(void **state)
 	compare_scene(ref, sl);
 }
 
+/* Time-domain inputs split over the ranks, gathered on rank 0: the serial
+ * image's responses (the serial run took all 36 inputs itself). */
+static void test_time_domain_split_over_ranks(void **state)
+{
+	const char *const ref[] = { TIME_DOMAIN, "--eigensolver", "lanczos", NULL };
+	const char *const sl[] = { TIME_DOMAIN, "--eigensolver", "slepc", NULL };
+
+	(void)state;
+	compare_scene(ref, sl);
+}
+
 /* Nothing of the image is left behind: no IMAGE, no IMAGE.tmp.* */
 static void assert_no_image(void)
 {
@@ -321,6 +336,7 @@ int main(void)
 		cmocka_unit_test_setup_teardown(test_grounded_matches_lanczos, setup, teardown),
 		cmocka_unit_test_setup_teardown(test_floating_matches_lanczos, setup, teardown),
 		cmocka_unit_test_setup_teardown(test_fir_matches_dense, setup, teardown),
+		cmocka_unit_test_setup_teardown(test_time_domain_split_over_ranks, setup, teardown),
 		cmocka_unit_test_setup_teardown(test_rank_cannot_read_mesh, setup, teardown),
 		cmocka_unit_test_setup_teardown(test_rank_out_of_memory, setup, teardown),
 		cmocka_unit_test_setup_teardown(test_rank_killed, setup, teardown),
