@@ -4,6 +4,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 
 #include "cli.h"
 #include "dist/dist.h"
@@ -262,6 +263,44 @@ static int run(const struct irdm_scene *sc, const struct irdm_precompute_opts *o
 	return 0;
 }
 
+/* Every rank's peak memory, on rank 0 (what bounds a cluster node). */
+static int say_rank_memory(const struct irdm_cli_progress *prog)
+{
+	int n = irdm_dist_size();
+	size_t *counts = calloc((size_t)n, sizeof(size_t));
+	double *all = calloc((size_t)n, sizeof(double)), mine;
+	struct rusage ru;
+	char err[256];
+	int rc = 1;
+
+	if (!counts || !all) {
+		irdm_dist_abort("precompute", IRDM_ENOMEM, "out of memory");
+		irdm_cli_fail("precompute", IRDM_ENOMEM, "out of memory");
+		goto out_free;
+	}
+	getrusage(RUSAGE_SELF, &ru);
+	mine = (double)ru.ru_maxrss / 1024.0;   /* KiB on Linux */
+	for (int r = 0; r < n; r++)
+		counts[r] = 1;
+	rc = irdm_dist_gather(&mine, counts, all, err, sizeof(err));
+	if (rc) {
+		irdm_dist_abort("precompute", rc, err);
+		irdm_cli_fail("precompute", rc, err);
+		rc = 1;
+		goto out_free;
+	}
+	if (!prog->quiet) {
+		printf("ranks         %d, peak memory per rank (MiB):", n);
+		for (int r = 0; r < n; r++)
+			printf(" %.0f", all[r]);
+		printf("\n");
+	}
+out_free:
+	free(counts);
+	free(all);
+	return rc;
+}
+
 /* eigensolver = slepc: the same run on every MPI rank (a single one without
  * mpirun); rank 0 alone shows progress and writes. */
 static int run_distributed(const struct irdm_scene *sc, const struct irdm_precompute_opts *o,
@@ -277,6 +316,8 @@ static int run_distributed(const struct irdm_scene *sc, const struct irdm_precom
 	if (irdm_dist_rank() != 0)
 		prog->quiet = 1;
 	rc = run(sc, o, prog);
+	if (!rc)
+		rc = say_rank_memory(prog);
 	if (!rc)
 		irdm_dist_wait_all();
 	irdm_dist_end();
