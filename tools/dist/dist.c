@@ -1,250 +1,149 @@
 /* SPDX-License-Identifier: MIT */
-/* MPI, PETSc and SLEPc for the precompute: start, stop, fail, gather. */
+/*
+ * The loader of the slepc plugin (dist_ops.h says why a plugin): found
+ * beside the executable (or its parent directory, for the test binaries)
+ * or at IRDM_SLEPC_PLUGIN, loaded on the first call that needs it.
+ * Without it, one rank, and the slepc eigensolver says it is not built in.
+ */
+#include <dlfcn.h>
+#include <limits.h>
 #include <stdio.h>
-#include <stdlib.h>
 #include <string.h>
-#include <time.h>
 #include <unistd.h>
 
 #include "dist/dist.h"
-#include "modal/lapack.h"
+#include "dist/dist_ops.h"
 
-static int rank_now;
-static int size_now = 1;
-static unsigned threads_now;
+static const struct irdm_dist_ops *ops;
+static bool tried;
+static char why_not[256] = "not built in";
+
+static void *open_beside_exe(const char *up)
+{
+	char path[PATH_MAX];
+	ssize_t len = readlink("/proc/self/exe", path, sizeof(path) - 1);
+	char *slash;
+
+	if (len <= 0)
+		return NULL;
+	path[len] = '\0';
+	slash = strrchr(path, '/');
+	if (!slash)
+		return NULL;
+	slash[1] = '\0';
+	if (strlen(path) + strlen(up) + sizeof(IRDM_SLEPC_PLUGIN) > sizeof(path))
+		return NULL;
+	strcat(path, up);
+	strcat(path, IRDM_SLEPC_PLUGIN);
+	return access(path, R_OK) ? NULL : dlopen(path, RTLD_NOW | RTLD_LOCAL);
+}
+
+static const struct irdm_dist_ops *load(void)
+{
+	const char *env = getenv("IRDM_SLEPC_PLUGIN");
+	irdm_slepc_plugin_fn entry;
+	void *h;
+
+	if (tried)
+		return ops;
+	tried = true;
+	h = env ? dlopen(env, RTLD_NOW | RTLD_LOCAL) : open_beside_exe("");
+	if (!h && !env)
+		h = open_beside_exe("../");
+	if (!h) {
+		const char *e = dlerror();
+		snprintf(why_not, sizeof(why_not), "not built in (%s%s)",
+			 e ? e : IRDM_SLEPC_PLUGIN " is not beside irdm",
+			 e ? "" : "; install petsc-dev slepc-dev and rebuild");
+		return NULL;
+	}
+	*(void **)&entry = dlsym(h, IRDM_SLEPC_PLUGIN_ENTRY);
+	ops = entry ? entry() : NULL;
+	if (!ops || ops->version != IRDM_DIST_OPS_VERSION) {
+		snprintf(why_not, sizeof(why_not), "%s is not this irdm's plugin", IRDM_SLEPC_PLUGIN);
+		ops = NULL;
+	}
+	/* the handle stays open: PETSc's libraries live until exit */
+	return ops;
+}
+
+bool irdm_dist_built_in(void)
+{
+	return load() != NULL;
+}
+
+int irdm_dist_begin(char *err, size_t errlen)
+{
+	if (!load()) {
+		snprintf(err, errlen, "slepc: %s", why_not);
+		return IRDM_EINVAL;
+	}
+	return ops->begin(err, errlen);
+}
+
+void irdm_dist_end(void)
+{
+	if (ops)
+		ops->end();
+}
 
 int irdm_dist_rank(void)
 {
-	return rank_now;
+	return ops ? ops->rank() : 0;
 }
 
 int irdm_dist_size(void)
 {
-	return size_now;
-}
-
-static unsigned machine_cores(void)
-{
-	long cpus = sysconf(_SC_NPROCESSORS_ONLN);
-
-	return cpus > 0 ? (unsigned)cpus : 1;
+	return ops ? ops->size() : 1;
 }
 
 unsigned irdm_dist_threads(void)
 {
-	return threads_now ? threads_now : machine_cores();
-}
+	long cpus;
 
-bool irdm_dist_fault(const char *where)
-{
-	const char *f = getenv("IRDM_TEST_FAULT");
-	char *end;
-	long r;
-
-	if (!f)
-		return false;
-	r = strtol(f, &end, 10);
-	return end != f && *end == ':' && r == rank_now && !strcmp(end + 1, where);
-}
-
-#if IRDM_HAVE_SLEPC
-#include <slepcsys.h>
-
-/*
- * The sanitizer build: OpenMPI leaks by design in plugins it unloads (some
- * within MPI_Init, the rest at MPI_Finalize), whose frames then cannot be
- * named, so no suppression could tell them from ours.  So MPI_Init's
- * allocations are not leak-checked, and the leak check runs before
- * MPI_Finalize, while the plugins are loaded: tests/lsan-mpi.supp names
- * MPI's libraries (never ours, nor PETSc's), and LSAN_OPTIONS=
- * leak_check_at_exit=0 skips the unnamed check at exit.
- */
-#if defined(__SANITIZE_ADDRESS__)
-#define IRDM_LSAN 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define IRDM_LSAN 1
-#endif
-#endif
-#ifdef IRDM_LSAN
-#include <sanitizer/lsan_interface.h>
-#define leak_check_before_finalize() __lsan_do_leak_check()
-#define leaks_ignored_begin() __lsan_disable()
-#define leaks_ignored_end() __lsan_enable()
-#else
-#define leak_check_before_finalize() ((void)0)
-#define leaks_ignored_begin() ((void)0)
-#define leaks_ignored_end() ((void)0)
-#endif
-
-static bool started;
-
-bool irdm_dist_built_in(void)
-{
-	return true;
-}
-
-/* Ranks sharing this machine, to split its cores between them. */
-static int ranks_on_this_machine(void)
-{
-	MPI_Comm node;
-	int n = 1;
-
-	if (MPI_Comm_split_type(MPI_COMM_WORLD, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL, &node))
-		return 1;
-	MPI_Comm_size(node, &n);
-	MPI_Comm_free(&node);
-	return n > 0 ? n : 1;
-}
-
-int irdm_dist_begin(char *err, size_t errlen)
-{
-	unsigned per_rank;
-	bool ok;
-
-	if (started)
-		return IRDM_OK;
-	/* our own crash reports stay ours (and the sanitizers'): PETSc's
-	 * handler would catch SIGSEGV and SIGFPE */
-	leaks_ignored_begin();
-	ok = !PetscOptionsSetValue(NULL, "-no_signal_handler", NULL) &&
-	     !SlepcInitialize(NULL, NULL, NULL, NULL);
-	leaks_ignored_end();
-	if (!ok) {
-		snprintf(err, errlen, "slepc: PETSc/SLEPc failed to start (MPI_Init?)");
-		return IRDM_ENUMERIC;
-	}
-	/* errors come back as codes, reported once with the rank by the
-	 * caller, not as PETSc's tracebacks on every rank */
-	PetscPushErrorHandler(PetscReturnErrorHandler, NULL);
-	started = true;
-	MPI_Comm_rank(MPI_COMM_WORLD, &rank_now);
-	MPI_Comm_size(MPI_COMM_WORLD, &size_now);
-	per_rank = machine_cores() / (unsigned)ranks_on_this_machine();
-	threads_now = per_rank ? per_rank : 1;
-	if ((unsigned)openblas_get_num_threads() > threads_now)
-		openblas_set_num_threads((int)threads_now);
-	return IRDM_OK;
-}
-
-void irdm_dist_end(void)
-{
-	if (!started)
-		return;
-	PetscPopErrorHandler();
-	leak_check_before_finalize();
-	SlepcFinalize();
-	started = false;
-	rank_now = 0;
-	size_now = 1;
-	threads_now = 0;
+	if (ops)
+		return ops->threads();
+	cpus = sysconf(_SC_NPROCESSORS_ONLN);
+	return cpus > 0 ? (unsigned)cpus : 1;
 }
 
 void irdm_dist_abort(const char *cmd, int code, const char *reason)
 {
-	if (!started || size_now < 2)
+	char line[1400];
+
+	if (!ops || ops->size() < 2)
 		return;
-	fprintf(stderr, "irdm %s: rank %d of %d: %s: %s\n", cmd, rank_now, size_now,
-		irdm_errname(code), reason);
-	fflush(stderr);
-	MPI_Abort(MPI_COMM_WORLD, 1);
-	_exit(1);       /* MPI_Abort does not return; if it did, still stop */
+	snprintf(line, sizeof(line), "irdm %s: rank %d of %d: %s: %s", cmd, ops->rank(),
+		 ops->size(), irdm_errname(code), reason);
+	ops->abort(line);
 }
 
 void irdm_dist_wait_all(void)
 {
-	const struct timespec nap = { 0, 2000000 };     /* 2 ms */
-	MPI_Request req;
-	int done = 0;
-
-	if (!started || size_now < 2)
-		return;
-	if (MPI_Ibarrier(MPI_COMM_WORLD, &req))
-		return;
-	while (!done && !MPI_Test(&req, &done, MPI_STATUS_IGNORE))
-		if (!done)
-			nanosleep(&nap, NULL);
+	if (ops)
+		ops->wait_all();
 }
 
 int irdm_dist_gather(const double *mine, const size_t *counts, double *all,
 		     char *err, size_t errlen)
 {
-	int *cnt = NULL, *off = NULL, ret = IRDM_ENUMERIC;
-	size_t total = 0;
-
-	if (!started || size_now < 2) {
-		if (counts[0])
-			memmove(all, mine, counts[0] * sizeof(double));
-		return IRDM_OK;
-	}
-	cnt = malloc((size_t)size_now * sizeof(int));
-	off = malloc((size_t)size_now * sizeof(int));
-	if (!cnt || !off) {
-		snprintf(err, errlen, "gather: out of memory");
-		ret = IRDM_ENOMEM;
-		goto out_free;
-	}
-	for (int r = 0; r < size_now; r++) {
-		/* MPI counts are int: a block beyond 2^31 doubles must be split by
-		 * more ranks (16 GiB a rank) */
-		if (counts[r] > 0x7fffffff || total > 0x7fffffff - counts[r]) {
-			snprintf(err, errlen, "gather: %zu doubles from rank %d exceed MPI's int counts: use more ranks",
-				 counts[r], r);
-			ret = IRDM_ERANGE;
-			goto out_free;
-		}
-		cnt[r] = (int)counts[r];
-		off[r] = (int)total;
-		total += counts[r];
-	}
-	if (MPI_Gatherv(mine, cnt[rank_now], MPI_DOUBLE, all, cnt, off, MPI_DOUBLE, 0,
-			MPI_COMM_WORLD)) {
-		snprintf(err, errlen, "gather: MPI_Gatherv failed");
-		goto out_free;
-	}
-	ret = IRDM_OK;
-out_free:
-	free(cnt);
-	free(off);
-	return ret;
-}
-
-#else   /* !IRDM_HAVE_SLEPC: one rank, and the option says why not more */
-
-bool irdm_dist_built_in(void)
-{
-	return false;
-}
-
-int irdm_dist_begin(char *err, size_t errlen)
-{
-	snprintf(err, errlen, "slepc: not built in (install petsc-dev slepc-dev and rebuild)");
-	return IRDM_EINVAL;
-}
-
-void irdm_dist_end(void)
-{
-}
-
-void irdm_dist_abort(const char *cmd, int code, const char *reason)
-{
-	(void)cmd;
-	(void)code;
-	(void)reason;
-}
-
-void irdm_dist_wait_all(void)
-{
-}
-
-int irdm_dist_gather(const double *mine, const size_t *counts, double *all,
-		     char *err, size_t errlen)
-{
-	(void)err;
-	(void)errlen;
+	if (ops)
+		return ops->gather(mine, counts, all, err, errlen);
 	if (counts[0])
 		memmove(all, mine, counts[0] * sizeof(double));
 	return IRDM_OK;
 }
 
-#endif
+bool irdm_dist_fault(const char *where)
+{
+	return irdm_dist_fault_at(irdm_dist_rank(), where);
+}
+
+int irdm_eig_slepc(const struct irdm_fem *fem, size_t n_lowest, double sigma,
+		   irdm_progress_fn progress, void *ctx, double *w2, double *phi,
+		   char *err, size_t errlen)
+{
+	int ret = irdm_dist_begin(err, errlen);
+
+	return ret ? ret : ops->eig(fem, n_lowest, sigma, progress, ctx, w2, phi, err, errlen);
+}

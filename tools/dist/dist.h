@@ -6,9 +6,10 @@
  * rank 0.  Started only when the scene asks for the slepc eigensolver, so
  * every other command runs as before (no MPI_Init, no PETSc).
  *
- * A build without PETSc/SLEPc (IRDM_HAVE_SLEPC=0) has the same functions:
- * irdm_dist_begin() then fails with "not built in", and everything else
- * answers as a single rank.
+ * PETSc, SLEPc and MPI live in a plugin, irdm-slepc.so (dist_ops.h), that
+ * these functions load when first needed.  Without it (a build without
+ * PETSc/SLEPc) irdm_dist_begin() fails with "not built in", and everything
+ * else answers as a single rank.
  */
 #ifndef IRDM_TOOLS_DIST_H
 #define IRDM_TOOLS_DIST_H

@@ -14,10 +14,8 @@
 #include <string.h>
 #include <time.h>
 
-#include "dist/dist.h"
-#include "modal/modal.h"
+#include "dist/plugin/plugin.h"
 
-#if IRDM_HAVE_SLEPC
 #include <slepceps.h>
 
 /* Tolerance of the eigensolve's relative residual: the serial solvers'
@@ -45,12 +43,12 @@ static void say_times(const struct monitor_ctx *m, const double t[5])
 {
 	char line[256];
 
-	if (!m->progress || irdm_dist_rank() != 0)
+	if (!m->progress || irdm_mpi_rank() != 0)
 		return;
 	snprintf(line, sizeof(line),
 		 "slepc on %d rank%s: assembly %.2f s, MUMPS factorisation %.2f s, "
-		 "Krylov-Schur %.2f s, gather %.2f s", irdm_dist_size(),
-		 irdm_dist_size() > 1 ? "s" : "", t[1] - t[0], t[2] - t[1], t[3] - t[2],
+		 "Krylov-Schur %.2f s, gather %.2f s", irdm_mpi_size(),
+		 irdm_mpi_size() > 1 ? "s" : "", t[1] - t[0], t[2] - t[1], t[3] - t[2],
 		 t[4] - t[3]);
 	m->progress(m->pctx, line, -1.0);
 }
@@ -66,7 +64,7 @@ static PetscErrorCode monitor(EPS eps, PetscInt its, PetscInt nconv, PetscScalar
 	(void)ei;
 	(void)errest;
 	(void)nest;
-	if (m->progress && irdm_dist_rank() == 0)
+	if (m->progress && irdm_mpi_rank() == 0)
 		m->progress(m->pctx, "SLEPc Krylov-Schur", fmin(0.99, (double)nconv / (double)m->nev));
 	return 0;
 }
@@ -85,7 +83,7 @@ static int csc_rows_to_petsc(const struct irdm_csc *a, PetscInt lo, PetscInt hi,
 	for (PetscInt i = lo; i < hi; i++)
 		if ((size_t)(a->colptr[i + 1] - a->colptr[i]) > max_row)
 			max_row = (size_t)(a->colptr[i + 1] - a->colptr[i]);
-	d_nnz = irdm_dist_fault("oom") ? NULL : malloc(((size_t)nloc + 1) * sizeof(PetscInt));
+	d_nnz = irdm_mpi_fault("oom") ? NULL : malloc(((size_t)nloc + 1) * sizeof(PetscInt));
 	o_nnz = malloc(((size_t)nloc + 1) * sizeof(PetscInt));
 	cols = malloc((max_row + 1) * sizeof(PetscInt));
 	if (!d_nnz || !o_nnz || !cols) {
@@ -242,7 +240,7 @@ static int solve(Mat K, Mat M, PetscInt nev, double sigma, struct monitor_ctx *m
 	perr = EPSCreate(PETSC_COMM_WORLD, &eps);
 	if (!perr)
 		perr = setup_eps(eps, K, M, nev, sigma, mon);
-	if (irdm_dist_fault("kill"))
+	if (irdm_mpi_fault("kill"))
 		raise(SIGKILL);
 	if (!perr)      /* the shift-and-invert factorisation */
 		perr = EPSSetUp(eps);
@@ -274,7 +272,7 @@ out_free:
 	return ret;
 }
 
-int irdm_eig_slepc(const struct irdm_fem *fem, size_t n_lowest, double sigma,
+int irdm_slepc_eig(const struct irdm_fem *fem, size_t n_lowest, double sigma,
 		   irdm_progress_fn progress, void *pctx, double *w2, double *phi,
 		   char *err, size_t errlen)
 {
@@ -285,14 +283,14 @@ int irdm_eig_slepc(const struct irdm_fem *fem, size_t n_lowest, double sigma,
 	int ret;
 
 	/* a no-op when the command started it (a singleton for a library caller) */
-	ret = irdm_dist_begin(err, errlen);
+	ret = irdm_mpi_begin(err, errlen);
 	if (ret)
 		return ret;
 	if (my_rows((PetscInt)fem->K.n, &lo, &hi)) {
 		snprintf(err, errlen, "slepc: cannot split %zu rows over the ranks", fem->K.n);
 		return IRDM_ENUMERIC;
 	}
-	if (progress && irdm_dist_rank() == 0)
+	if (progress && irdm_mpi_rank() == 0)
 		progress(pctx, "distributed assembly", 0.0);
 	ret = csc_rows_to_petsc(&fem->K, lo, hi, &K, err, errlen);
 	if (!ret)
@@ -305,22 +303,3 @@ int irdm_eig_slepc(const struct irdm_fem *fem, size_t n_lowest, double sigma,
 	MatDestroy(&M);
 	return ret;
 }
-
-#else   /* !IRDM_HAVE_SLEPC */
-
-int irdm_eig_slepc(const struct irdm_fem *fem, size_t n_lowest, double sigma,
-		   irdm_progress_fn progress, void *pctx, double *w2, double *phi,
-		   char *err, size_t errlen)
-{
-	(void)fem;
-	(void)n_lowest;
-	(void)sigma;
-	(void)progress;
-	(void)pctx;
-	(void)w2;
-	(void)phi;
-	snprintf(err, errlen, "slepc: not built in (install petsc-dev slepc-dev and rebuild)");
-	return IRDM_EINVAL;
-}
-
-#endif
