@@ -7,6 +7,7 @@
 #                   any finding fails the build and keeps the input
 #   make check      what CI runs: fuzz, clang + sanitizer tests, then the tests
 #   make bench      benchmarks (print figures; never pass/fail on time)
+#   make bench-mpi  the precompute of a 100k-node model, serial and over MPI ranks
 #   make run        the main job: the built-in default scene, end to end
 #   make jitter     irdm-fw's wake-up latency beside cyclictest's (JITTER_SECONDS)
 #   make hil        the CAN back-end end to end in a PREEMPT_RT VM (docs/hil.md)
@@ -117,7 +118,7 @@ TESTS    := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 TICK_TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TICK_TEST_SRC))
 BENCHES  := $(patsubst tests/bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC))
 
-.PHONY: all test san fuzz bench bench-precompute run jitter check deps clean docs cfg-fws sizes hil
+.PHONY: all test san fuzz bench bench-precompute bench-mpi run jitter check deps clean docs cfg-fws sizes hil
 .SECONDARY:
 all: $(if $(CONFIG),,$(IRDM) $(SLEPC_PLUGIN)) $(FW_LIB) $(HAL_LIB) $(SIM_LIB) $(if $(FWMAIN_SRC),$(IRDM_FW)) \
   $(if $(CDMAIN_SRC),$(IRDM_CD))
@@ -251,6 +252,11 @@ bench: $(BENCHES) $(IRDM) bench-precompute
 # Paper-scale images (cuboid, bunny): time and size beside the paper's.
 bench-precompute: $(IRDM) $(BUILD)/data/bunny.off
 	tools/scripts/bench-precompute.sh $(IRDM)
+
+# The precompute over MPI ranks: a 100k-node cuboid, serial and slepc on
+# np = 1, 2 (README, "Beyond one machine"); bounded by TIMEOUT per run.
+bench-mpi: $(IRDM) $(SLEPC_PLUGIN)
+	tools/scripts/bench-mpi.sh $(IRDM)
 
 $(BUILD)/data/bunny.off:
 	@mkdir -p $(dir $@)
