@@ -47,7 +47,7 @@ static void say_times(const struct monitor_ctx *m, const double t[5])
 		return;
 	snprintf(line, sizeof(line),
 		 "slepc on %d rank%s: assembly %.2f s, MUMPS factorisation %.2f s, "
-		 "Krylov-Schur %.2f s, gather %.2f s", irdm_mpi_size(),
+		 "Krylov-Schur %.2f s, eigenvectors to rank 0 %.2f s", irdm_mpi_size(),
 		 irdm_mpi_size() > 1 ? "s" : "", t[1] - t[0], t[2] - t[1], t[3] - t[2],
 		 t[4] - t[3]);
 	m->progress(m->pctx, line, -1.0);
