@@ -20,6 +20,7 @@
 #include "precompute/precompute.h"
 #include "precompute/td_part.h"
 #include "timedomain/timedomain.h"
+#include "util/clock.h"
 #include "util/fnv1a.h"
 
 struct build {
@@ -40,14 +41,6 @@ struct build {
 	char *prov;
 	uint64_t scene_hash;
 };
-
-static double now_s(void)
-{
-	struct timespec ts;
-
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 /* Modes the scene needs solved (0: all). */
 static size_t modes_needed(const struct irdm_scene *sc)
@@ -682,7 +675,7 @@ int irdm_precompute(const struct irdm_scene *sc, const struct irdm_precompute_op
 		    struct irdm_precompute_report *rep, char *err, size_t errlen)
 {
 	struct build b = { .sc = sc, .o = o };
-	double t0 = now_s(), t1;
+	double t0 = irdm_now_s(), t1;
 	int ret;
 
 	memset(rep, 0, sizeof(*rep));
@@ -699,19 +692,19 @@ int irdm_precompute(const struct irdm_scene *sc, const struct irdm_precompute_op
 			ret = td_distributed(&b, list_inputs(&b.m, NULL, NULL), err, errlen);
 		goto out_worker;
 	}
-	t1 = now_s();
+	t1 = irdm_now_s();
 	ret = responses(&b, err, errlen);
 	if (ret)
 		goto out_free;
-	rep->seconds_responses = now_s() - t1;
+	rep->seconds_responses = irdm_now_s() - t1;
 	if (o->part_out)
 		goto out_report;
 	fill_meta(&b);
-	t1 = now_s();
+	t1 = irdm_now_s();
 	ret = stability(&b, err, errlen);
 	if (ret)
 		goto out_free;
-	rep->seconds_stability = now_s() - t1;
+	rep->seconds_stability = irdm_now_s() - t1;
 	ret = fill_nodes_rigid(&b);
 	if (!ret)
 		ret = provenance(&b);
@@ -726,7 +719,7 @@ int irdm_precompute(const struct irdm_scene *sc, const struct irdm_precompute_op
 out_report:
 	report(&b, rep);
 out_worker:
-	rep->seconds_total = now_s() - t0;
+	rep->seconds_total = irdm_now_s() - t0;
 out_free:
 	build_free(&b);
 	return ret;

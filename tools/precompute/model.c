@@ -7,14 +7,7 @@
 
 #include "dist/dist.h"
 #include "precompute/model.h"
-
-static double now_s(void)
-{
-	struct timespec ts;
-
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
+#include "util/clock.h"
 
 /*
  * A mesh file; a surface is sized (target_nodes, max_tet_volume) unless the
@@ -146,7 +139,7 @@ int irdm_model_build(const struct irdm_scene *sc, size_t n_modes_needed,
 		     irdm_progress_fn progress, void *ctx, struct irdm_model *m,
 		     char *err, size_t errlen)
 {
-	double t0 = now_s();
+	double t0 = irdm_now_s();
 	int ret;
 
 	memset(m, 0, sizeof(*m));
@@ -169,18 +162,18 @@ int irdm_model_build(const struct irdm_scene *sc, size_t n_modes_needed,
 	if (ret)
 		goto out_fail;
 	say_stats(&m->mesh, progress, ctx);
-	m->seconds_mesh = now_s() - t0;
-	t0 = now_s();
+	m->seconds_mesh = irdm_now_s() - t0;
+	t0 = irdm_now_s();
 	ret = irdm_fem_assemble(&m->mesh, &sc->mat, sc->mass, m->fixed, &m->fem, err, errlen);
 	if (ret)
 		goto out_fail;
-	m->seconds_fem = now_s() - t0;
-	t0 = now_s();
+	m->seconds_fem = irdm_now_s() - t0;
+	t0 = irdm_now_s();
 	ret = irdm_modes_solve(&m->fem, n_modes_needed, sc->floating, sc->eigensolver, progress,
 			       ctx, &m->modes, err, errlen);
 	if (ret)
 		goto out_fail;
-	m->seconds_eig = now_s() - t0;
+	m->seconds_eig = irdm_now_s() - t0;
 	ret = pick_damping(sc, m, err, errlen);
 	if (ret)
 		goto out_fail;

@@ -15,6 +15,7 @@
 #include <time.h>
 
 #include "dist/plugin/plugin.h"
+#include "util/clock.h"
 
 #include <slepceps.h>
 
@@ -28,14 +29,6 @@ struct monitor_ctx {
 	void *pctx;
 	PetscInt nev;
 };
-
-static double now_s(void)
-{
-	struct timespec ts;
-
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 /* Where the time went, as a line of the progress (rank 0): what a user
  * extrapolates from (README, "Beyond one machine"). */
@@ -236,7 +229,7 @@ static int solve(Mat K, Mat M, PetscInt nev, double sigma, struct monitor_ctx *m
 		snprintf(err, errlen, "slepc: out of memory");
 		return IRDM_ENOMEM;
 	}
-	t[1] = now_s();
+	t[1] = irdm_now_s();
 	perr = EPSCreate(PETSC_COMM_WORLD, &eps);
 	if (!perr)
 		perr = setup_eps(eps, K, M, nev, sigma, mon);
@@ -244,10 +237,10 @@ static int solve(Mat K, Mat M, PetscInt nev, double sigma, struct monitor_ctx *m
 		raise(SIGKILL);
 	if (!perr)      /* the shift-and-invert factorisation */
 		perr = EPSSetUp(eps);
-	t[2] = now_s();
+	t[2] = irdm_now_s();
 	if (!perr)
 		perr = EPSSolve(eps);
-	t[3] = now_s();
+	t[3] = irdm_now_s();
 	if (perr) {
 		const char *text = NULL;
 		PetscErrorMessage(perr, &text, NULL);
@@ -264,7 +257,7 @@ static int solve(Mat K, Mat M, PetscInt nev, double sigma, struct monitor_ctx *m
 		snprintf(err, errlen, "slepc: gathering the eigenvectors failed");
 		goto out_free;
 	}
-	t[4] = now_s();
+	t[4] = irdm_now_s();
 	ret = IRDM_OK;
 out_free:
 	EPSDestroy(&eps);
@@ -279,7 +272,7 @@ int irdm_slepc_eig(const struct irdm_fem *fem, size_t n_lowest, double sigma,
 	struct monitor_ctx mon = { progress, pctx, (PetscInt)n_lowest };
 	Mat K = NULL, M = NULL;
 	PetscInt lo, hi;
-	double t[5] = { now_s(), 0, 0, 0, 0 };
+	double t[5] = { irdm_now_s(), 0, 0, 0, 0 };
 	int ret;
 
 	/* a no-op when the command started it (a singleton for a library caller) */
