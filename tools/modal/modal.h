@@ -46,6 +46,16 @@ typedef void (*irdm_progress_fn)(void *ctx, const char *stage, double fraction);
 int irdm_modes_solve(const struct irdm_fem *fem, size_t n_wanted, bool floating,
 		     enum irdm_eig_method method, irdm_progress_fn progress, void *ctx,
 		     struct irdm_modes *out, char *err, size_t errlen);
+/*
+ * The same; keep (n entries, NULL: all) marks the free DoFs whose elastic
+ * eigenvector entries the caller will read.  Over MPI (IRDM_EIG_SLEPC)
+ * only those cross the network to rank 0, whose other entries are NaN so
+ * that a stray read shows; rigid modes always come whole.
+ */
+int irdm_modes_solve_kept(const struct irdm_fem *fem, size_t n_wanted, bool floating,
+			  enum irdm_eig_method method, const bool *keep,
+			  irdm_progress_fn progress, void *ctx, struct irdm_modes *out,
+			  char *err, size_t errlen);
 void irdm_modes_free(struct irdm_modes *m);
 
 /* Internal solvers (exposed for tests: a second method to compare with). */
@@ -56,10 +66,12 @@ int irdm_eig_lanczos(const struct irdm_fem *fem, size_t n_lowest, double sigma,
 		     char *err, size_t errlen);
 /* The same by SLEPc (Krylov-Schur, shift-invert through MUMPS) over the
  * MPI ranks (started here if the caller did not): every rank gets w2,
- * rank 0 alone phi (NULL elsewhere).  Collective: every rank calls it. */
+ * rank 0 alone phi (NULL elsewhere): the first n_whole vectors whole, the
+ * others at the DoFs keep marks (NULL: all), NaN elsewhere.  Collective:
+ * every rank calls it. */
 int irdm_eig_slepc(const struct irdm_fem *fem, size_t n_lowest, double sigma,
-		   irdm_progress_fn progress, void *ctx, double *w2, double *phi,
-		   char *err, size_t errlen);
+		   const bool *keep, size_t n_whole, irdm_progress_fn progress, void *ctx,
+		   double *w2, double *phi, char *err, size_t errlen);
 
 /*
  * Exact zero-order-hold discretisation of q'' + 2 z w q' + w^2 q = g:

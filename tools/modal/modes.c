@@ -125,6 +125,15 @@ int irdm_modes_solve(const struct irdm_fem *fem, size_t n_wanted, bool floating,
 		     enum irdm_eig_method method, irdm_progress_fn progress, void *ctx,
 		     struct irdm_modes *out, char *err, size_t errlen)
 {
+	return irdm_modes_solve_kept(fem, n_wanted, floating, method, NULL, progress, ctx, out,
+				     err, errlen);
+}
+
+int irdm_modes_solve_kept(const struct irdm_fem *fem, size_t n_wanted, bool floating,
+			  enum irdm_eig_method method, const bool *keep,
+			  irdm_progress_fn progress, void *ctx, struct irdm_modes *out,
+			  char *err, size_t errlen)
+{
 	size_t n = fem->K.n, n_rigid = floating ? 6 : 0, n_req;
 	double max_scale, scale = typical_scale(fem, &max_scale);
 	double *w2 = NULL, *phi = NULL;
@@ -171,8 +180,8 @@ int irdm_modes_solve(const struct irdm_fem *fem, size_t n_wanted, bool floating,
 	if (method == IRDM_EIG_DENSE)
 		ret = irdm_eig_dense(fem, n_req, w2, phi, err, errlen);
 	else if (method == IRDM_EIG_SLEPC)
-		ret = irdm_eig_slepc(fem, n_req, floating ? -1e-6 * scale : 0.0, progress, ctx,
-				     w2, phi, err, errlen);
+		ret = irdm_eig_slepc(fem, n_req, floating ? -1e-6 * scale : 0.0, keep, n_rigid,
+				     progress, ctx, w2, phi, err, errlen);
 	else    /* a negative shift keeps K - sigma M definite for floating bodies */
 		ret = irdm_eig_lanczos(fem, n_req, floating ? -1e-6 * scale : 0.0, progress, ctx,
 				       w2, phi, err, errlen);

@@ -135,11 +135,29 @@ static void say_stats(const struct irdm_mesh *mesh, irdm_progress_fn progress, v
 		progress(ctx, lines[i], -1.0);
 }
 
+/* The free DoFs of the scene's rows and columns: all the image reads of an
+ * elastic mode (shapes, static correction, FIR from modes). */
+static bool *kept_dofs(const struct irdm_model *m)
+{
+	bool *keep = calloc(m->fem.map.n_free ? m->fem.map.n_free : 1, sizeof(bool));
+
+	if (!keep)
+		return NULL;
+	for (size_t r = 0; r < 3 * m->n_rows; r++)
+		if (m->row_dofs[r] >= 0)
+			keep[m->row_dofs[r]] = true;
+	for (size_t c = 0; c < 3 * m->n_cols; c++)
+		if (m->col_dofs[c] >= 0)
+			keep[m->col_dofs[c]] = true;
+	return keep;
+}
+
 int irdm_model_build(const struct irdm_scene *sc, size_t n_modes_needed,
 		     irdm_progress_fn progress, void *ctx, struct irdm_model *m,
 		     char *err, size_t errlen)
 {
 	double t0 = irdm_now_s();
+	bool *keep;
 	int ret;
 
 	memset(m, 0, sizeof(*m));
@@ -169,15 +187,24 @@ int irdm_model_build(const struct irdm_scene *sc, size_t n_modes_needed,
 		goto out_fail;
 	m->seconds_fem = irdm_now_s() - t0;
 	t0 = irdm_now_s();
-	ret = irdm_modes_solve(&m->fem, n_modes_needed, sc->floating, sc->eigensolver, progress,
-			       ctx, &m->modes, err, errlen);
+	/* the scene's rows and columns before the eigensolve: over MPI only
+	 * their eigenvector entries cross the network */
+	ret = irdm_model_select(sc, m, err, errlen);
+	if (ret)
+		goto out_fail;
+	keep = kept_dofs(m);
+	if (!keep) {
+		snprintf(err, errlen, "model: out of memory");
+		ret = IRDM_ENOMEM;
+		goto out_fail;
+	}
+	ret = irdm_modes_solve_kept(&m->fem, n_modes_needed, sc->floating, sc->eigensolver, keep,
+				    progress, ctx, &m->modes, err, errlen);
+	free(keep);
 	if (ret)
 		goto out_fail;
 	m->seconds_eig = irdm_now_s() - t0;
 	ret = pick_damping(sc, m, err, errlen);
-	if (ret)
-		goto out_fail;
-	ret = irdm_model_select(sc, m, err, errlen);
 	if (ret)
 		goto out_fail;
 	return IRDM_OK;

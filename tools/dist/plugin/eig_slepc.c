@@ -158,14 +158,66 @@ static int cmp_eig(const void *a, const void *b)
 	return (x > y) - (x < y);
 }
 
-/* Eigenpairs in ascending order: every rank the eigenvalues, rank 0 the
- * M-normalised vectors (phi may be NULL elsewhere). */
-static PetscErrorCode extract(EPS eps, Mat M, PetscInt nev, struct eig_idx *ix, double *w2,
-			      double *phi)
+/*
+ * The scatter of the kept DoFs to rank 0 (keep NULL: all of them): into xk,
+ * of length n_keep on rank 0 and 0 elsewhere; idx (rank 0) their indices.
+ */
+static PetscErrorCode kept_scatter(Vec x, const bool *keep, PetscInt n, VecScatter *sc, Vec *xk,
+				   PetscInt **idx, PetscInt *n_keep)
 {
-	Vec x, mx, x0;
-	VecScatter to0;
-	PetscInt n;
+	IS from, to;
+
+	*n_keep = 0;
+	*idx = NULL;
+	if (irdm_mpi_rank() == 0) {
+		PetscCall(PetscMalloc1(n ? n : 1, idx));
+		for (PetscInt i = 0; i < n; i++)
+			if (!keep || keep[i])
+				(*idx)[(*n_keep)++] = i;
+	}
+	PetscCall(ISCreateGeneral(PETSC_COMM_SELF, *n_keep, *idx, PETSC_USE_POINTER, &from));
+	PetscCall(ISCreateStride(PETSC_COMM_SELF, *n_keep, 0, 1, &to));
+	PetscCall(VecCreateSeq(PETSC_COMM_SELF, *n_keep, xk));
+	PetscCall(VecScatterCreate(x, from, *xk, to, sc));
+	PetscCall(ISDestroy(&from));
+	PetscCall(ISDestroy(&to));
+	return 0;
+}
+
+/* x (M-normalised here rather than by the solver's choice) to rank 0's
+ * column dst of n: the whole vector, or the kept DoFs and NaN elsewhere. */
+static PetscErrorCode send_vector(Vec x, Mat M, Vec mx, VecScatter sc, Vec xk,
+				  const PetscInt *idx, PetscInt n_keep, PetscInt n, double *dst)
+{
+	const PetscScalar *a;
+	PetscScalar xmx;
+
+	PetscCall(MatMult(M, x, mx));
+	PetscCall(VecDot(x, mx, &xmx));
+	PetscCall(VecScale(x, 1.0 / sqrt(PetscRealPart(xmx))));
+	PetscCall(VecScatterBegin(sc, x, xk, INSERT_VALUES, SCATTER_FORWARD));
+	PetscCall(VecScatterEnd(sc, x, xk, INSERT_VALUES, SCATTER_FORWARD));
+	if (!dst)
+		return 0;
+	if (n_keep < n)
+		for (PetscInt i = 0; i < n; i++)
+			dst[i] = NAN;
+	PetscCall(VecGetArrayRead(xk, &a));
+	for (PetscInt i = 0; i < n_keep; i++)
+		dst[idx[i]] = a[i];
+	PetscCall(VecRestoreArrayRead(xk, &a));
+	return 0;
+}
+
+/* Eigenpairs in ascending order: every rank the eigenvalues, rank 0 the
+ * vectors (phi may be NULL elsewhere): the first n_whole whole, the rest at
+ * the kept DoFs only, which alone cross the network. */
+static PetscErrorCode extract(EPS eps, Mat M, PetscInt nev, const bool *keep, PetscInt n_whole,
+			      struct eig_idx *ix, double *w2, double *phi)
+{
+	Vec x, mx, x_all, x_kept;
+	VecScatter to_all, to_kept;
+	PetscInt n, n_all, n_kept, *idx_all, *idx_kept;
 
 	for (PetscInt k = 0; k < nev; k++) {
 		PetscScalar kr;
@@ -175,26 +227,23 @@ static PetscErrorCode extract(EPS eps, Mat M, PetscInt nev, struct eig_idx *ix, 
 	qsort(ix, (size_t)nev, sizeof(*ix), cmp_eig);
 	PetscCall(MatCreateVecs(M, &x, &mx));
 	PetscCall(VecGetSize(x, &n));
-	PetscCall(VecScatterCreateToZero(x, &to0, &x0));
+	PetscCall(kept_scatter(x, NULL, n, &to_all, &x_all, &idx_all, &n_all));
+	PetscCall(kept_scatter(x, keep, n, &to_kept, &x_kept, &idx_kept, &n_kept));
 	for (PetscInt k = 0; k < nev; k++) {
-		PetscScalar kr, xmx;
+		PetscScalar kr;
+		bool whole = k < n_whole;
 		PetscCall(EPSGetEigenpair(eps, ix[k].i, &kr, NULL, x, NULL));
 		w2[k] = PetscRealPart(kr);
-		/* M-normalise here rather than rely on the solver's choice */
-		PetscCall(MatMult(M, x, mx));
-		PetscCall(VecDot(x, mx, &xmx));
-		PetscCall(VecScale(x, 1.0 / sqrt(PetscRealPart(xmx))));
-		PetscCall(VecScatterBegin(to0, x, x0, INSERT_VALUES, SCATTER_FORWARD));
-		PetscCall(VecScatterEnd(to0, x, x0, INSERT_VALUES, SCATTER_FORWARD));
-		if (phi) {
-			const PetscScalar *a;
-			PetscCall(VecGetArrayRead(x0, &a));
-			memcpy(&phi[(size_t)k * (size_t)n], a, (size_t)n * sizeof(double));
-			PetscCall(VecRestoreArrayRead(x0, &a));
-		}
+		PetscCall(send_vector(x, M, mx, whole ? to_all : to_kept, whole ? x_all : x_kept,
+				      whole ? idx_all : idx_kept, whole ? n_all : n_kept, n,
+				      phi ? &phi[(size_t)k * (size_t)n] : NULL));
 	}
-	PetscCall(VecScatterDestroy(&to0));
-	PetscCall(VecDestroy(&x0));
+	PetscCall(VecScatterDestroy(&to_all));
+	PetscCall(VecScatterDestroy(&to_kept));
+	PetscCall(VecDestroy(&x_all));
+	PetscCall(VecDestroy(&x_kept));
+	PetscCall(PetscFree(idx_all));
+	PetscCall(PetscFree(idx_kept));
 	PetscCall(VecDestroy(&x));
 	PetscCall(VecDestroy(&mx));
 	return 0;
@@ -216,8 +265,9 @@ static int my_rows(PetscInt n, PetscInt *lo, PetscInt *hi)
 
 /* t[0] is set (assembly's start); t[1..4]: assembled, factorised, solved,
  * gathered. */
-static int solve(Mat K, Mat M, PetscInt nev, double sigma, struct monitor_ctx *mon, double t[5],
-		 double *w2, double *phi, char *err, size_t errlen)
+static int solve(Mat K, Mat M, PetscInt nev, double sigma, const bool *keep, PetscInt n_whole,
+		 struct monitor_ctx *mon, double t[5], double *w2, double *phi, char *err,
+		 size_t errlen)
 {
 	struct eig_idx *ix = malloc((size_t)nev * sizeof(*ix));
 	PetscInt nconv = 0;
@@ -253,7 +303,7 @@ static int solve(Mat K, Mat M, PetscInt nev, double sigma, struct monitor_ctx *m
 		snprintf(err, errlen, "slepc: %ld of %ld eigenpairs converged", (long)nconv, (long)nev);
 		goto out_free;
 	}
-	if (extract(eps, M, nev, ix, w2, phi)) {
+	if (extract(eps, M, nev, keep, n_whole, ix, w2, phi)) {
 		snprintf(err, errlen, "slepc: gathering the eigenvectors failed");
 		goto out_free;
 	}
@@ -266,8 +316,8 @@ out_free:
 }
 
 int irdm_slepc_eig(const struct irdm_fem *fem, size_t n_lowest, double sigma,
-		   irdm_progress_fn progress, void *pctx, double *w2, double *phi,
-		   char *err, size_t errlen)
+		   const bool *keep, size_t n_whole, irdm_progress_fn progress, void *pctx,
+		   double *w2, double *phi, char *err, size_t errlen)
 {
 	struct monitor_ctx mon = { progress, pctx, (PetscInt)n_lowest };
 	Mat K = NULL, M = NULL;
@@ -289,7 +339,8 @@ int irdm_slepc_eig(const struct irdm_fem *fem, size_t n_lowest, double sigma,
 	if (!ret)
 		ret = csc_rows_to_petsc(&fem->M, lo, hi, &M, err, errlen);
 	if (!ret)
-		ret = solve(K, M, (PetscInt)n_lowest, sigma, &mon, t, w2, phi, err, errlen);
+		ret = solve(K, M, (PetscInt)n_lowest, sigma, keep, (PetscInt)n_whole, &mon, t, w2,
+			    phi, err, errlen);
 	if (!ret)
 		say_times(&mon, t);
 	MatDestroy(&K);
