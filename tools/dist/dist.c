@@ -140,11 +140,12 @@ bool irdm_dist_fault(const char *where)
 }
 
 int irdm_eig_slepc(const struct irdm_fem *fem, size_t n_lowest, double sigma,
-		   const bool *keep, size_t n_whole, irdm_progress_fn progress, void *ctx,
-		   double *w2, double *phi, char *err, size_t errlen)
+		   const struct irdm_modes_want *want, size_t n_whole,
+		   irdm_progress_fn progress, void *ctx, double *w2, double *phi,
+		   double *compliance, char *err, size_t errlen)
 {
 	int ret = irdm_dist_begin(err, errlen);
 
-	return ret ? ret : ops->eig(fem, n_lowest, sigma, keep, n_whole, progress, ctx, w2, phi,
-				    err, errlen);
+	return ret ? ret : ops->eig(fem, n_lowest, sigma, want, n_whole, progress, ctx, w2, phi,
+				    compliance, err, errlen);
 }

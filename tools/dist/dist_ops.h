@@ -18,7 +18,7 @@
 
 #define IRDM_SLEPC_PLUGIN "irdm-slepc.so"
 #define IRDM_SLEPC_PLUGIN_ENTRY "irdm_slepc_plugin"
-#define IRDM_DIST_OPS_VERSION 2
+#define IRDM_DIST_OPS_VERSION 3
 
 struct irdm_dist_ops {
 	int version;                    /* IRDM_DIST_OPS_VERSION */
@@ -32,9 +32,10 @@ struct irdm_dist_ops {
 	void (*wait_all)(void);
 	int (*gather)(const double *mine, const size_t *counts, double *all, char *err,
 		      size_t errlen);
-	int (*eig)(const struct irdm_fem *fem, size_t n_lowest, double sigma, const bool *keep,
-		   size_t n_whole, irdm_progress_fn progress, void *ctx, double *w2, double *phi,
-		   char *err, size_t errlen);
+	int (*eig)(const struct irdm_fem *fem, size_t n_lowest, double sigma,
+		   const struct irdm_modes_want *want, size_t n_whole, irdm_progress_fn progress,
+		   void *ctx, double *w2, double *phi, double *compliance, char *err,
+		   size_t errlen);
 };
 
 typedef const struct irdm_dist_ops *(*irdm_slepc_plugin_fn)(void);

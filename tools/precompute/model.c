@@ -135,21 +135,35 @@ static void say_stats(const struct irdm_mesh *mesh, irdm_progress_fn progress, v
 		progress(ctx, lines[i], -1.0);
 }
 
-/* The free DoFs of the scene's rows and columns: all the image reads of an
- * elastic mode (shapes, static correction, FIR from modes). */
-static bool *kept_dofs(const struct irdm_model *m)
+/*
+ * What the image reads of the modes: the free DoFs of the scene's rows and
+ * columns (shapes, static correction, FIR from modes), and the static
+ * correction's unit loads, in its order (tools/modal/static.c).
+ */
+static int wanted_of_modes(const struct irdm_scene *sc, const struct irdm_model *m,
+			   struct irdm_modes_want *w)
 {
 	bool *keep = calloc(m->fem.map.n_free ? m->fem.map.n_free : 1, sizeof(bool));
+	int64_t *loads = malloc((3 * m->n_cols + 1) * sizeof(int64_t));
+	size_t n_loads = 0;
 
-	if (!keep)
-		return NULL;
+	if (!keep || !loads) {
+		free(keep);
+		free(loads);
+		return IRDM_ENOMEM;
+	}
 	for (size_t r = 0; r < 3 * m->n_rows; r++)
 		if (m->row_dofs[r] >= 0)
 			keep[m->row_dofs[r]] = true;
 	for (size_t c = 0; c < 3 * m->n_cols; c++)
-		if (m->col_dofs[c] >= 0)
+		if (m->col_dofs[c] >= 0) {
 			keep[m->col_dofs[c]] = true;
-	return keep;
+			loads[n_loads++] = m->col_dofs[c];
+		}
+	*w = (struct irdm_modes_want){ keep, loads, n_loads };
+	if (!sc->static_correction || sc->method == IRDM_METHOD_TIME_DOMAIN)
+		w->n_loads = 0;
+	return IRDM_OK;
 }
 
 int irdm_model_build(const struct irdm_scene *sc, size_t n_modes_needed,
@@ -157,7 +171,7 @@ int irdm_model_build(const struct irdm_scene *sc, size_t n_modes_needed,
 		     char *err, size_t errlen)
 {
 	double t0 = irdm_now_s();
-	bool *keep;
+	struct irdm_modes_want want;
 	int ret;
 
 	memset(m, 0, sizeof(*m));
@@ -192,15 +206,15 @@ int irdm_model_build(const struct irdm_scene *sc, size_t n_modes_needed,
 	ret = irdm_model_select(sc, m, err, errlen);
 	if (ret)
 		goto out_fail;
-	keep = kept_dofs(m);
-	if (!keep) {
+	ret = wanted_of_modes(sc, m, &want);
+	if (ret) {
 		snprintf(err, errlen, "model: out of memory");
-		ret = IRDM_ENOMEM;
 		goto out_fail;
 	}
-	ret = irdm_modes_solve_kept(&m->fem, n_modes_needed, sc->floating, sc->eigensolver, keep,
+	ret = irdm_modes_solve_kept(&m->fem, n_modes_needed, sc->floating, sc->eigensolver, &want,
 				    progress, ctx, &m->modes, err, errlen);
-	free(keep);
+	free((void *)want.keep);
+	free((void *)want.load_dofs);
 	if (ret)
 		goto out_fail;
 	m->seconds_eig = irdm_now_s() - t0;

@@ -32,7 +32,7 @@ struct monitor_ctx {
 
 /* Where the time went, as a line of the progress (rank 0): what a user
  * extrapolates from (README, "Beyond one machine"). */
-static void say_times(const struct monitor_ctx *m, const double t[5])
+static void say_times(const struct monitor_ctx *m, const double t[6])
 {
 	char line[256];
 
@@ -40,9 +40,9 @@ static void say_times(const struct monitor_ctx *m, const double t[5])
 		return;
 	snprintf(line, sizeof(line),
 		 "slepc on %d rank%s: assembly %.2f s, MUMPS factorisation %.2f s, "
-		 "Krylov-Schur %.2f s, eigenvectors to rank 0 %.2f s", irdm_mpi_size(),
-		 irdm_mpi_size() > 1 ? "s" : "", t[1] - t[0], t[2] - t[1], t[3] - t[2],
-		 t[4] - t[3]);
+		 "Krylov-Schur %.2f s, eigenvectors to rank 0 %.2f s, static loads %.2f s",
+		 irdm_mpi_size(), irdm_mpi_size() > 1 ? "s" : "", t[1] - t[0], t[2] - t[1],
+		 t[3] - t[2], t[4] - t[3], t[5] - t[4]);
 	m->progress(m->pctx, line, -1.0);
 }
 
@@ -249,6 +249,71 @@ static PetscErrorCode extract(EPS eps, Mat M, PetscInt nev, const bool *keep, Pe
 	return 0;
 }
 
+/*
+ * The static correction's loads: K x = e_j for every load DoF, by the
+ * eigensolve's MUMPS factor of K (sigma = 0: the shift-and-invert operator
+ * is K itself), LOADS_PER_SOLVE right-hand sides at a time (what bounds the
+ * dense blocks: n x LOADS_PER_SOLVE doubles, split by rows), each column's
+ * kept DoFs to rank 0's compliance (NaN elsewhere).
+ */
+#define LOADS_PER_SOLVE 64
+
+static PetscErrorCode solve_loads(EPS eps, Mat K, const struct irdm_modes_want *want,
+				  double *compliance)
+{
+	PetscInt n, lo, hi, n_kept, *idx_kept;
+	Vec col, x_kept;
+	VecScatter to_kept;
+	Mat B, X;
+	ST st;
+	KSP ksp;
+
+	PetscCall(EPSGetST(eps, &st));
+	PetscCall(STGetKSP(st, &ksp));
+	PetscCall(MatGetSize(K, &n, NULL));
+	PetscCall(MatGetOwnershipRange(K, &lo, &hi));
+	PetscCall(MatCreateVecs(K, &col, NULL));
+	PetscCall(kept_scatter(col, want->keep, n, &to_kept, &x_kept, &idx_kept, &n_kept));
+	for (size_t j0 = 0; j0 < want->n_loads; j0 += LOADS_PER_SOLVE) {
+		PetscInt nb = (PetscInt)(want->n_loads - j0 < LOADS_PER_SOLVE ? want->n_loads - j0
+									    : LOADS_PER_SOLVE);
+		PetscCall(MatCreateDense(PETSC_COMM_WORLD, hi - lo, PETSC_DECIDE, n, nb, NULL, &B));
+		PetscCall(MatCreateDense(PETSC_COMM_WORLD, hi - lo, PETSC_DECIDE, n, nb, NULL, &X));
+		for (PetscInt j = 0; j < nb; j++) {
+			PetscInt d = (PetscInt)want->load_dofs[j0 + (size_t)j];
+			if (d >= lo && d < hi)
+				PetscCall(MatSetValue(B, d, j, 1.0, INSERT_VALUES));
+		}
+		PetscCall(MatAssemblyBegin(B, MAT_FINAL_ASSEMBLY));
+		PetscCall(MatAssemblyEnd(B, MAT_FINAL_ASSEMBLY));
+		PetscCall(KSPMatSolve(ksp, B, X));
+		for (PetscInt j = 0; j < nb; j++) {
+			Vec xj;
+			const PetscScalar *a;
+			double *dst = compliance ? &compliance[(j0 + (size_t)j) * (size_t)n] : NULL;
+			PetscCall(MatDenseGetColumnVecRead(X, j, &xj));
+			PetscCall(VecScatterBegin(to_kept, xj, x_kept, INSERT_VALUES, SCATTER_FORWARD));
+			PetscCall(VecScatterEnd(to_kept, xj, x_kept, INSERT_VALUES, SCATTER_FORWARD));
+			PetscCall(MatDenseRestoreColumnVecRead(X, j, &xj));
+			if (!dst)
+				continue;
+			for (PetscInt i = 0; i < n; i++)
+				dst[i] = NAN;
+			PetscCall(VecGetArrayRead(x_kept, &a));
+			for (PetscInt i = 0; i < n_kept; i++)
+				dst[idx_kept[i]] = a[i];
+			PetscCall(VecRestoreArrayRead(x_kept, &a));
+		}
+		PetscCall(MatDestroy(&B));
+		PetscCall(MatDestroy(&X));
+	}
+	PetscCall(VecScatterDestroy(&to_kept));
+	PetscCall(VecDestroy(&x_kept));
+	PetscCall(PetscFree(idx_kept));
+	PetscCall(VecDestroy(&col));
+	return 0;
+}
+
 /* This rank's share of the n rows (PETSc's split: contiguous blocks). */
 static int my_rows(PetscInt n, PetscInt *lo, PetscInt *hi)
 {
@@ -263,11 +328,11 @@ static int my_rows(PetscInt n, PetscInt *lo, PetscInt *hi)
 	return 0;
 }
 
-/* t[0] is set (assembly's start); t[1..4]: assembled, factorised, solved,
- * gathered. */
-static int solve(Mat K, Mat M, PetscInt nev, double sigma, const bool *keep, PetscInt n_whole,
-		 struct monitor_ctx *mon, double t[5], double *w2, double *phi, char *err,
-		 size_t errlen)
+/* t[0] is set (assembly's start); t[1..5]: assembled, factorised, solved,
+ * gathered, static loads solved. */
+static int solve(Mat K, Mat M, PetscInt nev, double sigma, const struct irdm_modes_want *want,
+		 PetscInt n_whole, struct monitor_ctx *mon, double t[6], double *w2, double *phi,
+		 double *compliance, char *err, size_t errlen)
 {
 	struct eig_idx *ix = malloc((size_t)nev * sizeof(*ix));
 	PetscInt nconv = 0;
@@ -303,11 +368,16 @@ static int solve(Mat K, Mat M, PetscInt nev, double sigma, const bool *keep, Pet
 		snprintf(err, errlen, "slepc: %ld of %ld eigenpairs converged", (long)nconv, (long)nev);
 		goto out_free;
 	}
-	if (extract(eps, M, nev, keep, n_whole, ix, w2, phi)) {
+	if (extract(eps, M, nev, want->keep, n_whole, ix, w2, phi)) {
 		snprintf(err, errlen, "slepc: gathering the eigenvectors failed");
 		goto out_free;
 	}
 	t[4] = irdm_now_s();
+	if (sigma == 0 && want->n_loads && solve_loads(eps, K, want, compliance)) {
+		snprintf(err, errlen, "slepc: the static correction's solves failed");
+		goto out_free;
+	}
+	t[5] = irdm_now_s();
 	ret = IRDM_OK;
 out_free:
 	EPSDestroy(&eps);
@@ -316,13 +386,14 @@ out_free:
 }
 
 int irdm_slepc_eig(const struct irdm_fem *fem, size_t n_lowest, double sigma,
-		   const bool *keep, size_t n_whole, irdm_progress_fn progress, void *pctx,
-		   double *w2, double *phi, char *err, size_t errlen)
+		   const struct irdm_modes_want *want, size_t n_whole,
+		   irdm_progress_fn progress, void *pctx, double *w2, double *phi,
+		   double *compliance, char *err, size_t errlen)
 {
 	struct monitor_ctx mon = { progress, pctx, (PetscInt)n_lowest };
 	Mat K = NULL, M = NULL;
 	PetscInt lo, hi;
-	double t[5] = { irdm_now_s(), 0, 0, 0, 0 };
+	double t[6] = { irdm_now_s(), 0, 0, 0, 0, 0 };
 	int ret;
 
 	/* a no-op when the command started it (a singleton for a library caller) */
@@ -339,8 +410,8 @@ int irdm_slepc_eig(const struct irdm_fem *fem, size_t n_lowest, double sigma,
 	if (!ret)
 		ret = csc_rows_to_petsc(&fem->M, lo, hi, &M, err, errlen);
 	if (!ret)
-		ret = solve(K, M, (PetscInt)n_lowest, sigma, keep, (PetscInt)n_whole, &mon, t, w2,
-			    phi, err, errlen);
+		ret = solve(K, M, (PetscInt)n_lowest, sigma, want, (PetscInt)n_whole, &mon, t, w2,
+			    phi, compliance, err, errlen);
 	if (!ret)
 		say_times(&mon, t);
 	MatDestroy(&K);

@@ -15,7 +15,8 @@ bool irdm_mpi_fault(const char *where);
 
 /* irdm_eig_slepc() of modal.h, here. */
 int irdm_slepc_eig(const struct irdm_fem *fem, size_t n_lowest, double sigma,
-		   const bool *keep, size_t n_whole, irdm_progress_fn progress, void *pctx,
-		   double *w2, double *phi, char *err, size_t errlen);
+		   const struct irdm_modes_want *want, size_t n_whole,
+		   irdm_progress_fn progress, void *pctx, double *w2, double *phi,
+		   double *compliance, char *err, size_t errlen);
 
 #endif
