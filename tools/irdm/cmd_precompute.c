@@ -352,6 +352,8 @@ int irdm_cmd_precompute(int argc, char **argv)
 	if (args.count_only) {
 		size_t n;
 		rc = irdm_precompute_count_inputs(&sc, &n, err, sizeof(err));
+		/* the slepc eigensolver started MPI as a singleton: stop it */
+		irdm_dist_end();
 		if (rc) {
 			irdm_cli_fail("precompute", rc, err);
 			return 1;
