@@ -8,6 +8,8 @@
 #   make check      what CI runs: fuzz, clang + sanitizer tests, then the tests
 #   make bench      benchmarks (print figures; never pass/fail on time)
 #   make bench-mpi  the precompute of a 100k-node model, serial and over MPI ranks
+#   make stability  the stability suite's long run (10^7-tick soak): a Markdown
+#                   table and a plot of the worst cases in out/stability/
 #   make run        the main job: the built-in default scene, end to end
 #   make jitter     irdm-fw's wake-up latency beside cyclictest's (JITTER_SECONDS)
 #   make hil        the CAN back-end end to end in a PREEMPT_RT VM (docs/hil.md)
@@ -48,7 +50,7 @@ $(if $(filter y,$(CONFIG_IRDM_MODAL) $(CONFIG_IRDM_FIR)),,\
 endif
 feature = $(if $(CONFIG),$(filter y,$(CONFIG_IRDM_$(1))),y)
 FEATURE_SRC_MODAL    = firmware/engine/engine_modal.c
-FEATURE_SRC_FIR      = firmware/engine/engine_fir.c firmware/engine/fir_sum.c
+FEATURE_SRC_FIR      = firmware/engine/engine_fir.c firmware/engine/fir_sum.c firmware/engine/fir_sum_avx2.c
 FEATURE_SRC_FLOATING = firmware/engine/floating.c $(wildcard firmware/rigid/*.c)
 FEATURE_SRC_DEFORM   = $(wildcard firmware/deform/*.c) firmware/session/session_deform.c
 FEATURE_OFF_SRC := $(foreach f,$(FEATURES),$(if $(call feature,$(f)),,$(FEATURE_SRC_$(f))))
@@ -118,7 +120,7 @@ TESTS    := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 TICK_TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TICK_TEST_SRC))
 BENCHES  := $(patsubst tests/bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC))
 
-.PHONY: all test san fuzz bench bench-precompute bench-mpi run jitter check deps clean docs cfg-fws sizes hil
+.PHONY: all test san fuzz bench bench-precompute bench-mpi run render stability jitter check deps clean docs cfg-fws sizes hil
 .SECONDARY:
 all: $(if $(CONFIG),,$(IRDM) $(SLEPC_PLUGIN)) $(FW_LIB) $(HAL_LIB) $(SIM_LIB) $(if $(FWMAIN_SRC),$(IRDM_FW)) \
   $(if $(CDMAIN_SRC),$(IRDM_CD))
@@ -244,6 +246,19 @@ fuzz:
 	  tail -n 4 $(FUZZ_BUILD)/$$n.log; \
 	done
 
+# The stability cases as the tests run them, and the soak at STAB_SOAK_SECONDS
+# of simulated time (10^4 s: 10^7 ticks at 1 ms); table and plot of the worst.
+STAB_OUT ?= out/stability
+STAB_SOAK_SECONDS ?= 10000
+stability: $(BUILD)/tests/test_stability_cases $(BUILD)/tests/test_stability_soak \
+  $(BUILD)/tests/test_stability_spin
+	rm -rf $(STAB_OUT)
+	mkdir -p $(STAB_OUT)
+	IRDM_STAB_OUT=$(STAB_OUT) $(BUILD)/tests/test_stability_cases
+	IRDM_STAB_OUT=$(STAB_OUT) $(BUILD)/tests/test_stability_spin
+	IRDM_STAB_OUT=$(STAB_OUT) IRDM_SOAK_SECONDS=$(STAB_SOAK_SECONDS) $(BUILD)/tests/test_stability_soak
+	python3 tools/scripts/stability-report.py $(STAB_OUT)
+
 bench: $(BENCHES) $(IRDM) bench-precompute
 	for b in $(BENCHES); do echo "== $$b"; IRDM=$(IRDM) $$b; done
 	@echo "== ticks paced at 1 kHz, deformation thread running (make jitter, 10 s)"
@@ -274,6 +289,12 @@ check: deps
 run: deps
 	$(MAKE) $(IRDM) $(IRDM_FW)
 	tools/scripts/run-default-scene.sh $(IRDM) $(IRDM_FW)
+
+# The default scene's deformed surface as VTK frames, PNGs and force plots
+# (irdm render; out/render-*; after make run it also renders that run's log)
+render: deps
+	$(MAKE) $(IRDM)
+	tools/scripts/render-default-scene.sh $(IRDM)
 
 # irdm-fw's wake-up latency beside cyclictest's (JITTER_SECONDS each, default 60)
 JITTER_IMAGE := $(BUILD)/data/jitter.img

@@ -316,6 +316,79 @@ static void test_fir(void **state)
 }
 
 /*
+ * The FIR history sum's two paths (fir_sum.c, portable; fir_sum_avx2.c,
+ * AVX2 + FMA where the processor has them) on the same runs: one node
+ * (one row), a triangle point beside one of its own nodes (three rows:
+ * one wide pass of three) and two triangle points (five rows: wide passes
+ * of three and two; portable ones of four and one).  Each against the reference, and the two
+ * against each other: they sum in different orders, so they agree to
+ * rounding but not bit for bit, which shows that both ran.
+ */
+static void test_fir_sum_paths(void **state)
+{
+	const double top[3] = { 0.05, 0.05, 0.2 };
+	const double pa[3] = { 0.03, 0.043, 0.2 }, pb[3] = { 0.068, 0.058, 0.2 };
+	const size_t N = 700;
+	bool wide = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") &&
+		    __builtin_cpu_supports("f16c");
+	double *u = calloc(N * 6, sizeof(double));
+	double *F[2] = { malloc(N * 6 * sizeof(double)), malloc(N * 6 * sizeof(double)) };
+	double *R = malloc(N * 6 * sizeof(double));
+	struct irdm_contact_site s[2];
+	struct irdm_engine_config cfg;
+
+	(void)state;
+	print_message("this processor %s AVX2 + FMA + F16C\n", wide ? "has" : "lacks");
+	for (size_t t = 0; t < N; t++)
+		for (int a = 0; a < 6; a++)
+			u[6 * t + (size_t)a] = t < 400 ? (a == 2 ? -0.01 : a == 5 ? -0.006 : 0) : NAN;
+	for (int k = 0; k < 3; k++) {
+		for (int layout = 0; layout < 3; layout++) {
+			int m = layout ? 2 : 1;
+			if (layout == 0)
+				node_site(&fir[k], top, &s[0]);
+			else
+				point_site(&fir[k], pa, &s[0]);
+			if (layout == 1)
+				node_site(&fir[k], top, &s[1]);
+			else if (layout == 2)
+				point_site(&fir[k], pb, &s[1]);
+			double *um = u;
+			double *u1 = NULL;
+			if (m == 1) {
+				u1 = malloc(N * 3 * sizeof(double));
+				for (size_t t = 0; t < N; t++)
+					memcpy(&u1[3 * t], &u[6 * t], 3 * sizeof(double));
+				um = u1;
+			}
+			size_t n = N * 3 * (size_t)m;
+			efx_reference_tail(&fir[k], s, m, N, um, fir_tail_r(&fir[k]), R);
+			for (int portable = 0; portable < 2; portable++) {
+				irdm_engine_config_default(&cfg);
+				cfg.fir_portable_sum = portable;
+				run_engine_cfg(&fir[k], cfg, s, m, N, um, IRDM_CONTACT_GRAB, F[portable],
+					       NULL);
+				double err = efx_rel_rms(F[portable], R, n);
+				print_message("FIR 200 %s, %d row(s), %-8s sum: error %.2e (limit %.0e)\n",
+					      fir_prec[k], distinct_rows(s, m), portable ? "portable" : "wide",
+					      err, TOL_FIR);
+				assert_true(err <= TOL_FIR);
+			}
+			double diff = efx_rel_rms(F[0], F[1], n);
+			print_message("  wide vs portable: %.2e\n", diff);
+			assert_true(diff <= TOL_FIR);
+			if (wide)
+				assert_true(memcmp(F[0], F[1], n * sizeof(double)) != 0);
+			free(u1);
+		}
+	}
+	free(u);
+	free(F[0]);
+	free(F[1]);
+	free(R);
+}
+
+/*
  * The engine in a non-default mode against efx_reference_opts (the same
  * mode written from its physics); returns the error, prints it.
  */
@@ -633,6 +706,7 @@ int main(void)
 		cmocka_unit_test(test_release),
 		cmocka_unit_test(test_two_points),
 		cmocka_unit_test(test_fir),
+		cmocka_unit_test(test_fir_sum_paths),
 		cmocka_unit_test(test_per_vertex),
 		cmocka_unit_test(test_coupling),
 		cmocka_unit_test(test_push_release),

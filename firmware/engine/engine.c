@@ -195,6 +195,9 @@ int irdm_engine_init(struct irdm_engine **out, const struct irdm_image *img,
 	e->ring.tick = (struct irdm_force_tick *)(base + l.ring);
 	if (e->T)
 		fir_tail(e, (double *)(base + l.tail));
+#if IRDM_CONFIG_FIR
+	e->fir_wide = e->T && !cfg->fir_portable_sum && irdm_fir_wide_usable();
+#endif
 	e->tail_w = (const double *)(base + l.tail);
 	irdm_bound_init(e, (double *)(base + l.bound));
 	e->bound_w = (const double *)(base + l.bound);

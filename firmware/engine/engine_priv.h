@@ -37,6 +37,7 @@ struct irdm_engine {
 	/* FIR */
 	struct irdm_fir_ring ring;
 	const double *tail_w;               /* T: r^s tail damping (1 when stable) */
+	bool fir_wide;                      /* history sum by fir_sum_avx2.c */
 	/* disp_bound.c: K (modal) max |phi_k| at a column, or T (FIR) max
 	 * ||R[s]||_F over force columns and touchable rows; set at init */
 	const double *bound_w;
@@ -64,6 +65,11 @@ void irdm_fir_free_disp(const struct irdm_engine *e, uint32_t col, double u[3]);
  * one pass over the ring for all of them. */
 void irdm_fir_free_disps(const struct irdm_engine *e, uint32_t n, const uint32_t *cols,
 			 double (*u)[3]);
+/* fir_sum_avx2.c: the same sum with AVX2 + FMA, at n image rows (not
+ * columns); only where irdm_fir_wide_usable() said so at init. */
+bool irdm_fir_wide_usable(void);
+void irdm_fir_sum_wide(const struct irdm_engine *e, uint32_t n, const uint32_t *rows,
+		       double (*u)[3]);
 void irdm_fir_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp, double blk[9]);
 void irdm_fir_apply(struct irdm_engine *e, const struct irdm_force_tick *f);
 

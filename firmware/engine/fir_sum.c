@@ -12,6 +12,9 @@
  * fills both lanes of its pair.  The element precision is fixed per image,
  * so each precision has its own loop, the switch hoisted out of it.
  *
+ * Processors with AVX2 and FMA take fir_sum_avx2.c's path instead (chosen
+ * at engine init); this one is the portable path and the reference for it.
+ *
  * Bit-identical to one scalar pass a row: every accumulator gets its terms
  * in the same order (age, then ring entry), each term formed as
  * w * ((R_i0 f_0 + R_i1 f_1) + R_i2 f_2), and vector lanes round as
@@ -186,6 +189,10 @@ void irdm_fir_free_disps(const struct irdm_engine *e, uint32_t n, const uint32_t
 
 	for (uint32_t v = 0; v < n; v++)
 		rows[v] = e->img->columns[cols[v]];
+	if (e->fir_wide) {
+		irdm_fir_sum_wide(e, n, rows, u);
+		return;
+	}
 	for (uint32_t v = n; v < 4 * ((n + 3) / 4); v++)
 		rows[v] = n ? rows[n - 1] : 0;
 	switch (e->img->meta->precision) {

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * The Hannaford-Ryu passivity observer and controller at each contact port.
+ * The Hannaford-Ryu passivity observer and controller at the contact ports.
  */
 
 
@@ -9,38 +9,54 @@
 #include "tick_priv.h"
 
 /*
- * Hannaford-Ryu at each contact port: E = sum F . du is the work done on
- * the object.  When the model has given out more than it received (E < 0)
- * the controller adds the damping alpha = -E / (dt |v|^2) along the
- * contact velocity, which returns E to zero.  du is measured between the
- * displacements the solve gave, before the controller's own force: that
- * force moves the point too (by R[0] times it), and a du taken from the
- * moved point one tick and the solved one the next mixes two ports, so
- * the zero the controller sets would not be the port's energy (a grab on
- * a ringing surface then kept handing energy to the tool, test_passivity).
+ * Hannaford-Ryu: E = sum F . du is the work done on the object.  Each port
+ * keeps its own observer, but the object is one multi-port and passive iff
+ * the total over its ports never goes below zero: a port may hand on what
+ * another port put in (two contacts on one node, or on neighbours, pulling
+ * different ways).  Run per port, the controller took such a port for an
+ * active one and, as its velocity settled, its alpha = -E dt / |du|^2 grew
+ * without bound (3e91 N, tests/test_stability_cases.c).  So when the total
+ * goes below zero the controller adds the one damping alpha =
+ * -E_total dt / sum |du_i|^2 along every port's velocity, which returns
+ * the total to zero.
+ *
+ * du is measured between the displacements the solve gave, before the
+ * controller's own force: that force moves the point too (by R[0] times
+ * it), and a du taken from the moved point one tick and the solved one the
+ * next mixes two ports, so the zero the controller sets would not be the
+ * port's energy (a grab on a ringing surface then kept handing energy to
+ * the tool, test_passivity).
  */
 void tick_passivity(struct irdm_engine *e, struct system *s)
 {
+	double du[IRDM_MAX_CONTACTS][3], v2[IRDM_MAX_CONTACTS], total = 0, v2_sum = 0;
+
 	for (int i = 0; i < s->m; i++) {
 		struct irdm_contact_state *c = &e->c[s->idx[i]];
-		double u[3], du[3], v2 = 0, work = 0;
+		double u[3], work = 0;
 		tick_contact_disp(s, i, u);
+		v2[i] = 0;
 		for (int r = 0; r < 3; r++) {
-			du[r] = u[r] - c->port_disp_prev_m[r];
-			v2 += du[r] * du[r];
-			work += s->f[3 * i + r] * du[r];
+			du[i][r] = u[r] - c->port_disp_prev_m[r];
+			v2[i] += du[i][r] * du[i][r];
+			work += s->f[3 * i + r] * du[i][r];
 		}
-		double energy = c->port_energy_j + work;
+		c->port_energy_j += work;
 		c->pc_damping_ns_per_m = 0;
-		if (e->cfg.passivity_control && energy < 0 && v2 > 0) {
-			double alpha = -energy * e->dt_s / v2;   /* N s/m, with v = du / dt */
-			for (int r = 0; r < 3; r++)
-				s->f[3 * i + r] += alpha * du[r] / e->dt_s;
-			energy = 0;
-			c->pc_damping_ns_per_m = alpha;
-			e->stats.pc_activations++;
-		}
-		c->port_energy_j = energy;
 		memcpy(c->port_disp_prev_m, u, sizeof(c->port_disp_prev_m));
+		total += c->port_energy_j;
+		v2_sum += v2[i];
 	}
+	if (!e->cfg.passivity_control || total >= 0 || v2_sum == 0)
+		return;
+	double alpha = -total * e->dt_s / v2_sum;       /* N s/m, with v = du / dt */
+	for (int i = 0; i < s->m; i++) {
+		struct irdm_contact_state *c = &e->c[s->idx[i]];
+		for (int r = 0; r < 3; r++)
+			s->f[3 * i + r] += alpha * du[i][r] / e->dt_s;
+		/* one port alone: exactly zero, as the law says */
+		c->port_energy_j = s->m == 1 ? 0 : c->port_energy_j + alpha * v2[i] / e->dt_s;
+		c->pc_damping_ns_per_m = alpha;
+	}
+	e->stats.pc_activations++;
 }

@@ -39,6 +39,15 @@ static void gather_forces(struct irdm_engine *e, const struct system *s, struct 
 	}
 }
 
+/* Finite and within IRDM_MAX_TARGET_M on every axis (NaN fails both). */
+static bool target_usable(const double p[3])
+{
+	for (int a = 0; a < 3; a++)
+		if (!(fabs(p[a]) <= IRDM_MAX_TARGET_M))
+			return false;
+	return true;
+}
+
 static int fault(struct irdm_engine *e)
 {
 	e->faulted = true;
@@ -118,7 +127,7 @@ int irdm_engine_tick(struct irdm_engine *e, const struct irdm_contact_cmd *cmd)
 			irdm_engine_contact_end(e, i);
 		if (e->c[i].mode == IRDM_CONTACT_OFF)
 			continue;
-		if (!irdm_v3_finite(cmd[i].target_m))
+		if (!target_usable(cmd[i].target_m))
 			return fault(e);
 		s.idx[s.m++] = i;
 	}

@@ -5,17 +5,15 @@
  * frames.vtk.series index (ParaView's JSON file-series format: each file
  * and its time), so ParaView opens the series with its times.  Each is
  * written beside its destination and renamed into place: a reader never
- * sees half a frame or half a series.
+ * sees half a frame or half a series (irdm/outdir.h).
  */
 #define _GNU_SOURCE
-#include <dirent.h>
 #include <errno.h>
 #include <stdio.h>
 #include <string.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 #include "irdm/error.h"
+#include "irdm/outdir.h"
 
 #include "fw.h"
 
@@ -138,24 +136,6 @@ int fw_frame_write(struct fw *fw)
 	return IRDM_OK;
 }
 
-/* Remove dir and the files in it (no subdirectories: ours has none). */
-static void remove_dir(const char *dir)
-{
-	char path[4200];
-	struct dirent *d;
-	DIR *h = opendir(dir);
-
-	while (h && (d = readdir(h))) {
-		if (!strcmp(d->d_name, ".") || !strcmp(d->d_name, ".."))
-			continue;
-		snprintf(path, sizeof(path), "%s/%s", dir, d->d_name);
-		remove(path);
-	}
-	if (h)
-		closedir(h);
-	rmdir(dir);
-}
-
 /* The frames and the index into dir.  Return: 0, or errno. */
 static int write_series_into(const struct fw *fw, const char *dir)
 {
@@ -188,16 +168,12 @@ static int write_series_into(const struct fw *fw, const char *dir)
 	return e;
 }
 
-/*
- * The series into DIR.tmp, then swapped in for DIR (an old DIR is moved
- * aside and removed after): DIR is the old series or the whole new one.
- */
+/* The series into DIR.tmp, then swapped in for DIR (irdm/outdir.h). */
 int fw_frame_write_series(struct fw *fw)
 {
 	const struct fw_frame *fr = &fw->frame;
 	const char *dir = fw->args.frames_out;
-	char tmp[4096], old[4096];
-	bool had_old;
+	char tmp[4096];
 	int e;
 
 	if (!dir)
@@ -205,34 +181,17 @@ int fw_frame_write_series(struct fw *fw)
 	for (unsigned k = 0; k < fr->n_slots; k++)
 		if (k != fr->single_slot && !fr->slot[k].held)
 			return no_frame(fw, dir);
-	if ((size_t)snprintf(tmp, sizeof(tmp), "%s.tmp", dir) >= sizeof(tmp) ||
-	    (size_t)snprintf(old, sizeof(old), "%s.old", dir) >= sizeof(old)) {
+	e = irdm_outdir_begin(dir, tmp, sizeof(tmp));
+	if (e == ENAMETOOLONG) {
 		snprintf(fw->err, sizeof(fw->err), "%s: path too long", dir);
 		return IRDM_EINVAL;
 	}
-	remove_dir(tmp);
-	if (mkdir(tmp, 0777))
-		return io_error(fw, tmp, errno);
+	if (e)
+		return io_error(fw, tmp, e);
 	e = write_series_into(fw, tmp);
 	if (e)
-		goto out_remove_tmp;
-	remove_dir(old);
-	had_old = rename(dir, old) == 0;
-	if (!had_old && errno != ENOENT) {
-		e = errno;
-		goto out_remove_tmp;
-	}
-	if (rename(tmp, dir)) {
-		e = errno;
-		if (had_old)
-			rename(old, dir);
-		goto out_remove_tmp;
-	}
-	if (had_old)
-		remove_dir(old);
-	return IRDM_OK;
-out_remove_tmp:
-	remove_dir(tmp);
-	return io_error(fw, dir, e);
+		irdm_outdir_remove(tmp);
+	else
+		e = irdm_outdir_commit(dir, tmp);
+	return e ? io_error(fw, dir, e) : IRDM_OK;
 }
-

@@ -38,6 +38,10 @@
 #define PAUSE_EVERY 100            /* ticks; then sleep PAUSE_NS (untimed) */
 #define PAUSE_NS 200000L
 #define FIFO_PRIO 80
+
+/* FIR history summed by the portable path (fir_sum.c) instead of the
+ * AVX2 one (fir_sum_avx2.c) the engine picks on this processor */
+static bool portable_sum;
 #define BENCH_CPU 1
 
 /* A PHANToM-Desktop-class device, as in the tests. */
@@ -152,6 +156,7 @@ static struct figures bench_case(const char *scene, const char *repr, const stru
 		return fig;
 	}
 	irdm_engine_config_haptic(&sc.engine, img->meta->dt_s, DEVICE_K, DEVICE_B, 0 /* no limit */);
+	sc.engine.fir_portable_sum = portable_sum;
 	if (irdm_session_open_image(&ses, img, &sc, err, sizeof(err))) {
 		printf("tick  %-14s %-16s %s  engine init failed: %s\n", scene, repr, kase_name[k],
 		       err);
@@ -327,7 +332,7 @@ int main(void)
 		"modes", "all", "touch", "box:0.03,0.03,0.199,0.07,0.07,0.201", "display", "touch",
 		NULL,
 	};
-	struct figures fir[K_COUNT] = { 0 }, m300[K_COUNT] = { 0 }, mall[K_COUNT] = { 0 };
+	struct figures fir[K_COUNT] = { 0 }, fir_portable[K_COUNT] = { 0 }, m300[K_COUNT] = { 0 }, mall[K_COUNT] = { 0 };
 	struct figures bunny[K_COUNT] = { 0 };
 	uint32_t mall_modes = 1;
 
@@ -361,8 +366,13 @@ int main(void)
 						 NULL);
 
 	header();
-	if (have_fir)
+	if (have_fir) {
 		bench_image("cuboid-paper", "fir-500 (2 ms)", "out/bench/cuboid-fir500-patch.img", fir);
+		portable_sum = true;
+		bench_image("cuboid-paper", "fir-500 portable", "out/bench/cuboid-fir500-patch.img",
+			    fir_portable);
+		portable_sum = false;
+	}
 	if (have_m300)
 		bench_image("cuboid-paper", "modal-300+sc", "out/bench/cuboid-paper.img", m300);
 	if (have_mall) {
@@ -378,6 +388,7 @@ int main(void)
 	target("FIR T=500, one point (node)", 10, &fir[K_NODE]);
 	target("FIR T=500, one point (triangle)", 10, &fir[K_TRI]);
 	target("FIR T=500, two points", 20, &fir[K_NODES]);
+	target("FIR T=500, triangle, portable sum", 10, &fir_portable[K_TRI]);
 	target("modal 300 + static corr, one point (node)", 5, &m300[K_NODE]);
 	target("modal 300 + static corr, one point (triangle)", 5, &m300[K_TRI]);
 	target("modal 300 + static corr, two points", 5, &m300[K_NODES]);

@@ -95,14 +95,15 @@ static double *contact_responses(const struct irdm_image *img, const struct irdm
 	return W;
 }
 
-/* Solve the n x n system a x = b (Gaussian elimination, partial pivoting). */
-static void dense_solve(double *a, double *b, int n)
+int efx_dense_solve(double *a, double *b, int n)
 {
 	for (int k = 0; k < n; k++) {
 		int p = k;
 		for (int i = k + 1; i < n; i++)
 			if (fabs(a[i * n + k]) > fabs(a[p * n + k]))
 				p = i;
+		if (fabs(a[p * n + k]) < 1e-300)
+			return -1;
 		for (int j = 0; j < n; j++) {
 			double t = a[k * n + j];
 			a[k * n + j] = a[p * n + j];
@@ -123,6 +124,7 @@ static void dense_solve(double *a, double *b, int n)
 			b[i] -= a[i * n + j] * b[j];
 		b[i] /= a[i * n + i];
 	}
+	return 0;
 }
 
 void efx_reference(const struct irdm_image *img, const struct irdm_contact_site *sites, int m,
@@ -226,7 +228,7 @@ void efx_reference_opts(const struct irdm_image *img, const struct irdm_contact_
 			if (!na)
 				break;
 			tick_system(W, F, target, n, t, act, na, o, prev, a, rhs);
-			dense_solve(a, rhs, na);
+			assert_int_equal(efx_dense_solve(a, rhs, na), 0);
 			for (int q = 0; q < na; q++)
 				F[t * n + act[q]] = rhs[q];
 			/* a push contact that would pull the tool lets go */

@@ -48,6 +48,10 @@ struct efx_ref_opts {
 void efx_reference_opts(const struct irdm_image *img, const struct irdm_contact_site *sites, int m,
 			size_t N, const double *target, const struct efx_ref_opts *o, double *F);
 
+/* Solve the n x n system a x = b in place (Gaussian elimination, partial
+ * pivoting); -1 if a pivot vanishes. */
+int efx_dense_solve(double *a, double *b, int n);
+
 /* Relative RMS of a - b over n values: |a - b|_2 / |b|_2. */
 double efx_rel_rms(const double *a, const double *b, size_t n);
 

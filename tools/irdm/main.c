@@ -14,6 +14,7 @@ static const char usage[] =
 	"  image verify validate an image the way the firmware does, plus physical checks\n"
 	"  image export write R[s] 3x3 blocks of one column as CSV\n"
 	"  replay       run the force engine on a prescribed displacement trajectory\n"
+	"  render       the deformed surface of a replay or an irdm-fw run: VTK frames, CSV\n"
 	"  log export   write an irdm-fw telemetry log as CSV\n"
 	"\n"
 	"'irdm COMMAND --help' for each.  Version: " IRDM_TOOL_VERSION "\n";
@@ -34,6 +35,8 @@ int main(int argc, char **argv)
 		return irdm_cmd_image(argc - 1, argv + 1);
 	if (!strcmp(argv[1], "replay"))
 		return irdm_cmd_replay(argc - 1, argv + 1);
+	if (!strcmp(argv[1], "render"))
+		return irdm_cmd_render(argc - 1, argv + 1);
 	if (!strcmp(argv[1], "log"))
 		return irdm_cmd_log(argc - 1, argv + 1);
 	fprintf(stderr, "irdm: unknown command '%s' (see irdm --help)\n", argv[1]);

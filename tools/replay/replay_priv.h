@@ -7,6 +7,7 @@
 #include <stdint.h>
 
 #include "irdm/error.h"
+#include "irdm/telemetry.h"
 
 struct trajectory {
 	size_t n_rows, n_cols;
@@ -23,6 +24,23 @@ int read_sites(const char *path, size_t n_contacts, double dt, uint32_t n_tris,
 	       struct trajectory *tr, char *err, size_t errlen);
 
 void irdm_trajectory_free(struct trajectory *tr);
+
+/*
+ * An irdm-fw log (irdm/telemetry.h) as the same tables (replay_log.c): per
+ * record and device the engine's command (sites: tri, b0..2, -1 when none;
+ * tr: its target, nan when none) and the force the controller's engine
+ * gave (forces: t, then fx, fy, fz per device).  The log's period must be
+ * dt and no record may be missing; *board gets the board's name it
+ * recorded (IRDM_LOG_NAME_LEN bytes).
+ */
+struct replay_log {
+	struct trajectory tr, sites, forces;
+	unsigned n_devices;
+	char board[IRDM_LOG_NAME_LEN];
+};
+int read_log(const char *path, double dt, uint32_t n_tris, struct replay_log *lg, char *err,
+	     size_t errlen);
+void replay_log_free(struct replay_log *lg);
 
 /* How many contacts a sites file describes (its first numeric row). */
 int sites_contacts(const char *path, unsigned *n, char *err, size_t errlen);

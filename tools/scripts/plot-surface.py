@@ -1,12 +1,18 @@
 #!/usr/bin/python3
 """Draw deformed-surface frames written by `irdm-fw --frame-at S --frame-out FILE.vtk`
-or `--frames-every S --frames-out DIR` (legacy VTK POLYDATA, ASCII): the shaded
-surface coloured by displacement magnitude (mm), the contact point and the force
-on the object as an arrow.  Several frames make a strip with one colour range.
+or `--frames-every S --frames-out DIR` (legacy VTK POLYDATA, ASCII), or by
+`irdm render` (VTK XML .vtu, ASCII; a .pvd stands for all its frames): the shaded
+surface coloured by displacement magnitude (mm), each contact point and the force
+on the object as an arrow.  Several frames make a strip with one colour range;
+--each OUTDIR draws one PNG per frame instead (OUTDIR/frame_NNNNN.png, every
+--step K-th frame), all with one scale and colour range, for a film.
 The displacement is exaggerated by --scale (default: so that the largest one is
 a tenth of the object's size); the colours are the true magnitudes.
-usage: plot-surface.py FRAME.vtk [FRAME.vtk ...] OUT.png [title] [--scale K]"""
+usage: plot-surface.py FRAME.vtk|.vtu|.pvd ... OUT.png [title] [--scale=K]
+       plot-surface.py FRAME.vtu|.pvd ... --each OUTDIR [--step=K] [title] [--scale=K]"""
+import os
 import sys
+import xml.etree.ElementTree as ET
 
 import matplotlib
 matplotlib.use("Agg")
@@ -69,6 +75,52 @@ def read_vtk(path):
     return out
 
 
+def read_vtu(path):
+    """The same dict from irdm render's UnstructuredGrid of triangles."""
+    try:
+        root = ET.parse(path).getroot()
+    except (OSError, ET.ParseError) as e:
+        fail(f"{path}: {e}")
+    grid = root.find("UnstructuredGrid")
+    if root.get("type") != "UnstructuredGrid" or grid is None:
+        fail(f"{path}: not a VTK UnstructuredGrid")
+
+    def arrays(node):
+        return {a.get("Name"): np.array((a.text or "").split(), dtype=float)
+                for a in (node.findall("DataArray") if node is not None else [])}
+
+    piece = grid.find("Piece")
+    n = int(piece.get("NumberOfPoints"))
+    pts = np.array(piece.find("Points/DataArray").text.split(), dtype=float).reshape(n, 3)
+    cells = arrays(piece.find("Cells"))
+    if (cells["types"] != 5).any():
+        fail(f"{path}: only triangles are drawn")
+    out = {"points": pts, "tris": cells["connectivity"].astype(int).reshape(-1, 3)}
+    out["displacement_m"] = arrays(piece.find("PointData"))["displacement_m"].reshape(n, 3)
+    field = arrays(grid.find("FieldData"))
+    out["field"] = {"time_s": field["time_s"].reshape(1, 1),
+                    "contact": field["contact"].reshape(-1, 1),
+                    "contact_point_m": field["contact_point_m"].reshape(-1, 3),
+                    "contact_force_n": field["contact_force_n"].reshape(-1, 3)}
+    return out
+
+
+def read_frames(path):
+    """A .pvd's frames in order, or the one file."""
+    if path.endswith(".pvd"):
+        base = os.path.dirname(path)
+        try:
+            sets = ET.parse(path).getroot().findall("Collection/DataSet")
+        except (OSError, ET.ParseError) as e:
+            fail(f"{path}: {e}")
+        return [os.path.join(base, d.get("file")) for d in sets]
+    return [path]
+
+
+def read_frame(path):
+    return read_vtu(path) if path.endswith(".vtu") else read_vtk(path)
+
+
 def shaded(pts, tris, colors):
     """Lambert shading by hand (older matplotlib has no shade= for polygons)."""
     a, b, c = pts[tris[:, 0]], pts[tris[:, 1]], pts[tris[:, 2]]
@@ -94,22 +146,25 @@ def draw(ax, d, scale, norm, cmap, size):
     poly.set_zorder(1)
     ax.add_collection3d(poly)
     f = d["field"]
-    if "contact_point_m" in f and f.get("contact", [[0]])[0][0]:
-        p = f["contact_point_m"][0]
+    for i, on in enumerate(f.get("contact", np.zeros((0, 1)))[:, 0]):
+        if not on:
+            continue
+        p = f["contact_point_m"][i]
         # the contact point rides on the exaggerated surface like its nodes
         near = np.argmin(np.linalg.norm(d["points"] - p, axis=1))
         p_shown = p + (scale - 1) * u[near]
-        force = f["contact_force_n"][0]
+        force = f["contact_force_n"][i]
         fn = np.linalg.norm(force)
         if fn > 0:
             arrow = force / fn * 0.3 * size     # along the force, ending at the contact
             ax.quiver(*(p_shown - arrow), *arrow, color="red", linewidth=2.5,
                       arrow_length_ratio=0.25, zorder=10)
         ax.scatter(*p_shown, color="red", s=30, depthshade=False, zorder=11,
-                   label=f"contact, force on the object {fn:.3f} N")
+                   label=f"contact {i + 1}, force on the object {fn:.3f} N")
         ax.legend(loc="upper left", fontsize=8)
-    lo, hi = shown.min(axis=0), shown.max(axis=0)
-    mid, half = (lo + hi) / 2, (hi - lo).max() / 2 * 1.05
+    # the rest shape sets the view: the same in every frame of a film
+    lo, hi = rest.min(axis=0), rest.max(axis=0)
+    mid, half = (lo + hi) / 2, (hi - lo).max() / 2 * 1.15
     for setter, c in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), mid):
         setter(c - half, c + half)
     ax.set_box_aspect((1, 1, 1))
@@ -120,25 +175,68 @@ def draw(ax, d, scale, norm, cmap, size):
     return f.get("time_s", [[float("nan")]])[0][0]
 
 
-def main():
-    args = [a for a in sys.argv[1:] if not a.startswith("--scale")]
-    scale = None
-    for a in sys.argv[1:]:
+def options(argv):
+    """Frames, other arguments, and the --scale, --each, --step values."""
+    opts = {"scale": None, "each": None, "step": 1}
+    rest, srcs, i = [], [], 0
+    while i < len(argv):
+        a = argv[i]
         if a.startswith("--scale="):
-            scale = float(a.split("=", 1)[1])
-    srcs = [a for a in args if a.endswith(".vtk")]
-    rest_args = [a for a in args if not a.endswith(".vtk")]
-    if not srcs or not rest_args:
-        fail(__doc__.strip().split("\n")[-1])
-    dst = rest_args[0]
-    title = rest_args[1] if len(rest_args) > 1 else srcs[0]
-    frames = [read_vtk(src) for src in srcs]
-    # one scale and one colour range for every frame: they compare
+            opts["scale"] = float(a.split("=", 1)[1])
+        elif a.startswith("--step="):
+            opts["step"] = int(a.split("=", 1)[1])
+        elif a == "--each" and i + 1 < len(argv):
+            opts["each"], i = argv[i + 1], i + 1
+        elif a.endswith((".vtk", ".vtu", ".pvd")):
+            srcs += read_frames(a)
+        else:
+            rest.append(a)
+        i += 1
+    if not srcs or (opts["each"] is None and not rest) or opts["step"] < 1:
+        fail(__doc__.strip().split("usage: ")[-1])
+    return srcs, rest, opts
+
+
+def ranges(frames, scale):
+    """One scale and one colour range for every frame: they compare."""
     size = max(np.ptp(d["points"] - d["displacement_m"], axis=0).max() for d in frames)
     umax = max(np.linalg.norm(d["displacement_m"], axis=1).max() for d in frames)
     if scale is None:
         scale = 0.1 * size / umax if umax > 0 else 1.0
-    norm = matplotlib.colors.Normalize(0, max(umax * 1e3, 1e-12))
+    return size, scale, matplotlib.colors.Normalize(0, max(umax * 1e3, 1e-12))
+
+
+def each(srcs, outdir, title, opts):
+    """One PNG per frame (every step-th), for a film."""
+    srcs = srcs[::opts["step"]]
+    frames = [read_frame(src) for src in srcs]
+    size, scale, norm = ranges(frames, opts["scale"])
+    cmap = plt.get_cmap("viridis")
+    os.makedirs(outdir, exist_ok=True)
+    for src, d in zip(srcs, frames):
+        fig = plt.figure(figsize=(6.4, 6))
+        ax = fig.add_subplot(1, 1, 1, projection="3d", computed_zorder=False)
+        t = draw(ax, d, scale, norm, cmap, size)
+        mag = np.linalg.norm(d["displacement_m"], axis=1).max() * 1e3
+        ax.set_title(f"{title}\nt = {t:.3f} s, max |u| = {mag:.2f} mm (shape x{scale:.1f})",
+                     fontsize=9)
+        fig.colorbar(matplotlib.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax, shrink=0.6,
+                     label="|displacement| (mm)")
+        name = os.path.splitext(os.path.basename(src))[0] + ".png"
+        fig.savefig(os.path.join(outdir, name), dpi=90)
+        plt.close(fig)
+    print(f"plot-surface: {len(frames)} frames -> {outdir}/")
+
+
+def main():
+    srcs, rest_args, opts = options(sys.argv[1:])
+    if opts["each"] is not None:
+        each(srcs, opts["each"], rest_args[0] if rest_args else srcs[0], opts)
+        return
+    dst = rest_args[0]
+    title = rest_args[1] if len(rest_args) > 1 else srcs[0]
+    frames = [read_frame(src) for src in srcs]
+    size, scale, norm = ranges(frames, opts["scale"])
     cmap = plt.get_cmap("viridis")
     n = len(frames)
     fig = plt.figure(figsize=(7.5 if n == 1 else 4.2 * n, 7 if n == 1 else 4.8))

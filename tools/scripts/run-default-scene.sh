@@ -12,15 +12,7 @@ set -euo pipefail
 irdm=${1:-build/irdm}
 fw=${2:-build/irdm-fw}
 py=/usr/bin/python3
-mkdir -p out
-key="$(sha256sum scenes/cuboid-top.scene | cut -c1-16) $("$irdm" --version)"
-if [ -f out/default.img ] && [ "$(cat out/default.img.key 2>/dev/null)" = "$key" ] &&
-	"$irdm" image verify out/default.img >/dev/null 2>&1; then
-	echo "run: out/default.img is up to date (scene and tool unchanged): precompute skipped"
-else
-	"$irdm" precompute --scene scenes/cuboid-top.scene -o out/default.img
-	echo "$key" > out/default.img.key
-fi
+tools/scripts/default-image.sh "$irdm"
 "$irdm" image verify out/default.img
 "$irdm" image info out/default.img | head -n 14
 # node 3246 = grid (6, 6, 22): the top face, next to its centre

@@ -58,6 +58,9 @@ struct irdm_engine_config {
 	 */
 	double stable_radius;
 	double max_force_n;             /* > 0: a larger force faults the engine (torque off) */
+	/* sum an FIR history with the portable code even on a processor with
+	 * AVX2 and FMA (the two agree to rounding; tests compare them) */
+	bool fir_portable_sum;
 	unsigned publish_every;         /* deformation snapshot every N ticks (0: never) */
 };
 
@@ -176,7 +179,7 @@ void irdm_engine_contact_end(struct irdm_engine *eng, unsigned i);
  * contact forces, advances the history, optionally publishes a snapshot.
  *
  * Return: IRDM_OK;
- * IRDM_EFAULT if a target is not finite, a force is not finite or over
+ * IRDM_EFAULT if a target is not finite or beyond IRDM_MAX_TARGET_M, a force is not finite or over
  * max_force_n, or a floating object's rigid step failed, or the engine had
  * already faulted: it then holds zero force until irdm_engine_reset().
  */
