@@ -350,6 +350,8 @@ static int solve(Mat K, Mat M, PetscInt nev, double sigma, const struct irdm_mod
 		perr = setup_eps(eps, K, M, nev, sigma, mon);
 	if (irdm_mpi_fault("kill"))
 		raise(SIGKILL);
+	if (mon->progress && irdm_mpi_rank() == 0)
+		mon->progress(mon->pctx, "MUMPS factorisation", 0.0);
 	if (!perr)      /* the shift-and-invert factorisation */
 		perr = EPSSetUp(eps);
 	t[2] = irdm_now_s();
