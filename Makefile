@@ -10,6 +10,8 @@
 #   make bench-mpi  the precompute of a 100k-node model, serial and over MPI ranks
 #   make stability  the stability suite's long run (10^7-tick soak): a Markdown
 #                   table and a plot of the worst cases in out/stability/
+#   make report     docs/report.md and its plots: every representation against
+#                   the exact model (irdm report; REPORT_CONFIGS, <= 10 min)
 #   make run        the main job: the built-in default scene, end to end
 #   make jitter     irdm-fw's wake-up latency beside cyclictest's (JITTER_SECONDS)
 #   make hil        the CAN back-end end to end in a PREEMPT_RT VM (docs/hil.md)
@@ -120,7 +122,7 @@ TESTS    := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 TICK_TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TICK_TEST_SRC))
 BENCHES  := $(patsubst tests/bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC))
 
-.PHONY: all test san fuzz bench bench-precompute bench-mpi run render stability jitter check deps clean docs cfg-fws sizes hil
+.PHONY: all test san fuzz bench bench-precompute bench-mpi run render stability report jitter check deps clean docs cfg-fws sizes hil
 .SECONDARY:
 all: $(if $(CONFIG),,$(IRDM) $(SLEPC_PLUGIN)) $(FW_LIB) $(HAL_LIB) $(SIM_LIB) $(if $(FWMAIN_SRC),$(IRDM_FW)) \
   $(if $(CDMAIN_SRC),$(IRDM_CD))
@@ -216,7 +218,7 @@ docs: $(IRDM)
 	mv docs/scene-format.md.tmp docs/scene-format.md
 
 san:
-	$(MAKE) BUILD=build-san SAN=1 OPT="-O1 -g" IRDM_SOAK_SECONDS=10 test
+	$(MAKE) BUILD=build-san SAN=1 OPT="-O1 -g" IRDM_SOAK_SECONDS=10 IRDM_TORUS=small test
 
 # libFuzzer needs clang.  Each target gets its own corpus directory; a
 # finding (crash, leak, sanitizer report: none recovers) stops the build and
@@ -257,12 +259,28 @@ stability: $(BUILD)/tests/test_stability_cases $(BUILD)/tests/test_stability_soa
 	IRDM_STAB_OUT=$(STAB_OUT) $(BUILD)/tests/test_stability_cases
 	IRDM_STAB_OUT=$(STAB_OUT) $(BUILD)/tests/test_stability_spin
 	IRDM_STAB_OUT=$(STAB_OUT) IRDM_SOAK_SECONDS=$(STAB_SOAK_SECONDS) $(BUILD)/tests/test_stability_soak
-	python3 tools/scripts/stability-report.py $(STAB_OUT)
+	/usr/bin/python3 tools/scripts/stability-report.py $(STAB_OUT)
 
 bench: $(BENCHES) $(IRDM) bench-precompute
 	for b in $(BENCHES); do echo "== $$b"; IRDM=$(IRDM) $$b; done
 	@echo "== ticks paced at 1 kHz, deformation thread running (make jitter, 10 s)"
 	$(MAKE) --no-print-directory jitter JITTER_SECONDS=10
+
+# Accuracy, tick time and image size of every representation against the
+# exact full model (irdm report --help); CSVs in out/report/, the report
+# and its Pareto plots in docs/ (committed).
+# The paper's cuboid at full resolution (its all-mode reference takes the
+# 9504-mode eigensolve, minutes): make report REPORT_CONFIGS=paper
+# REPORT_MD=docs/report-paper.md
+REPORT_CONFIGS ?= sweep
+REPORT_MD ?= docs/report.md
+report: $(IRDM)
+	@mkdir -p out/report docs/report
+	$(IRDM) report $(foreach c,$(REPORT_CONFIGS),--config $(c)) -o out/report \
+	  --md $(REPORT_MD) --plots report/report
+	for c in $(REPORT_CONFIGS); do \
+	  /usr/bin/python3 tools/scripts/plot-report.py out/report/report-$$c.csv docs/report/report-$$c; \
+	done
 
 # Paper-scale images (cuboid, bunny): time and size beside the paper's.
 bench-precompute: $(IRDM) $(BUILD)/data/bunny.off

@@ -157,6 +157,12 @@ static void test_bad_scene_values(void **state)
 	expect_failure(run("precompute", SMALL, "--colour", "red", "-o", img, NULL), "unknown scene key");
 	expect_failure(run("precompute", SMALL, "--representation", "fir:0", "-o", img, NULL),
 		       "representation");
+	expect_failure(run("precompute", SMALL, "--fir_tail", "window:10", "-o", img, NULL),
+		       "fir_tail = window:10 windows an FIR's tail");
+	expect_failure(run("precompute", SMALL, "--fir_tail", "window:0", "-o", img, NULL),
+		       "fir_tail");
+	expect_failure(run("precompute", SMALL, "--fir_tail", "hann:5", "-o", img, NULL),
+		       "expected none or window:L");
 	expect_failure(run("precompute", SMALL, "--touch", "z>=5", "-o", img, NULL), "selects no");
 	expect_failure(run("precompute", SMALL, NULL), "-o");
 	expect_failure(run("precompute", "--scene", path_in_dir("missing.scene"), "-o", img, NULL),

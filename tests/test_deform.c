@@ -263,7 +263,7 @@ static double modal_case(int which)
 	assert_non_null(h);
 	assert_non_null(x);
 	assert_non_null(uref);
-	assert_non_null(img->static_corr);       /* the default scene keeps it */
+	assert_non_null(img->corr_start);       /* the default scene keeps it */
 	random_history(img, h);
 	modal_states(img, h, x);
 	reference_disp(img, h, uref);

@@ -442,7 +442,7 @@ static void rig_init(struct rig *r, const struct irdm_image *img)
 	print_message("  %s: %u rows, %u columns, %s, push slides over rows %u/%u, grab on %s\n",
 		      img->meta->representation == IRDM_REPR_MODAL ? "modal" : "FIR",
 		      img->meta->n_nodes, img->meta->n_cols,
-		      img->static_corr ? "static correction" : "no static correction",
+		      img->corr_start ? "static correction" : "no static correction",
 		      r->push_row[0], r->push_row[1], r->grab_on_tri ? "a triangle point" : "a node");
 }
 

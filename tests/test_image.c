@@ -366,16 +366,16 @@ static void test_writer_layout(void **state)
 	fixture_buffer(&fx, &buf, &size);
 	h = get_header(buf);
 	assert_memory_equal(h.magic, "IRDMIMG", 8);
-	assert_int_equal(h.version_major, 1);
+	assert_int_equal(h.version_major, IRDM_IMAGE_VERSION_MAJOR);
 	assert_int_equal(h.version_minor, 0);
 	assert_int_equal(h.header_size, 64);
 	assert_int_equal(h.file_size, size);
-	assert_int_equal(h.section_count, 10);
+	assert_int_equal(h.section_count, 11);
 	assert_int_equal(h.section_table_offset, 64);
 	assert_int_equal(h.header_crc32c, irdm_crc32c(buf, 60));
 	assert_int_equal(h.table_crc32c,
-			 irdm_crc32c((uint8_t *)buf + 64, 10 * 32));
-	end = 64 + 10 * 32;
+			 irdm_crc32c((uint8_t *)buf + 64, 11 * 32));
+	end = 64 + 11 * 32;
 	for (unsigned i = 0; i < h.section_count; i++) {
 		struct irdm_image_section s = get_entry(buf, i);
 
@@ -498,7 +498,8 @@ static void test_fir_roundtrip(void **state)
 		assert_memory_equal(img.fir, fx.fir, fx.fir_bytes);
 		assert_null(img.modes);
 		assert_null(img.mode_shapes);
-		assert_null(img.static_corr);
+		assert_null(img.corr_blocks);
+		assert_null(img.corr_start);
 		assert_null(img.rigid);
 		irdm_image_unmap(&img);
 		assert_null(img.base);
@@ -529,10 +530,13 @@ static void test_modal_floating_roundtrip(void **state)
 	for (uint64_t k = 0; k < n; k++)
 		assert_true(irdm_elem_get(img.mode_shapes, IRDM_ELEM_F64, k) ==
 			    img_fixture_value(IRDM_SEC_MODE_SHAPES, k));
-	n = (uint64_t)2 * 2 * 9;        /* [col][col][3][3] */
+	n = (uint64_t)2 * 2 * 9;        /* every block kept: [col][col][3][3] */
 	for (uint64_t k = 0; k < n; k++)
-		assert_true(irdm_elem_get(img.static_corr, IRDM_ELEM_F64, k) ==
+		assert_true(irdm_elem_get(img.corr_blocks, IRDM_ELEM_F64, k) ==
 			    img_fixture_value(IRDM_SEC_STATIC_CORR, k));
+	for (uint32_t c = 0; c < 2; c++)
+		for (uint32_t r = 0; r < 2; r++)
+			assert_int_equal(irdm_image_corr_block(&img, c, r), 2 * c + r);
 	/* The fixture's modes are exact ZOH discretisations: |eig(A)| < 1. */
 	assert_true(img.modes[0].a[0] * img.modes[0].a[3] -
 		    img.modes[0].a[1] * img.modes[0].a[2] < 1);
@@ -703,17 +707,21 @@ static void test_bad_magic_and_version(void **state)
 	buf[7] = 0;
 
 	h = get_header(buf);
-	h.version_major = 2;
+	h.version_major = 3;
 	put_header(buf, &h);
 	img_fixture_reseal(buf, size);
-	expect_parse(buf, size, IRDM_EVERSION, "version 2.0");
+	expect_parse(buf, size, IRDM_EVERSION, "version 3.0");
+	h.version_major = 1;            /* the dense STATIC_CORR of before */
+	put_header(buf, &h);
+	img_fixture_reseal(buf, size);
+	expect_parse(buf, size, IRDM_EVERSION, "1.x kept the static correction dense; re-run irdm precompute");
 	h.version_major = 0;
 	put_header(buf, &h);
 	img_fixture_reseal(buf, size);
 	expect_parse(buf, size, IRDM_EVERSION, "not supported");
 
 	/* A newer minor is compatible, and may use reserved header fields. */
-	h.version_major = 1;
+	h.version_major = IRDM_IMAGE_VERSION_MAJOR;
 	h.version_minor = 3;
 	h.flags = 0x10;
 	h.reserved[5] = 7;
@@ -1065,6 +1073,44 @@ static void w_no_modes(struct irdm_image_writer *w) { w_remove(w, IRDM_SEC_MODES
 static void w_no_shapes(struct irdm_image_writer *w) { w_remove(w, IRDM_SEC_MODE_SHAPES); }
 static void w_no_rigid(struct irdm_image_writer *w) { w_remove(w, IRDM_SEC_RIGID); }
 static void w_no_corr(struct irdm_image_writer *w) { w_remove(w, IRDM_SEC_STATIC_CORR); }
+static void w_no_corr_index(struct irdm_image_writer *w) { w_remove(w, IRDM_SEC_STATIC_CORR_INDEX); }
+
+/* A 2-column correction of one block per column, each the other's: the
+ * diagonal of column 0 is missing. */
+static const uint32_t corr_index_no_diag[] = { 0, 1, 2, 1, 1 };
+static double corr_two_blocks[18];
+static uint32_t corr_index_long[3 + 4 + 1] = { 0, 2, 4, 0, 1, 0, 1, 0 };
+
+static void w_corr_no_diag(struct irdm_image_writer *w)
+{
+	w_remove(w, IRDM_SEC_STATIC_CORR);
+	w_remove(w, IRDM_SEC_STATIC_CORR_INDEX);
+	irdm_iw_add(w, IRDM_SEC_STATIC_CORR, IRDM_ELEM_F64, corr_two_blocks, sizeof(corr_two_blocks));
+	irdm_iw_add(w, IRDM_SEC_STATIC_CORR_INDEX, IRDM_ELEM_U32, corr_index_no_diag,
+		    sizeof(corr_index_no_diag));
+}
+
+/* an index one word longer than its starts say */
+static void w_corr_index_long(struct irdm_image_writer *w)
+{
+	w_remove(w, IRDM_SEC_STATIC_CORR_INDEX);
+	irdm_iw_add(w, IRDM_SEC_STATIC_CORR_INDEX, IRDM_ELEM_U32, corr_index_long,
+		    sizeof(corr_index_long));
+}
+
+/* blocks for 2 of the index's 4 */
+static void w_corr_short(struct irdm_image_writer *w)
+{
+	w_remove(w, IRDM_SEC_STATIC_CORR);
+	irdm_iw_add(w, IRDM_SEC_STATIC_CORR, IRDM_ELEM_F64, corr_two_blocks, sizeof(corr_two_blocks));
+}
+
+/* an index in a FIR image */
+static void w_add_corr_index(struct irdm_image_writer *w)
+{
+	irdm_iw_add(w, IRDM_SEC_STATIC_CORR_INDEX, IRDM_ELEM_U32, corr_index_no_diag,
+		    sizeof(corr_index_no_diag));
+}
 
 static void w_add_modes(struct irdm_image_writer *w)
 {
@@ -1132,7 +1178,8 @@ FX(m_fir_len5, fx->meta.fir_length = 5)
 FX(m_fir_modes, fx->meta.n_modes = 1)
 FX(m_fir_corr_flag, fx->meta.flags |= IRDM_META_STATIC_CORR)
 FX(m_unknown_flag, fx->meta.flags |= 1u << 9)
-FX(m_reserved0, fx->meta.reserved0 = 1)
+FX(m_fir_exact, fx->meta.fir_exact = 1)
+FX(m_fir_window_flag, fx->meta.flags |= IRDM_META_FIR_TAIL_WINDOW)
 FX(m_reserved, fx->meta.reserved[7] = 1)
 FX(m_tool_nul, memset(fx->meta.tool_version, 'x', 32))
 FX(m_name_nul, memset(fx->meta.mesh_name, 'x', 64))
@@ -1162,6 +1209,13 @@ FX(m_a_inf, fx->modes[2].a[3] = INFINITY)
 FX(m_b_nan, fx->modes[0].b[1] = NAN)
 FX(m_shape_nan, ((double *)fx->mode_shapes)[7] = NAN)
 FX(m_corr_inf, ((double *)fx->static_corr)[29] = INFINITY)
+/* index [0 2 4 | 0 1 | 0 1] of the fixture's 2 columns */
+FX(m_corr_start0, fx->corr_index[0] = 1)
+FX(m_corr_start_down, fx->corr_index[1] = 5)
+FX(m_corr_row_range, fx->corr_index[3 + 1] = 2)
+FX(m_corr_row_order, (fx->corr_index[3 + 2] = 1, fx->corr_index[3 + 3] = 0))
+FX(m_corr_row_repeat, fx->corr_index[3 + 1] = 0)
+FX(m_corr_blocks_big, fx->corr_index[2] = 0x40000000u)
 
 enum base { FIR, MODAL };
 
@@ -1196,7 +1250,9 @@ static const struct sem_case sem_cases[] = {
 	{ "FIR n_modes", FIR, m_fir_modes, NULL, IRDM_EFORMAT, "n_modes 1" },
 	{ "FIR corr flag", FIR, m_fir_corr_flag, NULL, IRDM_EFORMAT, "STATIC_CORR" },
 	{ "meta flag", FIR, m_unknown_flag, NULL, IRDM_EFORMAT, "unknown flags" },
-	{ "meta reserved0", FIR, m_reserved0, NULL, IRDM_EFORMAT, "reserved" },
+	{ "meta fir_exact without its flag", FIR, m_fir_exact, NULL, IRDM_EFORMAT, "fir_exact 1" },
+	{ "meta tail window without fir_exact", FIR, m_fir_window_flag, NULL, IRDM_EFORMAT,
+	  "FIR_TAIL_WINDOW set" },
 	{ "meta reserved", FIR, m_reserved, NULL, IRDM_EFORMAT, "reserved" },
 	{ "tool_version", FIR, m_tool_nul, NULL, IRDM_EFORMAT, "NUL-terminated" },
 	{ "mesh_name", FIR, m_name_nul, NULL, IRDM_EFORMAT, "NUL-terminated" },
@@ -1242,6 +1298,17 @@ static const struct sem_case sem_cases[] = {
 	{ "b NaN", MODAL, m_b_nan, NULL, IRDM_EFORMAT, "mode 0" },
 	{ "shape NaN", MODAL, m_shape_nan, NULL, IRDM_EFORMAT, "MODE_SHAPES element 7 is not finite" },
 	{ "corr inf", MODAL, m_corr_inf, NULL, IRDM_EFORMAT, "STATIC_CORR element 29 is not finite" },
+	{ "no STATIC_CORR_INDEX", MODAL, NULL, w_no_corr_index, IRDM_EMISSING, "STATIC_CORR_INDEX is missing" },
+	{ "corr start 0", MODAL, m_corr_start0, NULL, IRDM_EFORMAT, "start of column 0 is 1, not 0" },
+	{ "corr starts down", MODAL, m_corr_start_down, NULL, IRDM_EFORMAT, "start of column 2 (4) is below column 1's (5)" },
+	{ "corr row range", MODAL, m_corr_row_range, NULL, IRDM_EFORMAT, "column 0 block 1: row 2 >= n_cols 2" },
+	{ "corr row order", MODAL, m_corr_row_order, NULL, IRDM_EFORMAT, "column 1: rows not strictly increasing at block 3" },
+	{ "corr row repeat", MODAL, m_corr_row_repeat, NULL, IRDM_EFORMAT, "column 0: rows not strictly increasing at block 1" },
+	{ "corr no diagonal", MODAL, NULL, w_corr_no_diag, IRDM_EFORMAT, "column 0 lacks its diagonal block" },
+	{ "corr index long", MODAL, NULL, w_corr_index_long, IRDM_EFORMAT, "STATIC_CORR_INDEX has 32 bytes, expected 28" },
+	{ "corr index vs size", MODAL, m_corr_blocks_big, NULL, IRDM_EFORMAT, "STATIC_CORR_INDEX has 28 bytes, expected 4294967308" },
+	{ "corr blocks short", MODAL, NULL, w_corr_short, IRDM_EFORMAT, "section STATIC_CORR has 144 bytes, expected 288" },
+	{ "FIR + STATIC_CORR_INDEX", FIR, NULL, w_add_corr_index, IRDM_EFORMAT, "STATIC_CORR_INDEX must not be present (FIR image)" },
 	{ "no MODES", MODAL, NULL, w_no_modes, IRDM_EMISSING, "MODES is missing" },
 	{ "no MODE_SHAPES", MODAL, NULL, w_no_shapes, IRDM_EMISSING, "MODE_SHAPES is missing" },
 	{ "modal + FIR", MODAL, NULL, w_add_fir, IRDM_EFORMAT, "FIR must not be present (modal image)" },

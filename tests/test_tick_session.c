@@ -50,7 +50,7 @@ static void r0_self(const struct irdm_image *img, uint32_t col, double R[9])
 {
 	const struct irdm_meta *m = img->meta;
 	uint32_t row = img->columns[col], prec = m->precision;
-	size_t sc = ((size_t)col * m->n_cols + col) * 9;
+	long sc = irdm_image_corr_block(img, col, col);
 
 	memset(R, 0, 9 * sizeof(double));
 	if (m->representation == IRDM_REPR_FIR) {
@@ -64,9 +64,9 @@ static void r0_self(const struct irdm_image *img, uint32_t col, double R[9])
 			for (size_t k = 0; k < m->n_modes; k++)
 				R[3 * i + j] += phi(img, row, i, k) * phi(img, row, j, k) *
 						img->modes[k].b[0];
-			if (img->static_corr)
-				R[3 * i + j] += irdm_elem_get(img->static_corr, prec,
-							      sc + (size_t)(3 * i + j));
+			if (sc >= 0)
+				R[3 * i + j] += irdm_elem_get(img->corr_blocks, prec,
+							      (size_t)sc * 9 + (size_t)(3 * i + j));
 		}
 }
 

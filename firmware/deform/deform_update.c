@@ -25,21 +25,22 @@ static void sanitize(struct irdm_force_tick *f, uint32_t n_cols)
 }
 
 /*
- * Residual compliance of the dropped modes, stored between columns only:
- * block (c, c') maps a force at column c to the displacement of column c'.
+ * Residual compliance of the dropped modes, stored between columns only and
+ * only where it matters: column c's kept blocks map a force at c to the
+ * displacement of the columns in its row list.
  */
 static void static_correction(const struct irdm_deform_worker *w,
 			      const struct irdm_force_tick *f, double *pos)
 {
 	const struct irdm_image *img = w->img;
-	const void *S = img->static_corr;
-	size_t nc = w->n_cols;
+	const void *S = img->corr_blocks;
 
 	for (uint32_t e = 0; e < f->n; e++) {
 		const double *fe = f->f_n[e];
-		size_t base = (size_t)f->col[e] * nc * 9;
-		for (size_t c2 = 0; c2 < nc; c2++, base += 9) {
-			double *u = pos + 3 * (size_t)img->columns[c2];
+		uint32_t c = f->col[e];
+		for (uint32_t k = img->corr_start[c]; k < img->corr_start[c + 1]; k++) {
+			double *u = pos + 3 * (size_t)img->columns[img->corr_rows[k]];
+			size_t base = (size_t)k * 9;
 			for (size_t i = 0; i < 3; i++)
 				u[i] += irdm_elem_get(S, w->prec, base + 3 * i) * fe[0] +
 					irdm_elem_get(S, w->prec, base + 3 * i + 1) * fe[1] +
@@ -86,7 +87,7 @@ void deform_modal(struct irdm_deform_worker *w, struct deform_snap *s, double *p
 	modal_y(w, deform_payload(w->d, s));
 	deform_modal_product(w, pos);
 	sanitize(&s->f, w->n_cols);
-	if (w->img->static_corr)
+	if (w->img->corr_start)
 		static_correction(w, &s->f, pos);
 }
 

@@ -80,14 +80,20 @@ void irdm_engine_config_haptic(struct irdm_engine_config *cfg, double dt, double
 	cfg->max_force_n = max_force;
 }
 
-/* FIR tail damping: r = stable_radius / (largest recorded radius), if >= 1. */
+/*
+ * FIR tail damping, the fallback for an image whose certificate failed:
+ * r = stable_radius / (the image's largest recorded radius) when that
+ * radius is >= 1, on every column alike; r = 1 for a certified image (a
+ * windowed tail, fir_tail = window:L, is certified as it is and must run
+ * undamped, or its head and static compliance would be lost again).
+ */
 static void fir_tail(struct irdm_engine *e, double *w)
 {
 	double rho = e->img->meta->max_spectral_radius, r = 1.0, stable = e->cfg.stable_radius;
 
 	if (stable == 0)
 		stable = 0.999;
-	if (rho >= stable)
+	if (rho >= 1.0)
 		r = stable / rho;
 	w[0] = 1.0;
 	for (uint32_t s = 1; s < e->T; s++)
@@ -332,6 +338,11 @@ void irdm_engine_contact_end(struct irdm_engine *e, unsigned i)
 const struct irdm_contact_state *irdm_engine_contact(const struct irdm_engine *e, unsigned i)
 {
 	return i < IRDM_MAX_CONTACTS ? &e->c[i] : NULL;
+}
+
+const char *irdm_engine_fir_sum_name(const struct irdm_engine *e)
+{
+	return !e->T ? "none" : e->fir_wide ? "avx2" : "portable";
 }
 
 const struct irdm_engine_stats *irdm_engine_stats(const struct irdm_engine *e)

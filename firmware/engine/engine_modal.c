@@ -49,15 +49,17 @@ void irdm_modal_free_disp(const struct irdm_engine *e, uint32_t col, double u[3]
 	}
 }
 
-static double static_corr(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp,
-			  int i, int j)
+/* The static correction's block (force col_force -> displacement col_disp)
+ * into blk, or zeros where it was dropped (below the scene's tolerance). */
+static void static_corr(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp,
+			double blk[9])
 {
 	const struct irdm_image *img = e->img;
+	long k = irdm_image_corr_block(img, col_force, col_disp);
 
-	if (!img->static_corr)
-		return 0.0;
-	return irdm_elem_get(img->static_corr, img->meta->precision,
-			     (((size_t)col_force * e->n_cols + col_disp) * 3 + (size_t)i) * 3 + (size_t)j);
+	for (size_t i = 0; i < 9; i++)
+		blk[i] = k < 0 ? 0.0 : irdm_elem_get(img->corr_blocks, img->meta->precision,
+						      (size_t)k * 9 + i);
 }
 
 void irdm_modal_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp, double blk[9])
@@ -66,12 +68,13 @@ void irdm_modal_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col
 	const double *pd = &e->phi[(size_t)col_disp * 3 * e->K];
 	const double *pf = &e->phi[(size_t)col_force * 3 * e->K];
 
+	static_corr(e, col_force, col_disp, blk);
 	for (int i = 0; i < 3; i++)
 		for (int j = 0; j < 3; j++) {
 			double s = 0;
 			for (uint32_t k = 0; k < e->K; k++)
 				s += pd[(size_t)i * e->K + k] * pf[(size_t)j * e->K + k] * m[k].b[0];
-			blk[3 * i + j] = s + static_corr(e, col_force, col_disp, i, j);
+			blk[3 * i + j] += s;
 		}
 }
 

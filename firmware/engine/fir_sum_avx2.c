@@ -27,16 +27,33 @@
 #include "engine_priv.h"
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#include <cpuid.h>
 #include <immintrin.h>
 
 #define WIDE __attribute__((target("avx2,fma,f16c")))
 #define WIDE_INLINE inline __attribute__((always_inline, target("avx2,fma,f16c")))
 
+/*
+ * AVX2, FMA and F16C from CPUID, and the YMM state enabled by the kernel
+ * (OSXSAVE, then XCR0's SSE and AVX bits).  By hand rather than with
+ * __builtin_cpu_supports(): clang 14 does not know "f16c" there.
+ */
 bool irdm_fir_wide_usable(void)
 {
-	__builtin_cpu_init();
-	return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") &&
-	       __builtin_cpu_supports("f16c");
+	unsigned a, b, c, d, xcr0_lo, xcr0_hi;
+
+	if (!__get_cpuid(1, &a, &b, &c, &d))
+		return false;
+	bool fma = c & (1u << 12), osxsave = c & (1u << 27), avx = c & (1u << 28),
+	     f16c = c & (1u << 29);
+	if (!(fma && osxsave && avx && f16c))
+		return false;
+	__asm__ volatile("xgetbv" : "=a"(xcr0_lo), "=d"(xcr0_hi) : "c"(0));
+	if ((xcr0_lo & 6) != 6)
+		return false;
+	if (!__get_cpuid_count(7, 0, &a, &b, &c, &d))
+		return false;
+	return b & (1u << 5);                   /* AVX2 */
 }
 
 /* Four elements from i on, as doubles (f16: IEEE binary16, converted

@@ -25,6 +25,7 @@ static const struct {
 	[IRDM_SEC_RIGID] = { "RIGID", IRDM_ELEM_BYTES },
 	[IRDM_SEC_STABILITY] = { "STABILITY", IRDM_ELEM_BYTES },
 	[IRDM_SEC_CONTACT_BVH] = { "CONTACT_BVH", ELEM_ANY },
+	[IRDM_SEC_STATIC_CORR_INDEX] = { "STATIC_CORR_INDEX", IRDM_ELEM_U32 },
 };
 
 static const char *const elem_names[] = {

@@ -28,9 +28,11 @@ int img_check_header(struct parse *p)
 				h->magic[4], h->magic[5], h->magic[6], h->magic[7]);
 	if (h->version_major != IRDM_IMAGE_VERSION_MAJOR)
 		return img_fail(p, IRDM_EVERSION,
-				"image format version %u.%u is not supported: this loader reads %u.x",
+				"image format version %u.%u is not supported: this loader reads %u.x%s",
 				h->version_major, h->version_minor,
-				IRDM_IMAGE_VERSION_MAJOR);
+				IRDM_IMAGE_VERSION_MAJOR,
+				h->version_major == 1 ?
+				" (1.x kept the static correction dense; re-run irdm precompute)" : "");
 	if (h->header_size != HEADER_SIZE)
 		return img_fail(p, IRDM_ERANGE,
 				"header_size is %u, version 1 headers are %zu bytes",

@@ -9,7 +9,8 @@
 #include "image_priv.h"
 
 #define META_FLAGS_KNOWN (IRDM_META_FLOATING | IRDM_META_STATIC_CORR | \
-			  IRDM_META_CONSISTENT_MASS | IRDM_META_TIME_DOMAIN)
+			  IRDM_META_CONSISTENT_MASS | IRDM_META_TIME_DOMAIN | \
+			  IRDM_META_FIR_TAIL_WINDOW)
 
 static int check_meta_numbers(struct parse *p)
 {
@@ -70,6 +71,12 @@ static int check_meta_counts(struct parse *p)
 		return img_fail(p, IRDM_EFORMAT,
 				"modal image has n_modes %u, fir_length %u: need modes >= 1 and T = 0",
 				m->n_modes, m->fir_length);
+	if (!(m->flags & IRDM_META_FIR_TAIL_WINDOW) != !m->fir_exact ||
+	    (m->fir_exact && (m->representation != IRDM_REPR_FIR || m->fir_exact >= m->fir_length)))
+		return img_fail(p, IRDM_EFORMAT,
+				"meta fir_exact %u with fir_length %u, FIR_TAIL_WINDOW %s: need an FIR with 1 <= fir_exact < fir_length exactly when the flag is set",
+				m->fir_exact, m->fir_length,
+				m->flags & IRDM_META_FIR_TAIL_WINDOW ? "set" : "clear");
 	if (m->representation == IRDM_REPR_FIR &&
 	    (m->flags & IRDM_META_STATIC_CORR))
 		return img_fail(p, IRDM_EFORMAT,
@@ -106,7 +113,7 @@ int img_check_meta(struct parse *p)
 				"meta precision is %u, expected 1 (F16), 2 (F32) or 3 (F64)",
 				m->precision);
 	p->es = irdm_elem_size(m->precision);
-	if (p->strict && ((m->flags & ~META_FLAGS_KNOWN) || m->reserved0 ||
+	if (p->strict && ((m->flags & ~META_FLAGS_KNOWN) ||
 			  !all_zero(m->reserved, sizeof(m->reserved))))
 		return img_fail(p, IRDM_EFORMAT,
 				"meta has unknown flags (0x%08x) or non-zero reserved fields",

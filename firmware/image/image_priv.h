@@ -35,7 +35,7 @@
 #error "IRDM images are little-endian and used in place"
 #endif
 
-#define KIND_MAX IRDM_SEC_CONTACT_BVH
+#define KIND_MAX IRDM_SEC_STATIC_CORR_INDEX
 #define TABLE_ENTRY sizeof(struct irdm_image_section)
 #define HEADER_SIZE sizeof(struct irdm_image_header)
 
@@ -97,6 +97,10 @@ int img_check_stability(struct parse *p);
 int img_check_rigid(struct parse *p);
 int img_check_fir(struct parse *p);
 int img_check_modal(struct parse *p);
+/* image_static_corr.c, for img_check_modal (both sections present). */
+int img_check_static_corr(struct parse *p);
+/* image_responses.c: every element of kind's array (meta precision) finite. */
+int img_check_finite(struct parse *p, uint32_t kind, uint64_t count);
 int img_check_contact_bvh(struct parse *p);
 
 static inline bool all_zero(const void *data, size_t len)

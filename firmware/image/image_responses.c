@@ -2,7 +2,7 @@
 /*
  * The responses: STABILITY of the force recursion per column, then either
  * the FIR (R[s] blocks) or the modal form (MODES, MODE_SHAPES and the
- * optional STATIC_CORR), every value scanned for NaN and infinity.
+ * optional STATIC_CORR: image_static_corr.c), every value scanned for NaN and infinity.
  */
 #include <stdbool.h>
 #include <stdint.h>
@@ -50,7 +50,7 @@ static uint64_t first_non_finite(const void *data, uint32_t elem, uint64_t count
 }
 
 /* Scan a response array (elements of the meta precision) for NaN/inf. */
-static int check_finite(struct parse *p, uint32_t kind, uint64_t count)
+int img_check_finite(struct parse *p, uint32_t kind, uint64_t count)
 {
 	const void *data = img_payload(p, kind);
 	uint64_t bad = first_non_finite(data, p->meta.precision, count);
@@ -88,9 +88,11 @@ int img_check_fir(struct parse *p)
 	if (!ret)
 		ret = img_check_presence(p, IRDM_SEC_STATIC_CORR, false, "FIR image");
 	if (!ret)
+		ret = img_check_presence(p, IRDM_SEC_STATIC_CORR_INDEX, false, "FIR image");
+	if (!ret)
 		ret = img_check_shape(p, IRDM_SEC_FIR, f, 4, "n_cols x n_nodes x T x 9");
 	if (!ret)
-		ret = check_finite(p, IRDM_SEC_FIR, p->by_kind[IRDM_SEC_FIR]->size / p->es);
+		ret = img_check_finite(p, IRDM_SEC_FIR, p->by_kind[IRDM_SEC_FIR]->size / p->es);
 	if (ret)
 		return ret;
 	p->img.fir = img_payload(p, IRDM_SEC_FIR);
@@ -130,7 +132,6 @@ int img_check_modal(struct parse *p)
 	const struct irdm_meta *m = &p->meta;
 	bool corr = m->flags & IRDM_META_STATIC_CORR;
 	const uint64_t shapes[] = { m->n_nodes, 3, m->n_modes };
-	const uint64_t sc[] = { m->n_cols, m->n_cols, 9 };
 	int ret;
 
 	ret = img_check_presence(p, IRDM_SEC_FIR, false, "modal image");
@@ -143,22 +144,21 @@ int img_check_modal(struct parse *p)
 					 corr ? "meta flags say STATIC_CORR" :
 						"meta flags lack STATIC_CORR");
 	if (!ret)
+		ret = img_check_presence(p, IRDM_SEC_STATIC_CORR_INDEX, corr,
+					 corr ? "meta flags say STATIC_CORR" :
+						"meta flags lack STATIC_CORR");
+	if (!ret)
 		ret = check_modes(p);
 	if (!ret)
 		ret = img_check_shape(p, IRDM_SEC_MODE_SHAPES, shapes, 3,
 				      "n_nodes x 3 x n_modes");
 	if (!ret)
-		ret = check_finite(p, IRDM_SEC_MODE_SHAPES,
+		ret = img_check_finite(p, IRDM_SEC_MODE_SHAPES,
 				   p->by_kind[IRDM_SEC_MODE_SHAPES]->size / p->es);
 	if (!ret && corr)
-		ret = img_check_shape(p, IRDM_SEC_STATIC_CORR, sc, 3,
-				      "n_cols x n_cols x 9");
-	if (!ret && corr)
-		ret = check_finite(p, IRDM_SEC_STATIC_CORR,
-				   p->by_kind[IRDM_SEC_STATIC_CORR]->size / p->es);
+		ret = img_check_static_corr(p);
 	if (ret)
 		return ret;
 	p->img.mode_shapes = img_payload(p, IRDM_SEC_MODE_SHAPES);
-	p->img.static_corr = img_payload(p, IRDM_SEC_STATIC_CORR);
 	return IRDM_OK;
 }

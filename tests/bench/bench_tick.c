@@ -210,10 +210,12 @@ static struct figures bench_case(const char *scene, const char *repr, const stru
 	fig.max = bs.max;
 	fig.ok = true;
 	const double *f = irdm_engine_contact(e, 0)->force_n;
-	printf("tick  %-14s %-16s %s  median %6.2f us  p99 %6.2f us  max %7.2f us  (|F0| %.3f N, PC %llu)\n",
+	printf("tick  %-14s %-16s %s  median %6.2f us  p99 %6.2f us  max %7.2f us  (|F0| %.3f N, PC %llu%s%s)\n",
 	       scene, repr, kase_name[k], fig.median, fig.p99, fig.max,
 	       sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]),
-	       (unsigned long long)irdm_engine_stats(e)->pc_activations);
+	       (unsigned long long)irdm_engine_stats(e)->pc_activations,
+	       img->meta->representation == IRDM_REPR_FIR ? ", FIR sum " : "",
+	       img->meta->representation == IRDM_REPR_FIR ? irdm_engine_fir_sum_name(e) : "");
 	fflush(stdout);
 	irdm_session_close(ses);
 	return fig;
@@ -238,7 +240,7 @@ static void bench_image(const char *scene, const char *repr, const char *path,
 	       img.meta->n_nodes, img.meta->n_cols,
 	       img.meta->representation == IRDM_REPR_MODAL ? img.meta->n_modes : img.meta->fir_length,
 	       img.meta->representation == IRDM_REPR_MODAL ? "modes" : "taps", img.meta->dt_s * 1e3,
-	       img.static_corr ? ", static correction" : "",
+	       img.corr_start ? ", static correction" : "",
 	       img.locked ? ", locked" : "");
 	for (int k = 0; k < K_COUNT; k++)
 		fig[k] = bench_case(scene, repr, &img, &st, (enum kase)k);

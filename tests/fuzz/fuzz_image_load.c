@@ -57,11 +57,22 @@ static void walk_views(const struct irdm_image *img)
 	if (img->mode_shapes)
 		read_values(img->mode_shapes, m->precision,
 			    nodes * 3 * m->n_modes);
-	if (img->static_corr)
-		read_values(img->static_corr, m->precision, cols * cols * 9);
+	if (img->corr_start) {
+		uint64_t n_blocks = img->corr_start[cols];
+		read_bytes(img->corr_rows, n_blocks * 4);
+		read_values(img->corr_blocks, m->precision, n_blocks * 9);
+		/* the tick's lookup: every kept block, and the ends */
+		for (uint32_t c = 0; c < cols; c++) {
+			for (uint32_t k = img->corr_start[c]; k < img->corr_start[c + 1]; k++)
+				if (irdm_image_corr_block(img, c, img->corr_rows[k]) != (long)k)
+					abort();
+			(void)irdm_image_corr_block(img, c, 0);
+			(void)irdm_image_corr_block(img, c, (uint32_t)cols - 1);
+		}
+	}
 	if (img->rigid)
 		read_bytes(img->rigid, sizeof(*img->rigid));
-	for (uint32_t k = 0; k <= IRDM_SEC_CONTACT_BVH + 1; k++) {
+	for (uint32_t k = 0; k <= IRDM_SEC_STATIC_CORR_INDEX + 1; k++) {
 		const struct irdm_image_section *s = irdm_image_find(img, k);
 
 		if (s)

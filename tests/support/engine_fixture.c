@@ -65,8 +65,7 @@ uint32_t efx_column_row_near(const struct irdm_image *img, const double p[3])
 	return br;
 }
 
-/* W[s] (3m x 3m, row-major per s) of the contact points, times tail_r^s. */
-static double *contact_responses(const struct irdm_image *img, const struct irdm_contact_site *st,
+double *efx_contact_responses(const struct irdm_image *img, const struct irdm_contact_site *st,
 				 int m, size_t N, double tail_r)
 {
 	int n = 3 * m;
@@ -192,8 +191,16 @@ static void tick_system(const double *W, const double *F, const double *target, 
 void efx_reference_opts(const struct irdm_image *img, const struct irdm_contact_site *sites, int m,
 			size_t N, const double *target, const struct efx_ref_opts *o, double *F)
 {
+	double *W = efx_contact_responses(img, sites, m, N, o->tail_r);
+
+	efx_reference_w(W, m, N, target, o, F);
+	free(W);
+}
+
+void efx_reference_w(const double *W, int m, size_t N, const double *target,
+		     const struct efx_ref_opts *o, double *F)
+{
 	int n = 3 * m;
-	double *W = contact_responses(img, sites, m, N, o->tail_r);
 	double prev[24];                /* per unknown: the target and displacement of t-1 */
 	bool on[4] = { false }, released[4] = { false };
 
@@ -252,7 +259,6 @@ void efx_reference_opts(const struct irdm_image *img, const struct irdm_contact_
 				prev[2 * k + 1] = disp_at(W, F, n, t, k);
 			}
 	}
-	free(W);
 }
 
 double efx_rel_rms(const double *a, const double *b, size_t n)

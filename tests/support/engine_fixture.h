@@ -48,6 +48,17 @@ struct efx_ref_opts {
 void efx_reference_opts(const struct irdm_image *img, const struct irdm_contact_site *sites, int m,
 			size_t N, const double *target, const struct efx_ref_opts *o, double *F);
 
+/* W[s] (3m x 3m, row-major per s; rows: displacement of site i axis r,
+ * columns: force of site j axis c) of the sites from the image's R[s]
+ * blocks, times tail_r^s.  Malloc'd: the caller frees. */
+double *efx_contact_responses(const struct irdm_image *img, const struct irdm_contact_site *sites,
+			      int m, size_t N, double tail_r);
+
+/* efx_reference_opts() on responses W the caller built (and may have
+ * changed): what the engine should do with them. */
+void efx_reference_w(const double *W, int m, size_t N, const double *target,
+		     const struct efx_ref_opts *o, double *F);
+
 /* Solve the n x n system a x = b in place (Gaussian elimination, partial
  * pivoting); -1 if a pivot vanishes. */
 int efx_dense_solve(double *a, double *b, int n);

@@ -156,6 +156,25 @@ static void fill_rigid(struct irdm_rigid *rg)
 	rg->inertia_kg_m2[8] = 1.4e-4;
 }
 
+/* Every block of the n_cols x n_cols correction kept, rows in order. */
+static int fill_corr_index(struct img_fixture *fx, uint32_t n_cols)
+{
+	uint64_t n = (uint64_t)n_cols + 1 + (uint64_t)n_cols * n_cols;
+	uint32_t *rows;
+
+	fx->corr_index = malloc(n * sizeof(uint32_t));
+	if (!fx->corr_index)
+		return -1;
+	fx->corr_index_bytes = n * sizeof(uint32_t);
+	rows = fx->corr_index + n_cols + 1;
+	for (uint32_t c = 0; c <= n_cols; c++)
+		fx->corr_index[c] = c * n_cols;
+	for (uint32_t c = 0; c < n_cols; c++)
+		for (uint32_t r = 0; r < n_cols; r++)
+			rows[c * n_cols + r] = r;
+	return 0;
+}
+
 int img_fixture_modal(struct img_fixture *fx, uint32_t precision,
 		      uint32_t n_nodes, uint32_t n_cols, uint32_t n_modes,
 		      uint32_t meta_flags)
@@ -183,7 +202,7 @@ int img_fixture_modal(struct img_fixture *fx, uint32_t precision,
 		fx->static_corr = fill_values(IRDM_SEC_STATIC_CORR, precision,
 					      (uint64_t)n_cols * n_cols * 9,
 					      &fx->corr_bytes);
-		if (!fx->static_corr)
+		if (!fx->static_corr || fill_corr_index(fx, n_cols))
 			goto fail;
 	}
 	if (meta_flags & IRDM_META_FLOATING)
@@ -203,6 +222,7 @@ void img_fixture_free(struct img_fixture *fx)
 	free(fx->modes);
 	free(fx->mode_shapes);
 	free(fx->static_corr);
+	free(fx->corr_index);
 	free(fx->stability);
 	memset(fx, 0, sizeof(*fx));
 }
@@ -231,6 +251,9 @@ void img_fixture_add(const struct img_fixture *fx, struct irdm_image_writer *w)
 	if (fx->static_corr)
 		irdm_iw_add(w, IRDM_SEC_STATIC_CORR, m->precision,
 			    fx->static_corr, fx->corr_bytes);
+	if (fx->corr_index)
+		irdm_iw_add(w, IRDM_SEC_STATIC_CORR_INDEX, IRDM_ELEM_U32,
+			    fx->corr_index, fx->corr_index_bytes);
 	if (m->flags & IRDM_META_FLOATING)
 		irdm_iw_add(w, IRDM_SEC_RIGID, IRDM_ELEM_BYTES, &fx->rigid,
 			    sizeof(fx->rigid));

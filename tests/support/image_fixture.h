@@ -33,12 +33,15 @@ struct img_fixture {
 	struct irdm_mode *modes;            /* modal: n_modes */
 	void *mode_shapes;                  /* modal: shapes_bytes */
 	void *static_corr;                  /* modal + STATIC_CORR: corr_bytes */
+	/* its STATIC_CORR_INDEX: every block kept (the layout of tol = 0):
+	 * starts c n_cols, then rows 0..n_cols-1 for every column */
+	uint32_t *corr_index;
 	struct irdm_rigid rigid;            /* written iff FLOATING */
 	struct irdm_stability *stability;   /* n_cols */
 	/* Sizes of the arrays as built: what img_fixture_add() writes, so
 	 * tampering with meta counts never makes it read past an array. */
 	uint64_t nodes_bytes, columns_bytes, tris_bytes, stability_bytes;
-	uint64_t fir_bytes, modes_bytes, shapes_bytes, corr_bytes;
+	uint64_t fir_bytes, modes_bytes, shapes_bytes, corr_bytes, corr_index_bytes;
 };
 
 /* Grounded FIR image.  Returns 0, -1 when out of memory. */

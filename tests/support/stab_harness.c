@@ -102,7 +102,7 @@ void stab_poison(const struct stab_case *c, unsigned long t, double dt_s,
 /*
  * Static compliance between node sites: sum over s of R[s] (weighted by
  * the engine's FIR tail r^s, restated from docs/architecture.md: r =
- * 0.999 / rho when the recorded radius rho >= 0.999).  Modal images: the
+ * 0.999 / rho when the image's largest recorded radius rho >= 1).  Modal images: the
  * sum runs until the slowest mode has decayed (rho^s < 1e-12).
  */
 static void static_compliance(const struct irdm_image *img, uint32_t row, uint32_t col, double c[9])
@@ -113,7 +113,7 @@ static void static_compliance(const struct irdm_image *img, uint32_t row, uint32
 
 	if (mt->representation == IRDM_REPR_FIR) {
 		n = mt->fir_length;
-		if (rho >= 0.999)
+		if (rho >= 1.0)
 			r = 0.999 / rho;
 	} else {
 		n = (size_t)fmin(2e5, ceil(log(1e-12) / log(fmin(rho, 1 - 1e-6))));

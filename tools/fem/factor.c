@@ -15,7 +15,8 @@
  * is sorted too.  With rows == NULL only counts.
  */
 static size_t merge_upper(const struct irdm_csc *k, const struct irdm_csc *m, double ck,
-			  double cm, size_t j, SuiteSparse_long *rows, double *vals)
+			  double cm, const double *diag, size_t j, SuiteSparse_long *rows,
+			  double *vals)
 {
 	int64_t pk = k->colptr[j], ek = k->colptr[j + 1];
 	int64_t pm = m->colptr[j], em = m->colptr[j + 1];
@@ -33,6 +34,8 @@ static size_t merge_upper(const struct irdm_csc *k, const struct irdm_csc *m, do
 			v += ck * k->val[pk++];
 		if (rm == r)
 			v += cm * m->val[pm++];
+		if (diag && r == (int64_t)j)
+			v += diag[j];
 		if (rows) {
 			rows[n] = r;
 			vals[n] = v;
@@ -43,13 +46,13 @@ static size_t merge_upper(const struct irdm_csc *k, const struct irdm_csc *m, do
 }
 
 static cholmod_sparse *build_s(const struct irdm_fem *fem, double cm, double ck,
-			       cholmod_common *cc)
+			       const double *diag, cholmod_common *cc)
 {
 	size_t n = fem->K.n, nnz = 0;
 	cholmod_sparse *s;
 
 	for (size_t j = 0; j < n; j++)
-		nnz += merge_upper(&fem->K, &fem->M, ck, cm, j, NULL, NULL);
+		nnz += merge_upper(&fem->K, &fem->M, ck, cm, diag, j, NULL, NULL);
 	s = cholmod_l_allocate_sparse(n, n, nnz, 1, 1, 1, CHOLMOD_REAL, cc);
 	if (!s)
 		return NULL;
@@ -58,15 +61,22 @@ static cholmod_sparse *build_s(const struct irdm_fem *fem, double cm, double ck,
 
 	p[0] = 0;
 	for (size_t j = 0; j < n; j++)
-		p[j + 1] = p[j] + (SuiteSparse_long)merge_upper(&fem->K, &fem->M, ck, cm, j,
-								&i[p[j]], &x[p[j]]);
+		p[j + 1] = p[j] + (SuiteSparse_long)merge_upper(&fem->K, &fem->M, ck, cm, diag,
+								j, &i[p[j]], &x[p[j]]);
 	return s;
 }
 
 int irdm_fem_factor(const struct irdm_fem *fem, double ck, double cm, const char *what,
 		    cholmod_common *cc, cholmod_factor **L, char *err, size_t errlen)
 {
-	cholmod_sparse *s = build_s(fem, cm, ck, cc);
+	return irdm_fem_factor_diag(fem, ck, cm, NULL, what, cc, L, err, errlen);
+}
+
+int irdm_fem_factor_diag(const struct irdm_fem *fem, double ck, double cm, const double *diag,
+			 const char *what, cholmod_common *cc, cholmod_factor **L, char *err,
+			 size_t errlen)
+{
+	cholmod_sparse *s = build_s(fem, cm, ck, diag, cc);
 	int ret;
 
 	*L = NULL;

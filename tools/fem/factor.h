@@ -18,4 +18,10 @@
 int irdm_fem_factor(const struct irdm_fem *fem, double ck, double cm, const char *what,
 		    cholmod_common *cc, cholmod_factor **L, char *err, size_t errlen);
 
+/* The same with diag[j] added to diagonal entry j (diag: n free DoFs, or
+ * NULL): springs to ground at chosen DoFs. */
+int irdm_fem_factor_diag(const struct irdm_fem *fem, double ck, double cm, const double *diag,
+			 const char *what, cholmod_common *cc, cholmod_factor **L, char *err,
+			 size_t errlen);
+
 #endif

@@ -20,6 +20,7 @@ int irdm_cmd_image(int argc, char **argv);
 int irdm_cmd_image_config(int argc, char **argv);
 int irdm_cmd_replay(int argc, char **argv);
 int irdm_cmd_log(int argc, char **argv);
+int irdm_cmd_report(int argc, char **argv);
 int irdm_cmd_render(int argc, char **argv);
 
 /*

@@ -35,9 +35,9 @@ static const char *kind_name(uint32_t k)
 {
 	static const char *const names[] = { "?", "META", "PROVENANCE", "NODES", "COLUMNS",
 		"SURFACE", "FIR", "MODES", "MODE_SHAPES", "STATIC_CORR", "RIGID", "STABILITY",
-		"CONTACT_BVH" };
+		"CONTACT_BVH", "STATIC_CORR_INDEX" };
 
-	return k < 13 ? names[k] : "unknown";
+	return k < sizeof(names) / sizeof(names[0]) ? names[k] : "unknown";
 }
 
 static int open_image(const char *path, struct irdm_image *img)
@@ -68,10 +68,17 @@ static int cmd_info(const char *path)
 		printf("responses     FIR, T = %u samples (%.3f s), %s%s\n", m->fir_length,
 		       m->fir_length * m->dt_s, elem_name(m->precision),
 		       m->flags & IRDM_META_TIME_DOMAIN ? ", time-domain" : ", from modes");
-	else
+	if (m->flags & IRDM_META_FIR_TAIL_WINDOW)
+		printf("tail          samples 0..%u exact, %u past them windowed (fir_tail = window:%u), "
+		       "sum = static compliance\n", m->fir_exact - 1, m->fir_length - m->fir_exact,
+		       m->fir_length - m->fir_exact);
+	if (m->representation != IRDM_REPR_FIR)
 		printf("responses     modal, %u of %u modes%s, %s\n", m->n_modes, m->n_modes_total,
 		       m->flags & IRDM_META_STATIC_CORR ? " + static correction" : "",
 		       elem_name(m->precision));
+	if (img.corr_start)
+		printf("static corr   %u of %llu blocks kept\n", img.corr_start[m->n_cols],
+		       (unsigned long long)m->n_cols * m->n_cols);
 	printf("dt            %g s (%.0f Hz)\n", m->dt_s, 1.0 / m->dt_s);
 	printf("material      E %g Pa, nu %g, rho %g kg/m^3, %s mass\n", m->young_pa, m->poisson,
 	       m->density_kg_m3, m->flags & IRDM_META_CONSISTENT_MASS ? "consistent" : "lumped");
@@ -94,7 +101,7 @@ static int cmd_info(const char *path)
 	printf("sections\n");
 	const struct irdm_image_section *s = (const void *)(img.base + h->section_table_offset);
 	for (uint32_t i = 0; i < h->section_count; i++)
-		printf("  %-12s %-5s offset %10llu  size %12llu  crc32c %08x\n", kind_name(s[i].kind),
+		printf("  %-17s %-5s offset %10llu  size %12llu  crc32c %08x\n", kind_name(s[i].kind),
 		       elem_name(s[i].elem), (unsigned long long)s[i].offset,
 		       (unsigned long long)s[i].size, s[i].crc32c);
 	printf("columns (mesh nodes):");

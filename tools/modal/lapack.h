@@ -21,6 +21,8 @@ void dgeev_(const char *jobvl, const char *jobvr, const int *n, double *a, const
 void dgemm_(const char *ta, const char *tb, const int *m, const int *n, const int *k,
 	    const double *alpha, const double *a, const int *lda, const double *b,
 	    const int *ldb, const double *beta, double *c, const int *ldc);
+void dgesv_(const int *n, const int *nrhs, double *a, const int *lda, int *ipiv, double *b,
+	    const int *ldb, int *info);
 void openblas_set_num_threads(int n);
 int openblas_get_num_threads(void);
 

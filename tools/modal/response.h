@@ -37,6 +37,31 @@ int irdm_static_correction(const struct irdm_fem *fem, const struct irdm_modes *
 			   const int64_t *row_dofs, size_t n_rows, double *out,
 			   char *err, size_t errlen);
 
+/* A factorisation of K (floating: K + eps M) kept open so the compliance
+ * columns of many batches share it. */
+struct irdm_compliance;
+
+/* How a floating object's singular K is solved (static.c): K + eps M with
+ * eight refinement steps, or K with springs at six pinned DoFs, one solve.
+ * Both give the elastic compliance; grounded objects solve K once. */
+enum irdm_compliance_method {
+	IRDM_COMPLIANCE_SHIFTED,
+	IRDM_COMPLIANCE_PINNED,
+};
+
+/* Return: IRDM_OK; IRDM_ENOMEM; IRDM_ENUMERIC (as irdm_fem_factor). */
+int irdm_compliance_open(const struct irdm_fem *fem, const struct irdm_modes *m,
+			 bool floating, enum irdm_compliance_method method,
+			 struct irdm_compliance **c, char *err, size_t errlen);
+
+/* Compliance columns X (n x n_in) of the free DoFs in[] with c's factor.
+ * Return: IRDM_OK; IRDM_ENOMEM; IRDM_ENUMERIC if a solve fails. */
+int irdm_compliance_columns(struct irdm_compliance *c, const int64_t *in, size_t n_in,
+			    double *X, char *err, size_t errlen);
+
+/* Free c (NULL: no-op). */
+void irdm_compliance_close(struct irdm_compliance *c);
+
 /* Full static compliance columns X (n x n_in) for free DoFs in[] (same
  * meaning of G as above); exposed for tests and the static correction. */
 int irdm_compliance_solve(const struct irdm_fem *fem, const struct irdm_modes *m,

@@ -17,6 +17,8 @@
 #include "modal/lapack.h"
 #include "modal/response.h"
 #include "modal/stability.h"
+#include "modal/static_sparse.h"
+#include "precompute/fir_tail.h"
 #include "precompute/precompute.h"
 #include "precompute/td_part.h"
 #include "timedomain/timedomain.h"
@@ -31,7 +33,8 @@ struct build {
 	size_t n_modes;                 /* modes in the image (modal) */
 	double *fir;                    /* FIR, double, section layout */
 	double *shapes;                 /* modal: [row][3][mode] */
-	double *corr;                   /* static correction [c][r][3][3] or NULL */
+	double *corr;                   /* FIR: static correction [c][r][3][3] or NULL */
+	struct irdm_corr_sparse sparse; /* modal: the kept blocks (start NULL if none) */
 	void *stored[3];                /* converted to the scene's precision */
 	size_t stored_bytes[3];
 	struct irdm_stability *stab;
@@ -50,6 +53,12 @@ static size_t modes_needed(const struct irdm_scene *sc)
 	if (sc->method == IRDM_METHOD_TIME_DOMAIN)
 		return 1;       /* only the first mode, for the default damping */
 	return sc->modes;       /* FIR synthesised from modes */
+}
+
+/* FIR samples the image holds: T, plus a windowed tail (fir_tail.h). */
+static size_t fir_taps(const struct build *b)
+{
+	return (size_t)b->sc->fir_length + b->sc->fir_tail;
 }
 
 static bool truncated(const struct build *b)
@@ -74,20 +83,25 @@ static int modal_data(struct build *b, char *err, size_t errlen)
 			int64_t d = m->row_dofs[r];
 			b->shapes[r * K + k] = d < 0 ? 0.0 : m->modes.phi[k * n + (size_t)d];
 		}
-	if (b->sc->static_correction && truncated(b)) {
-		/* modal images keep it between columns; FIR adds it to R[0] of every row */
-		bool fir = b->sc->representation == IRDM_REPR_FIR;
-		size_t n_out = fir ? m->n_rows : m->n_cols;
-		b->corr = malloc(m->n_cols * n_out * 9 * sizeof(double));
-		if (!b->corr)
-			goto out_nomem;
-		ret = irdm_static_correction(&m->fem, &m->modes, b->sc->floating, m->col_dofs,
-					     m->n_cols, fir ? m->row_dofs : m->col_dofs, n_out,
-					     b->corr, err, errlen);
-		if (ret)
-			return ret;
-	}
-	return IRDM_OK;
+	if (!b->sc->static_correction || !truncated(b))
+		return IRDM_OK;
+	if (b->sc->representation == IRDM_REPR_MODAL)
+		/* between columns only, the blocks that matter (static_sparse.h) */
+		return irdm_static_correction_sparse(&m->fem, &m->modes, b->sc->floating,
+						     m->col_dofs, m->n_cols, b->sc->static_corr_tol,
+						     b->o->progress, b->o->ctx, &b->sparse,
+						     err, errlen);
+	/* an FIR adds it to R[0] of every row: as dense as the FIR itself */
+	b->corr = malloc(m->n_cols * m->n_rows * 9 * sizeof(double));
+	if (!b->corr)
+		goto out_nomem;
+	if (b->o->progress)
+		b->o->progress(b->o->ctx, "static correction", 0.0);
+	ret = irdm_static_correction(&m->fem, &m->modes, b->sc->floating, m->col_dofs,
+				     m->n_cols, m->row_dofs, m->n_rows, b->corr, err, errlen);
+	if (!ret && b->o->progress)
+		b->o->progress(b->o->ctx, "static correction", 1.0);
+	return ret;
 out_nomem:
 	snprintf(err, errlen, "precompute: out of memory for the modal data");
 	return IRDM_ENOMEM;
@@ -96,7 +110,7 @@ out_nomem:
 static int fir_from_modes(struct build *b, char *err, size_t errlen)
 {
 	struct irdm_model *m = &b->m;
-	size_t T = b->sc->fir_length;
+	size_t T = fir_taps(b);
 	int ret;
 
 	ret = modal_data(b, err, errlen);
@@ -152,7 +166,7 @@ static int td_run(struct build *b, size_t begin, size_t end, double *R, char *er
 	int64_t *global = malloc(n_in * sizeof(int64_t));
 	struct td_progress tp = { b->o->progress, b->o->ctx };
 	struct irdm_td_opts o = {
-		.dt_s = b->sc->dt_s, .n_samples = b->sc->fir_length, .substeps = b->sc->substeps,
+		.dt_s = b->sc->dt_s, .n_samples = fir_taps(b), .substeps = b->sc->substeps,
 		.damping = m->damping, .floating = b->sc->floating,
 		/* over MPI, the cores of a machine shared by its ranks */
 		.threads = b->sc->threads ? b->sc->threads : irdm_dist_threads(),
@@ -181,7 +195,7 @@ static int td_scatter(struct build *b, const double *R, size_t begin, size_t end
 		      char *err, size_t errlen)
 {
 	struct irdm_model *m = &b->m;
-	size_t T = b->sc->fir_length, n_out = 3 * m->n_rows;
+	size_t T = fir_taps(b), n_out = 3 * m->n_rows;
 	size_t *slot = malloc(3 * m->n_cols * sizeof(size_t));
 
 	if (!slot) {
@@ -205,7 +219,7 @@ static int td_scatter(struct build *b, const double *R, size_t begin, size_t end
 static int td_part(struct build *b, size_t n_in, char *err, size_t errlen)
 {
 	const struct irdm_precompute_opts *o = b->o;
-	size_t T = b->sc->fir_length, n_out = 3 * b->m.n_rows;
+	size_t T = fir_taps(b), n_out = 3 * b->m.n_rows;
 	size_t e = o->part_end < n_in ? o->part_end : n_in;
 	int ret;
 
@@ -231,7 +245,7 @@ static int td_part(struct build *b, size_t n_in, char *err, size_t errlen)
 static int td_merge(struct build *b, size_t n_in, char *err, size_t errlen)
 {
 	const struct irdm_precompute_opts *o = b->o;
-	size_t T = b->sc->fir_length, n_out = 3 * b->m.n_rows;
+	size_t T = fir_taps(b), n_out = 3 * b->m.n_rows;
 	unsigned char *seen = calloc(n_in ? n_in : 1, 1);
 	int ret = IRDM_EINVAL;
 
@@ -316,7 +330,7 @@ out_free:
 static int fir_time_domain(struct build *b, char *err, size_t errlen)
 {
 	struct irdm_model *m = &b->m;
-	size_t T = b->sc->fir_length, n_out = 3 * m->n_rows, n_in = list_inputs(m, NULL, NULL);
+	size_t T = fir_taps(b), n_out = 3 * m->n_rows, n_in = list_inputs(m, NULL, NULL);
 	size_t fir_n = m->n_cols * m->n_rows * T * 9;
 	double *R;
 	int ret;
@@ -371,20 +385,23 @@ static void stab_one(struct build *b, size_t c)
 	double rho;
 
 	if (b->sc->representation == IRDM_REPR_FIR) {
-		size_t T = b->sc->fir_length;
+		size_t T = fir_taps(b);
 		const double *R = &b->fir[(c * m->n_rows + row) * T * 9];
 		/* exact eigenvalues while the companion matrix is cheap (3(T-1)
 		 * <= 480), the argument-principle upper bound beyond */
 		rho = T <= 161 ? irdm_stability_fir_companion(R, T) : irdm_stability_fir(R, T);
 	} else {
 		size_t K = b->n_modes;
-		double D[9];
-		if (b->corr)
-			memcpy(D, &b->corr[(c * m->n_cols + c) * 9], sizeof(D));
+		const double *D = NULL;
+		/* the diagonal block, always kept: stored rows are sorted */
+		for (uint32_t k = b->sparse.start ? b->sparse.start[c] : 0;
+		     b->sparse.start && k < b->sparse.start[c + 1]; k++)
+			if (b->sparse.rows[k] == c)
+				D = &b->sparse.blocks[9 * (size_t)k];
 		/* the argument-principle certificate: O(modes) per point of a
 		 * circle where the dense eigenvalues are O(modes^3)
 		 * (irdm_stability_modal stays as the tests' reference) */
-		rho = irdm_stability_modal_ap(b->zoh, K, &b->shapes[3 * row * K], b->corr ? D : NULL);
+		rho = irdm_stability_modal_ap(b->zoh, K, &b->shapes[3 * row * K], D);
 	}
 	/* judge the stored float: a radius within 3e-8 below 1 rounds to 1.0f */
 	b->stab[c].spectral_radius = (float)rho;
@@ -457,12 +474,14 @@ static void fill_meta(struct build *b)
 	mt->n_nodes = (uint32_t)m->n_rows;
 	mt->n_cols = (uint32_t)m->n_cols;
 	mt->n_tris = (uint32_t)m->n_tris;
-	mt->fir_length = sc->representation == IRDM_REPR_FIR ? sc->fir_length : 0;
+	mt->fir_length = sc->representation == IRDM_REPR_FIR ? (uint32_t)fir_taps(b) : 0;
+	mt->fir_exact = sc->representation == IRDM_REPR_FIR && sc->fir_tail ? sc->fir_length : 0;
 	mt->n_modes = sc->representation == IRDM_REPR_MODAL ? (uint32_t)b->n_modes : 0;
 	mt->flags = (sc->floating ? IRDM_META_FLOATING : 0) |
-		    (b->corr && sc->representation == IRDM_REPR_MODAL ? IRDM_META_STATIC_CORR : 0) |
+		    (b->sparse.start ? IRDM_META_STATIC_CORR : 0) |
 		    (sc->mass == IRDM_MASS_CONSISTENT ? IRDM_META_CONSISTENT_MASS : 0) |
-		    (sc->method == IRDM_METHOD_TIME_DOMAIN ? IRDM_META_TIME_DOMAIN : 0);
+		    (sc->method == IRDM_METHOD_TIME_DOMAIN ? IRDM_META_TIME_DOMAIN : 0) |
+		    (mt->fir_exact ? IRDM_META_FIR_TAIL_WINDOW : 0);
 	mt->dt_s = sc->dt_s;
 	mt->young_pa = sc->mat.young_pa;
 	mt->poisson = sc->mat.poisson;
@@ -554,8 +573,12 @@ static int add_sections(struct build *b, struct irdm_image_writer *w, const void
 	} else {
 		ret |= irdm_iw_add(w, IRDM_SEC_MODES, IRDM_ELEM_BYTES, b->zoh, b->n_modes * sizeof(*b->zoh));
 		ret |= irdm_iw_add(w, IRDM_SEC_MODE_SHAPES, p, b->stored[1], b->stored_bytes[1]);
-		if (b->stored[2])
+		if (b->stored[2]) {
+			struct irdm_corr_sparse *s = &b->sparse;
 			ret |= irdm_iw_add(w, IRDM_SEC_STATIC_CORR, p, b->stored[2], b->stored_bytes[2]);
+			ret |= irdm_iw_add(w, IRDM_SEC_STATIC_CORR_INDEX, IRDM_ELEM_U32, s->start,
+					   (s->n_cols + 1 + s->n_blocks) * sizeof(uint32_t));
+		}
 	}
 	if (b->sc->floating)
 		ret |= irdm_iw_add(w, IRDM_SEC_RIGID, IRDM_ELEM_BYTES, &b->rigid, sizeof(b->rigid));
@@ -609,18 +632,24 @@ static int responses(struct build *b, char *err, size_t errlen)
 		ret = fir_from_modes(b, err, errlen);
 	if (ret || b->o->part_out)
 		return ret;
+	if (b->fir && b->sc->fir_tail) {
+		ret = irdm_fir_tail_window(m, b->sc->floating, b->sc->fir_length, b->sc->fir_tail,
+					   b->fir, err, errlen);
+		if (ret)
+			return ret;
+	}
 	if (b->fir)
-		b->stored[0] = store(b->fir, m->n_cols * m->n_rows * b->sc->fir_length * 9,
+		b->stored[0] = store(b->fir, m->n_cols * m->n_rows * fir_taps(b) * 9,
 				     b->sc->precision, &b->stored_bytes[0]);
 	if (b->shapes && b->sc->representation == IRDM_REPR_MODAL)
 		b->stored[1] = store(b->shapes, m->n_rows * 3 * b->n_modes, b->sc->precision,
 				     &b->stored_bytes[1]);
-	if (b->corr && b->sc->representation == IRDM_REPR_MODAL)
-		b->stored[2] = store(b->corr, m->n_cols * m->n_cols * 9, b->sc->precision,
+	if (b->sparse.start)
+		b->stored[2] = store(b->sparse.blocks, b->sparse.n_blocks * 9, b->sc->precision,
 				     &b->stored_bytes[2]);
 	if ((b->fir && !b->stored[0]) ||
 	    (b->shapes && b->sc->representation == IRDM_REPR_MODAL && !b->stored[1]) ||
-	    (b->corr && b->sc->representation == IRDM_REPR_MODAL && !b->stored[2])) {
+	    (b->sparse.start && !b->stored[2])) {
 		snprintf(err, errlen, "precompute: out of memory converting to the storage precision");
 		return IRDM_ENOMEM;
 	}
@@ -634,6 +663,7 @@ static void build_free(struct build *b)
 	free(b->fir);
 	free(b->shapes);
 	free(b->corr);
+	irdm_corr_sparse_free(&b->sparse);
 	for (int i = 0; i < 3; i++)
 		free(b->stored[i]);
 	free(b->stab);
@@ -660,6 +690,9 @@ static void report(const struct build *b, struct irdm_precompute_report *rep)
 	rep->max_spectral_radius = b->meta.max_spectral_radius;
 	for (size_t c = 0; b->stab && c < m->n_cols; c++)
 		rep->unstable_cols += !(b->stab[c].flags & IRDM_STAB_STABLE);
+	rep->corr_blocks = b->sparse.n_blocks;
+	rep->corr_tol = b->sc->static_corr_tol;
+	rep->corr_max_dropped_rel = b->sparse.max_dropped_rel;
 }
 
 static uint64_t scene_hash(const struct irdm_scene *sc)
@@ -713,9 +746,13 @@ int irdm_precompute(const struct irdm_scene *sc, const struct irdm_precompute_op
 			 : "precompute: the scene does not fit in the provenance text");
 		goto out_free;
 	}
+	if (o->progress)
+		o->progress(o->ctx, "contact BVH and image", 0.0);
 	ret = write_image(&b, &rep->image_bytes, err, errlen);
 	if (ret)
 		goto out_free;
+	if (o->progress)
+		o->progress(o->ctx, "contact BVH and image", 1.0);
 out_report:
 	report(&b, rep);
 out_worker:

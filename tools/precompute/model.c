@@ -184,6 +184,8 @@ int irdm_model_build(const struct irdm_scene *sc, size_t n_modes_needed,
 	ret = irdm_model_mesh(sc, &m->mesh, note, err, errlen);
 	if (ret)
 		goto out_fail;
+	if (progress)
+		progress(ctx, "mesh", 1.0);
 	if (progress && note[0])
 		progress(ctx, note, -1.0);
 	ret = mark_nodes(sc, m, err, errlen);
@@ -196,9 +198,13 @@ int irdm_model_build(const struct irdm_scene *sc, size_t n_modes_needed,
 	say_stats(&m->mesh, progress, ctx);
 	m->seconds_mesh = irdm_now_s() - t0;
 	t0 = irdm_now_s();
+	if (progress)
+		progress(ctx, "FEM assembly", 0.0);
 	ret = irdm_fem_assemble(&m->mesh, &sc->mat, sc->mass, m->fixed, &m->fem, err, errlen);
 	if (ret)
 		goto out_fail;
+	if (progress)
+		progress(ctx, "FEM assembly", 1.0);
 	m->seconds_fem = irdm_now_s() - t0;
 	t0 = irdm_now_s();
 	/* the scene's rows and columns before the eigensolve: over MPI only

@@ -27,6 +27,9 @@ struct irdm_precompute_report {
 	size_t mesh_nodes, mesh_tets, free_dofs, rows, cols, tris, modes, modes_total;
 	double first_elastic_hz, max_spectral_radius;
 	size_t unstable_cols;
+	/* modal static correction: blocks kept of n_cols^2 (0: none) */
+	size_t corr_blocks;
+	double corr_tol, corr_max_dropped_rel;
 };
 
 /*

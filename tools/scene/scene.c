@@ -9,6 +9,7 @@
 
 #include "irdm/error.h"
 #include "irdm/options.h"
+#include "modal/static_sparse.h"
 #include "scene/scene.h"
 
 void irdm_scene_defaults(struct irdm_scene *sc)
@@ -31,6 +32,7 @@ void irdm_scene_defaults(struct irdm_scene *sc)
 	sc->representation = IRDM_REPR_MODAL;
 	sc->modes = 300;
 	sc->static_correction = true;
+	sc->static_corr_tol = IRDM_STATIC_CORR_TOL_DEFAULT;
 	sc->precision = IRDM_ELEM_F32;
 	sc->fixed.kind = IRDM_REGION_PLANE;
 	sc->fixed.axis = 2;
@@ -305,6 +307,25 @@ static int set_representation(const struct irdm_opt *o, void *obj, const char *v
 	return parse_representation(obj, v) ? IRDM_EFORMAT : IRDM_OK;
 }
 
+/* "none", or "window:L": L samples past T, tapered (precompute/fir_tail.c). */
+static int set_fir_tail(const struct irdm_opt *o, void *obj, const char *v, char *why, size_t len)
+{
+	static const struct irdm_opt count = { .name = "fir_tail", .type = IRDM_OPT_UNSIGNED,
+		.size = sizeof(unsigned), .range = IRDM_OPT_GE | IRDM_OPT_LE, .min = 1, .max = 1000000 };
+	struct irdm_scene *sc = obj;
+
+	(void)o;
+	if (!strcmp(v, "none")) {
+		sc->fir_tail = 0;
+		return IRDM_OK;
+	}
+	if (strncmp(v, "window:", 7)) {
+		snprintf(why, len, "expected none or window:L");
+		return IRDM_EFORMAT;
+	}
+	return irdm_opt_parse_value(&count, &sc->fir_tail, v + 7, why, len);
+}
+
 /* "all" or "0": every mode; otherwise 1 to 1000000. */
 static int set_modes(const struct irdm_opt *o, void *obj, const char *v, char *why, size_t len)
 {
@@ -389,8 +410,16 @@ static const struct irdm_opt scene_opts[] = {
 	  .help = "K modes (1 to 1000000) or all, or an FIR of T samples (1 to 1000000) (default modal:300)" },
 	{ .name = "modes", .type = IRDM_OPT_CUSTOM, .parse = set_modes, .metavar = "K | all",
 	  .help = "modes that synthesise a modal-method FIR, 1 to 1000000 (default 300)" },
+	{ .name = "fir_tail", .type = IRDM_OPT_CUSTOM, .parse = set_fir_tail,
+	  .metavar = "none | window:L",
+	  .help = "FIR stabilisation: window:L appends L samples past T tapered to zero (Hann), "
+		  "the taps' sum restored to the static compliance; the first T stay exact "
+		  "(default none: the engine damps an unstable FIR's tail by r^s)" },
 	{ .name = "static_correction", .type = IRDM_OPT_BOOL, SC(static_correction),
 	  .help = "residual compliance of dropped modes (modal; default yes)" },
+	{ .name = "static_correction_tol", .type = IRDM_OPT_DOUBLE, SC(static_corr_tol),
+	  .metavar = "TOL", .range = IRDM_OPT_GE | IRDM_OPT_LT, .min = 0, .max = 1,
+	  .help = "modal: drop the static correction's block between touchable nodes a and b when its norm is below TOL sqrt(|S_aa| |S_bb|), the diagonal blocks' norms: the force error at a contact is of about that order (default 0.02; 0 keeps every block)" },
 	{ .name = "precision", .type = IRDM_OPT_ENUM, SC(precision), .names = precision_names,
 	  .help = "storage of the responses (default f32)" },
 	{ .name = "touch", .type = IRDM_OPT_CUSTOM, .parse = set_region, SC(touch),
@@ -474,6 +503,16 @@ int irdm_scene_check(const struct irdm_scene *sc, char *err, size_t errlen)
 		snprintf(err, errlen, "scene: method = time-domain makes FIR responses: use representation = fir:T");
 		return IRDM_EINVAL;
 	}
+	if (sc->fir_tail && sc->representation != IRDM_REPR_FIR) {
+		snprintf(err, errlen, "scene: fir_tail = window:%u windows an FIR's tail: use representation = fir:T",
+			 sc->fir_tail);
+		return IRDM_EINVAL;
+	}
+	if (sc->fir_tail && (uint64_t)sc->fir_tail + sc->fir_length > 1000000) {
+		snprintf(err, errlen, "scene: fir:%u with fir_tail = window:%u makes more than 1000000 samples",
+			 sc->fir_length, sc->fir_tail);
+		return IRDM_EINVAL;
+	}
 	if (sc->damping == IRDM_DAMP_RATIOS && sc->damp_hz[0] > 0 &&
 	    fabs(sc->damp_hz[0] - sc->damp_hz[1]) < 1e-9) {
 		snprintf(err, errlen, "scene: damping needs two different frequencies");
@@ -512,17 +551,24 @@ int irdm_scene_format(const struct irdm_scene *sc, char *buf, size_t len)
 		"name=%s\nmesh=%s\nresolution=%u,%u,%u\ntets_per_hex=%u\nmesh_scale=%.17g\n"
 		"tetgen=%s\nyoung=%.17g\npoisson=%.17g\ndensity=%.17g\nmass=%s\ndamping=%s\n"
 		"floating=%s\nfixed=%s\ndt=%.17g\nrepresentation=%s\nstatic_correction=%s\n"
+		"static_correction_tol=%.17g\n"
 		"precision=%s\ntouch=%s\ndisplay=%s\nmethod=%s\nsubsteps=%u\neigensolver=%s\nmodes=%u\n",
 		sc->name, sc->mesh, sc->res[0], sc->res[1], sc->res[2], sc->tets_per_hex,
 		sc->mesh_scale, sc->tetgen, sc->mat.young_pa, sc->mat.poisson,
 		sc->mat.density_kg_m3, sc->mass == IRDM_MASS_LUMPED ? "lumped" : "consistent",
 		damp, sc->floating ? "yes" : "no", region_text(&sc->fixed), sc->dt_s, repr,
-		sc->static_correction ? "yes" : "no", prec[sc->precision & 3],
+		sc->static_correction ? "yes" : "no", sc->static_corr_tol, prec[sc->precision & 3],
 		region_text(&sc->touch), region_text(&sc->display),
 		sc->method == IRDM_METHOD_MODAL ? "modal" : "time-domain", sc->substeps,
 		eig[sc->eigensolver], sc->modes);
 	if (n < 0 || (size_t)n >= len)
 		return -1;
+	if (sc->fir_tail) {         /* only when set: older scenes keep their text */
+		int t = snprintf(buf + n, len - (size_t)n, "fir_tail=window:%u\n", sc->fir_tail);
+		if (t < 0 || (size_t)t >= len - (size_t)n)
+			return -1;
+		n += t;
+	}
 	if (sc->tetgen_given || irdm_scene_builtin_mesh(sc))
 		return 0;       /* as before sizing existed: the same images */
 	int k = snprintf(buf + n, len - (size_t)n, "target_nodes=%u\nmax_tet_volume=%.17g\n",

@@ -64,8 +64,10 @@ struct irdm_scene {
 	double dt_s;
 	uint32_t representation; /* enum irdm_repr */
 	unsigned fir_length;
+	unsigned fir_tail;       /* FIR: samples windowed past fir_length (0: none) */
 	unsigned modes;          /* modes kept (0 = all) */
 	bool static_correction;
+	double static_corr_tol;   /* drop blocks below tol sqrt(|S_cc| |S_rr|) */
 	uint32_t precision;      /* enum irdm_elem */
 	struct irdm_region touch;
 	struct irdm_region display;

@@ -52,9 +52,13 @@ struct irdm_engine_config {
 	/* Hannaford-Ryu passivity observer/controller at each contact port. */
 	bool passivity_control;
 	/*
-	 * Unstable recursions are never run unprotected: an image column whose
-	 * recorded spectral radius is >= 1 gets its FIR tail damped by r^s so
-	 * that the radius becomes <= stable_radius (<1).  0 = 0.999.
+	 * Unstable recursions are never run unprotected: an FIR image whose
+	 * largest recorded spectral radius (meta max_spectral_radius) is >= 1
+	 * gets the tail of every column damped by w[s] = r^s, r =
+	 * stable_radius / that radius, so that its radius becomes <=
+	 * stable_radius (<1).  This distorts the response from the first
+	 * sample; an image made with fir_tail = window:L is stable as stored
+	 * and runs undamped.  0 = 0.999.
 	 */
 	double stable_radius;
 	double max_force_n;             /* > 0: a larger force faults the engine (torque off) */
@@ -188,6 +192,11 @@ int irdm_engine_tick(struct irdm_engine *eng, const struct irdm_contact_cmd *cmd
 /* The state of slot i, or NULL if i >= IRDM_MAX_CONTACTS. */
 const struct irdm_contact_state *irdm_engine_contact(const struct irdm_engine *eng, unsigned i);
 const struct irdm_engine_stats *irdm_engine_stats(const struct irdm_engine *eng);
+
+/* Which FIR history sum the engine runs: "avx2" (fir_sum_avx2.c, chosen at
+ * init where the processor has AVX2, FMA and F16C), "portable", or "none"
+ * (not an FIR image). */
+const char *irdm_engine_fir_sum_name(const struct irdm_engine *eng);
 
 /*
  * Points between the world frame and the object's own frame (the frame of

@@ -34,7 +34,12 @@ struct irdm_image {
 	const void *fir;                    /* FIR: n_cols*n_nodes*T*9 of precision */
 	const struct irdm_mode *modes;      /* modal: n_modes */
 	const void *mode_shapes;            /* modal: n_nodes*3*n_modes of precision */
-	const void *static_corr;            /* modal, optional: n_cols*n_cols*9 */
+	/* modal, optional (all NULL if absent): the static correction's kept
+	 * 3x3 blocks; column c's are k in [corr_start[c], corr_start[c+1]),
+	 * block k displaces column corr_rows[k] (increasing; c always there) */
+	const uint32_t *corr_start;         /* n_cols + 1 */
+	const uint32_t *corr_rows;          /* corr_start[n_cols] */
+	const void *corr_blocks;            /* corr_start[n_cols] x 9 of precision */
 	const struct irdm_rigid *rigid;     /* floating only, else NULL */
 	const struct irdm_stability *stability; /* n_cols */
 	/* optional CONTACT_BVH (NULL if absent): validated header, payload bytes */
@@ -87,6 +92,13 @@ void irdm_image_unmap(struct irdm_image *img);
  * absent (or img holds no image).  Cannot fail otherwise. */
 const struct irdm_image_section *irdm_image_find(const struct irdm_image *img,
 						 uint32_t kind);
+
+/* Index k of the static-correction block for a force at column col_force
+ * and the displacement of column col_disp (corr_blocks[9k..9k+8]), or -1 if
+ * the block was dropped or the image has no correction.  Binary search in
+ * the column's rows: O(log kept), no allocation (tick-safe). */
+long irdm_image_corr_block(const struct irdm_image *img, uint32_t col_force,
+			   uint32_t col_disp);
 
 /* CRC-32C (Castagnoli), reflected, init/xorout 0xFFFFFFFF. */
 uint32_t irdm_crc32c(const void *data, size_t len);

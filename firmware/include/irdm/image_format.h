@@ -15,7 +15,7 @@
 #include <stdint.h>
 
 #define IRDM_IMAGE_MAGIC "IRDMIMG"          /* 7 chars + NUL = 8 bytes */
-#define IRDM_IMAGE_VERSION_MAJOR 1u         /* incompatible layout change */
+#define IRDM_IMAGE_VERSION_MAJOR 2u         /* incompatible layout change */
 #define IRDM_IMAGE_VERSION_MINOR 0u         /* compatible additions */
 #define IRDM_IMAGE_ALIGN 64u                /* payload alignment, bytes */
 #define IRDM_IMAGE_MAX_SECTIONS 32u
@@ -62,10 +62,11 @@ enum irdm_section_kind {
 	IRDM_SEC_FIR = 6,          /* FIR only: R[s] blocks [col][row][s][3][3], elem = precision */
 	IRDM_SEC_MODES = 7,        /* modal only: n_modes x struct irdm_mode */
 	IRDM_SEC_MODE_SHAPES = 8,  /* modal only: [row][3][mode], elem = precision */
-	IRDM_SEC_STATIC_CORR = 9,  /* modal, optional: residual compliance [col][col'][3][3] */
+	IRDM_SEC_STATIC_CORR = 9,  /* modal, optional: kept residual-compliance blocks [k][3][3] */
 	IRDM_SEC_RIGID = 10,       /* floating only: struct irdm_rigid */
 	IRDM_SEC_STABILITY = 11,   /* n_cols x struct irdm_stability */
 	IRDM_SEC_CONTACT_BVH = 12, /* optional: contact BVH + adjacency, struct irdm_bvh_header */
+	IRDM_SEC_STATIC_CORR_INDEX = 13, /* with STATIC_CORR: u32 column starts + rows of its blocks */
 };
 
 enum irdm_repr {
@@ -78,6 +79,9 @@ enum irdm_meta_flags {
 	IRDM_META_STATIC_CORR = 1u << 1,    /* STATIC_CORR present */
 	IRDM_META_CONSISTENT_MASS = 1u << 2,
 	IRDM_META_TIME_DOMAIN = 1u << 3,    /* FIR computed by time integration */
+	/* FIR: samples [fir_exact, fir_length) are the response tapered to
+	 * zero, the taps' sum restored to the static compliance */
+	IRDM_META_FIR_TAIL_WINDOW = 1u << 4,
 };
 
 struct irdm_meta {                          /* 256 bytes */
@@ -102,7 +106,7 @@ struct irdm_meta {                          /* 256 bytes */
 	uint32_t mesh_nodes;                /* of the whole source mesh */
 	uint32_t mesh_tets;
 	uint32_t n_modes_total;             /* elastic modes of the whole model */
-	uint32_t reserved0;
+	uint32_t fir_exact;                 /* FIR_TAIL_WINDOW: samples kept exact, 1..T-1; else 0 */
 	uint64_t mesh_hash;                 /* FNV-1a 64 of positions and tets */
 	char     tool_version[32];          /* NUL-terminated */
 	char     mesh_name[64];             /* NUL-terminated */
