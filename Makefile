@@ -7,6 +7,7 @@
 #                   any finding fails the build and keeps the input
 #   make check      what CI runs: fuzz, clang + sanitizer tests, then the tests
 #   make bench      benchmarks (print figures; never pass/fail on time)
+#   make bench-mpi  the precompute of a 100k-node model, serial and over MPI ranks
 #   make stability  the stability suite's long run (10^7-tick soak): a Markdown
 #                   table and a plot of the worst cases in out/stability/
 #   make report     docs/report.md and its plots: every representation against
@@ -66,7 +67,21 @@ WARN     = -Wall -Wextra -Werror -Wshadow -Wstrict-prototypes -Wvla -Wundef
 OPT     ?= -O2 -g
 CFLAGS  += $(CSTD) $(WARN) $(OPT) -MMD -MP
 CFLAGS  += $(foreach f,$(FEATURES),-DIRDM_CONFIG_$(f)=$(if $(call feature,$(f)),1,0))
-LDLIBS   = -lcholmod -larpack -lopenblas -lpthread -lm
+LDLIBS   = -lcholmod -larpack -lopenblas -lpthread -ldl -lm
+
+# The distributed eigensolver (eigensolver = slepc, tools/dist/): PETSc and
+# SLEPc over MPI in a plugin, $(BUILD)/irdm-slepc.so beside irdm, built when
+# pkg-config finds them (Debian: petsc-dev slepc-dev libopenmpi-dev);
+# SLEPC=0 leaves it out (the option then says it is not built in).  irdm
+# itself never links them: it loads the plugin when a scene asks for it.
+# Their headers are -isystem: our warnings are not theirs to pass.
+MPI_PC  ?= ompi
+ifeq ($(origin SLEPC),undefined)
+SLEPC   := $(shell pkg-config --exists slepc PETSc $(MPI_PC) 2>/dev/null && echo 1 || echo 0)
+endif
+SLEPC_PLUGIN := $(if $(filter 1,$(SLEPC)),$(BUILD)/irdm-slepc.so)
+PLUGIN_INC = $(patsubst -I%,-isystem %,$(filter -I%,$(shell pkg-config --cflags slepc PETSc $(MPI_PC))))
+PLUGIN_LIBS = $(shell pkg-config --libs slepc PETSc $(MPI_PC)) -lopenblas -lm
 
 # Include paths, one set per layer (target-specific: an object sees only its own).
 FW_INC    = -Ifirmware/include
@@ -87,6 +102,7 @@ SIM_SRC   := $(filter-out sim/main/%,$(wildcard sim/*/*.c))
 CDMAIN_SRC := $(wildcard sim/main/*.c)
 TOOL_SRC  := $(filter-out tools/irdm/%,$(wildcard tools/*/*.c))
 CLI_SRC   := $(wildcard tools/irdm/*.c)
+PLUGIN_SRC := $(wildcard tools/dist/plugin/*.c)
 TEST_SRC  := $(wildcard tests/test_*.c)
 TICK_TEST_SRC := $(wildcard tests/test_tick_*.c)
 TESTSUP_SRC := $(wildcard tests/support/*.c)
@@ -106,9 +122,9 @@ TESTS    := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 TICK_TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TICK_TEST_SRC))
 BENCHES  := $(patsubst tests/bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC))
 
-.PHONY: all test san fuzz bench bench-precompute run render stability report jitter check deps clean docs cfg-fws sizes hil
+.PHONY: all test san fuzz bench bench-precompute bench-mpi run render stability report jitter check deps clean docs cfg-fws sizes hil
 .SECONDARY:
-all: $(if $(CONFIG),,$(IRDM)) $(FW_LIB) $(HAL_LIB) $(SIM_LIB) $(if $(FWMAIN_SRC),$(IRDM_FW)) \
+all: $(if $(CONFIG),,$(IRDM) $(SLEPC_PLUGIN)) $(FW_LIB) $(HAL_LIB) $(SIM_LIB) $(if $(FWMAIN_SRC),$(IRDM_FW)) \
   $(if $(CDMAIN_SRC),$(IRDM_CD))
 
 $(BUILD)/obj/firmware/%.o: LAYER_INC = $(FW_INC)
@@ -135,8 +151,16 @@ $(HAL_LIB):  $(call obj,$(HAL_SRC))
 $(SIM_LIB):  $(call obj,$(SIM_SRC))
 $(TOOL_LIB): $(call obj,$(TOOL_SRC))
 
-$(IRDM): $(call obj,$(CLI_SRC)) $(TOOL_LIB) $(FW_LIB)
+$(IRDM): $(call obj,$(CLI_SRC)) $(TOOL_LIB) $(FW_LIB) | $(SLEPC_PLUGIN)
 	$(CC) $(LDFLAGS) $^ -o $@ $(LDLIBS)
+
+# The slepc plugin: position-independent, only its entry point exported.
+$(BUILD)/obj/tools/dist/plugin/%.o: tools/dist/plugin/%.c
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) -fPIC -fvisibility=hidden $(TOOL_INC) $(PLUGIN_INC) -c $< -o $@
+
+$(BUILD)/irdm-slepc.so: $(call obj,$(PLUGIN_SRC))
+	$(CC) $(LDFLAGS) -shared $^ -o $@ $(PLUGIN_LIBS)
 
 TEST_LIBS := $(TOOL_LIB) $(SIM_LIB) $(HAL_LIB) $(FW_LIB)
 
@@ -153,7 +177,7 @@ $(TICK_TESTS): $(BUILD)/tests/test_tick_%: $(BUILD)/obj/tests/test_tick_%.o $(FW
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) $^ -o $@ -lcmocka -lm
 
-$(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(call obj,$(TESTSUP_SRC)) $(TEST_LIBS)
+$(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(call obj,$(TESTSUP_SRC)) $(TEST_LIBS) | $(SLEPC_PLUGIN)
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) $^ -o $@ $(LDLIBS) -lcmocka
 
@@ -261,6 +285,11 @@ report: $(IRDM)
 # Paper-scale images (cuboid, bunny): time and size beside the paper's.
 bench-precompute: $(IRDM) $(BUILD)/data/bunny.off
 	tools/scripts/bench-precompute.sh $(IRDM)
+
+# The precompute over MPI ranks: a 100k-node cuboid, serial and slepc on
+# np = 1, 2 (README, "Beyond one machine"); bounded by TIMEOUT per run.
+bench-mpi: $(IRDM) $(SLEPC_PLUGIN)
+	tools/scripts/bench-mpi.sh $(IRDM)
 
 $(BUILD)/data/bunny.off:
 	@mkdir -p $(dir $@)

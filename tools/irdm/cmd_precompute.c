@@ -7,6 +7,7 @@
 #include <sys/resource.h>
 
 #include "cli.h"
+#include "dist/dist.h"
 #include "irdm/error.h"
 #include "irdm/options.h"
 #include "irdm/options_doc.h"
@@ -272,12 +273,90 @@ static int output_opts(const struct irdm_scene *sc, const struct precompute_args
 	return 0;
 }
 
+static int run(const struct irdm_scene *sc, const struct irdm_precompute_opts *o,
+	       struct irdm_cli_progress *prog)
+{
+	struct irdm_precompute_report rep;
+	char err[1024];
+	int rc = irdm_precompute(sc, o, &rep, err, sizeof(err));
+
+	if (rc) {
+		/* over MPI: every rank stops, with this one's number and reason */
+		irdm_dist_abort("precompute", rc, err);
+		irdm_cli_fail("precompute", rc, err);
+		return 1;
+	}
+	if (!prog->quiet)
+		print_report(sc, o, &rep);
+	return 0;
+}
+
+/* Every rank's peak memory, on rank 0 (what bounds a cluster node). */
+static int say_rank_memory(const struct irdm_cli_progress *prog)
+{
+	int n = irdm_dist_size();
+	size_t *counts = calloc((size_t)n, sizeof(size_t));
+	double *all = calloc((size_t)n, sizeof(double)), mine;
+	struct rusage ru;
+	char err[256];
+	int rc = 1;
+
+	if (!counts || !all) {
+		irdm_dist_abort("precompute", IRDM_ENOMEM, "out of memory");
+		irdm_cli_fail("precompute", IRDM_ENOMEM, "out of memory");
+		goto out_free;
+	}
+	getrusage(RUSAGE_SELF, &ru);
+	mine = (double)ru.ru_maxrss / 1024.0;   /* KiB on Linux */
+	for (int r = 0; r < n; r++)
+		counts[r] = 1;
+	rc = irdm_dist_gather(&mine, counts, all, err, sizeof(err));
+	if (rc) {
+		irdm_dist_abort("precompute", rc, err);
+		irdm_cli_fail("precompute", rc, err);
+		rc = 1;
+		goto out_free;
+	}
+	if (!prog->quiet) {
+		printf("ranks         %d, peak memory per rank (MiB):", n);
+		for (int r = 0; r < n; r++)
+			printf(" %.0f", all[r]);
+		printf("\n");
+	}
+out_free:
+	free(counts);
+	free(all);
+	return rc;
+}
+
+/* eigensolver = slepc: the same run on every MPI rank (a single one without
+ * mpirun); rank 0 alone shows progress and writes. */
+static int run_distributed(const struct irdm_scene *sc, const struct irdm_precompute_opts *o,
+			   struct irdm_cli_progress *prog)
+{
+	char err[1024];
+	int rc = irdm_dist_begin(err, sizeof(err));
+
+	if (rc) {
+		irdm_cli_fail("precompute", rc, err);
+		return 1;
+	}
+	if (irdm_dist_rank() != 0)
+		prog->quiet = 1;
+	rc = run(sc, o, prog);
+	if (!rc)
+		rc = say_rank_memory(prog);
+	if (!rc)
+		irdm_dist_wait_all();
+	irdm_dist_end();
+	return rc;
+}
+
 int irdm_cmd_precompute(int argc, char **argv)
 {
 	struct irdm_scene sc;
 	struct precompute_args args = { 0 };
 	struct irdm_precompute_opts o = { 0 };
-	struct irdm_precompute_report rep;
 	struct irdm_cli_progress prog = { 0 };
 	const char *parts[MAX_PARTS];
 	char err[1024];
@@ -301,6 +380,8 @@ int irdm_cmd_precompute(int argc, char **argv)
 	if (args.count_only) {
 		size_t n;
 		rc = irdm_precompute_count_inputs(&sc, &n, err, sizeof(err));
+		/* the slepc eigensolver started MPI as a singleton: stop it */
+		irdm_dist_end();
 		if (rc) {
 			irdm_cli_fail("precompute", rc, err);
 			return 1;
@@ -313,12 +394,6 @@ int irdm_cmd_precompute(int argc, char **argv)
 		return rc;
 	o.progress = irdm_cli_progress;
 	o.ctx = &prog;
-	rc = irdm_precompute(&sc, &o, &rep, err, sizeof(err));
-	if (rc) {
-		irdm_cli_fail("precompute", rc, err);
-		return 1;
-	}
-	if (!prog.quiet)
-		print_report(&sc, &o, &rep);
-	return 0;
+	return sc.eigensolver == IRDM_EIG_SLEPC ? run_distributed(&sc, &o, &prog)
+					       : run(&sc, &o, &prog);
 }

@@ -7,14 +7,7 @@
 #include <unistd.h>
 
 #include "cli.h"
-
-static double now_s(void)
-{
-	struct timespec ts;
-
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
+#include "util/clock.h"
 
 void irdm_cli_progress(void *ctx, const char *stage, double fraction)
 {
@@ -32,7 +25,7 @@ void irdm_cli_progress(void *ctx, const char *stage, double fraction)
 	if (p->quiet)
 		return;
 	if (p->t0 == 0)
-		p->t0 = now_s();
+		p->t0 = irdm_now_s();
 	if (strcmp(stage, p->stage)) {
 		if (tty && p->stage[0])
 			fputc('\n', stderr);
@@ -40,13 +33,13 @@ void irdm_cli_progress(void *ctx, const char *stage, double fraction)
 		p->last_pct = -100;
 	}
 	if (tty) {
-		fprintf(stderr, "\r  %-24s %3d%%  (%.1f s)", stage, pct, now_s() - p->t0);
+		fprintf(stderr, "\r  %-24s %3d%%  (%.1f s)", stage, pct, irdm_now_s() - p->t0);
 		if (pct >= 100) {
 			fputc('\n', stderr);
 			p->stage[0] = 0;
 		}
 	} else if (pct >= p->last_pct + 25 || (pct >= 100 && p->last_pct < 100)) {
-		fprintf(stderr, "  %s %d%% (%.1f s)\n", stage, pct, now_s() - p->t0);
+		fprintf(stderr, "  %s %d%% (%.1f s)\n", stage, pct, irdm_now_s() - p->t0);
 		p->last_pct = pct;
 	}
 	fflush(stderr);

@@ -19,6 +19,7 @@ enum irdm_eig_method {
 	IRDM_EIG_AUTO = 0,      /* dense when small or all modes wanted, else Lanczos */
 	IRDM_EIG_DENSE = 1,
 	IRDM_EIG_LANCZOS = 2,
+	IRDM_EIG_SLEPC = 3,     /* SLEPc over MPI ranks (tools/dist/), if built in */
 };
 
 struct irdm_modes {
@@ -27,8 +28,21 @@ struct irdm_modes {
 	size_t  n_rigid;        /* rigid modes found and excluded */
 	size_t  n_elastic_total;/* elastic modes of the model: n - n_rigid */
 	double *omega2;         /* n_modes eigenvalues w^2 (rad^2/s^2) */
-	double *phi;            /* n x n_modes, column-major, Phi^T M Phi = I */
-	double *rigid_phi;      /* n x n_rigid (floating only) */
+	double *phi;            /* n x n_modes, column-major, Phi^T M Phi = I
+				 * (NULL on an MPI rank other than 0) */
+	double *rigid_phi;      /* n x n_rigid (floating only; NULL as phi) */
+	/* K^-1 e_j for the loads asked (struct irdm_modes_want), n x n_loads,
+	 * by the slepc path of a grounded object on rank 0 (NaN outside the
+	 * kept DoFs); NULL: the static correction solves for itself */
+	double *compliance;
+	size_t n_compliance;
+};
+
+/* What the caller will read of the modes (irdm_modes_solve_kept). */
+struct irdm_modes_want {
+	const bool *keep;          /* free DoFs read of elastic modes (NULL: all) */
+	const int64_t *load_dofs;  /* free DoFs of the static correction's unit loads */
+	size_t n_loads;
 };
 
 /* Progress of a stage in [0, 1]; a negative fraction: `stage` is a line to
@@ -44,6 +58,18 @@ typedef void (*irdm_progress_fn)(void *ctx, const char *stage, double fraction);
 int irdm_modes_solve(const struct irdm_fem *fem, size_t n_wanted, bool floating,
 		     enum irdm_eig_method method, irdm_progress_fn progress, void *ctx,
 		     struct irdm_modes *out, char *err, size_t errlen);
+/*
+ * The same; want->keep (n entries, NULL: all) marks the free DoFs whose
+ * elastic eigenvector entries the caller will read.  Over MPI
+ * (IRDM_EIG_SLEPC) only those cross the network to rank 0, whose other
+ * entries are NaN so that a stray read shows; rigid modes always come
+ * whole.  A grounded object's slepc path also solves K x = e_j for
+ * want->load_dofs with the eigensolve's MUMPS factor (out->compliance).
+ */
+int irdm_modes_solve_kept(const struct irdm_fem *fem, size_t n_wanted, bool floating,
+			  enum irdm_eig_method method, const struct irdm_modes_want *want,
+			  irdm_progress_fn progress, void *ctx, struct irdm_modes *out,
+			  char *err, size_t errlen);
 void irdm_modes_free(struct irdm_modes *m);
 
 /* Internal solvers (exposed for tests: a second method to compare with). */
@@ -52,6 +78,17 @@ int irdm_eig_dense(const struct irdm_fem *fem, size_t n_lowest, double *w2, doub
 int irdm_eig_lanczos(const struct irdm_fem *fem, size_t n_lowest, double sigma,
 		     irdm_progress_fn progress, void *ctx, double *w2, double *phi,
 		     char *err, size_t errlen);
+/* The same by SLEPc (Krylov-Schur, shift-invert through MUMPS) over the
+ * MPI ranks (started here if the caller did not): every rank gets w2,
+ * rank 0 alone phi (NULL elsewhere): the first n_whole vectors whole, the
+ * others at the DoFs want->keep marks, NaN elsewhere; with sigma = 0 and
+ * want->n_loads, also (K^-1 e_j at the kept DoFs, NaN elsewhere) into
+ * compliance (rank 0's n x n_loads; NULL elsewhere).  Collective: every
+ * rank calls it. */
+int irdm_eig_slepc(const struct irdm_fem *fem, size_t n_lowest, double sigma,
+		   const struct irdm_modes_want *want, size_t n_whole,
+		   irdm_progress_fn progress, void *ctx, double *w2, double *phi,
+		   double *compliance, char *err, size_t errlen);
 
 /*
  * Exact zero-order-hold discretisation of q'' + 2 z w q' + w^2 q = g:

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "dist/dist.h"
 #include "modal/modal.h"
 
 /* Dense is cheaper than Lanczos below this many DoFs, and always used when
@@ -34,6 +35,7 @@ void irdm_modes_free(struct irdm_modes *m)
 	free(m->omega2);
 	free(m->phi);
 	free(m->rigid_phi);
+	free(m->compliance);
 	memset(m, 0, sizeof(*m));
 }
 
@@ -102,13 +104,19 @@ static int split_rigid(struct irdm_modes *out, size_t n_req, const double *w2,
 	out->n_rigid = r;
 	out->n_modes = n_req - r;
 	out->omega2 = malloc(out->n_modes * sizeof(double));
-	out->phi = malloc(n * out->n_modes * sizeof(double));
-	out->rigid_phi = malloc(n * (r ? r : 1) * sizeof(double));
-	if (!out->omega2 || !out->phi || !out->rigid_phi) {
+	if (!out->omega2) {
 		snprintf(err, errlen, "modes: out of memory");
 		return IRDM_ENOMEM;
 	}
 	memcpy(out->omega2, w2 + r, out->n_modes * sizeof(double));
+	if (!phi)       /* an MPI rank other than 0: eigenvalues only */
+		return 0;
+	out->phi = malloc(n * out->n_modes * sizeof(double));
+	out->rigid_phi = malloc(n * (r ? r : 1) * sizeof(double));
+	if (!out->phi || !out->rigid_phi) {
+		snprintf(err, errlen, "modes: out of memory");
+		return IRDM_ENOMEM;
+	}
 	memcpy(out->phi, phi + n * r, n * out->n_modes * sizeof(double));
 	memcpy(out->rigid_phi, phi, n * r * sizeof(double));
 	return 0;
@@ -118,9 +126,45 @@ int irdm_modes_solve(const struct irdm_fem *fem, size_t n_wanted, bool floating,
 		     enum irdm_eig_method method, irdm_progress_fn progress, void *ctx,
 		     struct irdm_modes *out, char *err, size_t errlen)
 {
+	return irdm_modes_solve_kept(fem, n_wanted, floating, method, NULL, progress, ctx, out,
+				     err, errlen);
+}
+
+/* Over MPI ranks; a grounded object's static-correction loads solved with
+ * the eigensolve's factor of K (sigma = 0) into out->compliance. */
+static int solve_slepc(const struct irdm_fem *fem, size_t n_req, bool floating, double scale,
+		       const struct irdm_modes_want *want, irdm_progress_fn progress, void *ctx,
+		       double *w2, double *phi, struct irdm_modes *out, char *err, size_t errlen)
+{
+	size_t n = fem->K.n, n_loads = floating || !want ? 0 : want->n_loads;
+	struct irdm_modes_want w = want ? *want : (struct irdm_modes_want){ NULL, NULL, 0 };
+	int ret;
+
+	w.n_loads = n_loads;
+	if (n_loads && irdm_dist_rank() == 0) {
+		out->compliance = malloc(n * n_loads * sizeof(double));
+		if (!out->compliance) {
+			snprintf(err, errlen, "modes: out of memory for %zu static loads", n_loads);
+			return IRDM_ENOMEM;
+		}
+		out->n_compliance = n_loads;
+	}
+	/* a negative shift keeps K - sigma M definite for floating bodies */
+	ret = irdm_eig_slepc(fem, n_req, floating ? -1e-6 * scale : 0.0, &w, floating ? 6 : 0,
+			     progress, ctx, w2, phi, out->compliance, err, errlen);
+	return ret;
+}
+
+int irdm_modes_solve_kept(const struct irdm_fem *fem, size_t n_wanted, bool floating,
+			  enum irdm_eig_method method, const struct irdm_modes_want *want,
+			  irdm_progress_fn progress, void *ctx, struct irdm_modes *out,
+			  char *err, size_t errlen)
+{
 	size_t n = fem->K.n, n_rigid = floating ? 6 : 0, n_req;
 	double max_scale, scale = typical_scale(fem, &max_scale);
 	double *w2 = NULL, *phi = NULL;
+	/* the slepc path gathers the eigenvectors on rank 0 only */
+	bool has_phi;
 	int ret;
 
 	memset(out, 0, sizeof(*out));
@@ -143,17 +187,29 @@ int irdm_modes_solve(const struct irdm_fem *fem, size_t n_wanted, bool floating,
 				 ? IRDM_EIG_DENSE : IRDM_EIG_LANCZOS;
 	if (method == IRDM_EIG_LANCZOS && n_req * 2 + 20 > n)
 		method = IRDM_EIG_DENSE;
+	if (method == IRDM_EIG_SLEPC && n_req * 2 + 20 > n) {
+		/* every rank would hold the whole Krylov basis: no gain */
+		snprintf(err, errlen, "slepc: %zu modes of %zu DoFs are too many for a Krylov solver: "
+			 "use eigensolver = dense", n_req, n);
+		return IRDM_EINVAL;
+	}
+	has_phi = method != IRDM_EIG_SLEPC || irdm_dist_rank() == 0;
 	w2 = malloc(n_req * sizeof(double));
-	phi = malloc(n * n_req * sizeof(double));
-	if (!w2 || !phi) {
+	if (has_phi)
+		phi = malloc(n * n_req * sizeof(double));
+	if (!w2 || (has_phi && !phi)) {
 		snprintf(err, errlen, "modes: out of memory for %zu modes of %zu DoFs", n_req, n);
 		ret = IRDM_ENOMEM;
 		goto out_free;
 	}
 	if (progress)
-		progress(ctx, method == IRDM_EIG_DENSE ? "dense eigensolve" : "Lanczos eigensolve", 0.0);
+		progress(ctx, method == IRDM_EIG_DENSE ? "dense eigensolve"
+			 : method == IRDM_EIG_SLEPC ? "SLEPc eigensolve" : "Lanczos eigensolve", 0.0);
 	if (method == IRDM_EIG_DENSE)
 		ret = irdm_eig_dense(fem, n_req, w2, phi, err, errlen);
+	else if (method == IRDM_EIG_SLEPC)
+		ret = solve_slepc(fem, n_req, floating, scale, want, progress, ctx, w2, phi, out,
+				  err, errlen);
 	else    /* a negative shift keeps K - sigma M definite for floating bodies */
 		ret = irdm_eig_lanczos(fem, n_req, floating ? -1e-6 * scale : 0.0, progress, ctx,
 				       w2, phi, err, errlen);

@@ -280,6 +280,7 @@ int irdm_static_correction(const struct irdm_fem *fem, const struct irdm_modes *
 	int64_t *in = malloc(3 * n_cols * sizeof(int64_t));
 	size_t *slot = malloc(3 * n_cols * sizeof(size_t));
 	double *X = NULL;
+	const double *Xr;
 	int ret = IRDM_OK;
 
 	if (!in || !slot)
@@ -289,13 +290,19 @@ int irdm_static_correction(const struct irdm_fem *fem, const struct irdm_modes *
 			slot[c] = n_in;
 			in[n_in++] = col_dofs[c];
 		}
-	X = malloc(n * (n_in ? n_in : 1) * sizeof(double));
-	if (!X)
-		goto out_nomem;
-	if (n_in)
-		ret = irdm_compliance_solve(fem, m, floating, in, n_in, X, err, errlen);
-	if (ret)
-		goto out_free;
+	if (m->compliance && m->n_compliance == n_in) {
+		/* solved over the MPI ranks with the eigensolve's factor */
+		Xr = m->compliance;
+	} else {
+		X = malloc(n * (n_in ? n_in : 1) * sizeof(double));
+		if (!X)
+			goto out_nomem;
+		if (n_in)
+			ret = irdm_compliance_solve(fem, m, floating, in, n_in, X, err, errlen);
+		if (ret)
+			goto out_free;
+		Xr = X;
+	}
 	for (size_t c = 0; c < n_cols; c++)
 		for (size_t r = 0; r < n_rows; r++)
 			for (int i = 0; i < 3; i++)
@@ -303,7 +310,7 @@ int irdm_static_correction(const struct irdm_fem *fem, const struct irdm_modes *
 					int64_t ri = row_dofs[3 * r + i], cj = col_dofs[3 * c + j];
 					double v = 0;
 					if (ri >= 0 && cj >= 0) {
-						v = X[slot[3 * c + j] * n + (size_t)ri];
+						v = Xr[slot[3 * c + j] * n + (size_t)ri];
 						for (size_t k = 0; k < m->n_modes; k++)
 							v -= m->phi[k * n + (size_t)ri] * m->phi[k * n + (size_t)cj]
 							     / m->omega2[k];

@@ -8,6 +8,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "dist/dist.h"
 #include "image/bvh_build.h"
 #include "image/elem_store.h"
 #include "image/image_writer.h"
@@ -21,6 +22,7 @@
 #include "precompute/precompute.h"
 #include "precompute/td_part.h"
 #include "timedomain/timedomain.h"
+#include "util/clock.h"
 #include "util/fnv1a.h"
 
 struct build {
@@ -42,14 +44,6 @@ struct build {
 	char *prov;
 	uint64_t scene_hash;
 };
-
-static double now_s(void)
-{
-	struct timespec ts;
-
-	clock_gettime(CLOCK_MONOTONIC, &ts);
-	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
 
 /* Modes the scene needs solved (0: all). */
 static size_t modes_needed(const struct irdm_scene *sc)
@@ -173,7 +167,9 @@ static int td_run(struct build *b, size_t begin, size_t end, double *R, char *er
 	struct td_progress tp = { b->o->progress, b->o->ctx };
 	struct irdm_td_opts o = {
 		.dt_s = b->sc->dt_s, .n_samples = fir_taps(b), .substeps = b->sc->substeps,
-		.damping = m->damping, .floating = b->sc->floating, .threads = b->sc->threads,
+		.damping = m->damping, .floating = b->sc->floating,
+		/* over MPI, the cores of a machine shared by its ranks */
+		.threads = b->sc->threads ? b->sc->threads : irdm_dist_threads(),
 		.progress = td_progress, .progress_ctx = &tp,
 		/* rigid motion removed by a mass-weighted best fit (Kabsch):
 		 * docs/architecture.md, "Frames and signs" */
@@ -292,6 +288,45 @@ out_seen:
 	return ret;
 }
 
+/*
+ * Over MPI ranks: rank r computes inputs [n_in r / P, n_in (r + 1) / P) (the
+ * --part logic, driven by the rank) and rank 0 gathers them in memory into
+ * the FIR (R: rank 0's FIR is allocated, NULL elsewhere).  Every rank
+ * calls it; a failing rank stops them all (irdm_dist_abort).
+ */
+static int td_distributed(struct build *b, size_t n_in, char *err, size_t errlen)
+{
+	size_t per_input = b->sc->fir_length * 3 * b->m.n_rows, begin, end;
+	int P = irdm_dist_size(), me = irdm_dist_rank();
+	size_t *counts = malloc((size_t)P * sizeof(size_t));
+	double *mine = NULL, *all = NULL;
+	int ret = IRDM_ENOMEM;
+
+	begin = n_in * (size_t)me / (size_t)P;
+	end = n_in * (size_t)(me + 1) / (size_t)P;
+	if (counts)
+		mine = malloc((end > begin ? end - begin : 1) * per_input * sizeof(double));
+	if (counts && mine && me == 0)
+		all = malloc((n_in ? n_in : 1) * per_input * sizeof(double));
+	if (!counts || !mine || (me == 0 && !all)) {
+		snprintf(err, errlen, "precompute: out of memory for this rank's time-domain inputs");
+		goto out_free;
+	}
+	for (int q = 0; q < P; q++)
+		counts[q] = (n_in * (size_t)(q + 1) / (size_t)P - n_in * (size_t)q / (size_t)P) *
+			    per_input;
+	ret = end > begin ? td_run(b, begin, end, mine, err, errlen) : IRDM_OK;
+	if (!ret)
+		ret = irdm_dist_gather(mine, counts, all, err, errlen);
+	if (!ret && me == 0)
+		ret = td_scatter(b, all, 0, n_in, err, errlen);
+out_free:
+	free(counts);
+	free(mine);
+	free(all);
+	return ret;
+}
+
 static int fir_time_domain(struct build *b, char *err, size_t errlen)
 {
 	struct irdm_model *m = &b->m;
@@ -309,6 +344,8 @@ static int fir_time_domain(struct build *b, char *err, size_t errlen)
 	}
 	if (b->o->n_merge)
 		return td_merge(b, n_in, err, errlen);
+	if (irdm_dist_size() > 1)
+		return td_distributed(b, n_in, err, errlen);
 	R = malloc(n_in * T * n_out * sizeof(double));
 	if (!R) {
 		snprintf(err, errlen, "precompute: out of memory for time-domain responses");
@@ -671,7 +708,7 @@ int irdm_precompute(const struct irdm_scene *sc, const struct irdm_precompute_op
 		    struct irdm_precompute_report *rep, char *err, size_t errlen)
 {
 	struct build b = { .sc = sc, .o = o };
-	double t0 = now_s(), t1;
+	double t0 = irdm_now_s(), t1;
 	int ret;
 
 	memset(rep, 0, sizeof(*rep));
@@ -680,19 +717,27 @@ int irdm_precompute(const struct irdm_scene *sc, const struct irdm_precompute_op
 	if (ret)
 		return ret;
 	b.scene_hash = irdm_fnv1a(b.scene_hash, &b.m.damping, sizeof(b.m.damping));
-	t1 = now_s();
+	/* over MPI the ranks other than 0 are done once the eigenvectors are
+	 * gathered (rank 0 alone holds them and makes the image), or once they
+	 * gave rank 0 their share of the time-domain inputs */
+	if (irdm_dist_rank() != 0) {
+		if (sc->method == IRDM_METHOD_TIME_DOMAIN && !o->part_out && !o->n_merge)
+			ret = td_distributed(&b, list_inputs(&b.m, NULL, NULL), err, errlen);
+		goto out_worker;
+	}
+	t1 = irdm_now_s();
 	ret = responses(&b, err, errlen);
 	if (ret)
 		goto out_free;
-	rep->seconds_responses = now_s() - t1;
+	rep->seconds_responses = irdm_now_s() - t1;
 	if (o->part_out)
 		goto out_report;
 	fill_meta(&b);
-	t1 = now_s();
+	t1 = irdm_now_s();
 	ret = stability(&b, err, errlen);
 	if (ret)
 		goto out_free;
-	rep->seconds_stability = now_s() - t1;
+	rep->seconds_stability = irdm_now_s() - t1;
 	ret = fill_nodes_rigid(&b);
 	if (!ret)
 		ret = provenance(&b);
@@ -710,7 +755,8 @@ int irdm_precompute(const struct irdm_scene *sc, const struct irdm_precompute_op
 		o->progress(o->ctx, "contact BVH and image", 1.0);
 out_report:
 	report(&b, rep);
-	rep->seconds_total = now_s() - t0;
+out_worker:
+	rep->seconds_total = irdm_now_s() - t0;
 out_free:
 	build_free(&b);
 	return ret;

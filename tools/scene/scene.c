@@ -352,7 +352,7 @@ static const struct irdm_opt_name method_names[] = {
 };
 static const struct irdm_opt_name eig_names[] = {
 	{ "auto", IRDM_EIG_AUTO }, { "dense", IRDM_EIG_DENSE }, { "lanczos", IRDM_EIG_LANCZOS },
-	{ NULL, 0 },
+	{ "slepc", IRDM_EIG_SLEPC }, { NULL, 0 },
 };
 
 #define SC(member) IRDM_OPT_FIELD(struct irdm_scene, member)
@@ -433,7 +433,8 @@ static const struct irdm_opt scene_opts[] = {
 	  .range = IRDM_OPT_GE | IRDM_OPT_LE, .min = 1, .max = 100000,
 	  .help = "time-domain integration steps per sample (default 8)" },
 	{ .name = "eigensolver", .type = IRDM_OPT_ENUM, SC(eigensolver), .names = eig_names,
-	  .help = "eigenvalue solver (default auto: by size)" },
+	  .help = "eigenvalue solver (default auto: by size); slepc: SLEPc over MPI ranks "
+		  "(run under mpirun -np N; README, \"Beyond one machine\")" },
 	{ .name = "threads", .type = IRDM_OPT_UNSIGNED, SC(threads), .metavar = "N",
 	  .range = IRDM_OPT_LE, .max = 256, .help = "worker threads (0: all cores)" },
 };
@@ -529,7 +530,7 @@ int irdm_scene_format(const struct irdm_scene *sc, char *buf, size_t len)
 {
 	char damp[96], repr[32];
 	static const char *const prec[] = { "?", "f16", "f32", "f64" };
-	static const char *const eig[] = { "auto", "dense", "lanczos" };
+	static const char *const eig[] = { "auto", "dense", "lanczos", "slepc" };
 
 	if (sc->damping == IRDM_DAMP_RAYLEIGH)
 		snprintf(damp, sizeof(damp), "rayleigh:%.17g,%.17g", sc->rayleigh.a_per_s,
