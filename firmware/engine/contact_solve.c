@@ -38,8 +38,11 @@ static void solve_coupled(struct irdm_engine *e, struct system *s,
 					  - bterm * (c->target_prev_m[r] - c->disp_prev_m[r]);
 		}
 	}
-	if (irdm_solve_spd(a, s->f, n))
+	int rc = irdm_solve_spd(a, s->f, n);
+	if (rc)
 		e->stats.singular_solves++;
+	if (rc < 0)
+		s->contradictory = true;
 }
 
 /*
@@ -66,8 +69,11 @@ static void solve_per_vertex(struct irdm_engine *e, struct system *s,
 					a[4 * r] += 1.0 / kappa;
 			tick_free_disp(e, s, st->col[v], uv);
 			irdm_v3_sub(rhs, p, uv);
-			if (irdm_solve_spd(a, rhs, 3))
+			int rc = irdm_solve_spd(a, rhs, 3);
+			if (rc)
 				e->stats.singular_solves++;
+			if (rc < 0)
+				s->contradictory = true;
 			irdm_v3_axpy(F, st->weight[v], rhs);
 		}
 	}

@@ -77,7 +77,8 @@ void irdm_fir_apply(struct irdm_engine *e, const struct irdm_force_tick *f);
 void irdm_bound_init(const struct irdm_engine *e, double *w);
 
 /* solve.c: (W + C) F = rhs, n = 3 m unknowns, SPD up to regularisation.
- * Returns 1 if the system had to be regularised, 0 otherwise. */
+ * Returns 1 if the system had to be regularised, 0 otherwise, -1 if it had
+ * to be and the regularised F does not solve it (contradictory targets). */
 int irdm_solve_spd(double *a, double *rhs, int n);
 
 #endif

@@ -122,6 +122,7 @@ int irdm_engine_tick(struct irdm_engine *e, const struct irdm_contact_cmd *cmd)
 	if (e->faulted)
 		return IRDM_EFAULT;
 	s.m = 0;
+	s.contradictory = false;
 	for (unsigned i = 0; i < e->cfg.max_contacts; i++) {
 		if (cmd[i].mode == IRDM_CONTACT_OFF && e->c[i].mode != IRDM_CONTACT_OFF)
 			irdm_engine_contact_end(e, i);
@@ -137,6 +138,8 @@ int irdm_engine_tick(struct irdm_engine *e, const struct irdm_contact_cmd *cmd)
 		tick_assemble(e, &s);
 		start_fresh(e, &s);
 		tick_solve(e, &s, cmd);
+		if (s.contradictory)
+			return fault(e);
 		tick_release_pulling(e, &s, cmd);
 		tick_newton_floating(e, &s, cmd);
 		tick_passivity(e, &s);

@@ -22,6 +22,7 @@ struct system {
 	double w[MAX_SOLVE * MAX_SOLVE];    /* row-major 3m x 3m */
 	double f[MAX_SOLVE];
 	double f_body[MAX_SOLVE];
+	bool contradictory;                 /* the targets cannot all be met (solve.c) */
 	double x_now[IRDM_MAX_CONTACTS][3];     /* floating: world position of each point */
 	/* The free displacement of each distinct site node this tick, summed
 	 * once (the history does not change within a tick; a node two

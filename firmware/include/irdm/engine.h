@@ -183,9 +183,12 @@ void irdm_engine_contact_end(struct irdm_engine *eng, unsigned i);
  * contact forces, advances the history, optionally publishes a snapshot.
  *
  * Return: IRDM_OK;
- * IRDM_EFAULT if a target is not finite or beyond IRDM_MAX_TARGET_M, a force is not finite or over
- * max_force_n, or a floating object's rigid step failed, or the engine had
- * already faulted: it then holds zero force until irdm_engine_reset().
+ * IRDM_EFAULT if a target is not finite or beyond IRDM_MAX_TARGET_M, the
+ * targets contradict each other (rigid contacts on one node, or on fixed
+ * nodes, asked for displacements no force can give), a force is not finite
+ * or over max_force_n, or a floating object's rigid step failed, or the
+ * engine had already faulted: it then holds zero force until
+ * irdm_engine_reset().
  */
 int irdm_engine_tick(struct irdm_engine *eng, const struct irdm_contact_cmd *cmd);
 
