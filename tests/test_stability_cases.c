@@ -27,9 +27,7 @@
 #include <cmocka.h>
 
 #include "support/stab_harness.h"
-#include "support/test_files.h"
 
-static char dir[64];
 
 #define SMALL "resolution", "2,2,4", "representation", "modal:all", "touch", "z>=0.2", \
 	"display", "touch"
@@ -64,7 +62,7 @@ static void run_table(const struct stab_case *cases, size_t n)
 {
 	for (size_t i = 0; i < n; i++) {
 		struct stab_record r;
-		stab_run(dir, &cases[i], &r);
+		stab_run(stab_dir, &cases[i], &r);
 		stab_check(&cases[i], &r);
 	}
 }
@@ -207,19 +205,6 @@ static void test_bad_positions(void **state)
 	run_table(cases, sizeof(cases) / sizeof(cases[0]));
 }
 
-static int setup(void **state)
-{
-	(void)state;
-	return tf_tmpdir(dir, sizeof(dir), "stabc");
-}
-
-static int teardown(void **state)
-{
-	(void)state;
-	stab_images_free();
-	return tf_rmdir(dir);
-}
-
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -230,5 +215,5 @@ int main(void)
 		cmocka_unit_test(test_bad_positions),
 	};
 
-	return cmocka_run_group_tests(tests, setup, teardown);
+	return cmocka_run_group_tests(tests, stab_setup, stab_teardown);
 }

@@ -24,7 +24,6 @@
 #include "support/stab_harness.h"
 #include "support/test_files.h"
 
-static char dir[64];
 
 static void write_cube(const char *stem, double corner)
 {
@@ -47,7 +46,7 @@ static void test_flat_tet_refused(void **state)
 	char stem[128], mesh[160], out[160], err[1024];
 
 	(void)state;
-	snprintf(stem, sizeof(stem), "%s/flat", dir);
+	snprintf(stem, sizeof(stem), "%s/flat", stab_dir);
 	write_cube(stem, 2.0 / 3.0);
 	snprintf(mesh, sizeof(mesh), "%s.ele", stem);
 	snprintf(out, sizeof(out), "%s.img", stem);
@@ -70,7 +69,7 @@ static void test_sliver_stable(void **state)
 	char stem[128], mesh[160];
 
 	(void)state;
-	snprintf(stem, sizeof(stem), "%s/sliver", dir);
+	snprintf(stem, sizeof(stem), "%s/sliver", stab_dir);
 	write_cube(stem, 2.0 / 3.0 + 1e-4);
 	snprintf(mesh, sizeof(mesh), "%s.ele", stem);
 	const char *const image[] = { "mesh", mesh, "mesh_scale", "0.1", "representation", "modal:all",
@@ -85,21 +84,8 @@ static void test_sliver_stable(void **state)
 	};
 	struct stab_record r;
 
-	stab_run(dir, &c, &r);
+	stab_run(stab_dir, &c, &r);
 	stab_check(&c, &r);
-}
-
-static int setup(void **state)
-{
-	(void)state;
-	return tf_tmpdir(dir, sizeof(dir), "stabm");
-}
-
-static int teardown(void **state)
-{
-	(void)state;
-	stab_images_free();
-	return tf_rmdir(dir);
 }
 
 int main(void)
@@ -109,5 +95,5 @@ int main(void)
 		cmocka_unit_test(test_sliver_stable),
 	};
 
-	return cmocka_run_group_tests(tests, setup, teardown);
+	return cmocka_run_group_tests(tests, stab_setup, stab_teardown);
 }

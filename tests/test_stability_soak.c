@@ -20,9 +20,7 @@
 #include <cmocka.h>
 
 #include "support/stab_harness.h"
-#include "support/test_files.h"
 
-static char dir[64];
 
 static const char *const soft[] = { "resolution", "2,2,4", "representation", "modal:all", "touch",
 				     "z>=0.2", "display", "touch", "young", "2e3", "poisson", "0.4999",
@@ -61,7 +59,7 @@ static void test_held(void **state)
 	struct stab_record r;
 
 	(void)state;
-	stab_run(dir, &c, &r);
+	stab_run(stab_dir, &c, &r);
 	stab_check(&c, &r);
 	double drift = fabs(r.final_f_n - r.first_f_n);
 	print_message("held %.12f N after %.0f s, %.12f N at the end: drift %.1e N, spread %.1e N; "
@@ -85,7 +83,7 @@ static void test_released(void **state)
 	struct stab_record r;
 
 	(void)state;
-	stab_run(dir, &c, &r);
+	stab_run(stab_dir, &c, &r);
 	stab_check(&c, &r);
 	print_message("released: %.0f ns/tick first 10 %%, %.0f last 90 %% (%lu subnormal values seen)\n",
 		      r.ns_per_tick_first, r.ns_per_tick_last, r.subnormal);
@@ -95,19 +93,6 @@ static void test_released(void **state)
 	assert_int_equal(r.subnormal, 0);
 }
 
-static int setup(void **state)
-{
-	(void)state;
-	return tf_tmpdir(dir, sizeof(dir), "soak");
-}
-
-static int teardown(void **state)
-{
-	(void)state;
-	stab_images_free();
-	return tf_rmdir(dir);
-}
-
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -115,5 +100,5 @@ int main(void)
 		cmocka_unit_test(test_released),
 	};
 
-	return cmocka_run_group_tests(tests, setup, teardown);
+	return cmocka_run_group_tests(tests, stab_setup, stab_teardown);
 }

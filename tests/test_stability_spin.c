@@ -19,12 +19,10 @@
 #include <cmocka.h>
 
 #include "support/stab_harness.h"
-#include "support/test_files.h"
 
 #define OMEGA_RAD_S 30.0
 #define SPIN_UP_S 0.5
 
-static char dir[64];
 static const char *const cube[] = { "mesh", "cube", "resolution", "2,2,2", "floating", "yes",
 				     "representation", "modal:all", "touch", "surface", "display",
 				     "surface", NULL };
@@ -57,25 +55,12 @@ static void test_spinning_cube(void **state)
 	struct stab_record r;
 
 	(void)state;
-	stab_run(dir, &c, &r);
+	stab_run(stab_dir, &c, &r);
 	print_message("spin %.2f rad/s, kinetic %.4e J, work on it %.4e J\n", r.spin_rad_s, r.kinetic_j,
 		      r.work_max_j);
 	stab_check(&c, &r);
 	assert_true(r.spin_rad_s >= 0.9 * OMEGA_RAD_S);      /* measured 29.24 */
 	assert_true(r.kinetic_j <= r.work_max_j * (1 + 1e-9));
-}
-
-static int setup(void **state)
-{
-	(void)state;
-	return tf_tmpdir(dir, sizeof(dir), "spin");
-}
-
-static int teardown(void **state)
-{
-	(void)state;
-	stab_images_free();
-	return tf_rmdir(dir);
 }
 
 int main(void)
@@ -84,5 +69,5 @@ int main(void)
 		cmocka_unit_test(test_spinning_cube),
 	};
 
-	return cmocka_run_group_tests(tests, setup, teardown);
+	return cmocka_run_group_tests(tests, stab_setup, stab_teardown);
 }

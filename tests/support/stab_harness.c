@@ -14,6 +14,7 @@
 #include "image/image_response.h"
 #include "irdm/rigid.h"
 #include "stab_harness.h"
+#include "test_files.h"
 
 /* ---- image cache: one build per distinct key list per binary ---- */
 
@@ -413,4 +414,19 @@ void stab_check(const struct stab_case *c, const struct stab_record *r)
 		assert_true(isfinite(r->static_f_n));
 		assert_true(fabs(r->final_f_n - r->static_f_n) <= c->static_rel_tol * r->static_f_n);
 	}
+}
+
+char stab_dir[64];
+
+int stab_setup(void **state)
+{
+	(void)state;
+	return tf_tmpdir(stab_dir, sizeof(stab_dir), "stab");
+}
+
+int stab_teardown(void **state)
+{
+	(void)state;
+	stab_images_free();
+	return tf_rmdir(stab_dir);
 }

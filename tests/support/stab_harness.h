@@ -120,4 +120,12 @@ double stab_env(const char *name, double def);
 /* Monotonic clock, nanoseconds. */
 double stab_now_ns(void);
 
+/*
+ * The cmocka group set-up the stability tests share: a scratch directory
+ * stab_dir for the images and traces, removed with the cached images.
+ */
+extern char stab_dir[64];
+int stab_setup(void **state);
+int stab_teardown(void **state);
+
 #endif
