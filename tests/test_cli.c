@@ -485,6 +485,20 @@ static void test_replay(void **state)
 		p++;
 	}
 	assert_true(efx_rel_rms(got, ref, 300 * 3) < 1e-9);
+	/* a triangle of the touchable top (every vertex a column), and one
+	 * with none (the fixed bottom's) for the sites below */
+	long top_tri = -1, fixed_tri = -1;
+	for (uint32_t t = 0; t < im.meta->n_tris; t++) {
+		int cols = 0;
+		for (int k = 0; k < 3; k++)
+			for (uint32_t c = 0; c < im.meta->n_cols; c++)
+				cols += im.columns[c] == im.tris[3 * t + (uint32_t)k];
+		if (cols == 3 && top_tri < 0)
+			top_tri = t;
+		if (cols == 0 && fixed_tri < 0)
+			fixed_tri = t;
+	}
+	assert_true(top_tri >= 0 && fixed_tri >= 0);
 	irdm_image_unmap(&im);
 	remove(out);
 	tf_write_text(traj, "t,ux,uy,uz\n0,0,0,0\n0.002,0,0,0\n");
@@ -525,7 +539,16 @@ static void test_replay(void **state)
 				   "-o", out, NULL), "1 rows, but");
 		expect_failure(run("replay", "--image", img, "--sites", sites, "--contact", "40",
 				   "--displacement", traj, "-o", out, NULL), "exclude each other");
-		tf_write_text(sites, "t,tri,b0,b1,b2\n0,0,0.2,0.3,0.5\n0.001,-1,0,0,0\n");
+		/* pushed rigidly into a triangle that cannot move: refused,
+		 * saying why (the regularised solve gave about 1e4 N before) */
+		snprintf(text, sizeof(text), "t,tri,b0,b1,b2\n0,%ld,0.2,0.3,0.5\n0.001,-1,0,0,0\n",
+			 fixed_tri);
+		tf_write_text(sites, text);
+		expect_failure(run("replay", "--image", img, "--sites", sites, "--displacement", traj,
+				   "-o", out, NULL), "contact targets contradict each other");
+		snprintf(text, sizeof(text), "t,tri,b0,b1,b2\n0,%ld,0.2,0.3,0.5\n0.001,-1,0,0,0\n",
+			 top_tri);
+		tf_write_text(sites, text);
 		assert_int_equal(run("replay", "--image", img, "--sites", sites, "--displacement",
 				     traj, "-o", out, NULL), 0);
 		remove(out);

@@ -227,6 +227,7 @@ void irdm_engine_reset(struct irdm_engine *e)
 	for (unsigned i = 0; i < IRDM_MAX_CONTACTS; i++)
 		irdm_engine_contact_end(e, i);
 	e->faulted = false;
+	e->fault_why = NULL;
 }
 
 /* ---- contact sites ---- */
@@ -338,6 +339,11 @@ void irdm_engine_contact_end(struct irdm_engine *e, unsigned i)
 const struct irdm_contact_state *irdm_engine_contact(const struct irdm_engine *e, unsigned i)
 {
 	return i < IRDM_MAX_CONTACTS ? &e->c[i] : NULL;
+}
+
+const char *irdm_engine_fault_reason(const struct irdm_engine *e)
+{
+	return e->faulted ? e->fault_why : NULL;
 }
 
 const char *irdm_engine_fir_sum_name(const struct irdm_engine *e)

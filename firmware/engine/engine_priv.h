@@ -48,6 +48,7 @@ struct irdm_engine {
 	struct irdm_engine_stats stats;
 	uint64_t tick;
 	bool faulted;
+	const char *fault_why;              /* the fault's reason, a constant string */
 	struct irdm_deform *deform;
 	/* floating objects: the rigid motion, integrated with the contact forces */
 	bool floating;

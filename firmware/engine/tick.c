@@ -48,9 +48,12 @@ static bool target_usable(const double p[3])
 	return true;
 }
 
-static int fault(struct irdm_engine *e)
+/* Zero force and the engine stopped until a reset; why: a constant string
+ * (irdm_engine_fault_reason()). */
+static int fault(struct irdm_engine *e, const char *why)
 {
 	e->faulted = true;
+	e->fault_why = why;
 	for (unsigned i = 0; i < IRDM_MAX_CONTACTS; i++)
 		memset(e->c[i].force_n, 0, sizeof(e->c[i].force_n));
 	return IRDM_EFAULT;
@@ -129,7 +132,7 @@ int irdm_engine_tick(struct irdm_engine *e, const struct irdm_contact_cmd *cmd)
 		if (e->c[i].mode == IRDM_CONTACT_OFF)
 			continue;
 		if (!target_usable(cmd[i].target_m))
-			return fault(e);
+			return fault(e, "a contact target is not finite or beyond IRDM_MAX_TARGET_M");
 		s.idx[s.m++] = i;
 	}
 	repr_begin_tick(e);
@@ -139,7 +142,7 @@ int irdm_engine_tick(struct irdm_engine *e, const struct irdm_contact_cmd *cmd)
 		start_fresh(e, &s);
 		tick_solve(e, &s, cmd);
 		if (s.contradictory)
-			return fault(e);
+			return fault(e, "the contact targets contradict each other (rigid contacts on one node, or on fixed nodes, asked for displacements no force can give)");
 		tick_release_pulling(e, &s, cmd);
 		tick_newton_floating(e, &s, cmd);
 		tick_passivity(e, &s);
@@ -147,10 +150,11 @@ int irdm_engine_tick(struct irdm_engine *e, const struct irdm_contact_cmd *cmd)
 	for (int i = 0; i < 3 * s.m; i++)
 		if (!isfinite(s.f[i]) ||
 		    (e->cfg.max_force_n > 0 && fabs(s.f[i]) > e->cfg.max_force_n))
-			return fault(e);
+			return fault(e, isfinite(s.f[i]) ? "a contact force is over max_force_n" :
+				     "a contact force is not finite");
 	body_forces(e, &s);
 	if (FLOATING(e) && tick_move_rigid(e, &s))
-		return fault(e);
+		return fault(e, "the floating object's rigid step failed");
 	record(e, &s, cmd);
 	gather_forces(e, &s, &e->last);
 	repr_apply(e, &e->last);

@@ -358,7 +358,9 @@ static int step(struct irdm_replay *r, size_t row, char *err, size_t errlen)
 	if (ret)
 		return ret;
 	if (irdm_engine_tick(r->eng, cmd)) {
-		snprintf(err, errlen, "engine fault at t = %g s (non-finite or excessive force)", v[0]);
+		const char *why = irdm_engine_fault_reason(r->eng);
+		snprintf(err, errlen, "engine fault at t = %g s: %s", v[0],
+			 why ? why : "(no reason given)");
 		return IRDM_EFAULT;
 	}
 	if (r->logged.v)

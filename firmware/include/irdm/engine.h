@@ -196,6 +196,9 @@ int irdm_engine_tick(struct irdm_engine *eng, const struct irdm_contact_cmd *cmd
 const struct irdm_contact_state *irdm_engine_contact(const struct irdm_engine *eng, unsigned i);
 const struct irdm_engine_stats *irdm_engine_stats(const struct irdm_engine *eng);
 
+/* Why the engine faulted (a constant sentence), or NULL if it has not. */
+const char *irdm_engine_fault_reason(const struct irdm_engine *eng);
+
 /* Which FIR history sum the engine runs: "avx2" (fir_sum_avx2.c, chosen at
  * init where the processor has AVX2, FMA and F16C), "portable", or "none"
  * (not an FIR image). */
