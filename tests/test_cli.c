@@ -540,7 +540,7 @@ static void test_replay(void **state)
 		expect_failure(run("replay", "--image", img, "--sites", sites, "--contact", "40",
 				   "--displacement", traj, "-o", out, NULL), "exclude each other");
 		/* pushed rigidly into a triangle that cannot move: refused,
-		 * saying why (the regularised solve gave about 1e4 N before) */
+		 * saying why (the regularised solve gave 1e7 N for 1 mm before) */
 		snprintf(text, sizeof(text), "t,tri,b0,b1,b2\n0,%ld,0.2,0.3,0.5\n0.001,-1,0,0,0\n",
 			 fixed_tri);
 		tf_write_text(sites, text);
