@@ -30,6 +30,8 @@ static char dir[64];
 /* modal:all f64; modal:40 + static corr, f32, compressed hard enough to
  * drop blocks (so the tick meets missing ones) */
 static struct irdm_image exact, trunc32;
+/* modal:40 with the dropped modes' exact head (16 samples), f32 */
+static struct irdm_image hybrid;
 static struct irdm_image fir[3];                /* fir:200 f64, f32, f16 */
 static const char *const fir_prec[3] = { "f64", "f32", "f16" };
 
@@ -60,6 +62,10 @@ static int setup(void **state)
 		  "precision", "f64", "touch", "z>=0.2", NULL);
 	efx_image(&trunc32, p2, "resolution", "4,4,8", "representation", "modal:40",
 		  "precision", "f32", "touch", "z>=0.2", "static_correction_tol", "0.05", NULL);
+	snprintf(p2, sizeof(p2), "%s/hybrid.img", dir);
+	efx_image(&hybrid, p2, "resolution", "4,4,8", "representation", "modal:40",
+		  "precision", "f32", "touch", "z>=0.2", "static_correction_tol", "0.05",
+		  "exact_head", "16", NULL);
 	uint32_t nc = trunc32.meta->n_cols;
 	print_message("modal 40: %u of %u static-correction blocks kept\n",
 		      trunc32.corr_start[nc], nc * nc);
@@ -80,6 +86,7 @@ static int teardown(void **state)
 	(void)state;
 	irdm_image_unmap(&exact);
 	irdm_image_unmap(&trunc32);
+	irdm_image_unmap(&hybrid);
 	for (int k = 0; k < 3; k++)
 		irdm_image_unmap(&fir[k]);
 	snprintf(cmd, sizeof(cmd), "rm -rf '%s'", dir);
@@ -225,6 +232,8 @@ static void test_step(void **state)
 	compare("step, modal all modes f64", &exact, &s, 1, N_STEP, u, TOL_MODAL_F64);
 	node_site(&trunc32, top, &s);
 	compare("step, modal 40 + static corr f32", &trunc32, &s, 1, N_STEP, u, TOL_MODAL_F32);
+	node_site(&hybrid, top, &s);
+	compare("step, hybrid 40 + head 16 f32", &hybrid, &s, 1, N_STEP, u, TOL_MODAL_F32);
 	free(u);
 }
 

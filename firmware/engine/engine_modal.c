@@ -47,16 +47,24 @@ void irdm_modal_free_disp(const struct irdm_engine *e, uint32_t col, double u[3]
 			s += p[k] * e->y[2 * k];
 		u[i] = s;
 	}
+	if (e->H)
+		irdm_head_free_disp(e, col, u);
 }
 
 /* The static correction's block (force col_force -> displacement col_disp)
- * into blk, or zeros where it was dropped (below the scene's tolerance). */
+ * into blk, or zeros where it was dropped (below the scene's tolerance); a
+ * hybrid image's R[0] takes the head's first sample instead (the rest of
+ * the block comes over the following ticks, engine_head.c). */
 static void static_corr(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp,
 			double blk[9])
 {
 	const struct irdm_image *img = e->img;
 	long k = irdm_image_corr_block(img, col_force, col_disp);
 
+	if (e->H) {
+		irdm_head_r0(e, col_force, col_disp, blk);
+		return;
+	}
 	for (size_t i = 0; i < 9; i++)
 		blk[i] = k < 0 ? 0.0 : irdm_elem_get(img->corr_blocks, img->meta->precision,
 						      (size_t)k * 9 + i);
@@ -92,4 +100,6 @@ void irdm_modal_apply(struct irdm_engine *e, const struct irdm_force_tick *f)
 		e->x[2 * k] = flush_tiny(e->y[2 * k] + m[k].b[0] * g);
 		e->x[2 * k + 1] = flush_tiny(e->y[2 * k + 1] + m[k].b[1] * g);
 	}
+	if (e->H)
+		irdm_head_apply(e, f);
 }

@@ -29,18 +29,20 @@ struct irdm_engine {
 	struct irdm_engine_config cfg;
 	double dt_s;
 	uint32_t repr, n_nodes, n_cols, K, T;
+	uint32_t H;                         /* modal: exact head samples (0: none; engine_head.c) */
 	const uint32_t *col_of_row;         /* n_nodes, NO_COL if not touchable */
 	/* modal */
 	const double *phi;                  /* [col][3][K], converted at init */
 	double *x;                          /* 2K: (q, q') per mode, x[t] */
 	double *y;                          /* 2K: A x[t], the free evolution */
-	/* FIR */
+	/* FIR, and a modal image's exact head (ring of H ticks) */
 	struct irdm_fir_ring ring;
 	const double *tail_w;               /* T: r^s tail damping (1 when stable) */
 	bool fir_wide;                      /* history sum by fir_sum_avx2.c */
 	/* disp_bound.c: K (modal) max |phi_k| at a column, or T (FIR) max
 	 * ||R[s]||_F over force columns and touchable rows; set at init */
 	const double *bound_w;
+	const double *head_bound_w;         /* H: max ||D_s||_F over kept blocks */
 	/* contacts and solve */
 	struct irdm_contact_state c[IRDM_MAX_CONTACTS];
 	struct r0_table r0, r0_next;
@@ -73,6 +75,13 @@ void irdm_fir_sum_wide(const struct irdm_engine *e, uint32_t n, const uint32_t *
 		       double (*u)[3]);
 void irdm_fir_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp, double blk[9]);
 void irdm_fir_apply(struct irdm_engine *e, const struct irdm_force_tick *f);
+
+/* engine_head.c: a modal image's exact head (H >= 1 only). */
+void irdm_head_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp, double blk[9]);
+void irdm_head_free_disp(const struct irdm_engine *e, uint32_t col, double u[3]);
+void irdm_head_apply(struct irdm_engine *e, const struct irdm_force_tick *f);
+void irdm_head_bound_init(const struct irdm_engine *e, double *w);
+double irdm_head_bound(const struct irdm_engine *e, const double *w);
 
 /* disp_bound.c: fill bound_w (K or T doubles) once phi or the FIR is set. */
 void irdm_bound_init(const struct irdm_engine *e, double *w);

@@ -26,6 +26,7 @@ static const struct {
 	[IRDM_SEC_STABILITY] = { "STABILITY", IRDM_ELEM_BYTES },
 	[IRDM_SEC_CONTACT_BVH] = { "CONTACT_BVH", ELEM_ANY },
 	[IRDM_SEC_STATIC_CORR_INDEX] = { "STATIC_CORR_INDEX", IRDM_ELEM_U32 },
+	[IRDM_SEC_EXACT_HEAD] = { "EXACT_HEAD", ELEM_PRECISION },
 };
 
 static const char *const elem_names[] = {

@@ -420,6 +420,12 @@ static const struct irdm_opt scene_opts[] = {
 	{ .name = "static_correction_tol", .type = IRDM_OPT_DOUBLE, SC(static_corr_tol),
 	  .metavar = "TOL", .range = IRDM_OPT_GE | IRDM_OPT_LT, .min = 0, .max = 1,
 	  .help = "modal: drop the static correction's block between touchable nodes a and b when its norm is below TOL sqrt(|S_aa| |S_bb|), the diagonal blocks' norms: the force error at a contact is of about that order (default 0.02; 0 keeps every block)" },
+	{ .name = "exact_head", .type = IRDM_OPT_UNSIGNED, SC(exact_head), .metavar = "H",
+	  .range = IRDM_OPT_LE, .max = IRDM_HEAD_SAMPLES_MAX / 2,
+	  .help = "modal: the hybrid representation: the dropped modes' exact response over the "
+		  "first H samples between touchable nodes, on top of the kept modes, tapered off "
+		  "over H more with the static compliance kept exactly; needs every mode, a dense "
+		  "eigensolve (default 0: the static correction alone)" },
 	{ .name = "precision", .type = IRDM_OPT_ENUM, SC(precision), .names = precision_names,
 	  .help = "storage of the responses (default f32)" },
 	{ .name = "touch", .type = IRDM_OPT_CUSTOM, .parse = set_region, SC(touch),
@@ -513,6 +519,12 @@ int irdm_scene_check(const struct irdm_scene *sc, char *err, size_t errlen)
 			 sc->fir_length, sc->fir_tail);
 		return IRDM_EINVAL;
 	}
+	if (sc->exact_head && (sc->representation != IRDM_REPR_MODAL || !sc->modes ||
+			       !sc->static_correction)) {
+		snprintf(err, errlen, "scene: exact_head = %u adds the dropped modes' head to a truncated modal image: use representation = modal:K with static_correction = yes",
+			 sc->exact_head);
+		return IRDM_EINVAL;
+	}
 	if (sc->damping == IRDM_DAMP_RATIOS && sc->damp_hz[0] > 0 &&
 	    fabs(sc->damp_hz[0] - sc->damp_hz[1]) < 1e-9) {
 		snprintf(err, errlen, "scene: damping needs two different frequencies");
@@ -565,6 +577,12 @@ int irdm_scene_format(const struct irdm_scene *sc, char *buf, size_t len)
 		return -1;
 	if (sc->fir_tail) {         /* only when set: older scenes keep their text */
 		int t = snprintf(buf + n, len - (size_t)n, "fir_tail=window:%u\n", sc->fir_tail);
+		if (t < 0 || (size_t)t >= len - (size_t)n)
+			return -1;
+		n += t;
+	}
+	if (sc->exact_head) {       /* only when set, as fir_tail */
+		int t = snprintf(buf + n, len - (size_t)n, "exact_head=%u\n", sc->exact_head);
 		if (t < 0 || (size_t)t >= len - (size_t)n)
 			return -1;
 		n += t;

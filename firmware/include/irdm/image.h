@@ -40,6 +40,11 @@ struct irdm_image {
 	const uint32_t *corr_start;         /* n_cols + 1 */
 	const uint32_t *corr_rows;          /* corr_start[n_cols] */
 	const void *corr_blocks;            /* corr_start[n_cols] x 9 of precision */
+	/* modal, optional (NULL if absent): the dropped modes' response over
+	 * meta->head_samples samples for each kept block k, [k][s][3][3] of
+	 * precision (exact over the first half, tapered over the second); its
+	 * samples sum to block k of corr_blocks */
+	const void *exact_head;
 	const struct irdm_rigid *rigid;     /* floating only, else NULL */
 	const struct irdm_stability *stability; /* n_cols */
 	/* optional CONTACT_BVH (NULL if absent): validated header, payload bytes */

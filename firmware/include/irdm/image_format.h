@@ -16,7 +16,7 @@
 
 #define IRDM_IMAGE_MAGIC "IRDMIMG"          /* 7 chars + NUL = 8 bytes */
 #define IRDM_IMAGE_VERSION_MAJOR 2u         /* incompatible layout change */
-#define IRDM_IMAGE_VERSION_MINOR 0u         /* compatible additions */
+#define IRDM_IMAGE_VERSION_MINOR 1u         /* compatible additions: 2.1 EXACT_HEAD */
 #define IRDM_IMAGE_ALIGN 64u                /* payload alignment, bytes */
 #define IRDM_IMAGE_MAX_SECTIONS 32u
 
@@ -67,6 +67,8 @@ enum irdm_section_kind {
 	IRDM_SEC_STABILITY = 11,   /* n_cols x struct irdm_stability */
 	IRDM_SEC_CONTACT_BVH = 12, /* optional: contact BVH + adjacency, struct irdm_bvh_header */
 	IRDM_SEC_STATIC_CORR_INDEX = 13, /* with STATIC_CORR: u32 column starts + rows of its blocks */
+	/* 14 is reserved for the static correction's low-rank far field */
+	IRDM_SEC_EXACT_HEAD = 15,  /* modal, optional: [k][s][3][3] of the STATIC_CORR blocks, s < head_samples */
 };
 
 enum irdm_repr {
@@ -82,7 +84,12 @@ enum irdm_meta_flags {
 	/* FIR: samples [fir_exact, fir_length) are the response tapered to
 	 * zero, the taps' sum restored to the static compliance */
 	IRDM_META_FIR_TAIL_WINDOW = 1u << 4,
+	/* modal with STATIC_CORR: EXACT_HEAD present, head_samples samples */
+	IRDM_META_EXACT_HEAD = 1u << 5,
 };
+
+/* Longest head (samples): the engine keeps a ring of that many ticks. */
+#define IRDM_HEAD_SAMPLES_MAX 8192u
 
 struct irdm_meta {                          /* 256 bytes */
 	uint32_t representation;            /* enum irdm_repr */
@@ -110,7 +117,8 @@ struct irdm_meta {                          /* 256 bytes */
 	uint64_t mesh_hash;                 /* FNV-1a 64 of positions and tets */
 	char     tool_version[32];          /* NUL-terminated */
 	char     mesh_name[64];             /* NUL-terminated */
-	uint8_t  reserved[8];               /* 0 */
+	uint32_t head_samples;              /* EXACT_HEAD: samples stored, 1..IRDM_HEAD_SAMPLES_MAX; else 0 (2.1) */
+	uint8_t  reserved[4];               /* 0 */
 };
 
 struct irdm_node {                          /* 16 bytes */

@@ -1,0 +1,125 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * The hybrid representation's head (image section EXACT_HEAD): the exact
+ * response of the modes a modal image drops, over its first H samples,
+ * between touchable nodes whose static-correction block was kept.  On top
+ * of the kept modes' recursion it adds
+ *   u_v[t] += sum_{s=0}^{H-1} D_s(e -> v) f_e[t-s],
+ * with D_0 in R[0] (in place of the static correction block, which is the
+ * sum of the D_s) and the older samples summed over a ring of the last
+ * H - 1 ticks' forces.  Modal images without a head have H = 0 and never
+ * reach the ring.
+ */
+#include "engine_priv.h"
+
+/* Slot of the forces of age s >= 1 (tick t - s), as engine_fir.c's ring. */
+static const struct irdm_force_tick *head_tick(const struct irdm_engine *e, uint32_t s)
+{
+	const struct irdm_fir_ring *r = &e->ring;
+
+	return &r->tick[(r->head + e->H + 1 - s) % e->H];
+}
+
+/* D_s of kept block k into blk (row-major 3x3). */
+static void head_block(const struct irdm_engine *e, long k, uint32_t s, double blk[9])
+{
+	size_t base = ((size_t)k * e->H + s) * 9;
+
+	for (size_t i = 0; i < 9; i++)
+		blk[i] = irdm_elem_get(e->img->exact_head, e->img->meta->precision, base + i);
+}
+
+void irdm_head_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp, double blk[9])
+{
+	long k = irdm_image_corr_block(e->img, col_force, col_disp);
+
+	if (k < 0) {
+		for (int i = 0; i < 9; i++)
+			blk[i] = 0;
+		return;
+	}
+	head_block(e, k, 0, blk);
+}
+
+/* The kept blocks from force columns to col, looked up once a call: the
+ * ring holds the same few columns tick after tick. */
+struct block_cache {
+	uint32_t n;
+	uint32_t col[IRDM_MAX_FORCE_NODES];
+	long k[IRDM_MAX_FORCE_NODES];
+};
+
+static long cached_block(const struct irdm_engine *e, struct block_cache *c, uint32_t col_force,
+			 uint32_t col_disp)
+{
+	for (uint32_t i = 0; i < c->n; i++)
+		if (c->col[i] == col_force)
+			return c->k[i];
+	long k = irdm_image_corr_block(e->img, col_force, col_disp);
+	if (c->n < IRDM_MAX_FORCE_NODES) {
+		c->col[c->n] = col_force;
+		c->k[c->n++] = k;
+	}
+	return k;
+}
+
+void irdm_head_free_disp(const struct irdm_engine *e, uint32_t col, double u[3])
+{
+	struct block_cache cache = { .n = 0 };
+
+	for (uint32_t s = 1; s < e->H; s++) {
+		const struct irdm_force_tick *t = head_tick(e, s);
+		for (uint32_t n = 0; n < t->n; n++) {
+			long k = cached_block(e, &cache, t->col[n], col);
+			double blk[9];
+			if (k < 0)
+				continue;       /* a dropped block: no head either */
+			head_block(e, k, s, blk);
+			for (int i = 0; i < 3; i++)
+				u[i] += blk[3 * i] * t->f_n[n][0] + blk[3 * i + 1] * t->f_n[n][1] +
+					blk[3 * i + 2] * t->f_n[n][2];
+		}
+	}
+}
+
+void irdm_head_apply(struct irdm_engine *e, const struct irdm_force_tick *f)
+{
+	struct irdm_fir_ring *r = &e->ring;
+
+	if (e->H < 2)
+		return;
+	r->head = (r->head + 1) % e->H;
+	r->tick[r->head] = *f;
+}
+
+void irdm_head_bound_init(const struct irdm_engine *e, double *w)
+{
+	const struct irdm_image *img = e->img;
+	uint32_t n_blocks = img->corr_start[e->n_cols];
+
+	for (uint32_t s = 0; s < e->H; s++) {
+		double mx = 0;
+		for (uint32_t k = 0; k < n_blocks; k++) {
+			double blk[9], ss = 0;
+			head_block(e, k, s, blk);
+			for (int i = 0; i < 9; i++)
+				ss += blk[i] * blk[i];
+			mx = fmax(mx, sqrt(ss));
+		}
+		w[s] = mx;
+	}
+}
+
+double irdm_head_bound(const struct irdm_engine *e, const double *w)
+{
+	double b = 0;
+
+	for (uint32_t s = 1; s < e->H; s++) {
+		const struct irdm_force_tick *t = head_tick(e, s);
+		double f = 0;
+		for (uint32_t n = 0; n < t->n; n++)
+			f += irdm_v3_norm(t->f_n[n]);
+		b += w[s] * f;
+	}
+	return b;
+}
