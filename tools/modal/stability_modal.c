@@ -7,7 +7,9 @@
  *   N(r) = (open-loop poles inside r, in closed form) + wind_r(det H),
  * the winding number counting zeros minus poles of det H; pole-zero
  * cancellations cancel in the sum.  The spectral radius is the least r
- * with N(r) = 2K.
+ * with N(r) = 2K.  A head of H samples (node_tf.h) adds 3(H-1) poles at
+ * z = 0 to both A and det H; every circle (r >= IRDM_STAB_RHO_MIN > 0)
+ * holds them, so they cancel and the count is unchanged.
  *
  * Radius (the winding number is det_winding.c's): Newton on det H from
  * the phase-velocity peaks of the last circle with every pole inside and
@@ -197,14 +199,14 @@ static void bracket(struct search *s)
 			probe(s, sqrt(s->lo * s->hi));
 }
 
-int irdm_stability_modal_cert(const struct irdm_mode *zoh, size_t K, const double *phi_c,
-			      const double *D, struct irdm_stab_cert *out)
+int irdm_stability_modal_cert_head(const struct irdm_mode *zoh, size_t K, const double *phi_c,
+				   const double *head, size_t n_head, struct irdm_stab_cert *out)
 {
 	struct irdm_node_tf tf;
 	double complex r0[9];
 
 	*out = (struct irdm_stab_cert){ .rho = -1 };
-	if (irdm_node_tf_init(&tf, zoh, K, phi_c, D))
+	if (irdm_node_tf_init_head(&tf, zoh, K, phi_c, head, n_head))
 		return -1;
 	for (int e = 0; e < 9; e++)
 		r0[e] = tf.r0[e];
@@ -213,6 +215,8 @@ int irdm_stability_modal_cert(const struct irdm_mode *zoh, size_t K, const doubl
 		irdm_node_tf_free(&tf);
 		return -1;
 	}
+	/* the ring's 3(n_head - 1) poles at 0 lie inside every circle and
+	 * cancel the head's pole of det H there: all inside is still 2K */
 	/* open bracket just outside the bounds so the bounds themselves are probed */
 	struct search s = { .tf = &tf, .n_all = 2 * (long)K, .lo = IRDM_STAB_RHO_MIN / 2,
 			    .hi = IRDM_STAB_RHO_MAX * 2, .out = out };
@@ -232,10 +236,22 @@ int irdm_stability_modal_cert(const struct irdm_mode *zoh, size_t K, const doubl
 	return 0;
 }
 
-double irdm_stability_modal_ap(const struct irdm_mode *zoh, size_t K, const double *phi_c,
-			       const double *D)
+double irdm_stability_modal_ap_head(const struct irdm_mode *zoh, size_t K, const double *phi_c,
+				    const double *head, size_t n_head)
 {
 	struct irdm_stab_cert c;
 
-	return irdm_stability_modal_cert(zoh, K, phi_c, D, &c) ? -1 : c.rho;
+	return irdm_stability_modal_cert_head(zoh, K, phi_c, head, n_head, &c) ? -1 : c.rho;
+}
+
+int irdm_stability_modal_cert(const struct irdm_mode *zoh, size_t K, const double *phi_c,
+			      const double *D, struct irdm_stab_cert *out)
+{
+	return irdm_stability_modal_cert_head(zoh, K, phi_c, D, D ? 1 : 0, out);
+}
+
+double irdm_stability_modal_ap(const struct irdm_mode *zoh, size_t K, const double *phi_c,
+			       const double *D)
+{
+	return irdm_stability_modal_ap_head(zoh, K, phi_c, D, D ? 1 : 0);
 }
