@@ -156,6 +156,8 @@ static void add_head(const struct irdm_node_tf *tf, double complex z, double com
 		H[e] += pr[e] + I * pi[e];
 		dH[e] += mw2 * (dr[e] + I * di[e]);
 	}
+	/* the pad modes (den z^2) happen to put 0 in pole_xy too; the head's
+	 * pole does not rely on that */
 	*pole_dist = fmin(*pole_dist, cabs(z));
 }
 
