@@ -52,27 +52,6 @@ static double uniform(uint64_t *s, double lo, double hi)
 	return lo + (hi - lo) * (double)(*s >> 11) * 0x1p-53;
 }
 
-/*
- * The exact response of modes [K, K2) of a 3 x n_all shape matrix: the
- * head a hybrid image records for the modes it drops,
- * D_s = sum_k phi_k phi_k^T h_k[s], s < n_head.
- */
-static void dropped_head(const struct irdm_mode *zoh, const double *phi, size_t n_all, size_t K,
-			 size_t K2, size_t n_head, double *head)
-{
-	double h[MAX_HEAD];
-
-	memset(head, 0, 9 * n_head * sizeof(double));
-	for (size_t k = K; k < K2; k++) {
-		irdm_zoh_response(&zoh[k], n_head, h);
-		for (size_t s = 0; s < n_head; s++)
-			for (int i = 0; i < 3; i++)
-				for (int j = 0; j < 3; j++)
-					head[9 * s + 3 * (size_t)i + (size_t)j] +=
-						phi[(size_t)i * n_all + k] * phi[(size_t)j * n_all + k] * h[s];
-	}
-}
-
 /* the first K columns of a 3 x n_all shape matrix, 3 x K */
 static void kept_shapes(const double *phi, size_t n_all, size_t K, double *phi_c)
 {
@@ -132,11 +111,11 @@ static void node_cases(const char *what, struct tally *t, const struct irdm_mode
 	kept_shapes(phi, n_all, K, phi_c);
 	for (size_t l = 0; l < N_LENGTHS; l++) {
 		size_t H = head_lengths[l];
-		dropped_head(zoh, phi, n_all, K, n_all, H, head);
+		stab_dropped_head(zoh, phi, n_all, K, n_all, H, head);
 		check_case(what, t, zoh, K, phi_c, head, H);
 		for (size_t a = 0; H > 1 && a < sizeof(alpha) / sizeof(alpha[0]); a++)
 			for (size_t s = 1; s < H; s += H - 1 > 1 ? H - 2 : 1) {
-				dropped_head(zoh, phi, n_all, K, n_all, H, head);
+				stab_dropped_head(zoh, phi, n_all, K, n_all, H, head);
 				add_scaled_r0(zoh, phi_c, K, head, s, alpha[a]);
 				check_case(what, t, zoh, K, phi_c, head, H);
 			}
@@ -197,7 +176,7 @@ static void test_cuboid_fast_modes_in_head(void **state)
 		assert_null(efx_column_modal(&img, c, phi, D));
 		kept_shapes(phi, n_all, KEEP_SLOW, phi_c);
 		for (size_t l = 0; l < sizeof(lengths) / sizeof(lengths[0]); l++) {
-			dropped_head(img.modes, phi, n_all, KEEP_SLOW, n_all, lengths[l], head);
+			stab_dropped_head(img.modes, phi, n_all, KEEP_SLOW, n_all, lengths[l], head);
 			check_case("cuboid, 250 kept", &t, img.modes, KEEP_SLOW, phi_c, head, lengths[l]);
 		}
 		double full = irdm_stability_modal(img.modes, n_all, phi, NULL);

@@ -29,4 +29,13 @@
  */
 double stab_cert_check(const char *what, size_t c, double dense, const struct irdm_stab_cert *cert);
 
+/*
+ * The exact response at one node of modes [k0, k1) of a 3 x n_all shape
+ * matrix (phi[i n_all + k]): the FIR head a hybrid image records for the
+ * modes it drops, D_s = sum_k phi_k phi_k^T h_k[s], s < n_head, into head
+ * (n_head blocks of 9, row-major).
+ */
+void stab_dropped_head(const struct irdm_mode *zoh, const double *phi, size_t n_all, size_t k0,
+		       size_t k1, size_t n_head, double *head);
+
 #endif
