@@ -78,6 +78,19 @@ struct tally {
 	double worst_hi, worst_lo, max_rho;
 };
 
+/* a certificate against its reference radius, counted */
+static void tally_add(const char *what, struct tally *t, double dense,
+		      const struct irdm_stab_cert *cert)
+{
+	dense = stab_cert_check(what, t->cases, dense, cert);
+	t->worst_hi = fmax(t->worst_hi, cert->rho / dense - 1);
+	if (cert->rho_lo > 0)
+		t->worst_lo = fmax(t->worst_lo, fabs(1 - cert->rho_lo / dense));
+	t->max_rho = fmax(t->max_rho, dense);
+	t->unstable += dense >= 1;
+	t->cases++;
+}
+
 /* one case: certificate against the dense reference */
 static void check_case(const char *what, struct tally *t, const struct irdm_mode *zoh, size_t K,
 		       const double *phi_c, const double *head, size_t n_head)
@@ -86,13 +99,8 @@ static void check_case(const char *what, struct tally *t, const struct irdm_mode
 	double dense = irdm_stability_modal_head(zoh, K, phi_c, head, n_head);
 
 	assert_int_equal(irdm_stability_modal_cert_head(zoh, K, phi_c, head, n_head, &cert), 0);
-	dense = stab_cert_check(what, t->cases, dense, &cert);
 	assert_true(irdm_stability_modal_ap_head(zoh, K, phi_c, head, n_head) == cert.rho);
-	t->worst_hi = fmax(t->worst_hi, cert.rho / dense - 1);
-	t->worst_lo = fmax(t->worst_lo, fabs(1 - cert.rho_lo / dense));
-	t->max_rho = fmax(t->max_rho, dense);
-	t->unstable += dense >= 1;
-	t->cases++;
+	tally_add(what, t, dense, &cert);
 }
 
 /*
@@ -230,6 +238,40 @@ static void test_random_heads(void **state)
 }
 
 /*
+ * No kept mode at all: the head is a plain FIR image, and the certificate
+ * must agree with the FIR reference, the eigenvalues of the 3(H-1) block
+ * companion matrix (irdm_stability_fir_companion), as the modal dense
+ * reference at K = 0 must.  Unstable FIR heads have more closed-loop poles
+ * outside than the 2K = 0 modes could account for.
+ */
+static void test_head_alone_is_an_fir(void **state)
+{
+	enum { N_SYSTEMS = 6, MAX_ALL = 20 };
+	struct irdm_mode zoh[MAX_ALL];
+	double phi[3 * MAX_ALL], head[9 * MAX_HEAD];
+	struct tally t = { 0 };
+	uint64_t seed = 99;
+
+	(void)state;
+	for (int n = 0; n < N_SYSTEMS; n++) {
+		size_t n_all = 3 + (size_t)uniform(&seed, 0, MAX_ALL - 3);
+		random_system(&seed, n_all, n % 2 ? 0 : n_all, zoh, phi);
+		for (size_t l = 1; l < N_LENGTHS; l++) {
+			size_t H = head_lengths[l];
+			struct irdm_stab_cert cert;
+			stab_dropped_head(zoh, phi, n_all, 0, n_all, H, head);
+			double fir = irdm_stability_fir_companion(head, H);
+			assert_int_equal(irdm_stability_modal_cert_head(zoh, 0, NULL, head, H, &cert), 0);
+			assert_true(fabs(irdm_stability_modal_head(zoh, 0, NULL, head, H) - fir)
+				    <= STAB_DENSE_TOL * fir);
+			tally_add("head alone", &t, fir, &cert);
+		}
+	}
+	report("head alone (FIR companion)", &t);
+	assert_true(t.unstable > 0 && t.unstable < t.cases);
+}
+
+/*
  * The head terms of H(z) and H'(z) (node_tf.c's Horner in 1/z) against the
  * direct sums D_s z^-s and -s D_s z^(-s-1) over the same modes without a
  * head, on circles 0.5 .. 2; the head's pole at 0 in the pole distance.
@@ -343,6 +385,7 @@ int main(void)
 		cmocka_unit_test(test_cuboid_short_heads),
 		cmocka_unit_test(test_cuboid_fast_modes_in_head),
 		cmocka_unit_test(test_random_heads),
+		cmocka_unit_test(test_head_alone_is_an_fir),
 	};
 
 	return cmocka_run_group_tests(tests, setup, teardown);

@@ -24,8 +24,9 @@
  * dense (the reference radius, clamped here to the search's bounds) and
  * cert agree: the same verdict (radius < 1), rho_lo certified or a Newton
  * root, the bracket [rho_lo, rho] holds dense to the tolerances above and
- * is at most STAB_CERT_WIDTH wide.  Fails the test naming what and case
- * otherwise.  Returns the clamped dense radius.
+ * is at most STAB_CERT_WIDTH wide (or, for a radius below the search's
+ * lower bound, rho is that bound and rho_lo 0).  Fails the test naming
+ * what and case otherwise.  Returns the clamped dense radius.
  */
 double stab_cert_check(const char *what, size_t c, double dense, const struct irdm_stab_cert *cert);
 

@@ -208,9 +208,20 @@ void irdm_node_tf_eval(const struct irdm_node_tf *tf, double complex z, double c
 		add_head(tf, z, H, dH, pole_dist);
 }
 
+/* the head's ring of the last n_head - 1 forces: 3 poles at 0 each */
+static size_t ring_poles(const struct irdm_node_tf *tf)
+{
+	return tf->n_head > 1 ? 3 * (tf->n_head - 1) : 0;
+}
+
+size_t irdm_node_tf_order(const struct irdm_node_tf *tf)
+{
+	return 2 * tf->K + ring_poles(tf);
+}
+
 size_t irdm_node_tf_poles_inside(const struct irdm_node_tf *tf, double r)
 {
-	size_t n = 0;
+	size_t n = r > 0 ? ring_poles(tf) : 0;
 
 	for (size_t k = 0; k < 2 * tf->K; k++)
 		n += cabs(tf->pole[k]) < r;

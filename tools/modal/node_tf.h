@@ -56,7 +56,11 @@ void irdm_node_tf_free(struct irdm_node_tf *tf);
 void irdm_node_tf_eval(const struct irdm_node_tf *tf, double complex z, double complex H[9],
 		       double complex dH[9], double *pole_dist);
 
-/* Open-loop poles (both of every mode) with |l| < r. */
+/* Open-loop poles with |l| < r: both of every mode, and a head's ring of
+ * 3(n_head - 1) at 0 (r > 0). */
 size_t irdm_node_tf_poles_inside(const struct irdm_node_tf *tf, double r);
+
+/* All open-loop poles, the closed loop's order: 2K + 3(n_head - 1). */
+size_t irdm_node_tf_order(const struct irdm_node_tf *tf);
 
 #endif

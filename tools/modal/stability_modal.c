@@ -7,9 +7,11 @@
  *   N(r) = (open-loop poles inside r, in closed form) + wind_r(det H),
  * the winding number counting zeros minus poles of det H; pole-zero
  * cancellations cancel in the sum.  The spectral radius is the least r
- * with N(r) = 2K.  A head of H samples (node_tf.h) adds 3(H-1) poles at
- * z = 0 to both A and det H; every circle (r >= IRDM_STAB_RHO_MIN > 0)
- * holds them, so they cancel and the count is unchanged.
+ * with N(r) = 2K.  A head of H samples (node_tf.h) adds the ring's 3(H-1)
+ * open-loop poles at z = 0, inside every circle searched (r >=
+ * IRDM_STAB_RHO_MIN > 0), to both counts: N(r) = 2K + 3(H-1) when all are
+ * inside.  Counted explicitly, N stays >= 0 (the search's -1 means
+ * unresolved) when more than 2K ring poles are outside.
  *
  * Radius (the winding number is det_winding.c's): Newton on det H from
  * the phase-velocity peaks of the last circle with every pole inside and
@@ -81,7 +83,7 @@ static int newton(const struct irdm_node_tf *tf, double complex z, size_t m, dou
 
 struct search {
 	const struct irdm_node_tf *tf;
-	long n_all;                /* 2K closed-loop poles */
+	long n_all;                /* 2K + 3(n_head - 1) closed-loop poles */
 	double lo, hi;
 	bool lo_certified, lo_newton;
 	/* the last hi circle's peaks, the last lo circle's dips; fresh until tried */
@@ -215,11 +217,9 @@ int irdm_stability_modal_cert_head(const struct irdm_mode *zoh, size_t K, const 
 		irdm_node_tf_free(&tf);
 		return -1;
 	}
-	/* the ring's 3(n_head - 1) poles at 0 lie inside every circle and
-	 * cancel the head's pole of det H there: all inside is still 2K */
 	/* open bracket just outside the bounds so the bounds themselves are probed */
-	struct search s = { .tf = &tf, .n_all = 2 * (long)K, .lo = IRDM_STAB_RHO_MIN / 2,
-			    .hi = IRDM_STAB_RHO_MAX * 2, .out = out };
+	struct search s = { .tf = &tf, .n_all = (long)irdm_node_tf_order(&tf),
+			    .lo = IRDM_STAB_RHO_MIN / 2, .hi = IRDM_STAB_RHO_MAX * 2, .out = out };
 	probe(&s, IRDM_STAB_RHO_MAX);
 	if (s.hi == IRDM_STAB_RHO_MAX) {
 		probe(&s, IRDM_STAB_RHO_MIN);
