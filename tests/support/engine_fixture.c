@@ -11,6 +11,7 @@
 #include <cmocka.h>
 
 #include "engine_fixture.h"
+#include "irdm/precision.h"
 #include "image/image_response.h"
 #include "precompute/precompute.h"
 
@@ -45,6 +46,21 @@ struct irdm_session *efx_session(const struct irdm_image *img, const struct irdm
 	if (irdm_session_open_image(&s, img, &sc, err, sizeof(err)))
 		fail_msg("session: %s", err);
 	return s;
+}
+
+const double *efx_column_modal(const struct irdm_image *img, size_t c, double *phi, double D[9])
+{
+	size_t K = img->meta->n_modes, row = img->columns[c];
+	long k = irdm_image_corr_block(img, (uint32_t)c, (uint32_t)c);
+
+	for (size_t i = 0; i < 3 * K; i++)
+		phi[i] = irdm_elem_get(img->mode_shapes, img->meta->precision, row * 3 * K + i);
+	if (!img->corr_start)
+		return NULL;
+	assert_true(k >= 0);    /* the diagonal is always kept */
+	for (int e = 0; e < 9; e++)
+		D[e] = irdm_elem_get(img->corr_blocks, img->meta->precision, (size_t)k * 9 + (size_t)e);
+	return D;
 }
 
 uint32_t efx_column_row_near(const struct irdm_image *img, const double p[3])

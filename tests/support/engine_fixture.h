@@ -66,6 +66,11 @@ int efx_dense_solve(double *a, double *b, int n);
 /* Relative RMS of a - b over n values: |a - b|_2 / |b|_2. */
 double efx_rel_rms(const double *a, const double *b, size_t n);
 
+/* A modal image's column c at its own node: its 3 x K shapes (phi[i K + k])
+ * and its static-correction block into D, returning D, or NULL when the
+ * image has none. */
+const double *efx_column_modal(const struct irdm_image *img, size_t c, double *phi, double D[9]);
+
 /* Image node (row) index nearest to p among the columns. */
 uint32_t efx_column_row_near(const struct irdm_image *img, const double p[3]);
 
