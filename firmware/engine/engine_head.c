@@ -29,18 +29,6 @@ static void head_block(const struct irdm_engine *e, long k, uint32_t s, double b
 		blk[i] = irdm_elem_get(e->img->exact_head, e->img->meta->precision, base + i);
 }
 
-void irdm_head_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp, double blk[9])
-{
-	long k = irdm_image_corr_block(e->img, col_force, col_disp);
-
-	if (k < 0) {
-		for (int i = 0; i < 9; i++)
-			blk[i] = 0;
-		return;
-	}
-	head_block(e, k, 0, blk);
-}
-
 /* The kept blocks from force columns to col, looked up once a call: the
  * ring holds the same few columns tick after tick. */
 struct block_cache {
@@ -63,23 +51,67 @@ static long cached_block(const struct irdm_engine *e, struct block_cache *c, uin
 	return k;
 }
 
+void irdm_head_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp, double blk[9])
+{
+	long k = irdm_image_corr_block(e->img, col_force, col_disp);
+
+	if (k < 0) {
+		for (int i = 0; i < 9; i++)
+			blk[i] = 0;
+		return;
+	}
+	head_block(e, k, 0, blk);
+}
+
+/*
+ * acc[3 i + j] += sum over the ring's ticks of age s in [1, H) of
+ * D_s(k_s)[i][j] f_j, one loop per storage type so that the inner loop is
+ * loads and multiply-adds only (nine independent sums): a long head is
+ * hundreds of samples at every contact node every tick.
+ */
+#define HEAD_SUM(NAME, TYPE, LOAD)                                                       \
+static void NAME(const struct irdm_engine *e, uint32_t col, double acc[9])               \
+{                                                                                        \
+	const TYPE *D = e->img->exact_head;                                              \
+	struct block_cache cache = { .n = 0 };                                           \
+                                                                                         \
+	for (uint32_t s = 1; s < e->H; s++) {                                            \
+		const struct irdm_force_tick *t = head_tick(e, s);                       \
+		for (uint32_t n = 0; n < t->n; n++) {                                    \
+			long k = cached_block(e, &cache, t->col[n], col);                \
+			if (k < 0)                                                       \
+				continue;       /* a dropped block: no head either */    \
+			const TYPE *d = &D[((size_t)k * e->H + s) * 9];                  \
+			const double *f = t->f_n[n];                                     \
+			for (int i = 0; i < 9; i++)                                      \
+				acc[i] += LOAD(d[i]) * f[i % 3];                         \
+		}                                                                        \
+	}                                                                                \
+}
+
+#define LOAD_F(x) ((double)(x))
+#define LOAD_H(x) ((double)irdm_f16_to_f32(x))
+HEAD_SUM(head_sum_f64, double, LOAD_F)
+HEAD_SUM(head_sum_f32, float, LOAD_F)
+HEAD_SUM(head_sum_f16, uint16_t, LOAD_H)
+
 void irdm_head_free_disp(const struct irdm_engine *e, uint32_t col, double u[3])
 {
-	struct block_cache cache = { .n = 0 };
+	double acc[9] = { 0 };
 
-	for (uint32_t s = 1; s < e->H; s++) {
-		const struct irdm_force_tick *t = head_tick(e, s);
-		for (uint32_t n = 0; n < t->n; n++) {
-			long k = cached_block(e, &cache, t->col[n], col);
-			double blk[9];
-			if (k < 0)
-				continue;       /* a dropped block: no head either */
-			head_block(e, k, s, blk);
-			for (int i = 0; i < 3; i++)
-				u[i] += blk[3 * i] * t->f_n[n][0] + blk[3 * i + 1] * t->f_n[n][1] +
-					blk[3 * i + 2] * t->f_n[n][2];
-		}
+	switch (e->img->meta->precision) {
+	case IRDM_ELEM_F64:
+		head_sum_f64(e, col, acc);
+		break;
+	case IRDM_ELEM_F32:
+		head_sum_f32(e, col, acc);
+		break;
+	default:
+		head_sum_f16(e, col, acc);
+		break;
 	}
+	for (int i = 0; i < 3; i++)
+		u[i] += acc[3 * i] + acc[3 * i + 1] + acc[3 * i + 2];
 }
 
 void irdm_head_apply(struct irdm_engine *e, const struct irdm_force_tick *f)

@@ -76,7 +76,7 @@ static const struct irdm_report_model paper_model = {
  * (1000 modes: a Lanczos run of many minutes on this shared machine,
  * beyond the report's budget.) */
 static const struct irdm_report_repr paper_reprs[] = {
-	MODAL(300), HYBRID(300, 8), HYBRID(300, 16), HYBRID(300, 32), HYBRID(100, 32),
+	MODAL(300), HYBRID(300, 256), HYBRID(300, 512),
 };
 
 static const struct irdm_report_scenario *const paper_scenarios[] = {
