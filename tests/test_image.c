@@ -367,7 +367,7 @@ static void test_writer_layout(void **state)
 	h = get_header(buf);
 	assert_memory_equal(h.magic, "IRDMIMG", 8);
 	assert_int_equal(h.version_major, IRDM_IMAGE_VERSION_MAJOR);
-	assert_int_equal(h.version_minor, 0);
+	assert_int_equal(h.version_minor, IRDM_IMAGE_VERSION_MINOR);
 	assert_int_equal(h.header_size, 64);
 	assert_int_equal(h.file_size, size);
 	assert_int_equal(h.section_count, 11);
@@ -708,6 +708,7 @@ static void test_bad_magic_and_version(void **state)
 
 	h = get_header(buf);
 	h.version_major = 3;
+	h.version_minor = 0;
 	put_header(buf, &h);
 	img_fixture_reseal(buf, size);
 	expect_parse(buf, size, IRDM_EVERSION, "version 3.0");
@@ -1105,6 +1106,26 @@ static void w_corr_short(struct irdm_image_writer *w)
 	irdm_iw_add(w, IRDM_SEC_STATIC_CORR, IRDM_ELEM_F64, corr_two_blocks, sizeof(corr_two_blocks));
 }
 
+static double head_blocks[4 * 2 * 9];
+
+static void w_add_head(struct irdm_image_writer *w)
+{
+	for (size_t i = 0; i < sizeof(head_blocks) / sizeof(head_blocks[0]); i++)
+		head_blocks[i] = (double)i / 64;
+	irdm_iw_add(w, IRDM_SEC_EXACT_HEAD, IRDM_ELEM_F64, head_blocks, sizeof(head_blocks));
+}
+
+static void w_add_head_short(struct irdm_image_writer *w)
+{
+	irdm_iw_add(w, IRDM_SEC_EXACT_HEAD, IRDM_ELEM_F64, head_blocks, sizeof(head_blocks) / 2);
+}
+
+static void w_add_head_nan(struct irdm_image_writer *w)
+{
+	w_add_head(w);
+	head_blocks[40] = NAN;
+}
+
 /* an index in a FIR image */
 static void w_add_corr_index(struct irdm_image_writer *w)
 {
@@ -1180,7 +1201,13 @@ FX(m_fir_corr_flag, fx->meta.flags |= IRDM_META_STATIC_CORR)
 FX(m_unknown_flag, fx->meta.flags |= 1u << 9)
 FX(m_fir_exact, fx->meta.fir_exact = 1)
 FX(m_fir_window_flag, fx->meta.flags |= IRDM_META_FIR_TAIL_WINDOW)
-FX(m_reserved, fx->meta.reserved[7] = 1)
+FX(m_reserved, fx->meta.reserved[3] = 1)
+/* the hybrid's head (format 2.1): 2 samples of the modal fixture's 4 blocks */
+FX(m_head2, (fx->meta.flags |= IRDM_META_EXACT_HEAD, fx->meta.head_samples = 2))
+FX(m_head_samples_only, fx->meta.head_samples = 2)
+FX(m_head_no_corr, (fx->meta.flags = (fx->meta.flags & ~IRDM_META_STATIC_CORR) | IRDM_META_EXACT_HEAD,
+		    fx->meta.head_samples = 2))
+FX(m_head_big, (fx->meta.flags |= IRDM_META_EXACT_HEAD, fx->meta.head_samples = IRDM_HEAD_SAMPLES_MAX + 1))
 FX(m_tool_nul, memset(fx->meta.tool_version, 'x', 32))
 FX(m_name_nul, memset(fx->meta.mesh_name, 'x', 64))
 FX(m_node_nan, fx->nodes[3].pos_m[1] = NAN)
@@ -1309,6 +1336,15 @@ static const struct sem_case sem_cases[] = {
 	{ "corr index vs size", MODAL, m_corr_blocks_big, NULL, IRDM_EFORMAT, "STATIC_CORR_INDEX has 28 bytes, expected 4294967308" },
 	{ "corr blocks short", MODAL, NULL, w_corr_short, IRDM_EFORMAT, "section STATIC_CORR has 144 bytes, expected 288" },
 	{ "FIR + STATIC_CORR_INDEX", FIR, NULL, w_add_corr_index, IRDM_EFORMAT, "STATIC_CORR_INDEX must not be present (FIR image)" },
+	{ "head", MODAL, m_head2, w_add_head, IRDM_OK, NULL },
+	{ "head missing", MODAL, m_head2, NULL, IRDM_EMISSING, "EXACT_HEAD is missing" },
+	{ "head without its flag", MODAL, NULL, w_add_head, IRDM_EFORMAT, "EXACT_HEAD must not be present" },
+	{ "head_samples without the flag", MODAL, m_head_samples_only, NULL, IRDM_EFORMAT, "head_samples 2, EXACT_HEAD clear" },
+	{ "head without STATIC_CORR", MODAL, m_head_no_corr, NULL, IRDM_EFORMAT, "STATIC_CORR clear" },
+	{ "head too long", MODAL, m_head_big, NULL, IRDM_EFORMAT, "head_samples 8193" },
+	{ "head short", MODAL, m_head2, w_add_head_short, IRDM_EFORMAT, "section EXACT_HEAD has 288 bytes, expected 576" },
+	{ "head NaN", MODAL, m_head2, w_add_head_nan, IRDM_EFORMAT, "EXACT_HEAD element 40 is not finite" },
+	{ "FIR + head", FIR, NULL, w_add_head, IRDM_EFORMAT, "EXACT_HEAD must not be present (FIR image)" },
 	{ "no MODES", MODAL, NULL, w_no_modes, IRDM_EMISSING, "MODES is missing" },
 	{ "no MODE_SHAPES", MODAL, NULL, w_no_shapes, IRDM_EMISSING, "MODE_SHAPES is missing" },
 	{ "modal + FIR", MODAL, NULL, w_add_fir, IRDM_EFORMAT, "FIR must not be present (modal image)" },
