@@ -11,7 +11,8 @@
  *    model's, over the whole run and over the first ticks, where the
  *    static correction alone misses most of the force;
  *  - its certificate: every column recorded stable;
- *  - the scene checks that refuse a head where it means nothing.
+ *  - the scene checks that refuse a head where it means nothing, and the
+ *    refusal of a head too short for the modes it replaces (unstable).
  */
 #include <math.h>
 #include <setjmp.h>
@@ -26,6 +27,7 @@
 
 #include "image/image_response.h"
 #include "precompute/fir_tail.h"
+#include "precompute/precompute.h"
 #include "scene/scene.h"
 #include "support/engine_fixture.h"
 
@@ -284,6 +286,30 @@ static void test_scene_refusals(void **state)
 	assert_int_not_equal(irdm_scene_set(&sc, "exact_head", "5000", "test", err, sizeof(err)), 0);
 }
 
+/* A head shorter than the dropped modes' ringing is unstable: refused,
+ * with what to change, and no image written. */
+static void test_unstable_refused(void **state)
+{
+	struct irdm_scene sc;
+	struct irdm_precompute_report rep;
+	char path[128], err[512] = "";
+
+	(void)state;
+	snprintf(path, sizeof(path), "%s/unstable.img", dir);
+	struct irdm_precompute_opts o = { .out_path = path };
+	irdm_scene_defaults(&sc);
+	assert_int_equal(irdm_scene_set(&sc, "resolution", "4,4,8", "test", err, sizeof(err)), 0);
+	assert_int_equal(irdm_scene_set(&sc, "touch", "box:0.0499,0.0499,0.1999,0.0751,0.0751,0.2001",
+					"test", err, sizeof(err)), 0);
+	assert_int_equal(irdm_scene_set(&sc, "representation", "modal:40", "test", err, sizeof(err)), 0);
+	assert_int_equal(irdm_scene_set(&sc, "exact_head", "8", "test", err, sizeof(err)), 0);
+	assert_int_equal(irdm_precompute(&sc, &o, &rep, err, sizeof(err)), IRDM_ENUMERIC);
+	print_message("modal:40 + exact_head 8: %s\n", err);
+	assert_non_null(strstr(err, "unstable"));
+	assert_non_null(strstr(err, "raise exact_head"));
+	assert_int_equal(access(path, F_OK), -1);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -291,6 +317,7 @@ int main(void)
 		cmocka_unit_test(test_step_release),
 		cmocka_unit_test(test_certified),
 		cmocka_unit_test(test_scene_refusals),
+		cmocka_unit_test(test_unstable_refused),
 	};
 
 	return cmocka_run_group_tests(tests, setup, teardown);

@@ -489,6 +489,30 @@ static void *stab_worker(void *arg)
 	return NULL;
 }
 
+/*
+ * A hybrid whose head is shorter than the dropped modes' ringing is
+ * unstable (its force recursion has a zero outside the unit circle), and
+ * nothing in the engine can damp a modal recursion: refuse it here, with
+ * what to change, rather than write an image that faults at first touch.
+ */
+static int hybrid_stable(const struct build *b, char *err, size_t errlen)
+{
+	size_t unstable = 0, worst = 0;
+
+	for (size_t c = 0; c < b->m.n_cols; c++)
+		if (!(b->stab[c].flags & IRDM_STAB_STABLE)) {
+			if (!unstable || b->stab[c].spectral_radius > b->stab[worst].spectral_radius)
+				worst = c;
+			unstable++;
+		}
+	if (!unstable)
+		return IRDM_OK;
+	snprintf(err, errlen, "precompute: exact_head = %u on modal:%zu is unstable at %zu of %zu columns (spectral radius up to %.6f at mesh node %u): the dropped modes ring longer than the head; raise exact_head or keep more modes",
+		 b->sc->exact_head, b->n_modes, unstable, b->m.n_cols,
+		 (double)b->stab[worst].spectral_radius, b->m.rows[b->m.cols[worst]]);
+	return IRDM_ENUMERIC;
+}
+
 static int stability(struct build *b, char *err, size_t errlen)
 {
 	size_t n = b->m.n_cols;
@@ -529,7 +553,7 @@ static int stability(struct build *b, char *err, size_t errlen)
 		}
 		b->meta.max_spectral_radius = fmax(b->meta.max_spectral_radius, b->stab[c].spectral_radius);
 	}
-	return IRDM_OK;
+	return b->head ? hybrid_stable(b, err, errlen) : IRDM_OK;
 }
 
 static void fill_meta(struct build *b)
