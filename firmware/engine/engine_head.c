@@ -37,7 +37,7 @@ struct block_cache {
 	long k[IRDM_MAX_FORCE_NODES];
 };
 
-static long cached_block(const struct irdm_engine *e, struct block_cache *c, uint32_t col_force,
+static inline long cached_block(const struct irdm_engine *e, struct block_cache *c, uint32_t col_force,
 			 uint32_t col_disp)
 {
 	for (uint32_t i = 0; i < c->n; i++)
@@ -73,20 +73,29 @@ void irdm_head_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_
 static void NAME(const struct irdm_engine *e, uint32_t col, double acc[9])               \
 {                                                                                        \
 	const TYPE *D = e->img->exact_head;                                              \
+	const struct irdm_fir_ring *r = &e->ring;                                        \
 	struct block_cache cache = { .n = 0 };                                           \
+	double a0 = 0, a1 = 0, a2 = 0, a3 = 0, a4 = 0, a5 = 0, a6 = 0, a7 = 0, a8 = 0;   \
+	uint32_t slot = r->head;        /* age 1; older ticks one slot down each */      \
                                                                                          \
 	for (uint32_t s = 1; s < e->H; s++) {                                            \
-		const struct irdm_force_tick *t = head_tick(e, s);                       \
+		const struct irdm_force_tick *t = &r->tick[slot];                        \
+		slot = slot ? slot - 1 : e->H - 1;                                       \
 		for (uint32_t n = 0; n < t->n; n++) {                                    \
 			long k = cached_block(e, &cache, t->col[n], col);                \
 			if (k < 0)                                                       \
 				continue;       /* a dropped block: no head either */    \
 			const TYPE *d = &D[((size_t)k * e->H + s) * 9];                  \
-			const double *f = t->f_n[n];                                     \
-			for (int i = 0; i < 9; i++)                                      \
-				acc[i] += LOAD(d[i]) * f[i % 3];                         \
+			double f0 = t->f_n[n][0], f1 = t->f_n[n][1], f2 = t->f_n[n][2];  \
+			a0 += LOAD(d[0]) * f0, a1 += LOAD(d[1]) * f1;                    \
+			a2 += LOAD(d[2]) * f2, a3 += LOAD(d[3]) * f0;                    \
+			a4 += LOAD(d[4]) * f1, a5 += LOAD(d[5]) * f2;                    \
+			a6 += LOAD(d[6]) * f0, a7 += LOAD(d[7]) * f1;                    \
+			a8 += LOAD(d[8]) * f2;                                           \
 		}                                                                        \
 	}                                                                                \
+	acc[0] = a0, acc[1] = a1, acc[2] = a2, acc[3] = a3, acc[4] = a4;                 \
+	acc[5] = a5, acc[6] = a6, acc[7] = a7, acc[8] = a8;                              \
 }
 
 #define LOAD_F(x) ((double)(x))
@@ -97,7 +106,7 @@ HEAD_SUM(head_sum_f16, uint16_t, LOAD_H)
 
 void irdm_head_free_disp(const struct irdm_engine *e, uint32_t col, double u[3])
 {
-	double acc[9] = { 0 };
+	double acc[9];
 
 	switch (e->img->meta->precision) {
 	case IRDM_ELEM_F64:
