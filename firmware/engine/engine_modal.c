@@ -49,26 +49,14 @@ void irdm_modal_free_disp(const struct irdm_engine *e, uint32_t col, double u[3]
 	}
 }
 
-/* The static correction's block (force col_force -> displacement col_disp)
- * into blk, or zeros where it was dropped (below the scene's tolerance). */
-static void static_corr(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp,
-			double blk[9])
-{
-	const struct irdm_image *img = e->img;
-	long k = irdm_image_corr_block(img, col_force, col_disp);
-
-	for (size_t i = 0; i < 9; i++)
-		blk[i] = k < 0 ? 0.0 : irdm_elem_get(img->corr_blocks, img->meta->precision,
-						      (size_t)k * 9 + i);
-}
-
 void irdm_modal_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp, double blk[9])
 {
 	const struct irdm_mode *m = e->img->modes;
 	const double *pd = &e->phi[(size_t)col_disp * 3 * e->K];
 	const double *pf = &e->phi[(size_t)col_force * 3 * e->K];
 
-	static_corr(e, col_force, col_disp, blk);
+	/* the static correction: kept block (zero where dropped) + far field */
+	irdm_image_corr_value(e->img, col_force, col_disp, blk);
 	for (int i = 0; i < 3; i++)
 		for (int j = 0; j < 3; j++) {
 			double s = 0;

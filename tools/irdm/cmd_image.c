@@ -77,8 +77,9 @@ static int cmd_info(const char *path)
 		       m->flags & IRDM_META_STATIC_CORR ? " + static correction" : "",
 		       elem_name(m->precision));
 	if (img.corr_start)
-		printf("static corr   %u of %llu blocks kept\n", img.corr_start[m->n_cols],
-		       (unsigned long long)m->n_cols * m->n_cols);
+		printf("static corr   %u of %llu blocks kept, far field rank %u\n",
+		       img.corr_start[m->n_cols], (unsigned long long)m->n_cols * m->n_cols,
+		       img.corr_rank);
 	printf("dt            %g s (%.0f Hz)\n", m->dt_s, 1.0 / m->dt_s);
 	printf("material      E %g Pa, nu %g, rho %g kg/m^3, %s mass\n", m->young_pa, m->poisson,
 	       m->density_kg_m3, m->flags & IRDM_META_CONSISTENT_MASS ? "consistent" : "lumped");

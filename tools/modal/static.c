@@ -211,23 +211,82 @@ void irdm_compliance_close(struct irdm_compliance *c)
 	free(c);
 }
 
+/* f <- P f for each of the n_rhs loads: their rigid part removed. */
+static int elastic_loads(const struct irdm_fem *fem, const struct irdm_modes *m, double *f,
+			 size_t n_rhs, double *tmp)
+{
+	size_t n = m->n;
+	double *mt = m->n_rigid ? malloc(n * sizeof(double)) : NULL;
+
+	if (m->n_rigid && !mt)
+		return IRDM_ENOMEM;
+	for (size_t c = 0; c < n_rhs && m->n_rigid; c++) {
+		double *fc = &f[c * n];
+		memset(tmp, 0, n * sizeof(double));
+		for (size_t r = 0; r < m->n_rigid; r++) {
+			const double *phi = &m->rigid_phi[r * n];
+			double a = 0;
+			for (size_t i = 0; i < n; i++)
+				a += phi[i] * fc[i];
+			for (size_t i = 0; i < n; i++)
+				tmp[i] += a * phi[i];
+		}
+		irdm_csc_matvec(&fem->M, tmp, mt);
+		for (size_t i = 0; i < n; i++)
+			fc[i] -= mt[i];
+	}
+	free(mt);
+	return IRDM_OK;
+}
+
+static int solve_loads(struct irdm_compliance *c, const double *load, size_t n_in, double *X,
+		       char *err, size_t errlen);
+
 int irdm_compliance_columns(struct irdm_compliance *c, const int64_t *in, size_t n_in,
 			    double *X, char *err, size_t errlen)
 {
 	const struct irdm_fem *fem = c->fem;
 	size_t n = fem->K.n;
-	cholmod_dense *rhs, *sol = NULL;
-	double *load = malloc(n * n_in * sizeof(double)), *tmp = c->tmp;
+	double *load = malloc(n * n_in * sizeof(double));
 	int ret;
 
-	rhs = cholmod_l_allocate_dense(n, n_in, n, CHOLMOD_REAL, &c->cc);
-	if (!rhs || !load) {
+	if (!load) {
+		snprintf(err, errlen, "static compliance: out of memory");
+		return IRDM_ENOMEM;
+	}
+	for (size_t k = 0; k < n_in; k++)
+		elastic_load(fem, c->m, in[k], &load[k * n], c->tmp);
+	ret = solve_loads(c, load, n_in, X, err, errlen);
+	free(load);
+	return ret;
+}
+
+int irdm_compliance_loads(struct irdm_compliance *c, double *F, size_t n_rhs, double *X,
+			  char *err, size_t errlen)
+{
+	if (elastic_loads(c->fem, c->m, F, n_rhs, c->tmp)) {
+		snprintf(err, errlen, "static compliance: out of memory");
+		return IRDM_ENOMEM;
+	}
+	return solve_loads(c, F, n_rhs, X, err, errlen);
+}
+
+/* X = G load for n_in elastic (self-equilibrated) loads. */
+static int solve_loads(struct irdm_compliance *c, const double *load, size_t n_in, double *X,
+		       char *err, size_t errlen)
+{
+	const struct irdm_fem *fem = c->fem;
+	size_t n = fem->K.n;
+	cholmod_dense *rhs, *sol = NULL;
+	double *tmp = c->tmp;
+	int ret;
+
+	rhs = cholmod_l_allocate_dense(n, n_in ? n_in : 1, n, CHOLMOD_REAL, &c->cc);
+	if (!rhs) {
 		snprintf(err, errlen, "static compliance: out of memory");
 		ret = IRDM_ENOMEM;
 		goto out_free;
 	}
-	for (size_t k = 0; k < n_in; k++)
-		elastic_load(fem, c->m, in[k], &load[k * n], tmp);
 	memset(X, 0, n * n_in * sizeof(double));
 	for (int step = 0; step < c->steps; step++) {
 		double *b = rhs->x;
@@ -250,7 +309,6 @@ int irdm_compliance_columns(struct irdm_compliance *c, const int64_t *in, size_t
 	}
 	ret = IRDM_OK;
 out_free:
-	free(load);
 	cholmod_l_free_dense(&sol, &c->cc);
 	cholmod_l_free_dense(&rhs, &c->cc);
 	return ret;

@@ -17,6 +17,7 @@
 #include "modal/lapack.h"
 #include "modal/response.h"
 #include "modal/stability.h"
+#include "modal/static_lowrank.h"
 #include "modal/static_sparse.h"
 #include "precompute/fir_tail.h"
 #include "precompute/precompute.h"
@@ -35,8 +36,9 @@ struct build {
 	double *shapes;                 /* modal: [row][3][mode] */
 	double *corr;                   /* FIR: static correction [c][r][3][3] or NULL */
 	struct irdm_corr_sparse sparse; /* modal: the kept blocks (start NULL if none) */
-	void *stored[3];                /* converted to the scene's precision */
-	size_t stored_bytes[3];
+	struct irdm_corr_lowrank far;   /* modal: their far field (rank 0 if none) */
+	void *stored[4];                /* converted to the scene's precision */
+	size_t stored_bytes[4];
 	struct irdm_stability *stab;
 	struct irdm_meta meta;
 	struct irdm_rigid rigid;
@@ -85,12 +87,22 @@ static int modal_data(struct build *b, char *err, size_t errlen)
 		}
 	if (!b->sc->static_correction || !truncated(b))
 		return IRDM_OK;
-	if (b->sc->representation == IRDM_REPR_MODAL)
-		/* between columns only, the blocks that matter (static_sparse.h) */
-		return irdm_static_correction_sparse(&m->fem, &m->modes, b->sc->floating,
-						     m->col_dofs, m->n_cols, b->sc->static_corr_tol,
-						     b->o->progress, b->o->ctx, &b->sparse,
-						     err, errlen);
+	if (b->sc->representation == IRDM_REPR_MODAL) {
+		/* between columns only, the blocks that matter (static_sparse.h),
+		 * and what the dropped ones share far apart (static_lowrank.h) */
+		ret = irdm_static_correction_sparse(&m->fem, &m->modes, b->sc->floating,
+						    m->col_dofs, m->n_cols, b->sc->static_corr_tol,
+						    b->o->progress, b->o->ctx, &b->sparse,
+						    err, errlen);
+		if (ret || !b->sc->static_corr_rank || b->sparse.n_blocks == m->n_cols * m->n_cols)
+			return ret;
+		return irdm_static_correction_lowrank(&m->fem, &m->modes, b->sc->floating,
+						      m->col_dofs, &b->sparse,
+						      b->sc->static_corr_rank < 3 * m->n_cols ?
+						      b->sc->static_corr_rank : 3 * m->n_cols,
+						      b->o->progress, b->o->ctx, &b->far, err,
+						      errlen);
+	}
 	/* an FIR adds it to R[0] of every row: as dense as the FIR itself */
 	b->corr = malloc(m->n_cols * m->n_rows * 9 * sizeof(double));
 	if (!b->corr)
@@ -578,6 +590,9 @@ static int add_sections(struct build *b, struct irdm_image_writer *w, const void
 			ret |= irdm_iw_add(w, IRDM_SEC_STATIC_CORR, p, b->stored[2], b->stored_bytes[2]);
 			ret |= irdm_iw_add(w, IRDM_SEC_STATIC_CORR_INDEX, IRDM_ELEM_U32, s->start,
 					   (s->n_cols + 1 + s->n_blocks) * sizeof(uint32_t));
+			if (b->stored[3])
+				ret |= irdm_iw_add(w, IRDM_SEC_STATIC_CORR_LOWRANK, IRDM_ELEM_BYTES,
+						   b->stored[3], b->stored_bytes[3]);
 		}
 	}
 	if (b->sc->floating)
@@ -619,6 +634,25 @@ static int write_image(struct build *b, size_t *bytes, char *err, size_t errlen)
 	return IRDM_OK;
 }
 
+/* STATIC_CORR_LOWRANK's payload: header, lambda, U in the precision. */
+static void *store_far(const struct irdm_corr_lowrank *lr, uint32_t prec, size_t *bytes)
+{
+	struct irdm_corr_lowrank_header h = { .rank = (uint32_t)lr->rank };
+	size_t es = irdm_elem_size(prec), hdr = sizeof(h);
+	uint8_t *p;
+
+	*bytes = hdr + es * lr->rank * (1 + lr->n_dofs);
+	p = malloc(*bytes);
+	if (!p)
+		return NULL;
+	memcpy(p, &h, hdr);
+	for (size_t k = 0; k < lr->rank; k++)
+		irdm_elem_put(p + hdr, prec, k, lr->lambda[k]);
+	for (size_t i = 0; i < lr->rank * lr->n_dofs; i++)
+		irdm_elem_put(p + hdr + es * lr->rank, prec, i, lr->u[i]);
+	return p;
+}
+
 static int responses(struct build *b, char *err, size_t errlen)
 {
 	struct irdm_model *m = &b->m;
@@ -647,9 +681,11 @@ static int responses(struct build *b, char *err, size_t errlen)
 	if (b->sparse.start)
 		b->stored[2] = store(b->sparse.blocks, b->sparse.n_blocks * 9, b->sc->precision,
 				     &b->stored_bytes[2]);
+	if (b->far.rank)
+		b->stored[3] = store_far(&b->far, b->sc->precision, &b->stored_bytes[3]);
 	if ((b->fir && !b->stored[0]) ||
 	    (b->shapes && b->sc->representation == IRDM_REPR_MODAL && !b->stored[1]) ||
-	    (b->sparse.start && !b->stored[2])) {
+	    (b->sparse.start && !b->stored[2]) || (b->far.rank && !b->stored[3])) {
 		snprintf(err, errlen, "precompute: out of memory converting to the storage precision");
 		return IRDM_ENOMEM;
 	}
@@ -664,7 +700,8 @@ static void build_free(struct build *b)
 	free(b->shapes);
 	free(b->corr);
 	irdm_corr_sparse_free(&b->sparse);
-	for (int i = 0; i < 3; i++)
+	irdm_corr_lowrank_free(&b->far);
+	for (int i = 0; i < 4; i++)
 		free(b->stored[i]);
 	free(b->stab);
 	free(b->nodes);
@@ -693,6 +730,12 @@ static void report(const struct build *b, struct irdm_precompute_report *rep)
 	rep->corr_blocks = b->sparse.n_blocks;
 	rep->corr_tol = b->sc->static_corr_tol;
 	rep->corr_max_dropped_rel = b->sparse.max_dropped_rel;
+	rep->corr_rank = b->far.rank;
+	rep->corr_checked = b->far.n_checked;
+	rep->corr_far_max[0] = b->far.max_before;
+	rep->corr_far_max[1] = b->far.max_after;
+	rep->corr_far_rms[0] = b->far.rms_before;
+	rep->corr_far_rms[1] = b->far.rms_after;
 }
 
 static uint64_t scene_hash(const struct irdm_scene *sc)
