@@ -46,19 +46,19 @@ static double now_s(void)
 	return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-/* column c's 3 x K shapes and its own static-correction block (or NULL) */
+/* column c's 3 x K shapes and its own static-correction block, far field
+ * included (or NULL) */
 static const double *column_data(const struct irdm_image *img, size_t c, double *phi, double D[9])
 {
 	size_t K = img->meta->n_modes, row = img->columns[c];
-	long k = irdm_image_corr_block(img, (uint32_t)c, (uint32_t)c);
 
 	for (size_t i = 0; i < 3 * K; i++)
 		phi[i] = irdm_elem_get(img->mode_shapes, img->meta->precision, row * 3 * K + i);
 	if (!img->corr_start)
 		return NULL;
-	assert_true(k >= 0);    /* the diagonal is always kept */
-	for (int e = 0; e < 9; e++)
-		D[e] = irdm_elem_get(img->corr_blocks, img->meta->precision, (size_t)k * 9 + (size_t)e);
+	/* the diagonal is always kept */
+	assert_true(irdm_image_corr_block(img, (uint32_t)c, (uint32_t)c) >= 0);
+	efx_corr_block(img, (uint32_t)c, (uint32_t)c, D);     /* + the far field */
 	return D;
 }
 

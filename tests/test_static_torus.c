@@ -278,6 +278,7 @@ static double step_error(const struct irdm_image *img, struct irdm_model *m, con
 static void test_torus(void **state)
 {
 	const char *size = getenv("IRDM_TORUS"), *tol = getenv("IRDM_TORUS_TOL");
+	const char *rank = getenv("IRDM_TORUS_RANK");
 	bool small = size && !strcmp(size, "small");
 	char off[192], scene[192], path[192], text[512];
 	struct irdm_image img;
@@ -291,9 +292,10 @@ static void test_torus(void **state)
 	snprintf(path, sizeof(path), "%s/torus.img", dir);
 	write_torus(off, 33, 17);
 	snprintf(text, sizeof(text),
-		 "name = torus\nmesh = %s\nmesh_scale = %g\nfloating = yes\ntarget_nodes = %d\n%s%s%s",
+		 "name = torus\nmesh = %s\nmesh_scale = %g\nfloating = yes\ntarget_nodes = %d\n%s%s%s%s%s%s",
 		 off, SCALE, small ? 800 : 3000, tol ? "static_correction_tol = " : "",
-		 tol ? tol : "", tol ? "\n" : "");
+		 tol ? tol : "", tol ? "\n" : "", rank ? "static_correction_rank = " : "",
+		 rank ? rank : "", rank ? "\n" : "");
 	tf_write_text(scene, text);
 	precompute(scene, path);
 	assert_int_equal(irdm_image_map(path, 0, &img, err, sizeof(err)), 0);

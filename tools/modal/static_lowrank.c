@@ -204,11 +204,11 @@ out_free:
 	return ret;
 }
 
-/* The far field's block (force col_f -> displacement col_d), entry [i][j] =
- * sum_t (u[d i][t] u[f j][t]) lambda_t: the product of the two rows first,
- * so that block (f, d) is block (d, f) transposed to the bit. */
-static void far_block(const struct irdm_corr_lowrank *lr, size_t col_f, size_t col_d,
-		      double out[9])
+/* Entry [i][j] = sum_t (u[d i][t] u[f j][t]) lambda_t: the product of the
+ * two rows first, so that block (f, d) is block (d, f) transposed to the
+ * bit. */
+void irdm_corr_lowrank_block(const struct irdm_corr_lowrank *lr, size_t col_f, size_t col_d,
+			     double out[9])
 {
 	size_t r = lr->rank;
 
@@ -278,7 +278,7 @@ static int check(struct far *f, struct irdm_corr_lowrank *lr, const double *dn, 
 			double fb[9], lb[9], scale = sqrt(dn[c] * dn[r]), before, after;
 			if (is_kept(f->s, c, r) || !(scale > 0))
 				continue;
-			far_block(lr, c, r, lb);
+			irdm_corr_lowrank_block(lr, c, r, lb);
 			for (size_t i = 0; i < 3; i++)
 				for (size_t a = 0; a < 3; a++) {
 					fb[3 * i + a] = E[(3 * r + i) * w + 3 * j + a];
@@ -306,7 +306,7 @@ static void subtract_far(struct irdm_corr_sparse *s, const struct irdm_corr_lowr
 
 	for (size_t c = 0; c < s->n_cols; c++)
 		for (uint32_t k = s->start[c]; k < s->start[c + 1]; k++) {
-			far_block(lr, c, s->rows[k], lb);
+			irdm_corr_lowrank_block(lr, c, s->rows[k], lb);
 			for (int e = 0; e < 9; e++)
 				s->blocks[9 * (size_t)k + (size_t)e] -= lb[e];
 		}

@@ -50,6 +50,12 @@ int irdm_static_correction_lowrank(const struct irdm_fem *fem, const struct irdm
 				   irdm_progress_fn progress, void *ctx,
 				   struct irdm_corr_lowrank *out, char *err, size_t errlen);
 
+/* The far field's block for a force at column col_f and the displacement
+ * of column col_d: out[3i + j] = sum_t u[3 col_d + i][t] u[3 col_f + j][t]
+ * lambda[t] (0 for rank 0). */
+void irdm_corr_lowrank_block(const struct irdm_corr_lowrank *lr, size_t col_f, size_t col_d,
+			     double out[9]);
+
 /* Free what irdm_static_correction_lowrank() allocated and zero lr. */
 void irdm_corr_lowrank_free(struct irdm_corr_lowrank *lr);
 

@@ -405,11 +405,19 @@ static void stab_one(struct build *b, size_t c)
 	} else {
 		size_t K = b->n_modes;
 		const double *D = NULL;
+		double Df[9];
 		/* the diagonal block, always kept: stored rows are sorted */
 		for (uint32_t k = b->sparse.start ? b->sparse.start[c] : 0;
 		     b->sparse.start && k < b->sparse.start[c + 1]; k++)
 			if (b->sparse.rows[k] == c)
 				D = &b->sparse.blocks[9 * (size_t)k];
+		/* stored without the far field: R[0] has it */
+		if (D && b->far.rank) {
+			irdm_corr_lowrank_block(&b->far, c, c, Df);
+			for (int e = 0; e < 9; e++)
+				Df[e] += D[e];
+			D = Df;
+		}
 		/* the argument-principle certificate: O(modes) per point of a
 		 * circle where the dense eigenvalues are O(modes^3)
 		 * (irdm_stability_modal stays as the tests' reference) */
