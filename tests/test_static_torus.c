@@ -8,12 +8,16 @@
  * static correction of those three columns, solved independently here
  * (irdm_static_correction on the model rebuilt in this process).
  *
- * A second step puts the third node at the nearest column whose block was
- * dropped: the worst case of the tolerance, whose force error it states.
+ * The image carries the far field of the dropped blocks (rank 96): the
+ * reference replaces the image's whole blocks (kept + far field) between the
+ * three columns by the dense ones.  A second step puts the third node at
+ * the nearest column whose block was dropped: the worst case of the
+ * tolerance, whose force error it states.
  *
  * IRDM_TORUS=small (`make san`) meshes the torus with about 800 nodes
  * instead of 3000; IRDM_TORUS_TOL=T sets static_correction_tol (to
- * measure the force error against the tolerance).
+ * measure the force error against the tolerance), IRDM_TORUS_RANK=R
+ * static_correction_rank (0: the blocks alone).
  */
 #include <math.h>
 #include <setjmp.h>
@@ -42,16 +46,22 @@
 #define MAX_PEAK_MIB 1024.0
 #define MAX_IMAGE_MB 50.0
 /*
- * Force error of the compressed correction vs the dense one, with the far
- * node: 2.2e-3 measured at the default tol 0.02 (the far blocks are 0.2 to
- * 0.4 % of the diagonal ones on this torus: the truncation's residual has
- * a slowly decaying far field), limit about 2x.  The issue asked for 1e-3:
- * block dropping meets that only at tol <= 2e-3, which keeps ~90 % of the
- * blocks (docs/image-format.md).  For the nearest dropped node, in units
- * of the tolerance: the force error is about the dropped block's ratio.
+ * Force error of the compressed correction (kept blocks + the far field of
+ * rank 96, the default) vs the dense one, with the far node: 9.3e-4
+ * measured, the issue's 1e-3 the limit (7 % margin; 2.2e-3 with the blocks
+ * alone).  It is not monotone in the rank: rank 192 fits that node's
+ * blocks better (ratio left 0.0017 against 0.0024) and yet gives 1.6e-3,
+ * so the fit itself is held too: the far block's ratio left over the one
+ * dropped, 0.73 measured, limit 0.8 (1.0 without a far field).
+ * For the nearest dropped node, in units of the tolerance: the force error
+ * is about the dropped block's ratio, 0.95 tol measured (1.05 with the
+ * blocks alone), limit 1.2 tol.  The issue's 1e-3 there is out of reach
+ * of a low-rank term: that block is local (23 mm away); it needs tol near
+ * 1e-3, which keeps most blocks (docs/image-format.md).
  */
-#define MAX_FORCE_RMS 5e-3
-#define MAX_TOL_RATIO 1.5
+#define MAX_FORCE_RMS 1e-3
+#define MAX_FAR_LEFT 0.8
+#define MAX_TOL_RATIO 1.2
 
 #define N_TICKS 300
 #define SCALE 0.05              /* mesh_scale: tube 2 cm, ring 5 cm */
@@ -317,6 +327,8 @@ static void test_torus(void **state)
 		      col[0], col[1], col[2], img.meta->n_cols, e_far, MAX_FORCE_RMS, rho, left,
 		      img.corr_rank);
 	assert_true(e_far <= MAX_FORCE_RMS);
+	if (img.corr_rank)
+		assert_true(left <= MAX_FAR_LEFT * rho);
 
 	/* C the column nearest to A whose block was dropped: the worst case
 	 * the tolerance allows, whose force error it states */
