@@ -34,6 +34,17 @@
  * the floating cube of test_static_sparse, 1.8e-15 with no springs */
 #define MIN_RCOND 1e-10
 
+/* y <- y + s (phi . v) phi, n entries. */
+static void add_projection(const double *phi, size_t n, const double *v, double s, double *y)
+{
+	double a = 0;
+
+	for (size_t i = 0; i < n; i++)
+		a += phi[i] * v[i];
+	for (size_t i = 0; i < n; i++)
+		y[i] += s * a * phi[i];
+}
+
 /* x <- x - Phi_r Phi_r^T M x for each of the n_in columns. */
 static void remove_rigid(const struct irdm_fem *fem, const struct irdm_modes *m,
 			 double *x, size_t n_in, double *tmp)
@@ -41,16 +52,9 @@ static void remove_rigid(const struct irdm_fem *fem, const struct irdm_modes *m,
 	size_t n = m->n;
 
 	for (size_t c = 0; c < n_in; c++) {
-		double *xc = &x[c * n];
-		irdm_csc_matvec(&fem->M, xc, tmp);
-		for (size_t r = 0; r < m->n_rigid; r++) {
-			const double *phi = &m->rigid_phi[r * n];
-			double a = 0;
-			for (size_t i = 0; i < n; i++)
-				a += phi[i] * tmp[i];
-			for (size_t i = 0; i < n; i++)
-				xc[i] -= a * phi[i];
-		}
+		irdm_csc_matvec(&fem->M, &x[c * n], tmp);
+		for (size_t r = 0; r < m->n_rigid; r++)
+			add_projection(&m->rigid_phi[r * n], n, tmp, -1.0, &x[c * n]);
 	}
 }
 
@@ -211,7 +215,8 @@ void irdm_compliance_close(struct irdm_compliance *c)
 	free(c);
 }
 
-/* f <- P f for each of the n_rhs loads: their rigid part removed. */
+/* f <- P f = f - M Phi_r Phi_r^T f for each of the n_rhs loads: their
+ * rigid part removed. */
 static int elastic_loads(const struct irdm_fem *fem, const struct irdm_modes *m, double *f,
 			 size_t n_rhs, double *tmp)
 {
@@ -221,19 +226,12 @@ static int elastic_loads(const struct irdm_fem *fem, const struct irdm_modes *m,
 	if (m->n_rigid && !mt)
 		return IRDM_ENOMEM;
 	for (size_t c = 0; c < n_rhs && m->n_rigid; c++) {
-		double *fc = &f[c * n];
 		memset(tmp, 0, n * sizeof(double));
-		for (size_t r = 0; r < m->n_rigid; r++) {
-			const double *phi = &m->rigid_phi[r * n];
-			double a = 0;
-			for (size_t i = 0; i < n; i++)
-				a += phi[i] * fc[i];
-			for (size_t i = 0; i < n; i++)
-				tmp[i] += a * phi[i];
-		}
+		for (size_t r = 0; r < m->n_rigid; r++)
+			add_projection(&m->rigid_phi[r * n], n, &f[c * n], 1.0, tmp);
 		irdm_csc_matvec(&fem->M, tmp, mt);
 		for (size_t i = 0; i < n; i++)
-			fc[i] -= mt[i];
+			f[c * n + i] -= mt[i];
 	}
 	free(mt);
 	return IRDM_OK;
