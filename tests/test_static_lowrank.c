@@ -299,6 +299,7 @@ static void test_cuboid(void **state)
 	assert_memory_equal(lr.u, lr2.u, nd * RANK * sizeof(double));
 	assert_memory_equal(s.blocks, s2.blocks, s.n_blocks * 9 * sizeof(double));
 
+	irdm_corr_lowrank_free(&lr2);
 	/* a rank the DoFs cannot hold is refused */
 	assert_int_equal(irdm_static_correction_lowrank(&m.fem, &m.modes, false, m.col_dofs, &s2,
 							nd + 1, NULL, NULL, &lr2, err, sizeof(err)),
