@@ -2,10 +2,10 @@
 /*
  * The static correction's far field, STATIC_CORR_LOWRANK: a symmetric
  * low-rank term U diag(lambda) U^T over the touchable DoFs (values in the
- * image's precision) that every block adds, and the one function that reads a whole correction block (kept
- * block plus far field).  The checks make the reads safe: a rank the tick
- * can afford, the size exactly that of the rank and n_cols, every value
- * finite.
+ * image's precision) that every block adds, and the one function that
+ * reads a whole correction block (kept block plus far field).  The checks
+ * make the reads safe: a rank the tick can afford, the size exactly that
+ * of the rank and n_cols, every value finite.
  */
 #include <stdbool.h>
 #include <stdint.h>
