@@ -221,6 +221,42 @@ static void compare(const char *what, const struct irdm_image *img,
 	free(R);
 }
 
+/*
+ * The hybrid's head summed by the portable loop and, where the processor
+ * has AVX2 + FMA, by engine_head_avx2.c: each against the reference, and
+ * against each other (they must differ in the last bits: both ran).
+ */
+static void hybrid_paths(const struct irdm_contact_site *s, const double *u)
+{
+	struct irdm_engine_config cfg;
+	double *Fw = malloc(N_STEP * 3 * sizeof(double)), *Fp = malloc(N_STEP * 3 * sizeof(double));
+	double *R = malloc(N_STEP * 3 * sizeof(double));
+
+	assert_non_null(Fw);
+	assert_non_null(Fp);
+	assert_non_null(R);
+	irdm_engine_config_default(&cfg);
+	run_engine_cfg(&hybrid, cfg, s, 1, N_STEP, u, IRDM_CONTACT_GRAB, Fw, NULL);
+	cfg.fir_portable_sum = true;
+	run_engine_cfg(&hybrid, cfg, s, 1, N_STEP, u, IRDM_CONTACT_GRAB, Fp, NULL);
+	efx_reference(&hybrid, s, 1, N_STEP, u, R);
+	double ew = efx_rel_rms(Fw, R, N_STEP * 3), ep = efx_rel_rms(Fp, R, N_STEP * 3);
+	double apart = efx_rel_rms(Fw, Fp, N_STEP * 3);
+	print_message("hybrid head sum: default %.2e, portable %.2e (limit %.0e), %.2e apart\n", ew, ep,
+		      TOL_HYBRID, apart);
+	assert_true(ew <= TOL_HYBRID);
+	assert_true(ep <= TOL_HYBRID);
+	irdm_engine_config_default(&cfg);
+	struct irdm_session *ses = efx_session(&hybrid, &cfg);
+	bool wide = !strcmp(irdm_engine_fir_sum_name(ses->eng), "avx2");
+	irdm_session_close(ses);
+	if (wide)
+		assert_true(apart > 0);
+	free(Fw);
+	free(Fp);
+	free(R);
+}
+
 /* Paper Fig. 6a: the top-centre node pushed 1 cm down and held. */
 static void test_step(void **state)
 {
@@ -237,6 +273,7 @@ static void test_step(void **state)
 	compare("step, modal 40 + static corr f32", &trunc32, &s, 1, N_STEP, u, TOL_MODAL_F32);
 	node_site(&hybrid, top, &s);
 	compare("step, hybrid 300 + head 32 f32", &hybrid, &s, 1, N_STEP, u, TOL_HYBRID);
+	hybrid_paths(&s, u);
 	free(u);
 }
 

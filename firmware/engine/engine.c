@@ -43,7 +43,7 @@ static int plan(const struct irdm_image *img, const struct irdm_engine_config *c
 	l->tail = l->ring + up((T + H) * sizeof(struct irdm_force_tick));
 	l->bound = l->tail + up(T * sizeof(double));
 	l->head_bound = l->bound + up((K + T) * sizeof(double));
-	l->total = l->head_bound + up(H * sizeof(double));
+	l->total = l->head_bound + up(2 * H * sizeof(double));  /* bound weights, slot norms */
 	return 0;
 }
 
@@ -205,14 +205,16 @@ int irdm_engine_init(struct irdm_engine **out, const struct irdm_image *img,
 	if (e->T)
 		fir_tail(e, (double *)(base + l.tail));
 #if IRDM_CONFIG_FIR
-	e->fir_wide = e->T && !cfg->fir_portable_sum && irdm_fir_wide_usable();
+	e->fir_wide = e->T && !cfg->fir_portable_sum && irdm_wide_usable();
 #endif
+	e->head_wide = e->H && !cfg->fir_portable_sum && irdm_wide_usable();
 	e->tail_w = (const double *)(base + l.tail);
 	irdm_bound_init(e, (double *)(base + l.bound));
 	e->bound_w = (const double *)(base + l.bound);
 	if (e->H)
 		irdm_head_bound_init(e, (double *)(base + l.head_bound));
 	e->head_bound_w = (const double *)(base + l.head_bound);
+	e->head_norm = (double *)(base + l.head_bound) + e->H;
 	if (img->rigid && start_rigid(e)) {
 		snprintf(err, errlen, "engine: the image's rigid-body data is not usable (mass %g kg)",
 			 img->rigid->mass_kg);
@@ -230,6 +232,8 @@ void irdm_engine_reset(struct irdm_engine *e)
 		e->x[k] = e->y[k] = 0;
 	for (uint32_t s = 0; s < e->ring.T; s++)
 		e->ring.tick[s].n = 0;
+	for (uint32_t s = 0; s < e->H; s++)
+		e->head_norm[s] = 0;
 	for (unsigned i = 0; i < IRDM_MAX_CONTACTS; i++)
 		irdm_engine_contact_end(e, i);
 	e->faulted = false;
@@ -354,7 +358,9 @@ const char *irdm_engine_fault_reason(const struct irdm_engine *e)
 
 const char *irdm_engine_fir_sum_name(const struct irdm_engine *e)
 {
-	return !e->T ? "none" : e->fir_wide ? "avx2" : "portable";
+	bool wide = e->T ? e->fir_wide : e->head_wide;
+
+	return !e->T && !e->H ? "none" : wide ? "avx2" : "portable";
 }
 
 const struct irdm_engine_stats *irdm_engine_stats(const struct irdm_engine *e)

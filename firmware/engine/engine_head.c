@@ -12,14 +12,6 @@
  */
 #include "engine_priv.h"
 
-/* Slot of the forces of age s >= 1 (tick t - s), as engine_fir.c's ring. */
-static const struct irdm_force_tick *head_tick(const struct irdm_engine *e, uint32_t s)
-{
-	const struct irdm_fir_ring *r = &e->ring;
-
-	return &r->tick[(r->head + e->H + 1 - s) % e->H];
-}
-
 /* D_s of kept block k into blk (row-major 3x3). */
 static void head_block(const struct irdm_engine *e, long k, uint32_t s, double blk[9])
 {
@@ -27,28 +19,6 @@ static void head_block(const struct irdm_engine *e, long k, uint32_t s, double b
 
 	for (size_t i = 0; i < 9; i++)
 		blk[i] = irdm_elem_get(e->img->exact_head, e->img->meta->precision, base + i);
-}
-
-/* The kept blocks from force columns to col, looked up once a call: the
- * ring holds the same few columns tick after tick. */
-struct block_cache {
-	uint32_t n;
-	uint32_t col[IRDM_MAX_FORCE_NODES];
-	long k[IRDM_MAX_FORCE_NODES];
-};
-
-static inline long cached_block(const struct irdm_engine *e, struct block_cache *c, uint32_t col_force,
-			 uint32_t col_disp)
-{
-	for (uint32_t i = 0; i < c->n; i++)
-		if (c->col[i] == col_force)
-			return c->k[i];
-	long k = irdm_image_corr_block(e->img, col_force, col_disp);
-	if (c->n < IRDM_MAX_FORCE_NODES) {
-		c->col[c->n] = col_force;
-		c->k[c->n++] = k;
-	}
-	return k;
 }
 
 bool irdm_head_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp, double blk[9])
@@ -72,7 +42,7 @@ static void NAME(const struct irdm_engine *e, uint32_t col, double acc[9])      
 {                                                                                        \
 	const TYPE *D = e->img->exact_head;                                              \
 	const struct irdm_fir_ring *r = &e->ring;                                        \
-	struct block_cache cache = { .n = 0 };                                           \
+	struct irdm_head_cache cache = { .n = 0 };                                           \
 	double a0 = 0, a1 = 0, a2 = 0, a3 = 0, a4 = 0, a5 = 0, a6 = 0, a7 = 0, a8 = 0;   \
 	uint32_t slot = r->head;        /* age 1; older ticks one slot down each */      \
                                                                                          \
@@ -80,7 +50,7 @@ static void NAME(const struct irdm_engine *e, uint32_t col, double acc[9])      
 		const struct irdm_force_tick *t = &r->tick[slot];                        \
 		slot = slot ? slot - 1 : e->H - 1;                                       \
 		for (uint32_t n = 0; n < t->n; n++) {                                    \
-			long k = cached_block(e, &cache, t->col[n], col);                \
+			long k = irdm_head_cached_block(e, &cache, t->col[n], col);                \
 			if (k < 0)                                                       \
 				continue;       /* a dropped block: no head either */    \
 			const TYPE *d = &D[((size_t)k * e->H + s) * 9];                  \
@@ -106,6 +76,10 @@ void irdm_head_free_disp(const struct irdm_engine *e, uint32_t col, double u[3])
 {
 	double acc[9];
 
+	if (e->head_wide) {
+		irdm_head_sum_wide(e, col, u);
+		return;
+	}
 	switch (e->img->meta->precision) {
 	case IRDM_ELEM_F64:
 		head_sum_f64(e, col, acc);
@@ -129,6 +103,12 @@ void irdm_head_apply(struct irdm_engine *e, const struct irdm_force_tick *f)
 		return;
 	r->head = (r->head + 1) % e->H;
 	r->tick[r->head] = *f;
+	/* the tick's force norms, once: the displacement bound reads them
+	 * every tick for every age */
+	double sum = 0;
+	for (uint32_t n = 0; n < f->n; n++)
+		sum += irdm_v3_norm(f->f_n[n]);
+	e->head_norm[r->head] = sum;
 }
 
 void irdm_head_bound_init(const struct irdm_engine *e, double *w)
@@ -151,14 +131,12 @@ void irdm_head_bound_init(const struct irdm_engine *e, double *w)
 
 double irdm_head_bound(const struct irdm_engine *e, const double *w)
 {
+	uint32_t slot = e->ring.head;   /* age 1; older ticks one slot down each */
 	double b = 0;
 
 	for (uint32_t s = 1; s < e->H; s++) {
-		const struct irdm_force_tick *t = head_tick(e, s);
-		double f = 0;
-		for (uint32_t n = 0; n < t->n; n++)
-			f += irdm_v3_norm(t->f_n[n]);
-		b += w[s] * f;
+		b += w[s] * e->head_norm[slot];
+		slot = slot ? slot - 1 : e->H - 1;
 	}
 	return b;
 }
