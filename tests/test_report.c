@@ -288,7 +288,7 @@ static void test_bad_config(void **state)
 
 	(void)state;
 	assert_int_equal(rp_run(dir, irdm_path(), args, NULL, 0, err, sizeof(err)), 2);
-	assert_non_null(strstr(err, "--config nope: not one of sweep, paper, tiny"));
+	assert_non_null(strstr(err, "--config nope: not one of sweep, paper, floating, tiny, tiny-floating"));
 }
 
 static void test_bad_repr(void **state)
