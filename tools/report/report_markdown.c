@@ -246,8 +246,10 @@ void irdm_report_markdown(FILE *f, const struct irdm_report_config *cfg,
 	fputc('\n', f);
 	verdicts(f, cfg, S, n);
 	if (plots_prefix)
-		fprintf(f, "\n![error vs tick time](%s-%s-tick.png)\n![error vs image bytes](%s-%s-bytes.png)\n![settled error vs tick time](%s-%s-settled.png)\n",
-			plots_prefix, cfg->name, plots_prefix, cfg->name, plots_prefix, cfg->name);
+		fprintf(f, "\n![error vs tick time](%s-%s-tick.png)\n![error vs image bytes](%s-%s-bytes.png)\n",
+			plots_prefix, cfg->name, plots_prefix, cfg->name);
+	if (plots_prefix && irdm_report_step_index(cfg) >= 0)
+		fprintf(f, "![settled error vs tick time](%s-%s-settled.png)\n", plots_prefix, cfg->name);
 	fprintf(f, "\n%zu rows in %.0f s.\n\n", res->n_rows, res->seconds);
 	free(S);
 }
