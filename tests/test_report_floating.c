@@ -32,71 +32,20 @@
 #include "irdm/session.h"
 #include "report/report_scenario.h"
 #include "support/engine_fixture.h"
-#include "support/run_prog.h"
+#include "support/report_fixture.h"
 #include "support/test_files.h"
 
 static char dir[256];
-
-struct row {
-	char repr[48], scen[32];
-	double force_err, first10, after100, disp_err;
-	int cert_stable, bounded;
-	size_t ticks;
-};
-
 #define MAX_ROWS 16
-static struct row rows[MAX_ROWS];
+static struct rfx_row rows[MAX_ROWS];
 static int n_rows;
-
-static const char *irdm_path(void)
-{
-	const char *p = getenv("IRDM");
-
-	return p ? p : "build/irdm";
-}
-
-/* config,repr,dt_ms,scenario,force_err,first10,after100,disp_err,median,p99,
- * bytes,radius,cert_stable,run_bounded,raw_growth,ticks,paper,keys */
-static void read_csv(const char *path)
-{
-	char text[8192], *save = NULL;
-	int line = 0;
-
-	tf_read_text(path, text, sizeof(text));
-	for (char *l = strtok_r(text, "\n", &save); l; l = strtok_r(NULL, "\n", &save), line++) {
-		struct row *r = &rows[n_rows];
-		double dt, median, p99, radius, growth;
-		size_t bytes;
-		int paper;
-
-		if (!line)
-			continue;
-		assert_true(n_rows < MAX_ROWS);
-		assert_int_equal(sscanf(l, "tiny-floating,%47[^,],%lf,%31[^,],%lf,%lf,%lf,%lf,%lf,%lf,%zu,%lf,%d,%d,%lf,%zu,%d,",
-					r->repr, &dt, r->scen, &r->force_err, &r->first10, &r->after100,
-					&r->disp_err, &median, &p99, &bytes, &radius, &r->cert_stable,
-					&r->bounded, &growth, &r->ticks, &paper), 16);
-		assert_float_equal(dt, 1.0, 0);
-		n_rows++;
-	}
-}
 
 static int setup(void **state)
 {
-	const char *args[] = { "report", "--config", "tiny-floating", "-o", dir, "--keep-images", "-q", NULL };
-	char path[512], err[4096];
-	int rc;
-
 	(void)state;
-	if (tf_tmpdir(dir, sizeof(dir), "report-floating"))
+	if (rfx_run(dir, sizeof(dir), "tiny-floating"))
 		return -1;
-	rc = rp_run(dir, irdm_path(), args, NULL, 0, err, sizeof(err));
-	if (rc) {
-		fprintf(stderr, "irdm report: exit %d: %s\n", rc, err);
-		return -1;
-	}
-	snprintf(path, sizeof(path), "%s/report-tiny-floating.csv", dir);
-	read_csv(path);
+	n_rows = rfx_read_csv(dir, "tiny-floating", rows, MAX_ROWS);
 	return 0;
 }
 
@@ -106,13 +55,9 @@ static int teardown(void **state)
 	return tf_rmdir(dir);
 }
 
-static const struct row *row_of(const char *repr, const char *scen)
+static const struct rfx_row *row_of(const char *repr, const char *scen)
 {
-	for (int i = 0; i < n_rows; i++)
-		if (!strcmp(rows[i].repr, repr) && !strcmp(rows[i].scen, scen))
-			return &rows[i];
-	fail_msg("no row for %s on %s", repr, scen);
-	return NULL;
+	return rfx_row_of(rows, n_rows, repr, scen);
 }
 
 static const char *const scens[] = { "swing", "tap" };
@@ -121,6 +66,8 @@ static void test_rows(void **state)
 {
 	(void)state;
 	assert_int_equal(n_rows, 8);
+	for (int i = 0; i < n_rows; i++)
+		assert_float_equal(rows[i].dt_ms, 1.0, 0);
 	assert_int_equal(row_of("modal:all/f64", "swing")->ticks, 2000);   /* 2 s at 1 ms */
 	assert_int_equal(row_of("modal:all/f64", "tap")->ticks, 1000);
 }
@@ -131,7 +78,7 @@ static void test_exact_model_is_rounding(void **state)
 {
 	(void)state;
 	for (int k = 0; k < 2; k++) {
-		const struct row *r = row_of("modal:all/f64", scens[k]);
+		const struct rfx_row *r = row_of("modal:all/f64", scens[k]);
 
 		printf("modal:all f64, %s: force %.2e, surface %.2e\n", scens[k], r->force_err, r->disp_err);
 		assert_true(r->force_err < 1e-9);
@@ -145,7 +92,7 @@ static void test_f32_storage(void **state)
 {
 	(void)state;
 	for (int k = 0; k < 2; k++) {
-		const struct row *r = row_of("modal:all", scens[k]);
+		const struct rfx_row *r = row_of("modal:all", scens[k]);
 
 		printf("modal:all f32, %s: force %.2e, surface %.2e\n", scens[k], r->force_err, r->disp_err);
 		assert_true(r->force_err > 1e-10 && r->force_err < 1e-6);
@@ -160,7 +107,7 @@ static void test_truncated_is_off(void **state)
 	(void)state;
 	for (int i = 0; i < 2; i++)
 		for (int k = 0; k < 2; k++) {
-			const struct row *r = row_of(reprs[i], scens[k]);
+			const struct rfx_row *r = row_of(reprs[i], scens[k]);
 
 			printf("%s, %s: force %.3g, surface %.3g\n", reprs[i], scens[k], r->force_err,
 			       r->disp_err);
@@ -234,36 +181,6 @@ static void test_scenarios(void **state)
 	irdm_image_unmap(&img);
 }
 
-/* A scenario on one image in the engine, this file's own loop; F: N x 3. */
-static void engine_run(const struct irdm_image *img, const double p[3],
-		       void (*target)(size_t, double[3]), size_t N, double *F)
-{
-	struct irdm_engine_config cfg;
-	struct irdm_contact_site site;
-	struct irdm_session *ses;
-
-	irdm_engine_config_default(&cfg);
-	cfg.max_contacts = 1;
-	ses = efx_session(img, &cfg);
-	assert_int_equal(irdm_engine_site_node(ses->eng, efx_column_row_near(img, p), &site), 0);
-	for (size_t t = 0; t < N; t++) {
-		struct irdm_contact_cmd cmd[IRDM_MAX_CONTACTS];
-		double u[3];
-
-		memset(cmd, 0, sizeof(cmd));
-		target(t, u);
-		if (!isnan(u[0])) {
-			if (irdm_engine_contact(ses->eng, 0)->mode == IRDM_CONTACT_OFF)
-				assert_int_equal(irdm_engine_contact_begin(ses->eng, 0, &site, IRDM_CONTACT_GRAB), 0);
-			cmd[0].mode = IRDM_CONTACT_GRAB;
-			memcpy(cmd[0].target_m, u, sizeof(u));
-		}
-		assert_int_equal(irdm_engine_tick(ses->eng, cmd), 0);
-		memcpy(&F[3 * t], irdm_engine_contact(ses->eng, 0)->force_n, 3 * sizeof(double));
-	}
-	irdm_session_close(ses);
-}
-
 /* The report's force errors against the same figures computed here. */
 static void test_errors_recomputed(void **state)
 {
@@ -282,20 +199,24 @@ static void test_errors_recomputed(void **state)
 		{ "tap", { 0.12, 0.06, 0.06 }, tap_target, 1000 },
 	};
 	double *F = malloc(2000 * 3 * sizeof(double)), *Fref = malloc(2000 * 3 * sizeof(double));
+	double *u = malloc(2000 * 3 * sizeof(double));
 	struct irdm_image ref, img;
 
 	(void)state;
 	assert_non_null(F);
 	assert_non_null(Fref);
+	assert_non_null(u);
 	map("tiny-floating-reference-1ms.img", &ref);
 	for (size_t k = 0; k < 2; k++) {
-		engine_run(&ref, sc[k].p, sc[k].target, sc[k].N, Fref);
+		for (size_t t = 0; t < sc[k].N; t++)
+			sc[k].target(t, &u[3 * t]);
+		rfx_engine_grab(&ref, sc[k].p, u, sc[k].N, Fref);
 		for (size_t i = 0; i < sizeof(reprs) / sizeof(reprs[0]); i++) {
-			const struct row *r = row_of(reprs[i][0], sc[k].name);
+			const struct rfx_row *r = row_of(reprs[i][0], sc[k].name);
 			double e;
 
 			map(reprs[i][1], &img);
-			engine_run(&img, sc[k].p, sc[k].target, sc[k].N, F);
+			rfx_engine_grab(&img, sc[k].p, u, sc[k].N, F);
 			irdm_image_unmap(&img);
 			e = efx_rel_rms(F, Fref, 3 * sc[k].N);
 			printf("%s, %s: force error %.6e (report %.6e)\n", reprs[i][0], sc[k].name, e,
@@ -308,6 +229,7 @@ static void test_errors_recomputed(void **state)
 	irdm_image_unmap(&ref);
 	free(F);
 	free(Fref);
+	free(u);
 }
 
 /* The Markdown says what the reference is and how it is checked. */
