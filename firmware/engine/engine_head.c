@@ -51,16 +51,14 @@ static inline long cached_block(const struct irdm_engine *e, struct block_cache 
 	return k;
 }
 
-void irdm_head_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp, double blk[9])
+bool irdm_head_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp, double blk[9])
 {
 	long k = irdm_image_corr_block(e->img, col_force, col_disp);
 
-	if (k < 0) {
-		for (int i = 0; i < 9; i++)
-			blk[i] = 0;
-		return;
-	}
+	if (k < 0)
+		return false;   /* dropped: the far field alone, instantly */
 	head_block(e, k, 0, blk);
+	return true;
 }
 
 /*

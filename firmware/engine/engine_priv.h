@@ -77,7 +77,8 @@ void irdm_fir_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_d
 void irdm_fir_apply(struct irdm_engine *e, const struct irdm_force_tick *f);
 
 /* engine_head.c: a modal image's exact head (H >= 1 only). */
-void irdm_head_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp, double blk[9]);
+/* D_0 of the kept block into blk; false (blk untouched) if the block was dropped */
+bool irdm_head_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp, double blk[9]);
 void irdm_head_free_disp(const struct irdm_engine *e, uint32_t col, double u[3]);
 void irdm_head_apply(struct irdm_engine *e, const struct irdm_force_tick *f);
 void irdm_head_bound_init(const struct irdm_engine *e, double *w);

@@ -10,6 +10,7 @@
  *   image_meta.c       META, PROVENANCE
  *   image_object.c     NODES, COLUMNS, SURFACE, RIGID
  *   image_responses.c  STABILITY, FIR or MODES / MODE_SHAPES / STATIC_CORR
+ *                      (image_static_corr.c, its far field image_corr_lowrank.c)
  *   image_bvh.c        CONTACT_BVH
  *
  * image_parse.c is the entry point (irdm_image_parse) and
@@ -99,6 +100,8 @@ int img_check_fir(struct parse *p);
 int img_check_modal(struct parse *p);
 /* image_static_corr.c, for img_check_modal (both sections present). */
 int img_check_static_corr(struct parse *p);
+/* image_corr_lowrank.c: STATIC_CORR_LOWRANK, if present, after the above. */
+int img_check_corr_lowrank(struct parse *p);
 /* image_exact_head.c: EXACT_HEAD against the STATIC_CORR index (checked first) */
 int img_check_exact_head(struct parse *p);
 /* image_responses.c: every element of kind's array (meta precision) finite. */

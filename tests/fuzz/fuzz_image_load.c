@@ -73,6 +73,17 @@ static void walk_views(const struct irdm_image *img)
 		if (img->exact_head)
 			read_values(img->exact_head, m->precision, n_blocks * m->head_samples * 9);
 	}
+	if (img->corr_rank) {
+		/* the far field: every value, and a whole block at the ends
+		 * (the reader the engine and image_response use) */
+		double blk[9];
+		read_values(img->corr_lambda, m->precision, img->corr_rank);
+		read_values(img->corr_u, m->precision, 3 * cols * img->corr_rank);
+		irdm_image_corr_value(img, 0, (uint32_t)cols - 1, blk);
+		read_bytes(blk, sizeof(blk));
+		irdm_image_corr_value(img, (uint32_t)cols - 1, 0, blk);
+		read_bytes(blk, sizeof(blk));
+	}
 	if (img->rigid)
 		read_bytes(img->rigid, sizeof(*img->rigid));
 	for (uint32_t k = 0; k <= IRDM_SEC_EXACT_HEAD + 1; k++) {

@@ -58,8 +58,7 @@ const double *efx_column_modal(const struct irdm_image *img, size_t c, double *p
 	if (!img->corr_start)
 		return NULL;
 	assert_true(k >= 0);    /* the diagonal is always kept */
-	for (int e = 0; e < 9; e++)
-		D[e] = irdm_elem_get(img->corr_blocks, img->meta->precision, (size_t)k * 9 + (size_t)e);
+	efx_corr_block(img, (uint32_t)c, (uint32_t)c, D);      /* + the far field */
 	return D;
 }
 
@@ -286,4 +285,24 @@ double efx_rel_rms(const double *a, const double *b, size_t n)
 		r += b[i] * b[i];
 	}
 	return sqrt(d / r);
+}
+
+void efx_corr_block(const struct irdm_image *img, uint32_t col_force, uint32_t col_disp,
+		    double blk[9])
+{
+	uint32_t prec = img->meta ? img->meta->precision : 0;
+	size_t r = img->corr_rank;
+
+	memset(blk, 0, 9 * sizeof(double));
+	for (uint32_t k = img->corr_start ? img->corr_start[col_force] : 0;
+	     img->corr_start && k < img->corr_start[col_force + 1]; k++)
+		if (img->corr_rows[k] == col_disp)
+			for (size_t e = 0; e < 9; e++)
+				blk[e] = irdm_elem_get(img->corr_blocks, prec, (size_t)k * 9 + e);
+	for (size_t i = 0; i < 3; i++)
+		for (size_t j = 0; j < 3; j++)
+			for (size_t k = 0; k < r; k++)
+				blk[3 * i + j] += irdm_elem_get(img->corr_lambda, prec, k) *
+						  irdm_elem_get(img->corr_u, prec, (3 * (size_t)col_disp + i) * r + k) *
+						  irdm_elem_get(img->corr_u, prec, (3 * (size_t)col_force + j) * r + k);
 }

@@ -77,8 +77,9 @@ static int cmd_info(const char *path)
 		       m->flags & IRDM_META_STATIC_CORR ? " + static correction" : "",
 		       elem_name(m->precision));
 	if (img.corr_start)
-		printf("static corr   %u of %llu blocks kept\n", img.corr_start[m->n_cols],
-		       (unsigned long long)m->n_cols * m->n_cols);
+		printf("static corr   %u of %llu blocks kept, far field rank %u\n",
+		       img.corr_start[m->n_cols], (unsigned long long)m->n_cols * m->n_cols,
+		       img.corr_rank);
 	if (img.exact_head)
 		printf("exact head    the %u dropped modes' response at the kept blocks: samples "
 		       "0..%u exact, %u..%u tapered, sum = static correction (hybrid)\n",

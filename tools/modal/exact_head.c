@@ -75,8 +75,8 @@ static void taper(double *out, size_t H, const double *S)
 }
 
 int irdm_exact_head(const struct irdm_modes *modes, const struct irdm_mode *zoh_all, size_t k_kept,
-		    const int64_t *col_dofs, const struct irdm_corr_sparse *corr, size_t H,
-		    irdm_progress_fn progress, void *ctx, double *head)
+		    const int64_t *col_dofs, const struct irdm_corr_sparse *corr, const double *target,
+		    size_t H, irdm_progress_fn progress, void *ctx, double *head)
 {
 	size_t Kd = modes->n_modes > k_kept ? modes->n_modes - k_kept : 0, n_cols = corr->n_cols;
 	double *P = NULL, *h = NULL, *w = NULL, *hd = NULL;
@@ -99,7 +99,7 @@ int irdm_exact_head(const struct irdm_modes *modes, const struct irdm_mode *zoh_
 		for (uint32_t k = corr->start[c]; k < corr->start[c + 1]; k++) {
 			double *out = &head[(size_t)k * 2 * H * 9];
 			block_head(&P[3 * (size_t)corr->rows[k] * Kd], &P[3 * c * Kd], h, Kd, 2 * H, w, out);
-			taper(out, H, &corr->blocks[9 * (size_t)k]);
+			taper(out, H, &target[9 * (size_t)k]);
 		}
 		if (progress && (c % 16 == 0 || c + 1 == n_cols))
 			progress(ctx, "exact head", (double)(c + 1) / (double)n_cols);

@@ -18,6 +18,7 @@
 #include "modal/lapack.h"
 #include "modal/response.h"
 #include "modal/stability.h"
+#include "modal/static_lowrank.h"
 #include "modal/static_sparse.h"
 #include "precompute/fir_tail.h"
 #include "precompute/precompute.h"
@@ -37,8 +38,9 @@ struct build {
 	double *corr;                   /* FIR: static correction [c][r][3][3] or NULL */
 	struct irdm_corr_sparse sparse; /* modal: the kept blocks (start NULL if none) */
 	double *head;                   /* modal exact_head: [k][s][3][3] (exact_head.h) */
-	void *stored[4];                /* converted to the scene's precision */
-	size_t stored_bytes[4];
+	struct irdm_corr_lowrank far;   /* modal: their far field (rank 0 if none) */
+	void *stored[5];                /* converted to the scene's precision */
+	size_t stored_bytes[5];
 	struct irdm_stability *stab;
 	struct irdm_meta meta;
 	struct irdm_rigid rigid;
@@ -78,21 +80,35 @@ static int exact_head(struct build *b, const struct irdm_mode *zoh_all, size_t n
 		      size_t errlen)
 {
 	struct irdm_model *m = &b->m;
+	struct irdm_corr_sparse *sp = &b->sparse;
 	struct irdm_modes all = m->modes;
 	size_t H = b->sc->exact_head;
-	int ret;
+	double *target = malloc(sp->n_blocks * 9 * sizeof(double));
+	int ret = IRDM_ENOMEM;
 
 	all.n_modes = n_all;
-	b->head = malloc(b->sparse.n_blocks * 2 * H * 9 * sizeof(double));
-	if (!b->head) {
+	b->head = malloc(sp->n_blocks * 2 * H * 9 * sizeof(double));
+	if (!b->head || !target) {
 		snprintf(err, errlen, "precompute: the exact head (%zu blocks x %zu samples) does not fit in memory",
-			 b->sparse.n_blocks, H);
-		return IRDM_ENOMEM;
+			 sp->n_blocks, 2 * H);
+		goto out_free;
 	}
-	ret = irdm_exact_head(&all, zoh_all, m->modes.n_modes, m->col_dofs, &b->sparse, H,
+	/* what each kept block's head sums to: its whole correction, the
+	 * far field's value there included (the blocks are stored without) */
+	for (size_t c = 0; c < sp->n_cols; c++)
+		for (uint32_t k = sp->start[c]; k < sp->start[c + 1]; k++) {
+			double far[9] = { 0 };
+			if (b->far.rank)
+				irdm_corr_lowrank_block(&b->far, c, sp->rows[k], far);
+			for (int e = 0; e < 9; e++)
+				target[9 * (size_t)k + (size_t)e] = sp->blocks[9 * (size_t)k + (size_t)e] + far[e];
+		}
+	ret = irdm_exact_head(&all, zoh_all, m->modes.n_modes, m->col_dofs, sp, target, H,
 			      b->o->progress, b->o->ctx, b->head);
 	if (ret)
 		snprintf(err, errlen, "precompute: out of memory for the exact head");
+out_free:
+	free(target);
 	return ret;
 }
 
@@ -148,11 +164,21 @@ static int modal_data(struct build *b, char *err, size_t errlen)
 		return IRDM_OK;
 	}
 	if (b->sc->representation == IRDM_REPR_MODAL) {
-		/* between columns only, the blocks that matter (static_sparse.h) */
+		/* between columns only, the blocks that matter (static_sparse.h),
+		 * and what the dropped ones share far apart (static_lowrank.h) */
 		ret = irdm_static_correction_sparse(&m->fem, &m->modes, b->sc->floating,
 						    m->col_dofs, m->n_cols, b->sc->static_corr_tol,
 						    b->o->progress, b->o->ctx, &b->sparse,
 						    err, errlen);
+		if (!ret && b->sc->static_corr_rank && b->sparse.n_blocks < m->n_cols * m->n_cols)
+			ret = irdm_static_correction_lowrank(&m->fem, &m->modes, b->sc->floating,
+							     m->col_dofs, &b->sparse,
+							     b->sc->static_corr_rank < 3 * m->n_cols ?
+							     b->sc->static_corr_rank : 3 * m->n_cols,
+							     b->o->progress, b->o->ctx, &b->far, err,
+							     errlen);
+		/* the hybrid's head, after the far field: it sums to the whole
+		 * correction of each kept block */
 		if (!ret && zoh_all)
 			ret = exact_head(b, zoh_all, n_all, err, errlen);
 		free(zoh_all);
@@ -461,11 +487,20 @@ static void stab_one(struct build *b, size_t c)
 	} else {
 		size_t K = b->n_modes, H = b->head ? b->meta.head_samples : 1;
 		const double *D = NULL;
+		double Df[9];
 		/* the diagonal block, always kept: stored rows are sorted */
 		for (uint32_t k = b->sparse.start ? b->sparse.start[c] : 0;
 		     b->sparse.start && k < b->sparse.start[c + 1]; k++)
 			if (b->sparse.rows[k] == c)
 				D = b->head ? &b->head[9 * H * (size_t)k] : &b->sparse.blocks[9 * (size_t)k];
+		/* stored without the far field: R[0] has it (a hybrid's head
+		 * already sums to the whole block) */
+		if (D && b->far.rank && !b->head) {
+			irdm_corr_lowrank_block(&b->far, c, c, Df);
+			for (int e = 0; e < 9; e++)
+				Df[e] += D[e];
+			D = Df;
+		}
 		/* the argument-principle certificate: O(modes) per point of a
 		 * circle where the dense eigenvalues are O(modes^3)
 		 * (irdm_stability_modal stays as the tests' reference); a
@@ -673,9 +708,12 @@ static int add_sections(struct build *b, struct irdm_image_writer *w, const void
 			ret |= irdm_iw_add(w, IRDM_SEC_STATIC_CORR, p, b->stored[2], b->stored_bytes[2]);
 			ret |= irdm_iw_add(w, IRDM_SEC_STATIC_CORR_INDEX, IRDM_ELEM_U32, s->start,
 					   (s->n_cols + 1 + s->n_blocks) * sizeof(uint32_t));
+			if (b->stored[3])
+				ret |= irdm_iw_add(w, IRDM_SEC_STATIC_CORR_LOWRANK, IRDM_ELEM_BYTES,
+						   b->stored[3], b->stored_bytes[3]);
 		}
-		if (b->stored[3])
-			ret |= irdm_iw_add(w, IRDM_SEC_EXACT_HEAD, p, b->stored[3], b->stored_bytes[3]);
+		if (b->stored[4])
+			ret |= irdm_iw_add(w, IRDM_SEC_EXACT_HEAD, p, b->stored[4], b->stored_bytes[4]);
 	}
 	if (b->sc->floating)
 		ret |= irdm_iw_add(w, IRDM_SEC_RIGID, IRDM_ELEM_BYTES, &b->rigid, sizeof(b->rigid));
@@ -716,6 +754,25 @@ static int write_image(struct build *b, size_t *bytes, char *err, size_t errlen)
 	return IRDM_OK;
 }
 
+/* STATIC_CORR_LOWRANK's payload: header, lambda, U in the precision. */
+static void *store_far(const struct irdm_corr_lowrank *lr, uint32_t prec, size_t *bytes)
+{
+	struct irdm_corr_lowrank_header h = { .rank = (uint32_t)lr->rank };
+	size_t es = irdm_elem_size(prec), hdr = sizeof(h);
+	uint8_t *p;
+
+	*bytes = hdr + es * lr->rank * (1 + lr->n_dofs);
+	p = malloc(*bytes);
+	if (!p)
+		return NULL;
+	memcpy(p, &h, hdr);
+	for (size_t k = 0; k < lr->rank; k++)
+		irdm_elem_put(p + hdr, prec, k, lr->lambda[k]);
+	for (size_t i = 0; i < lr->rank * lr->n_dofs; i++)
+		irdm_elem_put(p + hdr + es * lr->rank, prec, i, lr->u[i]);
+	return p;
+}
+
 static int responses(struct build *b, char *err, size_t errlen)
 {
 	struct irdm_model *m = &b->m;
@@ -744,12 +801,15 @@ static int responses(struct build *b, char *err, size_t errlen)
 	if (b->sparse.start)
 		b->stored[2] = store(b->sparse.blocks, b->sparse.n_blocks * 9, b->sc->precision,
 				     &b->stored_bytes[2]);
+	if (b->far.rank)
+		b->stored[3] = store_far(&b->far, b->sc->precision, &b->stored_bytes[3]);
 	if (b->head)
-		b->stored[3] = store(b->head, b->sparse.n_blocks * 2 * b->sc->exact_head * 9,
-				     b->sc->precision, &b->stored_bytes[3]);
+		b->stored[4] = store(b->head, b->sparse.n_blocks * 2 * b->sc->exact_head * 9,
+				     b->sc->precision, &b->stored_bytes[4]);
 	if ((b->fir && !b->stored[0]) ||
 	    (b->shapes && b->sc->representation == IRDM_REPR_MODAL && !b->stored[1]) ||
-	    (b->sparse.start && !b->stored[2]) || (b->head && !b->stored[3])) {
+	    (b->sparse.start && !b->stored[2]) || (b->far.rank && !b->stored[3]) ||
+	    (b->head && !b->stored[4])) {
 		snprintf(err, errlen, "precompute: out of memory converting to the storage precision");
 		return IRDM_ENOMEM;
 	}
@@ -765,7 +825,8 @@ static void build_free(struct build *b)
 	free(b->corr);
 	irdm_corr_sparse_free(&b->sparse);
 	free(b->head);
-	for (int i = 0; i < 4; i++)
+	irdm_corr_lowrank_free(&b->far);
+	for (int i = 0; i < 5; i++)
 		free(b->stored[i]);
 	free(b->stab);
 	free(b->nodes);
@@ -794,6 +855,12 @@ static void report(const struct build *b, struct irdm_precompute_report *rep)
 	rep->corr_blocks = b->sparse.n_blocks;
 	rep->corr_tol = b->sc->static_corr_tol;
 	rep->corr_max_dropped_rel = b->sparse.max_dropped_rel;
+	rep->corr_rank = b->far.rank;
+	rep->corr_checked = b->far.n_checked;
+	rep->corr_far_max[0] = b->far.max_before;
+	rep->corr_far_max[1] = b->far.max_after;
+	rep->corr_far_rms[0] = b->far.rms_before;
+	rep->corr_far_rms[1] = b->far.rms_after;
 }
 
 static uint64_t scene_hash(const struct irdm_scene *sc)
