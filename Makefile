@@ -272,7 +272,7 @@ bench: $(BENCHES) $(IRDM) bench-precompute
 # The paper's cuboid at full resolution (its all-mode reference takes the
 # 9504-mode eigensolve, minutes): make report REPORT_CONFIGS=paper
 # REPORT_MD=docs/report-paper.md.  floating: the floating cube's swing and
-# tap (10 s).
+# tap (10 to 20 s).
 REPORT_CONFIGS ?= sweep floating
 REPORT_MD ?= docs/report.md
 report: $(IRDM)
