@@ -759,7 +759,7 @@ static void test_bad_magic_and_version(void **state)
 	h.version_minor = 0;
 	put_header(buf, &h);
 	img_fixture_reseal(buf, size);
-	expect_parse(buf, size, IRDM_EVERSION, "version 3.1");
+	expect_parse(buf, size, IRDM_EVERSION, "version 3.0");
 	h.version_major = 1;            /* the dense STATIC_CORR of before */
 	put_header(buf, &h);
 	img_fixture_reseal(buf, size);
