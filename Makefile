@@ -271,8 +271,9 @@ bench: $(BENCHES) $(IRDM) bench-precompute
 # and its Pareto plots in docs/ (committed).
 # The paper's cuboid at full resolution (its all-mode reference takes the
 # 9504-mode eigensolve, minutes): make report REPORT_CONFIGS=paper
-# REPORT_MD=docs/report-paper.md
-REPORT_CONFIGS ?= sweep
+# REPORT_MD=docs/report-paper.md.  floating: the floating cube's swing and
+# tap (10 to 20 s).
+REPORT_CONFIGS ?= sweep floating
 REPORT_MD ?= docs/report.md
 report: $(IRDM)
 	@mkdir -p out/report docs/report

@@ -263,7 +263,8 @@ static double modal_case(int which)
 	assert_non_null(h);
 	assert_non_null(x);
 	assert_non_null(uref);
-	assert_non_null(img->corr_start);       /* the default scene keeps it */
+	assert_non_null(img->corr_start);       /* the default scene keeps it, */
+	assert_true(img->corr_rank > 0);        /* and its far field */
 	random_history(img, h);
 	modal_states(img, h, x);
 	reference_disp(img, h, uref);

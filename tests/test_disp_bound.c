@@ -26,7 +26,7 @@
 #define LOOSE_MAX 50.0
 
 static char dir[64];
-static struct irdm_image modal64, modal32, fir, mode1;
+static struct irdm_image modal64, modal32, fir, mode1, hybrid;
 
 static int setup(void **state)
 {
@@ -45,6 +45,10 @@ static int setup(void **state)
 	snprintf(p, sizeof(p), "%s/mode1.img", dir);
 	efx_image(&mode1, p, "resolution", "4,4,8", "representation", "modal:1",
 		  "precision", "f64", "touch", "z>=0.2", NULL);
+	/* the hybrid: its head's past forces add to the free displacement */
+	snprintf(p, sizeof(p), "%s/hybrid.img", dir);
+	efx_image(&hybrid, p, "resolution", "4,4,8", "representation", "modal:300",
+		  "exact_head", "32", "precision", "f32", "touch", "z>=0.2", NULL);
 	snprintf(p, sizeof(p), "%s/fir.img", dir);
 	efx_image(&fir, p, "resolution", "4,4,8", "representation", "fir:100",
 		  "touch", "z>=0.2", NULL);
@@ -58,6 +62,7 @@ static int teardown(void **state)
 	(void)state;
 	irdm_image_unmap(&modal64);
 	irdm_image_unmap(&modal32);
+	irdm_image_unmap(&hybrid);
 	irdm_image_unmap(&fir);
 	irdm_image_unmap(&mode1);
 	snprintf(cmd, sizeof(cmd), "rm -rf '%s'", dir);
@@ -166,6 +171,12 @@ static void test_one_mode_is_tight(void **state)
 	assert_true(q.best < 1 + 1e-9);
 }
 
+static void test_hybrid(void **state)
+{
+	(void)state;
+	run("hybrid 300 + head 32 f32", &hybrid);
+}
+
 static void test_fir(void **state)
 {
 	(void)state;
@@ -179,6 +190,7 @@ int main(void)
 		cmocka_unit_test(test_modal_f32),
 		cmocka_unit_test(test_one_mode_is_tight),
 		cmocka_unit_test(test_fir),
+		cmocka_unit_test(test_hybrid),
 	};
 
 	return cmocka_run_group_tests(tests, setup, teardown);

@@ -30,6 +30,9 @@ static char dir[64];
 /* modal:all f64; modal:40 + static corr, f32, compressed hard enough to
  * drop blocks (so the tick meets missing ones) */
 static struct irdm_image exact, trunc32;
+/* modal:300 with the dropped modes' exact head (32 + 32 samples), f32,
+ * compressed as trunc32 (a head at every kept block only) */
+static struct irdm_image hybrid;
 static struct irdm_image fir[3];                /* fir:200 f64, f32, f16 */
 static const char *const fir_prec[3] = { "f64", "f32", "f16" };
 
@@ -38,11 +41,13 @@ static const char *const fir_prec[3] = { "f64", "f32", "f16" };
 /*
  * Limits, about 5x the largest relative RMS error measured (gcc -O2, clang
  * -O2, ASan -O1; 2026-11-24): modal f64 3.6e-13, modal 40 f32 5.3e-15,
- * stroke 1.7e-12, FIR 200 (f64, f32, f16) 5.6e-14.  All are rounding: the engine and the
- * reference read the same numbers from the image.
+ * stroke 1.7e-12, FIR 200 (f64, f32, f16) 5.6e-14, hybrid 300 + 32 f32 (step,
+ * two points, stroke) 6.7e-13, 1.4e-13, 1.9e-12.  All are rounding: the
+ * engine and the reference read the same numbers from the image.
  */
 #define TOL_MODAL_F64 2e-12
 #define TOL_MODAL_F32 3e-14
+#define TOL_HYBRID 3e-12
 #define TOL_STROKE 1e-11
 #define TOL_FIR 3e-13
 
@@ -60,11 +65,15 @@ static int setup(void **state)
 		  "precision", "f64", "touch", "z>=0.2", NULL);
 	efx_image(&trunc32, p2, "resolution", "4,4,8", "representation", "modal:40",
 		  "precision", "f32", "touch", "z>=0.2", "static_correction_tol", "0.05", NULL);
+	snprintf(p2, sizeof(p2), "%s/hybrid.img", dir);
+	efx_image(&hybrid, p2, "resolution", "4,4,8", "representation", "modal:300",
+		  "precision", "f32", "touch", "z>=0.2", "static_correction_tol", "0.05",
+		  "exact_head", "32", NULL);
 	uint32_t nc = trunc32.meta->n_cols;
-	print_message("modal 40: %u of %u static-correction blocks kept\n",
-		      trunc32.corr_start[nc], nc * nc);
-	if (trunc32.corr_start[nc] >= nc * nc)
-		return -1;
+	print_message("modal 40: %u of %u static-correction blocks kept, far field rank %u\n",
+		      trunc32.corr_start[nc], nc * nc, trunc32.corr_rank);
+	if (trunc32.corr_start[nc] >= nc * nc || trunc32.corr_rank == 0)
+		return -1;      /* the tick must meet dropped blocks and the far field */
 	for (int k = 0; k < 3; k++) {
 		snprintf(p1, sizeof(p1), "%s/fir-%s.img", dir, fir_prec[k]);
 		efx_image(&fir[k], p1, "resolution", "4,4,8", "representation", "fir:200",
@@ -80,6 +89,7 @@ static int teardown(void **state)
 	(void)state;
 	irdm_image_unmap(&exact);
 	irdm_image_unmap(&trunc32);
+	irdm_image_unmap(&hybrid);
 	for (int k = 0; k < 3; k++)
 		irdm_image_unmap(&fir[k]);
 	snprintf(cmd, sizeof(cmd), "rm -rf '%s'", dir);
@@ -211,6 +221,42 @@ static void compare(const char *what, const struct irdm_image *img,
 	free(R);
 }
 
+/*
+ * The hybrid's head summed by the portable loop and, where the processor
+ * has AVX2 + FMA, by engine_head_avx2.c: each against the reference, and
+ * against each other (they must differ in the last bits: both ran).
+ */
+static void hybrid_paths(const struct irdm_contact_site *s, const double *u)
+{
+	struct irdm_engine_config cfg;
+	double *Fw = malloc(N_STEP * 3 * sizeof(double)), *Fp = malloc(N_STEP * 3 * sizeof(double));
+	double *R = malloc(N_STEP * 3 * sizeof(double));
+
+	assert_non_null(Fw);
+	assert_non_null(Fp);
+	assert_non_null(R);
+	irdm_engine_config_default(&cfg);
+	run_engine_cfg(&hybrid, cfg, s, 1, N_STEP, u, IRDM_CONTACT_GRAB, Fw, NULL);
+	cfg.fir_portable_sum = true;
+	run_engine_cfg(&hybrid, cfg, s, 1, N_STEP, u, IRDM_CONTACT_GRAB, Fp, NULL);
+	efx_reference(&hybrid, s, 1, N_STEP, u, R);
+	double ew = efx_rel_rms(Fw, R, N_STEP * 3), ep = efx_rel_rms(Fp, R, N_STEP * 3);
+	double apart = efx_rel_rms(Fw, Fp, N_STEP * 3);
+	print_message("hybrid head sum: default %.2e, portable %.2e (limit %.0e), %.2e apart\n", ew, ep,
+		      TOL_HYBRID, apart);
+	assert_true(ew <= TOL_HYBRID);
+	assert_true(ep <= TOL_HYBRID);
+	irdm_engine_config_default(&cfg);
+	struct irdm_session *ses = efx_session(&hybrid, &cfg);
+	bool wide = !strcmp(irdm_engine_fir_sum_name(ses->eng), "avx2");
+	irdm_session_close(ses);
+	if (wide)
+		assert_true(apart > 0);
+	free(Fw);
+	free(Fp);
+	free(R);
+}
+
 /* Paper Fig. 6a: the top-centre node pushed 1 cm down and held. */
 static void test_step(void **state)
 {
@@ -225,6 +271,9 @@ static void test_step(void **state)
 	compare("step, modal all modes f64", &exact, &s, 1, N_STEP, u, TOL_MODAL_F64);
 	node_site(&trunc32, top, &s);
 	compare("step, modal 40 + static corr f32", &trunc32, &s, 1, N_STEP, u, TOL_MODAL_F32);
+	node_site(&hybrid, top, &s);
+	compare("step, hybrid 300 + head 32 f32", &hybrid, &s, 1, N_STEP, u, TOL_HYBRID);
+	hybrid_paths(&s, u);
 	free(u);
 }
 
@@ -255,12 +304,14 @@ static void test_two_points(void **state)
 	(void)state;
 	for (size_t t = 0; t < N; t++)
 		u[6 * t + 5] = -0.01 * fmin(1.0, (double)t / 1000.0);   /* b ramps to 1 cm */
-	for (int pass = 0; pass < 2; pass++) {
-		const struct irdm_image *img = pass ? &trunc32 : &exact;
+	for (int pass = 0; pass < 3; pass++) {
+		static const char *const what[3] = { "two points, modal f64", "two points, modal 40 f32",
+						     "two points, hybrid 300 + 32 f32" };
+		const struct irdm_image *img = pass == 2 ? &hybrid : pass ? &trunc32 : &exact;
 		node_site(img, a, &s[0]);
 		node_site(img, b, &s[1]);
-		compare(pass ? "two points, modal 40 f32" : "two points, modal f64", img, s, 2, N, u,
-			pass ? TOL_MODAL_F32 : TOL_MODAL_F64);
+		compare(what[pass], img, s, 2, N, u,
+			pass == 2 ? TOL_HYBRID : pass ? TOL_MODAL_F32 : TOL_MODAL_F64);
 	}
 	/* the held point's force grows as the other is pushed (the ring-down
 	 * wobbles, so compare averages) */
@@ -603,7 +654,7 @@ static void stroke_reference(const struct irdm_image *img, const struct irdm_con
 }
 
 /* Paper Fig. 6c: stroking along the top, 5 mm deep, sliding 6 cm in 1.5 s. */
-static void test_stroke(void **state)
+static void stroke(const struct irdm_image *img, const char *what)
 {
 	struct irdm_engine_config cfg;
 	struct irdm_contact_cmd cmd[IRDM_MAX_CONTACTS];
@@ -611,16 +662,15 @@ static void test_stroke(void **state)
 	double *u = calloc(N_STROKE * 3, sizeof(double));
 	double *F = malloc(N_STROKE * 3 * sizeof(double)), *R = malloc(N_STROKE * 3 * sizeof(double));
 
-	(void)state;
 	irdm_engine_config_default(&cfg);
 	cfg.max_contacts = 1;
-	struct irdm_session *ses = efx_session(&exact, &cfg);
+	struct irdm_session *ses = efx_session(img, &cfg);
 	struct irdm_engine *e = ses->eng;
 	unsigned changes = 0;
 	for (size_t t = 0; t < N_STROKE; t++) {
 		double p[3] = { 0.02 + 0.06 * (double)t / N_STROKE, 0.043, 0.2 }, bary[3];
 		uint32_t tri;
-		assert_int_equal(irdm_replay_locate(&exact, p, &tri, bary), 0);
+		assert_int_equal(irdm_replay_locate(img, p, &tri, bary), 0);
 		assert_int_equal(irdm_engine_site_point(e, tri, bary, &sites[t]), 0);
 		changes += t > 0 && memcmp(sites[t].row, sites[t - 1].row, sizeof(sites[t].row)) != 0;
 		u[3 * t + 2] = -0.005 * fmin(1.0, (double)t / 100.0);
@@ -633,7 +683,7 @@ static void test_stroke(void **state)
 		memcpy(&F[3 * t], irdm_engine_contact(e, 0)->force_n, 3 * sizeof(double));
 	}
 	irdm_session_close(ses);
-	stroke_reference(&exact, sites, u, R);
+	stroke_reference(img, sites, u, R);
 	double err = efx_rel_rms(F, R, N_STROKE * 3);
 	/*
 	 * Smooth (Fig. 6c): crossing an edge adds no jump of its own.  With the
@@ -652,8 +702,8 @@ static void test_stroke(void **state)
 			elsewhere = fmax(elsewhere, d);
 		mean += fabs(F[3 * t + 2]) / (N_STROKE - 200);
 	}
-	print_message("stroke: %u triangle changes, relative RMS force error %.2e; largest tick-to-tick |dFz| %.2e N at a crossing, %.2e N elsewhere (mean |Fz| %.3f N)\n",
-		      changes, err, at_cross, elsewhere, mean);
+	print_message("stroke, %s: %u triangle changes, relative RMS force error %.2e; largest tick-to-tick |dFz| %.2e N at a crossing, %.2e N elsewhere (mean |Fz| %.3f N)\n",
+		      what, changes, err, at_cross, elsewhere, mean);
 	assert_true(changes >= 4);
 	assert_true(err <= TOL_STROKE);
 	assert_true(at_cross <= elsewhere);
@@ -661,6 +711,13 @@ static void test_stroke(void **state)
 	free(u);
 	free(F);
 	free(R);
+}
+
+static void test_stroke(void **state)
+{
+	(void)state;
+	stroke(&exact, "modal f64");
+	stroke(&hybrid, "hybrid 300 + 32 f32");
 }
 
 /* Each error the engine's header documents, from the call that returns it. */

@@ -15,8 +15,9 @@
  *    itself in seccomp strict mode, where any system call but read, write,
  *    _exit and sigreturn kills it with SIGKILL.
  *
- * The scenario: modal (300 modes + static correction) and FIR (T = 500)
- * images of the paper's cuboid at a modest resolution, the haptic
+ * The scenario: modal (300 modes + static correction), FIR (T = 500) and
+ * hybrid (300 modes + an exact head of 32 + 32 samples) images of the
+ * paper's cuboid at a modest resolution, the haptic
  * configuration (virtual coupling + passivity control + force limit), two
  * contacts -- a push on a top node that slides to a neighbouring node every
  * 50 ticks (irdm_engine_site_node + irdm_engine_contact_begin inside the
@@ -335,7 +336,7 @@ static void faults(long *minflt, long *majflt)
 /* ---- images and the scenario ---- */
 
 static char dir[64];
-static struct irdm_image modal_img, fir_img;
+static struct irdm_image modal_img, fir_img, hybrid_img;
 
 struct rig {
 	const struct irdm_image *img;
@@ -635,6 +636,12 @@ static void test_fir_alloc_and_fault_free(void **state)
 	alloc_and_fault_free(&fir_img);
 }
 
+static void test_hybrid_alloc_and_fault_free(void **state)
+{
+	(void)state;
+	alloc_and_fault_free(&hybrid_img);
+}
+
 /* ---- proof 3: no system call ---- */
 
 /* The ticks in seccomp strict mode (support/strict_mode.h). */
@@ -700,6 +707,12 @@ static void test_fir_no_system_call(void **state)
 {
 	(void)state;
 	no_system_call(&fir_img);
+}
+
+static void test_hybrid_no_system_call(void **state)
+{
+	(void)state;
+	no_system_call(&hybrid_img);
 }
 
 /* The harness can fail: a system call in strict mode does kill the child. */
@@ -805,6 +818,11 @@ static int setup(void **state)
 	 */
 	efx_image(&fir_img, p2, "resolution", "6,6,12", "representation", "fir:500",
 		  "touch", "box:0.03,0.049,0.199,0.09,0.051,0.201", "display", "touch", NULL);
+	/* the hybrid: 300 modes and the other 1464's exact head (32 + 32
+	 * samples: the head's ring and sums), the top face touchable */
+	snprintf(p2, sizeof(p2), "%s/hybrid.img", dir);
+	efx_image(&hybrid_img, p2, "resolution", "6,6,12", "representation", "modal:300",
+		  "exact_head", "32", "touch", "z>=0.2", "display", "touch", NULL);
 	/*
 	 * Lock what is mapped and what will be.  Best effort: without it the
 	 * fault check can still pass on an idle machine, and says "NOT
@@ -829,6 +847,7 @@ static int teardown(void **state)
 		irdm_rt_unlock_memory();
 	irdm_image_unmap(&modal_img);
 	irdm_image_unmap(&fir_img);
+	irdm_image_unmap(&hybrid_img);
 	snprintf(cmd, sizeof(cmd), "rm -rf '%s'", dir);
 	return system(cmd) ? -1 : 0;
 }
@@ -842,6 +861,8 @@ int main(void)
 		cmocka_unit_test(test_fir_alloc_and_fault_free),
 		cmocka_unit_test(test_modal_no_system_call),
 		cmocka_unit_test(test_fir_no_system_call),
+		cmocka_unit_test(test_hybrid_alloc_and_fault_free),
+		cmocka_unit_test(test_hybrid_no_system_call),
 	};
 
 	return cmocka_run_group_tests(tests, setup, teardown);

@@ -367,7 +367,7 @@ static void test_writer_layout(void **state)
 	h = get_header(buf);
 	assert_memory_equal(h.magic, "IRDMIMG", 8);
 	assert_int_equal(h.version_major, IRDM_IMAGE_VERSION_MAJOR);
-	assert_int_equal(h.version_minor, 0);
+	assert_int_equal(h.version_minor, IRDM_IMAGE_VERSION_MINOR);
 	assert_int_equal(h.header_size, 64);
 	assert_int_equal(h.file_size, size);
 	assert_int_equal(h.section_count, 11);
@@ -544,6 +544,54 @@ static void test_modal_floating_roundtrip(void **state)
 	img_fixture_free(&fx);
 }
 
+/* The far field: views, and every block irdm_image_corr_value() returns
+ * is the kept block + sum_k lambda_k U[r][i][k] U[c][j][k] of the fixture's
+ * values (every precision: the values are exact in each). */
+static void test_modal_lowrank_roundtrip(void **state)
+{
+	static const uint32_t precs[] = { IRDM_ELEM_F16, IRDM_ELEM_F32, IRDM_ELEM_F64 };
+	const uint32_t K = IRDM_SEC_STATIC_CORR_LOWRANK, R = 3;
+	struct img_fixture fx;
+	struct irdm_image img;
+	char err[256];
+	size_t size;
+	void *buf;
+
+	(void)state;
+	for (size_t p = 0; p < 3; p++) {
+		assert_int_equal(img_fixture_modal(&fx, precs[p], 5, 2, 3, IRDM_META_STATIC_CORR), 0);
+		assert_int_equal(img_fixture_lowrank(&fx, R), 0);
+		fixture_buffer(&fx, &buf, &size);
+		assert_int_equal(irdm_image_parse(buf, size, &img, err, sizeof(err)), IRDM_OK);
+		assert_int_equal(img.corr_rank, R);
+		for (uint32_t c = 0; c < 2; c++)
+			for (uint32_t r = 0; r < 2; r++) {
+				double blk[9];
+				irdm_image_corr_value(&img, c, r, blk);
+				for (uint32_t i = 0; i < 3; i++)
+					for (uint32_t j = 0; j < 3; j++) {
+						double want = img_fixture_value(IRDM_SEC_STATIC_CORR,
+										(2 * c + r) * 9 + 3 * i + j);
+						for (uint32_t k = 0; k < R; k++)
+							want += img_fixture_value(K, k) *
+								img_fixture_value(K, R + (3 * r + i) * R + k) *
+								img_fixture_value(K, R + (3 * c + j) * R + k);
+						assert_true(fabs(blk[3 * i + j] - want) <= 1e-15);
+					}
+			}
+		free(buf);
+		img_fixture_free(&fx);
+	}
+	/* without the section: no far field, the kept block alone */
+	small_modal(&fx);
+	fixture_buffer(&fx, &buf, &size);
+	assert_int_equal(irdm_image_parse(buf, size, &img, err, sizeof(err)), IRDM_OK);
+	assert_int_equal(img.corr_rank, 0);
+	assert_null(img.corr_u);
+	free(buf);
+	img_fixture_free(&fx);
+}
+
 /* Grounded modal image without static correction, f16. */
 static void test_modal_grounded_f16_roundtrip(void **state)
 {
@@ -708,6 +756,7 @@ static void test_bad_magic_and_version(void **state)
 
 	h = get_header(buf);
 	h.version_major = 3;
+	h.version_minor = 0;
 	put_header(buf, &h);
 	img_fixture_reseal(buf, size);
 	expect_parse(buf, size, IRDM_EVERSION, "version 3.0");
@@ -1105,6 +1154,26 @@ static void w_corr_short(struct irdm_image_writer *w)
 	irdm_iw_add(w, IRDM_SEC_STATIC_CORR, IRDM_ELEM_F64, corr_two_blocks, sizeof(corr_two_blocks));
 }
 
+static double head_blocks[4 * 2 * 9];
+
+static void w_add_head(struct irdm_image_writer *w)
+{
+	for (size_t i = 0; i < sizeof(head_blocks) / sizeof(head_blocks[0]); i++)
+		head_blocks[i] = (double)i / 64;
+	irdm_iw_add(w, IRDM_SEC_EXACT_HEAD, IRDM_ELEM_F64, head_blocks, sizeof(head_blocks));
+}
+
+static void w_add_head_short(struct irdm_image_writer *w)
+{
+	irdm_iw_add(w, IRDM_SEC_EXACT_HEAD, IRDM_ELEM_F64, head_blocks, sizeof(head_blocks) / 2);
+}
+
+static void w_add_head_nan(struct irdm_image_writer *w)
+{
+	w_add_head(w);
+	head_blocks[40] = NAN;
+}
+
 /* an index in a FIR image */
 static void w_add_corr_index(struct irdm_image_writer *w)
 {
@@ -1180,7 +1249,13 @@ FX(m_fir_corr_flag, fx->meta.flags |= IRDM_META_STATIC_CORR)
 FX(m_unknown_flag, fx->meta.flags |= 1u << 9)
 FX(m_fir_exact, fx->meta.fir_exact = 1)
 FX(m_fir_window_flag, fx->meta.flags |= IRDM_META_FIR_TAIL_WINDOW)
-FX(m_reserved, fx->meta.reserved[7] = 1)
+FX(m_reserved, fx->meta.reserved[3] = 1)
+/* the hybrid's head (format 2.1): 2 samples of the modal fixture's 4 blocks */
+FX(m_head2, (fx->meta.flags |= IRDM_META_EXACT_HEAD, fx->meta.head_samples = 2))
+FX(m_head_samples_only, fx->meta.head_samples = 2)
+FX(m_head_no_corr, (fx->meta.flags = (fx->meta.flags & ~IRDM_META_STATIC_CORR) | IRDM_META_EXACT_HEAD,
+		    fx->meta.head_samples = 2))
+FX(m_head_big, (fx->meta.flags |= IRDM_META_EXACT_HEAD, fx->meta.head_samples = IRDM_HEAD_SAMPLES_MAX + 1))
 FX(m_tool_nul, memset(fx->meta.tool_version, 'x', 32))
 FX(m_name_nul, memset(fx->meta.mesh_name, 'x', 64))
 FX(m_node_nan, fx->nodes[3].pos_m[1] = NAN)
@@ -1216,6 +1291,58 @@ FX(m_corr_row_range, fx->corr_index[3 + 1] = 2)
 FX(m_corr_row_order, (fx->corr_index[3 + 2] = 1, fx->corr_index[3 + 3] = 0))
 FX(m_corr_row_repeat, fx->corr_index[3 + 1] = 0)
 FX(m_corr_blocks_big, fx->corr_index[2] = 0x40000000u)
+
+/* STATIC_CORR_LOWRANK of rank 2 on the fixture's 2 columns (6 DoFs): the
+ * header, then 2 lambdas and 6 x 2 U values, f64 */
+static struct irdm_corr_lowrank_header *with_lowrank(struct img_fixture *fx)
+{
+	assert_int_equal(img_fixture_lowrank(fx, 2), 0);
+	return fx->corr_lowrank;
+}
+
+static double *lowrank_values(struct img_fixture *fx)
+{
+	return (double *)((uint8_t *)with_lowrank(fx) + sizeof(struct irdm_corr_lowrank_header));
+}
+
+FX(m_lr_rank0, with_lowrank(fx)->rank = 0)
+FX(m_lr_rank_big, with_lowrank(fx)->rank = 7)
+FX(m_lr_rank_size, with_lowrank(fx)->rank = 1)
+FX(m_lr_reserved, with_lowrank(fx)->reserved[1] = 1)
+FX(m_lr_lambda_nan, lowrank_values(fx)[1] = NAN)
+FX(m_lr_u_inf, lowrank_values(fx)[2 + 2 * (3 + 2)] = INFINITY)    /* U[5][0] */
+FX(m_lr_short, (with_lowrank(fx), fx->lowrank_bytes = 8))
+FX(m_lr_long, (with_lowrank(fx), fx->lowrank_bytes -= 8))
+/* the far field without the correction it belongs to */
+static void m_lr_no_corr(struct img_fixture *fx)
+{
+	with_lowrank(fx);
+	fx->meta.flags &= ~(uint32_t)IRDM_META_STATIC_CORR;
+	free(fx->static_corr);
+	free(fx->corr_index);
+	fx->static_corr = NULL;
+	fx->corr_index = NULL;
+}
+
+static const uint8_t lowrank_bytes[16 + 8 * 2 * 7] = { 2 };   /* rank 2, zeros */
+
+static void w_add_lowrank(struct irdm_image_writer *w)
+{
+	irdm_iw_add(w, IRDM_SEC_STATIC_CORR_LOWRANK, IRDM_ELEM_BYTES, lowrank_bytes,
+		    sizeof(lowrank_bytes));
+}
+
+static void w_lowrank_f64(struct irdm_image_writer *w)
+{
+	for (unsigned i = 0; i < w->n; i++)
+		if (w->sec[i].kind == IRDM_SEC_STATIC_CORR_LOWRANK)
+			w->sec[i].elem = IRDM_ELEM_F64;
+}
+
+static void m_lr_elem(struct img_fixture *fx)
+{
+	with_lowrank(fx);
+}
 
 enum base { FIR, MODAL };
 
@@ -1309,9 +1436,29 @@ static const struct sem_case sem_cases[] = {
 	{ "corr index vs size", MODAL, m_corr_blocks_big, NULL, IRDM_EFORMAT, "STATIC_CORR_INDEX has 28 bytes, expected 4294967308" },
 	{ "corr blocks short", MODAL, NULL, w_corr_short, IRDM_EFORMAT, "section STATIC_CORR has 144 bytes, expected 288" },
 	{ "FIR + STATIC_CORR_INDEX", FIR, NULL, w_add_corr_index, IRDM_EFORMAT, "STATIC_CORR_INDEX must not be present (FIR image)" },
+	{ "head", MODAL, m_head2, w_add_head, IRDM_OK, NULL },
+	{ "head missing", MODAL, m_head2, NULL, IRDM_EMISSING, "EXACT_HEAD is missing" },
+	{ "head without its flag", MODAL, NULL, w_add_head, IRDM_EFORMAT, "EXACT_HEAD must not be present" },
+	{ "head_samples without the flag", MODAL, m_head_samples_only, NULL, IRDM_EFORMAT, "head_samples 2, EXACT_HEAD clear" },
+	{ "head without STATIC_CORR", MODAL, m_head_no_corr, NULL, IRDM_EFORMAT, "STATIC_CORR clear" },
+	{ "head too long", MODAL, m_head_big, NULL, IRDM_EFORMAT, "head_samples 8193" },
+	{ "head short", MODAL, m_head2, w_add_head_short, IRDM_EFORMAT, "section EXACT_HEAD has 288 bytes, expected 576" },
+	{ "head NaN", MODAL, m_head2, w_add_head_nan, IRDM_EFORMAT, "EXACT_HEAD element 40 is not finite" },
+	{ "FIR + head", FIR, NULL, w_add_head, IRDM_EFORMAT, "EXACT_HEAD must not be present (FIR image)" },
 	{ "no MODES", MODAL, NULL, w_no_modes, IRDM_EMISSING, "MODES is missing" },
 	{ "no MODE_SHAPES", MODAL, NULL, w_no_shapes, IRDM_EMISSING, "MODE_SHAPES is missing" },
 	{ "modal + FIR", MODAL, NULL, w_add_fir, IRDM_EFORMAT, "FIR must not be present (modal image)" },
+	{ "lowrank rank 0", MODAL, m_lr_rank0, NULL, IRDM_EFORMAT, "STATIC_CORR_LOWRANK: rank 0 is not in 1..6 (3 n_cols, at most 1024)" },
+	{ "lowrank rank > 3 n_cols", MODAL, m_lr_rank_big, NULL, IRDM_EFORMAT, "STATIC_CORR_LOWRANK: rank 7 is not in 1..6" },
+	{ "lowrank rank vs size", MODAL, m_lr_rank_size, NULL, IRDM_EFORMAT, "section STATIC_CORR_LOWRANK has 128 bytes, expected 72 (16 + rank 1 x (1 + 3 n_cols) x 8)" },
+	{ "lowrank long", MODAL, m_lr_long, NULL, IRDM_EFORMAT, "section STATIC_CORR_LOWRANK has 120 bytes, expected 128" },
+	{ "lowrank short", MODAL, m_lr_short, NULL, IRDM_EFORMAT, "section STATIC_CORR_LOWRANK has 8 bytes, fewer than its 16-byte header" },
+	{ "lowrank reserved", MODAL, m_lr_reserved, NULL, IRDM_EFORMAT, "STATIC_CORR_LOWRANK: reserved header words not 0" },
+	{ "lowrank lambda NaN", MODAL, m_lr_lambda_nan, NULL, IRDM_EFORMAT, "STATIC_CORR_LOWRANK: lambda[1] is not finite" },
+	{ "lowrank U inf", MODAL, m_lr_u_inf, NULL, IRDM_EFORMAT, "STATIC_CORR_LOWRANK: U element (column 1, axis 2, term 0) is not finite" },
+	{ "lowrank elem", MODAL, m_lr_elem, w_lowrank_f64, IRDM_EFORMAT, "section STATIC_CORR_LOWRANK has element type F64, expected BYTES" },
+	{ "lowrank without STATIC_CORR", MODAL, m_lr_no_corr, NULL, IRDM_EFORMAT, "STATIC_CORR_LOWRANK must not be present (its far field needs STATIC_CORR)" },
+	{ "FIR + lowrank", FIR, NULL, w_add_lowrank, IRDM_EFORMAT, "STATIC_CORR_LOWRANK must not be present (FIR image)" },
 };
 
 static void test_semantic_validation(void **state)
@@ -1566,6 +1713,7 @@ int main(void)
 		cmocka_unit_test(test_writer_add_rejects),
 		cmocka_unit_test(test_fir_roundtrip),
 		cmocka_unit_test(test_modal_floating_roundtrip),
+		cmocka_unit_test(test_modal_lowrank_roundtrip),
 		cmocka_unit_test(test_modal_grounded_f16_roundtrip),
 		cmocka_unit_test(test_map_lock),
 		cmocka_unit_test(test_map_errors),

@@ -30,23 +30,12 @@
 #include "irdm/image.h"
 #include "irdm/session.h"
 #include "support/engine_fixture.h"
+#include "support/report_fixture.h"
 #include "support/run_prog.h"
 #include "support/test_files.h"
 
 static char dir[256];
-
-struct row {
-	char repr[48];
-	double force_err, first10, after100, disp_err, median_us, p99_us;
-	size_t bytes;
-	double radius;
-	int cert_stable, bounded;
-	double growth;
-	size_t ticks;
-	int paper;
-};
-
-static struct row rows[8];
+static struct rfx_row rows[8];
 static int n_rows;
 
 static const char *irdm_path(void)
@@ -56,48 +45,12 @@ static const char *irdm_path(void)
 	return p ? p : "build/irdm";
 }
 
-/* config,repr,dt_ms,scenario,force_err,first10,after100,disp_err,median,p99,
- * bytes,radius,cert_stable,run_bounded,raw_growth,ticks,paper,keys */
-static void read_csv(const char *path)
-{
-	char text[8192], *save = NULL;
-	int line = 0;
-
-	tf_read_text(path, text, sizeof(text));
-	for (char *l = strtok_r(text, "\n", &save); l; l = strtok_r(NULL, "\n", &save), line++) {
-		struct row *r = &rows[n_rows];
-		double dt;
-		char scen[32];
-
-		if (!line)
-			continue;
-		assert_true(n_rows < 8);
-		assert_int_equal(sscanf(l, "tiny,%47[^,],%lf,%31[^,],%lf,%lf,%lf,%lf,%lf,%lf,%zu,%lf,%d,%d,%lf,%zu,%d,",
-					r->repr, &dt, scen, &r->force_err, &r->first10, &r->after100,
-					&r->disp_err, &r->median_us, &r->p99_us, &r->bytes, &r->radius,
-					&r->cert_stable, &r->bounded, &r->growth, &r->ticks, &r->paper), 16);
-		assert_float_equal(dt, 2.0, 0);
-		assert_string_equal(scen, "step");
-		n_rows++;
-	}
-}
-
 static int setup(void **state)
 {
-	const char *args[] = { "report", "--config", "tiny", "-o", dir, "--keep-images", "-q", NULL };
-	char path[512], err[4096];
-	int rc;
-
 	(void)state;
-	if (tf_tmpdir(dir, sizeof(dir), "report"))
+	if (rfx_run(dir, sizeof(dir), "tiny"))
 		return -1;
-	rc = rp_run(dir, irdm_path(), args, NULL, 0, err, sizeof(err));
-	if (rc) {
-		fprintf(stderr, "irdm report: exit %d: %s\n", rc, err);
-		return -1;
-	}
-	snprintf(path, sizeof(path), "%s/report-tiny.csv", dir);
-	read_csv(path);
+	n_rows = rfx_read_csv(dir, "tiny", rows, 8);
 	return 0;
 }
 
@@ -107,13 +60,9 @@ static int teardown(void **state)
 	return tf_rmdir(dir);
 }
 
-static const struct row *row_of(const char *repr)
+static const struct rfx_row *row_of(const char *repr)
 {
-	for (int i = 0; i < n_rows; i++)
-		if (!strcmp(rows[i].repr, repr))
-			return &rows[i];
-	fail_msg("no row for %s", repr);
-	return NULL;
+	return rfx_row_of(rows, n_rows, repr, NULL);
 }
 
 static void test_rows(void **state)
@@ -121,6 +70,8 @@ static void test_rows(void **state)
 	(void)state;
 	assert_int_equal(n_rows, 3);
 	for (int i = 0; i < n_rows; i++) {
+		assert_float_equal(rows[i].dt_ms, 2.0, 0);
+		assert_string_equal(rows[i].scenario, "step");
 		assert_int_equal(rows[i].ticks, 1500);      /* 3 s at 2 ms */
 		assert_true(rows[i].median_us > 0 && rows[i].p99_us >= rows[i].median_us);
 	}
@@ -129,7 +80,7 @@ static void test_rows(void **state)
 /* The exact model run by the engine agrees with the reference's convolution. */
 static void test_exact_model_is_rounding(void **state)
 {
-	const struct row *r = row_of("modal:all/f64");
+	const struct rfx_row *r = row_of("modal:all/f64");
 
 	(void)state;
 	printf("modal:all f64 against the reference: force %.2e, surface %.2e\n", r->force_err,
@@ -145,7 +96,7 @@ static void test_exact_model_is_rounding(void **state)
  * at the certificate's rate (our own convolution, not the certificate). */
 static void test_truncated_fir_unstable(void **state)
 {
-	const struct row *r = row_of("fir:100");
+	const struct rfx_row *r = row_of("fir:100");
 	double ticks = 20.0 / 0.002, rate = log(r->growth) / ticks;
 
 	(void)state;
@@ -165,7 +116,7 @@ static void test_truncated_fir_unstable(void **state)
  * (the correction is K^-1's residual), the first ticks are not. */
 static void test_truncated_modal(void **state)
 {
-	const struct row *r = row_of("modal:20+sc");
+	const struct rfx_row *r = row_of("modal:20+sc");
 
 	(void)state;
 	assert_true(r->cert_stable && r->bounded);
@@ -191,30 +142,6 @@ static void test_bytes_are_file_sizes(void **state)
 	}
 }
 
-/* The step (1 cm down at the top centre, held) on image path, in the
- * engine; F: N x 3. */
-static void engine_step(const char *path, const struct irdm_contact_site *site, size_t N,
-			double *F)
-{
-	struct irdm_image img;
-	struct irdm_engine_config cfg;
-	struct irdm_session *ses;
-	struct irdm_contact_cmd cmd = { .mode = IRDM_CONTACT_GRAB, .target_m = { 0, 0, -0.01 } };
-	char err[512];
-
-	assert_int_equal(irdm_image_map(path, 0, &img, err, sizeof(err)), 0);
-	irdm_engine_config_default(&cfg);
-	cfg.max_contacts = 1;
-	ses = efx_session(&img, &cfg);
-	assert_int_equal(irdm_engine_contact_begin(ses->eng, 0, site, IRDM_CONTACT_GRAB), 0);
-	for (size_t t = 0; t < N; t++) {
-		assert_int_equal(irdm_engine_tick(ses->eng, &cmd), 0);
-		memcpy(&F[3 * t], irdm_engine_contact(ses->eng, 0)->force_n, 3 * sizeof(double));
-	}
-	irdm_session_close(ses);
-	irdm_image_unmap(&img);
-}
-
 /* The report's error figures against the same figures computed here. */
 static void test_errors_recomputed(void **state)
 {
@@ -226,7 +153,7 @@ static void test_errors_recomputed(void **state)
 	const double top[3] = { 0.05, 0.05, 0.2 };
 	double *F = malloc(N * 3 * sizeof(double)), *Fref = malloc(N * 3 * sizeof(double));
 	double *target = malloc(N * 3 * sizeof(double));
-	struct irdm_image ref;
+	struct irdm_image ref, img;
 	struct irdm_contact_site site;
 	struct irdm_engine_config cfg;
 	struct irdm_session *ses;
@@ -248,11 +175,13 @@ static void test_errors_recomputed(void **state)
 	irdm_session_close(ses);
 	efx_reference(&ref, &site, 1, N, target, Fref);
 	for (size_t i = 0; i < sizeof(reprs) / sizeof(reprs[0]); i++) {
-		const struct row *r = row_of(reprs[i][0]);
+		const struct rfx_row *r = row_of(reprs[i][0]);
 		double whole, first, after;
 
 		snprintf(path, sizeof(path), "%s/tmp/%s", dir, reprs[i][1]);
-		engine_step(path, &site, N, F);
+		assert_int_equal(irdm_image_map(path, 0, &img, err, sizeof(err)), 0);
+		rfx_engine_grab(&img, top, target, N, F);
+		irdm_image_unmap(&img);
 		whole = efx_rel_rms(F, Fref, 3 * N);
 		first = efx_rel_rms(F, Fref, 30);
 		after = efx_rel_rms(F + 300, Fref + 300, 3 * (N - 100));
@@ -288,7 +217,7 @@ static void test_bad_config(void **state)
 
 	(void)state;
 	assert_int_equal(rp_run(dir, irdm_path(), args, NULL, 0, err, sizeof(err)), 2);
-	assert_non_null(strstr(err, "--config nope: not one of sweep, paper, tiny"));
+	assert_non_null(strstr(err, "--config nope: not one of sweep, paper, floating, tiny, tiny-floating"));
 }
 
 static void test_bad_repr(void **state)

@@ -8,12 +8,16 @@
  * static correction of those three columns, solved independently here
  * (irdm_static_correction on the model rebuilt in this process).
  *
- * A second step puts the third node at the nearest column whose block was
- * dropped: the worst case of the tolerance, whose force error it states.
+ * The image carries the far field of the dropped blocks (rank 96): the
+ * reference replaces the image's whole blocks (kept + far field) between the
+ * three columns by the dense ones.  A second step puts the third node at
+ * the nearest column whose block was dropped: the worst case of the
+ * tolerance, whose force error it states.
  *
  * IRDM_TORUS=small (`make san`) meshes the torus with about 800 nodes
  * instead of 3000; IRDM_TORUS_TOL=T sets static_correction_tol (to
- * measure the force error against the tolerance).
+ * measure the force error against the tolerance), IRDM_TORUS_RANK=R
+ * static_correction_rank (0: the blocks alone).
  */
 #include <math.h>
 #include <setjmp.h>
@@ -42,16 +46,22 @@
 #define MAX_PEAK_MIB 1024.0
 #define MAX_IMAGE_MB 50.0
 /*
- * Force error of the compressed correction vs the dense one, with the far
- * node: 2.2e-3 measured at the default tol 0.02 (the far blocks are 0.2 to
- * 0.4 % of the diagonal ones on this torus: the truncation's residual has
- * a slowly decaying far field), limit about 2x.  The issue asked for 1e-3:
- * block dropping meets that only at tol <= 2e-3, which keeps ~90 % of the
- * blocks (docs/image-format.md).  For the nearest dropped node, in units
- * of the tolerance: the force error is about the dropped block's ratio.
+ * Force error of the compressed correction (kept blocks + the far field of
+ * rank 96, the default) vs the dense one, with the far node: 9.3e-4
+ * measured, the issue's 1e-3 the limit (7 % margin; 2.2e-3 with the blocks
+ * alone).  It is not monotone in the rank: rank 192 fits that node's
+ * blocks better (ratio left 0.0017 against 0.0024) and yet gives 1.6e-3,
+ * so the fit itself is held too: the far block's ratio left over the one
+ * dropped, 0.73 measured, limit 0.8 (1.0 without a far field).
+ * For the nearest dropped node, in units of the tolerance: the force error
+ * is about the dropped block's ratio, 0.95 tol measured (1.05 with the
+ * blocks alone), limit 1.2 tol.  The issue's 1e-3 there is out of reach
+ * of a low-rank term: that block is local (23 mm away); it needs tol near
+ * 1e-3, which keeps most blocks (docs/image-format.md).
  */
-#define MAX_FORCE_RMS 5e-3
-#define MAX_TOL_RATIO 1.5
+#define MAX_FORCE_RMS 1e-3
+#define MAX_FAR_LEFT 0.8
+#define MAX_TOL_RATIO 1.2
 
 #define N_TICKS 300
 #define SCALE 0.05              /* mesh_scale: tube 2 cm, ring 5 cm */
@@ -218,10 +228,11 @@ static void node_sites(const struct irdm_image *img, const uint32_t col[3],
  * Relative RMS force error of a step at columns col[] with the image's
  * (compressed) static correction against the same with the dense blocks of
  * the three columns solved here; *rho: the largest dropped block's norm
- * over sqrt(|S_aa| |S_bb|), from the dense blocks.
+ * over sqrt(|S_aa| |S_bb|), from the dense blocks; *left: what the image's
+ * far field leaves of it, in the same units.
  */
 static double step_error(const struct irdm_image *img, struct irdm_model *m, const uint32_t col[3],
-			 double *rho)
+			 double *rho, double *left)
 {
 	struct irdm_contact_site sites[3];
 	int64_t cd[9];
@@ -240,20 +251,21 @@ static double step_error(const struct irdm_image *img, struct irdm_model *m, con
 	memcpy(Wd, W, N_TICKS * 81 * sizeof(double));
 	for (int s = 0; s < 3; s++)
 		dn[s] = frob(&D[(s * 3 + s) * 9]);
-	*rho = 0;
+	*rho = *left = 0;
 	for (int i = 0; i < 3; i++)
 		for (int j = 0; j < 3; j++) {
-			long k = irdm_image_corr_block(img, col[j], col[i]);
 			const double *d = &D[(j * 3 + i) * 9];
-			if (k < 0)
+			double sv[9], diff[9];
+			irdm_image_corr_value(img, col[j], col[i], sv);
+			for (int e = 0; e < 9; e++)
+				diff[e] = d[e] - sv[e];
+			if (irdm_image_corr_block(img, col[j], col[i]) < 0) {
 				*rho = fmax(*rho, frob(d) / sqrt(dn[i] * dn[j]));
+				*left = fmax(*left, frob(diff) / sqrt(dn[i] * dn[j]));
+			}
 			for (int r = 0; r < 3; r++)
-				for (int c = 0; c < 3; c++) {
-					double sp = k < 0 ? 0.0 :
-						irdm_elem_get(img->corr_blocks, img->meta->precision,
-							      (size_t)k * 9 + (size_t)(3 * r + c));
-					Wd[(3 * i + r) * 9 + 3 * j + c] += d[3 * r + c] - sp;
-				}
+				for (int c = 0; c < 3; c++)
+					Wd[(3 * i + r) * 9 + 3 * j + c] += diff[3 * r + c];
 		}
 	double *u = malloc(N_TICKS * 9 * sizeof(double));
 	double *F = malloc(N_TICKS * 9 * sizeof(double)), *Fd = malloc(N_TICKS * 9 * sizeof(double));
@@ -276,12 +288,13 @@ static double step_error(const struct irdm_image *img, struct irdm_model *m, con
 static void test_torus(void **state)
 {
 	const char *size = getenv("IRDM_TORUS"), *tol = getenv("IRDM_TORUS_TOL");
+	const char *rank = getenv("IRDM_TORUS_RANK");
 	bool small = size && !strcmp(size, "small");
 	char off[192], scene[192], path[192], text[512];
 	struct irdm_image img;
 	struct irdm_model m;
 	char err[512];
-	double rho;
+	double rho, left;
 
 	(void)state;
 	snprintf(off, sizeof(off), "%s/torus.off", dir);
@@ -289,9 +302,10 @@ static void test_torus(void **state)
 	snprintf(path, sizeof(path), "%s/torus.img", dir);
 	write_torus(off, 33, 17);
 	snprintf(text, sizeof(text),
-		 "name = torus\nmesh = %s\nmesh_scale = %g\nfloating = yes\ntarget_nodes = %d\n%s%s%s",
+		 "name = torus\nmesh = %s\nmesh_scale = %g\nfloating = yes\ntarget_nodes = %d\n%s%s%s%s%s%s",
 		 off, SCALE, small ? 800 : 3000, tol ? "static_correction_tol = " : "",
-		 tol ? tol : "", tol ? "\n" : "");
+		 tol ? tol : "", tol ? "\n" : "", rank ? "static_correction_rank = " : "",
+		 rank ? rank : "", rank ? "\n" : "");
 	tf_write_text(scene, text);
 	precompute(scene, path);
 	assert_int_equal(irdm_image_map(path, 0, &img, err, sizeof(err)), 0);
@@ -308,10 +322,13 @@ static void test_torus(void **state)
 	col[1] = column_near(&img, pa_f, col[0], false);
 	col[2] = column_near(&img, pa_f, col[0], true);
 	assert_true(irdm_image_corr_block(&img, col[0], col[1]) >= 0);  /* neighbours kept */
-	double e_far = step_error(&img, &m, col, &rho);
-	print_message("step at A, its neighbour B and the farthest C (columns %u, %u, %u of %u): relative RMS force error %.2e (limit %.0e), largest dropped block %.3g\n",
-		      col[0], col[1], col[2], img.meta->n_cols, e_far, MAX_FORCE_RMS, rho);
+	double e_far = step_error(&img, &m, col, &rho, &left);
+	print_message("step at A, its neighbour B and the farthest C (columns %u, %u, %u of %u): relative RMS force error %.2e (limit %.0e), largest dropped block %.3g, %.3g left with the far field of rank %u\n",
+		      col[0], col[1], col[2], img.meta->n_cols, e_far, MAX_FORCE_RMS, rho, left,
+		      img.corr_rank);
 	assert_true(e_far <= MAX_FORCE_RMS);
+	if (img.corr_rank)
+		assert_true(left <= MAX_FAR_LEFT * rho);
 
 	/* C the column nearest to A whose block was dropped: the worst case
 	 * the tolerance allows, whose force error it states */
@@ -326,9 +343,9 @@ static void test_torus(void **state)
 	}
 	if (best < 1e300) {
 		double t = tol ? strtod(tol, NULL) : IRDM_STATIC_CORR_TOL_DEFAULT;
-		double e_near = step_error(&img, &m, col, &rho);
-		print_message("step at A, B and the nearest dropped C (column %u, %.1f mm away): relative RMS force error %.2e, largest dropped block %.3g (tol %g, limit %.2g)\n",
-			      col[2], 1e3 * sqrt(best), e_near, rho, t, MAX_TOL_RATIO * t);
+		double e_near = step_error(&img, &m, col, &rho, &left);
+		print_message("step at A, B and the nearest dropped C (column %u, %.1f mm away): relative RMS force error %.2e, largest dropped block %.3g, %.3g left (tol %g, limit %.2g)\n",
+			      col[2], 1e3 * sqrt(best), e_near, rho, left, t, MAX_TOL_RATIO * t);
 		assert_true(rho < t);
 		assert_true(e_near <= MAX_TOL_RATIO * t);
 	}

@@ -50,7 +50,7 @@ static void r0_self(const struct irdm_image *img, uint32_t col, double R[9])
 {
 	const struct irdm_meta *m = img->meta;
 	uint32_t row = img->columns[col], prec = m->precision;
-	long sc = irdm_image_corr_block(img, col, col);
+	double S[9];
 
 	memset(R, 0, 9 * sizeof(double));
 	if (m->representation == IRDM_REPR_FIR) {
@@ -59,14 +59,14 @@ static void r0_self(const struct irdm_image *img, uint32_t col, double R[9])
 			R[i] = irdm_elem_get(img->fir, prec, b + (size_t)i);
 		return;
 	}
+	/* kept block + far field (none in the tick image: modal:all) */
+	irdm_image_corr_value(img, col, col, S);
 	for (int i = 0; i < 3; i++)
 		for (int j = 0; j < 3; j++) {
 			for (size_t k = 0; k < m->n_modes; k++)
 				R[3 * i + j] += phi(img, row, i, k) * phi(img, row, j, k) *
 						img->modes[k].b[0];
-			if (sc >= 0)
-				R[3 * i + j] += irdm_elem_get(img->corr_blocks, prec,
-							      (size_t)sc * 9 + (size_t)(3 * i + j));
+			R[3 * i + j] += S[3 * i + j];
 		}
 }
 

@@ -49,6 +49,44 @@ static void static_correction(const struct irdm_deform_worker *w,
 	}
 }
 
+/*
+ * The correction's far field, U diag(lambda) U^T over the touchable DoFs:
+ * the force nodes' weights g = diag(lambda) U_e^T f_e summed first
+ * (O(rank) per node), then u_c += U_c g for every column (O(n_cols rank)).
+ */
+static void far_field(const struct irdm_deform_worker *w, const struct irdm_force_tick *f,
+		      double *pos)
+{
+	const struct irdm_image *img = w->img;
+	size_t r = img->corr_rank, nc = w->n_cols;
+	const void *U = img->corr_u;
+	double *g = w->far_g;
+
+	if (!f->n)
+		return;
+	for (size_t k = 0; k < r; k++)
+		g[k] = 0;
+	for (uint32_t e = 0; e < f->n; e++) {
+		size_t b = 3 * (size_t)f->col[e] * r;
+		const double *fe = f->f_n[e];
+		for (size_t k = 0; k < r; k++)
+			g[k] += irdm_elem_get(img->corr_lambda, w->prec, k) *
+				(irdm_elem_get(U, w->prec, b + k) * fe[0] +
+				 irdm_elem_get(U, w->prec, b + r + k) * fe[1] +
+				 irdm_elem_get(U, w->prec, b + 2 * r + k) * fe[2]);
+	}
+	for (size_t c = 0; c < nc; c++) {
+		double *u = pos + 3 * (size_t)img->columns[c];
+		for (size_t i = 0; i < 3; i++) {
+			size_t b = (3 * c + i) * r;
+			double s = 0;
+			for (size_t k = 0; k < r; k++)
+				s += irdm_elem_get(U, w->prec, b + k) * g[k];
+			u[i] += s;
+		}
+	}
+}
+
 void deform_modal_product(struct irdm_deform_worker *w, double *pos)
 {
 	int n3 = 3 * (int)w->n_nodes, K = (int)w->n_modes;
@@ -89,6 +127,8 @@ void deform_modal(struct irdm_deform_worker *w, struct deform_snap *s, double *p
 	sanitize(&s->f, w->n_cols);
 	if (w->img->corr_start)
 		static_correction(w, &s->f, pos);
+	if (w->img->corr_rank)
+		far_field(w, &s->f, pos);
 }
 
 /*

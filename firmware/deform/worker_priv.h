@@ -37,6 +37,9 @@ struct irdm_deform_worker {
 	void *y;                            /* n_modes of the matrix's type */
 	float *uf;                          /* f32 product, 3 n_nodes */
 	double *frame_pos;                  /* the thread's frame, 3 n_nodes */
+	/* the static correction's far field (NULL without one): the weights
+	 * diag(lambda) U^T f, corr_rank */
+	double *far_g;
 
 	struct irdm_deform_thread th;
 };

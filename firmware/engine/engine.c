@@ -18,7 +18,7 @@ static size_t up(size_t n)
 }
 
 struct layout {
-	size_t engine, col_of_row, phi, x, y, ring, tail, bound, total;
+	size_t engine, col_of_row, phi, x, y, ring, tail, bound, head_bound, total;
 };
 
 static int plan(const struct irdm_image *img, const struct irdm_engine_config *cfg,
@@ -27,6 +27,7 @@ static int plan(const struct irdm_image *img, const struct irdm_engine_config *c
 	const struct irdm_meta *m = img->meta;
 	bool modal = m->representation == IRDM_REPR_MODAL;
 	size_t K = modal ? m->n_modes : 0, T = modal ? 0 : m->fir_length;
+	size_t H = modal ? m->head_samples : 0;
 
 	if (!cfg || cfg->max_contacts < 1 || cfg->max_contacts > IRDM_MAX_CONTACTS ||
 	    !(cfg->coupling_k_n_per_m >= 0) || !(cfg->coupling_b_ns_per_m >= 0) ||
@@ -39,9 +40,10 @@ static int plan(const struct irdm_image *img, const struct irdm_engine_config *c
 	l->x = l->phi + up((size_t)m->n_cols * 3 * K * sizeof(double));
 	l->y = l->x + up(2 * K * sizeof(double));
 	l->ring = l->y + up(2 * K * sizeof(double));
-	l->tail = l->ring + up(T * sizeof(struct irdm_force_tick));
+	l->tail = l->ring + up((T + H) * sizeof(struct irdm_force_tick));
 	l->bound = l->tail + up(T * sizeof(double));
-	l->total = l->bound + up((K + T) * sizeof(double));
+	l->head_bound = l->bound + up((K + T) * sizeof(double));
+	l->total = l->head_bound + up(2 * H * sizeof(double));  /* bound weights, slot norms */
 	return 0;
 }
 
@@ -186,6 +188,7 @@ int irdm_engine_init(struct irdm_engine **out, const struct irdm_image *img,
 	e->n_cols = img->meta->n_cols;
 	e->K = e->repr == IRDM_REPR_MODAL ? img->meta->n_modes : 0;
 	e->T = e->repr == IRDM_REPR_FIR ? img->meta->fir_length : 0;
+	e->H = e->repr == IRDM_REPR_MODAL ? img->meta->head_samples : 0;
 	uint32_t *cor = (uint32_t *)(base + l.col_of_row);
 	for (uint32_t r = 0; r < e->n_nodes; r++)
 		cor[r] = NO_COL;
@@ -197,16 +200,21 @@ int irdm_engine_init(struct irdm_engine **out, const struct irdm_image *img,
 	if (e->K)
 		convert_shapes(e, (double *)(base + l.phi));
 	e->phi = (const double *)(base + l.phi);
-	e->ring.T = e->T;
+	e->ring.T = e->T + e->H;           /* one of the two is 0 */
 	e->ring.tick = (struct irdm_force_tick *)(base + l.ring);
 	if (e->T)
 		fir_tail(e, (double *)(base + l.tail));
 #if IRDM_CONFIG_FIR
-	e->fir_wide = e->T && !cfg->fir_portable_sum && irdm_fir_wide_usable();
+	e->fir_wide = e->T && !cfg->fir_portable_sum && irdm_wide_usable();
 #endif
+	e->head_wide = e->H && !cfg->fir_portable_sum && irdm_wide_usable();
 	e->tail_w = (const double *)(base + l.tail);
 	irdm_bound_init(e, (double *)(base + l.bound));
 	e->bound_w = (const double *)(base + l.bound);
+	if (e->H)
+		irdm_head_bound_init(e, (double *)(base + l.head_bound));
+	e->head_bound_w = (const double *)(base + l.head_bound);
+	e->head_norm = (double *)(base + l.head_bound) + e->H;
 	if (img->rigid && start_rigid(e)) {
 		snprintf(err, errlen, "engine: the image's rigid-body data is not usable (mass %g kg)",
 			 img->rigid->mass_kg);
@@ -222,8 +230,10 @@ void irdm_engine_reset(struct irdm_engine *e)
 		start_rigid(e);
 	for (uint32_t k = 0; k < 2 * e->K; k++)
 		e->x[k] = e->y[k] = 0;
-	for (uint32_t s = 0; s < e->T; s++)
+	for (uint32_t s = 0; s < e->ring.T; s++)
 		e->ring.tick[s].n = 0;
+	for (uint32_t s = 0; s < e->H; s++)
+		e->head_norm[s] = 0;
 	for (unsigned i = 0; i < IRDM_MAX_CONTACTS; i++)
 		irdm_engine_contact_end(e, i);
 	e->faulted = false;
@@ -348,7 +358,9 @@ const char *irdm_engine_fault_reason(const struct irdm_engine *e)
 
 const char *irdm_engine_fir_sum_name(const struct irdm_engine *e)
 {
-	return !e->T ? "none" : e->fir_wide ? "avx2" : "portable";
+	bool wide = e->T ? e->fir_wide : e->head_wide;
+
+	return !e->T && !e->H ? "none" : wide ? "avx2" : "portable";
 }
 
 const struct irdm_engine_stats *irdm_engine_stats(const struct irdm_engine *e)

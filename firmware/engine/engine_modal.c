@@ -47,19 +47,8 @@ void irdm_modal_free_disp(const struct irdm_engine *e, uint32_t col, double u[3]
 			s += p[k] * e->y[2 * k];
 		u[i] = s;
 	}
-}
-
-/* The static correction's block (force col_force -> displacement col_disp)
- * into blk, or zeros where it was dropped (below the scene's tolerance). */
-static void static_corr(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp,
-			double blk[9])
-{
-	const struct irdm_image *img = e->img;
-	long k = irdm_image_corr_block(img, col_force, col_disp);
-
-	for (size_t i = 0; i < 9; i++)
-		blk[i] = k < 0 ? 0.0 : irdm_elem_get(img->corr_blocks, img->meta->precision,
-						      (size_t)k * 9 + i);
+	if (e->H)
+		irdm_head_free_disp(e, col, u);
 }
 
 void irdm_modal_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp, double blk[9])
@@ -68,7 +57,11 @@ void irdm_modal_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col
 	const double *pd = &e->phi[(size_t)col_disp * 3 * e->K];
 	const double *pf = &e->phi[(size_t)col_force * 3 * e->K];
 
-	static_corr(e, col_force, col_disp, blk);
+	/* the static correction: kept block (zero where dropped) + far field;
+	 * a hybrid image's kept blocks take the head's first sample instead
+	 * (the head's samples sum to the whole block, far field included) */
+	if (!e->H || !irdm_head_r0(e, col_force, col_disp, blk))
+		irdm_image_corr_value(e->img, col_force, col_disp, blk);
 	for (int i = 0; i < 3; i++)
 		for (int j = 0; j < 3; j++) {
 			double s = 0;
@@ -92,4 +85,6 @@ void irdm_modal_apply(struct irdm_engine *e, const struct irdm_force_tick *f)
 		e->x[2 * k] = flush_tiny(e->y[2 * k] + m[k].b[0] * g);
 		e->x[2 * k + 1] = flush_tiny(e->y[2 * k + 1] + m[k].b[1] * g);
 	}
+	if (e->H)
+		irdm_head_apply(e, f);
 }

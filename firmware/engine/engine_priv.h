@@ -29,18 +29,22 @@ struct irdm_engine {
 	struct irdm_engine_config cfg;
 	double dt_s;
 	uint32_t repr, n_nodes, n_cols, K, T;
+	uint32_t H;                         /* modal: exact head samples (0: none; engine_head.c) */
 	const uint32_t *col_of_row;         /* n_nodes, NO_COL if not touchable */
 	/* modal */
 	const double *phi;                  /* [col][3][K], converted at init */
 	double *x;                          /* 2K: (q, q') per mode, x[t] */
 	double *y;                          /* 2K: A x[t], the free evolution */
-	/* FIR */
+	/* FIR, and a modal image's exact head (ring of H ticks) */
 	struct irdm_fir_ring ring;
 	const double *tail_w;               /* T: r^s tail damping (1 when stable) */
 	bool fir_wide;                      /* history sum by fir_sum_avx2.c */
 	/* disp_bound.c: K (modal) max |phi_k| at a column, or T (FIR) max
 	 * ||R[s]||_F over force columns and touchable rows; set at init */
 	const double *bound_w;
+	const double *head_bound_w;         /* H: max ||D_s||_F over kept blocks */
+	double *head_norm;                  /* H: sum of |f| of each ring slot (0 if empty) */
+	bool head_wide;                     /* head sum by engine_head_avx2.c */
 	/* contacts and solve */
 	struct irdm_contact_state c[IRDM_MAX_CONTACTS];
 	struct r0_table r0, r0_next;
@@ -67,12 +71,45 @@ void irdm_fir_free_disp(const struct irdm_engine *e, uint32_t col, double u[3]);
 void irdm_fir_free_disps(const struct irdm_engine *e, uint32_t n, const uint32_t *cols,
 			 double (*u)[3]);
 /* fir_sum_avx2.c: the same sum with AVX2 + FMA, at n image rows (not
- * columns); only where irdm_fir_wide_usable() said so at init. */
-bool irdm_fir_wide_usable(void);
+ * columns); only where irdm_wide_usable() said so at init. */
+/* wide_usable.c: AVX2, FMA and F16C usable (CPUID and XCR0), for both wide sums */
+bool irdm_wide_usable(void);
 void irdm_fir_sum_wide(const struct irdm_engine *e, uint32_t n, const uint32_t *rows,
 		       double (*u)[3]);
 void irdm_fir_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp, double blk[9]);
 void irdm_fir_apply(struct irdm_engine *e, const struct irdm_force_tick *f);
+
+/* engine_head.c: a modal image's exact head (H >= 1 only).  The kept
+ * blocks from force columns to one column, looked up once a sum: the ring
+ * holds the same few columns tick after tick. */
+struct irdm_head_cache {
+	uint32_t n;
+	uint32_t col[IRDM_MAX_FORCE_NODES];
+	long k[IRDM_MAX_FORCE_NODES];
+};
+
+static inline long irdm_head_cached_block(const struct irdm_engine *e, struct irdm_head_cache *c,
+					  uint32_t col_force, uint32_t col_disp)
+{
+	for (uint32_t i = 0; i < c->n; i++)
+		if (c->col[i] == col_force)
+			return c->k[i];
+	long k = irdm_image_corr_block(e->img, col_force, col_disp);
+	if (c->n < IRDM_MAX_FORCE_NODES) {
+		c->col[c->n] = col_force;
+		c->k[c->n++] = k;
+	}
+	return k;
+}
+
+/* D_0 of the kept block into blk; false (blk untouched) if the block was dropped */
+bool irdm_head_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp, double blk[9]);
+void irdm_head_free_disp(const struct irdm_engine *e, uint32_t col, double u[3]);
+void irdm_head_apply(struct irdm_engine *e, const struct irdm_force_tick *f);
+void irdm_head_bound_init(const struct irdm_engine *e, double *w);
+double irdm_head_bound(const struct irdm_engine *e, const double *w);
+/* engine_head_avx2.c: the head sum with AVX2 + FMA (head_wide only). */
+void irdm_head_sum_wide(const struct irdm_engine *e, uint32_t col, double u[3]);
 
 /* disp_bound.c: fill bound_w (K or T doubles) once phi or the FIR is set. */
 void irdm_bound_init(const struct irdm_engine *e, double *w);

@@ -27,92 +27,8 @@
 #include "engine_priv.h"
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-#include <cpuid.h>
-#include <immintrin.h>
+#include "wide_block.h"
 
-#define WIDE __attribute__((target("avx2,fma,f16c")))
-#define WIDE_INLINE inline __attribute__((always_inline, target("avx2,fma,f16c")))
-
-/*
- * AVX2, FMA and F16C from CPUID, and the YMM state enabled by the kernel
- * (OSXSAVE, then XCR0's SSE and AVX bits).  By hand rather than with
- * __builtin_cpu_supports(): clang 14 does not know "f16c" there.
- */
-bool irdm_fir_wide_usable(void)
-{
-	unsigned a, b, c, d, xcr0_lo, xcr0_hi;
-
-	if (!__get_cpuid(1, &a, &b, &c, &d))
-		return false;
-	bool fma = c & (1u << 12), osxsave = c & (1u << 27), avx = c & (1u << 28),
-	     f16c = c & (1u << 29);
-	if (!(fma && osxsave && avx && f16c))
-		return false;
-	__asm__ volatile("xgetbv" : "=a"(xcr0_lo), "=d"(xcr0_hi) : "c"(0));
-	if ((xcr0_lo & 6) != 6)
-		return false;
-	if (!__get_cpuid_count(7, 0, &a, &b, &c, &d))
-		return false;
-	return b & (1u << 5);                   /* AVX2 */
-}
-
-/* Four elements from i on, as doubles (f16: IEEE binary16, converted
- * exactly, as irdm_f16_to_f32() does). */
-static WIDE_INLINE __m256d load4(const void *fir, uint32_t prec, size_t i)
-{
-	switch (prec) {
-	case IRDM_ELEM_F64:
-		return _mm256_loadu_pd((const double *)fir + i);
-	case IRDM_ELEM_F32:
-		return _mm256_cvtps_pd(_mm_loadu_ps((const float *)fir + i));
-	default: {
-		uint64_t h;
-		memcpy(&h, (const uint16_t *)fir + i, sizeof(h));
-		return _mm256_cvtps_pd(_mm_cvtph_ps(_mm_cvtsi64_si128((long long)h)));
-	}
-	}
-}
-
-static WIDE_INLINE double load1(const void *fir, uint32_t prec, size_t i)
-{
-	switch (prec) {
-	case IRDM_ELEM_F64:
-		return ((const double *)fir)[i];
-	case IRDM_ELEM_F32:
-		return ((const float *)fir)[i];
-	default: {
-		uint16_t h;
-		memcpy(&h, (const uint16_t *)fir + i, sizeof(h));
-		return _mm_cvtss_f32(_mm_cvtph_ps(_mm_cvtsi32_si128(h)));
-	}
-	}
-}
-
-struct row_acc {
-	__m256d a0, a1;     /* elements 0..3, 4..7 */
-	double a2;          /* element 8 */
-};
-
-/* acc += R (9 elements at i) times the weighted force pattern p0 p1 p2 */
-static WIDE_INLINE void block_acc(const void *fir, uint32_t prec, size_t i, __m256d p0,
-				  __m256d p1, double p2, struct row_acc *acc)
-{
-	acc->a0 = _mm256_fmadd_pd(load4(fir, prec, i), p0, acc->a0);
-	acc->a1 = _mm256_fmadd_pd(load4(fir, prec, i + 4), p1, acc->a1);
-	acc->a2 = __builtin_fma(load1(fir, prec, i + 8), p2, acc->a2);
-}
-
-/* u[i] = A[3i] + A[3i+1] + A[3i+2] */
-static WIDE_INLINE void row_fold(const struct row_acc *acc, double u[3])
-{
-	double a[9];
-
-	_mm256_storeu_pd(a, acc->a0);
-	_mm256_storeu_pd(a + 4, acc->a1);
-	a[8] = acc->a2;
-	for (int i = 0; i < 3; i++)
-		u[i] = a[3 * i] + a[3 * i + 1] + a[3 * i + 2];
-}
 
 /*
  * One pass over the ring for n_rows (1..3, a constant at each call site,
@@ -136,10 +52,9 @@ static WIDE_INLINE void wide_pass(const struct irdm_engine *e, uint32_t prec, ui
 		const struct irdm_force_tick *t = &r->tick[slot];
 		double w = e->tail_w[s];
 		for (uint32_t n = 0; n < t->n; n++) {
-			const double *f = t->f_n[n];
-			__m256d p0 = _mm256_set_pd(w * f[0], w * f[2], w * f[1], w * f[0]);
-			__m256d p1 = _mm256_set_pd(w * f[1], w * f[0], w * f[2], w * f[1]);
-			double p2 = w * f[2];
+			__m256d p0, p1;
+			double p2;
+			force_pattern(t->f_n[n], w, &p0, &p1, &p2);
 			size_t base = (size_t)t->col[n] * e->n_nodes;
 			block_acc(fir, prec, ((base + rows[0]) * T + s) * 9, p0, p1, p2, &a0);
 			if (n_rows > 1)
@@ -210,11 +125,6 @@ void irdm_fir_sum_wide(const struct irdm_engine *e, uint32_t n, const uint32_t *
 }
 
 #else /* no AVX2 path on this target: the portable sum is used */
-
-bool irdm_fir_wide_usable(void)
-{
-	return false;
-}
 
 void irdm_fir_sum_wide(const struct irdm_engine *e, uint32_t n, const uint32_t *rows,
 		       double (*u)[3])

@@ -19,9 +19,9 @@ static int r0_index(const struct r0_table *t, uint32_t col)
 
 /*
  * Bring the R[0] table to the nodes of the active sites: blocks between
- * nodes already there are kept, the others computed (9 K multiply-adds
- * each for a modal image, a read for FIR).  Nothing happens while the
- * sites stay the same.
+ * nodes already there are kept, the others computed (9 (K + r)
+ * multiply-adds each for a modal image with a far field of rank r, a read
+ * for FIR).  Nothing happens while the sites stay the same.
  */
 void tick_r0_refresh(struct irdm_engine *e, const unsigned *idx, int m)
 {

@@ -187,4 +187,6 @@ void irdm_engine_node_disp(const struct irdm_engine *e, uint32_t row, double u[3
 		for (int i = 0; i < 3; i++)
 			u[i] += phi[(size_t)i * e->K + k] * yq;
 	}
+	if (e->H)
+		irdm_head_free_disp(e, col, u);
 }

@@ -10,7 +10,7 @@
 
 #define META_FLAGS_KNOWN (IRDM_META_FLOATING | IRDM_META_STATIC_CORR | \
 			  IRDM_META_CONSISTENT_MASS | IRDM_META_TIME_DOMAIN | \
-			  IRDM_META_FIR_TAIL_WINDOW)
+			  IRDM_META_FIR_TAIL_WINDOW | IRDM_META_EXACT_HEAD)
 
 static int check_meta_numbers(struct parse *p)
 {
@@ -81,6 +81,13 @@ static int check_meta_counts(struct parse *p)
 	    (m->flags & IRDM_META_STATIC_CORR))
 		return img_fail(p, IRDM_EFORMAT,
 				"FIR image has the STATIC_CORR flag (modal only)");
+	if (!(m->flags & IRDM_META_EXACT_HEAD) != !m->head_samples ||
+	    m->head_samples > IRDM_HEAD_SAMPLES_MAX ||
+	    (m->head_samples && !(m->flags & IRDM_META_STATIC_CORR)))
+		return img_fail(p, IRDM_EFORMAT,
+				"meta head_samples %u, EXACT_HEAD %s, STATIC_CORR %s: need 1 <= head_samples <= %u on a modal image with STATIC_CORR exactly when the flag is set",
+				m->head_samples, m->flags & IRDM_META_EXACT_HEAD ? "set" : "clear",
+				m->flags & IRDM_META_STATIC_CORR ? "set" : "clear", IRDM_HEAD_SAMPLES_MAX);
 	return IRDM_OK;
 }
 

@@ -10,6 +10,7 @@
  *   image_meta.c       META, PROVENANCE
  *   image_object.c     NODES, COLUMNS, SURFACE, RIGID
  *   image_responses.c  STABILITY, FIR or MODES / MODE_SHAPES / STATIC_CORR
+ *                      (image_static_corr.c, its far field image_corr_lowrank.c)
  *   image_bvh.c        CONTACT_BVH
  *
  * image_parse.c is the entry point (irdm_image_parse) and
@@ -35,7 +36,7 @@
 #error "IRDM images are little-endian and used in place"
 #endif
 
-#define KIND_MAX IRDM_SEC_STATIC_CORR_INDEX
+#define KIND_MAX IRDM_SEC_EXACT_HEAD
 #define TABLE_ENTRY sizeof(struct irdm_image_section)
 #define HEADER_SIZE sizeof(struct irdm_image_header)
 
@@ -99,6 +100,10 @@ int img_check_fir(struct parse *p);
 int img_check_modal(struct parse *p);
 /* image_static_corr.c, for img_check_modal (both sections present). */
 int img_check_static_corr(struct parse *p);
+/* image_corr_lowrank.c: STATIC_CORR_LOWRANK, if present, after the above. */
+int img_check_corr_lowrank(struct parse *p);
+/* image_exact_head.c: EXACT_HEAD against the STATIC_CORR index (checked first) */
+int img_check_exact_head(struct parse *p);
 /* image_responses.c: every element of kind's array (meta precision) finite. */
 int img_check_finite(struct parse *p, uint32_t kind, uint64_t count);
 int img_check_contact_bvh(struct parse *p);

@@ -90,6 +90,10 @@ int img_check_fir(struct parse *p)
 	if (!ret)
 		ret = img_check_presence(p, IRDM_SEC_STATIC_CORR_INDEX, false, "FIR image");
 	if (!ret)
+		ret = img_check_presence(p, IRDM_SEC_STATIC_CORR_LOWRANK, false, "FIR image");
+	if (!ret)
+		ret = img_check_presence(p, IRDM_SEC_EXACT_HEAD, false, "FIR image");
+	if (!ret)
 		ret = img_check_shape(p, IRDM_SEC_FIR, f, 4, "n_cols x n_nodes x T x 9");
 	if (!ret)
 		ret = img_check_finite(p, IRDM_SEC_FIR, p->by_kind[IRDM_SEC_FIR]->size / p->es);
@@ -155,8 +159,15 @@ int img_check_modal(struct parse *p)
 	if (!ret)
 		ret = img_check_finite(p, IRDM_SEC_MODE_SHAPES,
 				   p->by_kind[IRDM_SEC_MODE_SHAPES]->size / p->es);
+	if (!ret && !corr && p->by_kind[IRDM_SEC_STATIC_CORR_LOWRANK])
+		ret = img_check_presence(p, IRDM_SEC_STATIC_CORR_LOWRANK, false,
+					 "its far field needs STATIC_CORR");
 	if (!ret && corr)
 		ret = img_check_static_corr(p);
+	if (!ret && corr)
+		ret = img_check_corr_lowrank(p);
+	if (!ret)
+		ret = img_check_exact_head(p);
 	if (ret)
 		return ret;
 	p->img.mode_shapes = img_payload(p, IRDM_SEC_MODE_SHAPES);

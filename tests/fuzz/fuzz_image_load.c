@@ -69,10 +69,24 @@ static void walk_views(const struct irdm_image *img)
 			(void)irdm_image_corr_block(img, c, 0);
 			(void)irdm_image_corr_block(img, c, (uint32_t)cols - 1);
 		}
+		/* the hybrid's head: head_samples runs of 9 per kept block */
+		if (img->exact_head)
+			read_values(img->exact_head, m->precision, n_blocks * m->head_samples * 9);
+	}
+	if (img->corr_rank) {
+		/* the far field: every value, and a whole block at the ends
+		 * (the reader the engine and image_response use) */
+		double blk[9];
+		read_values(img->corr_lambda, m->precision, img->corr_rank);
+		read_values(img->corr_u, m->precision, 3 * cols * img->corr_rank);
+		irdm_image_corr_value(img, 0, (uint32_t)cols - 1, blk);
+		read_bytes(blk, sizeof(blk));
+		irdm_image_corr_value(img, (uint32_t)cols - 1, 0, blk);
+		read_bytes(blk, sizeof(blk));
 	}
 	if (img->rigid)
 		read_bytes(img->rigid, sizeof(*img->rigid));
-	for (uint32_t k = 0; k <= IRDM_SEC_STATIC_CORR_INDEX + 1; k++) {
+	for (uint32_t k = 0; k <= IRDM_SEC_EXACT_HEAD + 1; k++) {
 		const struct irdm_image_section *s = irdm_image_find(img, k);
 
 		if (s)

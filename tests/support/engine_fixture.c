@@ -11,6 +11,7 @@
 #include <cmocka.h>
 
 #include "engine_fixture.h"
+#include "irdm/precision.h"
 #include "image/image_response.h"
 #include "precompute/precompute.h"
 
@@ -45,6 +46,20 @@ struct irdm_session *efx_session(const struct irdm_image *img, const struct irdm
 	if (irdm_session_open_image(&s, img, &sc, err, sizeof(err)))
 		fail_msg("session: %s", err);
 	return s;
+}
+
+const double *efx_column_modal(const struct irdm_image *img, size_t c, double *phi, double D[9])
+{
+	size_t K = img->meta->n_modes, row = img->columns[c];
+	long k = irdm_image_corr_block(img, (uint32_t)c, (uint32_t)c);
+
+	for (size_t i = 0; i < 3 * K; i++)
+		phi[i] = irdm_elem_get(img->mode_shapes, img->meta->precision, row * 3 * K + i);
+	if (!img->corr_start)
+		return NULL;
+	assert_true(k >= 0);    /* the diagonal is always kept */
+	efx_corr_block(img, (uint32_t)c, (uint32_t)c, D);      /* + the far field */
+	return D;
 }
 
 uint32_t efx_column_row_near(const struct irdm_image *img, const double p[3])
@@ -270,4 +285,24 @@ double efx_rel_rms(const double *a, const double *b, size_t n)
 		r += b[i] * b[i];
 	}
 	return sqrt(d / r);
+}
+
+void efx_corr_block(const struct irdm_image *img, uint32_t col_force, uint32_t col_disp,
+		    double blk[9])
+{
+	uint32_t prec = img->meta ? img->meta->precision : 0;
+	size_t r = img->corr_rank;
+
+	memset(blk, 0, 9 * sizeof(double));
+	for (uint32_t k = img->corr_start ? img->corr_start[col_force] : 0;
+	     img->corr_start && k < img->corr_start[col_force + 1]; k++)
+		if (img->corr_rows[k] == col_disp)
+			for (size_t e = 0; e < 9; e++)
+				blk[e] = irdm_elem_get(img->corr_blocks, prec, (size_t)k * 9 + e);
+	for (size_t i = 0; i < 3; i++)
+		for (size_t j = 0; j < 3; j++)
+			for (size_t k = 0; k < r; k++)
+				blk[3 * i + j] += irdm_elem_get(img->corr_lambda, prec, k) *
+						  irdm_elem_get(img->corr_u, prec, (3 * (size_t)col_disp + i) * r + k) *
+						  irdm_elem_get(img->corr_u, prec, (3 * (size_t)col_force + j) * r + k);
 }

@@ -66,6 +66,17 @@ int efx_dense_solve(double *a, double *b, int n);
 /* Relative RMS of a - b over n values: |a - b|_2 / |b|_2. */
 double efx_rel_rms(const double *a, const double *b, size_t n);
 
+/* A modal image's column c at its own node: its 3 x K shapes (phi[i K + k])
+ * and its static-correction block (far field included) into D, returning
+ * D, or NULL when the image has none. */
+const double *efx_column_modal(const struct irdm_image *img, size_t c, double *phi, double D[9]);
+/* The image's static-correction block (force col_force -> displacement
+ * col_disp) written out here, independently of irdm_image_corr_value():
+ * the kept block (0 if dropped) + sum_k lambda_k u[disp][i][k] u[force][j][k]
+ * of STATIC_CORR_LOWRANK; zeros without a correction. */
+void efx_corr_block(const struct irdm_image *img, uint32_t col_force, uint32_t col_disp,
+		    double blk[9]);
+
 /* Image node (row) index nearest to p among the columns. */
 uint32_t efx_column_row_near(const struct irdm_image *img, const double p[3]);
 

@@ -213,6 +213,27 @@ fail:
 	return -1;
 }
 
+int img_fixture_lowrank(struct img_fixture *fx, uint32_t rank)
+{
+	struct irdm_corr_lowrank_header h = { .rank = rank };
+	uint64_t n = (uint64_t)rank * (1 + 3 * (uint64_t)fx->meta.n_cols), vb;
+	void *v = fill_values(IRDM_SEC_STATIC_CORR_LOWRANK, fx->meta.precision, n, &vb);
+	uint8_t *p = malloc(sizeof(h) + vb);
+
+	if (!v || !p) {
+		free(v);
+		free(p);
+		return -1;
+	}
+	memcpy(p, &h, sizeof(h));
+	memcpy(p + sizeof(h), v, vb);
+	free(v);
+	free(fx->corr_lowrank);
+	fx->corr_lowrank = p;
+	fx->lowrank_bytes = sizeof(h) + vb;
+	return 0;
+}
+
 void img_fixture_free(struct img_fixture *fx)
 {
 	free(fx->nodes);
@@ -223,6 +244,7 @@ void img_fixture_free(struct img_fixture *fx)
 	free(fx->mode_shapes);
 	free(fx->static_corr);
 	free(fx->corr_index);
+	free(fx->corr_lowrank);
 	free(fx->stability);
 	memset(fx, 0, sizeof(*fx));
 }
@@ -254,6 +276,9 @@ void img_fixture_add(const struct img_fixture *fx, struct irdm_image_writer *w)
 	if (fx->corr_index)
 		irdm_iw_add(w, IRDM_SEC_STATIC_CORR_INDEX, IRDM_ELEM_U32,
 			    fx->corr_index, fx->corr_index_bytes);
+	if (fx->corr_lowrank)
+		irdm_iw_add(w, IRDM_SEC_STATIC_CORR_LOWRANK, IRDM_ELEM_BYTES,
+			    fx->corr_lowrank, fx->lowrank_bytes);
 	if (m->flags & IRDM_META_FLOATING)
 		irdm_iw_add(w, IRDM_SEC_RIGID, IRDM_ELEM_BYTES, &fx->rigid,
 			    sizeof(fx->rigid));

@@ -36,12 +36,16 @@ struct img_fixture {
 	/* its STATIC_CORR_INDEX: every block kept (the layout of tol = 0):
 	 * starts c n_cols, then rows 0..n_cols-1 for every column */
 	uint32_t *corr_index;
+	/* optional STATIC_CORR_LOWRANK (img_fixture_lowrank): header, then
+	 * lambda and U of fixture values */
+	void *corr_lowrank;
 	struct irdm_rigid rigid;            /* written iff FLOATING */
 	struct irdm_stability *stability;   /* n_cols */
 	/* Sizes of the arrays as built: what img_fixture_add() writes, so
 	 * tampering with meta counts never makes it read past an array. */
 	uint64_t nodes_bytes, columns_bytes, tris_bytes, stability_bytes;
 	uint64_t fir_bytes, modes_bytes, shapes_bytes, corr_bytes, corr_index_bytes;
+	uint64_t lowrank_bytes;
 };
 
 /* Grounded FIR image.  Returns 0, -1 when out of memory. */
@@ -54,9 +58,15 @@ int img_fixture_modal(struct img_fixture *fx, uint32_t precision,
 		      uint32_t n_nodes, uint32_t n_cols, uint32_t n_modes,
 		      uint32_t meta_flags);
 
+/* Add a valid STATIC_CORR_LOWRANK of the given rank to a modal fixture
+ * (meta precision; lambda[k] is value k, U element i value rank + i of
+ * the kind).  Returns 0, -1 when out of memory. */
+int img_fixture_lowrank(struct img_fixture *fx, uint32_t rank);
+
 void img_fixture_free(struct img_fixture *fx);
 
-/* Value stored at element i of section kind (FIR, MODE_SHAPES, STATIC_CORR). */
+/* Value stored at element i of section kind (FIR, MODE_SHAPES, STATIC_CORR,
+ * STATIC_CORR_LOWRANK's values after the header). */
 double img_fixture_value(uint32_t kind, uint64_t i);
 
 /* Add every section the fixture holds (by meta) to w. */

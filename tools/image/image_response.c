@@ -62,12 +62,22 @@ static int modal_response(const struct irdm_image *img, uint32_t col, uint32_t r
 			x0 = y0;
 		}
 	}
-	/* the static correction is stored between columns only, where it matters */
+	/* the static correction is stored between columns only: the kept block
+	 * plus the far field; a hybrid image spreads a kept block (far field
+	 * included) over its head's samples */
 	int64_t rc = img->corr_start && n > 0 ? irdm_image_col_of(img, row) : -1;
-	long blk = rc >= 0 ? irdm_image_corr_block(img, col, (uint32_t)rc) : -1;
-	if (blk >= 0)
+	long blk = rc >= 0 && img->exact_head ? irdm_image_corr_block(img, col, (uint32_t)rc) : -1;
+	size_t H = m->head_samples;
+	for (size_t s = 0; blk >= 0 && s < H && s < n; s++)
 		for (int e = 0; e < 9; e++)
-			out[e] += irdm_elem_get(img->corr_blocks, m->precision, (size_t)blk * 9 + (size_t)e);
+			out[9 * s + (size_t)e] += irdm_elem_get(img->exact_head, m->precision,
+								((size_t)blk * H + s) * 9 + (size_t)e);
+	if (rc >= 0 && blk < 0) {
+		double s[9];
+		irdm_image_corr_value(img, col, (uint32_t)rc, s);
+		for (int e = 0; e < 9; e++)
+			out[e] += s[e];
+	}
 	free(pr);
 	free(pc);
 	return IRDM_OK;

@@ -77,8 +77,14 @@ static int cmd_info(const char *path)
 		       m->flags & IRDM_META_STATIC_CORR ? " + static correction" : "",
 		       elem_name(m->precision));
 	if (img.corr_start)
-		printf("static corr   %u of %llu blocks kept\n", img.corr_start[m->n_cols],
-		       (unsigned long long)m->n_cols * m->n_cols);
+		printf("static corr   %u of %llu blocks kept, far field rank %u\n",
+		       img.corr_start[m->n_cols], (unsigned long long)m->n_cols * m->n_cols,
+		       img.corr_rank);
+	if (img.exact_head)
+		printf("exact head    the %u dropped modes' response at the kept blocks: samples "
+		       "0..%u exact, %u..%u tapered, sum = static correction (hybrid)\n",
+		       m->n_modes_total - m->n_modes, m->head_samples / 2 - 1, m->head_samples / 2,
+		       m->head_samples - 1);
 	printf("dt            %g s (%.0f Hz)\n", m->dt_s, 1.0 / m->dt_s);
 	printf("material      E %g Pa, nu %g, rho %g kg/m^3, %s mass\n", m->young_pa, m->poisson,
 	       m->density_kg_m3, m->flags & IRDM_META_CONSISTENT_MASS ? "consistent" : "lumped");

@@ -177,6 +177,10 @@ static void print_report(const struct irdm_scene *sc, const struct irdm_precompu
 		       r->corr_blocks, r->cols * r->cols,
 		       100.0 * (double)r->corr_blocks / ((double)r->cols * (double)r->cols),
 		       r->corr_tol, r->corr_max_dropped_rel);
+	if (r->corr_rank)
+		printf("far field     rank %zu; dropped blocks of %zu checked columns off by max %.3g, RMS %.3g (without it %.3g, %.3g)\n",
+		       r->corr_rank, r->corr_checked, r->corr_far_max[1], r->corr_far_rms[1],
+		       r->corr_far_max[0], r->corr_far_rms[0]);
 	printf("time          %.2f s total: mesh %.2f, FEM %.2f, eigen %.2f, responses %.2f, stability %.2f\n",
 	       r->seconds_total, r->seconds_mesh, r->seconds_fem, r->seconds_eig,
 	       r->seconds_responses, r->seconds_stability);

@@ -23,6 +23,10 @@ void dgemm_(const char *ta, const char *tb, const int *m, const int *n, const in
 	    const int *ldb, const double *beta, double *c, const int *ldc);
 void dgesv_(const int *n, const int *nrhs, double *a, const int *lda, int *ipiv, double *b,
 	    const int *ldb, int *info);
+void dgeqrf_(const int *m, const int *n, double *a, const int *lda, double *tau, double *work,
+	     const int *lwork, int *info);
+void dorgqr_(const int *m, const int *n, const int *k, double *a, const int *lda,
+	     const double *tau, double *work, const int *lwork, int *info);
 void openblas_set_num_threads(int n);
 int openblas_get_num_threads(void);
 

@@ -48,6 +48,12 @@ static int alloc_modes(struct irdm_node_tf *tf, size_t K)
 int irdm_node_tf_init(struct irdm_node_tf *tf, const struct irdm_mode *zoh, size_t K,
 		      const double *phi_c, const double *D)
 {
+	return irdm_node_tf_init_head(tf, zoh, K, phi_c, D, D ? 1 : 0);
+}
+
+int irdm_node_tf_init_head(struct irdm_node_tf *tf, const struct irdm_mode *zoh, size_t K,
+			   const double *phi_c, const double *head, size_t n_head)
+{
 	static const int row[6] = { 0, 0, 0, 1, 1, 2 }, col[6] = { 0, 1, 2, 1, 2, 2 };
 
 	if (alloc_modes(tf, K))
@@ -75,8 +81,12 @@ int irdm_node_tf_init(struct irdm_node_tf *tf, const struct irdm_mode *zoh, size
 			for (int j = 0; j < 3; j++)
 				tf->r0[3 * i + j] += phi[i] * phi[j] * b[0];
 	}
+	if (!head)
+		n_head = 0;
 	for (int e = 0; e < 9; e++)
-		tf->r0[e] += D ? D[e] : 0.0;
+		tf->r0[e] += n_head ? head[e] : 0.0;
+	tf->head = head;
+	tf->n_head = n_head;
 	return 0;
 }
 
@@ -112,6 +122,43 @@ static inline v2d load2(const double *p)
 static inline double sum2(v2d v)
 {
 	return v[0] + v[1];
+}
+
+/*
+ * The head's sum_{s=1}^{H-1} D_s w^s, w = 1/z, and its z-derivative
+ * -w^2 sum_s s D_s w^(s-1), by Horner in w (value and w-derivative
+ * together), all 9 entries (the blocks need not be symmetric); and z = 0,
+ * the head's pole, in the pole distance.  |w| <= 1 / IRDM_STAB_RHO_MIN = 2
+ * on every circle searched: w^s stays finite for H up to ~1000, and an
+ * overflow makes the point non-finite, which the walk counts as
+ * unresolved (the safe side).
+ */
+static void add_head(const struct irdm_node_tf *tf, double complex z, double complex H[9],
+		     double complex dH[9], double *pole_dist)
+{
+	double complex w = 1 / z;
+	double wr = creal(w), wi = cimag(w), pr[9] = { 0 }, pi[9] = { 0 }, dr[9] = { 0 },
+	       di[9] = { 0 };
+
+	for (size_t s = tf->n_head; s-- > 0;) {
+		const double *c = s ? &tf->head[9 * s] : NULL;   /* D_0 is in R0 */
+		for (int e = 0; e < 9; e++) {
+			double t = dr[e] * wr - di[e] * wi + pr[e];
+			di[e] = dr[e] * wi + di[e] * wr + pi[e];
+			dr[e] = t;
+			t = pr[e] * wr - pi[e] * wi + (c ? c[e] : 0.0);
+			pi[e] = pr[e] * wi + pi[e] * wr;
+			pr[e] = t;
+		}
+	}
+	double complex mw2 = -w * w;
+	for (int e = 0; e < 9; e++) {
+		H[e] += pr[e] + I * pi[e];
+		dH[e] += mw2 * (dr[e] + I * di[e]);
+	}
+	/* the pad modes (den z^2) happen to put 0 in pole_xy too; the head's
+	 * pole does not rely on that */
+	*pole_dist = fmin(*pole_dist, cabs(z));
 }
 
 void irdm_node_tf_eval(const struct irdm_node_tf *tf, double complex z, double complex H[9],
@@ -157,11 +204,24 @@ void irdm_node_tf_eval(const struct irdm_node_tf *tf, double complex z, double c
 	}
 	unpack_sym(s, tf->r0, H);
 	unpack_sym(ds, NULL, dH);
+	if (tf->n_head > 1)
+		add_head(tf, z, H, dH, pole_dist);
+}
+
+/* the head's ring of the last n_head - 1 forces: 3 poles at 0 each */
+static size_t ring_poles(const struct irdm_node_tf *tf)
+{
+	return tf->n_head > 1 ? 3 * (tf->n_head - 1) : 0;
+}
+
+size_t irdm_node_tf_order(const struct irdm_node_tf *tf)
+{
+	return 2 * tf->K + ring_poles(tf);
 }
 
 size_t irdm_node_tf_poles_inside(const struct irdm_node_tf *tf, double r)
 {
-	size_t n = 0;
+	size_t n = r > 0 ? ring_poles(tf) : 0;
 
 	for (size_t k = 0; k < 2 * tf->K; k++)
 		n += cabs(tf->pole[k]) < r;

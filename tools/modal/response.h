@@ -59,6 +59,12 @@ int irdm_compliance_open(const struct irdm_fem *fem, const struct irdm_modes *m,
 int irdm_compliance_columns(struct irdm_compliance *c, const int64_t *in, size_t n_in,
 			    double *X, char *err, size_t errlen);
 
+/* Compliance X = G F (n x n_rhs) of n_rhs full-length loads F (n x n_rhs,
+ * column after column), whose rigid part is removed here, in place.
+ * Return: IRDM_OK; IRDM_ENOMEM; IRDM_ENUMERIC if a solve fails. */
+int irdm_compliance_loads(struct irdm_compliance *c, double *F, size_t n_rhs, double *X,
+			  char *err, size_t errlen);
+
 /* Free c (NULL: no-op). */
 void irdm_compliance_close(struct irdm_compliance *c);
 

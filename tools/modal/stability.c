@@ -202,27 +202,32 @@ double irdm_stability_fir_companion(const double *R, size_t T)
 	return rho;
 }
 
-double irdm_stability_modal(const struct irdm_mode *zoh, size_t K, const double *phi_c,
-			    const double *D)
+/* R0 = sum_k phi_k phi_k^T b_k,0 + D_0, summed in node_tf.c's order; its
+ * inverse, or -1 if singular. */
+static int modal_r0_inv(const struct irdm_mode *zoh, size_t K, const double *phi_c,
+			const double *D0, double r0i[9])
 {
-	int n = 2 * (int)K;
-	double r0[9] = { 0 }, r0i[9];
+	double r0[9] = { 0 };
 
 	for (size_t k = 0; k < K; k++)
 		for (int i = 0; i < 3; i++)
 			for (int j = 0; j < 3; j++)
 				r0[3 * i + j] += phi_c[(size_t)i * K + k] * phi_c[(size_t)j * K + k]
 						 * zoh[k].b[0];
-	if (D)
+	if (D0)
 		for (int e = 0; e < 9; e++)
-			r0[e] += D[e];
-	if (inv3(r0, r0i))
-		return -1;
-	double *a = calloc((size_t)n * n, sizeof(double));
-	double *w = malloc(3 * (size_t)n * sizeof(double));  /* W = R0^-1 C A, 3 x n */
-	double rho = -1;
-	if (!a || !w)
-		goto out_free;
+			r0[e] += D0[e];
+	return inv3(r0, r0i);
+}
+
+/*
+ * f[t] = -W X[t], X = (x_1 .. x_K, f[t-1] .. f[t-H+1]): W = R0^-1 (C A,
+ * D_1 .. D_{H-1}), 3 x n row-major.
+ */
+static void modal_force_gain(const struct irdm_mode *zoh, size_t K, const double *phi_c,
+			     const double *head, size_t n_head, const double r0i[9], double *w,
+			     size_t n)
+{
 	for (size_t k = 0; k < K; k++)
 		for (int i = 0; i < 3; i++)
 			for (int col = 0; col < 2; col++) {
@@ -231,22 +236,60 @@ double irdm_stability_modal(const struct irdm_mode *zoh, size_t K, const double 
 					v += r0i[3 * i + l] * phi_c[(size_t)l * K + k];
 				w[(size_t)i * n + 2 * k + (size_t)col] = v * zoh[k].a[col];
 			}
-	/* A_cl = A - B W, B rows (2k, 2k+1) = b_k phi_ck^T; column-major a */
+	for (size_t s = 1; s < n_head; s++)
+		for (int i = 0; i < 3; i++)
+			for (int j = 0; j < 3; j++) {
+				double v = 0;
+				for (int l = 0; l < 3; l++)
+					v += r0i[3 * i + l] * head[9 * s + 3 * (size_t)l + (size_t)j];
+				w[(size_t)i * n + 2 * K + 3 * (s - 1) + (size_t)j] = v;
+			}
+}
+
+double irdm_stability_modal_head(const struct irdm_mode *zoh, size_t K, const double *phi_c,
+				 const double *head, size_t n_head)
+{
+	if (!head)
+		n_head = 0;
+	size_t ring = n_head > 1 ? 3 * (n_head - 1) : 0, n = 2 * K + ring;
+	double r0i[9];
+
+	if (modal_r0_inv(zoh, K, phi_c, n_head ? head : NULL, r0i))
+		return -1;
+	double *a = calloc(n * n, sizeof(double));
+	double *w = malloc(3 * n * sizeof(double));
+	double rho = -1;
+	if (!a || !w)
+		goto out_free;
+	modal_force_gain(zoh, K, phi_c, head, n_head, r0i, w, n);
+	/* x[t+1] = A x - B W X, B rows (2k, 2k+1) = b_k phi_ck^T; column-major a */
 	for (size_t k = 0; k < K; k++)
 		for (int row = 0; row < 2; row++) {
 			size_t r = 2 * k + (size_t)row;
 			for (int col = 0; col < 2; col++)
 				a[(2 * k + (size_t)col) * n + r] = zoh[k].a[2 * row + col];
-			for (int c = 0; c < n; c++) {
+			for (size_t c = 0; c < n; c++) {
 				double bw = 0;
 				for (int i = 0; i < 3; i++)
-					bw += phi_c[(size_t)i * K + k] * w[(size_t)i * n + (size_t)c];
-				a[(size_t)c * n + r] -= zoh[k].b[row] * bw;
+					bw += phi_c[(size_t)i * K + k] * w[(size_t)i * n + c];
+				a[c * n + r] -= zoh[k].b[row] * bw;
 			}
 		}
-	rho = max_abs_eig(a, n);
+	/* the ring: f[t] = -W X into its first slot, the others shift down */
+	for (size_t c = 0; ring && c < n; c++)
+		for (size_t i = 0; i < 3; i++)
+			a[c * n + 2 * K + i] = -w[i * n + c];
+	for (size_t i = 2 * K + 3; i < n; i++)
+		a[(i - 3) * n + i] = 1.0;
+	rho = max_abs_eig(a, (int)n);
 out_free:
 	free(a);
 	free(w);
 	return rho;
+}
+
+double irdm_stability_modal(const struct irdm_mode *zoh, size_t K, const double *phi_c,
+			    const double *D)
+{
+	return irdm_stability_modal_head(zoh, K, phi_c, D, D ? 1 : 0);
 }

@@ -41,6 +41,18 @@ double irdm_stability_modal(const struct irdm_mode *zoh, size_t K, const double 
 			    const double *D);
 
 /*
+ * The same with an exact FIR head (the hybrid representation, node_tf.h):
+ * u[t] = sum_k phi_k x_k,q[t+1] + sum_{s<n_head} D_s f[t-s], head: n_head
+ * blocks D_s of 9 ([s][i][j] row-major), head[0] = D_0 in place of D
+ * (n_head 0 or head NULL: none; n_head 1: the call above with D = head).
+ * The eigenvalues of the explicit closed-loop state matrix of dimension
+ * 2K + 3(n_head - 1) (the modes and the ring of the last n_head - 1
+ * forces): dense LAPACK, the brute-force reference.  -1 on failure.
+ */
+double irdm_stability_modal_head(const struct irdm_mode *zoh, size_t K, const double *phi_c,
+				 const double *head, size_t n_head);
+
+/*
  * Modal, by the argument principle on det H(z), H the node's 3x3
  * force-to-displacement transfer function (stability_modal.c): O(modes)
  * per point of a circle, no eigenproblem.  rho is an upper bound of the
@@ -66,5 +78,22 @@ int irdm_stability_modal_cert(const struct irdm_mode *zoh, size_t K, const doubl
 /* The same, rho only (-1 on failure). */
 double irdm_stability_modal_ap(const struct irdm_mode *zoh, size_t K, const double *phi_c,
 			       const double *D);
+
+/*
+ * The certificate with an exact FIR head (head, n_head as for
+ * irdm_stability_modal_head): H(z) gains sum_{s>=1} D_s z^-s, a pole of
+ * order up to 3(n_head - 1) at z = 0, and the count of closed-loop poles
+ * the ring's 3(n_head - 1) open-loop poles there; the search and its
+ * accuracy are those of irdm_stability_modal_cert (which is this with
+ * head = D, n_head = 1).  Each point costs O(n_head) more (bench_head_cert:
+ * ~15 ns per head sample).  Past n_head ~1000, |z|^-n_head overflows on
+ * the smallest circles, which then count as unresolved (the safe side).
+ */
+int irdm_stability_modal_cert_head(const struct irdm_mode *zoh, size_t K, const double *phi_c,
+				   const double *head, size_t n_head, struct irdm_stab_cert *out);
+
+/* The same, rho only (-1 on failure). */
+double irdm_stability_modal_ap_head(const struct irdm_mode *zoh, size_t K, const double *phi_c,
+				    const double *head, size_t n_head);
 
 #endif

@@ -7,7 +7,11 @@
  *   N(r) = (open-loop poles inside r, in closed form) + wind_r(det H),
  * the winding number counting zeros minus poles of det H; pole-zero
  * cancellations cancel in the sum.  The spectral radius is the least r
- * with N(r) = 2K.
+ * with N(r) = 2K.  A head of H samples (node_tf.h) adds the ring's 3(H-1)
+ * open-loop poles at z = 0, inside every circle searched (r >=
+ * IRDM_STAB_RHO_MIN > 0), to both counts: N(r) = 2K + 3(H-1) when all are
+ * inside.  Counted explicitly, N stays >= 0 (the search's -1 means
+ * unresolved) when more than 2K ring poles are outside.
  *
  * Radius (the winding number is det_winding.c's): Newton on det H from
  * the phase-velocity peaks of the last circle with every pole inside and
@@ -79,7 +83,7 @@ static int newton(const struct irdm_node_tf *tf, double complex z, size_t m, dou
 
 struct search {
 	const struct irdm_node_tf *tf;
-	long n_all;                /* 2K closed-loop poles */
+	long n_all;                /* 2K + 3(n_head - 1) closed-loop poles */
 	double lo, hi;
 	bool lo_certified, lo_newton;
 	/* the last hi circle's peaks, the last lo circle's dips; fresh until tried */
@@ -197,14 +201,14 @@ static void bracket(struct search *s)
 			probe(s, sqrt(s->lo * s->hi));
 }
 
-int irdm_stability_modal_cert(const struct irdm_mode *zoh, size_t K, const double *phi_c,
-			      const double *D, struct irdm_stab_cert *out)
+int irdm_stability_modal_cert_head(const struct irdm_mode *zoh, size_t K, const double *phi_c,
+				   const double *head, size_t n_head, struct irdm_stab_cert *out)
 {
 	struct irdm_node_tf tf;
 	double complex r0[9];
 
 	*out = (struct irdm_stab_cert){ .rho = -1 };
-	if (irdm_node_tf_init(&tf, zoh, K, phi_c, D))
+	if (irdm_node_tf_init_head(&tf, zoh, K, phi_c, head, n_head))
 		return -1;
 	for (int e = 0; e < 9; e++)
 		r0[e] = tf.r0[e];
@@ -214,8 +218,8 @@ int irdm_stability_modal_cert(const struct irdm_mode *zoh, size_t K, const doubl
 		return -1;
 	}
 	/* open bracket just outside the bounds so the bounds themselves are probed */
-	struct search s = { .tf = &tf, .n_all = 2 * (long)K, .lo = IRDM_STAB_RHO_MIN / 2,
-			    .hi = IRDM_STAB_RHO_MAX * 2, .out = out };
+	struct search s = { .tf = &tf, .n_all = (long)irdm_node_tf_order(&tf),
+			    .lo = IRDM_STAB_RHO_MIN / 2, .hi = IRDM_STAB_RHO_MAX * 2, .out = out };
 	probe(&s, IRDM_STAB_RHO_MAX);
 	if (s.hi == IRDM_STAB_RHO_MAX) {
 		probe(&s, IRDM_STAB_RHO_MIN);
@@ -232,10 +236,22 @@ int irdm_stability_modal_cert(const struct irdm_mode *zoh, size_t K, const doubl
 	return 0;
 }
 
-double irdm_stability_modal_ap(const struct irdm_mode *zoh, size_t K, const double *phi_c,
-			       const double *D)
+double irdm_stability_modal_ap_head(const struct irdm_mode *zoh, size_t K, const double *phi_c,
+				    const double *head, size_t n_head)
 {
 	struct irdm_stab_cert c;
 
-	return irdm_stability_modal_cert(zoh, K, phi_c, D, &c) ? -1 : c.rho;
+	return irdm_stability_modal_cert_head(zoh, K, phi_c, head, n_head, &c) ? -1 : c.rho;
+}
+
+int irdm_stability_modal_cert(const struct irdm_mode *zoh, size_t K, const double *phi_c,
+			      const double *D, struct irdm_stab_cert *out)
+{
+	return irdm_stability_modal_cert_head(zoh, K, phi_c, D, D ? 1 : 0, out);
+}
+
+double irdm_stability_modal_ap(const struct irdm_mode *zoh, size_t K, const double *phi_c,
+			       const double *D)
+{
+	return irdm_stability_modal_ap_head(zoh, K, phi_c, D, D ? 1 : 0);
 }

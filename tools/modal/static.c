@@ -34,6 +34,17 @@
  * the floating cube of test_static_sparse, 1.8e-15 with no springs */
 #define MIN_RCOND 1e-10
 
+/* y <- y + s (phi . v) phi, n entries. */
+static void add_projection(const double *phi, size_t n, const double *v, double s, double *y)
+{
+	double a = 0;
+
+	for (size_t i = 0; i < n; i++)
+		a += phi[i] * v[i];
+	for (size_t i = 0; i < n; i++)
+		y[i] += s * a * phi[i];
+}
+
 /* x <- x - Phi_r Phi_r^T M x for each of the n_in columns. */
 static void remove_rigid(const struct irdm_fem *fem, const struct irdm_modes *m,
 			 double *x, size_t n_in, double *tmp)
@@ -41,16 +52,9 @@ static void remove_rigid(const struct irdm_fem *fem, const struct irdm_modes *m,
 	size_t n = m->n;
 
 	for (size_t c = 0; c < n_in; c++) {
-		double *xc = &x[c * n];
-		irdm_csc_matvec(&fem->M, xc, tmp);
-		for (size_t r = 0; r < m->n_rigid; r++) {
-			const double *phi = &m->rigid_phi[r * n];
-			double a = 0;
-			for (size_t i = 0; i < n; i++)
-				a += phi[i] * tmp[i];
-			for (size_t i = 0; i < n; i++)
-				xc[i] -= a * phi[i];
-		}
+		irdm_csc_matvec(&fem->M, &x[c * n], tmp);
+		for (size_t r = 0; r < m->n_rigid; r++)
+			add_projection(&m->rigid_phi[r * n], n, tmp, -1.0, &x[c * n]);
 	}
 }
 
@@ -211,23 +215,76 @@ void irdm_compliance_close(struct irdm_compliance *c)
 	free(c);
 }
 
+/* f <- P f = f - M Phi_r Phi_r^T f for each of the n_rhs loads: their
+ * rigid part removed. */
+static int elastic_loads(const struct irdm_fem *fem, const struct irdm_modes *m, double *f,
+			 size_t n_rhs, double *tmp)
+{
+	size_t n = m->n;
+	double *mt = m->n_rigid ? malloc(n * sizeof(double)) : NULL;
+
+	if (m->n_rigid && !mt)
+		return IRDM_ENOMEM;
+	for (size_t c = 0; c < n_rhs && m->n_rigid; c++) {
+		memset(tmp, 0, n * sizeof(double));
+		for (size_t r = 0; r < m->n_rigid; r++)
+			add_projection(&m->rigid_phi[r * n], n, &f[c * n], 1.0, tmp);
+		irdm_csc_matvec(&fem->M, tmp, mt);
+		for (size_t i = 0; i < n; i++)
+			f[c * n + i] -= mt[i];
+	}
+	free(mt);
+	return IRDM_OK;
+}
+
+static int solve_loads(struct irdm_compliance *c, const double *load, size_t n_in, double *X,
+		       char *err, size_t errlen);
+
 int irdm_compliance_columns(struct irdm_compliance *c, const int64_t *in, size_t n_in,
 			    double *X, char *err, size_t errlen)
 {
 	const struct irdm_fem *fem = c->fem;
 	size_t n = fem->K.n;
-	cholmod_dense *rhs, *sol = NULL;
-	double *load = malloc(n * n_in * sizeof(double)), *tmp = c->tmp;
+	double *load = malloc(n * n_in * sizeof(double));
 	int ret;
 
-	rhs = cholmod_l_allocate_dense(n, n_in, n, CHOLMOD_REAL, &c->cc);
-	if (!rhs || !load) {
+	if (!load) {
+		snprintf(err, errlen, "static compliance: out of memory");
+		return IRDM_ENOMEM;
+	}
+	for (size_t k = 0; k < n_in; k++)
+		elastic_load(fem, c->m, in[k], &load[k * n], c->tmp);
+	ret = solve_loads(c, load, n_in, X, err, errlen);
+	free(load);
+	return ret;
+}
+
+int irdm_compliance_loads(struct irdm_compliance *c, double *F, size_t n_rhs, double *X,
+			  char *err, size_t errlen)
+{
+	if (elastic_loads(c->fem, c->m, F, n_rhs, c->tmp)) {
+		snprintf(err, errlen, "static compliance: out of memory");
+		return IRDM_ENOMEM;
+	}
+	return solve_loads(c, F, n_rhs, X, err, errlen);
+}
+
+/* X = G load for n_in elastic (self-equilibrated) loads. */
+static int solve_loads(struct irdm_compliance *c, const double *load, size_t n_in, double *X,
+		       char *err, size_t errlen)
+{
+	const struct irdm_fem *fem = c->fem;
+	size_t n = fem->K.n;
+	cholmod_dense *rhs, *sol = NULL;
+	double *tmp = c->tmp;
+	int ret;
+
+	rhs = cholmod_l_allocate_dense(n, n_in ? n_in : 1, n, CHOLMOD_REAL, &c->cc);
+	if (!rhs) {
 		snprintf(err, errlen, "static compliance: out of memory");
 		ret = IRDM_ENOMEM;
 		goto out_free;
 	}
-	for (size_t k = 0; k < n_in; k++)
-		elastic_load(fem, c->m, in[k], &load[k * n], tmp);
 	memset(X, 0, n * n_in * sizeof(double));
 	for (int step = 0; step < c->steps; step++) {
 		double *b = rhs->x;
@@ -250,7 +307,6 @@ int irdm_compliance_columns(struct irdm_compliance *c, const int64_t *in, size_t
 	}
 	ret = IRDM_OK;
 out_free:
-	free(load);
 	cholmod_l_free_dense(&sol, &c->cc);
 	cholmod_l_free_dense(&rhs, &c->cc);
 	return ret;

@@ -71,9 +71,8 @@ static void lower_free(struct lower *l)
 	free(l->blk);
 }
 
-/* P[3c + i][k] = phi_k at column c, axis i (0 at a fixed DoF); Ps = P / w_k^2. */
-static int modal_basis(const struct irdm_modes *m, const int64_t *col_dofs, size_t n_cols,
-		       double **P, double **Ps)
+int irdm_corr_modal_basis(const struct irdm_modes *m, const int64_t *col_dofs, size_t n_cols,
+			  double **P, double **Ps)
 {
 	size_t K = m->n_modes, n = m->n;
 
@@ -222,7 +221,7 @@ int irdm_static_correction_sparse(const struct irdm_fem *fem, const struct irdm_
 
 	memset(out, 0, sizeof(*out));
 	out->n_cols = n_cols;
-	if (!X || !mod || !diag_norm || !in || !slot || modal_basis(m, col_dofs, n_cols, &P, &Ps))
+	if (!X || !mod || !diag_norm || !in || !slot || irdm_corr_modal_basis(m, col_dofs, n_cols, &P, &Ps))
 		goto out_nomem;
 	/* the slepc path solved every column's loads over the MPI ranks with
 	 * its factor of K (grounded): taken in order, batch after batch */

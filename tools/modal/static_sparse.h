@@ -44,6 +44,12 @@ int irdm_static_correction_sparse(const struct irdm_fem *fem, const struct irdm_
 				  double tol, irdm_progress_fn progress, void *ctx,
 				  struct irdm_corr_sparse *out, char *err, size_t errlen);
 
+/* The kept modes at the columns: P[3c + i][k] = phi_k at column c, axis i
+ * (0 at a fixed DoF), Ps = P / omega_k^2, both 3 n_cols x n_modes and
+ * allocated here (free them).  Return: IRDM_OK; IRDM_ENOMEM. */
+int irdm_corr_modal_basis(const struct irdm_modes *m, const int64_t *col_dofs, size_t n_cols,
+			  double **P, double **Ps);
+
 /* Free what irdm_static_correction_sparse() allocated and zero s. */
 void irdm_corr_sparse_free(struct irdm_corr_sparse *s);
 

@@ -14,9 +14,11 @@
 #include "image/image_writer.h"
 #include "irdm/error.h"
 #include "irdm/image.h"
+#include "modal/exact_head.h"
 #include "modal/lapack.h"
 #include "modal/response.h"
 #include "modal/stability.h"
+#include "modal/static_lowrank.h"
 #include "modal/static_sparse.h"
 #include "precompute/fir_tail.h"
 #include "precompute/precompute.h"
@@ -35,8 +37,10 @@ struct build {
 	double *shapes;                 /* modal: [row][3][mode] */
 	double *corr;                   /* FIR: static correction [c][r][3][3] or NULL */
 	struct irdm_corr_sparse sparse; /* modal: the kept blocks (start NULL if none) */
-	void *stored[3];                /* converted to the scene's precision */
-	size_t stored_bytes[3];
+	double *head;                   /* modal exact_head: [k][s][3][3] (exact_head.h) */
+	struct irdm_corr_lowrank far;   /* modal: their far field (rank 0 if none) */
+	void *stored[5];                /* converted to the scene's precision */
+	size_t stored_bytes[5];
 	struct irdm_stability *stab;
 	struct irdm_meta meta;
 	struct irdm_rigid rigid;
@@ -49,7 +53,7 @@ struct build {
 static size_t modes_needed(const struct irdm_scene *sc)
 {
 	if (sc->representation == IRDM_REPR_MODAL)
-		return sc->modes;
+		return sc->exact_head ? 0 : sc->modes;  /* the head needs every mode */
 	if (sc->method == IRDM_METHOD_TIME_DOMAIN)
 		return 1;       /* only the first mode, for the default damping */
 	return sc->modes;       /* FIR synthesised from modes */
@@ -66,11 +70,83 @@ static bool truncated(const struct build *b)
 	return b->m.modes.n_modes < b->m.modes.n_elastic_total;
 }
 
+/*
+ * The hybrid representation (scene key exact_head): every mode was solved;
+ * the image keeps the scene's K, and the dropped ones' exact response over
+ * the head's samples at the static correction's kept blocks.  Called once
+ * the static correction of the K kept modes is known.
+ */
+static int exact_head(struct build *b, const struct irdm_mode *zoh_all, size_t n_all, char *err,
+		      size_t errlen)
+{
+	struct irdm_model *m = &b->m;
+	struct irdm_corr_sparse *sp = &b->sparse;
+	struct irdm_modes all = m->modes;
+	size_t H = b->sc->exact_head;
+	double *target = malloc(sp->n_blocks * 9 * sizeof(double));
+	int ret = IRDM_ENOMEM;
+
+	all.n_modes = n_all;
+	b->head = malloc(sp->n_blocks * 2 * H * 9 * sizeof(double));
+	if (!b->head || !target) {
+		snprintf(err, errlen, "precompute: the exact head (%zu blocks x %zu samples) does not fit in memory",
+			 sp->n_blocks, 2 * H);
+		goto out_free;
+	}
+	/* what each kept block's head sums to: its whole correction, the
+	 * far field's value there included (the blocks are stored without) */
+	for (size_t c = 0; c < sp->n_cols; c++)
+		for (uint32_t k = sp->start[c]; k < sp->start[c + 1]; k++) {
+			double far[9] = { 0 };
+			if (b->far.rank)
+				irdm_corr_lowrank_block(&b->far, c, sp->rows[k], far);
+			for (int e = 0; e < 9; e++)
+				target[9 * (size_t)k + (size_t)e] = sp->blocks[9 * (size_t)k + (size_t)e] + far[e];
+		}
+	ret = irdm_exact_head(&all, zoh_all, m->modes.n_modes, m->col_dofs, sp, target, H,
+			      b->o->progress, b->o->ctx, b->head);
+	if (ret)
+		snprintf(err, errlen, "precompute: out of memory for the exact head");
+out_free:
+	free(target);
+	return ret;
+}
+
+/* exact_head: discretise every mode, then keep the scene's K. */
+static int split_modes(struct build *b, struct irdm_mode **zoh_all, size_t *n_all, char *err,
+		       size_t errlen)
+{
+	struct irdm_modes *md = &b->m.modes;
+
+	*n_all = md->n_modes;
+	if (b->sc->modes >= md->n_modes) {
+		snprintf(err, errlen, "scene: exact_head needs dropped modes, but modal:%u keeps all %zu",
+			 b->sc->modes, md->n_modes);
+		return IRDM_EINVAL;
+	}
+	*zoh_all = malloc(md->n_modes * sizeof(**zoh_all));
+	if (!*zoh_all) {
+		snprintf(err, errlen, "precompute: out of memory");
+		return IRDM_ENOMEM;
+	}
+	irdm_modes_discretise(md, &b->m.damping, b->sc->dt_s, *zoh_all);
+	md->n_modes = b->sc->modes;     /* phi is column-major: the first K columns */
+	return IRDM_OK;
+}
+
 static int modal_data(struct build *b, char *err, size_t errlen)
 {
 	struct irdm_model *m = &b->m;
-	size_t K = m->modes.n_modes, n = m->modes.n;
+	struct irdm_mode *zoh_all = NULL;
+	size_t n_all = 0, K, n = m->modes.n;
 	int ret;
+
+	if (b->sc->exact_head && b->sc->representation == IRDM_REPR_MODAL) {
+		ret = split_modes(b, &zoh_all, &n_all, err, errlen);
+		if (ret)
+			return ret;
+	}
+	K = m->modes.n_modes;
 
 	b->n_modes = K;
 	b->zoh = malloc(K * sizeof(*b->zoh));
@@ -83,14 +159,31 @@ static int modal_data(struct build *b, char *err, size_t errlen)
 			int64_t d = m->row_dofs[r];
 			b->shapes[r * K + k] = d < 0 ? 0.0 : m->modes.phi[k * n + (size_t)d];
 		}
-	if (!b->sc->static_correction || !truncated(b))
+	if (!b->sc->static_correction || !truncated(b)) {
+		free(zoh_all);
 		return IRDM_OK;
-	if (b->sc->representation == IRDM_REPR_MODAL)
-		/* between columns only, the blocks that matter (static_sparse.h) */
-		return irdm_static_correction_sparse(&m->fem, &m->modes, b->sc->floating,
-						     m->col_dofs, m->n_cols, b->sc->static_corr_tol,
-						     b->o->progress, b->o->ctx, &b->sparse,
-						     err, errlen);
+	}
+	if (b->sc->representation == IRDM_REPR_MODAL) {
+		/* between columns only, the blocks that matter (static_sparse.h),
+		 * and what the dropped ones share far apart (static_lowrank.h) */
+		ret = irdm_static_correction_sparse(&m->fem, &m->modes, b->sc->floating,
+						    m->col_dofs, m->n_cols, b->sc->static_corr_tol,
+						    b->o->progress, b->o->ctx, &b->sparse,
+						    err, errlen);
+		if (!ret && b->sc->static_corr_rank && b->sparse.n_blocks < m->n_cols * m->n_cols)
+			ret = irdm_static_correction_lowrank(&m->fem, &m->modes, b->sc->floating,
+							     m->col_dofs, &b->sparse,
+							     b->sc->static_corr_rank < 3 * m->n_cols ?
+							     b->sc->static_corr_rank : 3 * m->n_cols,
+							     b->o->progress, b->o->ctx, &b->far, err,
+							     errlen);
+		/* the hybrid's head, after the far field: it sums to the whole
+		 * correction of each kept block */
+		if (!ret && zoh_all)
+			ret = exact_head(b, zoh_all, n_all, err, errlen);
+		free(zoh_all);
+		return ret;
+	}
 	/* an FIR adds it to R[0] of every row: as dense as the FIR itself */
 	b->corr = malloc(m->n_cols * m->n_rows * 9 * sizeof(double));
 	if (!b->corr)
@@ -103,6 +196,7 @@ static int modal_data(struct build *b, char *err, size_t errlen)
 		b->o->progress(b->o->ctx, "static correction", 1.0);
 	return ret;
 out_nomem:
+	free(zoh_all);
 	snprintf(err, errlen, "precompute: out of memory for the modal data");
 	return IRDM_ENOMEM;
 }
@@ -391,17 +485,27 @@ static void stab_one(struct build *b, size_t c)
 		 * <= 480), the argument-principle upper bound beyond */
 		rho = T <= 161 ? irdm_stability_fir_companion(R, T) : irdm_stability_fir(R, T);
 	} else {
-		size_t K = b->n_modes;
+		size_t K = b->n_modes, H = b->head ? b->meta.head_samples : 1;
 		const double *D = NULL;
+		double Df[9];
 		/* the diagonal block, always kept: stored rows are sorted */
 		for (uint32_t k = b->sparse.start ? b->sparse.start[c] : 0;
 		     b->sparse.start && k < b->sparse.start[c + 1]; k++)
 			if (b->sparse.rows[k] == c)
-				D = &b->sparse.blocks[9 * (size_t)k];
+				D = b->head ? &b->head[9 * H * (size_t)k] : &b->sparse.blocks[9 * (size_t)k];
+		/* stored without the far field: R[0] has it (a hybrid's head
+		 * already sums to the whole block) */
+		if (D && b->far.rank && !b->head) {
+			irdm_corr_lowrank_block(&b->far, c, c, Df);
+			for (int e = 0; e < 9; e++)
+				Df[e] += D[e];
+			D = Df;
+		}
 		/* the argument-principle certificate: O(modes) per point of a
 		 * circle where the dense eigenvalues are O(modes^3)
-		 * (irdm_stability_modal stays as the tests' reference) */
-		rho = irdm_stability_modal_ap(b->zoh, K, &b->shapes[3 * row * K], D);
+		 * (irdm_stability_modal stays as the tests' reference); a
+		 * hybrid image's head is a polynomial in 1/z added to H(z) */
+		rho = irdm_stability_modal_ap_head(b->zoh, K, &b->shapes[3 * row * K], D, D ? H : 0);
 	}
 	/* judge the stored float: a radius within 3e-8 below 1 rounds to 1.0f */
 	b->stab[c].spectral_radius = (float)rho;
@@ -418,6 +522,30 @@ static void *stab_worker(void *arg)
 			j->b->o->progress(j->b->o->ctx, "stability", (double)(c + 1) / (double)j->end);
 	}
 	return NULL;
+}
+
+/*
+ * A hybrid whose head is shorter than the dropped modes' ringing is
+ * unstable (its force recursion has a zero outside the unit circle), and
+ * nothing in the engine can damp a modal recursion: refuse it here, with
+ * what to change, rather than write an image that faults at first touch.
+ */
+static int hybrid_stable(const struct build *b, char *err, size_t errlen)
+{
+	size_t unstable = 0, worst = 0;
+
+	for (size_t c = 0; c < b->m.n_cols; c++)
+		if (!(b->stab[c].flags & IRDM_STAB_STABLE)) {
+			if (!unstable || b->stab[c].spectral_radius > b->stab[worst].spectral_radius)
+				worst = c;
+			unstable++;
+		}
+	if (!unstable)
+		return IRDM_OK;
+	snprintf(err, errlen, "precompute: exact_head = %u on modal:%zu is unstable at %zu of %zu columns (spectral radius up to %.6f at mesh node %u): the dropped modes ring longer than the head; raise exact_head or keep more modes",
+		 b->sc->exact_head, b->n_modes, unstable, b->m.n_cols,
+		 (double)b->stab[worst].spectral_radius, b->m.rows[b->m.cols[worst]]);
+	return IRDM_ENUMERIC;
 }
 
 static int stability(struct build *b, char *err, size_t errlen)
@@ -460,7 +588,7 @@ static int stability(struct build *b, char *err, size_t errlen)
 		}
 		b->meta.max_spectral_radius = fmax(b->meta.max_spectral_radius, b->stab[c].spectral_radius);
 	}
-	return IRDM_OK;
+	return b->head ? hybrid_stable(b, err, errlen) : IRDM_OK;
 }
 
 static void fill_meta(struct build *b)
@@ -481,7 +609,9 @@ static void fill_meta(struct build *b)
 		    (b->sparse.start ? IRDM_META_STATIC_CORR : 0) |
 		    (sc->mass == IRDM_MASS_CONSISTENT ? IRDM_META_CONSISTENT_MASS : 0) |
 		    (sc->method == IRDM_METHOD_TIME_DOMAIN ? IRDM_META_TIME_DOMAIN : 0) |
-		    (mt->fir_exact ? IRDM_META_FIR_TAIL_WINDOW : 0);
+		    (mt->fir_exact ? IRDM_META_FIR_TAIL_WINDOW : 0) |
+		    (b->head ? IRDM_META_EXACT_HEAD : 0);
+	mt->head_samples = b->head ? 2 * sc->exact_head : 0;
 	mt->dt_s = sc->dt_s;
 	mt->young_pa = sc->mat.young_pa;
 	mt->poisson = sc->mat.poisson;
@@ -578,7 +708,12 @@ static int add_sections(struct build *b, struct irdm_image_writer *w, const void
 			ret |= irdm_iw_add(w, IRDM_SEC_STATIC_CORR, p, b->stored[2], b->stored_bytes[2]);
 			ret |= irdm_iw_add(w, IRDM_SEC_STATIC_CORR_INDEX, IRDM_ELEM_U32, s->start,
 					   (s->n_cols + 1 + s->n_blocks) * sizeof(uint32_t));
+			if (b->stored[3])
+				ret |= irdm_iw_add(w, IRDM_SEC_STATIC_CORR_LOWRANK, IRDM_ELEM_BYTES,
+						   b->stored[3], b->stored_bytes[3]);
 		}
+		if (b->stored[4])
+			ret |= irdm_iw_add(w, IRDM_SEC_EXACT_HEAD, p, b->stored[4], b->stored_bytes[4]);
 	}
 	if (b->sc->floating)
 		ret |= irdm_iw_add(w, IRDM_SEC_RIGID, IRDM_ELEM_BYTES, &b->rigid, sizeof(b->rigid));
@@ -619,6 +754,25 @@ static int write_image(struct build *b, size_t *bytes, char *err, size_t errlen)
 	return IRDM_OK;
 }
 
+/* STATIC_CORR_LOWRANK's payload: header, lambda, U in the precision. */
+static void *store_far(const struct irdm_corr_lowrank *lr, uint32_t prec, size_t *bytes)
+{
+	struct irdm_corr_lowrank_header h = { .rank = (uint32_t)lr->rank };
+	size_t es = irdm_elem_size(prec), hdr = sizeof(h);
+	uint8_t *p;
+
+	*bytes = hdr + es * lr->rank * (1 + lr->n_dofs);
+	p = malloc(*bytes);
+	if (!p)
+		return NULL;
+	memcpy(p, &h, hdr);
+	for (size_t k = 0; k < lr->rank; k++)
+		irdm_elem_put(p + hdr, prec, k, lr->lambda[k]);
+	for (size_t i = 0; i < lr->rank * lr->n_dofs; i++)
+		irdm_elem_put(p + hdr + es * lr->rank, prec, i, lr->u[i]);
+	return p;
+}
+
 static int responses(struct build *b, char *err, size_t errlen)
 {
 	struct irdm_model *m = &b->m;
@@ -647,9 +801,15 @@ static int responses(struct build *b, char *err, size_t errlen)
 	if (b->sparse.start)
 		b->stored[2] = store(b->sparse.blocks, b->sparse.n_blocks * 9, b->sc->precision,
 				     &b->stored_bytes[2]);
+	if (b->far.rank)
+		b->stored[3] = store_far(&b->far, b->sc->precision, &b->stored_bytes[3]);
+	if (b->head)
+		b->stored[4] = store(b->head, b->sparse.n_blocks * 2 * b->sc->exact_head * 9,
+				     b->sc->precision, &b->stored_bytes[4]);
 	if ((b->fir && !b->stored[0]) ||
 	    (b->shapes && b->sc->representation == IRDM_REPR_MODAL && !b->stored[1]) ||
-	    (b->sparse.start && !b->stored[2])) {
+	    (b->sparse.start && !b->stored[2]) || (b->far.rank && !b->stored[3]) ||
+	    (b->head && !b->stored[4])) {
 		snprintf(err, errlen, "precompute: out of memory converting to the storage precision");
 		return IRDM_ENOMEM;
 	}
@@ -664,7 +824,9 @@ static void build_free(struct build *b)
 	free(b->shapes);
 	free(b->corr);
 	irdm_corr_sparse_free(&b->sparse);
-	for (int i = 0; i < 3; i++)
+	free(b->head);
+	irdm_corr_lowrank_free(&b->far);
+	for (int i = 0; i < 5; i++)
 		free(b->stored[i]);
 	free(b->stab);
 	free(b->nodes);
@@ -693,6 +855,12 @@ static void report(const struct build *b, struct irdm_precompute_report *rep)
 	rep->corr_blocks = b->sparse.n_blocks;
 	rep->corr_tol = b->sc->static_corr_tol;
 	rep->corr_max_dropped_rel = b->sparse.max_dropped_rel;
+	rep->corr_rank = b->far.rank;
+	rep->corr_checked = b->far.n_checked;
+	rep->corr_far_max[0] = b->far.max_before;
+	rep->corr_far_max[1] = b->far.max_after;
+	rep->corr_far_rms[0] = b->far.rms_before;
+	rep->corr_far_rms[1] = b->far.rms_after;
 }
 
 static uint64_t scene_hash(const struct irdm_scene *sc)

@@ -30,6 +30,11 @@ struct irdm_precompute_report {
 	/* modal static correction: blocks kept of n_cols^2 (0: none) */
 	size_t corr_blocks;
 	double corr_tol, corr_max_dropped_rel;
+	/* its far field: rank (0: none), and over the dropped blocks of
+	 * corr_checked columns, without [0] and with [1] it, in units of
+	 * sqrt(|S_aa| |S_bb|): the largest and the RMS error */
+	size_t corr_rank, corr_checked;
+	double corr_far_max[2], corr_far_rms[2];
 };
 
 /*

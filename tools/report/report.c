@@ -115,6 +115,36 @@ static int resolve_cmds(const struct irdm_report_scenario *sc, const struct irdm
 	return IRDM_OK;
 }
 
+/*
+ * A floating object's reference: the exact model through the force engine,
+ * whose floating path adds the rigid body (its pose, the rigid compliance
+ * in the contact solve, the midpoint step) that the convolution lacks.
+ * That path is checked against an RK4 rigid body and a finite-difference
+ * Newton solve in tests/test_floating.c.  Displayed nodes: world positions
+ * (pose included) less their rest positions.
+ */
+static int engine_reference(const struct irdm_image *ref, struct scen_ref *sr, char *err,
+			    size_t errlen)
+{
+	struct irdm_report_engine_out eo;
+	int ret = irdm_report_engine_run(ref, sr->cmds, sr->sc->n_contacts, sr->N,
+					 IRDM_REPORT_DISP_EVERY, &eo, err, errlen);
+
+	if (ret)
+		return ret;
+	if (eo.faulted) {
+		snprintf(err, errlen, "reference: scenario %s: the exact model's engine run faulted",
+			 sr->sc->name);
+		irdm_report_engine_free(&eo);
+		return IRDM_ECONTACT;
+	}
+	sr->out.F = eo.F;
+	sr->out.disp = eo.disp;
+	sr->out.n_eval = eo.n_eval;
+	free(eo.tick_us);
+	return IRDM_OK;
+}
+
 /* The exact full model's forces and displayed nodes for every scenario. */
 static int references(const struct irdm_report_opts *o, const struct irdm_image *ref, double dt_s,
 		      struct scen_ref *sr, char *err, size_t errlen)
@@ -135,7 +165,8 @@ static int references(const struct irdm_report_opts *o, const struct irdm_image 
 		c.cmds = sr[k].cmds;
 		snprintf(pp.prefix, sizeof(pp.prefix), "reference dt %g ms", dt_s * 1e3);
 		prefixed_progress(&pp, sr[k].sc->name, (double)(k + 1) / (double)cfg->n_scenarios);
-		ret = irdm_report_convolve(&c, &sr[k].out, err, errlen);
+		ret = ref->rigid ? engine_reference(ref, &sr[k], err, errlen) :
+			irdm_report_convolve(&c, &sr[k].out, err, errlen);
 		if (ret)
 			return ret;
 	}
@@ -221,8 +252,7 @@ static int add_row(struct irdm_report_result *res, const struct irdm_report_row 
 	return IRDM_OK;
 }
 
-/* The step scenario's index (the raw recursion and the check use it), or -1. */
-static int step_of(const struct irdm_report_config *cfg)
+int irdm_report_step_index(const struct irdm_report_config *cfg)
 {
 	for (size_t k = 0; k < cfg->n_scenarios; k++)
 		if (cfg->scenarios[k] == &irdm_report_step)
@@ -248,6 +278,7 @@ static int one_repr(const struct irdm_report_opts *o, const struct irdm_report_r
 	struct irdm_report_image ri;
 	struct irdm_report_row row;
 	struct prefixed pp = { .o = o };
+	int step = irdm_report_step_index(cfg);
 	double growth;
 	int ret;
 
@@ -267,7 +298,7 @@ static int one_repr(const struct irdm_report_opts *o, const struct irdm_report_r
 	}
 	prefixed_progress(&pp, "raw recursion", 0.0);
 	growth = NAN;
-	ret = step_of(cfg) >= 0 ? raw_growth(&ri.img, &sr[step_of(cfg)], dt_s, &growth, err, errlen) : 0;
+	ret = step >= 0 ? raw_growth(&ri.img, &sr[step], dt_s, &growth, err, errlen) : 0;
 	for (size_t k = 0; !ret && k < cfg->n_scenarios; k++) {
 		prefixed_progress(&pp, "scenarios", (double)k / (double)cfg->n_scenarios);
 		memset(&row, 0, sizeof(row));
@@ -314,6 +345,7 @@ static int one_dt(const struct irdm_report_opts *o, double dt_s, struct irdm_rep
 	struct scen_ref *sr = calloc(cfg->n_scenarios, sizeof(*sr));
 	struct irdm_report_image ref;
 	struct prefixed pp = { .o = o };
+	int step = irdm_report_step_index(cfg);
 	int ret;
 
 	if (!sr)
@@ -324,10 +356,11 @@ static int one_dt(const struct irdm_report_opts *o, double dt_s, struct irdm_rep
 	ret = irdm_report_image_build(&ref, o->tmp_dir, name, keys, prefixed_progress, &pp, err, errlen);
 	if (ret)
 		goto out_refs;
+	res->engine_reference = ref.img.rigid != NULL;
 	ret = references(o, &ref.img, dt_s, sr, err, errlen);
-	if (!ret && step_of(cfg) >= 0)
-		ret = irdm_report_check_reference(o, &ref.img, dt_s, sr[step_of(cfg)].sc,
-						  sr[step_of(cfg)].out.F, res, err, errlen);
+	if (!ret && step >= 0)
+		ret = irdm_report_check_reference(o, &ref.img, dt_s, sr[step].sc, sr[step].out.F, res,
+						  err, errlen);
 	for (size_t i = 0; !ret && i < cfg->n_reprs; i++) {
 		char prefix[32];
 

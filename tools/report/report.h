@@ -12,8 +12,11 @@
  * no static correction, double precision (representation = modal:all),
  * its responses R[s] read back for every sample of the run (no
  * truncation) and the contact forces solved by direct convolution in
- * double (report_reference.c), not by the engine.  The representation
- * under test runs in the force engine, as the firmware runs it.
+ * double (report_reference.c), not by the engine.  A floating object's
+ * reference is that exact model run by the force engine with its rigid
+ * body (the convolution has no rigid motion): report.c, engine_reference().
+ * The representation under test runs in the force engine, as the firmware
+ * runs it.
  */
 #ifndef IRDM_TOOLS_REPORT_H
 #define IRDM_TOOLS_REPORT_H
@@ -51,10 +54,14 @@ struct irdm_report_config {
 	double check_s;         /* the reference check's length (report_check.h) */
 };
 
-/* The shipped configurations by name ("sweep", "paper", "tiny"), or NULL. */
+/* The shipped configurations by name ("sweep", "paper", "floating", "tiny",
+ * "tiny-floating"), or NULL. */
 const struct irdm_report_config *irdm_report_config_find(const char *name);
 /* Their names, comma-separated (for help texts). */
 const char *irdm_report_config_names(void);
+/* The index of the step scenario in cfg (the raw FIR recursion, the
+ * reference check and the settled-force verdicts use it), or -1. */
+int irdm_report_step_index(const struct irdm_report_config *cfg);
 
 /* One row of the report: a representation at one dt on one scenario. */
 struct irdm_report_row {
@@ -108,6 +115,9 @@ struct irdm_report_result {
 	size_t n_rows;
 	struct irdm_report_check *checks;   /* one per dt */
 	size_t n_checks;
+	/* the reference was the exact model run by the engine (a floating
+	 * object), not the convolution */
+	bool engine_reference;
 	double seconds;
 };
 

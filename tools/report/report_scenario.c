@@ -41,6 +41,35 @@ const struct irdm_report_scenario irdm_report_stroke = {
 		    .depth_m = 0.005, .ramp_s = 0.1 } },
 };
 
+/*
+ * The paper's Fig. 9 (the swing of test_floating): the floating cube
+ * grabbed at the top centre node, the grab point moved 3 cm sideways
+ * (+x) and back, to 3 cm the other way and back, twice (1 Hz); no gravity,
+ * so the cube follows and turns about the grab point.
+ */
+const struct irdm_report_scenario irdm_report_swing = {
+	.name = "swing",
+	.what = "floating cube grabbed at the top centre node, the grab point moved +-3 cm sideways (x) at 1 Hz, 2 periods",
+	.duration_s = 2.0, .n_contacts = 1,
+	.path = { { .on_node = true, .on_s = 0, .off_s = 1e9, .depth_m = 0.03,
+		    .dir = { 1, 0, 0 }, .shape = IRDM_REPORT_SINE, .wave_hz = 1.0 } },
+};
+
+/*
+ * Fig. 10's tap, on a side: the centre node of the cube's +x face (6 cm
+ * out and 6 cm down from the top centre) pushed 2 mm into the cube (-x)
+ * over 10 ms and back over 10 ms, then let go: the cube flies off turning
+ * and vibrating.
+ */
+const struct irdm_report_scenario irdm_report_tap = {
+	.name = "tap",
+	.what = "floating cube: the centre node of its +x face pushed 2 mm in (-x) over 10 ms, back over 10 ms, let go, 1 s of free flight",
+	.duration_s = 1.0, .n_contacts = 1,
+	.path = { { .on_node = true, .from_m = { 0.06, 0, -0.06 }, .on_s = 0, .off_s = 0.02,
+		    .depth_m = 0.002, .ramp_s = 0.01, .dir = { -1, 0, 0 },
+		    .shape = IRDM_REPORT_TAP } },
+};
+
 size_t irdm_report_scenario_ticks(const struct irdm_report_scenario *sc, double dt_s)
 {
 	return (size_t)llround(sc->duration_s / dt_s);
@@ -89,6 +118,22 @@ static double clamp01(double x)
 	return x < 0 ? 0 : (x > 1 ? 1 : x);
 }
 
+/* The fraction of depth_m the path is at, time_s from its start. */
+static double depth_fraction(const struct irdm_report_path *p, double time_s)
+{
+	double s = time_s - p->on_s;
+
+	switch (p->shape) {
+	case IRDM_REPORT_SINE:
+		return sin(2 * M_PI * p->wave_hz * s);
+	case IRDM_REPORT_TAP:
+		return clamp01(fmin(s, 2 * p->ramp_s - s) / p->ramp_s);
+	case IRDM_REPORT_HOLD:
+	default:
+		return p->ramp_s > 0 ? clamp01(s / p->ramp_s) : 1;
+	}
+}
+
 int irdm_report_scenario_cmds(const struct irdm_report_scenario *sc,
 			      const struct irdm_image *img, double dt_s, size_t t,
 			      struct irdm_report_cmd *cmd)
@@ -100,14 +145,17 @@ int irdm_report_scenario_cmds(const struct irdm_report_scenario *sc,
 		const struct irdm_report_path *p = &sc->path[i];
 		double s = p->slide_end_s > p->slide_begin_s ?
 			clamp01((time_s - p->slide_begin_s) / (p->slide_end_s - p->slide_begin_s)) : 0;
-		double depth = p->ramp_s > 0 ? clamp01((time_s - p->on_s) / p->ramp_s) : 1;
+		double depth = p->depth_m * depth_fraction(p, time_s);
+		bool down = !p->dir[0] && !p->dir[1] && !p->dir[2];
 		double at[3] = { c[0] + p->from_m[0] + s * (p->to_m[0] - p->from_m[0]),
-				 c[1] + p->from_m[1] + s * (p->to_m[1] - p->from_m[1]), c[2] };
+				 c[1] + p->from_m[1] + s * (p->to_m[1] - p->from_m[1]),
+				 c[2] + p->from_m[2] };
 
 		memset(&cmd[i], 0, sizeof(cmd[i]));
 		cmd[i].active = time_s >= p->on_s && time_s < p->off_s;
 		cmd[i].on_node = p->on_node;
-		cmd[i].target_m[2] = -p->depth_m * depth;
+		for (int a = 0; a < 3; a++)
+			cmd[i].target_m[a] = down ? (a == 2 ? -depth : 0) : depth * p->dir[a];
 		if (p->on_node)
 			cmd[i].row = nearest_column(img, at);
 		else if (irdm_replay_locate(img, at, &cmd[i].tri, cmd[i].bary))

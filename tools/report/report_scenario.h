@@ -1,8 +1,10 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * Report scenarios: prescribed contact trajectories on the top face of a
- * grounded object, in offsets from the top centre of the image's nodes,
- * resolved on an image to a contact site and a target per tick.
+ * Report scenarios: prescribed contact trajectories on an object, in
+ * offsets from the top centre of the image's nodes, resolved on an image
+ * to a contact site and a target per tick.  The target is the grabbed
+ * point's displacement from its rest position, in the world frame (for a
+ * floating object the engine's world, docs/architecture.md).
  */
 #ifndef IRDM_TOOLS_REPORT_SCENARIO_H
 #define IRDM_TOOLS_REPORT_SCENARIO_H
@@ -14,15 +16,26 @@
 #include "irdm/image.h"
 #include "irdm/limits.h"
 
-/* One contact: a node (the column nearest to from_m) or a point on the
- * surface that slides from from_m to to_m; pushed down depth_m along -z,
- * reached over ramp_s (0: a step), active in [on_s, off_s). */
+/* How a path's depth goes over time from on_s. */
+enum irdm_report_shape {
+	IRDM_REPORT_HOLD = 0,   /* reached over ramp_s (0: a step), held */
+	IRDM_REPORT_TAP,        /* in over ramp_s, back out over ramp_s */
+	IRDM_REPORT_SINE,       /* depth sin(2 pi wave_hz t): there and back */
+};
+
+/* One contact: a node (the column nearest to from_m) or a point on the top
+ * surface that slides from from_m to to_m (x, y; to_m's z unused); pushed
+ * depth_m along dir (a unit vector; all zero: -z, down), in the shape of
+ * `shape`, active in [on_s, off_s). */
 struct irdm_report_path {
 	bool on_node;
-	double from_m[2], to_m[2];
+	double from_m[3], to_m[3];
 	double slide_begin_s, slide_end_s;
 	double on_s, off_s;
 	double depth_m, ramp_s;
+	double dir[3];
+	enum irdm_report_shape shape;
+	double wave_hz;
 };
 
 struct irdm_report_scenario {
@@ -52,8 +65,9 @@ int irdm_report_scenario_cmds(const struct irdm_report_scenario *sc,
 /* Ticks the scenario runs at dt_s. */
 size_t irdm_report_scenario_ticks(const struct irdm_report_scenario *sc, double dt_s);
 
-/* The shipped scenarios. */
+/* The shipped scenarios: grounded, then the floating cube's (12 cm). */
 extern const struct irdm_report_scenario irdm_report_step, irdm_report_release,
 	irdm_report_two_points, irdm_report_stroke;
+extern const struct irdm_report_scenario irdm_report_swing, irdm_report_tap;
 
 #endif

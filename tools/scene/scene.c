@@ -9,6 +9,7 @@
 
 #include "irdm/error.h"
 #include "irdm/options.h"
+#include "modal/static_lowrank.h"
 #include "modal/static_sparse.h"
 #include "scene/scene.h"
 
@@ -33,6 +34,7 @@ void irdm_scene_defaults(struct irdm_scene *sc)
 	sc->modes = 300;
 	sc->static_correction = true;
 	sc->static_corr_tol = IRDM_STATIC_CORR_TOL_DEFAULT;
+	sc->static_corr_rank = IRDM_STATIC_CORR_RANK_DEFAULT;
 	sc->precision = IRDM_ELEM_F32;
 	sc->fixed.kind = IRDM_REGION_PLANE;
 	sc->fixed.axis = 2;
@@ -420,6 +422,15 @@ static const struct irdm_opt scene_opts[] = {
 	{ .name = "static_correction_tol", .type = IRDM_OPT_DOUBLE, SC(static_corr_tol),
 	  .metavar = "TOL", .range = IRDM_OPT_GE | IRDM_OPT_LT, .min = 0, .max = 1,
 	  .help = "modal: drop the static correction's block between touchable nodes a and b when its norm is below TOL sqrt(|S_aa| |S_bb|), the diagonal blocks' norms: the force error at a contact is of about that order (default 0.02; 0 keeps every block)" },
+	{ .name = "static_correction_rank", .type = IRDM_OPT_UNSIGNED, SC(static_corr_rank),
+	  .metavar = "R", .range = IRDM_OPT_GE | IRDM_OPT_LE, .min = 0, .max = IRDM_CORR_LOWRANK_MAX,
+	  .help = "modal: the far field of the dropped static-correction blocks as a symmetric term of rank R over the touchable nodes, added to every block (image section STATIC_CORR_LOWRANK, R (1 + 3 n_cols) values); 0 leaves it out (default 96)" },
+	{ .name = "exact_head", .type = IRDM_OPT_UNSIGNED, SC(exact_head), .metavar = "H",
+	  .range = IRDM_OPT_LE, .max = IRDM_HEAD_SAMPLES_MAX / 2,
+	  .help = "modal: the hybrid representation: the dropped modes' exact response over the "
+		  "first H samples between touchable nodes, on top of the kept modes, tapered off "
+		  "over H more with the static compliance kept exactly; needs every mode, a dense "
+		  "eigensolve (default 0: the static correction alone)" },
 	{ .name = "precision", .type = IRDM_OPT_ENUM, SC(precision), .names = precision_names,
 	  .help = "storage of the responses (default f32)" },
 	{ .name = "touch", .type = IRDM_OPT_CUSTOM, .parse = set_region, SC(touch),
@@ -513,6 +524,12 @@ int irdm_scene_check(const struct irdm_scene *sc, char *err, size_t errlen)
 			 sc->fir_length, sc->fir_tail);
 		return IRDM_EINVAL;
 	}
+	if (sc->exact_head && (sc->representation != IRDM_REPR_MODAL || !sc->modes ||
+			       !sc->static_correction)) {
+		snprintf(err, errlen, "scene: exact_head = %u adds the dropped modes' head to a truncated modal image: use representation = modal:K with static_correction = yes",
+			 sc->exact_head);
+		return IRDM_EINVAL;
+	}
 	if (sc->damping == IRDM_DAMP_RATIOS && sc->damp_hz[0] > 0 &&
 	    fabs(sc->damp_hz[0] - sc->damp_hz[1]) < 1e-9) {
 		snprintf(err, errlen, "scene: damping needs two different frequencies");
@@ -551,13 +568,14 @@ int irdm_scene_format(const struct irdm_scene *sc, char *buf, size_t len)
 		"name=%s\nmesh=%s\nresolution=%u,%u,%u\ntets_per_hex=%u\nmesh_scale=%.17g\n"
 		"tetgen=%s\nyoung=%.17g\npoisson=%.17g\ndensity=%.17g\nmass=%s\ndamping=%s\n"
 		"floating=%s\nfixed=%s\ndt=%.17g\nrepresentation=%s\nstatic_correction=%s\n"
-		"static_correction_tol=%.17g\n"
+		"static_correction_tol=%.17g\nstatic_correction_rank=%u\n"
 		"precision=%s\ntouch=%s\ndisplay=%s\nmethod=%s\nsubsteps=%u\neigensolver=%s\nmodes=%u\n",
 		sc->name, sc->mesh, sc->res[0], sc->res[1], sc->res[2], sc->tets_per_hex,
 		sc->mesh_scale, sc->tetgen, sc->mat.young_pa, sc->mat.poisson,
 		sc->mat.density_kg_m3, sc->mass == IRDM_MASS_LUMPED ? "lumped" : "consistent",
 		damp, sc->floating ? "yes" : "no", region_text(&sc->fixed), sc->dt_s, repr,
-		sc->static_correction ? "yes" : "no", sc->static_corr_tol, prec[sc->precision & 3],
+		sc->static_correction ? "yes" : "no", sc->static_corr_tol, sc->static_corr_rank,
+		prec[sc->precision & 3],
 		region_text(&sc->touch), region_text(&sc->display),
 		sc->method == IRDM_METHOD_MODAL ? "modal" : "time-domain", sc->substeps,
 		eig[sc->eigensolver], sc->modes);
@@ -565,6 +583,12 @@ int irdm_scene_format(const struct irdm_scene *sc, char *buf, size_t len)
 		return -1;
 	if (sc->fir_tail) {         /* only when set: older scenes keep their text */
 		int t = snprintf(buf + n, len - (size_t)n, "fir_tail=window:%u\n", sc->fir_tail);
+		if (t < 0 || (size_t)t >= len - (size_t)n)
+			return -1;
+		n += t;
+	}
+	if (sc->exact_head) {       /* only when set, as fir_tail */
+		int t = snprintf(buf + n, len - (size_t)n, "exact_head=%u\n", sc->exact_head);
 		if (t < 0 || (size_t)t >= len - (size_t)n)
 			return -1;
 		n += t;

@@ -68,6 +68,8 @@ struct irdm_scene {
 	unsigned modes;          /* modes kept (0 = all) */
 	bool static_correction;
 	double static_corr_tol;   /* drop blocks below tol sqrt(|S_cc| |S_rr|) */
+	unsigned static_corr_rank; /* far field of the dropped blocks: rank (0: none) */
+	unsigned exact_head;     /* modal: exact samples of the dropped modes' head (0: none; stored: 2x) */
 	uint32_t precision;      /* enum irdm_elem */
 	struct irdm_region touch;
 	struct irdm_region display;

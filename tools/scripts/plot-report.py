@@ -6,7 +6,8 @@ worst scenario) and against its image bytes, and the step's settled error
 drawn, the unstable ones as crosses, the paper's setting starred; errors
 over 1000 % drawn at the top edge.
 usage: plot-report.py REPORT-NAME.csv OUT-PREFIX
-writes OUT-PREFIX-tick.png, OUT-PREFIX-bytes.png, OUT-PREFIX-settled.png"""
+writes OUT-PREFIX-tick.png, OUT-PREFIX-bytes.png, and OUT-PREFIX-settled.png
+if the configuration has the step (the floating one has not)"""
 import csv
 import sys
 
@@ -93,8 +94,9 @@ def main():
         sys.exit("plot-report.py: %s: no rows" % sys.argv[1])
     plot(reps, "tick", "force tick, median (us, worst scenario)", sys.argv[2] + "-tick.png", paper)
     plot(reps, "bytes", "image bytes", sys.argv[2] + "-bytes.png", paper)
-    plot(reps, "tick", "force tick, median (us, worst scenario)", sys.argv[2] + "-settled.png",
-         paper, "settled", "relative RMS force error, the step from tick 100 on")
+    if any(e["settled"] == e["settled"] for e in reps.values()):
+        plot(reps, "tick", "force tick, median (us, worst scenario)", sys.argv[2] + "-settled.png",
+             paper, "settled", "relative RMS force error, the step from tick 100 on")
 
 
 if __name__ == "__main__":

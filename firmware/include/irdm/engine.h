@@ -62,8 +62,9 @@ struct irdm_engine_config {
 	 */
 	double stable_radius;
 	double max_force_n;             /* > 0: a larger force faults the engine (torque off) */
-	/* sum an FIR history with the portable code even on a processor with
-	 * AVX2 and FMA (the two agree to rounding; tests compare them) */
+	/* sum an FIR history, or a hybrid image's head, with the portable
+	 * code even on a processor with AVX2 and FMA (the two agree to
+	 * rounding; tests compare them) */
 	bool fir_portable_sum;
 	unsigned publish_every;         /* deformation snapshot every N ticks (0: never) */
 };
@@ -199,9 +200,10 @@ const struct irdm_engine_stats *irdm_engine_stats(const struct irdm_engine *eng)
 /* Why the engine faulted (a constant sentence), or NULL if it has not. */
 const char *irdm_engine_fault_reason(const struct irdm_engine *eng);
 
-/* Which FIR history sum the engine runs: "avx2" (fir_sum_avx2.c, chosen at
- * init where the processor has AVX2, FMA and F16C), "portable", or "none"
- * (not an FIR image). */
+/* Which history sum the engine runs, of an FIR image or of a hybrid image's
+ * head: "avx2" (fir_sum_avx2.c or engine_head_avx2.c, chosen at init where
+ * the processor has AVX2, FMA and F16C), "portable", or "none" (a modal
+ * image without a head). */
 const char *irdm_engine_fir_sum_name(const struct irdm_engine *eng);
 
 /*

@@ -40,6 +40,16 @@ struct irdm_image {
 	const uint32_t *corr_start;         /* n_cols + 1 */
 	const uint32_t *corr_rows;          /* corr_start[n_cols] */
 	const void *corr_blocks;            /* corr_start[n_cols] x 9 of precision */
+	/* optional far field of the correction (STATIC_CORR_LOWRANK; rank 0
+	 * and NULL if absent): every block gets U[c'] diag(lambda) U[c]^T */
+	uint32_t corr_rank;
+	const void *corr_lambda;            /* corr_rank of precision */
+	const void *corr_u;                 /* 3 n_cols x corr_rank of precision */
+	/* modal, optional (NULL if absent): the dropped modes' response over
+	 * meta->head_samples samples for each kept block k, [k][s][3][3] of
+	 * precision (exact over the first half, tapered over the second); its
+	 * samples sum to block k of corr_blocks */
+	const void *exact_head;
 	const struct irdm_rigid *rigid;     /* floating only, else NULL */
 	const struct irdm_stability *stability; /* n_cols */
 	/* optional CONTACT_BVH (NULL if absent): validated header, payload bytes */
@@ -99,6 +109,14 @@ const struct irdm_image_section *irdm_image_find(const struct irdm_image *img,
  * the column's rows: O(log kept), no allocation (tick-safe). */
 long irdm_image_corr_block(const struct irdm_image *img, uint32_t col_force,
 			   uint32_t col_disp);
+
+/* The static correction's block for a force at column col_force and the
+ * displacement of column col_disp, entry [i][j] = displacement along i per
+ * unit force along j, into blk: the kept block (zero where dropped) plus
+ * the low-rank far field.  Zeros if the image has no correction.
+ * O(log kept + 9 corr_rank), no allocation (tick-safe). */
+void irdm_image_corr_value(const struct irdm_image *img, uint32_t col_force,
+			   uint32_t col_disp, double blk[9]);
 
 /* CRC-32C (Castagnoli), reflected, init/xorout 0xFFFFFFFF. */
 uint32_t irdm_crc32c(const void *data, size_t len);

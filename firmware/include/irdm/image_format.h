@@ -16,7 +16,7 @@
 
 #define IRDM_IMAGE_MAGIC "IRDMIMG"          /* 7 chars + NUL = 8 bytes */
 #define IRDM_IMAGE_VERSION_MAJOR 2u         /* incompatible layout change */
-#define IRDM_IMAGE_VERSION_MINOR 0u         /* compatible additions */
+#define IRDM_IMAGE_VERSION_MINOR 1u         /* compatible additions: 2.1 STATIC_CORR_LOWRANK, EXACT_HEAD */
 #define IRDM_IMAGE_ALIGN 64u                /* payload alignment, bytes */
 #define IRDM_IMAGE_MAX_SECTIONS 32u
 
@@ -67,6 +67,8 @@ enum irdm_section_kind {
 	IRDM_SEC_STABILITY = 11,   /* n_cols x struct irdm_stability */
 	IRDM_SEC_CONTACT_BVH = 12, /* optional: contact BVH + adjacency, struct irdm_bvh_header */
 	IRDM_SEC_STATIC_CORR_INDEX = 13, /* with STATIC_CORR: u32 column starts + rows of its blocks */
+	IRDM_SEC_STATIC_CORR_LOWRANK = 14, /* optional, with STATIC_CORR: far field U diag(lambda) U^T */
+	IRDM_SEC_EXACT_HEAD = 15,  /* modal, optional: [k][s][3][3] of the STATIC_CORR blocks, s < head_samples */
 };
 
 enum irdm_repr {
@@ -82,7 +84,12 @@ enum irdm_meta_flags {
 	/* FIR: samples [fir_exact, fir_length) are the response tapered to
 	 * zero, the taps' sum restored to the static compliance */
 	IRDM_META_FIR_TAIL_WINDOW = 1u << 4,
+	/* modal with STATIC_CORR: EXACT_HEAD present, head_samples samples */
+	IRDM_META_EXACT_HEAD = 1u << 5,
 };
+
+/* Longest head (samples): the engine keeps a ring of that many ticks. */
+#define IRDM_HEAD_SAMPLES_MAX 8192u
 
 struct irdm_meta {                          /* 256 bytes */
 	uint32_t representation;            /* enum irdm_repr */
@@ -110,7 +117,8 @@ struct irdm_meta {                          /* 256 bytes */
 	uint64_t mesh_hash;                 /* FNV-1a 64 of positions and tets */
 	char     tool_version[32];          /* NUL-terminated */
 	char     mesh_name[64];             /* NUL-terminated */
-	uint8_t  reserved[8];               /* 0 */
+	uint32_t head_samples;              /* EXACT_HEAD: samples stored, 1..IRDM_HEAD_SAMPLES_MAX; else 0 (2.1) */
+	uint8_t  reserved[4];               /* 0 */
 };
 
 struct irdm_node {                          /* 16 bytes */
@@ -197,6 +205,27 @@ struct irdm_bvh_node {                      /* 32 bytes */
 	uint32_t count_or_right;
 };
 
+/*
+ * STATIC_CORR_LOWRANK (kind 14, elem BYTES, optional, only with STATIC_CORR,
+ * since minor 1): the static correction's far field, the part of the
+ * dropped blocks that is smooth, as a symmetric low-rank term added to
+ * every block (kept or not): block (c, c') += U[c'] diag(lambda) U[c]^T.
+ * The payload is, the values in the image's precision (as STATIC_CORR),
+ *
+ *   struct irdm_corr_lowrank_header            16 bytes at 0
+ *   lambda[rank]                               at 16
+ *   u[3 n_cols][rank]                          at 16 + rank x elem size
+ *
+ * u's row 3c + i is column c's axis i (a DoF of a fixed node is a row of
+ * zeros), its rank values contiguous (one dot product per block entry).
+ */
+#define IRDM_CORR_LOWRANK_MAX 1024u         /* rank bound: the tick's cost per block */
+
+struct irdm_corr_lowrank_header {           /* 16 bytes */
+	uint32_t rank;                      /* 1..min(3 n_cols, IRDM_CORR_LOWRANK_MAX) */
+	uint32_t reserved[3];               /* 0 */
+};
+
 _Static_assert(sizeof(struct irdm_image_header) == 64, "header size");
 _Static_assert(sizeof(struct irdm_image_section) == 32, "section size");
 _Static_assert(sizeof(struct irdm_meta) == 256, "meta size");
@@ -206,5 +235,6 @@ _Static_assert(sizeof(struct irdm_rigid) == 128, "rigid size");
 _Static_assert(sizeof(struct irdm_stability) == 8, "stability size");
 _Static_assert(sizeof(struct irdm_bvh_header) == 64, "bvh header size");
 _Static_assert(sizeof(struct irdm_bvh_node) == 32, "bvh node size");
+_Static_assert(sizeof(struct irdm_corr_lowrank_header) == 16, "lowrank header size");
 
 #endif /* IRDM_IMAGE_FORMAT_H */

@@ -1,0 +1,142 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * The hybrid representation's head (image section EXACT_HEAD): the exact
+ * response of the modes a modal image drops, over its first H samples,
+ * between touchable nodes whose static-correction block was kept.  On top
+ * of the kept modes' recursion it adds
+ *   u_v[t] += sum_{s=0}^{H-1} D_s(e -> v) f_e[t-s],
+ * with D_0 in R[0] (in place of the static correction block, which is the
+ * sum of the D_s) and the older samples summed over a ring of the last
+ * H - 1 ticks' forces.  Modal images without a head have H = 0 and never
+ * reach the ring.
+ */
+#include "engine_priv.h"
+
+/* D_s of kept block k into blk (row-major 3x3). */
+static void head_block(const struct irdm_engine *e, long k, uint32_t s, double blk[9])
+{
+	size_t base = ((size_t)k * e->H + s) * 9;
+
+	for (size_t i = 0; i < 9; i++)
+		blk[i] = irdm_elem_get(e->img->exact_head, e->img->meta->precision, base + i);
+}
+
+bool irdm_head_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp, double blk[9])
+{
+	long k = irdm_image_corr_block(e->img, col_force, col_disp);
+
+	if (k < 0)
+		return false;   /* dropped: the far field alone, instantly */
+	head_block(e, k, 0, blk);
+	return true;
+}
+
+/*
+ * acc[3 i + j] += sum over the ring's ticks of age s in [1, H) of
+ * D_s(k_s)[i][j] f_j, one loop per storage type so that the inner loop is
+ * loads and multiply-adds only (nine independent sums): a long head is
+ * hundreds of samples at every contact node every tick.
+ */
+#define HEAD_SUM(NAME, TYPE, LOAD)                                                       \
+static void NAME(const struct irdm_engine *e, uint32_t col, double acc[9])               \
+{                                                                                        \
+	const TYPE *D = e->img->exact_head;                                              \
+	const struct irdm_fir_ring *r = &e->ring;                                        \
+	struct irdm_head_cache cache = { .n = 0 };                                           \
+	double a0 = 0, a1 = 0, a2 = 0, a3 = 0, a4 = 0, a5 = 0, a6 = 0, a7 = 0, a8 = 0;   \
+	uint32_t slot = r->head;        /* age 1; older ticks one slot down each */      \
+                                                                                         \
+	for (uint32_t s = 1; s < e->H; s++) {                                            \
+		const struct irdm_force_tick *t = &r->tick[slot];                        \
+		slot = slot ? slot - 1 : e->H - 1;                                       \
+		for (uint32_t n = 0; n < t->n; n++) {                                    \
+			long k = irdm_head_cached_block(e, &cache, t->col[n], col);                \
+			if (k < 0)                                                       \
+				continue;       /* a dropped block: no head either */    \
+			const TYPE *d = &D[((size_t)k * e->H + s) * 9];                  \
+			double f0 = t->f_n[n][0], f1 = t->f_n[n][1], f2 = t->f_n[n][2];  \
+			a0 += LOAD(d[0]) * f0, a1 += LOAD(d[1]) * f1;                    \
+			a2 += LOAD(d[2]) * f2, a3 += LOAD(d[3]) * f0;                    \
+			a4 += LOAD(d[4]) * f1, a5 += LOAD(d[5]) * f2;                    \
+			a6 += LOAD(d[6]) * f0, a7 += LOAD(d[7]) * f1;                    \
+			a8 += LOAD(d[8]) * f2;                                           \
+		}                                                                        \
+	}                                                                                \
+	acc[0] = a0, acc[1] = a1, acc[2] = a2, acc[3] = a3, acc[4] = a4;                 \
+	acc[5] = a5, acc[6] = a6, acc[7] = a7, acc[8] = a8;                              \
+}
+
+#define LOAD_F(x) ((double)(x))
+#define LOAD_H(x) ((double)irdm_f16_to_f32(x))
+HEAD_SUM(head_sum_f64, double, LOAD_F)
+HEAD_SUM(head_sum_f32, float, LOAD_F)
+HEAD_SUM(head_sum_f16, uint16_t, LOAD_H)
+
+void irdm_head_free_disp(const struct irdm_engine *e, uint32_t col, double u[3])
+{
+	double acc[9];
+
+	if (e->head_wide) {
+		irdm_head_sum_wide(e, col, u);
+		return;
+	}
+	switch (e->img->meta->precision) {
+	case IRDM_ELEM_F64:
+		head_sum_f64(e, col, acc);
+		break;
+	case IRDM_ELEM_F32:
+		head_sum_f32(e, col, acc);
+		break;
+	default:
+		head_sum_f16(e, col, acc);
+		break;
+	}
+	for (int i = 0; i < 3; i++)
+		u[i] += acc[3 * i] + acc[3 * i + 1] + acc[3 * i + 2];
+}
+
+void irdm_head_apply(struct irdm_engine *e, const struct irdm_force_tick *f)
+{
+	struct irdm_fir_ring *r = &e->ring;
+
+	if (e->H < 2)
+		return;
+	r->head = (r->head + 1) % e->H;
+	r->tick[r->head] = *f;
+	/* the tick's force norms, once: the displacement bound reads them
+	 * every tick for every age */
+	double sum = 0;
+	for (uint32_t n = 0; n < f->n; n++)
+		sum += irdm_v3_norm(f->f_n[n]);
+	e->head_norm[r->head] = sum;
+}
+
+void irdm_head_bound_init(const struct irdm_engine *e, double *w)
+{
+	const struct irdm_image *img = e->img;
+	uint32_t n_blocks = img->corr_start[e->n_cols];
+
+	for (uint32_t s = 0; s < e->H; s++) {
+		double mx = 0;
+		for (uint32_t k = 0; k < n_blocks; k++) {
+			double blk[9], ss = 0;
+			head_block(e, k, s, blk);
+			for (int i = 0; i < 9; i++)
+				ss += blk[i] * blk[i];
+			mx = fmax(mx, sqrt(ss));
+		}
+		w[s] = mx;
+	}
+}
+
+double irdm_head_bound(const struct irdm_engine *e, const double *w)
+{
+	uint32_t slot = e->ring.head;   /* age 1; older ticks one slot down each */
+	double b = 0;
+
+	for (uint32_t s = 1; s < e->H; s++) {
+		b += w[s] * e->head_norm[slot];
+		slot = slot ? slot - 1 : e->H - 1;
+	}
+	return b;
+}
