@@ -1,11 +1,12 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * The hybrid representation's head (image section EXACT_HEAD): the exact
- * response of the modes a modal image drops, over its first H samples,
- * between touchable nodes whose static-correction block was kept.  On top
- * of the kept modes' recursion it adds
+ * The hybrid representation's head (image section EXACT_HEAD): the
+ * response of the modes a modal image drops, over its H = head_samples
+ * samples (exact over the first half, tapered over the second), between
+ * touchable nodes whose static-correction block was kept.  On top of the
+ * kept modes' recursion it adds
  *   u_v[t] += sum_{s=0}^{H-1} D_s(e -> v) f_e[t-s],
- * with D_0 in R[0] (in place of the static correction block, which is the
+ * with D_0 in R[0] (in place of the whole correction block, which is the
  * sum of the D_s) and the older samples summed over a ring of the last
  * H - 1 ticks' forces.  Modal images without a head have H = 0 and never
  * reach the ring.
@@ -42,7 +43,7 @@ static void NAME(const struct irdm_engine *e, uint32_t col, double acc[9])      
 {                                                                                        \
 	const TYPE *D = e->img->exact_head;                                              \
 	const struct irdm_fir_ring *r = &e->ring;                                        \
-	struct irdm_head_cache cache = { .n = 0 };                                           \
+	struct irdm_head_cache cache = { .n = 0 };                                       \
 	double a0 = 0, a1 = 0, a2 = 0, a3 = 0, a4 = 0, a5 = 0, a6 = 0, a7 = 0, a8 = 0;   \
 	uint32_t slot = r->head;        /* age 1; older ticks one slot down each */      \
                                                                                          \
@@ -50,7 +51,7 @@ static void NAME(const struct irdm_engine *e, uint32_t col, double acc[9])      
 		const struct irdm_force_tick *t = &r->tick[slot];                        \
 		slot = slot ? slot - 1 : e->H - 1;                                       \
 		for (uint32_t n = 0; n < t->n; n++) {                                    \
-			long k = irdm_head_cached_block(e, &cache, t->col[n], col);                \
+			long k = irdm_head_cached_block(e, &cache, t->col[n], col);      \
 			if (k < 0)                                                       \
 				continue;       /* a dropped block: no head either */    \
 			const TYPE *d = &D[((size_t)k * e->H + s) * 9];                  \

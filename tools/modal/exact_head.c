@@ -1,12 +1,13 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * The dropped modes' exact head.  The high modes a truncated image drops
- * answer a force within a few samples (they are stiff and, with Rayleigh
- * damping, heavily damped): the static correction puts all of that into
- * R[0], which misses the impulsive response after a step (the first
- * ticks' forces).  Their response over H samples, summed mode by mode at
- * the kept blocks only, restores it; H more samples taper it off and keep
- * the rest of the static compliance.
+ * The dropped modes' exact head.  The static correction puts everything
+ * the dropped modes do into R[0], which misses their impulsive response
+ * after a step (the first ticks' forces) and their ringing after it.
+ * Their response over H samples, summed mode by mode at the kept blocks
+ * only, restores both; H more samples taper it off and keep the rest of
+ * the static compliance.  H must outlast the ringing: on a soft material
+ * the first dropped modes ring for hundreds of ticks, and a shorter head
+ * is unstable (the precompute's certificate refuses it).
  */
 #include <stdlib.h>
 #include <string.h>
