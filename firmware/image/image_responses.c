@@ -162,8 +162,13 @@ int img_check_modal(struct parse *p)
 	if (!ret && !corr && p->by_kind[IRDM_SEC_STATIC_CORR_LOWRANK])
 		ret = img_check_presence(p, IRDM_SEC_STATIC_CORR_LOWRANK, false,
 					 "its far field needs STATIC_CORR");
+	if (!ret && !corr && p->by_kind[IRDM_SEC_STATIC_CORR_CLUSTERS])
+		ret = img_check_presence(p, IRDM_SEC_STATIC_CORR_CLUSTERS, false,
+					 "its clusters need STATIC_CORR");
 	if (!ret && corr)
 		ret = img_check_static_corr(p);
+	if (!ret && corr)
+		ret = img_check_corr_clusters(p);
 	if (!ret && corr)
 		ret = img_check_corr_lowrank(p);
 	if (!ret)
