@@ -63,6 +63,14 @@
 #define MAX_FAR_LEFT 0.8
 #define MAX_TOL_RATIO 1.2
 
+/* The clustered correction (the test's default): at most 128 nodes per
+ * cluster, every block within 8e-4 sqrt(|S_aa| |S_bb|); measured block
+ * errors against the independent dense blocks reach XXX of tol (limit
+ * 1.01: f32 storage rounds). */
+#define CLUSTER "128"
+#define CLUSTER_TOL "8e-4"
+#define MAX_BLOCK_ERR 1.01
+
 #define N_TICKS 300
 #define SCALE 0.05              /* mesh_scale: tube 2 cm, ring 5 cm */
 
@@ -285,10 +293,68 @@ static double step_error(const struct irdm_image *img, struct irdm_model *m, con
 	return e;
 }
 
+/* Squared distance between two columns' rest positions. */
+static double dist2(const struct irdm_image *img, uint32_t a, uint32_t b)
+{
+	const float *p = img->nodes[img->columns[a]].pos_m, *q = img->nodes[img->columns[b]].pos_m;
+
+	return pow(q[0] - p[0], 2) + pow(q[1] - p[1], 2) + pow(q[2] - p[2], 2);
+}
+
+/* The column nearest to A whose block with A is a low-rank pair's (other
+ * than skip): the largest block the truncation approximates. */
+static uint32_t nearest_lowrank(const struct irdm_image *img, uint32_t a, uint32_t skip)
+{
+	uint32_t la, lc, ca = irdm_image_corr_cluster(img, a, &la), best_c = a;
+	double best = 1e300;
+
+	for (uint32_t c = 0; c < img->meta->n_cols; c++) {
+		uint32_t cc = irdm_image_corr_cluster(img, c, &lc);
+		if (irdm_image_corr_pair(img, ca, cc)->rank != IRDM_CORR_PAIR_DENSE &&
+		    c != skip && dist2(img, a, c) < best) {
+			best = dist2(img, a, c);
+			best_c = c;
+		}
+	}
+	return best_c;
+}
+
+/*
+ * The clustered correction: no block is dropped, every one is within tol
+ * of the dense one (the precompute measured it; here against blocks solved
+ * independently).  Steps at A, its neighbour B and (1) the farthest
+ * column, (2) the nearest column in a low-rank pair with A, (3) with B
+ * replaced by the nearest low-rank column of C: three truncated blocks.
+ */
+static void clustered_steps(const struct irdm_image *img, struct irdm_model *m, uint32_t col[3],
+			    double tol)
+{
+	static const char *const what[3] = { "A, its neighbour B and the farthest C",
+					     "A, B and the nearest C in a low-rank pair with A",
+					     "A, C and C's nearest D in a low-rank pair with C" };
+	double rho, left, worst = 0;
+
+	for (int k = 0; k < 3; k++) {
+		if (k == 1)
+			col[2] = nearest_lowrank(img, col[0], col[1]);
+		if (k == 2)
+			col[1] = nearest_lowrank(img, col[2], col[0]);
+		double e = step_error(img, m, col, &rho, &left);
+		print_message("step at %s (columns %u, %u, %u; %.1f and %.1f mm from A): relative RMS force error %.2e (limit %.0e); largest off-diagonal block %.3g, off by %.3g (tol %g)\n",
+			      what[k], col[0], col[1], col[2], 1e3 * sqrt(dist2(img, col[0], col[1])),
+			      1e3 * sqrt(dist2(img, col[0], col[2])), e, MAX_FORCE_RMS, rho, left, tol);
+		assert_true(left <= MAX_BLOCK_ERR * tol);
+		assert_true(e <= MAX_FORCE_RMS);
+		worst = fmax(worst, e);
+	}
+	print_message("clustered: %u clusters, largest rank %u; worst force error %.2e\n",
+		      img->corr_clusters->n_clusters, img->corr_clusters->max_rank, worst);
+}
+
 static void test_torus(void **state)
 {
 	const char *size = getenv("IRDM_TORUS"), *tol = getenv("IRDM_TORUS_TOL");
-	const char *rank = getenv("IRDM_TORUS_RANK");
+	const char *rank = getenv("IRDM_TORUS_RANK"), *cluster = getenv("IRDM_TORUS_CLUSTER");
 	bool small = size && !strcmp(size, "small");
 	char off[192], scene[192], path[192], text[512];
 	struct irdm_image img;
@@ -301,9 +367,14 @@ static void test_torus(void **state)
 	snprintf(scene, sizeof(scene), "%s/torus.scene", dir);
 	snprintf(path, sizeof(path), "%s/torus.img", dir);
 	write_torus(off, 33, 17);
+	if (!cluster)
+		cluster = CLUSTER;
+	if (!tol)
+		tol = strcmp(cluster, "0") ? CLUSTER_TOL : NULL;
 	snprintf(text, sizeof(text),
-		 "name = torus\nmesh = %s\nmesh_scale = %g\nfloating = yes\ntarget_nodes = %d\n%s%s%s%s%s%s",
-		 off, SCALE, small ? 800 : 3000, tol ? "static_correction_tol = " : "",
+		 "name = torus\nmesh = %s\nmesh_scale = %g\nfloating = yes\ntarget_nodes = %d\n"
+		 "static_correction_cluster = %s\n%s%s%s%s%s%s",
+		 off, SCALE, small ? 800 : 3000, cluster, tol ? "static_correction_tol = " : "",
 		 tol ? tol : "", tol ? "\n" : "", rank ? "static_correction_rank = " : "",
 		 rank ? rank : "", rank ? "\n" : "");
 	tf_write_text(scene, text);
@@ -321,6 +392,12 @@ static void test_torus(void **state)
 	const double pa_f[3] = { qa[0], qa[1], qa[2] };
 	col[1] = column_near(&img, pa_f, col[0], false);
 	col[2] = column_near(&img, pa_f, col[0], true);
+	if (img.corr_clusters) {
+		clustered_steps(&img, &m, col, strtod(tol, NULL));
+		irdm_model_free(&m);
+		irdm_image_unmap(&img);
+		return;
+	}
 	assert_true(irdm_image_corr_block(&img, col[0], col[1]) >= 0);  /* neighbours kept */
 	double e_far = step_error(&img, &m, col, &rho, &left);
 	print_message("step at A, its neighbour B and the farthest C (columns %u, %u, %u of %u): relative RMS force error %.2e (limit %.0e), largest dropped block %.3g, %.3g left with the far field of rank %u\n",
