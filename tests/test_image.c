@@ -138,6 +138,20 @@ static void fixture_buffer(const struct img_fixture *fx, void **buf,
 	assert_int_equal(img_fixture_buffer(fx, buf, size), 0);
 }
 
+/* The fixture's image in a new buffer (the caller frees it), parsed into
+ * img, which must succeed. */
+static void *parse_fixture(const struct img_fixture *fx, struct irdm_image *img)
+{
+	char err[256];
+	size_t size;
+	void *buf;
+
+	fixture_buffer(fx, &buf, &size);
+	if (irdm_image_parse(buf, size, img, err, sizeof(err)))
+		fail_msg("fixture image refused: %s", err);
+	return buf;
+}
+
 static void small_fir(struct img_fixture *fx)
 {
 	assert_int_equal(img_fixture_fir(fx, IRDM_ELEM_F32, 6, 2, 4), 0);
@@ -554,16 +568,13 @@ static void test_modal_lowrank_roundtrip(void **state)
 	const uint32_t K = IRDM_SEC_STATIC_CORR_LOWRANK, R = 3;
 	struct img_fixture fx;
 	struct irdm_image img;
-	char err[256];
-	size_t size;
 	void *buf;
 
 	(void)state;
 	for (size_t p = 0; p < 3; p++) {
 		assert_int_equal(img_fixture_modal(&fx, precs[p], 5, 2, 3, IRDM_META_STATIC_CORR), 0);
 		assert_int_equal(img_fixture_lowrank(&fx, R), 0);
-		fixture_buffer(&fx, &buf, &size);
-		assert_int_equal(irdm_image_parse(buf, size, &img, err, sizeof(err)), IRDM_OK);
+		buf = parse_fixture(&fx, &img);
 		assert_int_equal(img.corr_rank, R);
 		for (uint32_t c = 0; c < 2; c++)
 			for (uint32_t r = 0; r < 2; r++) {
@@ -585,8 +596,7 @@ static void test_modal_lowrank_roundtrip(void **state)
 	}
 	/* without the section: no far field, the kept block alone */
 	small_modal(&fx);
-	fixture_buffer(&fx, &buf, &size);
-	assert_int_equal(irdm_image_parse(buf, size, &img, err, sizeof(err)), IRDM_OK);
+	buf = parse_fixture(&fx, &img);
 	assert_int_equal(img.corr_rank, 0);
 	assert_null(img.corr_u);
 	free(buf);
@@ -669,8 +679,6 @@ static void test_modal_clusters_roundtrip(void **state)
 	double S[21 * 21];
 	struct img_fixture fx;
 	struct irdm_image img;
-	char err[256];
-	size_t size;
 	void *buf;
 
 	(void)state;
@@ -684,8 +692,7 @@ static void test_modal_clusters_roundtrip(void **state)
 		for (uint32_t r = 0; r < 3 * NC; r++)
 			for (uint32_t c = 0; c < r; c++)
 				assert_true(S[r * 3 * NC + c] == S[c * 3 * NC + r]);
-		fixture_buffer(&fx, &buf, &size);
-		assert_int_equal(irdm_image_parse(buf, size, &img, err, sizeof(err)), IRDM_OK);
+		buf = parse_fixture(&fx, &img);
 		assert_non_null(img.corr_clusters);
 		assert_int_equal(img.corr_clusters->n_clusters, runs[n].n_clusters);
 		check_cluster_tables(&img, NC, runs[n].n_clusters, runs[n].rank);
@@ -706,8 +713,7 @@ static void test_modal_clusters_roundtrip(void **state)
 	}
 	/* without the section: no views */
 	small_modal(&fx);
-	fixture_buffer(&fx, &buf, &size);
-	assert_int_equal(irdm_image_parse(buf, size, &img, err, sizeof(err)), IRDM_OK);
+	buf = parse_fixture(&fx, &img);
 	assert_null(img.corr_clusters);
 	assert_null(img.corr_cl_values);
 	free(buf);
@@ -1338,11 +1344,17 @@ static void w_modes_short(struct irdm_image_writer *w)
 			w->sec[i].size -= 64;
 }
 
-static void w_fir_elem(struct irdm_image_writer *w)
+/* The element type section kind declares in its table entry. */
+static void w_set_elem(struct irdm_image_writer *w, uint32_t kind, uint32_t elem)
 {
 	for (unsigned i = 0; i < w->n; i++)
-		if (w->sec[i].kind == IRDM_SEC_FIR)
-			w->sec[i].elem = IRDM_ELEM_U32;
+		if (w->sec[i].kind == kind)
+			w->sec[i].elem = elem;
+}
+
+static void w_fir_elem(struct irdm_image_writer *w)
+{
+	w_set_elem(w, IRDM_SEC_FIR, IRDM_ELEM_U32);
 }
 
 #define FX(name, stmt) \
@@ -1435,16 +1447,18 @@ FX(m_lr_lambda_nan, lowrank_values(fx)[1] = NAN)
 FX(m_lr_u_inf, lowrank_values(fx)[2 + 2 * (3 + 2)] = INFINITY)    /* U[5][0] */
 FX(m_lr_short, (with_lowrank(fx), fx->lowrank_bytes = 8))
 FX(m_lr_long, (with_lowrank(fx), fx->lowrank_bytes -= 8))
-/* the far field without the correction it belongs to */
-static void m_lr_no_corr(struct img_fixture *fx)
+/* The modal fixture without its static correction (flag and sections). */
+static void drop_corr(struct img_fixture *fx)
 {
-	with_lowrank(fx);
 	fx->meta.flags &= ~(uint32_t)IRDM_META_STATIC_CORR;
 	free(fx->static_corr);
 	free(fx->corr_index);
 	fx->static_corr = NULL;
 	fx->corr_index = NULL;
 }
+
+/* the far field without the correction it belongs to */
+FX(m_lr_no_corr, (with_lowrank(fx), drop_corr(fx)))
 
 static const uint8_t lowrank_bytes[16 + 8 * 2 * 7] = { 2 };   /* rank 2, zeros */
 
@@ -1456,9 +1470,7 @@ static void w_add_lowrank(struct irdm_image_writer *w)
 
 static void w_lowrank_f64(struct irdm_image_writer *w)
 {
-	for (unsigned i = 0; i < w->n; i++)
-		if (w->sec[i].kind == IRDM_SEC_STATIC_CORR_LOWRANK)
-			w->sec[i].elem = IRDM_ELEM_F64;
+	w_set_elem(w, IRDM_SEC_STATIC_CORR_LOWRANK, IRDM_ELEM_F64);
 }
 
 static void m_lr_elem(struct img_fixture *fx)
@@ -1530,15 +1542,7 @@ FX(m_cl_nan, cl_values(fx)[3] = NAN)
 FX(m_cl_inf, cl_values(fx)[29] = -INFINITY)
 FX(m_cl_asymmetric, cl_values(fx)[21 + 3 * 1 + 2] += 1.0 / 1024)
 /* the clusters without the correction they belong to */
-static void m_cl_no_corr(struct img_fixture *fx)
-{
-	clusters(fx);
-	fx->meta.flags &= ~(uint32_t)IRDM_META_STATIC_CORR;
-	free(fx->static_corr);
-	free(fx->corr_index);
-	fx->static_corr = NULL;
-	fx->corr_index = NULL;
-}
+FX(m_cl_no_corr, (clusters(fx), drop_corr(fx)))
 
 static const uint8_t clusters_bytes[32] = { 1 };  /* 1 cluster, tables missing */
 
@@ -1550,9 +1554,7 @@ static void w_add_clusters(struct irdm_image_writer *w)
 
 static void w_clusters_f64(struct irdm_image_writer *w)
 {
-	for (unsigned i = 0; i < w->n; i++)
-		if (w->sec[i].kind == IRDM_SEC_STATIC_CORR_CLUSTERS)
-			w->sec[i].elem = IRDM_ELEM_F64;
+	w_set_elem(w, IRDM_SEC_STATIC_CORR_CLUSTERS, IRDM_ELEM_F64);
 }
 
 enum base { FIR, MODAL };
