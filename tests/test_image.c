@@ -1736,6 +1736,30 @@ static void test_semantic_validation(void **state)
 	current_case = "";
 }
 
+/* A newer minor may give STATIC_CORR_CLUSTERS' reserved words (header and
+ * pair) a meaning: they are ignored there, refused at our own minor. */
+static void test_clusters_reserved_newer_minor(void **state)
+{
+	struct irdm_image_header h;
+	struct img_fixture fx;
+	size_t size;
+	uint8_t *buf;
+
+	(void)state;
+	small_modal(&fx);
+	cl_hdr(&fx)->reserved[0] = 1;
+	cl_pairs(&fx)[1].reserved = 1;
+	fixture_buffer(&fx, (void **)&buf, &size);
+	expect_parse(buf, size, IRDM_EFORMAT, "STATIC_CORR_CLUSTERS: reserved header words not 0");
+	h = get_header(buf);
+	h.version_minor = IRDM_IMAGE_VERSION_MINOR + 1;
+	put_header(buf, &h);
+	img_fixture_reseal(buf, size);
+	expect_parse(buf, size, IRDM_OK, NULL);
+	free(buf);
+	img_fixture_free(&fx);
+}
+
 /* Empty payloads (no surface) are valid, also as the last section, where
  * the file ends at the (aligned) offset of the empty payload. */
 static void test_empty_section(void **state)
@@ -1975,6 +1999,7 @@ int main(void)
 		cmocka_unit_test(test_unaligned_buffer),
 		cmocka_unit_test(test_unknown_kind),
 		cmocka_unit_test(test_semantic_validation),
+		cmocka_unit_test(test_clusters_reserved_newer_minor),
 		cmocka_unit_test(test_empty_section),
 		cmocka_unit_test(test_f16_nan_in_fir),
 		cmocka_unit_test(test_strerror),
