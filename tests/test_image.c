@@ -720,6 +720,41 @@ static void test_modal_clusters_roundtrip(void **state)
 	img_fixture_free(&fx);
 }
 
+/* Exact transposition must not lean on exact arithmetic: with every value
+ * of the clusters made inexact (x -> x (1 + sqrt(2) 1e-3) + 1/3, which
+ * keeps the self pairs symmetric), block (f, d) is still block (d, f)
+ * transposed to the bit, rank 6 cross pairs rounding at every term. */
+static void test_clusters_transpose_inexact(void **state)
+{
+	const uint32_t NC = 7;
+	struct img_fixture fx;
+	struct irdm_image img;
+	double *v;
+	void *buf;
+
+	(void)state;
+	assert_int_equal(img_fixture_modal(&fx, IRDM_ELEM_F64, 8, NC, 3, IRDM_META_STATIC_CORR), 0);
+	symmetric_kept(&fx);
+	assert_int_equal(img_fixture_lowrank(&fx, 2), 0);
+	assert_int_equal(img_fixture_clusters(&fx, 3, 6, NULL), 0);
+	v = (double *)((uint8_t *)fx.corr_clusters + img_fixture_clusters_tables(3, NC) +
+		       6 * sizeof(struct irdm_corr_pair));
+	for (uint64_t i = 0; i < ((struct irdm_corr_clusters_header *)fx.corr_clusters)->n_values; i++)
+		v[i] = v[i] * (1 + sqrt(2) * 1e-3) + 1.0 / 3;
+	buf = parse_fixture(&fx, &img);
+	for (uint32_t f = 0; f < NC; f++)
+		for (uint32_t d = 0; d < NC; d++) {
+			double blk[9], mirror[9];
+			irdm_image_corr_value(&img, f, d, blk);
+			irdm_image_corr_value(&img, d, f, mirror);
+			for (uint32_t i = 0; i < 3; i++)
+				for (uint32_t j = 0; j < 3; j++)
+					assert_true(blk[3 * i + j] == mirror[3 * j + i]);
+		}
+	free(buf);
+	img_fixture_free(&fx);
+}
+
 /* Grounded modal image without static correction, f16. */
 static void test_modal_grounded_f16_roundtrip(void **state)
 {
@@ -1985,6 +2020,7 @@ int main(void)
 		cmocka_unit_test(test_modal_floating_roundtrip),
 		cmocka_unit_test(test_modal_lowrank_roundtrip),
 		cmocka_unit_test(test_modal_clusters_roundtrip),
+		cmocka_unit_test(test_clusters_transpose_inexact),
 		cmocka_unit_test(test_modal_grounded_f16_roundtrip),
 		cmocka_unit_test(test_map_lock),
 		cmocka_unit_test(test_map_errors),
