@@ -91,6 +91,13 @@ static uint64_t pair_values(uint32_t rank, uint64_t rows, uint64_t cols)
 	return rank == IRDM_CORR_PAIR_DENSE ? rows * cols : (uint64_t)rank * (rows + cols);
 }
 
+/* Pair (a, b)'s matrix within the left values; divides so that no product
+ * of 3 n_cols-sized factors can wrap (next never passes n_values). */
+static bool pair_fits(uint32_t rank, uint64_t rows, uint64_t cols, uint64_t left)
+{
+	return rank == IRDM_CORR_PAIR_DENSE ? rows <= left / cols : rank <= left / (rows + cols);
+}
+
 static int check_pairs(struct parse *p, const struct irdm_corr_clusters_header *h,
 		       const uint32_t *start, const struct irdm_corr_pair *pairs)
 {
@@ -119,6 +126,11 @@ static int check_pairs(struct parse *p, const struct irdm_corr_clusters_header *
 				return img_fail(p, IRDM_EFORMAT,
 						"STATIC_CORR_CLUSTERS: pair (%u, %u) starts at value %llu, expected %llu (pairs follow each other)",
 						a, b, (unsigned long long)q->offset,
+						(unsigned long long)next);
+			if (!pair_fits(q->rank, ra, rb, h->n_values - next))
+				return img_fail(p, IRDM_EFORMAT,
+						"STATIC_CORR_CLUSTERS: pair (%u, %u) runs past the header's %llu values (from value %llu)",
+						a, b, (unsigned long long)h->n_values,
 						(unsigned long long)next);
 			next += pair_values(q->rank, ra, rb);
 		}

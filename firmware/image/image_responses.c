@@ -92,6 +92,8 @@ int img_check_fir(struct parse *p)
 	if (!ret)
 		ret = img_check_presence(p, IRDM_SEC_STATIC_CORR_LOWRANK, false, "FIR image");
 	if (!ret)
+		ret = img_check_presence(p, IRDM_SEC_STATIC_CORR_CLUSTERS, false, "FIR image");
+	if (!ret)
 		ret = img_check_presence(p, IRDM_SEC_EXACT_HEAD, false, "FIR image");
 	if (!ret)
 		ret = img_check_shape(p, IRDM_SEC_FIR, f, 4, "n_cols x n_nodes x T x 9");
