@@ -15,8 +15,10 @@
  *    itself in seccomp strict mode, where any system call but read, write,
  *    _exit and sigreturn kills it with SIGKILL.
  *
- * The scenario: modal (300 modes + static correction), FIR (T = 500) and
- * hybrid (300 modes + an exact head of 32 + 32 samples) images of the
+ * The scenario: modal (300 modes + static correction), FIR (T = 500),
+ * hybrid (300 modes + an exact head of 32 + 32 samples) and clustered
+ * (300 modes + the clustered correction: dense and low-rank pairs read
+ * whenever a contact begins) images of the
  * paper's cuboid at a modest resolution, the haptic
  * configuration (virtual coupling + passivity control + force limit), two
  * contacts -- a push on a top node that slides to a neighbouring node every
@@ -336,7 +338,7 @@ static void faults(long *minflt, long *majflt)
 /* ---- images and the scenario ---- */
 
 static char dir[64];
-static struct irdm_image modal_img, fir_img, hybrid_img;
+static struct irdm_image modal_img, fir_img, hybrid_img, clustered_img;
 
 struct rig {
 	const struct irdm_image *img;
@@ -642,6 +644,12 @@ static void test_hybrid_alloc_and_fault_free(void **state)
 	alloc_and_fault_free(&hybrid_img);
 }
 
+static void test_clustered_alloc_and_fault_free(void **state)
+{
+	(void)state;
+	alloc_and_fault_free(&clustered_img);
+}
+
 /* ---- proof 3: no system call ---- */
 
 /* The ticks in seccomp strict mode (support/strict_mode.h). */
@@ -713,6 +721,12 @@ static void test_hybrid_no_system_call(void **state)
 {
 	(void)state;
 	no_system_call(&hybrid_img);
+}
+
+static void test_clustered_no_system_call(void **state)
+{
+	(void)state;
+	no_system_call(&clustered_img);
 }
 
 /* The harness can fail: a system call in strict mode does kill the child. */
@@ -823,6 +837,15 @@ static int setup(void **state)
 	snprintf(p2, sizeof(p2), "%s/hybrid.img", dir);
 	efx_image(&hybrid_img, p2, "resolution", "6,6,12", "representation", "modal:300",
 		  "exact_head", "32", "touch", "z>=0.2", "display", "touch", NULL);
+	/* the clustered correction: clusters of at most 8 of the top face's
+	 * columns, so that the contacts' blocks come from dense and low-rank
+	 * pairs */
+	snprintf(p2, sizeof(p2), "%s/clustered.img", dir);
+	efx_image(&clustered_img, p2, "resolution", "6,6,12", "representation", "modal:300",
+		  "static_correction_cluster", "8", "static_correction_tol", "1e-3", "touch", "z>=0.2",
+		  "display", "touch", NULL);
+	if (!clustered_img.corr_clusters)
+		return -1;
 	/*
 	 * Lock what is mapped and what will be.  Best effort: without it the
 	 * fault check can still pass on an idle machine, and says "NOT
@@ -848,6 +871,7 @@ static int teardown(void **state)
 	irdm_image_unmap(&modal_img);
 	irdm_image_unmap(&fir_img);
 	irdm_image_unmap(&hybrid_img);
+	irdm_image_unmap(&clustered_img);
 	snprintf(cmd, sizeof(cmd), "rm -rf '%s'", dir);
 	return system(cmd) ? -1 : 0;
 }
@@ -863,6 +887,8 @@ int main(void)
 		cmocka_unit_test(test_fir_no_system_call),
 		cmocka_unit_test(test_hybrid_alloc_and_fault_free),
 		cmocka_unit_test(test_hybrid_no_system_call),
+		cmocka_unit_test(test_clustered_alloc_and_fault_free),
+		cmocka_unit_test(test_clustered_no_system_call),
 	};
 
 	return cmocka_run_group_tests(tests, setup, teardown);
