@@ -5,7 +5,8 @@
  * checks make every read safe and bounded: the member lists a permutation
  * with its inverse, each pair's matrix inside the values and the values
  * tiling them, ranks no higher than the tick can afford, self pairs dense
- * and exactly symmetric (R[0] must be), every value finite.
+ * (stored as their upper triangle: symmetric, as R[0] must be), every
+ * value finite.
  */
 #include <stdbool.h>
 #include <stdint.h>
@@ -85,16 +86,21 @@ static int check_tables(struct parse *p, uint32_t n_clusters, const uint32_t *st
 	return IRDM_OK;
 }
 
-/* Elements of pair (a, b)'s matrix. */
-static uint64_t pair_values(uint32_t rank, uint64_t rows, uint64_t cols)
+/* Elements of pair (a, b)'s matrix (a self pair: its upper triangle). */
+static uint64_t pair_values(uint32_t rank, uint64_t rows, uint64_t cols, bool self)
 {
+	if (self)
+		return rows * (rows + 1) / 2;
 	return rank == IRDM_CORR_PAIR_DENSE ? rows * cols : (uint64_t)rank * (rows + cols);
 }
 
-/* Pair (a, b)'s matrix within the left values; divides so that no product
- * of 3 n_cols-sized factors can wrap (next never passes n_values). */
-static bool pair_fits(uint32_t rank, uint64_t rows, uint64_t cols, uint64_t left)
+/* Pair (a, b)'s matrix within the left values; divides (or bounds the
+ * factors first) so that no product of 3 n_cols-sized factors can wrap
+ * (next never passes n_values). */
+static bool pair_fits(uint32_t rank, uint64_t rows, uint64_t cols, uint64_t left, bool self)
 {
+	if (self)
+		return rows < (1ull << 31) && rows * (rows + 1) / 2 <= left;
 	return rank == IRDM_CORR_PAIR_DENSE ? rows <= left / cols : rank <= left / (rows + cols);
 }
 
@@ -127,12 +133,12 @@ static int check_pairs(struct parse *p, const struct irdm_corr_clusters_header *
 						"STATIC_CORR_CLUSTERS: pair (%u, %u) starts at value %llu, expected %llu (pairs follow each other)",
 						a, b, (unsigned long long)q->offset,
 						(unsigned long long)next);
-			if (!pair_fits(q->rank, ra, rb, h->n_values - next))
+			if (!pair_fits(q->rank, ra, rb, h->n_values - next, a == b))
 				return img_fail(p, IRDM_EFORMAT,
 						"STATIC_CORR_CLUSTERS: pair (%u, %u) runs past the header's %llu values (from value %llu)",
 						a, b, (unsigned long long)h->n_values,
 						(unsigned long long)next);
-			next += pair_values(q->rank, ra, rb);
+			next += pair_values(q->rank, ra, rb, a == b);
 		}
 	if (next != h->n_values)
 		return img_fail(p, IRDM_EFORMAT,
@@ -141,28 +147,16 @@ static int check_pairs(struct parse *p, const struct irdm_corr_clusters_header *
 	return IRDM_OK;
 }
 
-/* Every value finite; every self pair exactly symmetric. */
+/* Every value finite. */
 static int check_values(struct parse *p, const struct irdm_corr_clusters_header *h,
-			const uint32_t *start, const struct irdm_corr_pair *pairs,
 			const uint8_t *values)
 {
 	uint32_t prec = p->meta.precision;
-	uint64_t k = 0;
 
 	for (uint64_t i = 0; i < h->n_values; i++)
 		if (!f64_finite(irdm_elem_get(values, prec, (size_t)i)))
 			return img_fail(p, IRDM_EFORMAT, "STATIC_CORR_CLUSTERS: value %llu is not finite",
 					(unsigned long long)i);
-	for (uint32_t a = 0; a < h->n_clusters; k += h->n_clusters - a, a++) {
-		size_t n = 3 * (size_t)(start[a + 1] - start[a]), o = (size_t)pairs[k].offset;
-		for (size_t i = 0; i < n; i++)
-			for (size_t j = 0; j < i; j++)
-				if (irdm_elem_get(values, prec, o + i * n + j) !=
-				    irdm_elem_get(values, prec, o + j * n + i))
-					return img_fail(p, IRDM_EFORMAT,
-							"STATIC_CORR_CLUSTERS: self pair %u is not symmetric (entry %zu, %zu)",
-							a, i, j);
-	}
 	return IRDM_OK;
 }
 
@@ -201,8 +195,7 @@ int img_check_corr_clusters(struct parse *p)
 	if (!ret)
 		ret = check_pairs(p, &h, start, pairs);
 	if (!ret)
-		ret = check_values(p, &h, start, pairs,
-				   pl + tb + sizeof(struct irdm_corr_pair) * n_pairs(h.n_clusters));
+		ret = check_values(p, &h, pl + tb + sizeof(struct irdm_corr_pair) * n_pairs(h.n_clusters));
 	if (ret)
 		return ret;
 	p->img.corr_clusters = (const struct irdm_corr_clusters_header *)pl;
@@ -268,7 +261,10 @@ void img_corr_clusters_add(const struct irdm_image *img, uint32_t col_force, uin
 		for (size_t y = 0; y < 3; y++) {
 			size_t r = 3 * (size_t)lr + (swap ? y : x), c = 3 * (size_t)lc + (swap ? x : y);
 			double s = 0;
-			if (q->rank == IRDM_CORR_PAIR_DENSE) {
+			if (ar == ac) {
+				size_t i = r < c ? r : c, j = r < c ? c : r;
+				s = irdm_elem_get(v, prec, o + i * nr - i * (i ? i - 1 : 0) / 2 + (j - i));
+			} else if (q->rank == IRDM_CORR_PAIR_DENSE) {
 				s = irdm_elem_get(v, prec, o + r * ncl + c);
 			} else {
 				size_t ur = o + r * q->rank, vc = o + nr * q->rank + c * q->rank;

@@ -10,7 +10,7 @@
  * builds the same target with the checksum comparisons compiled out.
  *
  * Seeds (tests/fuzz/seeds/, the same in both targets' folders): valid
- * images of each kind.  clusters_f16.img (format 2.2, 2600 bytes) is the
+ * images of each kind.  clusters_f16.img (format 2.2, 2536 bytes) is the
  * test fixture's img_fixture_modal(f16, 6 nodes, 5 columns, 2 modes,
  * STATIC_CORR) with img_fixture_lowrank(rank 1) and
  * img_fixture_clusters(3 clusters, cross pairs of rank 2), written by

@@ -302,6 +302,13 @@ static void cl_put_pair(const struct cl_layout *l, uint32_t prec, uint32_t a, ui
 	uint64_t ra = 3 * (uint64_t)(l->start[a + 1] - l->start[a]);
 	uint64_t rb = 3 * (uint64_t)(l->start[b + 1] - l->start[b]);
 
+	if (a == b) {           /* the upper triangle, row by row */
+		for (uint64_t i = 0, k = 0; i < ra; i++)
+			for (uint64_t j = i; j < rb; j++)
+				irdm_elem_put(values, prec, o + k++,
+					      cl_s(l, cl_dof(l, a, i), cl_dof(l, b, j)));
+		return;
+	}
 	if (dense) {
 		for (uint64_t i = 0; i < ra; i++)
 			for (uint64_t j = 0; j < rb; j++)
@@ -335,7 +342,7 @@ static uint64_t cl_fill_pairs(const struct cl_layout *l, uint32_t prec,
 				pairs[k].rank = dense ? IRDM_CORR_PAIR_DENSE : l->rank;
 				cl_put_pair(l, prec, a, b, dense, values, next);
 			}
-			next += dense ? ra * rb : l->rank * (ra + rb);
+			next += a == b ? ra * (ra + 1) / 2 : dense ? ra * rb : l->rank * (ra + rb);
 		}
 	return next;
 }

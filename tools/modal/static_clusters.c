@@ -273,16 +273,18 @@ static void shares(struct svd *v)
 	}
 }
 
-/* The dense pair, row-major; a self pair made exactly symmetric. */
+/* The dense pair, row-major; a self pair (m = n) its symmetric part's
+ * upper triangle, row by row. */
 static double *store_dense(const double *A, size_t m, size_t n, bool self)
 {
-	double *p = malloc(m * n * sizeof(double));
+	double *p = malloc((self ? m * (m + 1) / 2 : m * n) * sizeof(double));
+	size_t k = 0;
 
 	if (!p)
 		return NULL;
 	for (size_t i = 0; i < m; i++)
-		for (size_t j = 0; j < n; j++)
-			p[i * n + j] = self ? 0.5 * (A[i + j * m] + A[j + i * m]) : A[i + j * m];
+		for (size_t j = self ? i : 0; j < n; j++)
+			p[k++] = self ? 0.5 * (A[i + j * m] + A[j + i * m]) : A[i + j * m];
 	return p;
 }
 
@@ -408,7 +410,8 @@ static int pack(struct sweep *s)
 		for (size_t b = a; b < cl->n_clusters; b++, q++) {
 			size_t m = 3 * cl_size(cl, a), n = 3 * cl_size(cl, b);
 			cl->offset[q] = at;
-			at += cl->rank[q] == IRDM_CORR_PAIR_DENSE ? m * n : cl->rank[q] * (m + n);
+			at += a == b ? m * (m + 1) / 2 :
+			      cl->rank[q] == IRDM_CORR_PAIR_DENSE ? m * n : cl->rank[q] * (m + n);
 		}
 	cl->n_values = at;
 	cl->values = malloc((at ? at : 1) * sizeof(double));
@@ -570,7 +573,10 @@ void irdm_corr_clusters_block(const struct irdm_corr_clusters *cl, size_t col_f,
 		for (size_t y = 0; y < 3; y++) {
 			size_t r = 3 * lr + (swap ? y : x), c = 3 * lc + (swap ? x : y);
 			double s = 0;
-			if (k == IRDM_CORR_PAIR_DENSE)
+			if (ar == ac) {
+				size_t i = r < c ? r : c, j = r < c ? c : r;
+				s = cl->values[o + i * nr - i * (i ? i - 1 : 0) / 2 + (j - i)];
+			} else if (k == IRDM_CORR_PAIR_DENSE)
 				s = cl->values[o + r * ncl + c];
 			else
 				for (size_t t = 0; t < k; t++)

@@ -250,9 +250,11 @@ struct irdm_corr_lowrank_header {           /* 16 bytes */
  * values[offset] it is, for rank IRDM_CORR_PAIR_DENSE, the 3|a| x 3|b|
  * matrix row-major; else U[3|a|][rank] then V[3|b|][rank], the matrix
  * U V^T (rank 0: zero).  Pair (b, a) is pair (a, b) transposed, so every
- * block (c, c') is block (c', c) transposed to the bit; a self pair (a, a)
- * is dense and exactly symmetric.  The pairs' values follow each other in
- * table order, with no gaps.
+ * block (c, c') is block (c', c) transposed to the bit.  A self pair
+ * (a, a) has rank IRDM_CORR_PAIR_DENSE and holds only its upper triangle,
+ * row by row (n = 3|a|: entry (i, j), i <= j, at i n - i (i - 1) / 2 +
+ * j - i; n (n + 1) / 2 values), so it is symmetric by construction.  The
+ * pairs' values follow each other in table order, with no gaps.
  */
 #define IRDM_CORR_CLUSTERS_MAX 4096u        /* clusters: bounds the pair table */
 #define IRDM_CORR_PAIR_DENSE 0xffffffffu    /* irdm_corr_pair.rank of a dense pair */
