@@ -18,7 +18,7 @@ struct pair_view {
 	size_t disp_off, force_off;         /* low-rank: S(a, b) = D F^T, D [3|a|][rank] */
 };
 
-static void pair_view(const struct irdm_image *img, uint32_t a, uint32_t b,
+static void view_pair(const struct irdm_image *img, uint32_t a, uint32_t b,
 		      struct pair_view *v)
 {
 	const struct irdm_corr_pair *q = irdm_image_corr_pair(img, a, b);
@@ -90,7 +90,7 @@ void deform_clusters(const struct irdm_deform_worker *w, const struct irdm_force
 		uint32_t j, b = irdm_image_corr_cluster(img, f->col[e], &j);
 		for (uint32_t a = 0; a < nC; a++) {
 			struct pair_view v;
-			pair_view(img, a, b, &v);
+			view_pair(img, a, b, &v);
 			if (v.rank == IRDM_CORR_PAIR_DENSE)
 				dense_pair(w, &v, members + st[a], st[a + 1] - st[a], j,
 					   f->f_n[e], pos);
