@@ -493,12 +493,14 @@ static void clusters(int which, double tol_corr, double tol_all)
  * correction is summed in double from the image's values on both sides
  * (only the order differs: U (V^T f) against (U V^T) f), so it agrees to
  * double rounding for either precision; Phi y is an f32 BLAS product on an
- * f32 image.
+ * f32 image.  Measured (gcc, clang, sanitizers alike): f64 1.3e-15 alone,
+ * 8.3e-16 with Phi y; f32 1.0e-15 alone, 1.2e-7 with Phi y; each bound
+ * about 8x above.
  */
 static void test_clusters_f64(void **state)
 {
 	(void)state;
-	clusters(IMG_CL64, 1e-14, 1e-14);
+	clusters(IMG_CL64, 1e-14, 8e-15);
 }
 
 static void test_clusters_f32(void **state)
