@@ -5,7 +5,7 @@
  * member j) displaces every cluster a by S(a, b)[:, 3j..3j+2] f.  A pair is
  * stored once, for (min, max), so S(a, b) with a > b is the stored
  * matrix transposed: the strides (dense) or the factors U, V (low-rank)
- * swap roles.  Every pair of the force's cluster is read, O(3 n_cols) per
+ * swap roles; a self pair (a, a) holds its upper triangle only.  Every pair of the force's cluster is read, O(3 n_cols) per
  * dense pair and O(rank (3 + 3|a|)) per low-rank one.
  */
 #include "worker_priv.h"
@@ -33,6 +33,32 @@ static void view_pair(const struct irdm_image *img, uint32_t a, uint32_t b,
 	/* stored pair (p, q): U [3|p|][rank] first, then V [3|q|][rank] */
 	v->disp_off = stored ? v->o : v->o + nb * q->rank;
 	v->force_off = stored ? v->o + na * q->rank : v->o;
+}
+
+/* Entry (r, c) of a self pair of n rows: its upper triangle, row by row. */
+static size_t tri_index(size_t n, size_t r, size_t c)
+{
+	size_t i = r < c ? r : c, j = r < c ? c : r;
+
+	return i * n - i * (i ? i - 1 : 0) / 2 + (j - i);
+}
+
+/* u[3 i + x] += S(a, a)[3 i + x][3j..3j+2] fe, over cluster a's members i. */
+static void self_pair(const struct irdm_deform_worker *w, size_t o, const uint32_t *members,
+		      size_t n_members, size_t j, const double *fe, double *pos)
+{
+	const void *S = w->img->corr_cl_values;
+	size_t n = 3 * n_members;
+
+	for (size_t i = 0; i < n_members; i++) {
+		double *u = pos + 3 * (size_t)w->img->columns[members[i]];
+		for (size_t x = 0; x < 3; x++) {
+			size_t r = 3 * i + x;
+			u[x] += irdm_elem_get(S, w->prec, o + tri_index(n, r, 3 * j)) * fe[0] +
+				irdm_elem_get(S, w->prec, o + tri_index(n, r, 3 * j + 1)) * fe[1] +
+				irdm_elem_get(S, w->prec, o + tri_index(n, r, 3 * j + 2)) * fe[2];
+		}
+	}
 }
 
 /* u[3 i + x] += S(a, b)[3 i + x][3j..3j+2] fe, over cluster a's members i. */
@@ -91,7 +117,10 @@ void deform_clusters(const struct irdm_deform_worker *w, const struct irdm_force
 		for (uint32_t a = 0; a < nC; a++) {
 			struct pair_view v;
 			view_pair(img, a, b, &v);
-			if (v.rank == IRDM_CORR_PAIR_DENSE)
+			if (a == b)
+				self_pair(w, v.o, members + st[a], st[a + 1] - st[a], j, f->f_n[e],
+					  pos);
+			else if (v.rank == IRDM_CORR_PAIR_DENSE)
 				dense_pair(w, &v, members + st[a], st[a + 1] - st[a], j,
 					   f->f_n[e], pos);
 			else
