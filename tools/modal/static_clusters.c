@@ -527,7 +527,13 @@ int irdm_static_correction_clusters(const struct irdm_fem *fem, const struct ird
 	if (!out->rank || !out->offset || !s.pair || !s.sd ||
 	    irdm_corr_modal_basis(m, col_dofs, n_cols, &s.P, &s.Ps))
 		goto out_nomem;
+	/* one BLAS thread: the pairs' SVDs and GEMMs are a few hundred wide,
+	 * where a second thread only spins (on the 2520-column torus this
+	 * stage took 11.6 s wall with one thread or two, and the whole
+	 * precompute 48 s of CPU with two) */
+	int saved = irdm_blas_serial_begin();
 	ret = sweep_all(&s, fem, floating, progress, ctx, err, errlen);
+	irdm_blas_serial_end(saved);
 	if (ret == IRDM_ENOMEM)
 		goto out_nomem;
 	if (!ret)
