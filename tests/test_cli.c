@@ -25,6 +25,7 @@
 #include "modal/response.h"
 #include "image/image_response.h"
 #include "support/engine_fixture.h"
+#include "support/image_fixture.h"
 #include "support/model_fixture.h"
 #include "support/test_files.h"
 
@@ -383,6 +384,35 @@ static void test_export_matches_library(void **state)
 }
 
 /* max |a - b| / max |a| over the numbers of two CSV texts of one shape */
+/* image info on STATIC_CORR_CLUSTERS: the counts of the fixture's section
+ * (3 clusters over 5 columns: 3 self pairs, 3 cross pairs of the rank
+ * asked) and its size as built, in its line and in the section list. */
+static void test_info_clusters(void **state)
+{
+	static const uint32_t ranks[] = { 2, IRDM_CORR_PAIR_DENSE };
+	char want[200], err[256];
+	struct img_fixture fx;
+	const char *img = path_in_dir("clusters.img");
+
+	(void)state;
+	for (size_t k = 0; k < 2; k++) {
+		bool dense = ranks[k] == IRDM_CORR_PAIR_DENSE;
+		assert_int_equal(img_fixture_modal(&fx, IRDM_ELEM_F32, 6, 5, 2, IRDM_META_STATIC_CORR), 0);
+		assert_int_equal(img_fixture_clusters(&fx, 3, ranks[k], NULL), 0);
+		assert_int_equal(img_fixture_write(&fx, img, err, sizeof(err)), 0);
+		assert_int_equal(run("image", "info", img, NULL), 0);
+		snprintf(want, sizeof(want),
+			 "\nclusters      3 over 5 columns, pairs %d dense, %d low-rank (largest rank %u), %llu bytes\n",
+			 dense ? 6 : 3, dense ? 0 : 3, dense ? 0 : ranks[k],
+			 (unsigned long long)fx.clusters_bytes);
+		if (!strstr(out_text, want))
+			fail_msg("no '%s' in: %s", want + 1, out_text);
+		snprintf(want, sizeof(want), "  STATIC_CORR_CLUSTERS bytes offset");
+		assert_non_null(strstr(out_text, want));
+		img_fixture_free(&fx);
+	}
+}
+
 static double csv_max_diff(const char *a, const char *b)
 {
 	double diff = 0, scale = 0;
@@ -606,6 +636,7 @@ int main(void)
 		cmocka_unit_test(test_failure_keeps_existing_image),
 		cmocka_unit_test(test_bad_images),
 		cmocka_unit_test(test_export_matches_library),
+		cmocka_unit_test(test_info_clusters),
 		cmocka_unit_test(test_time_domain_split_and_merge),
 		cmocka_unit_test(test_replay),
 		cmocka_unit_test(test_help_for_every_command),

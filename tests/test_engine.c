@@ -33,6 +33,9 @@ static struct irdm_image exact, trunc32;
 /* modal:300 with the dropped modes' exact head (32 + 32 samples), f32,
  * compressed as trunc32 (a head at every kept block only) */
 static struct irdm_image hybrid;
+/* modal:40 with the clustered correction (clusters of at most 8 columns,
+ * tol 1e-2, the upper half touchable), f32: every block from the clusters, dense and low-rank pairs */
+static struct irdm_image clustered;
 static struct irdm_image fir[3];                /* fir:200 f64, f32, f16 */
 static const char *const fir_prec[3] = { "f64", "f32", "f16" };
 
@@ -69,6 +72,17 @@ static int setup(void **state)
 	efx_image(&hybrid, p2, "resolution", "4,4,8", "representation", "modal:300",
 		  "precision", "f32", "touch", "z>=0.2", "static_correction_tol", "0.05",
 		  "exact_head", "32", NULL);
+	snprintf(p2, sizeof(p2), "%s/clustered.img", dir);
+	efx_image(&clustered, p2, "resolution", "4,4,8", "representation", "modal:40",
+		  "precision", "f32", "touch", "z>=0.1", "static_correction_tol", "1e-2",
+		  "static_correction_cluster", "8", NULL);
+	uint32_t n_lowrank = 0, nC = clustered.corr_clusters ? clustered.corr_clusters->n_clusters : 0;
+	for (uint32_t a = 0; a < nC; a++)
+		for (uint32_t b = a + 1; b < nC; b++)
+			n_lowrank += irdm_image_corr_pair(&clustered, a, b)->rank != IRDM_CORR_PAIR_DENSE;
+	print_message("clustered: %u clusters, %u low-rank pairs\n", nC, n_lowrank);
+	if (!n_lowrank)
+		return -1;      /* the tick must read low-rank pairs */
 	uint32_t nc = trunc32.meta->n_cols;
 	print_message("modal 40: %u of %u static-correction blocks kept, far field rank %u\n",
 		      trunc32.corr_start[nc], nc * nc, trunc32.corr_rank);
@@ -90,6 +104,7 @@ static int teardown(void **state)
 	irdm_image_unmap(&exact);
 	irdm_image_unmap(&trunc32);
 	irdm_image_unmap(&hybrid);
+	irdm_image_unmap(&clustered);
 	for (int k = 0; k < 3; k++)
 		irdm_image_unmap(&fir[k]);
 	snprintf(cmd, sizeof(cmd), "rm -rf '%s'", dir);
@@ -274,6 +289,8 @@ static void test_step(void **state)
 	node_site(&hybrid, top, &s);
 	compare("step, hybrid 300 + head 32 f32", &hybrid, &s, 1, N_STEP, u, TOL_HYBRID);
 	hybrid_paths(&s, u);
+	node_site(&clustered, top, &s);
+	compare("step, modal 40 + clustered corr f32", &clustered, &s, 1, N_STEP, u, TOL_MODAL_F32);
 	free(u);
 }
 
@@ -304,10 +321,12 @@ static void test_two_points(void **state)
 	(void)state;
 	for (size_t t = 0; t < N; t++)
 		u[6 * t + 5] = -0.01 * fmin(1.0, (double)t / 1000.0);   /* b ramps to 1 cm */
-	for (int pass = 0; pass < 3; pass++) {
-		static const char *const what[3] = { "two points, modal f64", "two points, modal 40 f32",
-						     "two points, hybrid 300 + 32 f32" };
-		const struct irdm_image *img = pass == 2 ? &hybrid : pass ? &trunc32 : &exact;
+	for (int pass = 0; pass < 4; pass++) {
+		static const char *const what[4] = { "two points, modal f64", "two points, modal 40 f32",
+						     "two points, hybrid 300 + 32 f32",
+						     "two points, modal 40 + clustered f32" };
+		const struct irdm_image *img = pass == 3 ? &clustered : pass == 2 ? &hybrid :
+					       pass ? &trunc32 : &exact;
 		node_site(img, a, &s[0]);
 		node_site(img, b, &s[1]);
 		compare(what[pass], img, s, 2, N, u,
@@ -718,6 +737,7 @@ static void test_stroke(void **state)
 	(void)state;
 	stroke(&exact, "modal f64");
 	stroke(&hybrid, "hybrid 300 + 32 f32");
+	stroke(&clustered, "modal 40 + clustered f32");
 }
 
 /* Each error the engine's header documents, from the call that returns it. */

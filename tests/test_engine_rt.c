@@ -15,15 +15,19 @@
  *    itself in seccomp strict mode, where any system call but read, write,
  *    _exit and sigreturn kills it with SIGKILL.
  *
- * The scenario: modal (300 modes + static correction), FIR (T = 500) and
- * hybrid (300 modes + an exact head of 32 + 32 samples) images of the
+ * The scenario: modal (300 modes + static correction), FIR (T = 500),
+ * hybrid (300 modes + an exact head of 32 + 32 samples) and clustered
+ * (300 modes + the clustered correction: dense and low-rank pairs read
+ * whenever a contact begins) images of the
  * paper's cuboid at a modest resolution, the haptic
  * configuration (virtual coupling + passivity control + force limit), two
  * contacts -- a push on a top node that slides to a neighbouring node every
  * 50 ticks (irdm_engine_site_node + irdm_engine_contact_begin inside the
  * loop) and a grab (on a triangle point where the image has one) -- with
  * sinusoidal targets, and a deformation context attached that receives a
- * snapshot every 16 ticks.  The forces must be finite and not all zero, so
+ * snapshot every 16 ticks; the worker's update of the newest one (the
+ * clustered correction's product included) is measured for allocation and
+ * page faults as the ticks are.  The forces must be finite and not all zero, so
  * the test cannot pass by doing nothing; a NaN target must fault the
  * engine, again without allocating.
  */
@@ -57,6 +61,8 @@
 #include "irdm/session.h"
 #include "support/engine_fixture.h"
 #include "support/strict_mode.h"
+
+void openblas_set_num_threads(int n);
 
 /*
  * AddressSanitizer (make san) replaces malloc and friends and mmap with
@@ -336,7 +342,7 @@ static void faults(long *minflt, long *majflt)
 /* ---- images and the scenario ---- */
 
 static char dir[64];
-static struct irdm_image modal_img, fir_img, hybrid_img;
+static struct irdm_image modal_img, fir_img, hybrid_img, clustered_img;
 
 struct rig {
 	const struct irdm_image *img;
@@ -348,6 +354,7 @@ struct rig {
 	bool grab_on_tri;
 	uint64_t t;                    /* scenario time, ticks */
 	struct irdm_contact_cmd cmd[IRDM_MAX_CONTACTS];
+	double *pos;                   /* the worker's frame, 3 n_nodes */
 };
 
 struct run_result {
@@ -416,6 +423,8 @@ static void rig_init(struct rig *r, const struct irdm_image *img)
 
 	memset(r, 0, sizeof(*r));
 	r->img = img;
+	r->pos = calloc(3 * (size_t)img->meta->n_nodes, sizeof(double));
+	assert_non_null(r->pos);
 	irdm_engine_config_haptic(&sc.engine, img->meta->dt_s, DEVICE_K, DEVICE_B, DEVICE_F);
 	sc.engine.publish_every = PUBLISH_EVERY;
 	if (irdm_session_open_image(&r->s, img, &sc, err, sizeof(err)) ||
@@ -450,6 +459,7 @@ static void rig_init(struct rig *r, const struct irdm_image *img)
 static void rig_free(struct rig *r)
 {
 	irdm_session_close(r->s);
+	free(r->pos);
 }
 
 /*
@@ -545,6 +555,8 @@ static void warm_up(struct rig *r)
 	nan_target(r, &warm);
 	irdm_engine_reset(r->e);
 	run(r, N_WARMUP, &warm);
+	/* and the worker's code and scratch: its first update is not measured */
+	irdm_deform_update(r->s->worker, r->pos, NULL);
 	/* a refusal (no room on the stack) would show as page faults */
 	irdm_rt_prefault_stack(STACK_PREFAULT);
 	/* and the harness: its counters' first write is a fault too */
@@ -570,9 +582,60 @@ static void check_result(const char *what, const struct run_result *res, unsigne
 
 /* ---- proof 1 and 2: no allocation, no page fault ---- */
 
+/* The worker's update of the newest snapshot, measured as the ticks are:
+ * it allocates nothing after init either (its scratch, e.g. the clustered
+ * correction's weights, is laid out then). */
+struct update_result {
+	bool updated, pos_finite;
+	uint64_t tick;
+	unsigned long ncalls;
+	long minflt, majflt;
+	char calls[256];
+};
+
+static void measured_update(struct rig *r, struct update_result *u)
+{
+	long min0, maj0, min1, maj1;
+
+	memset(u, 0, sizeof(*u));
+	arm();
+	faults(&min0, &maj0);
+	u->updated = irdm_deform_update(r->s->worker, r->pos, &u->tick);
+	faults(&min1, &maj1);
+	disarm();
+	u->ncalls = calls_total();
+	calls_text(u->calls, sizeof(u->calls));
+	u->minflt = min1 - min0;
+	u->majflt = maj1 - maj0;
+	u->pos_finite = true;
+	for (size_t i = 0; u->updated && i < 3 * (size_t)r->img->meta->n_nodes; i++)
+		u->pos_finite = u->pos_finite && isfinite(r->pos[i]);
+}
+
+static void check_update(const struct update_result *u, uint64_t ticks)
+{
+	print_message("  deformation update: page faults minor %ld, major %ld\n", u->minflt,
+		      u->majflt);
+	if (!RT_ASAN)
+		print_message("  deformation update: %lu allocator/mapping calls%s%s\n", u->ncalls,
+			      u->ncalls ? ": " : "", u->calls);
+	if (u->ncalls)
+		fail_msg("the deformation update called the allocator or mapped memory: %s",
+			 u->calls);
+	if (u->minflt || u->majflt)
+		fail_msg("the deformation update took page faults: %ld minor, %ld major",
+			 u->minflt, u->majflt);
+	/* the snapshots did go out: the newest is the last multiple of 16 */
+	assert_true(u->updated);
+	assert_true(u->pos_finite);
+	assert_int_equal(u->tick % PUBLISH_EVERY, 0);
+	assert_true(u->tick + PUBLISH_EVERY > ticks - 1);   /* the newest, before the reset tick */
+}
+
 static void alloc_and_fault_free(const struct irdm_image *img)
 {
 	struct run_result res = { .all_finite = true };
+	struct update_result upd;
 	long min0, maj0, min1, maj1;
 	unsigned long ncalls;
 	char buf[256];
@@ -588,14 +651,9 @@ static void alloc_and_fault_free(const struct irdm_image *img)
 	faults(&min1, &maj1);
 	disarm();
 	ncalls = calls_total();
+	calls_text(buf, sizeof(buf));
 
-	/* the snapshots did go out: the newest is the last multiple of 16 */
-	double *pos = malloc(3 * (size_t)img->meta->n_nodes * sizeof(double));
-	uint64_t tick = 0;
-	bool updated = pos && irdm_deform_update(r.s->worker, pos, &tick), pos_finite = true;
-	for (size_t i = 0; updated && i < 3 * (size_t)img->meta->n_nodes; i++)
-		pos_finite = pos_finite && isfinite(pos[i]);
-	free(pos);
+	measured_update(&r, &upd);
 	/* out of the fault */
 	irdm_engine_reset(r.e);
 	memset(r.cmd, 0, sizeof(r.cmd));
@@ -608,19 +666,15 @@ static void alloc_and_fault_free(const struct irdm_image *img)
 		print_message("  allocator interposition skipped: built with AddressSanitizer, which owns malloc and mmap\n");
 	else
 		print_message("  allocator/mapping calls during %d ticks: %lu%s%s\n", N_TICKS, ncalls,
-			      ncalls ? ": " : "", calls_text(buf, sizeof(buf)));
+			      ncalls ? ": " : "", buf);
 	print_message("  page faults during %d ticks: minor %ld, major %ld (memory %slocked)\n",
 		      N_TICKS, min1 - min0, maj1 - maj0, locked ? "" : "NOT ");
 	if (ncalls)
-		fail_msg("the tick called the allocator or mapped memory: %s",
-			 calls_text(buf, sizeof(buf)));
+		fail_msg("the tick called the allocator or mapped memory: %s", buf);
 	if (min1 != min0 || maj1 != maj0)
 		fail_msg("the tick took page faults: %ld minor, %ld major (memory %slocked; a fault in the image mapping means the loader's MAP_POPULATE/touch did not hold)",
 			 min1 - min0, maj1 - maj0, locked ? "" : "not ");
-	assert_true(updated);
-	assert_true(pos_finite);
-	assert_int_equal(tick % PUBLISH_EVERY, 0);
-	assert_true(tick + PUBLISH_EVERY > ticks - 1);   /* the newest, before the reset tick */
+	check_update(&upd, ticks);
 	assert_int_equal(reset_rc, IRDM_OK);
 }
 
@@ -640,6 +694,12 @@ static void test_hybrid_alloc_and_fault_free(void **state)
 {
 	(void)state;
 	alloc_and_fault_free(&hybrid_img);
+}
+
+static void test_clustered_alloc_and_fault_free(void **state)
+{
+	(void)state;
+	alloc_and_fault_free(&clustered_img);
 }
 
 /* ---- proof 3: no system call ---- */
@@ -713,6 +773,12 @@ static void test_hybrid_no_system_call(void **state)
 {
 	(void)state;
 	no_system_call(&hybrid_img);
+}
+
+static void test_clustered_no_system_call(void **state)
+{
+	(void)state;
+	no_system_call(&clustered_img);
 }
 
 /* The harness can fail: a system call in strict mode does kill the child. */
@@ -823,6 +889,15 @@ static int setup(void **state)
 	snprintf(p2, sizeof(p2), "%s/hybrid.img", dir);
 	efx_image(&hybrid_img, p2, "resolution", "6,6,12", "representation", "modal:300",
 		  "exact_head", "32", "touch", "z>=0.2", "display", "touch", NULL);
+	/* the clustered correction: clusters of at most 8 of the top face's
+	 * columns, so that the contacts' blocks come from dense and low-rank
+	 * pairs */
+	snprintf(p2, sizeof(p2), "%s/clustered.img", dir);
+	efx_image(&clustered_img, p2, "resolution", "6,6,12", "representation", "modal:300",
+		  "static_correction_cluster", "8", "static_correction_tol", "1e-3", "touch", "z>=0.2",
+		  "display", "touch", NULL);
+	if (!clustered_img.corr_clusters)
+		return -1;
 	/*
 	 * Lock what is mapped and what will be.  Best effort: without it the
 	 * fault check can still pass on an idle machine, and says "NOT
@@ -830,6 +905,10 @@ static int setup(void **state)
 	 * nothing) and its shadow memory is not ours to lock.
 	 */
 	int rc = irdm_rt_lock_memory();
+
+	/* the deformation thread's BLAS threads, as a caller of
+	 * irdm_deform_update() sets them (irdm/deform_worker.h) */
+	openblas_set_num_threads(IRDM_DEFORM_BLAS_THREADS);
 
 	locked = rc == IRDM_OK;
 	if (!locked)
@@ -848,6 +927,7 @@ static int teardown(void **state)
 	irdm_image_unmap(&modal_img);
 	irdm_image_unmap(&fir_img);
 	irdm_image_unmap(&hybrid_img);
+	irdm_image_unmap(&clustered_img);
 	snprintf(cmd, sizeof(cmd), "rm -rf '%s'", dir);
 	return system(cmd) ? -1 : 0;
 }
@@ -863,6 +943,8 @@ int main(void)
 		cmocka_unit_test(test_fir_no_system_call),
 		cmocka_unit_test(test_hybrid_alloc_and_fault_free),
 		cmocka_unit_test(test_hybrid_no_system_call),
+		cmocka_unit_test(test_clustered_alloc_and_fault_free),
+		cmocka_unit_test(test_clustered_no_system_call),
 	};
 
 	return cmocka_run_group_tests(tests, setup, teardown);

@@ -22,6 +22,7 @@
 #include <unistd.h>
 
 #include "irdm/image.h"
+#include "image/elem_store.h"
 #include "image/image_writer.h"
 #include "support/image_fixture.h"
 
@@ -135,6 +136,20 @@ static void fixture_buffer(const struct img_fixture *fx, void **buf,
 			   size_t *size)
 {
 	assert_int_equal(img_fixture_buffer(fx, buf, size), 0);
+}
+
+/* The fixture's image in a new buffer (the caller frees it), parsed into
+ * img, which must succeed. */
+static void *parse_fixture(const struct img_fixture *fx, struct irdm_image *img)
+{
+	char err[256];
+	size_t size;
+	void *buf;
+
+	fixture_buffer(fx, &buf, &size);
+	if (irdm_image_parse(buf, size, img, err, sizeof(err)))
+		fail_msg("fixture image refused: %s", err);
+	return buf;
 }
 
 static void small_fir(struct img_fixture *fx)
@@ -553,16 +568,13 @@ static void test_modal_lowrank_roundtrip(void **state)
 	const uint32_t K = IRDM_SEC_STATIC_CORR_LOWRANK, R = 3;
 	struct img_fixture fx;
 	struct irdm_image img;
-	char err[256];
-	size_t size;
 	void *buf;
 
 	(void)state;
 	for (size_t p = 0; p < 3; p++) {
 		assert_int_equal(img_fixture_modal(&fx, precs[p], 5, 2, 3, IRDM_META_STATIC_CORR), 0);
 		assert_int_equal(img_fixture_lowrank(&fx, R), 0);
-		fixture_buffer(&fx, &buf, &size);
-		assert_int_equal(irdm_image_parse(buf, size, &img, err, sizeof(err)), IRDM_OK);
+		buf = parse_fixture(&fx, &img);
 		assert_int_equal(img.corr_rank, R);
 		for (uint32_t c = 0; c < 2; c++)
 			for (uint32_t r = 0; r < 2; r++) {
@@ -584,10 +596,161 @@ static void test_modal_lowrank_roundtrip(void **state)
 	}
 	/* without the section: no far field, the kept block alone */
 	small_modal(&fx);
-	fixture_buffer(&fx, &buf, &size);
-	assert_int_equal(irdm_image_parse(buf, size, &img, err, sizeof(err)), IRDM_OK);
+	buf = parse_fixture(&fx, &img);
 	assert_int_equal(img.corr_rank, 0);
 	assert_null(img.corr_u);
+	free(buf);
+	img_fixture_free(&fx);
+}
+
+/* Every kept block made the transpose of its mirror, block (r, c) =
+ * block (c, r)^T, as a real static correction is: then every value
+ * irdm_image_corr_value() returns can transpose to the bit. */
+static void symmetric_kept(struct img_fixture *fx)
+{
+	uint32_t nc = fx->meta.n_cols, prec = fx->meta.precision;
+
+	for (uint32_t c = 0; c < nc; c++)
+		for (uint32_t r = c; r < nc; r++)
+			for (uint32_t i = 0; i < 3; i++)
+				for (uint32_t j = 0; j < 3; j++)
+					if (c != r || j > i)
+						irdm_elem_put(fx->static_corr, prec,
+							      ((size_t)r * nc + c) * 9 + 3 * j + i,
+							      irdm_elem_get(fx->static_corr, prec,
+									    ((size_t)c * nc + r) * 9 + 3 * i + j));
+}
+
+/* Entry [i][j] of the brute-force block (force at f, displacement of d):
+ * the kept block, the far field sum_k lambda_k U[d][i][k] U[f][j][k]
+ * (rank far, the fixture's values) and S's entry. */
+static double clusters_want(const struct img_fixture *fx, const double *S, uint32_t far,
+			    uint32_t f, uint32_t d, uint32_t i, uint32_t j)
+{
+	const uint32_t K = IRDM_SEC_STATIC_CORR_LOWRANK, nc = fx->meta.n_cols;
+	double want = irdm_elem_get(fx->static_corr, fx->meta.precision,
+				    ((size_t)f * nc + d) * 9 + 3 * i + j);
+
+	for (uint32_t k = 0; k < far; k++)
+		want += img_fixture_value(K, k) * img_fixture_value(K, far + (3 * d + i) * far + k) *
+			img_fixture_value(K, far + (3 * f + j) * far + k);
+	return want + S[(3 * (size_t)d + i) * 3 * nc + 3 * f + j];
+}
+
+/* The pair table and the cluster lookup against the fixture's layout:
+ * members in reverse column order, cluster a from member a nc / n on. */
+static void check_cluster_tables(const struct irdm_image *img, uint32_t nc, uint32_t n,
+				 uint32_t rank)
+{
+	for (uint32_t col = 0; col < nc; col++) {
+		uint32_t pos = nc - 1 - col, a = 0, local;
+		while ((uint64_t)(a + 1) * nc / n <= pos)
+			a++;
+		assert_int_equal(irdm_image_corr_cluster(img, col, &local), a);
+		assert_int_equal(local, pos - (uint32_t)((uint64_t)a * nc / n));
+	}
+	for (uint32_t a = 0; a < n; a++)
+		for (uint32_t b = 0; b < n; b++) {
+			const struct irdm_corr_pair *q = irdm_image_corr_pair(img, a, b);
+			assert_ptr_equal(q, irdm_image_corr_pair(img, b, a));
+			assert_int_equal(q->rank, a == b ? IRDM_CORR_PAIR_DENSE : rank);
+		}
+}
+
+/* STATIC_CORR_CLUSTERS: every block irdm_image_corr_value() returns, for
+ * every ordered pair of 7 columns, is the kept block + the far field + the
+ * block of S, the fixture's dense symmetric matrix whose cross-cluster
+ * blocks are exact products G H^T; and block (f, d) is block (d, f)
+ * transposed to the bit.  The fixture's values are k/1024 with |k| <= 500,
+ * so every product and sum here is exact: the comparisons are ==. */
+static void test_modal_clusters_roundtrip(void **state)
+{
+	static const struct {
+		uint32_t prec, n_clusters, rank, far;
+	} runs[] = {
+		{ IRDM_ELEM_F16, 3, 2, 0 },     /* clusters of 2, 2, 3 columns */
+		{ IRDM_ELEM_F32, 3, 6, 2 },     /* full rank of the smaller cluster */
+		{ IRDM_ELEM_F64, 2, IRDM_CORR_PAIR_DENSE, 3 },
+		{ IRDM_ELEM_F64, 7, 0, 0 },     /* one column each, cross pairs zero */
+		{ IRDM_ELEM_F64, 1, 0, 2 },     /* one dense self pair */
+		{ IRDM_ELEM_F64, 4, 3, 1 },
+	};
+	const uint32_t NC = 7;
+	double S[21 * 21];
+	struct img_fixture fx;
+	struct irdm_image img;
+	void *buf;
+
+	(void)state;
+	for (size_t n = 0; n < sizeof(runs) / sizeof(runs[0]); n++) {
+		assert_int_equal(img_fixture_modal(&fx, runs[n].prec, 8, NC, 3,
+						   IRDM_META_STATIC_CORR), 0);
+		symmetric_kept(&fx);
+		if (runs[n].far)
+			assert_int_equal(img_fixture_lowrank(&fx, runs[n].far), 0);
+		assert_int_equal(img_fixture_clusters(&fx, runs[n].n_clusters, runs[n].rank, S), 0);
+		for (uint32_t r = 0; r < 3 * NC; r++)
+			for (uint32_t c = 0; c < r; c++)
+				assert_true(S[r * 3 * NC + c] == S[c * 3 * NC + r]);
+		buf = parse_fixture(&fx, &img);
+		assert_non_null(img.corr_clusters);
+		assert_int_equal(img.corr_clusters->n_clusters, runs[n].n_clusters);
+		check_cluster_tables(&img, NC, runs[n].n_clusters, runs[n].rank);
+		for (uint32_t f = 0; f < NC; f++)
+			for (uint32_t d = 0; d < NC; d++) {
+				double blk[9], mirror[9];
+				irdm_image_corr_value(&img, f, d, blk);
+				irdm_image_corr_value(&img, d, f, mirror);
+				for (uint32_t i = 0; i < 3; i++)
+					for (uint32_t j = 0; j < 3; j++) {
+						assert_true(blk[3 * i + j] ==
+							    clusters_want(&fx, S, runs[n].far, f, d, i, j));
+						assert_true(blk[3 * i + j] == mirror[3 * j + i]);
+					}
+			}
+		free(buf);
+		img_fixture_free(&fx);
+	}
+	/* without the section: no views */
+	small_modal(&fx);
+	buf = parse_fixture(&fx, &img);
+	assert_null(img.corr_clusters);
+	assert_null(img.corr_cl_values);
+	free(buf);
+	img_fixture_free(&fx);
+}
+
+/* Exact transposition must not lean on exact arithmetic: with every value
+ * of the clusters made inexact (x -> x (1 + sqrt(2) 1e-3) + 1/3, which
+ * keeps the self pairs symmetric), block (f, d) is still block (d, f)
+ * transposed to the bit, rank 6 cross pairs rounding at every term. */
+static void test_clusters_transpose_inexact(void **state)
+{
+	const uint32_t NC = 7;
+	struct img_fixture fx;
+	struct irdm_image img;
+	double *v;
+	void *buf;
+
+	(void)state;
+	assert_int_equal(img_fixture_modal(&fx, IRDM_ELEM_F64, 8, NC, 3, IRDM_META_STATIC_CORR), 0);
+	symmetric_kept(&fx);
+	assert_int_equal(img_fixture_lowrank(&fx, 2), 0);
+	assert_int_equal(img_fixture_clusters(&fx, 3, 6, NULL), 0);
+	v = (double *)((uint8_t *)fx.corr_clusters + img_fixture_clusters_tables(3, NC) +
+		       6 * sizeof(struct irdm_corr_pair));
+	for (uint64_t i = 0; i < ((struct irdm_corr_clusters_header *)fx.corr_clusters)->n_values; i++)
+		v[i] = v[i] * (1 + sqrt(2) * 1e-3) + 1.0 / 3;
+	buf = parse_fixture(&fx, &img);
+	for (uint32_t f = 0; f < NC; f++)
+		for (uint32_t d = 0; d < NC; d++) {
+			double blk[9], mirror[9];
+			irdm_image_corr_value(&img, f, d, blk);
+			irdm_image_corr_value(&img, d, f, mirror);
+			for (uint32_t i = 0; i < 3; i++)
+				for (uint32_t j = 0; j < 3; j++)
+					assert_true(blk[3 * i + j] == mirror[3 * j + i]);
+		}
 	free(buf);
 	img_fixture_free(&fx);
 }
@@ -1216,11 +1379,17 @@ static void w_modes_short(struct irdm_image_writer *w)
 			w->sec[i].size -= 64;
 }
 
-static void w_fir_elem(struct irdm_image_writer *w)
+/* The element type section kind declares in its table entry. */
+static void w_set_elem(struct irdm_image_writer *w, uint32_t kind, uint32_t elem)
 {
 	for (unsigned i = 0; i < w->n; i++)
-		if (w->sec[i].kind == IRDM_SEC_FIR)
-			w->sec[i].elem = IRDM_ELEM_U32;
+		if (w->sec[i].kind == kind)
+			w->sec[i].elem = elem;
+}
+
+static void w_fir_elem(struct irdm_image_writer *w)
+{
+	w_set_elem(w, IRDM_SEC_FIR, IRDM_ELEM_U32);
 }
 
 #define FX(name, stmt) \
@@ -1313,16 +1482,18 @@ FX(m_lr_lambda_nan, lowrank_values(fx)[1] = NAN)
 FX(m_lr_u_inf, lowrank_values(fx)[2 + 2 * (3 + 2)] = INFINITY)    /* U[5][0] */
 FX(m_lr_short, (with_lowrank(fx), fx->lowrank_bytes = 8))
 FX(m_lr_long, (with_lowrank(fx), fx->lowrank_bytes -= 8))
-/* the far field without the correction it belongs to */
-static void m_lr_no_corr(struct img_fixture *fx)
+/* The modal fixture without its static correction (flag and sections). */
+static void drop_corr(struct img_fixture *fx)
 {
-	with_lowrank(fx);
 	fx->meta.flags &= ~(uint32_t)IRDM_META_STATIC_CORR;
 	free(fx->static_corr);
 	free(fx->corr_index);
 	fx->static_corr = NULL;
 	fx->corr_index = NULL;
 }
+
+/* the far field without the correction it belongs to */
+FX(m_lr_no_corr, (with_lowrank(fx), drop_corr(fx)))
 
 static const uint8_t lowrank_bytes[16 + 8 * 2 * 7] = { 2 };   /* rank 2, zeros */
 
@@ -1334,14 +1505,91 @@ static void w_add_lowrank(struct irdm_image_writer *w)
 
 static void w_lowrank_f64(struct irdm_image_writer *w)
 {
-	for (unsigned i = 0; i < w->n; i++)
-		if (w->sec[i].kind == IRDM_SEC_STATIC_CORR_LOWRANK)
-			w->sec[i].elem = IRDM_ELEM_F64;
+	w_set_elem(w, IRDM_SEC_STATIC_CORR_LOWRANK, IRDM_ELEM_F64);
 }
 
 static void m_lr_elem(struct img_fixture *fx)
 {
 	with_lowrank(fx);
+}
+
+/* STATIC_CORR_CLUSTERS on the fixture's 2 columns, f64: 2 clusters of one
+ * column (members [1 0], col_pos [1 0]), self pairs their upper triangles
+ * (6 values each), the cross pair of rank 2 (U, V: 6 x 2 values); built
+ * once per case so that several edits add up.  Bytes: header 0..32, start
+ * 32..44, members 44..52, col_pos 52..60, padding 60..64, pairs 64..112,
+ * values 112..304. */
+static uint8_t *clusters(struct img_fixture *fx)
+{
+	if (!fx->corr_clusters)
+		assert_int_equal(img_fixture_clusters(fx, 2, 2, NULL), 0);
+	return fx->corr_clusters;
+}
+
+static struct irdm_corr_clusters_header *cl_hdr(struct img_fixture *fx)
+{
+	return (struct irdm_corr_clusters_header *)clusters(fx);
+}
+
+/* start[0..2], members[3..4], col_pos[5..6] */
+static uint32_t *cl_tables(struct img_fixture *fx)
+{
+	return (uint32_t *)(clusters(fx) + sizeof(struct irdm_corr_clusters_header));
+}
+
+static struct irdm_corr_pair *cl_pairs(struct img_fixture *fx)
+{
+	return (struct irdm_corr_pair *)(clusters(fx) + img_fixture_clusters_tables(2, 2));
+}
+
+/* pair (0, 0) at 0..8, (0, 1) at 9..20, (1, 1) at 21..29 */
+static double *cl_values(struct img_fixture *fx)
+{
+	return (double *)(cl_pairs(fx) + 3);
+}
+
+FX(m_cl_ok, clusters(fx))
+FX(m_cl_short, (clusters(fx), fx->clusters_bytes = 24))
+FX(m_cl_long, (clusters(fx), fx->clusters_bytes -= 8))
+FX(m_cl_none, cl_hdr(fx)->n_clusters = 0)
+FX(m_cl_many, cl_hdr(fx)->n_clusters = 3)
+FX(m_cl_max_rank, cl_hdr(fx)->max_rank = IRDM_CORR_LOWRANK_MAX + 1)
+FX(m_cl_reserved, cl_hdr(fx)->reserved[3] = 1)
+FX(m_cl_n_values, cl_hdr(fx)->n_values = 25)
+/* 8 n_values wraps to the right size: only the overflow guard catches it */
+FX(m_cl_n_values_wrap, cl_hdr(fx)->n_values = (UINT64_MAX / 8 + 1) + 30)
+FX(m_cl_start0, cl_tables(fx)[0] = 1)
+FX(m_cl_start_end, cl_tables(fx)[2] = 1)
+FX(m_cl_empty, cl_tables(fx)[1] = 0)
+FX(m_cl_reversed, cl_tables(fx)[1] = 3)
+FX(m_cl_member_range, cl_tables(fx)[3] = 2)
+FX(m_cl_col_pos, cl_tables(fx)[5 + 1] = 1)
+FX(m_cl_member_repeat, cl_tables(fx)[4] = 1)
+FX(m_cl_padding, clusters(fx)[60] = 1)
+FX(m_cl_self_rank, cl_pairs(fx)[0].rank = 2)
+FX(m_cl_self_rank_last, cl_pairs(fx)[2].rank = 0)
+FX(m_cl_rank_size, (cl_pairs(fx)[1].rank = 4, cl_hdr(fx)->max_rank = 4))
+FX(m_cl_rank_max, cl_hdr(fx)->max_rank = 1)
+FX(m_cl_pair_reserved, cl_pairs(fx)[1].reserved = 1)
+FX(m_cl_offset_gap, cl_pairs(fx)[1].offset = 10)
+FX(m_cl_pairs_short, (cl_pairs(fx)[1].rank = 1, cl_pairs(fx)[2].offset = 6 + 6))
+FX(m_cl_pairs_long, (cl_pairs(fx)[1].rank = 3, cl_hdr(fx)->max_rank = 3, cl_pairs(fx)[2].offset = 6 + 18))
+FX(m_cl_nan, cl_values(fx)[3] = NAN)
+FX(m_cl_inf, cl_values(fx)[23] = -INFINITY)
+/* the clusters without the correction they belong to */
+FX(m_cl_no_corr, (clusters(fx), drop_corr(fx)))
+
+static const uint8_t clusters_bytes[32] = { 1 };  /* 1 cluster, tables missing */
+
+static void w_add_clusters(struct irdm_image_writer *w)
+{
+	irdm_iw_add(w, IRDM_SEC_STATIC_CORR_CLUSTERS, IRDM_ELEM_BYTES, clusters_bytes,
+		    sizeof(clusters_bytes));
+}
+
+static void w_clusters_f64(struct irdm_image_writer *w)
+{
+	w_set_elem(w, IRDM_SEC_STATIC_CORR_CLUSTERS, IRDM_ELEM_F64);
 }
 
 enum base { FIR, MODAL };
@@ -1459,6 +1707,38 @@ static const struct sem_case sem_cases[] = {
 	{ "lowrank elem", MODAL, m_lr_elem, w_lowrank_f64, IRDM_EFORMAT, "section STATIC_CORR_LOWRANK has element type F64, expected BYTES" },
 	{ "lowrank without STATIC_CORR", MODAL, m_lr_no_corr, NULL, IRDM_EFORMAT, "STATIC_CORR_LOWRANK must not be present (its far field needs STATIC_CORR)" },
 	{ "FIR + lowrank", FIR, NULL, w_add_lowrank, IRDM_EFORMAT, "STATIC_CORR_LOWRANK must not be present (FIR image)" },
+#define CL "STATIC_CORR_CLUSTERS: "
+	{ "clusters", MODAL, m_cl_ok, NULL, IRDM_OK, NULL },
+	{ "clusters elem", MODAL, m_cl_ok, w_clusters_f64, IRDM_EFORMAT, "section STATIC_CORR_CLUSTERS has element type F64, expected BYTES" },
+	{ "clusters short", MODAL, m_cl_short, NULL, IRDM_EFORMAT, "section STATIC_CORR_CLUSTERS has 24 bytes, fewer than its 32-byte header" },
+	{ "clusters long", MODAL, m_cl_long, NULL, IRDM_EFORMAT, "section STATIC_CORR_CLUSTERS has 296 bytes, expected 304 for 2 clusters and 24 values" },
+	{ "clusters 0", MODAL, m_cl_none, NULL, IRDM_EFORMAT, CL "0 clusters is not in 1..2 (n_cols, at most 4096)" },
+	{ "clusters > n_cols", MODAL, m_cl_many, NULL, IRDM_EFORMAT, CL "3 clusters is not in 1..2" },
+	{ "clusters max_rank", MODAL, m_cl_max_rank, NULL, IRDM_EFORMAT, CL "max_rank 1025 is above 1024" },
+	{ "clusters reserved", MODAL, m_cl_reserved, NULL, IRDM_EFORMAT, CL "reserved header words not 0" },
+	{ "clusters n_values vs size", MODAL, m_cl_n_values, NULL, IRDM_EFORMAT, "section STATIC_CORR_CLUSTERS has 304 bytes, expected 312 for 2 clusters and 25 values" },
+	{ "clusters n_values wraps", MODAL, m_cl_n_values_wrap, NULL, IRDM_EFORMAT, "section STATIC_CORR_CLUSTERS has 304 bytes, expected" },
+	{ "clusters start 0", MODAL, m_cl_start0, NULL, IRDM_EFORMAT, CL "cluster starts run 1..2, expected 0..2 (n_cols)" },
+	{ "clusters start n_cols", MODAL, m_cl_start_end, NULL, IRDM_EFORMAT, CL "cluster starts run 0..1, expected 0..2 (n_cols)" },
+	{ "clusters empty", MODAL, m_cl_empty, NULL, IRDM_EFORMAT, CL "cluster 0 is empty or reversed (start 0, next 0)" },
+	{ "clusters reversed", MODAL, m_cl_reversed, NULL, IRDM_EFORMAT, CL "cluster 1 is empty or reversed (start 3, next 2)" },
+	{ "clusters member range", MODAL, m_cl_member_range, NULL, IRDM_EFORMAT, CL "member 0 is column 2, not below n_cols 2" },
+	{ "clusters col_pos", MODAL, m_cl_col_pos, NULL, IRDM_EFORMAT, CL "column 1 is member 0, but col_pos says 1" },
+	{ "clusters member repeat", MODAL, m_cl_member_repeat, NULL, IRDM_EFORMAT, CL "column 1 is member 1, but col_pos says 0" },
+	{ "clusters padding", MODAL, m_cl_padding, NULL, IRDM_EFORMAT, CL "padding not 0" },
+	{ "clusters self pair rank", MODAL, m_cl_self_rank, NULL, IRDM_EFORMAT, CL "self pair 0 has rank 2, must be dense" },
+	{ "clusters last self pair rank", MODAL, m_cl_self_rank_last, NULL, IRDM_EFORMAT, CL "self pair 1 has rank 0, must be dense" },
+	{ "clusters rank > 3 |a|", MODAL, m_cl_rank_size, NULL, IRDM_EFORMAT, CL "pair (0, 1) has rank 4, above min(3, 3, max_rank 4)" },
+	{ "clusters rank > max_rank", MODAL, m_cl_rank_max, NULL, IRDM_EFORMAT, CL "pair (0, 1) has rank 2, above min(3, 3, max_rank 1)" },
+	{ "clusters pair reserved", MODAL, m_cl_pair_reserved, NULL, IRDM_EFORMAT, CL "pair (0, 1) reserved word not 0" },
+	{ "clusters offset gap", MODAL, m_cl_offset_gap, NULL, IRDM_EFORMAT, CL "pair (0, 1) starts at value 10, expected 6" },
+	{ "clusters pairs vs n_values", MODAL, m_cl_pairs_short, NULL, IRDM_EFORMAT, CL "the pairs hold 18 values, the header says 24" },
+	{ "clusters pairs past n_values", MODAL, m_cl_pairs_long, NULL, IRDM_EFORMAT, CL "pair (1, 1) runs past the header's 24 values (from value 24)" },
+	{ "clusters NaN", MODAL, m_cl_nan, NULL, IRDM_EFORMAT, CL "value 3 is not finite" },
+	{ "clusters inf", MODAL, m_cl_inf, NULL, IRDM_EFORMAT, CL "value 23 is not finite" },
+	{ "clusters without STATIC_CORR", MODAL, m_cl_no_corr, NULL, IRDM_EFORMAT, "STATIC_CORR_CLUSTERS must not be present (its clusters need STATIC_CORR)" },
+	{ "FIR + clusters", FIR, NULL, w_add_clusters, IRDM_EFORMAT, "STATIC_CORR_CLUSTERS must not be present (FIR image)" },
+#undef CL
 };
 
 static void test_semantic_validation(void **state)
@@ -1488,6 +1768,30 @@ static void test_semantic_validation(void **state)
 		img_fixture_free(&fx);
 	}
 	current_case = "";
+}
+
+/* A newer minor may give STATIC_CORR_CLUSTERS' reserved words (header and
+ * pair) a meaning: they are ignored there, refused at our own minor. */
+static void test_clusters_reserved_newer_minor(void **state)
+{
+	struct irdm_image_header h;
+	struct img_fixture fx;
+	size_t size;
+	uint8_t *buf;
+
+	(void)state;
+	small_modal(&fx);
+	cl_hdr(&fx)->reserved[0] = 1;
+	cl_pairs(&fx)[1].reserved = 1;
+	fixture_buffer(&fx, (void **)&buf, &size);
+	expect_parse(buf, size, IRDM_EFORMAT, "STATIC_CORR_CLUSTERS: reserved header words not 0");
+	h = get_header(buf);
+	h.version_minor = IRDM_IMAGE_VERSION_MINOR + 1;
+	put_header(buf, &h);
+	img_fixture_reseal(buf, size);
+	expect_parse(buf, size, IRDM_OK, NULL);
+	free(buf);
+	img_fixture_free(&fx);
 }
 
 /* Empty payloads (no surface) are valid, also as the last section, where
@@ -1714,6 +2018,8 @@ int main(void)
 		cmocka_unit_test(test_fir_roundtrip),
 		cmocka_unit_test(test_modal_floating_roundtrip),
 		cmocka_unit_test(test_modal_lowrank_roundtrip),
+		cmocka_unit_test(test_modal_clusters_roundtrip),
+		cmocka_unit_test(test_clusters_transpose_inexact),
 		cmocka_unit_test(test_modal_grounded_f16_roundtrip),
 		cmocka_unit_test(test_map_lock),
 		cmocka_unit_test(test_map_errors),
@@ -1728,6 +2034,7 @@ int main(void)
 		cmocka_unit_test(test_unaligned_buffer),
 		cmocka_unit_test(test_unknown_kind),
 		cmocka_unit_test(test_semantic_validation),
+		cmocka_unit_test(test_clusters_reserved_newer_minor),
 		cmocka_unit_test(test_empty_section),
 		cmocka_unit_test(test_f16_nan_in_fir),
 		cmocka_unit_test(test_strerror),

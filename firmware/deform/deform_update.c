@@ -129,6 +129,8 @@ void deform_modal(struct irdm_deform_worker *w, struct deform_snap *s, double *p
 		static_correction(w, &s->f, pos);
 	if (w->img->corr_rank)
 		far_field(w, &s->f, pos);
+	if (w->img->corr_clusters)
+		deform_clusters(w, &s->f, pos);
 }
 
 /*

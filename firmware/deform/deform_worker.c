@@ -9,7 +9,7 @@
 #include "worker_priv.h"
 
 struct worker_layout {
-	size_t off_y, off_uf, off_shapes, off_frame, off_far, total;
+	size_t off_y, off_uf, off_shapes, off_frame, off_far, off_cl, total;
 };
 
 /* Whether the image has what the update reads (the loader checked sizes). */
@@ -48,9 +48,12 @@ static void worker_layout(const struct irdm_image *img, struct worker_layout *l)
 	if (modal && m->precision == IRDM_ELEM_F16)
 		l->off_frame += deform_align_up(n3 * K * sizeof(float));
 	l->off_far = l->off_frame + deform_align_up(n3 * sizeof(double));
-	l->total = l->off_far;
+	l->off_cl = l->off_far;
 	if (modal && img->corr_rank)    /* the far field's weights */
-		l->total += deform_align_up(img->corr_rank * sizeof(double));
+		l->off_cl += deform_align_up(img->corr_rank * sizeof(double));
+	l->total = l->off_cl;
+	if (modal && img->corr_clusters)        /* one low-rank pair's weights */
+		l->total += deform_align_up(img->corr_clusters->max_rank * sizeof(double));
 }
 
 size_t irdm_deform_worker_mem_size(const struct irdm_image *img)
@@ -102,6 +105,8 @@ static void worker_setup(struct irdm_deform_worker *w, struct irdm_deform *d,
 	w->frame_pos = (double *)(base + l->off_frame);
 	if (w->repr == IRDM_REPR_MODAL && img->corr_rank)
 		w->far_g = (double *)(base + l->off_far);
+	if (w->repr == IRDM_REPR_MODAL && img->corr_clusters && img->corr_clusters->max_rank)
+		w->cl_g = (double *)(base + l->off_cl);
 }
 
 int irdm_deform_worker_init(struct irdm_deform_worker **wp, struct irdm_deform *d, void *mem,

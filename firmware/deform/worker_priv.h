@@ -40,6 +40,9 @@ struct irdm_deform_worker {
 	/* the static correction's far field (NULL without one): the weights
 	 * diag(lambda) U^T f, corr_rank */
 	double *far_g;
+	/* the clustered correction's low-rank weights (NULL without a
+	 * low-rank pair): F^T f of one pair, the header's max_rank */
+	double *cl_g;
 
 	struct irdm_deform_thread th;
 };
@@ -47,6 +50,10 @@ struct irdm_deform_worker {
 /* Displacements (object frame) of every image node from a snapshot. */
 void deform_modal(struct irdm_deform_worker *w, struct deform_snap *s, double *pos);
 void deform_fir(struct irdm_deform_worker *w, struct deform_snap *s, double *pos);
+/* pos += the clustered correction's displacement of every column under f
+ * (deform_clusters.c); the image has STATIC_CORR_CLUSTERS. */
+void deform_clusters(const struct irdm_deform_worker *w, const struct irdm_force_tick *f,
+		     double *pos);
 /* pos = Phi y with y as it stands: the warm-up's product. */
 void deform_modal_product(struct irdm_deform_worker *w, double *pos);
 

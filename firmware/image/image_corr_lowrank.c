@@ -117,4 +117,6 @@ void irdm_image_corr_value(const struct irdm_image *img, uint32_t col_force,
 						      (size_t)k * 9 + i);
 	if (img->corr_rank)
 		add_far_field(img, col_force, col_disp, blk);
+	if (img->corr_clusters)
+		img_corr_clusters_add(img, col_force, col_disp, blk);
 }

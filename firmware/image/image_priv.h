@@ -36,7 +36,7 @@
 #error "IRDM images are little-endian and used in place"
 #endif
 
-#define KIND_MAX IRDM_SEC_EXACT_HEAD
+#define KIND_MAX IRDM_SEC_STATIC_CORR_CLUSTERS
 #define TABLE_ENTRY sizeof(struct irdm_image_section)
 #define HEADER_SIZE sizeof(struct irdm_image_header)
 
@@ -102,6 +102,11 @@ int img_check_modal(struct parse *p);
 int img_check_static_corr(struct parse *p);
 /* image_corr_lowrank.c: STATIC_CORR_LOWRANK, if present, after the above. */
 int img_check_corr_lowrank(struct parse *p);
+/* image_corr_clusters.c: STATIC_CORR_CLUSTERS, if present, after
+ * STATIC_CORR; and what irdm_image_corr_value() adds from it. */
+int img_check_corr_clusters(struct parse *p);
+void img_corr_clusters_add(const struct irdm_image *img, uint32_t col_force, uint32_t col_disp,
+			   double blk[9]);
 /* image_exact_head.c: EXACT_HEAD against the STATIC_CORR index (checked first) */
 int img_check_exact_head(struct parse *p);
 /* image_responses.c: every element of kind's array (meta precision) finite. */

@@ -92,6 +92,8 @@ int img_check_fir(struct parse *p)
 	if (!ret)
 		ret = img_check_presence(p, IRDM_SEC_STATIC_CORR_LOWRANK, false, "FIR image");
 	if (!ret)
+		ret = img_check_presence(p, IRDM_SEC_STATIC_CORR_CLUSTERS, false, "FIR image");
+	if (!ret)
 		ret = img_check_presence(p, IRDM_SEC_EXACT_HEAD, false, "FIR image");
 	if (!ret)
 		ret = img_check_shape(p, IRDM_SEC_FIR, f, 4, "n_cols x n_nodes x T x 9");
@@ -162,8 +164,13 @@ int img_check_modal(struct parse *p)
 	if (!ret && !corr && p->by_kind[IRDM_SEC_STATIC_CORR_LOWRANK])
 		ret = img_check_presence(p, IRDM_SEC_STATIC_CORR_LOWRANK, false,
 					 "its far field needs STATIC_CORR");
+	if (!ret && !corr && p->by_kind[IRDM_SEC_STATIC_CORR_CLUSTERS])
+		ret = img_check_presence(p, IRDM_SEC_STATIC_CORR_CLUSTERS, false,
+					 "its clusters need STATIC_CORR");
 	if (!ret && corr)
 		ret = img_check_static_corr(p);
+	if (!ret && corr)
+		ret = img_check_corr_clusters(p);
 	if (!ret && corr)
 		ret = img_check_corr_lowrank(p);
 	if (!ret)

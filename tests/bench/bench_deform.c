@@ -85,17 +85,17 @@ out:
 	return rc;
 }
 
-static int bench_scene(const char *name, const char *scene, const char *precision,
+/* kv: scene keys over the scene's, NULL-terminated pairs, or NULL */
+static int bench_scene(const char *name, const char *scene, const char *const *kv,
 		       const char *path)
 {
-	const char *const kv[] = { "precision", precision, NULL };
 	struct irdm_session_config sc = { .deform = true };
 	const struct irdm_meta *m;
 	struct irdm_session *ses;
 	char err[1024];
 	int rc = 0;
 
-	if (bench_ensure_image("deform", path, scene, precision ? kv : NULL))
+	if (bench_ensure_image("deform", path, scene, kv))
 		return -1;
 	irdm_engine_config_default(&sc.engine);
 	if (irdm_session_open(&ses, path, &sc, err, sizeof(err))) {
@@ -107,9 +107,13 @@ static int bench_scene(const char *name, const char *scene, const char *precisio
 		printf("deform  %s: %s is not modal, skipped\n", name, path);
 		goto out;
 	}
-	printf("deform  %s  %s: %u modes, %s, %u columns\n", name, path, m->n_modes,
+	printf("deform  %s  %s: %u modes, %s, %u columns", name, path, m->n_modes,
 	       m->precision == IRDM_ELEM_F64 ? "f64" : m->precision == IRDM_ELEM_F32 ? "f32" : "f16",
 	       m->n_cols);
+	if (ses->img->corr_clusters)
+		printf(", correction in %u clusters (max rank %u)", ses->img->corr_clusters->n_clusters,
+		       ses->img->corr_clusters->max_rank);
+	printf("\n");
 	rc = irdm_session_deform_open(ses, err, sizeof(err));
 	if (rc)
 		fprintf(stderr, "deform  %s: %s\n", name, err);
@@ -122,6 +126,8 @@ out:
 
 int main(void)
 {
+	static const char *const f64[] = { "precision", "f64", NULL };
+	static const char *const clustered[] = { "static_correction_cluster", "16", NULL };
 	int rc = 0;
 
 	/* the deformation thread's setting: one BLAS thread */
@@ -129,8 +135,11 @@ int main(void)
 	rc |= bench_scene("cuboid-300modes", "scenes/cuboid-top.scene", NULL,
 			  "out/bench/cuboid-top.img");
 	/* the same in f64: the dgemv path, twice the bytes to stream */
-	rc |= bench_scene("cuboid-300modes-f64", "scenes/cuboid-top.scene", "f64",
+	rc |= bench_scene("cuboid-300modes-f64", "scenes/cuboid-top.scene", f64,
 			  "out/bench/cuboid-top-f64.img");
+	/* the correction between every pair of touchable nodes, clustered */
+	rc |= bench_scene("cuboid-300modes-clustered", "scenes/cuboid-top.scene", clustered,
+			  "out/bench/cuboid-top-clustered.img");
 	if (!bench_file_exists("out/bench/bunny.img") && !bench_file_exists("build/data/bunny.off"))
 		printf("deform  bunny-300modes: skipped (no build/data/bunny.off: "
 		       "tools/scripts/bunny-off.sh build/data/bunny.off)\n");

@@ -8,6 +8,13 @@
  *
  * Checksums stop almost every mutation at the header; fuzz_image_semantic.c
  * builds the same target with the checksum comparisons compiled out.
+ *
+ * Seeds (tests/fuzz/seeds/, the same in both targets' folders): valid
+ * images of each kind.  clusters_f16.img (format 2.2, 2536 bytes) is the
+ * test fixture's img_fixture_modal(f16, 6 nodes, 5 columns, 2 modes,
+ * STATIC_CORR) with img_fixture_lowrank(rank 1) and
+ * img_fixture_clusters(3 clusters, cross pairs of rank 2), written by
+ * img_fixture_write (tests/support/image_fixture.h).
  */
 #include <stddef.h>
 #include <stdint.h>
@@ -37,6 +44,35 @@ static void read_values(const void *p, uint32_t elem, uint64_t count)
 	for (uint64_t i = 0; i < count; i++)
 		acc += irdm_elem_get(p, elem, i);
 	fuzz_sink += (uint64_t)(acc != acc);
+}
+
+/* STATIC_CORR_CLUSTERS: the tables and values, every column's cluster
+ * lookup against the members list, and whole blocks (the tick's reader)
+ * for the first, last and a middle column in both orders. */
+static void walk_clusters(const struct irdm_image *img)
+{
+	const struct irdm_corr_clusters_header *h = img->corr_clusters;
+	uint32_t cols = img->meta->n_cols, ends[3] = { 0, cols / 2, cols - 1 };
+	double blk[9];
+
+	read_bytes(img->corr_cl_start, 4 * ((uint64_t)h->n_clusters + 1));
+	read_bytes(img->corr_cl_members, 4 * (uint64_t)cols);
+	read_bytes(img->corr_cl_pos, 4 * (uint64_t)cols);
+	read_bytes(img->corr_cl_pairs,
+		   sizeof(*img->corr_cl_pairs) * ((uint64_t)h->n_clusters * (h->n_clusters + 1) / 2));
+	read_values(img->corr_cl_values, img->meta->precision, h->n_values);
+	for (uint32_t c = 0; c < cols; c++) {
+		uint32_t local, a = irdm_image_corr_cluster(img, c, &local);
+		if (a >= h->n_clusters ||
+		    local >= img->corr_cl_start[a + 1] - img->corr_cl_start[a] ||
+		    img->corr_cl_members[img->corr_cl_start[a] + local] != c)
+			abort();
+	}
+	for (unsigned i = 0; i < 3; i++)
+		for (unsigned j = 0; j < 3; j++) {
+			irdm_image_corr_value(img, ends[i], ends[j], blk);
+			read_bytes(blk, sizeof(blk));
+		}
 }
 
 static void walk_views(const struct irdm_image *img)
@@ -84,9 +120,11 @@ static void walk_views(const struct irdm_image *img)
 		irdm_image_corr_value(img, (uint32_t)cols - 1, 0, blk);
 		read_bytes(blk, sizeof(blk));
 	}
+	if (img->corr_clusters)
+		walk_clusters(img);
 	if (img->rigid)
 		read_bytes(img->rigid, sizeof(*img->rigid));
-	for (uint32_t k = 0; k <= IRDM_SEC_EXACT_HEAD + 1; k++) {
+	for (uint32_t k = 0; k <= IRDM_SEC_STATIC_CORR_CLUSTERS + 1; k++) {
 		const struct irdm_image_section *s = irdm_image_find(img, k);
 
 		if (s)

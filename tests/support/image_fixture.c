@@ -234,6 +234,161 @@ int img_fixture_lowrank(struct img_fixture *fx, uint32_t rank)
 	return 0;
 }
 
+/* STATIC_CORR_CLUSTERS's layout as the fixture builds it (image_fixture.h). */
+struct cl_layout {
+	uint32_t n_cols, n_clusters, rank;
+	uint32_t *start, *members;
+};
+
+uint64_t img_fixture_clusters_tables(uint32_t n_clusters, uint32_t n_cols)
+{
+	uint64_t b = sizeof(struct irdm_corr_clusters_header) +
+		     4 * ((uint64_t)n_clusters + 1 + 2 * (uint64_t)n_cols);
+
+	return (b + 7) / 8 * 8;
+}
+
+static uint32_t cl_cluster_of(const struct cl_layout *l, uint32_t col)
+{
+	uint32_t pos = l->n_cols - 1 - col, a = 0;
+
+	while (l->start[a + 1] <= pos)
+		a++;
+	return a;
+}
+
+/* The factors of the cross pairs, by DoF 3 c + x in column order. */
+static double cl_g(const struct cl_layout *l, uint64_t r, uint64_t t)
+{
+	uint64_t n = 3 * (uint64_t)l->n_cols;
+
+	return img_fixture_value(IRDM_SEC_STATIC_CORR_CLUSTERS, n * n + r * l->rank + t);
+}
+
+static double cl_h(const struct cl_layout *l, uint64_t c, uint64_t t)
+{
+	uint64_t n = 3 * (uint64_t)l->n_cols;
+
+	return img_fixture_value(IRDM_SEC_STATIC_CORR_CLUSTERS,
+				 n * n + n * l->rank + c * l->rank + t);
+}
+
+/* S[r][c], summed in the order the loader's reader sums U V^T. */
+static double cl_s(const struct cl_layout *l, uint64_t r, uint64_t c)
+{
+	uint32_t ar = cl_cluster_of(l, (uint32_t)(r / 3)), ac = cl_cluster_of(l, (uint32_t)(c / 3));
+	uint64_t n = 3 * (uint64_t)l->n_cols, lo = r < c ? r : c, hi = r < c ? c : r;
+	double s = 0;
+
+	if (ar == ac || l->rank == IRDM_CORR_PAIR_DENSE)
+		return img_fixture_value(IRDM_SEC_STATIC_CORR_CLUSTERS, lo * n + hi);
+	lo = ar < ac ? r : c;
+	hi = ar < ac ? c : r;
+	for (uint64_t t = 0; t < l->rank; t++)
+		s += cl_g(l, lo, t) * cl_h(l, hi, t);
+	return s;
+}
+
+/* Column DoF of row i of cluster a's part of a pair. */
+static uint64_t cl_dof(const struct cl_layout *l, uint32_t a, uint64_t i)
+{
+	return 3 * (uint64_t)l->members[l->start[a] + i / 3] + i % 3;
+}
+
+/* Pair (a, b)'s values at element o: dense, or U (G's rows) then V (H's). */
+static void cl_put_pair(const struct cl_layout *l, uint32_t prec, uint32_t a, uint32_t b,
+			bool dense, void *values, uint64_t o)
+{
+	uint64_t ra = 3 * (uint64_t)(l->start[a + 1] - l->start[a]);
+	uint64_t rb = 3 * (uint64_t)(l->start[b + 1] - l->start[b]);
+
+	if (a == b) {           /* the upper triangle, row by row */
+		for (uint64_t i = 0, k = 0; i < ra; i++)
+			for (uint64_t j = i; j < rb; j++)
+				irdm_elem_put(values, prec, o + k++,
+					      cl_s(l, cl_dof(l, a, i), cl_dof(l, b, j)));
+		return;
+	}
+	if (dense) {
+		for (uint64_t i = 0; i < ra; i++)
+			for (uint64_t j = 0; j < rb; j++)
+				irdm_elem_put(values, prec, o + i * rb + j,
+					      cl_s(l, cl_dof(l, a, i), cl_dof(l, b, j)));
+		return;
+	}
+	for (uint64_t t = 0; t < l->rank; t++) {
+		for (uint64_t i = 0; i < ra; i++)
+			irdm_elem_put(values, prec, o + i * l->rank + t, cl_g(l, cl_dof(l, a, i), t));
+		for (uint64_t j = 0; j < rb; j++)
+			irdm_elem_put(values, prec, o + (ra + j) * l->rank + t,
+				      cl_h(l, cl_dof(l, b, j), t));
+	}
+}
+
+/* The pair table and values in table order; only counts if pairs is NULL. */
+static uint64_t cl_fill_pairs(const struct cl_layout *l, uint32_t prec,
+			      struct irdm_corr_pair *pairs, void *values)
+{
+	uint64_t next = 0, k = 0;
+
+	for (uint32_t a = 0; a < l->n_clusters; a++)
+		for (uint32_t b = a; b < l->n_clusters; b++, k++) {
+			uint64_t ra = 3 * (uint64_t)(l->start[a + 1] - l->start[a]);
+			uint64_t rb = 3 * (uint64_t)(l->start[b + 1] - l->start[b]);
+			bool dense = a == b || l->rank == IRDM_CORR_PAIR_DENSE;
+
+			if (pairs) {
+				pairs[k].offset = next;
+				pairs[k].rank = dense ? IRDM_CORR_PAIR_DENSE : l->rank;
+				cl_put_pair(l, prec, a, b, dense, values, next);
+			}
+			next += a == b ? ra * (ra + 1) / 2 : dense ? ra * rb : l->rank * (ra + rb);
+		}
+	return next;
+}
+
+int img_fixture_clusters(struct img_fixture *fx, uint32_t n_clusters, uint32_t rank,
+			 double *s_out)
+{
+	uint32_t nc = fx->meta.n_cols, prec = fx->meta.precision;
+	uint32_t *start = calloc((size_t)n_clusters + 1, 4), *members = calloc(nc, 4);
+	struct cl_layout l = { nc, n_clusters, rank, start, members };
+	struct irdm_corr_clusters_header h = { .n_clusters = n_clusters };
+	uint64_t tb = img_fixture_clusters_tables(n_clusters, nc);
+	uint64_t np = (uint64_t)n_clusters * (n_clusters + 1) / 2, bytes;
+	uint8_t *p = NULL;
+
+	if (!start || !members || n_clusters < 1 || n_clusters > nc)
+		goto out;
+	for (uint32_t a = 0; a <= n_clusters; a++)
+		start[a] = (uint32_t)((uint64_t)a * nc / n_clusters);
+	for (uint32_t i = 0; i < nc; i++)
+		members[i] = nc - 1 - i;
+	h.max_rank = rank == IRDM_CORR_PAIR_DENSE ? 0 : rank;
+	h.n_values = cl_fill_pairs(&l, prec, NULL, NULL);
+	bytes = tb + sizeof(struct irdm_corr_pair) * np + irdm_elem_size(prec) * h.n_values;
+	p = calloc(1, bytes);
+	if (!p)
+		goto out;
+	memcpy(p, &h, sizeof(h));
+	memcpy(p + sizeof(h), start, 4 * ((size_t)n_clusters + 1));
+	memcpy(p + sizeof(h) + 4 * ((size_t)n_clusters + 1), members, 4 * (size_t)nc);
+	for (uint32_t i = 0; i < nc; i++)       /* col_pos: reverse order is its own inverse */
+		memcpy(p + sizeof(h) + 4 * ((size_t)n_clusters + 1 + nc + members[i]), &i, 4);
+	cl_fill_pairs(&l, prec, (struct irdm_corr_pair *)(p + tb),
+		      p + tb + sizeof(struct irdm_corr_pair) * np);
+	for (uint64_t r = 0; s_out && r < 3 * (uint64_t)nc; r++)
+		for (uint64_t c = 0; c < 3 * (uint64_t)nc; c++)
+			s_out[r * 3 * nc + c] = cl_s(&l, r, c);
+	free(fx->corr_clusters);
+	fx->corr_clusters = p;
+	fx->clusters_bytes = bytes;
+out:
+	free(start);
+	free(members);
+	return p ? 0 : -1;
+}
+
 void img_fixture_free(struct img_fixture *fx)
 {
 	free(fx->nodes);
@@ -245,6 +400,7 @@ void img_fixture_free(struct img_fixture *fx)
 	free(fx->static_corr);
 	free(fx->corr_index);
 	free(fx->corr_lowrank);
+	free(fx->corr_clusters);
 	free(fx->stability);
 	memset(fx, 0, sizeof(*fx));
 }
@@ -279,6 +435,9 @@ void img_fixture_add(const struct img_fixture *fx, struct irdm_image_writer *w)
 	if (fx->corr_lowrank)
 		irdm_iw_add(w, IRDM_SEC_STATIC_CORR_LOWRANK, IRDM_ELEM_BYTES,
 			    fx->corr_lowrank, fx->lowrank_bytes);
+	if (fx->corr_clusters)
+		irdm_iw_add(w, IRDM_SEC_STATIC_CORR_CLUSTERS, IRDM_ELEM_BYTES,
+			    fx->corr_clusters, fx->clusters_bytes);
 	if (m->flags & IRDM_META_FLOATING)
 		irdm_iw_add(w, IRDM_SEC_RIGID, IRDM_ELEM_BYTES, &fx->rigid,
 			    sizeof(fx->rigid));

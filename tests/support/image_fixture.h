@@ -39,13 +39,16 @@ struct img_fixture {
 	/* optional STATIC_CORR_LOWRANK (img_fixture_lowrank): header, then
 	 * lambda and U of fixture values */
 	void *corr_lowrank;
+	/* optional STATIC_CORR_CLUSTERS (img_fixture_clusters): the payload
+	 * as image_format.h lays it out */
+	void *corr_clusters;
 	struct irdm_rigid rigid;            /* written iff FLOATING */
 	struct irdm_stability *stability;   /* n_cols */
 	/* Sizes of the arrays as built: what img_fixture_add() writes, so
 	 * tampering with meta counts never makes it read past an array. */
 	uint64_t nodes_bytes, columns_bytes, tris_bytes, stability_bytes;
 	uint64_t fir_bytes, modes_bytes, shapes_bytes, corr_bytes, corr_index_bytes;
-	uint64_t lowrank_bytes;
+	uint64_t lowrank_bytes, clusters_bytes;
 };
 
 /* Grounded FIR image.  Returns 0, -1 when out of memory. */
@@ -62,6 +65,25 @@ int img_fixture_modal(struct img_fixture *fx, uint32_t precision,
  * (meta precision; lambda[k] is value k, U element i value rank + i of
  * the kind).  Returns 0, -1 when out of memory. */
 int img_fixture_lowrank(struct img_fixture *fx, uint32_t rank);
+
+/* Add a valid STATIC_CORR_CLUSTERS to a modal fixture with STATIC_CORR:
+ * the columns in reverse order (members[i] = n_cols - 1 - i) split into
+ * n_clusters clusters, cluster a from member a n_cols / n_clusters on;
+ * self pairs dense, every cross pair of the given rank (at most
+ * 3 x the smaller cluster's size; IRDM_CORR_PAIR_DENSE: dense).  The
+ * section holds the symmetric 3 n_cols x 3 n_cols matrix S (row 3 c + x:
+ * column c's axis x; displacement rows, force columns), written to s_out
+ * row-major when not NULL: within a cluster S[r][c] is fixture value
+ * min(r, c) 3 n_cols + max(r, c) of the kind; between r in a lower cluster
+ * than c it is sum_t G[r][t] H[c][t] (G, H of fixture values), exact in
+ * every precision.  Returns 0, -1 when out of memory or n_clusters is not
+ * in 1..n_cols. */
+int img_fixture_clusters(struct img_fixture *fx, uint32_t n_clusters, uint32_t rank,
+			 double *s_out);
+
+/* Bytes of STATIC_CORR_CLUSTERS' header and tables, padded to 8: where its
+ * pair table starts (image_format.h). */
+uint64_t img_fixture_clusters_tables(uint32_t n_clusters, uint32_t n_cols);
 
 void img_fixture_free(struct img_fixture *fx);
 

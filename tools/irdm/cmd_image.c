@@ -35,7 +35,8 @@ static const char *kind_name(uint32_t k)
 {
 	static const char *const names[] = { "?", "META", "PROVENANCE", "NODES", "COLUMNS",
 		"SURFACE", "FIR", "MODES", "MODE_SHAPES", "STATIC_CORR", "RIGID", "STABILITY",
-		"CONTACT_BVH", "STATIC_CORR_INDEX" };
+		"CONTACT_BVH", "STATIC_CORR_INDEX", "STATIC_CORR_LOWRANK", "EXACT_HEAD",
+		"STATIC_CORR_CLUSTERS" };
 
 	return k < sizeof(names) / sizeof(names[0]) ? names[k] : "unknown";
 }
@@ -50,6 +51,25 @@ static int open_image(const char *path, struct irdm_image *img)
 		return -1;
 	}
 	return 0;
+}
+
+/* STATIC_CORR_CLUSTERS: its clusters, its pairs by kind, its bytes. */
+static void print_clusters(const struct irdm_image *img)
+{
+	uint32_t n = img->corr_clusters->n_clusters, top = 0;
+	unsigned long long dense = 0, low = 0;
+
+	for (uint32_t a = 0; a < n; a++)
+		for (uint32_t b = a; b < n; b++) {
+			uint32_t rank = irdm_image_corr_pair(img, a, b)->rank;
+			dense += rank == IRDM_CORR_PAIR_DENSE;
+			low += rank != IRDM_CORR_PAIR_DENSE;
+			if (rank != IRDM_CORR_PAIR_DENSE && rank > top)
+				top = rank;
+		}
+	printf("clusters      %u over %u columns, pairs %llu dense, %llu low-rank (largest rank %u), "
+	       "%llu bytes\n", n, img->meta->n_cols, dense, low, top,
+	       (unsigned long long)irdm_image_find(img, IRDM_SEC_STATIC_CORR_CLUSTERS)->size);
 }
 
 static int cmd_info(const char *path)
@@ -80,6 +100,8 @@ static int cmd_info(const char *path)
 		printf("static corr   %u of %llu blocks kept, far field rank %u\n",
 		       img.corr_start[m->n_cols], (unsigned long long)m->n_cols * m->n_cols,
 		       img.corr_rank);
+	if (img.corr_clusters)
+		print_clusters(&img);
 	if (img.exact_head)
 		printf("exact head    the %u dropped modes' response at the kept blocks: samples "
 		       "0..%u exact, %u..%u tapered, sum = static correction (hybrid)\n",
@@ -107,7 +129,7 @@ static int cmd_info(const char *path)
 	printf("sections\n");
 	const struct irdm_image_section *s = (const void *)(img.base + h->section_table_offset);
 	for (uint32_t i = 0; i < h->section_count; i++)
-		printf("  %-17s %-5s offset %10llu  size %12llu  crc32c %08x\n", kind_name(s[i].kind),
+		printf("  %-20s %-5s offset %10llu  size %12llu  crc32c %08x\n", kind_name(s[i].kind),
 		       elem_name(s[i].elem), (unsigned long long)s[i].offset,
 		       (unsigned long long)s[i].size, s[i].crc32c);
 	printf("columns (mesh nodes):");

@@ -172,7 +172,12 @@ static void print_report(const struct irdm_scene *sc, const struct irdm_precompu
 		       (double)r->image_bytes / (1 << 20),
 		       sc->representation == IRDM_REPR_FIR ? "FIR" : "modal");
 	}
-	if (r->corr_blocks)
+	if (r->corr_clusters)
+		printf("static corr   %zu clusters, %zu of %zu pairs dense, low-rank up to rank %zu; every block within %.3g of sqrt(|S_aa| |S_bb|) (tol %g); %zu values\n",
+		       r->corr_clusters, r->corr_cluster_pairs_dense,
+		       r->corr_clusters * (r->corr_clusters + 1) / 2, r->corr_cluster_max_rank,
+		       r->corr_cluster_max_err, r->corr_tol, r->corr_cluster_values);
+	else if (r->corr_blocks)
 		printf("static corr   %zu of %zu blocks kept (%.2f %%), tol %g, largest dropped %.3g\n",
 		       r->corr_blocks, r->cols * r->cols,
 		       100.0 * (double)r->corr_blocks / ((double)r->cols * (double)r->cols),

@@ -27,6 +27,9 @@ void dgeqrf_(const int *m, const int *n, double *a, const int *lda, double *tau,
 	     const int *lwork, int *info);
 void dorgqr_(const int *m, const int *n, const int *k, double *a, const int *lda,
 	     const double *tau, double *work, const int *lwork, int *info);
+void dgesdd_(const char *jobz, const int *m, const int *n, double *a, const int *lda, double *s,
+	     double *u, const int *ldu, double *vt, const int *ldvt, double *work,
+	     const int *lwork, int *iwork, int *info);
 void openblas_set_num_threads(int n);
 int openblas_get_num_threads(void);
 

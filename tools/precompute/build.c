@@ -19,6 +19,7 @@
 #include "modal/response.h"
 #include "modal/stability.h"
 #include "modal/static_lowrank.h"
+#include "modal/static_clusters.h"
 #include "modal/static_sparse.h"
 #include "precompute/fir_tail.h"
 #include "precompute/precompute.h"
@@ -39,8 +40,9 @@ struct build {
 	struct irdm_corr_sparse sparse; /* modal: the kept blocks (start NULL if none) */
 	double *head;                   /* modal exact_head: [k][s][3][3] (exact_head.h) */
 	struct irdm_corr_lowrank far;   /* modal: their far field (rank 0 if none) */
-	void *stored[5];                /* converted to the scene's precision */
-	size_t stored_bytes[5];
+	struct irdm_corr_clusters clusters; /* modal: every block, clustered (0 clusters if not) */
+	void *stored[6];                /* converted to the scene's precision */
+	size_t stored_bytes[6];
 	struct irdm_stability *stab;
 	struct irdm_meta meta;
 	struct irdm_rigid rigid;
@@ -134,6 +136,29 @@ static int split_modes(struct build *b, struct irdm_mode **zoh_all, size_t *n_al
 	return IRDM_OK;
 }
 
+
+/* The static correction clustered: the columns' rest positions set the
+ * clusters. */
+static int clustered(struct build *b, char *err, size_t errlen)
+{
+	struct irdm_model *m = &b->m;
+	double *pos = malloc(3 * (m->n_cols ? m->n_cols : 1) * sizeof(double));
+	int ret;
+
+	if (!pos) {
+		snprintf(err, errlen, "precompute: out of memory for the column positions");
+		return IRDM_ENOMEM;
+	}
+	for (size_t c = 0; c < m->n_cols; c++)
+		memcpy(&pos[3 * c], &m->mesh.pos_m[3 * (size_t)m->rows[m->cols[c]]],
+		       3 * sizeof(double));
+	ret = irdm_static_correction_clusters(&m->fem, &m->modes, b->sc->floating, m->col_dofs, pos,
+					      m->n_cols, b->sc->static_corr_cluster,
+					      b->sc->static_corr_tol, b->o->progress, b->o->ctx,
+					      &b->sparse, &b->clusters, err, errlen);
+	free(pos);
+	return ret;
+}
 static int modal_data(struct build *b, char *err, size_t errlen)
 {
 	struct irdm_model *m = &b->m;
@@ -162,6 +187,12 @@ static int modal_data(struct build *b, char *err, size_t errlen)
 	if (!b->sc->static_correction || !truncated(b)) {
 		free(zoh_all);
 		return IRDM_OK;
+	}
+	if (b->sc->representation == IRDM_REPR_MODAL && b->sc->static_corr_cluster) {
+		/* every block, block low-rank over clusters (static_clusters.h) */
+		ret = clustered(b, err, errlen);
+		free(zoh_all);
+		return ret;
 	}
 	if (b->sc->representation == IRDM_REPR_MODAL) {
 		/* between columns only, the blocks that matter (static_sparse.h),
@@ -501,6 +532,13 @@ static void stab_one(struct build *b, size_t c)
 				Df[e] += D[e];
 			D = Df;
 		}
+		/* clustered: the kept diagonal is zero, the value is the pair's */
+		if (D && b->clusters.n_clusters) {
+			irdm_corr_clusters_block(&b->clusters, c, c, Df);
+			for (int e = 0; e < 9; e++)
+				Df[e] += D[e];
+			D = Df;
+		}
 		/* the argument-principle certificate: O(modes) per point of a
 		 * circle where the dense eigenvalues are O(modes^3)
 		 * (irdm_stability_modal stays as the tests' reference); a
@@ -711,6 +749,9 @@ static int add_sections(struct build *b, struct irdm_image_writer *w, const void
 			if (b->stored[3])
 				ret |= irdm_iw_add(w, IRDM_SEC_STATIC_CORR_LOWRANK, IRDM_ELEM_BYTES,
 						   b->stored[3], b->stored_bytes[3]);
+			if (b->stored[5])
+				ret |= irdm_iw_add(w, IRDM_SEC_STATIC_CORR_CLUSTERS, IRDM_ELEM_BYTES,
+						   b->stored[5], b->stored_bytes[5]);
 		}
 		if (b->stored[4])
 			ret |= irdm_iw_add(w, IRDM_SEC_EXACT_HEAD, p, b->stored[4], b->stored_bytes[4]);
@@ -773,6 +814,35 @@ static void *store_far(const struct irdm_corr_lowrank *lr, uint32_t prec, size_t
 	return p;
 }
 
+/* STATIC_CORR_CLUSTERS' payload (image_format.h): header, the three
+ * tables, padding, the pair table, the values in the precision. */
+static void *store_clusters(const struct irdm_corr_clusters *cl, uint32_t prec, size_t *bytes)
+{
+	struct irdm_corr_clusters_header h = { .n_clusters = (uint32_t)cl->n_clusters,
+					       .max_rank = (uint32_t)cl->max_rank,
+					       .n_values = cl->n_values };
+	size_t es = irdm_elem_size(prec), nc = cl->n_cols, nC = cl->n_clusters;
+	size_t tables = (sizeof(h) + 4 * (nC + 1 + 2 * nc) + 7) & ~(size_t)7;
+	size_t pairs = sizeof(struct irdm_corr_pair) * cl->n_pairs;
+	uint8_t *p;
+
+	*bytes = tables + pairs + es * cl->n_values;
+	p = calloc(1, *bytes);
+	if (!p)
+		return NULL;
+	memcpy(p, &h, sizeof(h));
+	memcpy(p + sizeof(h), cl->start, 4 * (nC + 1));
+	memcpy(p + sizeof(h) + 4 * (nC + 1), cl->members, 4 * nc);
+	memcpy(p + sizeof(h) + 4 * (nC + 1 + nc), cl->col_pos, 4 * nc);
+	for (size_t q = 0; q < cl->n_pairs; q++) {
+		struct irdm_corr_pair e = { .offset = cl->offset[q], .rank = cl->rank[q] };
+		memcpy(p + tables + q * sizeof(e), &e, sizeof(e));
+	}
+	for (size_t i = 0; i < cl->n_values; i++)
+		irdm_elem_put(p + tables + pairs, prec, i, cl->values[i]);
+	return p;
+}
+
 static int responses(struct build *b, char *err, size_t errlen)
 {
 	struct irdm_model *m = &b->m;
@@ -806,10 +876,12 @@ static int responses(struct build *b, char *err, size_t errlen)
 	if (b->head)
 		b->stored[4] = store(b->head, b->sparse.n_blocks * 2 * b->sc->exact_head * 9,
 				     b->sc->precision, &b->stored_bytes[4]);
+	if (b->clusters.n_clusters)
+		b->stored[5] = store_clusters(&b->clusters, b->sc->precision, &b->stored_bytes[5]);
 	if ((b->fir && !b->stored[0]) ||
 	    (b->shapes && b->sc->representation == IRDM_REPR_MODAL && !b->stored[1]) ||
 	    (b->sparse.start && !b->stored[2]) || (b->far.rank && !b->stored[3]) ||
-	    (b->head && !b->stored[4])) {
+	    (b->head && !b->stored[4]) || (b->clusters.n_clusters && !b->stored[5])) {
 		snprintf(err, errlen, "precompute: out of memory converting to the storage precision");
 		return IRDM_ENOMEM;
 	}
@@ -826,7 +898,8 @@ static void build_free(struct build *b)
 	irdm_corr_sparse_free(&b->sparse);
 	free(b->head);
 	irdm_corr_lowrank_free(&b->far);
-	for (int i = 0; i < 5; i++)
+	irdm_corr_clusters_free(&b->clusters);
+	for (int i = 0; i < 6; i++)
 		free(b->stored[i]);
 	free(b->stab);
 	free(b->nodes);
@@ -861,6 +934,11 @@ static void report(const struct build *b, struct irdm_precompute_report *rep)
 	rep->corr_far_max[1] = b->far.max_after;
 	rep->corr_far_rms[0] = b->far.rms_before;
 	rep->corr_far_rms[1] = b->far.rms_after;
+	rep->corr_clusters = b->clusters.n_clusters;
+	rep->corr_cluster_pairs_dense = b->clusters.n_dense;
+	rep->corr_cluster_max_rank = b->clusters.max_rank;
+	rep->corr_cluster_max_err = b->clusters.max_err;
+	rep->corr_cluster_values = b->clusters.n_values;
 }
 
 static uint64_t scene_hash(const struct irdm_scene *sc)

@@ -35,6 +35,10 @@ struct irdm_precompute_report {
 	 * sqrt(|S_aa| |S_bb|): the largest and the RMS error */
 	size_t corr_rank, corr_checked;
 	double corr_far_max[2], corr_far_rms[2];
+	/* static_correction_cluster: clusters, dense pairs, largest rank,
+	 * largest block error left (units of sqrt(|S_aa| |S_bb|)), values */
+	size_t corr_clusters, corr_cluster_pairs_dense, corr_cluster_max_rank, corr_cluster_values;
+	double corr_cluster_max_err;
 };
 
 /*

@@ -9,6 +9,7 @@
 
 #include "irdm/error.h"
 #include "irdm/options.h"
+#include "modal/static_clusters.h"
 #include "modal/static_lowrank.h"
 #include "modal/static_sparse.h"
 #include "scene/scene.h"
@@ -425,6 +426,9 @@ static const struct irdm_opt scene_opts[] = {
 	{ .name = "static_correction_rank", .type = IRDM_OPT_UNSIGNED, SC(static_corr_rank),
 	  .metavar = "R", .range = IRDM_OPT_GE | IRDM_OPT_LE, .min = 0, .max = IRDM_CORR_LOWRANK_MAX,
 	  .help = "modal: the far field of the dropped static-correction blocks as a symmetric term of rank R over the touchable nodes, added to every block (image section STATIC_CORR_LOWRANK, R (1 + 3 n_cols) values); 0 leaves it out (default 96)" },
+	{ .name = "static_correction_cluster", .type = IRDM_OPT_UNSIGNED, SC(static_corr_cluster),
+	  .metavar = "N", .range = IRDM_OPT_LE, .max = IRDM_STATIC_CORR_CLUSTER_MAX,
+	  .help = "modal: keep the static correction between every pair of touchable nodes, block low-rank over clusters of at most N nearby nodes (image section STATIC_CORR_CLUSTERS): static_correction_tol then bounds every block's error, not the dropped ones', and static_correction_rank is not used; 0 drops blocks instead (default 0)" },
 	{ .name = "exact_head", .type = IRDM_OPT_UNSIGNED, SC(exact_head), .metavar = "H",
 	  .range = IRDM_OPT_LE, .max = IRDM_HEAD_SAMPLES_MAX / 2,
 	  .help = "modal: the hybrid representation: the dropped modes' exact response over the "
@@ -530,6 +534,22 @@ int irdm_scene_check(const struct irdm_scene *sc, char *err, size_t errlen)
 			 sc->exact_head);
 		return IRDM_EINVAL;
 	}
+	if (sc->static_corr_cluster && (sc->representation != IRDM_REPR_MODAL ||
+					!sc->static_correction)) {
+		snprintf(err, errlen, "scene: static_correction_cluster = %u clusters a modal image's static correction: use representation = modal:K with static_correction = yes",
+			 sc->static_corr_cluster);
+		return IRDM_EINVAL;
+	}
+	if (sc->static_corr_cluster && sc->static_corr_cluster < IRDM_STATIC_CORR_CLUSTER_MIN) {
+		snprintf(err, errlen, "scene: static_correction_cluster = %u is below %d nodes per cluster (0 turns it off)",
+			 sc->static_corr_cluster, IRDM_STATIC_CORR_CLUSTER_MIN);
+		return IRDM_EINVAL;
+	}
+	if (sc->static_corr_cluster && sc->exact_head) {
+		snprintf(err, errlen, "scene: exact_head = %u with static_correction_cluster = %u: the hybrid's head needs the dropped-block correction (static_correction_cluster = 0)",
+			 sc->exact_head, sc->static_corr_cluster);
+		return IRDM_EINVAL;
+	}
 	if (sc->damping == IRDM_DAMP_RATIOS && sc->damp_hz[0] > 0 &&
 	    fabs(sc->damp_hz[0] - sc->damp_hz[1]) < 1e-9) {
 		snprintf(err, errlen, "scene: damping needs two different frequencies");
@@ -583,6 +603,13 @@ int irdm_scene_format(const struct irdm_scene *sc, char *buf, size_t len)
 		return -1;
 	if (sc->fir_tail) {         /* only when set: older scenes keep their text */
 		int t = snprintf(buf + n, len - (size_t)n, "fir_tail=window:%u\n", sc->fir_tail);
+		if (t < 0 || (size_t)t >= len - (size_t)n)
+			return -1;
+		n += t;
+	}
+	if (sc->static_corr_cluster) {      /* only when set, as fir_tail */
+		int t = snprintf(buf + n, len - (size_t)n, "static_correction_cluster=%u\n",
+				 sc->static_corr_cluster);
 		if (t < 0 || (size_t)t >= len - (size_t)n)
 			return -1;
 		n += t;

@@ -69,6 +69,7 @@ struct irdm_scene {
 	bool static_correction;
 	double static_corr_tol;   /* drop blocks below tol sqrt(|S_cc| |S_rr|) */
 	unsigned static_corr_rank; /* far field of the dropped blocks: rank (0: none) */
+	unsigned static_corr_cluster; /* nodes per cluster of the clustered correction (0: off) */
 	unsigned exact_head;     /* modal: exact samples of the dropped modes' head (0: none; stored: 2x) */
 	uint32_t precision;      /* enum irdm_elem */
 	struct irdm_region touch;

@@ -45,6 +45,14 @@ struct irdm_image {
 	uint32_t corr_rank;
 	const void *corr_lambda;            /* corr_rank of precision */
 	const void *corr_u;                 /* 3 n_cols x corr_rank of precision */
+	/* optional block low-rank correction (STATIC_CORR_CLUSTERS; all NULL
+	 * if absent): every block adds its pair's value (image_format.h) */
+	const struct irdm_corr_clusters_header *corr_clusters;
+	const uint32_t *corr_cl_start;      /* n_clusters + 1 */
+	const uint32_t *corr_cl_members;    /* n_cols */
+	const uint32_t *corr_cl_pos;        /* n_cols */
+	const struct irdm_corr_pair *corr_cl_pairs; /* n_clusters (n_clusters + 1) / 2 */
+	const void *corr_cl_values;         /* n_values of precision */
 	/* modal, optional (NULL if absent): the dropped modes' response over
 	 * meta->head_samples samples for each kept block k, [k][s][3][3] of
 	 * precision (exact over the first half, tapered over the second); its
@@ -98,6 +106,14 @@ int irdm_image_parse(const void *buf, size_t size, struct irdm_image *img,
  * zero img.  Cannot fail. */
 void irdm_image_unmap(struct irdm_image *img);
 
+/* STATIC_CORR_CLUSTERS (img->corr_clusters non-NULL): the cluster of
+ * column col, and its index among the cluster's members into *local
+ * (O(log n_clusters)); the pair table entry of clusters a and b in either
+ * order (stored once, for min, max).  Tick-safe. */
+uint32_t irdm_image_corr_cluster(const struct irdm_image *img, uint32_t col, uint32_t *local);
+const struct irdm_corr_pair *irdm_image_corr_pair(const struct irdm_image *img, uint32_t a,
+						  uint32_t b);
+
 /* Section lookup in a validated image: the table entry of kind, or NULL if
  * absent (or img holds no image).  Cannot fail otherwise. */
 const struct irdm_image_section *irdm_image_find(const struct irdm_image *img,
@@ -113,8 +129,9 @@ long irdm_image_corr_block(const struct irdm_image *img, uint32_t col_force,
 /* The static correction's block for a force at column col_force and the
  * displacement of column col_disp, entry [i][j] = displacement along i per
  * unit force along j, into blk: the kept block (zero where dropped) plus
- * the low-rank far field.  Zeros if the image has no correction.
- * O(log kept + 9 corr_rank), no allocation (tick-safe). */
+ * the low-rank far field plus the clusters' value.  Zeros if the image has
+ * no correction.  O(log kept + 9 corr_rank + log n_clusters + 9 rank of
+ * the clusters' pair), no allocation (tick-safe). */
 void irdm_image_corr_value(const struct irdm_image *img, uint32_t col_force,
 			   uint32_t col_disp, double blk[9]);
 

@@ -16,7 +16,7 @@
 
 #define IRDM_IMAGE_MAGIC "IRDMIMG"          /* 7 chars + NUL = 8 bytes */
 #define IRDM_IMAGE_VERSION_MAJOR 2u         /* incompatible layout change */
-#define IRDM_IMAGE_VERSION_MINOR 1u         /* compatible additions: 2.1 STATIC_CORR_LOWRANK, EXACT_HEAD */
+#define IRDM_IMAGE_VERSION_MINOR 2u         /* compatible additions: 2.1 STATIC_CORR_LOWRANK, EXACT_HEAD; 2.2 STATIC_CORR_CLUSTERS */
 #define IRDM_IMAGE_ALIGN 64u                /* payload alignment, bytes */
 #define IRDM_IMAGE_MAX_SECTIONS 32u
 
@@ -69,6 +69,7 @@ enum irdm_section_kind {
 	IRDM_SEC_STATIC_CORR_INDEX = 13, /* with STATIC_CORR: u32 column starts + rows of its blocks */
 	IRDM_SEC_STATIC_CORR_LOWRANK = 14, /* optional, with STATIC_CORR: far field U diag(lambda) U^T */
 	IRDM_SEC_EXACT_HEAD = 15,  /* modal, optional: [k][s][3][3] of the STATIC_CORR blocks, s < head_samples */
+	IRDM_SEC_STATIC_CORR_CLUSTERS = 16, /* optional, with STATIC_CORR: every block, block low-rank over clusters */
 };
 
 enum irdm_repr {
@@ -226,6 +227,51 @@ struct irdm_corr_lowrank_header {           /* 16 bytes */
 	uint32_t reserved[3];               /* 0 */
 };
 
+/*
+ * STATIC_CORR_CLUSTERS (kind 16, elem BYTES, optional, only with STATIC_CORR,
+ * since minor 2): the static correction between every pair of touchable
+ * nodes, block low-rank.  The columns are split into clusters of nearby
+ * nodes; the correction between two clusters far apart is smooth enough
+ * for a low-rank product, between near ones it is stored whole.  Every
+ * block (kept or not) adds its value from here.  The payload is
+ *
+ *   struct irdm_corr_clusters_header     32 bytes at 0
+ *   u32 start[n_clusters + 1]            at 32: cluster a is members
+ *                                        [start[a], start[a + 1])
+ *   u32 members[n_cols]                  the columns, cluster by cluster
+ *   u32 col_pos[n_cols]                  column c is members[col_pos[c]]
+ *   zero bytes up to a multiple of 8
+ *   struct irdm_corr_pair pairs[n_clusters (n_clusters + 1) / 2]
+ *   values[n_values]                     the image's precision
+ *
+ * Pair (a, b) with a <= b is entry a n_clusters - a (a - 1) / 2 + b - a:
+ * the matrix from a force at cluster b's members to the displacement of
+ * cluster a's, row (col) 3 i + x being the i-th member's axis x.  At
+ * values[offset] it is, for rank IRDM_CORR_PAIR_DENSE, the 3|a| x 3|b|
+ * matrix row-major; else U[3|a|][rank] then V[3|b|][rank], the matrix
+ * U V^T (rank 0: zero).  Pair (b, a) is pair (a, b) transposed, so every
+ * block (c, c') is block (c', c) transposed to the bit.  A self pair
+ * (a, a) has rank IRDM_CORR_PAIR_DENSE and holds only its upper triangle,
+ * row by row (n = 3|a|: entry (i, j), i <= j, at i n - i (i - 1) / 2 +
+ * j - i; n (n + 1) / 2 values), so it is symmetric by construction.  The
+ * pairs' values follow each other in table order, with no gaps.
+ */
+#define IRDM_CORR_CLUSTERS_MAX 4096u        /* clusters: bounds the pair table */
+#define IRDM_CORR_PAIR_DENSE 0xffffffffu    /* irdm_corr_pair.rank of a dense pair */
+
+struct irdm_corr_clusters_header {          /* 32 bytes */
+	uint32_t n_clusters;                /* 1..min(n_cols, IRDM_CORR_CLUSTERS_MAX) */
+	uint32_t max_rank;                  /* largest low-rank pair's rank, <= IRDM_CORR_LOWRANK_MAX */
+	uint64_t n_values;                  /* elements of values[] */
+	uint32_t reserved[4];               /* 0 */
+};
+
+struct irdm_corr_pair {                     /* 16 bytes */
+	uint64_t offset;                    /* element index into values[] */
+	uint32_t rank;                      /* IRDM_CORR_PAIR_DENSE, or 0..min(3|a|, 3|b|, max_rank) */
+	uint32_t reserved;                  /* 0 */
+};
+
 _Static_assert(sizeof(struct irdm_image_header) == 64, "header size");
 _Static_assert(sizeof(struct irdm_image_section) == 32, "section size");
 _Static_assert(sizeof(struct irdm_meta) == 256, "meta size");
@@ -236,5 +282,7 @@ _Static_assert(sizeof(struct irdm_stability) == 8, "stability size");
 _Static_assert(sizeof(struct irdm_bvh_header) == 64, "bvh header size");
 _Static_assert(sizeof(struct irdm_bvh_node) == 32, "bvh node size");
 _Static_assert(sizeof(struct irdm_corr_lowrank_header) == 16, "lowrank header size");
+_Static_assert(sizeof(struct irdm_corr_clusters_header) == 32, "clusters header size");
+_Static_assert(sizeof(struct irdm_corr_pair) == 16, "cluster pair size");
 
 #endif /* IRDM_IMAGE_FORMAT_H */
