@@ -5,8 +5,9 @@
  * member j) displaces every cluster a by S(a, b)[:, 3j..3j+2] f.  A pair is
  * stored once, for (min, max), so S(a, b) with a > b is the stored
  * matrix transposed: the strides (dense) or the factors U, V (low-rank)
- * swap roles; a self pair (a, a) holds its upper triangle only.  Every pair of the force's cluster is read, O(3 n_cols) per
- * dense pair and O(rank (3 + 3|a|)) per low-rank one.
+ * swap roles; a self pair (a, a) holds its upper triangle only.  Every
+ * pair of the force's cluster is read, O(3 n_cols) per dense pair and
+ * O(rank (3 + 3|a|)) per low-rank one.
  */
 #include "worker_priv.h"
 
@@ -38,9 +39,7 @@ static void view_pair(const struct irdm_image *img, uint32_t a, uint32_t b,
 /* Entry (r, c) of a self pair of n rows: its upper triangle, row by row. */
 static size_t tri_index(size_t n, size_t r, size_t c)
 {
-	size_t i = r < c ? r : c, j = r < c ? c : r;
-
-	return i * n - i * (i ? i - 1 : 0) / 2 + (j - i);
+	return r < c ? irdm_upper_index(n, r, c) : irdm_upper_index(n, c, r);
 }
 
 /* u[3 i + x] += S(a, a)[3 i + x][3j..3j+2] fe, over cluster a's members i. */

@@ -218,7 +218,7 @@ const struct irdm_corr_pair *irdm_image_corr_pair(const struct irdm_image *img, 
 		b = t;
 	}
 	/* row a of the upper triangle starts after a nC - a (a - 1) / 2 pairs */
-	return &img->corr_cl_pairs[(uint64_t)a * nC - (uint64_t)a * (a ? a - 1 : 0) / 2 + (b - a)];
+	return &img->corr_cl_pairs[irdm_upper_index(nC, a, b)];
 }
 
 uint32_t irdm_image_corr_cluster(const struct irdm_image *img, uint32_t col, uint32_t *local)
@@ -263,7 +263,7 @@ void img_corr_clusters_add(const struct irdm_image *img, uint32_t col_force, uin
 			double s = 0;
 			if (ar == ac) {
 				size_t i = r < c ? r : c, j = r < c ? c : r;
-				s = irdm_elem_get(v, prec, o + i * nr - i * (i ? i - 1 : 0) / 2 + (j - i));
+				s = irdm_elem_get(v, prec, o + irdm_upper_index(nr, i, j));
 			} else if (q->rank == IRDM_CORR_PAIR_DENSE) {
 				s = irdm_elem_get(v, prec, o + r * ncl + c);
 			} else {

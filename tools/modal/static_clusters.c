@@ -27,7 +27,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "irdm/image_format.h"
+#include "irdm/image.h"
 #include "modal/lapack.h"
 #include "modal/response.h"
 #include "modal/static_clusters.h"
@@ -118,7 +118,7 @@ out_free:
 
 static size_t pair_index(size_t n_clusters, size_t a, size_t b)
 {
-	return a * n_clusters - a * (a ? a - 1 : 0) / 2 + (b - a);
+	return irdm_upper_index(n_clusters, a, b);
 }
 
 static size_t cl_size(const struct irdm_corr_clusters *cl, size_t a)
@@ -581,7 +581,7 @@ void irdm_corr_clusters_block(const struct irdm_corr_clusters *cl, size_t col_f,
 			double s = 0;
 			if (ar == ac) {
 				size_t i = r < c ? r : c, j = r < c ? c : r;
-				s = cl->values[o + i * nr - i * (i ? i - 1 : 0) / 2 + (j - i)];
+				s = cl->values[o + irdm_upper_index(nr, i, j)];
 			} else if (k == IRDM_CORR_PAIR_DENSE)
 				s = cl->values[o + r * ncl + c];
 			else

@@ -111,6 +111,15 @@ void irdm_image_unmap(struct irdm_image *img);
  * (O(log n_clusters)); the pair table entry of clusters a and b in either
  * order (stored once, for min, max).  Tick-safe. */
 uint32_t irdm_image_corr_cluster(const struct irdm_image *img, uint32_t col, uint32_t *local);
+
+/* Entry (i, j), i <= j, of an n x n upper triangle stored row by row:
+ * both the pair table (n = n_clusters) and a self pair's values (n = 3|a|)
+ * are laid out so. */
+static inline size_t irdm_upper_index(size_t n, size_t i, size_t j)
+{
+	return i * n - i * (i ? i - 1 : 0) / 2 + (j - i);
+}
+
 const struct irdm_corr_pair *irdm_image_corr_pair(const struct irdm_image *img, uint32_t a,
 						  uint32_t b);
 
