@@ -164,6 +164,20 @@ static void test_bad_scene_values(void **state)
 		       "fir_tail");
 	expect_failure(run("precompute", SMALL, "--fir_tail", "hann:5", "-o", img, NULL),
 		       "expected none or window:L");
+	/* the clustered static correction: its range and what it combines with */
+	expect_failure(run("precompute", SMALL, "--static_correction_cluster", "3", "-o", img, NULL),
+		       "static_correction_cluster = 3 is below 4 nodes per cluster");
+	expect_failure(run("precompute", SMALL, "--static_correction_cluster", "1025", "-o", img,
+			   NULL), "static_correction_cluster");
+	expect_failure(run("precompute", SMALL, "--static_correction_cluster", "8", "--exact_head",
+			   "4", "-o", img, NULL),
+		       "exact_head = 4 with static_correction_cluster = 8");
+	expect_failure(run("precompute", SMALL, "--static_correction_cluster", "8",
+			   "--representation", "fir:10", "-o", img, NULL),
+		       "static_correction_cluster = 8 clusters a modal image's static correction");
+	expect_failure(run("precompute", SMALL, "--static_correction_cluster", "8",
+			   "--static_correction", "no", "-o", img, NULL),
+		       "static_correction_cluster = 8 clusters a modal image's static correction");
 	expect_failure(run("precompute", SMALL, "--touch", "z>=5", "-o", img, NULL), "selects no");
 	expect_failure(run("precompute", SMALL, NULL), "-o");
 	expect_failure(run("precompute", "--scene", path_in_dir("missing.scene"), "-o", img, NULL),
