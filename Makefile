@@ -5,7 +5,10 @@
 #   make san        the same tests under AddressSanitizer + UBSan (build-san/)
 #   make fuzz       libFuzzer targets, each for FUZZ_SECONDS (clang only);
 #                   any finding fails the build and keeps the input
-#   make check      what CI runs: fuzz, clang + sanitizer tests, then the tests
+#   make test-variants  the stability suite with OPENBLAS_NUM_THREADS=1, then
+#                   with the portable history sums forced
+#   make check      what CI runs: fuzz, clang + sanitizer tests, the
+#                   variants, then the tests
 #   make bench      benchmarks (print figures; never pass/fail on time)
 #   make bench-mpi  the precompute of a 100k-node model, serial and over MPI ranks
 #   make stability  the stability suite's long run (10^7-tick soak): a Markdown
@@ -122,7 +125,7 @@ TESTS    := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 TICK_TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TICK_TEST_SRC))
 BENCHES  := $(patsubst tests/bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC))
 
-.PHONY: all test san fuzz bench bench-precompute bench-mpi run render stability report jitter check deps clean docs cfg-fws sizes hil
+.PHONY: all test test-variants san fuzz bench bench-precompute bench-mpi run render stability report jitter check deps clean docs cfg-fws sizes hil
 .SECONDARY:
 all: $(if $(CONFIG),,$(IRDM) $(SLEPC_PLUGIN)) $(FW_LIB) $(HAL_LIB) $(SIM_LIB) $(if $(FWMAIN_SRC),$(IRDM_FW)) \
   $(if $(CDMAIN_SRC),$(IRDM_CD))
@@ -196,6 +199,17 @@ $(TICK_IMAGE): $(IRDM)
 test: $(TESTS) $(IRDM) $(IRDM_FW) $(IRDM_CD) $(TICK_IMAGE) $(BUILD)/data/bunny.off cfg-fws
 	IRDM=$(IRDM) IRDM_FW=$(IRDM_FW) IRDM_BUILD=$(BUILD) IRDM_TICK_IMAGE=$(TICK_IMAGE) \
 	  tests/run-tests.sh $(TESTS)
+
+# The stability suite again with what changes the rounding of its images
+# and sums: OpenBLAS on one thread (the precompute's eigensolve and
+# products), then the portable history sums where AVX2 would run.  A limit
+# that only one rounding meets fails here, not on the next machine.
+STAB_TESTS := $(filter $(BUILD)/tests/test_stability%,$(TESTS))
+test-variants: $(STAB_TESTS) $(IRDM) $(TICK_IMAGE)
+	OPENBLAS_NUM_THREADS=1 IRDM=$(IRDM) IRDM_BUILD=$(BUILD) IRDM_TICK_IMAGE=$(TICK_IMAGE) \
+	  tests/run-tests.sh $(STAB_TESTS)
+	IRDM_TEST_PORTABLE_SUM=1 IRDM=$(IRDM) IRDM_BUILD=$(BUILD) IRDM_TICK_IMAGE=$(TICK_IMAGE) \
+	  tests/run-tests.sh $(STAB_TESTS)
 
 # The firmware built with the shipped trimmed configurations, beside the
 # full one (test_build_config checks what they leave out and refuse).
@@ -306,6 +320,7 @@ check: deps
 	$(MAKE) -j$(CHECK_JOBS) fuzz FUZZ_SECONDS=$(CHECK_FUZZ_SECONDS)
 	$(MAKE) -j$(CHECK_JOBS) CC=clang BUILD=build-clang test
 	$(MAKE) -j$(CHECK_JOBS) san
+	$(MAKE) -j$(CHECK_JOBS) test-variants
 	$(MAKE) -j$(CHECK_JOBS) test
 	$(MAKE) -j$(CHECK_JOBS) hil
 

@@ -435,6 +435,55 @@ static void test_hal_failures(void **state)
 	}
 }
 
+/*
+ * Forces back on with the tool 1.5 mm inside (a HAL fault, a reset, enable
+ * without moving): the contact engages softly.  The first enabled tick
+ * renders no force; the force then grows over the engine's fade
+ * (IRDM_ENGINE_ENGAGE_FADE_S) without a release, each tick's step within
+ * 1.5 % of the held force (measured 1.3 %: the fade's own steepest step is
+ * 0.6 %, the soft object's ringing adds the rest), and ends at the force
+ * held before the fault.  A hard engagement renders 1.64 N at the first
+ * tick, 34 times the held force, and the push chatters.
+ */
+static void test_enable_inside_fades_in(void **state)
+{
+	struct rig r;
+	unsigned fade = (unsigned)ceil(IRDM_ENGINE_ENGAGE_FADE_S / 1e-3 - 1e-9);
+	double held, f_prev = 0, max_step = 0;
+	(void)state;
+
+	contact_rig(&r, NULL, 0);
+	for (int k = 0; k < 2000; k++)          /* settle: the held force */
+		assert_int_equal(tick(&r), IRDM_OK);
+	held = irdm_v3_norm(r.out.dev[0].force_obj_n);
+	tick_cmd(&r, IRDM_CTRL_CMD_HAL_FAULT);
+	assert_faulted(&r, IRDM_FAULT_HAL_FAULT);
+	tick_cmd(&r, IRDM_CTRL_CMD_RESET);
+	assert_int_equal(r.out.state, IRDM_SAFETY_READY);
+	for (int k = 0; k < 2000; k++)          /* the object relaxes under the tool */
+		assert_int_equal(tick(&r), IRDM_OK);
+	tick_cmd(&r, IRDM_CTRL_CMD_ENABLE);
+	assert_int_equal(r.out.state, IRDM_SAFETY_ENABLED);
+	assert_int_equal(r.out.dev[0].proxy_event, IRDM_PROXY_TOUCH);
+	assert_true(irdm_v3_norm(r.out.dev[0].force_obj_n) <= 1e-9 * held);
+	for (unsigned k = 0; k < fade + 500; k++) {
+		double f;
+
+		assert_int_equal(tick(&r), IRDM_OK);
+		assert_int_equal(r.out.dev[0].proxy_event, IRDM_PROXY_SLIDE);
+		f = irdm_v3_norm(r.out.dev[0].force_obj_n);
+		max_step = fmax(max_step, fabs(f - f_prev));
+		f_prev = f;
+	}
+	print_message("re-engaged 1.5 mm inside: held %.4f N before the fault, %.4f N after the "
+		      "fade; largest step %.3e N per tick (the fade's steepest %.3e)\n",
+		      held, f_prev, max_step, M_PI / 2 * held / fade);
+	assert_true(max_step <= 0.015 * held);
+	assert_true(fabs(f_prev - held) <= 1e-3 * held);
+	assert_int_equal(irdm_engine_stats(r.s->eng)->releases, 0);
+	rig_close(&r);
+}
+
 static void test_encoder_nan_and_range(void **state)
 {
 	struct rig r;
@@ -1340,6 +1389,7 @@ int main(void)
 		cmocka_unit_test(test_transitions_through_the_tick),
 		cmocka_unit_test(test_signal_mid_contact),
 		cmocka_unit_test(test_hal_failures),
+		cmocka_unit_test(test_enable_inside_fades_in),
 		cmocka_unit_test(test_encoder_nan_and_range),
 		cmocka_unit_test(test_watchdog),
 		cmocka_unit_test(test_overruns),

@@ -465,7 +465,8 @@ static void rig_free(struct rig *r)
 /*
  * One tick of the scenario.  Only what a real force loop does between two
  * ticks: slide the push to the next node every SLIDE_EVERY ticks (a new
- * site), re-touch a released push, set the targets.  No libc but sin().
+ * site), re-touch a released push (softly: irdm_engine_contact_soften()),
+ * set the targets.  No libc but sin().
  */
 static int scenario_tick(struct rig *r, struct run_result *res)
 {
@@ -476,10 +477,14 @@ static int scenario_tick(struct rig *r, struct run_result *res)
 	int rc;
 
 	if (r->t % SLIDE_EVERY == 0 || c0->mode == IRDM_CONTACT_OFF) {
+		bool was_off = c0->mode == IRDM_CONTACT_OFF;
 		struct irdm_contact_site s;
 		uint32_t row = r->push_row[(r->t / SLIDE_EVERY) % (uint64_t)r->n_push];
 		if (irdm_engine_site_node(e, row, &s) ||
 		    irdm_engine_contact_begin(e, 0, &s, IRDM_CONTACT_PUSH))
+			return -1;
+		/* a released push comes back with the tool inside: softly */
+		if (was_off && irdm_engine_contact_soften(e, 0))
 			return -1;
 		if (r->t % SLIDE_EVERY == 0)
 			res->slides++;

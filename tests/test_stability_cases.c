@@ -1,17 +1,18 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * Issue 10, the stability suite: the stiff and extreme cases, one table
+ * The stability suite: the stiff and extreme cases, one table
  * row each, run by the harness (tests/support/stab_harness.h) and checked
  * for bounded forces, no energy created, no NaN, the held force against
  * the static force from an independent sum of the image's responses, and
  * a clear refusal where the input is unusable.  tests/test_stability.c
- * holds the 60 s sweeps of E, nu and FIR length (issue 3); the meshes,
+ * holds the 60 s sweeps of E, nu and FIR length; the meshes,
  * the soak and the spinning body have files of their own.
  *
  * Limits: a force bound is the case's physics where it is sharp (the
  * coupling spring at the held depth plus its damper at the approach
- * speed), else the measured peak with 5-20 % margin (the table in the
- * README has both); the held force is within 1e-4 of the static force
+ * speed, or at a jump's speed), else the measured peak with 5-20 % margin;
+ * the margins hold across OpenBLAS's thread counts and the history sums
+ * (make test-variants runs this file with each); the held force is within 1e-4 of the static force
  * (measured agreement 1e-6 or better); the energy tolerance is what W(t) =
  * sum F . du, the work done on the object through the contact ports, may
  * go below zero (a passive object gives back at most what it received).
@@ -45,6 +46,12 @@ static const char *const fir500[] = { FIR, "representation", "fir:500", NULL };
  * (0.2 m/s; b = 2.25 N s/m at 1 ms, 2.0 at 2 ms), + 10 mN */
 #define HAPTIC_1CM_1MS (1000.0 * 0.01 + 2.25 * 0.2 + 0.01)
 #define HAPTIC_1CM_2MS (1000.0 * 0.01 + 2.0 * 0.2 + 0.01)
+/* A jump of 1 m in one tick: the spring at 1 m, and the coupling's damper
+ * (2.25 N s/m) and the passivity controller's largest damping (what the
+ * device's margin leaves: 5 - 1000 * 0.001 / 2 - 2.25 = 2.25 N s/m) at the
+ * jump's speed, 1 m per tick.  The object only answers the tool, so no
+ * relative speed in the run exceeds the jump's. */
+#define JUMP_1M_1MS (1000.0 * 1.0 + (2.25 + 2.25) * 1.0 / 0.001)
 #define HOLD_1MS 20000          /* 20 s: the soft cuboid's slowest mode settles to < 1e-4 */
 #define HOLD_2MS 10000
 
@@ -159,7 +166,7 @@ static void test_penetration(void **state)
 		  .energy_tol_j = 1e-12 },
 		{ .name = "1 m deep in one tick, haptic", .image = soft_1ms, .at_m = TOP,
 		  .mode = IRDM_CONTACT_PUSH, .depth_m = { 1.0 }, .target = teleport, .ticks = HOLD_1MS,
-		  .max_f_limit_n = 3e4, .static_rel_tol = 1e-4, .energy_tol_j = 1e-12 },
+		  .max_f_limit_n = JUMP_1M_1MS, .static_rel_tol = 1e-4, .energy_tol_j = 1e-12 },
 		{ .name = "1 m deep, rigid", .image = soft_1ms, .at_m = TOP, .coupling = STAB_RIGID,
 		  .mode = IRDM_CONTACT_GRAB, .depth_m = { 1.0 }, .ticks = HOLD_1MS, .max_f_limit_n = 730.0,
 		  .static_rel_tol = 1e-4, .energy_tol_j = 1e-12 },
@@ -179,14 +186,22 @@ static void test_bad_positions(void **state)
 		{ .name = "NaN target at 1 s", .image = soft_1ms, .at_m = TOP, .mode = IRDM_CONTACT_PUSH,
 		  .depth_m = { 0.01 }, .target = stab_poison, .poison_tick = 1000, .poison_m = NAN,
 		  .ticks = 3000, .max_f_limit_n = 1.2, .energy_tol_j = 1e-12, .expect_rc = IRDM_EFAULT },
+		/* out of the fault the tool is 1 cm inside: the contact engages
+		 * softly (irdm_engine_contact_soften()), so the press is
+		 * quasi-static: no release, and after the reset no more than
+		 * the static force (0.8625 N) and 5 % (measured 0.8686) */
 		{ .name = "Inf target at 1 s, reset", .image = soft_1ms, .at_m = TOP,
 		  .mode = IRDM_CONTACT_PUSH, .depth_m = { 0.01 }, .target = stab_poison,
 		  .poison_tick = 1000, .poison_m = INFINITY, .reset_after_fault = 1, .ticks = HOLD_1MS,
-		  /* touched again 1 cm deep after the reset: the damper against the
-		   * rebounding surface, push released and re-touched 21 times
-		   * (measured 254 N; see teleport) */
-		  .max_f_limit_n = 280.0, .static_rel_tol = 1e-4, .energy_tol_j = 1e-12,
-		  .expect_rc = IRDM_EFAULT },
+		  .max_f_limit_n = 1.2, .static_rel_tol = 1e-4, .energy_tol_j = 1e-12,
+		  .expect_rc = IRDM_EFAULT, .no_releases = true, .reset_max_f_limit_n = 0.9 },
+		/* the coupling dominates a stiff object: after the reset the
+		 * spring at 1 cm (10 N) and 0.5 % (measured 10.000) */
+		{ .name = "stiff, Inf target at 1 s, reset", .image = stiff_1ms, .at_m = TOP,
+		  .mode = IRDM_CONTACT_PUSH, .depth_m = { 0.01 }, .target = stab_poison,
+		  .poison_tick = 1000, .poison_m = INFINITY, .reset_after_fault = 1, .ticks = 5000,
+		  .max_f_limit_n = HAPTIC_1CM_1MS, .static_rel_tol = 1e-4, .energy_tol_j = 1e-12,
+		  .expect_rc = IRDM_EFAULT, .no_releases = true, .reset_max_f_limit_n = 10.05 },
 		{ .name = "-1e300 m target, haptic", .image = soft_1ms, .at_m = TOP,
 		  .mode = IRDM_CONTACT_PUSH, .depth_m = { 0.01 }, .target = stab_poison,
 		  .poison_tick = 1000, .poison_m = -1e300, .ticks = 3000, .max_f_limit_n = 1.2,

@@ -32,6 +32,7 @@ static int plan(const struct irdm_image *img, const struct irdm_engine_config *c
 	if (!cfg || cfg->max_contacts < 1 || cfg->max_contacts > IRDM_MAX_CONTACTS ||
 	    !(cfg->coupling_k_n_per_m >= 0) || !(cfg->coupling_b_ns_per_m >= 0) ||
 	    !(cfg->stable_radius >= 0 && cfg->stable_radius < 1) || !(cfg->max_force_n >= 0) ||
+	    !(cfg->engage_fade_s >= 0 && cfg->engage_fade_s <= IRDM_ENGINE_ENGAGE_FADE_MAX_S) ||
 	    (cfg->solve != IRDM_SOLVE_COUPLED && cfg->solve != IRDM_SOLVE_PER_VERTEX))
 		return -1;
 	l->engine = 0;
@@ -60,6 +61,7 @@ void irdm_engine_config_default(struct irdm_engine_config *cfg)
 	cfg->max_contacts = 2;
 	cfg->solve = IRDM_SOLVE_COUPLED;
 	cfg->stable_radius = 0.999;
+	cfg->engage_fade_s = IRDM_ENGINE_ENGAGE_FADE_S;
 }
 
 void irdm_engine_coupling_for_device(double k_max, double b_device, double dt,
@@ -79,6 +81,9 @@ void irdm_engine_config_haptic(struct irdm_engine_config *cfg, double dt, double
 	irdm_engine_coupling_for_device(k_max, b_device, dt, &cfg->coupling_k_n_per_m,
 					&cfg->coupling_b_ns_per_m);
 	cfg->passivity_control = true;
+	/* b_device > K dt / 2 + B + alpha: what the coupling left */
+	cfg->passivity_max_damping_ns_per_m =
+		fmax(0.0, b_device - cfg->coupling_k_n_per_m * dt / 2 - cfg->coupling_b_ns_per_m);
 	cfg->max_force_n = max_force;
 }
 
@@ -170,8 +175,8 @@ int irdm_engine_init(struct irdm_engine **out, const struct irdm_image *img,
 	if (img && img->meta && unsupported(img, err, errlen))
 		return IRDM_ENOTSUP;
 	if (!img || !img->meta || plan(img, cfg, &l)) {
-		snprintf(err, errlen, "engine: invalid configuration (contacts 1..%d, coupling >= 0, stable radius in [0, 1), force limit >= 0)",
-			 IRDM_MAX_CONTACTS);
+		snprintf(err, errlen, "engine: invalid configuration (contacts 1..%d, coupling >= 0, stable radius in [0, 1), force limit >= 0, engage fade 0..%g s)",
+			 IRDM_MAX_CONTACTS, IRDM_ENGINE_ENGAGE_FADE_MAX_S);
 		return IRDM_EINVAL;
 	}
 	if (!mem || ((uintptr_t)mem & 15) || mem_size < l.total) {
@@ -183,6 +188,8 @@ int irdm_engine_init(struct irdm_engine **out, const struct irdm_image *img,
 	e->img = img;
 	e->cfg = *cfg;
 	e->dt_s = img->meta->dt_s;
+	/* whole ticks; the 1e-9 keeps 0.25 s at 1 ms from rounding up to 251 */
+	e->engage_ticks = (uint32_t)ceil(cfg->engage_fade_s / e->dt_s - 1e-9);
 	e->repr = img->meta->representation;
 	e->n_nodes = img->meta->n_nodes;
 	e->n_cols = img->meta->n_cols;
@@ -337,6 +344,18 @@ int irdm_engine_contact_begin(struct irdm_engine *e, unsigned i, const struct ir
 	}
 	c->mode = mode;
 	c->site = *site;
+	return IRDM_OK;
+}
+
+int irdm_engine_contact_soften(struct irdm_engine *e, unsigned i)
+{
+	struct irdm_contact_state *c;
+
+	if (i >= e->cfg.max_contacts || e->c[i].mode == IRDM_CONTACT_OFF || !e->c[i].fresh)
+		return IRDM_EINVAL;
+	c = &e->c[i];
+	if (e->cfg.coupling_k_n_per_m > 0)
+		c->engage_ticks = e->engage_ticks;
 	return IRDM_OK;
 }
 

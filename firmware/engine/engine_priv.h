@@ -28,6 +28,7 @@ struct irdm_engine {
 	const struct irdm_image *img;
 	struct irdm_engine_config cfg;
 	double dt_s;
+	uint32_t engage_ticks;              /* cfg.engage_fade_s in ticks */
 	uint32_t repr, n_nodes, n_cols, K, T;
 	uint32_t H;                         /* modal: exact head samples (0: none; engine_head.c) */
 	const uint32_t *col_of_row;         /* n_nodes, NO_COL if not touchable */

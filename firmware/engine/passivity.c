@@ -4,6 +4,7 @@
  */
 
 
+#include <math.h>
 #include <string.h>
 
 #include "tick_priv.h"
@@ -50,6 +51,8 @@ void tick_passivity(struct irdm_engine *e, struct system *s)
 	if (!e->cfg.passivity_control || total >= 0 || v2_sum == 0)
 		return;
 	double alpha = -total * e->dt_s / v2_sum;       /* N s/m, with v = du / dt */
+	if (e->cfg.passivity_max_damping_ns_per_m > 0)
+		alpha = fmin(alpha, e->cfg.passivity_max_damping_ns_per_m);
 	for (int i = 0; i < s->m; i++) {
 		struct irdm_contact_state *c = &e->c[s->idx[i]];
 		for (int r = 0; r < 3; r++)

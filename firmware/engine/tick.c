@@ -118,8 +118,10 @@ static void publish(struct irdm_engine *e)
 #endif
 }
 
-int irdm_engine_tick(struct irdm_engine *e, const struct irdm_contact_cmd *cmd)
+int irdm_engine_tick(struct irdm_engine *e, const struct irdm_contact_cmd *cmd_in)
 {
+	struct irdm_contact_cmd eff[IRDM_MAX_CONTACTS];
+	const struct irdm_contact_cmd *cmd = cmd_in;
 	struct system s;
 
 	if (e->faulted)
@@ -140,6 +142,7 @@ int irdm_engine_tick(struct irdm_engine *e, const struct irdm_contact_cmd *cmd)
 		tick_history_terms(e, &s);
 		tick_assemble(e, &s);
 		start_fresh(e, &s);
+		cmd = tick_engage(e, &s, cmd_in, eff);
 		tick_solve(e, &s, cmd);
 		if (s.contradictory)
 			return fault(e, "the contact targets contradict each other (rigid contacts on one node, or on fixed nodes, asked for displacements no force can give)");

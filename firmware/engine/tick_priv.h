@@ -57,6 +57,12 @@ void tick_history_terms(struct irdm_engine *e, struct system *s);
 void tick_assemble(struct irdm_engine *e, struct system *s);
 void tick_contact_disp(const struct system *s, int i, double u[3]);
 
+/* engage.c: the commands with each softly engaging contact's anchor moved
+ * back by its fading offset (into eff), or cmd itself when none fades. */
+const struct irdm_contact_cmd *tick_engage(struct irdm_engine *e, const struct system *s,
+					   const struct irdm_contact_cmd *cmd,
+					   struct irdm_contact_cmd *eff);
+
 /* floating.c; a build without floating objects (irdm/build_config.h) has
  * none: the engine refuses their images, and these are never reached */
 #if IRDM_CONFIG_FLOATING

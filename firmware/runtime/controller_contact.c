@@ -66,6 +66,19 @@ static void proxy_out(const struct irdm_ctrl *c, const struct irdm_proxy *px,
 	o->depth_m = px->depth_m;
 }
 
+/*
+ * A touch deeper than the tip can travel in one period at the speed limit
+ * did not come from outside: the tool was already inside (at enable, out of
+ * a fault, or rising into the detection radius from within).  Such a
+ * contact engages softly (irdm_engine_contact_soften()): from zero force,
+ * the full coupling after the engine's fade, instead of the spring's whole
+ * depth in one tick.
+ */
+static bool began_inside(const struct irdm_ctrl *c, const struct irdm_proxy *px)
+{
+	return -px->depth_m > c->cfg.limits.max_tip_speed_m_per_s * c->cfg.period_us * 1e-6;
+}
+
 /* Device i's proxy and engine command.  Return: IRDM_OK; IRDM_EFAULT. */
 static int touch(struct irdm_ctrl *c, unsigned i, const struct irdm_proxy_config *pc,
 		 struct irdm_ctrl_device_output *o)
@@ -87,6 +100,9 @@ static int touch(struct irdm_ctrl *c, unsigned i, const struct irdm_proxy_config
 	proxy_out(c, &d->px, o);
 	if (irdm_proxy_site(&d->px, &c->cm, &site) ||
 	    irdm_engine_contact_begin(c->s->eng, i, &site, IRDM_CONTACT_PUSH))
+		return IRDM_EFAULT;
+	if (ev == IRDM_PROXY_TOUCH && began_inside(c, &d->px) &&
+	    irdm_engine_contact_soften(c->s->eng, i))
 		return IRDM_EFAULT;
 	d->cmd.mode = IRDM_CONTACT_PUSH;
 	irdm_v3_sub(d->cmd.target_m, o->tip_obj_m, site.rest_m);

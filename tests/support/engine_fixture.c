@@ -40,8 +40,14 @@ void efx_image(struct irdm_image *img, const char *path, ...)
 struct irdm_session *efx_session(const struct irdm_image *img, const struct irdm_engine_config *cfg)
 {
 	struct irdm_session_config sc = { .engine = *cfg };
+	const char *portable = getenv("IRDM_TEST_PORTABLE_SUM");
 	struct irdm_session *s;
 	char err[512];
+
+	/* the spread of a figure across the history sums (make check runs
+	 * the stability suite with each): the portable one where AVX2 is */
+	if (portable && strcmp(portable, "1") == 0)
+		sc.engine.fir_portable_sum = true;
 
 	if (irdm_session_open_image(&s, img, &sc, err, sizeof(err)))
 		fail_msg("session: %s", err);

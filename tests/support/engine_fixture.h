@@ -12,7 +12,10 @@
 void efx_image(struct irdm_image *img, const char *path, ...);
 
 /* A session (engine only) on img, which it borrows; aborts the test on
- * failure.  irdm_session_close() frees it. */
+ * failure.  irdm_session_close() frees it.  IRDM_TEST_PORTABLE_SUM=1
+ * forces the portable history sums (cfg.fir_portable_sum): make
+ * test-variants runs the stability suite so, to catch a figure that only
+ * one sum's rounding meets. */
 struct irdm_session *efx_session(const struct irdm_image *img, const struct irdm_engine_config *cfg);
 
 /*

@@ -211,11 +211,15 @@ static int sites_of(struct irdm_engine *e, const struct irdm_image *img, const s
 	return 2;
 }
 
+/* soft: the tool is already inside (out of a fault), as the controller
+ * engages it (irdm_engine_contact_soften()) */
 static void begin_all(struct irdm_engine *e, const struct stab_case *c,
-		      const struct irdm_contact_site *st, int m, double (*u_prev)[3])
+		      const struct irdm_contact_site *st, int m, double (*u_prev)[3], bool soft)
 {
 	for (int i = 0; i < m; i++) {
 		assert_int_equal(irdm_engine_contact_begin(e, (unsigned)i, &st[i], c->mode), 0);
+		if (soft)
+			assert_int_equal(irdm_engine_contact_soften(e, (unsigned)i), 0);
 		irdm_engine_node_disp(e, st[i].row[0], u_prev[i]);
 	}
 }
@@ -237,6 +241,22 @@ static void retouch(struct irdm_engine *e, const struct stab_case *c,
 			memcpy(u_prev[i], uf, sizeof(uf));
 		}
 	}
+}
+
+/* What the re-engagement fade may hand the object: per contact |o|
+ * (k |o| + b pi |o| / (2 T)), o the offset from the object at rest (after
+ * the reset) to the target the case holds (irdm/engine.h). */
+static double engage_work_limit(const struct irdm_engine_config *cfg, const struct stab_case *c,
+				int m, double dt)
+{
+	double k = cfg->coupling_k_n_per_m, b = cfg->coupling_b_ns_per_m, lim = 0;
+	double fade_s = ceil(cfg->engage_fade_s / dt - 1e-9) * dt;
+
+	for (int i = 0; i < m; i++) {
+		double o = fabs(c->depth_m[i]);
+		lim += o * (k * o + b * M_PI * o / (2 * fade_s));
+	}
+	return lim;
 }
 
 /* Decimated trace for the plot: about 2000 points per case. */
@@ -280,6 +300,8 @@ void stab_run(const char *dir, const struct stab_case *c, struct stab_record *re
 	stab_target_fn target = c->target ? c->target : stab_step;
 	double tail_sum = 0, tail_min = INFINITY, tail_max = -INFINITY;
 	int reset_done = 0;
+	unsigned long reset_tick = 0, fade_ticks = (unsigned long)ceil(IRDM_ENGINE_ENGAGE_FADE_S / dt - 1e-9);
+	double reset_work0 = 0;
 
 	memset(rec, 0, sizeof(*rec));
 	rec->work_min_j = INFINITY;
@@ -295,7 +317,7 @@ void stab_run(const char *dir, const struct stab_case *c, struct stab_record *re
 	int m = sites_of(e, img, c, st);
 	FILE *tr = trace_open(c->name);
 
-	begin_all(e, c, st, m, u_prev);
+	begin_all(e, c, st, m, u_prev, false);
 	for (unsigned long t = 0; t < N; t++) {
 		memset(cmd, 0, sizeof(cmd));
 		target(c, t, dt, cmd);
@@ -320,8 +342,11 @@ void stab_run(const char *dir, const struct stab_case *c, struct stab_record *re
 		if (rc && c->reset_after_fault && !reset_done) {
 			/* out of the fault, as the controller does: zero and touch again */
 			irdm_engine_reset(e);
-			begin_all(e, c, st, m, u_prev);
+			begin_all(e, c, st, m, u_prev, true);
 			reset_done = 1;
+			reset_tick = t;
+			reset_work0 = work;
+			rec->reset_work_limit_j = engage_work_limit(&cfg, c, m, dt);
 		}
 		double fsum = 0;
 		for (int i = 0; i < m; i++) {
@@ -337,6 +362,11 @@ void stab_run(const char *dir, const struct stab_case *c, struct stab_record *re
 			fsum += norm3(s->force_n);
 		}
 		rec->max_f_n = fmax(rec->max_f_n, fsum);
+		if (reset_done && t > reset_tick) {
+			rec->reset_max_f_n = fmax(rec->reset_max_f_n, fsum);
+			if (t <= reset_tick + fade_ticks)
+				rec->reset_work_j = fmax(rec->reset_work_j, work - reset_work0);
+		}
 		if (t + 1 == win)
 			rec->first_f_n = fsum;
 		rec->work_min_j = fmin(rec->work_min_j, work);
@@ -410,6 +440,15 @@ void stab_check(const struct stab_case *c, const struct stab_record *r)
 	assert_true(r->max_f_n <= c->max_f_limit_n);
 	assert_true(r->work_min_j >= -c->energy_tol_j);
 	assert_int_equal(r->rc, c->expect_rc);
+	if (c->no_releases)
+		assert_int_equal(r->releases, 0);
+	if (c->reset_after_fault) {
+		print_message("%-34s after the reset: max|F| %.4g N (limit %.4g), work over the fade %.3e J (limit %.3e)\n",
+			      "", r->reset_max_f_n, c->reset_max_f_limit_n, r->reset_work_j,
+			      r->reset_work_limit_j);
+		assert_true(r->reset_max_f_n <= c->reset_max_f_limit_n);
+		assert_true(r->reset_work_j <= r->reset_work_limit_j);
+	}
 	if (c->static_rel_tol > 0) {
 		assert_true(isfinite(r->static_f_n));
 		assert_true(fabs(r->final_f_n - r->static_f_n) <= c->static_rel_tol * r->static_f_n);

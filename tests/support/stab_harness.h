@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * The stability harness (issue 10): runs one stiff or extreme case on the
+ * The stability harness: runs one stiff or extreme case on the
  * engine for N ticks and records what the stability suite asserts and
  * `make stability` tabulates -- the largest force, the held force against
  * the static force an independent sum of the image's responses predicts,
@@ -15,6 +15,7 @@
 #ifndef IRDM_TESTS_STAB_HARNESS_H
 #define IRDM_TESTS_STAB_HARNESS_H
 
+#include <stdbool.h>
 #include <stddef.h>
 
 #include "irdm/engine.h"
@@ -62,6 +63,8 @@ struct stab_case {
 	double static_rel_tol;          /* |held - static| / static; 0: not checked */
 	double energy_tol_j;            /* -min W allowed */
 	int expect_rc;                  /* what the first refusal must be (0: none) */
+	bool no_releases;               /* no push may be released (re-engagement) */
+	double reset_max_f_limit_n;     /* max sum |F| after the reset (reset_after_fault) */
 };
 
 struct stab_record {
@@ -82,6 +85,10 @@ struct stab_record {
 	unsigned long singular;         /* regularised coupled solves */
 	unsigned long releases;
 	double ns_per_tick_first, ns_per_tick_last; /* first and last 10 % */
+	/* after a reset (reset_after_fault): the largest sum |F| and the work
+	 * done on the object over the re-engagement fade, and the limit that
+	 * work must stay under (irdm_engine_contact_soften()) */
+	double reset_max_f_n, reset_work_j, reset_work_limit_j;
 };
 
 /* The default target: every contact ramps to depth_m along -z in 50 ms

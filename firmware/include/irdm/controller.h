@@ -27,6 +27,13 @@
  *  8. torque out: zero unless ENABLED                controller.c
  * A fault zeroes the torque in the tick that detects it.
  *
+ * Re-engagement.  A touch deeper than one period at the tip speed limit
+ * cannot have come from outside: the tool was inside when the forces came
+ * on (enable, or enable after a fault's reset).  Its contact engages softly
+ * (irdm_engine_contact_soften(): zero force at first, the full coupling
+ * after the engine's engage_fade_s), so the hand is eased out rather than
+ * struck by the spring's whole depth, and the push does not chatter.
+ *
  * Overrun policy.  The loop reports the previous tick's wake-up latency and
  * compute time.  That tick overran when it ended after this tick's release
  * time: latency + compute > period.  A tick that follows an overrun still

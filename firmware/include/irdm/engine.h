@@ -51,6 +51,11 @@ struct irdm_engine_config {
 	double coupling_b_ns_per_m;
 	/* Hannaford-Ryu passivity observer/controller at each contact port. */
 	bool passivity_control;
+	/* The most damping the controller may add (N s/m; 0: unbounded).  A
+	 * virtual damper beyond the device's own damping margin makes the
+	 * sampled loop active (Colgate), so the haptic default bounds it by
+	 * what the coupling leaves of that margin. */
+	double passivity_max_damping_ns_per_m;
 	/*
 	 * Unstable recursions are never run unprotected: an FIR image whose
 	 * largest recorded spectral radius (meta max_spectral_radius) is >= 1
@@ -67,7 +72,20 @@ struct irdm_engine_config {
 	 * rounding; tests compare them) */
 	bool fir_portable_sum;
 	unsigned publish_every;         /* deformation snapshot every N ticks (0: never) */
+	/*
+	 * A contact begun with irdm_engine_contact_soften() (the tool already
+	 * inside the object: out of a fault, at enable) starts at zero force
+	 * and reaches the full coupling over this time (seconds; 0: at once).
+	 * Only a coupled contact (k > 0) fades; a rigid one is its target.
+	 */
+	double engage_fade_s;
 };
+
+/* The default re-engagement fade (irdm_engine_config_default()): long
+ * against a hand's reaction (~0.1 s), short against a user's patience. */
+#define IRDM_ENGINE_ENGAGE_FADE_S 0.25
+/* The longest fade a configuration may ask for (seconds). */
+#define IRDM_ENGINE_ENGAGE_FADE_MAX_S 10.0
 
 /* One contact's command for a tick. */
 struct irdm_contact_cmd {
@@ -89,6 +107,11 @@ struct irdm_contact_state {
 					 * its controller's force, like this tick's */
 	double pc_damping_ns_per_m;     /* passivity controller's damping this tick */
 	uint32_t fresh;                 /* began since the last tick */
+	/* soft engagement (irdm_engine_contact_soften()): the coupling's
+	 * anchor is target - offset * w, w falling from 1 to 0 over the fade */
+	uint32_t engage_ticks;          /* the fade's length in ticks (0: none) */
+	uint32_t engage_done;           /* ticks of it gone */
+	double engage_offset_m[3];      /* target - free displacement at its start */
 };
 
 struct irdm_engine_stats {
@@ -104,7 +127,7 @@ struct irdm_engine;   /* opaque; lives in the caller's memory */
 size_t irdm_engine_mem_size(const struct irdm_image *img, const struct irdm_engine_config *cfg);
 
 /* Defaults: 2 contacts, coupled, rigid coupling, no PC, radius 0.999, no
- * force limit, no snapshots. */
+ * force limit, no snapshots, IRDM_ENGINE_ENGAGE_FADE_S. */
 void irdm_engine_config_default(struct irdm_engine_config *cfg);
 
 /*
@@ -131,7 +154,7 @@ void irdm_engine_config_haptic(struct irdm_engine_config *cfg, double dt_s, doub
  * Return: IRDM_OK;
  * IRDM_EINVAL if img is NULL or has no metadata, cfg is not valid (contacts
  * 1..IRDM_MAX_CONTACTS, coupling >= 0, stable radius in [0, 1), force
- * limit >= 0, a known solve mode), or the image's rigid-body section is not
+ * limit >= 0, a known solve mode, a fade in [0, IRDM_ENGINE_ENGAGE_FADE_MAX_S]), or the image's rigid-body section is not
  * usable (irdm_rigid_init());
  * IRDM_ENOMEM if mem is NULL, not 16-byte aligned or smaller than
  * irdm_engine_mem_size().
@@ -175,6 +198,25 @@ int irdm_engine_site_point(const struct irdm_engine *eng, uint32_t tri, const do
  */
 int irdm_engine_contact_begin(struct irdm_engine *eng, unsigned i,
 			      const struct irdm_contact_site *site, enum irdm_contact_mode mode);
+
+/*
+ * Let the contact begun in slot i since the last tick engage softly: the
+ * tool is already inside the object (out of a fault, at enable), so the
+ * virtual coupling's anchor starts at the contact point (zero force) and
+ * moves to the target over engage_fade_s along a raised cosine (no jump in
+ * force or in the damper's velocity at either end).  Sliding during the
+ * fade keeps it.  A hard engagement would pull the spring's whole depth at
+ * once, and the object's rebound then releases and re-touches the push.
+ *
+ * The energy the moving anchor can hand the object is at most
+ * |offset| (k |offset| + b pi |offset| / (2 engage_fade_s)), the largest
+ * coupling force times the anchor's path.
+ *
+ * Return: IRDM_OK;
+ * IRDM_EINVAL if i >= max_contacts or slot i holds no contact begun since
+ * the last tick.
+ */
+int irdm_engine_contact_soften(struct irdm_engine *eng, unsigned i);
 
 /* End the contact in slot i (any i: out of range does nothing). */
 void irdm_engine_contact_end(struct irdm_engine *eng, unsigned i);
