@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * A floating object pushed off-centre and let go (issue 11): the rigid
+ * A floating object pushed off-centre and let go: the rigid
  * body's linear momentum must equal the applied linear impulse, sum F dt,
  * and its angular momentum about the centre of mass the applied angular
  * impulse, sum (x - c) x F dt, for lumped and consistent mass, on the
@@ -17,6 +17,7 @@
  * and inertia, so the test checks the bookkeeping of the push (the lever
  * arm of each force), not the inertia (test_mass does that).
  */
+#include <float.h>
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -42,6 +43,7 @@ static char dir[64];
 
 struct impulse {
 	double lin[3];          /* sum F dt, N s */
+	double lin_abs;         /* sum |F| dt: the scale of the sums' rounding */
 	double ang[3];          /* sum (x - c) x F dt about the moving COM, N m s */
 };
 
@@ -130,6 +132,7 @@ static void add_tick(struct impulse *imp, struct body_ref *b, const double x[3],
 	irdm_v3_cross(tau, arm, F);
 	irdm_v3_axpy(imp->ang, dt_s, tau);
 	irdm_v3_axpy(imp->lin, dt_s, F);
+	imp->lin_abs += dt_s * irdm_v3_norm(F);
 	memcpy(b->com, com1, sizeof(com1));
 	irdm_v3_axpy(b->vel, dt_s / b->m_kg, F);
 	irdm_v3_axpy(b->turn, dt_s, w);
@@ -145,7 +148,7 @@ static double rel_err(const double a[3], const double ref[3])
 
 /* Push the image's body at the surface node near p_obj, let go, compare. */
 static void run(const char *what, const char *mesh, const char *res, const char *mass,
-		const double p_obj[3], double *lin_err, double *ang_err)
+		const double p_obj[3], double *lin_err, double *ang_err, double *lin_limit)
 {
 	char path[128];
 	struct irdm_image img;
@@ -187,17 +190,24 @@ static void run(const char *what, const char *mesh, const char *res, const char 
 	irdm_rigid_linear_momentum_world(rb, p);
 	irdm_rigid_angular_momentum_world(rb, l);
 	*lin_err = rel_err(p, imp.lin);
+	/* two sums of the same forces over n ticks, the engine's and ours:
+	 * each within n eps sum |F dt| of exact, whatever the rounding */
+	*lin_limit = 2.0 * (push_ticks + FREE_TICKS) * DBL_EPSILON * imp.lin_abs /
+		     irdm_v3_norm(imp.lin);
 	*ang_err = rel_err(l, imp.ang);
 	print_message("%-23s |J| %.3e N s, |H| %.3e N m s, turned %.1e rad: linear %.1e, "
-		      "angular %.1e relative\n", what, irdm_v3_norm(imp.lin), irdm_v3_norm(imp.ang),
-		      irdm_v3_norm(b.turn), *lin_err, *ang_err);
+		      "angular %.1e relative (linear limit %.1e)\n", what, irdm_v3_norm(imp.lin),
+		      irdm_v3_norm(imp.ang), irdm_v3_norm(b.turn), *lin_err, *ang_err, *lin_limit);
 	irdm_session_close(ses);
 	irdm_image_unmap(&img);
 }
 
 /*
- * Limits about 5x the measured errors (linear 1.2e-15; angular 7.4e-10 on
- * the cube, 7.1e-9 on the plate, which turns further).  Before the lever
+ * The linear limit is the summation bound (run()): the measured error is
+ * rounding alone and moved from 8e-16 to 6.9e-15 between OpenBLAS on two
+ * threads and on one, past a limit of 5x one machine's figure.  Angular:
+ * about 5x the measured errors (7.4e-10 on the cube, 7.1e-9 on the plate,
+ * which turns further; the same with one thread or two).  Before the lever
  * arm took the contact point's actual deformation (static correction
  * included), the angular error was 1.4e-3 (cube) and 1.0e-3 (plate) at
  * dt = 1 ms and at 0.5 ms alike.
@@ -209,10 +219,10 @@ static void check(const char *what, const char *mesh, const char *res, const dou
 
 	for (int k = 0; k < 2; k++) {
 		char name[64];
-		double lin, ang;
+		double lin, ang, lin_limit;
 		snprintf(name, sizeof(name), "%s, %s", what, masses[k]);
-		run(name, mesh, res, masses[k], p, &lin, &ang);
-		assert_true(lin <= 6e-15);
+		run(name, mesh, res, masses[k], p, &lin, &ang, &lin_limit);
+		assert_true(lin <= lin_limit);
 		assert_true(ang <= ang_limit);
 	}
 }
