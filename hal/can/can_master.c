@@ -65,6 +65,21 @@ static int send_off(struct irdm_can_master *m)
 	return rc ? rc : r;
 }
 
+int irdm_can_master_emergency_off(const struct irdm_can_master *m)
+{
+	struct irdm_can_frame f;
+	int rc = IRDM_OK;
+
+	for (unsigned k = 0; k < m->cfg.n_axes; k++)
+		if (irdm_can_send(&m->port, &m->off[k]) != IRDM_OK)
+			rc = IRDM_EHW;
+	/* a counter the drives accept: the one after the last sent */
+	irdm_co_sync(&f, m->cfg.sync_counter ? m->sync_count % IRDM_CAN_SYNC_COUNTER_MAX + 1 : 0);
+	if (irdm_can_send(&m->port, &f) != IRDM_OK)
+		rc = IRDM_EHW;
+	return rc;
+}
+
 void irdm_can_master_lose(struct irdm_can_master *m, int axis, const char *reason)
 {
 	bool first = !m->faulted;

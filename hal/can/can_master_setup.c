@@ -228,8 +228,10 @@ int irdm_can_master_init(struct irdm_can_master *m, const struct irdm_can_port *
 		return rc;
 	m->cfg = *cfg;
 	m->port = *port;
-	for (unsigned k = 0; k < cfg->n_axes; k++)
+	for (unsigned k = 0; k < cfg->n_axes; k++) {
 		m->ax[k].state = IRDM_CIA402_UNKNOWN;
+		irdm_co_rpdo_cst(&m->off[k], cfg->axis[k].node, IRDM_CIA402_CW_DISABLE_VOLTAGE, 0);
+	}
 	for (unsigned k = 0; k < cfg->n_axes; k++) {
 		rc = configure_drive(m, k, err, errlen);
 		if (rc)

@@ -249,6 +249,15 @@ void irdm_hal_can_close(struct irdm_hal_dev *dev)
 	c->state = HAL_CAN_CLOSED;
 }
 
+int irdm_hal_can_emergency_off(struct irdm_hal_dev *dev)
+{
+	struct irdm_hal_can *c = can_of(dev);
+
+	if (c->state == HAL_CAN_CLOSED)
+		return IRDM_OK;
+	return irdm_can_master_emergency_off(&c->m);
+}
+
 void irdm_hal_can_reset_faults(struct irdm_hal_dev *dev)
 {
 	irdm_can_master_reset_faults(&can_of(dev)->m);

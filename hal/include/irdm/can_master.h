@@ -74,6 +74,7 @@ struct irdm_can_master {
 	bool faulted;                   /* latched: torque off until a reset */
 	bool link_lost;                 /* the fault is the link's, not a drive's */
 	char why[IRDM_CAN_WHY_MAX];     /* the first fault, one line */
+	struct irdm_can_frame off[IRDM_CAN_AXES_MAX];   /* each axis's torque-off RPDO1 */
 	uint64_t bad_frames;            /* malformed frames of ours (wrong DLC, content) */
 	uint64_t unknown_frames;        /* identifiers we do not expect */
 	uint64_t sdo_stragglers;        /* SDO answers after set-up */
@@ -162,6 +163,15 @@ int irdm_can_master_safe_off(struct irdm_can_master *m);
  * axis -1 for the link.  Every axis goes off at once; the first reason wins.
  */
 void irdm_can_master_lose(struct irdm_can_master *m, int axis, const char *reason);
+
+/*
+ * Torque off from a signal handler: the disable-voltage, zero-torque RPDO1
+ * of every axis (built at init) and a SYNC, each one irdm_can_send(), and
+ * nothing else: async-signal-safe when the port's send is (SocketCAN's is
+ * one write(2)).  Touches no other state of the master.
+ * Return: IRDM_OK; IRDM_EHW if a frame could not be sent.
+ */
+int irdm_can_master_emergency_off(const struct irdm_can_master *m);
 
 /* The operator's fault reset: clear the latch and send fault reset
  * (bit 7's rising edge) to faulted drives; they then re-enable only if

@@ -101,13 +101,17 @@ int irdm_hal_can_write(struct irdm_hal_dev *dev, const double tau_nm[IRDM_HAL_JO
 int irdm_hal_can_safe_off(struct irdm_hal_dev *dev);
 int irdm_hal_can_poll(struct irdm_hal_dev *dev, uint32_t *faults);
 void irdm_hal_can_close(struct irdm_hal_dev *dev);
+/* emergency_off on a port whose send is one write(2) (SocketCAN): the
+ * master's frames built at open, irdm_can_master_emergency_off(). */
+int irdm_hal_can_emergency_off(struct irdm_hal_dev *dev);
 
 /* A CAN back-end's ops table: its own open, the shared rest. */
-#define IRDM_HAL_CAN_OPS(open_fn)                                                              \
+#define IRDM_HAL_CAN_OPS(open_fn, emergency_fn)                                                \
 	{                                                                                      \
 		.open = (open_fn), .start = irdm_hal_can_start, .read = irdm_hal_can_read,     \
 		.write = irdm_hal_can_write, .safe_off = irdm_hal_can_safe_off,                \
 		.poll = irdm_hal_can_poll, .close = irdm_hal_can_close,                        \
+		.emergency_off = (emergency_fn),                                               \
 	}
 
 /* The operator's fault reset (tests; the controller has no such command yet). */
