@@ -107,6 +107,17 @@ static int open_inputs(struct fw *fw)
 	return meet_user(fw);
 }
 
+/* A device's info, each line as "hal 'NAME': line". */
+static void print_info(const char *hal, const char *info)
+{
+	while (*info) {
+		size_t n = strcspn(info, "\n");
+
+		printf("hal '%s': %.*s\n", hal, (int)n, info);
+		info += n + (info[n] == '\n');
+	}
+}
+
 static int open_devices(struct fw *fw)
 {
 	const struct irdm_hal_backend *be;
@@ -138,7 +149,7 @@ static int open_devices(struct fw *fw)
 				    fw->hal[i].why[0] ? fw->hal[i].why : "the device does not open");
 		fw->hal_open[i] = true;
 		if (fw->hal[i].info[0] && !fw->args.quiet)
-			printf("hal '%s': %s\n", fw->board.hal, fw->hal[i].info);
+			print_info(fw->board.hal, fw->hal[i].info);
 	}
 	return FW_EXIT_OK;
 }

@@ -49,6 +49,10 @@ static int master_cfg(struct irdm_hal_dev *dev, const struct irdm_hal_can_opts *
 	mc->heartbeat_ms = o->heartbeat_ms;
 	mc->heartbeat_timeout_ms = o->heartbeat_timeout_ms;
 	mc->tpdo_missing_periods = o->tpdo_missing_periods;
+	mc->master_node = o->master_node;
+	/* the drive's deadline: the option, else three periods in whole ms */
+	mc->rpdo_timeout_ms = (uint16_t)(o->rpdo_timeout_ms ? o->rpdo_timeout_ms
+							    : (3u * period_us + 999u) / 1000u);
 	mc->sdo_timeout_polls = (unsigned)((o->sdo_timeout_ms * 1000ull + period_us - 1) / period_us);
 	mc->idle = can_of(dev)->link->idle;
 	mc->idle_ctx = dev;
@@ -86,6 +90,13 @@ int irdm_hal_can_open(struct irdm_hal_dev *dev, const struct irdm_hal_can_link *
 	if (rc) {
 		link->close(dev);
 		return rc;
+	}
+	for (unsigned k = 0; k < c->m.cfg.n_axes; k++) {
+		size_t used = strlen(dev->info);
+
+		dev->info[used] = '\n';
+		irdm_can_master_identity_line(&c->m, k, dev->info + used + 1,
+					      sizeof(dev->info) - used - 1);
 	}
 	c->written = false;
 	c->seq = 0;

@@ -49,6 +49,7 @@
 #define IRDM_HAL_JOINTS IRDM_DEVICE_JOINTS
 #define IRDM_HAL_BACKENDS_MAX 8
 #define IRDM_HAL_WHY_MAX 192    /* bytes of a back-end's one-line reason */
+#define IRDM_HAL_INFO_MAX 640   /* bytes of what to print after open (lines) */
 
 /* Asynchronous fault bits (poll); a back-end sets the ones it can detect. */
 enum irdm_hal_fault {
@@ -156,10 +157,11 @@ struct irdm_hal_dev {
 	 *       naming the part and the cause ("drive 2 (node 2): SDO abort
 	 *       0x06020000 ... writing 0x6060:00"); set where the error is
 	 *       returned (open, start) or the fault latched (poll, read).
-	 * info  what the caller should print once after open (e.g. a bus load).
+	 * info  what the caller should print once after open (e.g. a bus load,
+	 *       the drives found), one or more lines separated by '\n'.
 	 */
 	char why[IRDM_HAL_WHY_MAX];
-	char info[IRDM_HAL_WHY_MAX];
+	char info[IRDM_HAL_INFO_MAX];
 };
 
 /*

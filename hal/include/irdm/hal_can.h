@@ -45,6 +45,8 @@ struct irdm_hal_can_opts {
 	uint32_t sdo_timeout_ms;
 	uint32_t enable_timeout_ms;
 	unsigned substeps;              /* canemu only: the emulated arm's steps a period */
+	unsigned master_node;           /* the master's own node id (its heartbeat) */
+	uint32_t rpdo_timeout_ms;       /* each drive's RPDO1 deadline (0: 3 periods) */
 	unsigned emcy_drive;            /* canemu only: drive (1..) that faults, 0: none */
 	uint32_t emcy_at_ms;            /*   at this virtual time, with EMCY 0x2310 */
 };
