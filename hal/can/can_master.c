@@ -358,6 +358,14 @@ void irdm_can_master_enable(struct irdm_can_master *m, bool on)
 		m->ax[k].was_enabled = false;
 }
 
+int irdm_can_master_first_stale(const struct irdm_can_master *m)
+{
+	for (unsigned k = 0; k < m->cfg.n_axes; k++)
+		if (!m->ax[k].fresh)
+			return (int)k;
+	return -1;
+}
+
 int irdm_can_master_first_not_enabled(const struct irdm_can_master *m)
 {
 	for (unsigned k = 0; k < m->cfg.n_axes; k++)

@@ -42,6 +42,9 @@ static int link_open(struct irdm_hal_dev *dev, struct irdm_can_port *port, char 
 		snprintf(err, errlen, "canemu: the emulated arm refuses this board's arm");
 		return IRDM_EINVAL;
 	}
+	/* as the arm of irdm-candrives: at rest in its dock until the first
+	 * torque, not sagging through the start-up's disabled SYNCs */
+	d->drives.docked = true;
 	return IRDM_OK;
 }
 

@@ -154,6 +154,9 @@ void irdm_can_master_enable(struct irdm_can_master *m, bool on);
 /* Every axis reports operation enabled (from its latest TPDO). */
 bool irdm_can_master_all_enabled(const struct irdm_can_master *m);
 
+/* The first axis without a TPDO1 in the last receive, or -1. */
+int irdm_can_master_first_stale(const struct irdm_can_master *m);
+
 /* The first axis not operation enabled, or -1. */
 int irdm_can_master_first_not_enabled(const struct irdm_can_master *m);
 

@@ -11,7 +11,9 @@
  * HAL ops on the master:
  *   open      parse the options, open the port, SDO set-up, NMT start;
  *             dev->info: the bus load; dev->why: the reason of a failure
- *   start     enable every drive, bounded (enable_timeout_ms)
+ *   start     the cycle with the drives disabled until every drive has
+ *             answered IRDM_HAL_CAN_STEADY_PERIODS SYNCs in a row, then
+ *             enable every drive; both within enable_timeout_ms
  *   read      receive and judge; a period nobody wrote is closed first
  *             (zero torque, the SYNC) so every period has its SYNC
  *   write     RPDO1 per axis, then the SYNC
@@ -30,6 +32,7 @@
 #include "irdm/hal.h"
 
 #define IRDM_HAL_CAN_IFNAME_MAX 16
+#define IRDM_HAL_CAN_STEADY_PERIODS 5   /* start: disabled SYNCs answered in a row first */
 
 /* The board's hal_options, parsed. */
 struct irdm_hal_can_opts {
