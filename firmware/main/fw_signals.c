@@ -12,8 +12,12 @@
  *    faulted, so it takes the emergency path at once: every open device's
  *    emergency_off (irdm/hal.h: async-signal-safe, for SocketCAN frames
  *    built at open and written with write(2)), one line on stderr with
- *    write(2), _exit(FW_EXIT_EMERGENCY).  It runs on its own stack (a stack
- *    overflow is a SIGSEGV too) with every other signal blocked.
+ *    write(2), _exit(FW_EXIT_EMERGENCY).  In the force thread it runs on
+ *    its own stack (a stack overflow is a SIGSEGV too); every other signal
+ *    is blocked meanwhile.
+ *
+ * SIGPIPE never escalates: it comes from irdm-fw's own writes (a reader
+ * gone), not from someone asking twice.
  *
  * What cannot be caught (SIGKILL, a power loss) is the drives' own
  * deadline's to answer (docs/canopen.md).
@@ -104,7 +108,7 @@ static void on_soft(int sig)
 {
 	int saved = errno;
 
-	if (*loop_flag)
+	if (*loop_flag && sig != SIGPIPE)
 		emergency(sig);
 	*loop_flag = sig;
 	errno = saved;

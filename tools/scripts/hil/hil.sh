@@ -70,14 +70,16 @@ echo "FAULT_AT=$fault_at TPDO_MISSING=$tpdo_missing KILL_WAIT=$kill_wait" > "$st
 # emulator's, not the RT kernel's: a late tick there says nothing about
 # the controller); the drives' RPDO deadline rpdo_timeout_ms (a vCPU stall
 # of 260 ms must not trip it; their heartbeat consumer is the master's
-# tolerance, 100 periods)
+# tolerance, 100 periods); start's disabled exchange and enabling within
+# 2 s (5 SYNCs answered in a row, then the enable sequence: 10 periods
+# would leave no room for one late TPDO1)
 vm_board() {
 	sed -e 's/iface=can0/iface=vcan0/' -e 's/^deform_rate_hz *= *[0-9.]*/deform_rate_hz = 0/' \
 		-e "s/heartbeat_ms=[0-9]*/heartbeat_ms=$((period_us * 5 / 1000))/" \
 		-e "s/heartbeat_timeout_ms=[0-9]*/heartbeat_timeout_ms=$((period_us * 100 / 1000))/" \
 		-e "s/tpdo_missing_periods=[0-9]*/tpdo_missing_periods=$tpdo_missing/" \
 		-e "s/^period_us *= *[0-9]*/period_us = $period_us/" \
-		-e "s/^\(hal_options *=.*\)$/\1 rpdo_timeout_ms=$rpdo_timeout_ms/" \
+		-e "s/^\(hal_options *=.*\)$/\1 rpdo_timeout_ms=$rpdo_timeout_ms enable_timeout_ms=2000/" \
 		-e 's/^overrun_fault_count *= *[0-9]*/overrun_fault_count = 1000/' \
 		-e 's/^watchdog_us *= *[0-9]*/watchdog_us = 1000000/' "$1"
 }
