@@ -44,7 +44,7 @@ scenario() {
 # irdm-fw killed with SIGKILL mid-run, nothing caught: the drives must stop
 # by themselves within their deadline (candump shows their EMCYs)
 scenario_kill() {
-	echo "hil-guest: scenario kill (irdm-fw killed with SIGKILL 2.5 s after its start)"
+	echo "hil-guest: scenario kill (irdm-fw killed with SIGKILL 3 s after its start)"
 	candump -r 4194304 -L vcan0 > /out/kill.candump 2>/dev/null &
 	dump=$!
 	$H/irdm-candrives --board $B --if vcan0 --user $H/press-hold-release.user \
@@ -53,7 +53,7 @@ scenario_kill() {
 	sleep 0.3
 	$H/irdm-fw --board $B --image $H/default.img --duration 4 > /out/kill.fw.txt 2>&1 &
 	fw=$!
-	sleep 2.5       # the set-up, then the hold (1.2-3.2 s of the run)
+	sleep 3         # the set-up (1.0-1.3 s under TCG), then the hold (1.2-3.2 s of the run)
 	kill -KILL $fw
 	wait $fw
 	echo $? > /out/kill.fw.rc
@@ -83,7 +83,8 @@ scenario drop-short 2.5 drop:2:$FAULT_AT:$((TPDO_MISSING / 2))
 scenario delay 2.5 delay:2:$FAULT_AT:5:30000
 scenario flood 2.5 flood:$FAULT_AT:1000
 scenario sdo 2.5 sdo-wrong:2
-# bus-off: the interface goes away under both ends 1.5 s into the run
-( sleep 1.8; ip link set vcan0 down; echo "hil-guest: vcan0 down" ) &
+# bus-off: the interface goes away under both ends 3 s after the start
+# (the set-up takes 1.0-1.3 s under TCG: mid-run)
+( sleep 3; ip link set vcan0 down; echo "hil-guest: vcan0 down" ) &
 scenario busoff 2.5
 ip link set vcan0 up

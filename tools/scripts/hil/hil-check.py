@@ -262,6 +262,8 @@ def fault_scenario(d, name, kind, args):
         print(f"  the link is gone: no frame can carry the torque off (last frame "
               f"{last[1]:03X}#{last[2].hex()} at its end)" if last else "  no frames")
         check("link" in reason, f"{name}: the reason says the link")
+        syncs = sum(1 for f in fr if f[1] == SYNC)
+        check(syncs > 0, f"{name}: the link went down mid-run ({syncs} SYNCs before)")
 
 
 def sdo_transfers(fr, node):
