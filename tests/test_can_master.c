@@ -90,6 +90,8 @@ static struct irdm_can_master_cfg cfg_3axes(void)
 		.heartbeat_ms = 10,
 		.heartbeat_timeout_ms = 30,
 		.tpdo_missing_periods = 3,
+		.master_node = 127,
+		.rpdo_timeout_ms = 3,
 		.sdo_timeout_polls = 5,
 		.idle = drives_turn,
 	};
@@ -160,21 +162,34 @@ static void expect_frame(unsigned i, uint32_t id, unsigned dlc, const uint8_t *b
 }
 
 /*
- * One drive's set-up, as CiA 301 lays the expedited download out: the
- * command byte (0x2F / 0x2B / 0x23: 1 / 2 / 4 bytes, expedited, size
- * given), the index little endian, the sub-index, the value little endian
- * in the 4 data bytes.  A PDO's COB-ID carries the node: the rows marked
- * add it to data byte 4 (0x200 + n is 0x00 + n, 0x02; 0x180 + n is
- * 0x80 + n, 0x01; bit 31, not valid, is 0x80 in byte 7).
+ * One drive's set-up, as CiA 301 lays the expedited transfers out: an
+ * upload request is 0x40, the index little endian, the sub-index, 4 zero
+ * bytes; a download's command byte is 0x2F / 0x2B / 0x23 for 1 / 2 / 4
+ * bytes (expedited, size given), then the index, the sub-index, the value
+ * little endian.  A PDO's COB-ID carries the node: the rows marked add it
+ * to data byte 4 (0x200 + n is 0x00 + n, 0x02; 0x180 + n is 0x80 + n,
+ * 0x01; bit 31, not valid, is 0x80 in byte 7, bit 30, no RTR, 0x40).
+ * The order is the standard's: 0x1019 only while 0x1006 is 0; a PDO's
+ * mapping only while it is off.
  */
-#define SETUP_SDOS 17
+#define SETUP_SDOS 29
 static const struct {
 	uint8_t bytes[8];
 	bool plus_node;
 } setup_sdo[SETUP_SDOS] = {
+	{ { 0x40, 0x00, 0x10, 0x00, 0, 0, 0, 0 }, false },        /* read 0x1000 device type */
+	{ { 0x40, 0x18, 0x10, 0x01, 0, 0, 0, 0 }, false },        /* read 0x1018:01 vendor */
+	{ { 0x40, 0x18, 0x10, 0x02, 0, 0, 0, 0 }, false },        /* :02 product */
+	{ { 0x40, 0x18, 0x10, 0x03, 0, 0, 0, 0 }, false },        /* :03 revision */
+	{ { 0x40, 0x18, 0x10, 0x04, 0, 0, 0, 0 }, false },        /* :04 serial */
 	{ { 0x2F, 0x60, 0x60, 0x00, 0x0A, 0, 0, 0 }, false },     /* 0x6060 = 10 (CST), 1 B */
 	{ { 0x2B, 0x17, 0x10, 0x00, 0x0A, 0, 0, 0 }, false },     /* 0x1017 = 10 ms, 2 B */
 	{ { 0x23, 0x76, 0x60, 0x00, 0xF4, 0x01, 0, 0 }, false },     /* 0x6076 = 500 mN m */
+	{ { 0x23, 0x06, 0x10, 0x00, 0x00, 0x00, 0, 0 }, false },     /* 0x1006 = 0 first */
+	{ { 0x2F, 0x19, 0x10, 0x00, 0x00, 0, 0, 0 }, false },     /* 0x1019 = 0: no counter */
+	{ { 0x23, 0x06, 0x10, 0x00, 0xE8, 0x03, 0, 0 }, false },     /* 0x1006 = 1000 us */
+	{ { 0x23, 0x16, 0x10, 0x01, 0x1E, 0x00, 0x7F, 0x00 }, false },  /* 0x1016:01 node 127, 30 ms */
+	{ { 0x2B, 0x07, 0x60, 0x00, 0x02, 0x00, 0, 0 }, false },     /* 0x6007 = 2 disable voltage */
 	/* RPDO1 */
 	{ { 0x23, 0x00, 0x14, 0x01, 0x00, 0x02, 0x00, 0x80 }, true },      /* 0x1400:01 off */
 	{ { 0x2F, 0x00, 0x16, 0x00, 0x00, 0, 0, 0 }, false },     /* 0x1600:00 = 0 */
@@ -182,20 +197,23 @@ static const struct {
 	{ { 0x23, 0x00, 0x16, 0x02, 0x10, 0x00, 0x71, 0x60 }, false },     /* 0x6071, 16 bit */
 	{ { 0x2F, 0x00, 0x16, 0x00, 0x02, 0, 0, 0 }, false },     /* two entries */
 	{ { 0x2F, 0x00, 0x14, 0x02, 0x01, 0, 0, 0 }, false },     /* every SYNC */
+	{ { 0x2B, 0x00, 0x14, 0x05, 0x03, 0x00, 0, 0 }, false },     /* deadline 3 ms */
 	{ { 0x23, 0x00, 0x14, 0x01, 0x00, 0x02, 0x00, 0x00 }, true },      /* 0x1400:01 on */
 	/* TPDO1 */
-	{ { 0x23, 0x00, 0x18, 0x01, 0x80, 0x01, 0x00, 0x80 }, true },      /* 0x1800:01 off */
+	{ { 0x23, 0x00, 0x18, 0x01, 0x80, 0x01, 0x00, 0xC0 }, true },      /* 0x1800:01 off, no RTR */
 	{ { 0x2F, 0x00, 0x1A, 0x00, 0x00, 0, 0, 0 }, false },     /* 0x1A00:00 = 0 */
 	{ { 0x23, 0x00, 0x1A, 0x01, 0x10, 0x00, 0x41, 0x60 }, false },     /* 0x6041, 16 bit */
 	{ { 0x23, 0x00, 0x1A, 0x02, 0x20, 0x00, 0x64, 0x60 }, false },     /* 0x6064, 32 bit */
 	{ { 0x2F, 0x00, 0x1A, 0x00, 0x02, 0, 0, 0 }, false },     /* two entries */
 	{ { 0x2F, 0x00, 0x18, 0x02, 0x01, 0, 0, 0 }, false },     /* every SYNC */
-	{ { 0x23, 0x00, 0x18, 0x01, 0x80, 0x01, 0x00, 0x00 }, true },      /* 0x1800:01 on */
+	{ { 0x23, 0x00, 0x18, 0x01, 0x80, 0x01, 0x00, 0x40 }, true },      /* 0x1800:01 on, no RTR */
+	{ { 0x40, 0x61, 0x60, 0x00, 0, 0, 0, 0 }, false },        /* read 0x6061 mode display */
 };
 
 static void test_setup_sequence(void **state)
 {
 	struct irdm_can_master_cfg c = cfg_3axes();
+	char line[200];
 
 	(void)state;
 	bus_up();
@@ -222,15 +240,60 @@ static void test_setup_sequence(void **state)
 		assert_int_equal(dr.d[k].rated_torque_mnm, 500);
 		assert_int_equal(dr.d[k].nmt, IRDM_CO_STATE_OPERATIONAL);
 		assert_int_equal(dr.d[k].rpdo1.cob_id, 0x200 + k + 1);
-		assert_int_equal(dr.d[k].tpdo1.cob_id, 0x180 + k + 1);
+		assert_int_equal(dr.d[k].tpdo1.cob_id, 0x40000180 + k + 1);
 		assert_int_equal(dr.d[k].rpdo1.n_mapped, 2);
 		assert_int_equal(dr.d[k].tpdo1.n_mapped, 2);
 		assert_int_equal(dr.d[k].rpdo1.transmission, 1);
 		assert_int_equal(dr.d[k].tpdo1.transmission, 1);
+		assert_int_equal(dr.d[k].rpdo1.event_timer_ms, 3);
+		assert_int_equal(dr.d[k].sync_overflow, 0);
+		assert_int_equal(dr.d[k].cycle_us, 1000);
+		assert_int_equal(dr.d[k].hb_consumer, 127u << 16 | 30u);
+		assert_int_equal(dr.d[k].abort_option, 2);
 	}
+	irdm_can_master_identity_line(&m, 1, line, sizeof(line));
+	assert_string_equal(line, "drive 2 (node 2): CiA 402 device type 0x00020192, vendor "
+			    "0x00000000, product 0x00000402, revision 0x00010000, serial 0x00000002");
 }
 
-/* A drive that answers every SDO request with these 8 bytes. */
+/* With the SYNC counter: 0x1019 = 240 between 0x1006 = 0 and the period,
+ * the drives' overflow set so, and their SYNCs taken (none refused). */
+static void test_setup_sync_counter(void **state)
+{
+	struct irdm_can_master_cfg c = cfg_3axes();
+	static const uint8_t zero_cycle[8] = { 0x23, 0x06, 0x10, 0x00, 0, 0, 0, 0 };
+	static const uint8_t overflow[8] = { 0x2F, 0x19, 0x10, 0x00, 0xF0, 0, 0, 0 };
+
+	(void)state;
+	c.sync_counter = true;
+	bus_up();
+	master_up(&c);
+	expect_frame(8, 0x601, 8, zero_cycle);
+	expect_frame(9, 0x601, 8, overflow);
+	for (unsigned k = 0; k < 3; k++)
+		assert_int_equal(dr.d[k].sync_overflow, 240);
+	irdm_can_master_enable(&m, true);
+	for (int p = 0; p < 100; p++)
+		period(NULL);
+	assert_true(irdm_can_master_all_enabled(&m));
+	assert_int_equal(dr.sync_length_errors, 0);
+}
+
+/* The answer of a CiA 402 drive to an upload request f: 4 bytes, 0x1000
+ * the drive profile, 0x6061 cyclic synchronous torque, anything else 0. */
+static void upload_answer(const struct irdm_can_frame *f, struct irdm_can_frame *a)
+{
+	uint16_t index = (uint16_t)(f->data[1] | f->data[2] << 8);
+	uint32_t v = index == 0x1000 ? 0x00020192 : index == 0x6061 ? 10 : 0;
+
+	memset(a->data, 0, 8);
+	a->data[0] = 0x43;
+	memcpy(a->data + 1, f->data + 1, 3);
+	for (int b = 0; b < 4; b++)
+		a->data[4 + b] = (uint8_t)(v >> (8 * b));
+}
+
+/* A drive that answers every SDO download with these 8 bytes. */
 static uint8_t canned[8];
 static bool silent;
 
@@ -239,11 +302,15 @@ static void canned_turn(void *ctx)
 	struct irdm_can_frame f, a = { .id = 0x581, .dlc = 8 };
 
 	(void)ctx;
-	while (irdm_can_recv(&rogue, &f) == 1)
-		if (f.id == 0x601 && !silent) {
+	while (irdm_can_recv(&rogue, &f) == 1) {
+		if (f.id != 0x601 || silent)
+			continue;
+		if (f.data[0] == 0x40)
+			upload_answer(&f, &a);
+		else
 			memcpy(a.data, canned, 8);
-			irdm_can_send(&rogue, &a);
-		}
+		irdm_can_send(&rogue, &a);
+	}
 }
 
 static int init_against(const uint8_t answer[8])
@@ -293,7 +360,7 @@ static void test_setup_aborts_named(void **state)
 	}
 	silent = true;
 	assert_int_equal(init_against(ok), IRDM_ETIMEDOUT);
-	assert_string_equal(err, "drive 1 (node 1): no SDO answer (time-out) writing 0x6060:00");
+	assert_string_equal(err, "drive 1 (node 1): no SDO answer (time-out) reading 0x1000:00");
 	/* the emulator answering about another object: refused */
 	bus_up();
 	dr.d[1].sdo_wrong = true;
@@ -319,6 +386,11 @@ static void picky_turn(void *ctx)
 	while (irdm_can_recv(&rogue, &f) == 1) {
 		if (f.id != 0x601)
 			continue;
+		if (f.data[0] == 0x40) {
+			upload_answer(&f, &a);
+			irdm_can_send(&rogue, &a);
+			continue;
+		}
 		memset(a.data, 0, 8);
 		a.data[0] = 0x60;                       /* download confirmed */
 		memcpy(a.data + 1, f.data + 1, 3);
@@ -356,7 +428,7 @@ static void test_setup_pdo_refused_named(void **state)
 	assert_int_equal(irdm_can_master_init(&m, &wrapped, &c, err, sizeof(err)), IRDM_EHW);
 	assert_string_equal(err, "drive 2 (node 2): SDO abort 0x06040041 object cannot be mapped "
 				 "to the PDO writing 0x1600:02");
-	assert_int_equal(n_sent, SETUP_SDOS + 7);       /* drive 1, then drive 2 up to 0x1600:02 */
+	assert_int_equal(n_sent, SETUP_SDOS + 17);      /* drive 1, then drive 2 up to 0x1600:02 */
 	c.n_axes = 1;
 	c.idle = picky_turn;
 	for (size_t i = 0; i < sizeof(cases) / sizeof(cases[0]); i++) {
@@ -728,11 +800,16 @@ static void test_config_refused(void **state)
 	assert_int_equal(irdm_can_master_check(&c, err, sizeof(err)), IRDM_EINVAL);
 }
 
-/* One RPDO per axis between two SYNCs, and the counter 1, 2, ..., 240, 1. */
+/*
+ * One RPDO per axis between two SYNCs, and the counter 1, 2, ..., 240, 1,
+ * which the strict drives take (0x1019 written); the master's heartbeat
+ * (0x77F, operational) every 10 periods, heard by every drive's consumer,
+ * and no drive's deadline ever missed.
+ */
 static void test_one_rpdo_per_sync_and_counter(void **state)
 {
 	struct irdm_can_master_cfg c = cfg_3axes();
-	unsigned rpdos[3] = { 0, 0, 0 }, syncs = 0, last = 0;
+	unsigned rpdos[3] = { 0, 0, 0 }, syncs = 0, last = 0, beats = 0;
 	double tau[3] = { 0.01, 0.02, 0.03 };
 
 	(void)state;
@@ -757,19 +834,101 @@ static void test_one_rpdo_per_sync_and_counter(void **state)
 			syncs++;
 		} else if (f->id >= 0x201 && f->id <= 0x203) {
 			rpdos[f->id - 0x201]++;
+		} else if (f->id == 0x77F && f->dlc == 1 && f->data[0] == 0x05) {
+			assert_int_equal(sent[i].period % 10, 0);
+			beats++;
 		} else {
 			fail_msg("frame %03X in a running cycle", (unsigned)f->id);
 		}
 	}
 	assert_int_equal(syncs, 500);
+	assert_int_equal(beats, 50);
 	assert_int_equal(dr.syncs, m.period);     /* every SYNC reached the drives */
 	assert_int_equal(dr.sync_counter, last);
+	assert_int_equal(dr.sync_length_errors, 0);
+	for (unsigned k = 0; k < 3; k++) {
+		assert_true(dr.d[k].master_beat_seen);
+		assert_true(dr.d[k].rpdo_seen);
+		assert_int_equal(dr.d[k].lost_code, 0);
+	}
+	assert_false(m.faulted);
+}
+
+/*
+ * The master dies mid-run (a kill -9: not one more frame), the drives on
+ * the wall clock as a drive process runs: each stops by itself, at the
+ * first of its deadlines the master configured.  rpdo_ms: the RPDO1
+ * deadline (0x1400:05); the consumer heartbeat is the master's tolerance,
+ * 30 ms.  Return: the time from the master's last frame to the last
+ * drive's torque-off, in us; each drive's EMCY code in codes.
+ */
+static uint64_t master_dies(uint16_t rpdo_ms, uint16_t codes[3])
+{
+	struct irdm_can_master_cfg c = cfg_3axes();
+	double tau[3] = { 0.05, -0.05, 0.05 };
+	uint64_t t = 1000000, last, worst = 0;
+
+	c.rpdo_timeout_ms = rpdo_ms;
+	bus_up();
+	dr.wall_heartbeat = true;
+	irdm_can_drives_wall(&dr, t);
+	master_up(&c);
+	irdm_can_master_enable(&m, true);
+	for (int p = 0; p < 105; p++) {
+		t += 1000;
+		irdm_can_drives_wall(&dr, t);
+		assert_int_equal(irdm_can_master_send(&m, tau), IRDM_OK);
+		irdm_can_drives_poll(&dr);
+		(void)irdm_can_master_receive(&m);
+	}
+	assert_true(irdm_can_master_all_enabled(&m));
+	for (unsigned k = 0; k < 3; k++)
+		assert_int_not_equal(dr.d[k].rpdo_torque_permille, 0);
+	last = t;
+	while (t < last + 200000) {
+		t += 100;
+		irdm_can_drives_wall(&dr, t);
+	}
+	for (unsigned k = 0; k < 3; k++) {
+		assert_int_not_equal(dr.d[k].lost_code, 0);
+		assert_int_equal(dr.d[k].rpdo_torque_permille, 0);
+		assert_int_equal(dr.d[k].fsa.state, IRDM_CIA402_SWITCH_ON_DISABLED);
+		codes[k] = dr.d[k].lost_code;
+		if (dr.d[k].lost_at_us - last > worst)
+			worst = dr.d[k].lost_at_us - last;
+	}
+	return worst;
+}
+
+static void test_master_dies_drives_stop(void **state)
+{
+	uint16_t codes[3];
+	uint64_t us;
+
+	(void)state;
+	/* the RPDO1 deadline first: 3 ms after the last RPDO1 (3 periods) */
+	us = master_dies(3, codes);
+	print_message("master silent: every drive off %.1f ms after its last frame (RPDO1 "
+		      "deadline 3 ms)\n", us / 1000.0);
+	for (unsigned k = 0; k < 3; k++)
+		assert_int_equal(codes[k], 0x8250);
+	assert_true(us > 3000 && us <= 3100);
+	/* a drive without an RPDO deadline (the longest 0x1400:05 allows):
+	 * the master's heartbeat, 30 ms after the last beat (at most one
+	 * heartbeat period, 10 ms, before the last frame) */
+	us = master_dies(65535, codes);
+	print_message("master silent: every drive off %.1f ms after its last frame (consumer "
+		      "heartbeat 30 ms)\n", us / 1000.0);
+	for (unsigned k = 0; k < 3; k++)
+		assert_int_equal(codes[k], 0x8130);
+	assert_true(us > 20000 && us <= 30100);
 }
 
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_setup_sequence),
+		cmocka_unit_test(test_setup_sync_counter),
 		cmocka_unit_test(test_setup_pdo_refused_named),
 		cmocka_unit_test(test_setup_aborts_named),
 		cmocka_unit_test(test_every_axis_enabled),
@@ -786,6 +945,7 @@ int main(void)
 		cmocka_unit_test(test_bus_load),
 		cmocka_unit_test(test_config_refused),
 		cmocka_unit_test(test_one_rpdo_per_sync_and_counter),
+		cmocka_unit_test(test_master_dies_drives_stop),
 	};
 
 	return cmocka_run_group_tests(tests, NULL, NULL);

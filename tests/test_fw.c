@@ -9,7 +9,12 @@
  *    static amplitude at the touched node), not at one the loop invents;
  *  - --require-rt refuses a kernel that is not PREEMPT_RT (checked here
  *    independently) and runs on one that is;
- *  - SIGTERM mid-contact: torque off within the tick, the reason logged;
+ *  - SIGTERM, SIGHUP, SIGQUIT mid-contact: torque off and state off in the
+ *    next tick, the reason logged, exit 6; SIGSEGV: the emergency path,
+ *    exit 8;
+ *  - the image file truncated or written over under a running loop: the
+ *    run goes on to its end on its own copy;
+ *  - a run whose limits never let the torque on exits 7 naming the limit;
  *  - --frame-at: the deformed surface in VTK, checked physically (a dent
  *    at the pressed top centre, a still bottom) and byte-identical in
  *    virtual time.
@@ -280,43 +285,214 @@ static void relaxed_board(char *path, size_t len)
 	tf_write_text(path, out);
 }
 
-static void test_sigterm_mid_contact_turns_torque_off(void **state)
+/* The log's records: how many, how many in contact from tick `from` on,
+ * and the last one. */
+static uint64_t read_log(const char *log, uint64_t from, uint64_t *contact_ticks,
+			 struct irdm_tick_record *last)
 {
-	char log[320], board[320];
-	struct timespec t = { 1, 700000000 };    /* 1.7 s: pressed and holding */
-	struct irdm_tick_record rec, last;
+	struct irdm_tick_record rec;
 	struct irdm_log_reader *r;
 	char err[256];
-	uint64_t n = 0, contact_ticks = 0;
-	pid_t pid;
+	uint64_t n = 0;
 
-	(void)state;
-	snprintf(log, sizeof(log), "%s/sig.log", dir);
+	*contact_ticks = 0;
+	assert_int_equal(irdm_log_open(&r, log, err, sizeof(err)), 0);
+	memset(last, 0, sizeof(*last));
+	while (irdm_log_next(r, &rec, err, sizeof(err)) == 1) {
+		*contact_ticks += rec.tick >= from && rec.dev[0].contact_tri != IRDM_TELEM_NO_TRI;
+		*last = rec;
+		n++;
+	}
+	irdm_log_close(r);
+	return n;
+}
+
+static void assert_off_with_zero_torque(const struct irdm_tick_record *last)
+{
+	assert_int_equal(last->state, IRDM_SAFETY_OFF);
+	for (int j = 0; j < 3; j++)
+		assert_true(last->dev[0].joint_torque_nm[j] == 0.0);
+}
+
+/*
+ * A signal asking irdm-fw to end, mid-contact on a real-clock run: the
+ * next tick shuts down (state off, torque zero, the signal logged as the
+ * reason) and irdm-fw exits 6, as --help says.
+ */
+static void signal_mid_contact(int sig, const char *name)
+{
+	char log[320], board[320], line[96];
+	struct timespec t = { 1, 700000000 };    /* 1.7 s: pressed and holding */
+	struct irdm_tick_record last;
+	uint64_t n, contact_ticks;
+	pid_t pid;
+	int rc;
+
+	snprintf(log, sizeof(log), "%s/sig-%d.log", dir, sig);
 	relaxed_board(board, sizeof(board));
 	pid = spawn(env_or("IRDM_FW", "build/irdm-fw"), (const char *const[]){
 		"--board", board, "--image", image, "--user", PRESS, "--clock", "real",
 		"--log", log, NULL });
 	nanosleep(&t, NULL);
-	kill(pid, SIGTERM);
-	if (finish(pid) != 0)
-		fail_msg("irdm-fw did not stop cleanly on SIGTERM: %s", err_text);
-	assert_non_null(strstr(err_text, "stopped by signal 15: torque off"));
-	assert_int_equal(irdm_log_open(&r, log, err, sizeof(err)), 0);
-	memset(&last, 0, sizeof(last));
-	while (irdm_log_next(r, &rec, err, sizeof(err)) == 1) {
-		contact_ticks += rec.dev[0].contact_tri != IRDM_TELEM_NO_TRI;
-		last = rec;
-		n++;
-	}
-	irdm_log_close(r);
-	print_message("%llu ticks logged, %llu in contact; last: state %u, faults 0x%x\n",
+	kill(pid, sig);
+	rc = finish(pid);
+	if (rc != 6)
+		fail_msg("%s: expected exit 6 (stopped by a signal), got %d: %s", name, rc, err_text);
+	snprintf(line, sizeof(line), "stopped by %s (signal %d)", name, sig);
+	assert_non_null(strstr(err_text, line));
+	assert_non_null(strstr(err_text, "torque off, state off"));
+	n = read_log(log, 0, &contact_ticks, &last);
+	print_message("%s: %llu ticks logged, %llu in contact; last: state %u, faults 0x%x\n", name,
 		      (unsigned long long)n, (unsigned long long)contact_ticks, last.state,
 		      last.fault_flags);
 	assert_true(contact_ticks > 100);       /* the signal came mid-contact */
-	assert_int_equal(last.state, IRDM_SAFETY_FAULT);
+	assert_off_with_zero_torque(&last);
 	assert_true(last.fault_flags & IRDM_FAULT_SIGNAL);
-	for (int j = 0; j < 3; j++)
-		assert_true(last.dev[0].joint_torque_nm[j] == 0.0);
+}
+
+static void test_sigterm_mid_contact_turns_torque_off(void **state)
+{
+	(void)state;
+	signal_mid_contact(SIGTERM, "SIGTERM");
+}
+
+static void test_sighup_mid_contact_turns_torque_off(void **state)
+{
+	(void)state;
+	signal_mid_contact(SIGHUP, "SIGHUP");
+}
+
+static void test_sigquit_mid_contact_turns_torque_off(void **state)
+{
+	(void)state;
+	signal_mid_contact(SIGQUIT, "SIGQUIT");
+}
+
+/*
+ * A fatal signal (here sent, as a crash would raise it) takes the
+ * emergency path: torque off on the device, one line, exit 8.
+ */
+static void test_sigsegv_takes_the_emergency_path(void **state)
+{
+	struct timespec t = { 1, 200000000 };
+	char board[320];
+	pid_t pid;
+	int rc;
+
+	(void)state;
+	relaxed_board(board, sizeof(board));
+	pid = spawn(env_or("IRDM_FW", "build/irdm-fw"), (const char *const[]){
+		"--board", board, "--image", image, "--user", PRESS, "--clock", "real", NULL });
+	nanosleep(&t, NULL);
+	kill(pid, SIGSEGV);
+	rc = finish(pid);
+	if (rc != 8 || !strstr(err_text, "SIGSEGV (signal 11): emergency torque off on 1 of 1 device\n"))
+		fail_msg("expected exit 8 and the emergency line; got %d: %s", rc, err_text);
+}
+
+/* Copy src to dst (the image a run reads, which the test then damages). */
+static void copy_file(const char *src, const char *dst)
+{
+	size_t len;
+	char *bytes = tf_load(src, &len);
+	FILE *f = fopen(dst, "wb");
+
+	assert_non_null(f);
+	assert_int_equal(fwrite(bytes, 1, len, f), len);
+	assert_int_equal(fclose(f), 0);
+	free(bytes);
+}
+
+/* Replace every byte of path in place (same inode, same size). */
+static void scribble_over(const char *path)
+{
+	size_t len;
+	char *bytes = tf_load(path, &len);
+	FILE *f = fopen(path, "r+b");
+
+	assert_non_null(f);
+	for (size_t i = 0; i < len; i++)
+		bytes[i] = (char)(i * 131u + 7u);
+	assert_int_equal(fwrite(bytes, 1, len, f), len);
+	assert_int_equal(fclose(f), 0);
+	free(bytes);
+}
+
+/*
+ * The image file truncated, or written over, under a real-clock run in
+ * contact: the loop reads its own copy, so the run goes on in contact to
+ * its end (exit 0), the last record state off with zero torque.  (A file
+ * mapped in place gives SIGBUS or garbage in the force tick.)
+ */
+static void image_changed_under_run(bool truncate_it)
+{
+	char log[320], board[320], live[320];
+	struct timespec t = { 1, 500000000 };    /* 1.5 s: holding */
+	struct irdm_tick_record last;
+	uint64_t n, contact_after;
+	pid_t pid;
+	int rc;
+
+	snprintf(log, sizeof(log), "%s/changed-%d.log", dir, truncate_it);
+	snprintf(live, sizeof(live), "%s/live-%d.img", dir, truncate_it);
+	copy_file(image, live);
+	relaxed_board(board, sizeof(board));
+	pid = spawn(env_or("IRDM_FW", "build/irdm-fw"), (const char *const[]){
+		"--board", board, "--image", live, "--user", PRESS, "--clock", "real",
+		"--duration", "2.5", "--log", log, NULL });
+	nanosleep(&t, NULL);
+	if (truncate_it)
+		assert_int_equal(truncate(live, 0), 0);
+	else
+		scribble_over(live);
+	rc = finish(pid);
+	if (rc != 0)
+		fail_msg("image %s under the run: exit %d: %s", truncate_it ? "truncated" : "overwritten",
+			 rc, err_text);
+	n = read_log(log, 1600, &contact_after, &last);
+	print_message("image %s at 1.5 s: %llu ticks, %llu in contact after 1.6 s\n",
+		      truncate_it ? "truncated" : "overwritten", (unsigned long long)n,
+		      (unsigned long long)contact_after);
+	assert_true(n == 2500);
+	assert_true(contact_after > 500);       /* still pressing, on the same surface */
+	assert_off_with_zero_torque(&last);
+}
+
+static void test_image_truncated_under_run(void **state)
+{
+	(void)state;
+	image_changed_under_run(true);
+}
+
+static void test_image_overwritten_under_run(void **state)
+{
+	(void)state;
+	image_changed_under_run(false);
+}
+
+/*
+ * A limit that holds all run long (the speed limit far below the sag of
+ * the unpowered arm, then the tip below the workspace where it came to
+ * rest): every enable request refused, exit 7 naming the condition.
+ */
+static void test_never_enabled_exits_nonzero(void **state)
+{
+	char text[16384], out[16384] = "", *line, *save, board[320];
+	int rc;
+
+	(void)state;
+	tf_read_text(BOARD, text, sizeof(text));
+	for (line = strtok_r(text, "\n", &save); line; line = strtok_r(NULL, "\n", &save)) {
+		if (!strncmp(line, "max_tip_speed_m_per_s", 21))
+			line = "max_tip_speed_m_per_s = 0.0001";
+		strncat(out, line, sizeof(out) - strlen(out) - 2);
+		strcat(out, "\n");
+	}
+	snprintf(board, sizeof(board), "%s/slow.board", dir);
+	tf_write_text(board, out);
+	rc = run_fw((const char *const[]){ "--board", board, "--image", image, "--clock", "virtual",
+					  "--duration", "0.5", "-q", NULL });
+	expect_error(rc, 7, "the torque was never enabled in 500 ticks: 'workspace' refused");
 }
 
 /* The numbers after the first line starting with `key` (NULL if none). */
@@ -641,6 +817,12 @@ int main(void)
 		cmocka_unit_test(test_release_ringing_is_the_dominant_mode),
 		cmocka_unit_test(test_require_rt),
 		cmocka_unit_test(test_sigterm_mid_contact_turns_torque_off),
+		cmocka_unit_test(test_sighup_mid_contact_turns_torque_off),
+		cmocka_unit_test(test_sigquit_mid_contact_turns_torque_off),
+		cmocka_unit_test(test_sigsegv_takes_the_emergency_path),
+		cmocka_unit_test(test_image_truncated_under_run),
+		cmocka_unit_test(test_image_overwritten_under_run),
+		cmocka_unit_test(test_never_enabled_exits_nonzero),
 		cmocka_unit_test(test_frame_at_writes_the_deformed_surface),
 		cmocka_unit_test(test_frames_series),
 		cmocka_unit_test(test_frame_at_in_real_time),

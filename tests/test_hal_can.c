@@ -92,6 +92,9 @@ static void test_options_refused_by_name(void **state)
 						  "heartbeat_ms" },
 		{ "nodes=1,3,4 rated_torque_mnm=100", "hal_options nodes: the emulator's nodes are "
 						      "consecutive (e.g. 1,2,3)" },
+		{ OPTS " master_node=2", "hal_options master_node: is a drive's node id" },
+		{ OPTS " master_node=128", "hal_options master_node: 1..127" },
+		{ OPTS " rpdo_timeout_ms=0", "hal_options rpdo_timeout_ms: 1..65535 ms" },
 	};
 
 	(void)state;
@@ -178,8 +181,15 @@ static void test_canemu_runs_and_faults(void **state)
 
 	(void)state;
 	assert_int_equal(open_as("canemu", OPTS), IRDM_OK);
+	/* the bus load, then each drive as its 0x1000 and 0x1018 say */
 	assert_string_equal(dev.info, "CAN bus load: SYNC + 3 x RPDO1 (4 B) + 3 x TPDO1 (6 B) = "
-			    "695 bits worst case in 1000 us at 1000000 bit/s: 69.5 %");
+			    "695 bits worst case in 1000 us at 1000000 bit/s: 69.5 %\n"
+			    "drive 1 (node 1): CiA 402 device type 0x00020192, vendor 0x00000000, "
+			    "product 0x00000402, revision 0x00010000, serial 0x00000001\n"
+			    "drive 2 (node 2): CiA 402 device type 0x00020192, vendor 0x00000000, "
+			    "product 0x00000402, revision 0x00010000, serial 0x00000002\n"
+			    "drive 3 (node 3): CiA 402 device type 0x00020192, vendor 0x00000000, "
+			    "product 0x00000402, revision 0x00010000, serial 0x00000003");
 	assert_int_equal(irdm_hal_write(&dev, tau), IRDM_EINVAL);      /* not started */
 	assert_int_equal(irdm_hal_start(&dev), IRDM_OK);
 	run_ticks(100, tau, &bad);
@@ -262,7 +272,7 @@ static void test_one_sync_per_tick(void **state)
 			if (syncs++)
 				assert_int_equal(f->data[0], last % 240 + 1);
 			last = f->data[0];
-		} else {
+		} else if (f->id != 0x77F) {    /* (the master's heartbeat) */
 			assert_true(f->id >= 0x201 && f->id <= 0x203);
 			rpdos[f->id - 0x201]++;
 		}
@@ -272,12 +282,51 @@ static void test_one_sync_per_tick(void **state)
 	irdm_hal_close(&dev);
 }
 
+/*
+ * start: the cycle runs with every drive held at disable voltage (RPDO1
+ * 00 00 00 00) for 5 SYNCs answered by every drive, with the master's
+ * heartbeat from the first; only then the enable sequence (0x06, ...).
+ */
+static void test_start_steady_before_enable(void **state)
+{
+	unsigned syncs = 0, first_enable_sync = 0, beats_before = 0;
+
+	(void)state;
+	assert_int_equal(open_as("canemu", OPTS), IRDM_OK);
+	assert_int_equal(irdm_hal_start(&dev), IRDM_OK);
+	for (unsigned i = 0; i < n_log; i++) {
+		const struct irdm_can_frame *f = &bus_log[i].f;
+
+		if (bus_log[i].from != 0)
+			continue;
+		if (f->id == 0x080)
+			syncs++;
+		else if (f->id == 0x77F && !first_enable_sync)
+			beats_before++;
+		else if (f->id >= 0x201 && f->id <= 0x203 && (f->data[0] | f->data[1]) &&
+			 !first_enable_sync)
+			first_enable_sync = syncs + 1;
+	}
+	print_message("start: %u SYNCs, the enable sequence from SYNC %u\n", syncs,
+		      first_enable_sync);
+	assert_int_equal(first_enable_sync, 6);
+	assert_int_equal(beats_before, 1);
+	irdm_hal_close(&dev);
+}
+
 static void test_canemu_start_times_out(void **state)
 {
 	(void)state;
+	/* 2 ms: not even the disabled SYNCs that come before enabling */
 	assert_int_equal(open_as("canemu", OPTS " enable_timeout_ms=2"), IRDM_OK);
 	assert_int_equal(irdm_hal_start(&dev), IRDM_ETIMEDOUT);
-	assert_non_null(strstr(dev.why, "drive 1 (node 1): not operation enabled after 2 ms ("));
+	assert_string_equal(dev.why, "CAN: fewer than 5 SYNCs answered in a row before enabling, "
+			    "within 2 ms");
+	irdm_hal_close(&dev);
+	/* 6 ms: those, then not the enable sequence (3 SYNCs at least) */
+	assert_int_equal(open_as("canemu", OPTS " enable_timeout_ms=6"), IRDM_OK);
+	assert_int_equal(irdm_hal_start(&dev), IRDM_ETIMEDOUT);
+	assert_non_null(strstr(dev.why, "drive 1 (node 1): not operation enabled after 6 ms ("));
 	irdm_hal_close(&dev);
 }
 
@@ -374,6 +423,7 @@ int main(void)
 		cmocka_unit_test(test_socketcan_bus_off_loses_link),
 		cmocka_unit_test(test_canemu_runs_and_faults),
 		cmocka_unit_test(test_one_sync_per_tick),
+		cmocka_unit_test(test_start_steady_before_enable),
 		cmocka_unit_test(test_canemu_start_times_out),
 		cmocka_unit_test(test_tick_ops_no_system_call_no_allocation),
 	};

@@ -71,7 +71,7 @@ static int wire_open(struct irdm_hal_dev *dev)
 	return irdm_hal_can_open(dev, &wire_link, 0);
 }
 
-static const struct irdm_hal_ops wire_ops = IRDM_HAL_CAN_OPS(wire_open);
+static const struct irdm_hal_ops wire_ops = IRDM_HAL_CAN_OPS(wire_open, NULL);
 
 static const struct irdm_hal_backend wire_backend = {
 	.name = "test-wire",

@@ -1,8 +1,8 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * Getting an image's bytes on a POSIX system: open, map read-only,
- * optionally lock, fault every page in, then hand the bytes to
- * irdm_image_parse().  Every system call of the loader is here and nowhere
+ * Getting an image's bytes on a POSIX system: open, copy the file into
+ * private anonymous memory made read-only, optionally lock it, fault every
+ * page in, then hand the bytes to irdm_image_parse().  Every system call of the loader is here and nowhere
  * else: a port to a bare-metal flash replaces this one file with one whose
  * irdm_image_map() points at the flash and whose irdm_image_unmap() does
  * nothing.
@@ -60,11 +60,45 @@ static int lock_pages(struct irdm_image *raw, char *msg, size_t msglen)
 			  " (raise RLIMIT_MEMLOCK or run with CAP_IPC_LOCK)" : "");
 }
 
-/* mmap the whole file read-only into raw; the caller closes fd. */
+/*
+ * Read the whole file (st_size bytes) into base; the file must neither
+ * shrink nor grow while it is read.
+ */
+static int read_all(int fd, uint8_t *base, size_t size, char *msg, size_t msglen)
+{
+	size_t done = 0;
+	uint8_t extra;
+	ssize_t n;
+
+	while (done < size) {
+		n = pread(fd, base + done, size - done, (off_t)done);
+		if (n < 0 && errno == EINTR)
+			continue;
+		if (n < 0)
+			return img_report(msg, msglen, IRDM_EIO, "cannot read: %s", strerror(errno));
+		if (n == 0)
+			return img_report(msg, msglen, IRDM_ETRUNC,
+					  "image is truncated: the file shrank to %zu bytes while "
+					  "it was read (%zu expected)", done, size);
+		done += (size_t)n;
+	}
+	if (pread(fd, &extra, 1, (off_t)size) > 0)
+		return img_report(msg, msglen, IRDM_EIO,
+				  "the file grew past %zu bytes while it was read", size);
+	return IRDM_OK;
+}
+
+/*
+ * A private copy of the whole file in anonymous memory, read-only once
+ * filled; the caller closes fd.  Not a mapping of the file: a file mapped
+ * in place (even MAP_PRIVATE) is still the file's page cache, and a
+ * truncation under a running loop gives SIGBUS, a copy over it changes the
+ * bytes the loop reads.  The copy cannot change after it was checked.
+ */
 static int map_fd(int fd, unsigned flags, struct irdm_image *raw,
 		  char *msg, size_t msglen)
 {
-	int mflags = MAP_PRIVATE;
+	int mflags = MAP_PRIVATE | MAP_ANONYMOUS;
 	struct stat st;
 	void *base;
 	int ret;
@@ -84,12 +118,20 @@ static int map_fd(int fd, unsigned flags, struct irdm_image *raw,
 #ifdef MAP_POPULATE
 	mflags |= MAP_POPULATE;
 #endif
-	base = mmap(NULL, (size_t)st.st_size, PROT_READ, mflags, fd, 0);
+	base = mmap(NULL, (size_t)st.st_size, PROT_READ | PROT_WRITE, mflags, -1, 0);
 	if (base == MAP_FAILED)
 		return img_report(msg, msglen, IRDM_EIO, "cannot map: %s",
 				  strerror(errno));
 	raw->base = base;
 	raw->size = (size_t)st.st_size;
+	ret = read_all(fd, base, raw->size, msg, msglen);
+	if (ret)
+		goto unmap;
+	if (mprotect(base, raw->size, PROT_READ)) {
+		ret = img_report(msg, msglen, IRDM_EIO, "cannot protect the copy: %s",
+				 strerror(errno));
+		goto unmap;
+	}
 	if (flags & IRDM_IMAGE_MAP_LOCK) {
 		ret = lock_pages(raw, msg, msglen);
 		if (ret)
@@ -123,7 +165,7 @@ int irdm_image_map(const char *path, unsigned flags, struct irdm_image *img,
 		goto out_msg;
 	}
 	ret = map_fd(fd, flags, &raw, msg, sizeof(msg));
-	close(fd);              /* the mapping keeps the file */
+	close(fd);              /* the copy needs the file no more */
 	if (ret)
 		goto out_msg;
 	ret = irdm_image_parse(raw.base, raw.size, img, msg, sizeof(msg));

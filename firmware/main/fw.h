@@ -32,6 +32,9 @@ enum fw_exit {
 	FW_EXIT_INPUT = 3,      /* board, image or user script refused */
 	FW_EXIT_SETUP = 4,      /* HAL, real time (--require-rt) or memory refused */
 	FW_EXIT_FAULT = 5,      /* the controller faulted: torque off, reason printed */
+	FW_EXIT_SIGNAL = 6,     /* stopped by a signal: torque off, state off, logged */
+	FW_EXIT_NEVER_ENABLED = 7,      /* ran, but a limit kept the torque off throughout */
+	FW_EXIT_EMERGENCY = 8,  /* a fatal (or second) signal: emergency torque off */
 };
 
 struct fw_args {
@@ -129,6 +132,8 @@ struct fw {
 	bool watching;
 	double watch_normal[3];
 	uint64_t ticks;
+	bool enabled_once;              /* the state was ENABLED in some tick */
+	uint32_t enable_blocked;        /* the conditions that refused the last enable */
 	uint32_t last_cause;
 	int last_state;
 	char err[512];
@@ -143,8 +148,14 @@ void fw_args_usage(FILE *f);
 int fw_config_from_board(struct irdm_ctrl_config *c, const struct irdm_board *b);
 
 /* fw_loop.c: runs until the duration is over, a fault or a signal.
- * Returns FW_EXIT_OK or FW_EXIT_FAULT. */
+ * Returns FW_EXIT_OK, FW_EXIT_FAULT, FW_EXIT_SIGNAL or FW_EXIT_NEVER_ENABLED. */
 int fw_loop_run(struct fw *fw, volatile sig_atomic_t *signalled);
+
+/* fw_signals.c: every signal's way out turns the torque off (armed before
+ * any device opens; disarmed once they are closed).  flag: the loop's. */
+int fw_signals_arm(struct fw *fw, volatile sig_atomic_t *flag);
+void fw_signals_disarm(void);
+const char *fw_signal_name(int sig);
 
 /* fw_log.c: open the log (--log) before the loop, drain and close after. */
 int fw_log_open(struct fw *fw);

@@ -71,11 +71,18 @@ void fw_args_usage(FILE *f)
 	      "\n"
 	      "Runs the force loop on a board's device: HAL read, encoders, kinematics,\n"
 	      "proxy on the deformed surface, force engine, J^T and limits, HAL write,\n"
-	      "every period; torque off on any fault, SIGINT or SIGTERM.\n\n", f);
+	      "every period; torque off on any fault and on every signal.  The torque is\n"
+	      "asked for from the second tick on and the request stands until the limits\n"
+	      "(workspace, speed, encoders) allow it; once on, a fault ends the run.\n\n", f);
 	irdm_opt_print_help(f, &fw_table, IRDM_OPT_STYLE_ARG);
-	fputs("\nexit codes: 0 ran to the end; 2 bad arguments; 3 board, image or user\n"
-	      "script refused; 4 HAL, real time (--require-rt) or memory refused;\n"
-	      "5 the controller faulted (torque off, reason printed)\n", f);
+	fputs("\nexit codes: 0 ran to the end with the torque enabled; 2 bad arguments;\n"
+	      "3 board, image or user script refused; 4 HAL, real time (--require-rt) or\n"
+	      "memory refused; 5 the controller faulted (torque off, reason printed);\n"
+	      "6 stopped by SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGPIPE or SIGXCPU (torque\n"
+	      "off and state off in the next tick, logged); 7 the torque was never\n"
+	      "enabled (the limit that refused it printed); 8 SIGSEGV, SIGBUS, SIGFPE,\n"
+	      "SIGILL, SIGABRT or a second signal: torque off at once by the emergency\n"
+	      "path, the log cut short\n", f);
 }
 
 int fw_args_parse(struct fw_args *a, int argc, char **argv, char *err, size_t errlen)

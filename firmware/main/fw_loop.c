@@ -108,22 +108,48 @@ static double now_ns(void)
 
 /*
  * Commands of the run: calibrate at the first tick (the arm starts at its
- * calibration pose), enable at the second, shut down at the end; a signal
- * faults (SIGNAL) and stops the run.
+ * calibration pose), ask to enable from the second on until the torque
+ * has been enabled once (a limit that holds, e.g. the arm still too fast,
+ * refuses it; the request stands until it clears), shut down at the end.
+ * A signal raises SIGNAL (the reason, logged) and shuts down in the same
+ * tick: state off.  Once enabled, nothing re-enables: a later fault ends
+ * the run.
  */
-static uint32_t run_commands(uint64_t tick, uint64_t last, bool signalled)
+static uint32_t run_commands(uint64_t tick, uint64_t last, bool signalled, bool enabled_once)
 {
 	uint32_t cmd = 0;
 
 	if (tick == 0)
 		cmd |= IRDM_CTRL_CMD_CALIBRATE;
-	if (tick == 1)
+	if (tick >= 1 && !enabled_once)
 		cmd |= IRDM_CTRL_CMD_ENABLE;
 	if (tick == last)
 		cmd |= IRDM_CTRL_CMD_SHUTDOWN;
 	if (signalled)
-		cmd |= IRDM_CTRL_CMD_SIGNAL;
+		cmd |= IRDM_CTRL_CMD_SIGNAL | IRDM_CTRL_CMD_SHUTDOWN;
 	return cmd;
+}
+
+/* Whether the torque came on; if not, what held it off this tick. */
+static void watch_enable(struct fw *fw, const struct irdm_ctrl_input *in,
+			 const struct irdm_ctrl_output *out)
+{
+	if (out->state == IRDM_SAFETY_ENABLED)
+		fw->enabled_once = true;
+	else if ((in->cmd & IRDM_CTRL_CMD_ENABLE) && out->state == IRDM_SAFETY_READY)
+		fw->enable_blocked = fw->ctrl.active & IRDM_FAULT_FATAL;
+	else if ((in->cmd & IRDM_CTRL_CMD_ENABLE) && out->state == IRDM_SAFETY_INIT)
+		fw->enable_blocked = 0;         /* not calibrated: main says so */
+}
+
+/* The run's exit code from its last tick. */
+static int run_end(const struct fw *fw, const struct irdm_ctrl_output *out, bool sig)
+{
+	if (sig)
+		return FW_EXIT_SIGNAL;
+	if (out->state == IRDM_SAFETY_FAULT)
+		return FW_EXIT_FAULT;
+	return fw->enabled_once ? FW_EXIT_OK : FW_EXIT_NEVER_ENABLED;
 }
 
 int fw_loop_run(struct fw *fw, volatile sig_atomic_t *signalled)
@@ -145,7 +171,7 @@ int fw_loop_run(struct fw *fw, volatile sig_atomic_t *signalled)
 			for (unsigned h = 0; h < fw->user->hands && h < fw->board.devices; h++)
 				push_hand(fw, h, t_s);
 		read_devices(fw, &in);
-		in.cmd |= carry | run_commands(k, n_ticks - 1, sig);
+		in.cmd |= carry | run_commands(k, n_ticks - 1, sig, fw->enabled_once);
 		in.prev_latency_ns = prev_lat;
 		in.prev_compute_ns = prev_comp;
 		if (irdm_ctrl_tick(&fw->ctrl, &in, &out) == IRDM_EFAULT || sig)
@@ -159,6 +185,7 @@ int fw_loop_run(struct fw *fw, volatile sig_atomic_t *signalled)
 			prev_lat = (uint64_t)(latency_ns > 0 ? latency_ns : 0);
 			prev_comp = (uint64_t)irdm_clock_elapsed_ns(&fw->clock);
 		}
+		watch_enable(fw, &in, &out);
 		trace_tick(fw, &out);
 		/* after the tick's timing: virtual time's update is not the tick's */
 		fw_frame_tick(fw, &out);
@@ -170,8 +197,7 @@ int fw_loop_run(struct fw *fw, volatile sig_atomic_t *signalled)
 		fw->last_cause = out.cause;
 		if (out.state == IRDM_SAFETY_FAULT || out.state == IRDM_SAFETY_OFF) {
 			safe_off_all(fw);
-			rc = out.state == IRDM_SAFETY_FAULT && out.cause != IRDM_FAULT_SIGNAL
-				     ? FW_EXIT_FAULT : FW_EXIT_OK;
+			rc = run_end(fw, &out, sig);
 			break;
 		}
 	}

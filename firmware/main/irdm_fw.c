@@ -26,11 +26,6 @@
 
 static volatile sig_atomic_t signalled;
 
-static void on_signal(int sig)
-{
-	signalled = sig;
-}
-
 /* One line on stderr, "irdm-fw: ENAME: reason", and the exit code. */
 static int fail(int exit_code, int rc, const char *fmt, const char *what, const char *why)
 {
@@ -112,6 +107,17 @@ static int open_inputs(struct fw *fw)
 	return meet_user(fw);
 }
 
+/* A device's info, each line as "hal 'NAME': line". */
+static void print_info(const char *hal, const char *info)
+{
+	while (*info) {
+		size_t n = strcspn(info, "\n");
+
+		printf("hal '%s': %.*s\n", hal, (int)n, info);
+		info += n + (info[n] == '\n');
+	}
+}
+
 static int open_devices(struct fw *fw)
 {
 	const struct irdm_hal_backend *be;
@@ -143,7 +149,18 @@ static int open_devices(struct fw *fw)
 				    fw->hal[i].why[0] ? fw->hal[i].why : "the device does not open");
 		fw->hal_open[i] = true;
 		if (fw->hal[i].info[0] && !fw->args.quiet)
-			printf("hal '%s': %s\n", fw->board.hal, fw->hal[i].info);
+			print_info(fw->board.hal, fw->hal[i].info);
+	}
+	return FW_EXIT_OK;
+}
+
+/* Enable the drives: last, once real time is set up and every thread runs
+ * (a drive's deadline must not see the set-up's silences). */
+static int start_devices(struct fw *fw)
+{
+	int rc;
+
+	for (unsigned i = 0; i < fw->board.devices; i++) {
 		rc = irdm_hal_start(&fw->hal[i]);
 		if (rc)
 			return fail(FW_EXIT_SETUP, rc, "hal '%s': %s", fw->board.hal,
@@ -194,9 +211,10 @@ static uint64_t run_ticks(const struct fw *fw)
 
 static int start(struct fw *fw)
 {
-	struct sigaction sa;
 	int rc;
 
+	if (fw_signals_arm(fw, &signalled))
+		return fail(FW_EXIT_SETUP, IRDM_EIO, "%s%s", "", "cannot install the signal handlers");
 	rc = open_inputs(fw);
 	if (!rc)
 		rc = open_devices(fw);
@@ -217,10 +235,6 @@ static int start(struct fw *fw)
 	rc = fw_log_open(fw);
 	if (rc)
 		return fail(FW_EXIT_SETUP, rc, "%s: %s", fw->args.log ? fw->args.log : "log", fw->err);
-	memset(&sa, 0, sizeof(sa));
-	sa.sa_handler = on_signal;
-	sigaction(SIGINT, &sa, NULL);
-	sigaction(SIGTERM, &sa, NULL);
 	rc = setup_realtime(fw);
 	if (rc)
 		return rc;
@@ -228,7 +242,7 @@ static int start(struct fw *fw)
 	rc = fw_frame_start(fw);
 	if (rc)
 		return fail(FW_EXIT_SETUP, rc, "%s%s", "", fw->err);
-	return FW_EXIT_OK;
+	return start_devices(fw);
 }
 
 /* Torque off first, then everything else.  The frame (--frame-at) is
@@ -239,7 +253,7 @@ static int stop(struct fw *fw, int rc)
 		if (fw->hal_open[i])
 			irdm_hal_safe_off(&fw->hal[i]);
 	fw_frame_stop(fw);
-	if (rc == FW_EXIT_OK || rc == FW_EXIT_FAULT) {
+	if (rc == FW_EXIT_OK || rc == FW_EXIT_FAULT || rc == FW_EXIT_NEVER_ENABLED) {
 		int wrc = fw_frame_write(fw);
 		/* a fault's exit code says more than the frame it cut short */
 		if (wrc && fail(FW_EXIT_SETUP, wrc, "%s%s", "", fw->err) && rc == FW_EXIT_OK)
@@ -248,6 +262,8 @@ static int stop(struct fw *fw, int rc)
 		if (wrc && fail(FW_EXIT_SETUP, wrc, "%s%s", "", fw->err) && rc == FW_EXIT_OK)
 			rc = FW_EXIT_SETUP;
 	}
+	/* the torque is off: the emergency path must not touch what closes */
+	fw_signals_disarm();
 	for (unsigned i = 0; i < IRDM_BOARD_DEVICES_MAX; i++) {
 		if (fw->hal_open[i])
 			irdm_hal_close(&fw->hal[i]);
@@ -259,6 +275,33 @@ static int stop(struct fw *fw, int rc)
 	fw_frame_free(fw);
 	irdm_session_close(fw->s);
 	return rc;
+}
+
+/* The one line a run that did not end as asked for leaves on stderr. */
+static void say_end(struct fw *fw, int rc)
+{
+	switch (rc) {
+	case FW_EXIT_SIGNAL:
+		fprintf(stderr, "irdm-fw: stopped by %s (signal %d) at tick %llu: torque off, state off\n",
+			fw_signal_name((int)signalled), (int)signalled, (unsigned long long)fw->ticks);
+		break;
+	case FW_EXIT_FAULT:
+		fprintf(stderr, "irdm-fw: EFAULT: fault %s at tick %llu: torque off%s%s\n",
+			irdm_safety_fault_name(fw->last_cause), (unsigned long long)fw->ticks,
+			fw_hal_why(fw)[0] ? ": " : "", fw_hal_why(fw));
+		break;
+	case FW_EXIT_NEVER_ENABLED:
+		if (fw->enable_blocked)
+			fprintf(stderr, "irdm-fw: EPERM: the torque was never enabled in %llu ticks: "
+				"'%s' refused every request\n", (unsigned long long)fw->ticks,
+				irdm_safety_fault_name(fw->enable_blocked));
+		else
+			fprintf(stderr, "irdm-fw: EPERM: the torque was never enabled in %llu ticks: "
+				"the device was never calibrated\n", (unsigned long long)fw->ticks);
+		break;
+	default:
+		break;
+	}
 }
 
 int main(int argc, char **argv)
@@ -282,15 +325,11 @@ int main(int argc, char **argv)
 	rc = start(fw);
 	if (!rc) {
 		rc = fw_loop_run(fw, &signalled);
-		if (signalled)
-			fprintf(stderr, "irdm-fw: stopped by signal %d: torque off\n", (int)signalled);
-		else if (rc == FW_EXIT_FAULT)
-			fprintf(stderr, "irdm-fw: EFAULT: fault %s at tick %llu: torque off%s%s\n",
-				irdm_safety_fault_name(fw->last_cause), (unsigned long long)fw->ticks,
-				fw_hal_why(fw)[0] ? ": " : "", fw_hal_why(fw));
+		say_end(fw, rc);
 	}
 	rc = stop(fw, rc);
-	if ((rc == FW_EXIT_OK || rc == FW_EXIT_FAULT) && !fw->args.quiet)
+	if ((rc == FW_EXIT_OK || rc == FW_EXIT_FAULT || rc == FW_EXIT_NEVER_ENABLED) &&
+	    !fw->args.quiet)
 		fw_summary_print(fw);
 	fw_trace_free(&fw->trace);
 	free(fw);

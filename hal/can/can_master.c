@@ -48,6 +48,26 @@ static int send_sync(struct irdm_can_master *m)
 	return put(m, &f);
 }
 
+/*
+ * The master's own heartbeat (operational), every heartbeat_ms counted in
+ * periods, from the first cycle on: each drive consumes it (0x1016) and
+ * stops by itself when it goes quiet.  The set-up sends none: a drive's
+ * watch starts at the first beat it hears, when the cycle does.
+ */
+static int beat(struct irdm_can_master *m)
+{
+	uint64_t every = (uint64_t)m->cfg.heartbeat_ms * 1000u / m->cfg.period_us;
+	struct irdm_can_frame f = { .id = IRDM_CO_HEARTBEAT + m->cfg.master_node, .dlc = 1 };
+
+	if (every == 0)
+		every = 1;
+	if (m->period % every)
+		return IRDM_OK;
+	f.data[0] = IRDM_CO_STATE_OPERATIONAL;
+	m->beats++;
+	return put(m, &f);
+}
+
 /* Disable voltage and zero torque to every axis, then a SYNC so
  * synchronous drives act on it now.  IRDM_OK, or the first send error. */
 static int send_off(struct irdm_can_master *m)
@@ -63,6 +83,21 @@ static int send_off(struct irdm_can_master *m)
 	}
 	r = send_sync(m);
 	return rc ? rc : r;
+}
+
+int irdm_can_master_emergency_off(const struct irdm_can_master *m)
+{
+	struct irdm_can_frame f;
+	int rc = IRDM_OK;
+
+	for (unsigned k = 0; k < m->cfg.n_axes; k++)
+		if (irdm_can_send(&m->port, &m->off[k]) != IRDM_OK)
+			rc = IRDM_EHW;
+	/* a counter the drives accept: the one after the last sent */
+	irdm_co_sync(&f, m->cfg.sync_counter ? m->sync_count % IRDM_CAN_SYNC_COUNTER_MAX + 1 : 0);
+	if (irdm_can_send(&m->port, &f) != IRDM_OK)
+		rc = IRDM_EHW;
+	return rc;
 }
 
 void irdm_can_master_lose(struct irdm_can_master *m, int axis, const char *reason)
@@ -308,6 +343,8 @@ int irdm_can_master_send(struct irdm_can_master *m, const double *tau_joint_nm)
 		if (rc == IRDM_OK)
 			rc = send_sync(m);
 	}
+	if (rc == IRDM_OK)
+		rc = beat(m);
 	m->period++;
 	if (rc != IRDM_OK && !m->faulted)
 		irdm_can_master_lose(m, -1, "link down (bus-off or interface gone) on send");
@@ -319,6 +356,14 @@ void irdm_can_master_enable(struct irdm_can_master *m, bool on)
 	m->enable = on && !m->faulted;
 	for (unsigned k = 0; k < m->cfg.n_axes; k++)
 		m->ax[k].was_enabled = false;
+}
+
+int irdm_can_master_first_stale(const struct irdm_can_master *m)
+{
+	for (unsigned k = 0; k < m->cfg.n_axes; k++)
+		if (!m->ax[k].fresh)
+			return (int)k;
+	return -1;
 }
 
 int irdm_can_master_first_not_enabled(const struct irdm_can_master *m)

@@ -24,6 +24,10 @@
 static const uint32_t rpdo1_map[PDO_ENTRIES] = { 0x60400010, 0x60710010 };
 static const uint32_t tpdo1_map[PDO_ENTRIES] = { 0x60410010, 0x60640020 };
 #define PDO_NOT_VALID 0x80000000u       /* COB-ID bit 31 */
+#define PDO_NO_RTR 0x40000000u          /* COB-ID bit 30: no remote request (RTR) */
+#define CIA402_PROFILE 0x0192u          /* 0x1000's low 16 bits for a drive */
+#define ABORT_FAULT 1                   /* 0x6007 values (CiA 402) */
+#define ABORT_DISABLE_VOLTAGE 2
 #define PDO_SYNC_EVERY 1                /* transmission type: synchronous, every SYNC */
 
 unsigned irdm_can_master_cycle_bits(const struct irdm_can_master_cfg *cfg)
@@ -90,6 +94,13 @@ int irdm_can_master_check(const struct irdm_can_master_cfg *cfg, char *err, size
 		return refuse(err, errlen, "heartbeat_timeout_ms", "must exceed heartbeat_ms");
 	if (cfg->tpdo_missing_periods == 0)
 		return refuse(err, errlen, "tpdo_missing_periods", "must be > 0");
+	if (cfg->master_node < IRDM_CO_NODE_MIN || cfg->master_node > IRDM_CO_NODE_MAX)
+		return refuse(err, errlen, "master_node", "1..127");
+	for (unsigned k = 0; k < cfg->n_axes; k++)
+		if (cfg->axis[k].node == cfg->master_node)
+			return refuse(err, errlen, "master_node", "is a drive's node id");
+	if (cfg->rpdo_timeout_ms == 0)
+		return refuse(err, errlen, "rpdo_timeout_ms", "must be > 0 (the drives' deadline)");
 	if (cfg->sdo_timeout_polls == 0 || !cfg->idle)
 		return refuse(err, errlen, "sdo_timeout", "must be > 0, with a wait");
 	bits = irdm_can_master_cycle_bits(cfg);
@@ -102,55 +113,73 @@ int irdm_can_master_check(const struct irdm_can_master_cfg *cfg, char *err, size
 	return IRDM_OK;
 }
 
-/* One object to write during set-up. */
+/* One object to read or write during set-up. */
+enum sdo_dir { SDO_WRITE, SDO_READ };
+
 struct sdo_item {
 	uint16_t index;
 	uint8_t sub;
-	uint8_t size;
-	uint32_t value;
+	uint8_t size;                   /* bytes written; a read takes what comes */
+	uint32_t value;                 /* written; a read's answer */
+	enum sdo_dir dir;
+	uint32_t skip_abort;            /* this abort means "no such object here": go on */
 };
+
+/* A write of size bytes of v to index:sub. */
+#define WR(i, s, z, v) { .index = (i), .sub = (s), .size = (z), .value = (v), .dir = SDO_WRITE }
 
 static void say_drive(const struct irdm_can_master *m, unsigned k, const struct sdo_item *it,
 		      char *err, size_t errlen, const char *what)
 {
-	snprintf(err, errlen, "drive %u (node %u): %s writing 0x%04X:%02X", k + 1,
-		 m->cfg.axis[k].node, what, it->index, it->sub);
+	snprintf(err, errlen, "drive %u (node %u): %s %s 0x%04X:%02X", k + 1, m->cfg.axis[k].node,
+		 what, it->dir == SDO_READ ? "reading" : "writing", it->index, it->sub);
 }
 
 /* The answer to it from drive k, or an error (err says which). */
-static int sdo_answer(struct irdm_can_master *m, unsigned k, const struct sdo_item *it,
-		      const struct irdm_can_frame *f, char *err, size_t errlen)
+static int sdo_answer(struct irdm_can_master *m, unsigned k, struct sdo_item *it,
+		      const struct irdm_can_frame *f, uint32_t *abort_code, char *err,
+		      size_t errlen)
 {
-	uint32_t value, abort_code = 0;
+	uint32_t value;
 	unsigned size;
 	char what[IRDM_CAN_WHY_MAX];
 	int rc = irdm_co_sdo_answer(f, m->cfg.axis[k].node, it->index, it->sub, &value, &size,
-				    &abort_code);
+				    abort_code);
 
-	if (rc == IRDM_OK && size == 0)
+	if (rc == IRDM_OK && (it->dir == SDO_READ) == (size != 0)) {
+		if (it->dir == SDO_READ)
+			it->value = value;
 		return IRDM_OK;
+	}
 	if (rc == IRDM_EHW) {
-		snprintf(what, sizeof(what), "SDO abort 0x%08X %s", (unsigned)abort_code,
-			 irdm_co_abort_name(abort_code));
+		snprintf(what, sizeof(what), "SDO abort 0x%08X %s", (unsigned)*abort_code,
+			 irdm_co_abort_name(*abort_code));
 	} else {
 		rc = IRDM_EFORMAT;
-		snprintf(what, sizeof(what),
-			 "malformed SDO answer %02X %02X %02X %02X (not a confirmation)", f->data[0],
-			 f->data[1], f->data[2], f->data[3]);
+		snprintf(what, sizeof(what), "malformed SDO answer %02X %02X %02X %02X (not %s)",
+			 f->data[0], f->data[1], f->data[2], f->data[3],
+			 it->dir == SDO_READ ? "an upload's answer" : "a confirmation");
 	}
 	say_drive(m, k, it, err, errlen, what);
 	return rc;
 }
 
-/* Write one object to drive k and wait (bounded) for its confirmation. */
-static int sdo_write(struct irdm_can_master *m, unsigned k, const struct sdo_item *it, char *err,
-		     size_t errlen)
+/*
+ * Read or write one object of drive k and wait (bounded) for the answer.
+ * *abort_code: the drive's abort, if it sent one (IRDM_EHW).
+ */
+static int sdo_transfer(struct irdm_can_master *m, unsigned k, struct sdo_item *it,
+			uint32_t *abort_code, char *err, size_t errlen)
 {
 	unsigned node = m->cfg.axis[k].node;
 	struct irdm_can_frame f;
 	int rc;
 
-	irdm_co_sdo_write(&f, node, it->index, it->sub, it->value, it->size);
+	*abort_code = 0;
+	if (it->dir == SDO_READ)
+		irdm_co_sdo_read(&f, node, it->index, it->sub);
+	else
+		irdm_co_sdo_write(&f, node, it->index, it->sub, it->value, it->size);
 	if (irdm_can_send(&m->port, &f) != IRDM_OK) {
 		say_drive(m, k, it, err, errlen, "CAN link down or queue full");
 		return IRDM_EIO;
@@ -159,7 +188,7 @@ static int sdo_write(struct irdm_can_master *m, unsigned k, const struct sdo_ite
 		m->cfg.idle(m->cfg.idle_ctx);
 		while ((rc = irdm_can_recv(&m->port, &f)) == 1)
 			if (f.id == IRDM_CO_SDO_TX + node)
-				return sdo_answer(m, k, it, &f, err, errlen);
+				return sdo_answer(m, k, it, &f, abort_code, err, errlen);
 			else
 				(void)irdm_can_master_take(m, &f);
 		if (rc < 0) {
@@ -171,49 +200,174 @@ static int sdo_write(struct irdm_can_master *m, unsigned k, const struct sdo_ite
 	return IRDM_ETIMEDOUT;
 }
 
+/* Run items in order; an abort a item names as "absent" is passed over
+ * (and counted in *skipped, the bits of the items skipped). */
+static int sdo_run(struct irdm_can_master *m, unsigned k, struct sdo_item *items, size_t n,
+		   uint32_t *skipped, char *err, size_t errlen)
+{
+	uint32_t abort_code;
+
+	for (size_t i = 0; i < n; i++) {
+		int rc = sdo_transfer(m, k, &items[i], &abort_code, err, errlen);
+
+		if (rc == IRDM_EHW && items[i].skip_abort && abort_code == items[i].skip_abort) {
+			*skipped |= 1u << i;
+			continue;
+		}
+		if (rc)
+			return rc;
+	}
+	return IRDM_OK;
+}
+
 /*
  * A PDO's mapping the way CiA 301 lets it change (most drives refuse a
  * mapping write otherwise): switch the PDO off (COB-ID bit 31), empty the
  * mapping (sub 0 = 0), write the entries, set their number, make it
- * synchronous (transmission type 1: every SYNC), switch it on again.
- * Return: the items written into it (PDO_ITEMS).
+ * synchronous (transmission type 1: every SYNC), give an RPDO its deadline
+ * (event timer :05), switch it on again.  cob_id carries bit 30 (no RTR)
+ * for a TPDO.  Return: the items written into it.
  */
-#define PDO_ITEMS (5 + PDO_ENTRIES)
+#define PDO_ITEMS_MAX (6 + PDO_ENTRIES)
 
 static size_t pdo_items(struct sdo_item *it, uint16_t comm_index, uint16_t map_index,
-			uint32_t cob_id, const uint32_t map[PDO_ENTRIES])
+			uint32_t cob_id, const uint32_t map[PDO_ENTRIES], uint16_t deadline_ms)
 {
 	size_t n = 0;
 
-	it[n++] = (struct sdo_item){ comm_index, 1, 4, cob_id | PDO_NOT_VALID };
-	it[n++] = (struct sdo_item){ map_index, 0, 1, 0 };
+	it[n++] = (struct sdo_item)WR(comm_index, 1, 4, cob_id | PDO_NOT_VALID);
+	it[n++] = (struct sdo_item)WR(map_index, 0, 1, 0);
 	for (uint8_t e = 0; e < PDO_ENTRIES; e++)
-		it[n++] = (struct sdo_item){ map_index, (uint8_t)(e + 1), 4, map[e] };
-	it[n++] = (struct sdo_item){ map_index, 0, 1, PDO_ENTRIES };
-	it[n++] = (struct sdo_item){ comm_index, 2, 1, PDO_SYNC_EVERY };
-	it[n++] = (struct sdo_item){ comm_index, 1, 4, cob_id };
+		it[n++] = (struct sdo_item)WR(map_index, (uint8_t)(e + 1), 4, map[e]);
+	it[n++] = (struct sdo_item)WR(map_index, 0, 1, PDO_ENTRIES);
+	it[n++] = (struct sdo_item)WR(comm_index, 2, 1, PDO_SYNC_EVERY);
+	if (deadline_ms)
+		it[n++] = (struct sdo_item)WR(comm_index, 5, 2, deadline_ms);
+	it[n++] = (struct sdo_item)WR(comm_index, 1, 4, cob_id);
 	return n;
+}
+
+/* 0x1000 and 0x1018: a CiA 402 drive, and which one. */
+static int identify(struct irdm_can_master *m, unsigned k, char *err, size_t errlen)
+{
+	struct sdo_item items[5] = {
+		{ .index = 0x1000, .dir = SDO_READ },
+		{ .index = 0x1018, .sub = 1, .dir = SDO_READ },
+		{ .index = 0x1018, .sub = 2, .dir = SDO_READ },
+		{ .index = 0x1018, .sub = 3, .dir = SDO_READ },
+		{ .index = 0x1018, .sub = 4, .dir = SDO_READ },
+	};
+	uint32_t skipped = 0;
+	int rc = sdo_run(m, k, items, 5, &skipped, err, errlen);
+
+	if (rc)
+		return rc;
+	m->ax[k].device_type = items[0].value;
+	for (unsigned i = 0; i < 4; i++)
+		m->ax[k].identity[i] = items[1 + i].value;
+	if ((items[0].value & 0xFFFFu) != CIA402_PROFILE) {
+		snprintf(err, errlen, "drive %u (node %u): device type 0x%08X (0x1000) is not a "
+			 "CiA 402 drive (profile 0x%04X, not 0x%04X)", k + 1, m->cfg.axis[k].node,
+			 (unsigned)items[0].value, (unsigned)(items[0].value & 0xFFFFu),
+			 CIA402_PROFILE);
+		return IRDM_ENOTSUP;
+	}
+	return IRDM_OK;
+}
+
+/*
+ * The SYNC format and the drive's watch on the master, in the order CiA
+ * 301 allows: 0x1019 (the counter's overflow, 0 for a SYNC without one)
+ * may change only while 0x1006 (the cycle period) is 0, so 0x1006 = 0,
+ * then 0x1019, then 0x1006 = the period (the drive's SYNC monitor).  A
+ * drive without 0x1006 (abort 0x06020000) has no monitor to stop; without
+ * 0x1019 it takes only SYNCs without a counter.  Then the master's
+ * heartbeat as the drive's consumer entry 0x1016:01 (node << 16 | ms, the
+ * same tolerance the master gives the drives', at most 65535 ms).
+ */
+static size_t sync_items(const struct irdm_can_master *m, struct sdo_item *it)
+{
+	uint32_t hb_ms = m->cfg.heartbeat_timeout_ms > 0xFFFF ? 0xFFFF : m->cfg.heartbeat_timeout_ms;
+	size_t n = 0;
+
+	it[n] = (struct sdo_item)WR(0x1006, 0, 4, 0);
+	it[n++].skip_abort = 0x06020000;
+	it[n] = (struct sdo_item)WR(0x1019, 0, 1, m->cfg.sync_counter ? IRDM_CAN_SYNC_COUNTER_MAX : 0);
+	it[n++].skip_abort = m->cfg.sync_counter ? 0 : 0x06020000;
+	it[n] = (struct sdo_item)WR(0x1006, 0, 4, m->cfg.period_us);
+	it[n++].skip_abort = 0x06020000;
+	it[n++] = (struct sdo_item)WR(0x1016, 1, 4, (uint32_t)m->cfg.master_node << 16 | hb_ms);
+	return n;
+}
+
+/*
+ * 0x6007, the drive's reaction to a lost master (a heartbeat or an RPDO
+ * deadline missed): disable voltage, the torque off at once whatever
+ * 0x605E says; a drive that takes only the default (abort 0x06090030)
+ * gets "fault" (1), which also ends in no torque.
+ */
+static int abort_option(struct irdm_can_master *m, unsigned k, char *err, size_t errlen)
+{
+	struct sdo_item it = WR(0x6007, 0, 2, ABORT_DISABLE_VOLTAGE);
+	uint32_t abort_code;
+	int rc = sdo_transfer(m, k, &it, &abort_code, err, errlen);
+
+	if (rc == IRDM_EHW && abort_code == 0x06090030) {
+		it.value = ABORT_FAULT;
+		rc = sdo_transfer(m, k, &it, &abort_code, err, errlen);
+	}
+	m->ax[k].abort_option = (uint16_t)it.value;
+	return rc;
 }
 
 static int configure_drive(struct irdm_can_master *m, unsigned k, char *err, size_t errlen)
 {
 	unsigned node = m->cfg.axis[k].node;
-	struct sdo_item items[3 + 2 * PDO_ITEMS] = {
-		{ 0x6060, 0, 1, MODE_CST },
-		{ 0x1017, 0, 2, m->cfg.heartbeat_ms },
-		{ 0x6076, 0, 4, m->cfg.axis[k].rated_torque_mnm },
+	struct sdo_item items[3 + 4 + 2 * PDO_ITEMS_MAX] = {
+		WR(0x6060, 0, 1, MODE_CST),
+		WR(0x1017, 0, 2, m->cfg.heartbeat_ms),
+		WR(0x6076, 0, 4, m->cfg.axis[k].rated_torque_mnm),
 	};
+	struct sdo_item mode = { .index = 0x6061, .dir = SDO_READ };
+	uint32_t skipped = 0;
 	size_t n = 3;
+	int rc = identify(m, k, err, errlen);
 
-	n += pdo_items(items + n, 0x1400, 0x1600, IRDM_CO_RPDO1 + node, rpdo1_map);
-	n += pdo_items(items + n, 0x1800, 0x1A00, IRDM_CO_TPDO1 + node, tpdo1_map);
-	for (size_t i = 0; i < n; i++) {
-		int rc = sdo_write(m, k, &items[i], err, errlen);
-
-		if (rc)
-			return rc;
+	if (rc)
+		return rc;
+	n += sync_items(m, items + n);
+	rc = sdo_run(m, k, items, n, &skipped, err, errlen);
+	if (!rc)
+		rc = abort_option(m, k, err, errlen);
+	if (rc)
+		return rc;
+	n = pdo_items(items, 0x1400, 0x1600, IRDM_CO_RPDO1 + node, rpdo1_map,
+		      m->cfg.rpdo_timeout_ms);
+	n += pdo_items(items + n, 0x1800, 0x1A00, PDO_NO_RTR | (IRDM_CO_TPDO1 + node), tpdo1_map, 0);
+	n += 1;
+	items[n - 1] = mode;
+	rc = sdo_run(m, k, items, n, &skipped, err, errlen);
+	if (rc)
+		return rc;
+	/* the mode the drive runs, read back: a drive may keep another */
+	if ((uint8_t)items[n - 1].value != MODE_CST) {
+		snprintf(err, errlen, "drive %u (node %u): mode of operation display 0x6061 is %d, "
+			 "not 10 (cyclic synchronous torque)", k + 1, node,
+			 (int8_t)items[n - 1].value);
+		return IRDM_ENOTSUP;
 	}
 	return IRDM_OK;
+}
+
+void irdm_can_master_identity_line(const struct irdm_can_master *m, unsigned k, char *line,
+				   size_t len)
+{
+	const struct irdm_can_master_axis *a = &m->ax[k];
+
+	snprintf(line, len, "drive %u (node %u): CiA 402 device type 0x%08X, vendor 0x%08X, "
+		 "product 0x%08X, revision 0x%08X, serial 0x%08X", k + 1, m->cfg.axis[k].node,
+		 (unsigned)a->device_type, (unsigned)a->identity[0], (unsigned)a->identity[1],
+		 (unsigned)a->identity[2], (unsigned)a->identity[3]);
 }
 
 int irdm_can_master_init(struct irdm_can_master *m, const struct irdm_can_port *port,
@@ -228,8 +382,10 @@ int irdm_can_master_init(struct irdm_can_master *m, const struct irdm_can_port *
 		return rc;
 	m->cfg = *cfg;
 	m->port = *port;
-	for (unsigned k = 0; k < cfg->n_axes; k++)
+	for (unsigned k = 0; k < cfg->n_axes; k++) {
 		m->ax[k].state = IRDM_CIA402_UNKNOWN;
+		irdm_co_rpdo_cst(&m->off[k], cfg->axis[k].node, IRDM_CIA402_CW_DISABLE_VOLTAGE, 0);
+	}
 	for (unsigned k = 0; k < cfg->n_axes; k++) {
 		rc = configure_drive(m, k, err, errlen);
 		if (rc)

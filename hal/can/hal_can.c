@@ -49,6 +49,10 @@ static int master_cfg(struct irdm_hal_dev *dev, const struct irdm_hal_can_opts *
 	mc->heartbeat_ms = o->heartbeat_ms;
 	mc->heartbeat_timeout_ms = o->heartbeat_timeout_ms;
 	mc->tpdo_missing_periods = o->tpdo_missing_periods;
+	mc->master_node = o->master_node;
+	/* the drive's deadline: the option, else three periods in whole ms */
+	mc->rpdo_timeout_ms = (uint16_t)(o->rpdo_timeout_ms ? o->rpdo_timeout_ms
+							    : (3u * period_us + 999u) / 1000u);
 	mc->sdo_timeout_polls = (unsigned)((o->sdo_timeout_ms * 1000ull + period_us - 1) / period_us);
 	mc->idle = can_of(dev)->link->idle;
 	mc->idle_ctx = dev;
@@ -87,6 +91,13 @@ int irdm_hal_can_open(struct irdm_hal_dev *dev, const struct irdm_hal_can_link *
 		link->close(dev);
 		return rc;
 	}
+	for (unsigned k = 0; k < c->m.cfg.n_axes; k++) {
+		size_t used = strlen(dev->info);
+
+		dev->info[used] = '\n';
+		irdm_can_master_identity_line(&c->m, k, dev->info + used + 1,
+					      sizeof(dev->info) - used - 1);
+	}
 	c->written = false;
 	c->seq = 0;
 	c->state = HAL_CAN_OPEN;
@@ -118,19 +129,63 @@ static void send_hold(struct irdm_hal_dev *dev)
 	pump(dev);
 }
 
+/*
+ * The cycle with every drive held at disable voltage until each has
+ * answered IRDM_HAL_CAN_STEADY_PERIODS SYNCs in a row: the drives'
+ * deadlines (RPDO, the master's heartbeat) start with this exchange, and
+ * the enable sequence comes only once it runs steadily.  Return: the
+ * periods it took, or periods + 1 if it never did (or a fault).
+ */
+static unsigned steady(struct irdm_hal_dev *dev, unsigned periods)
+{
+	struct irdm_hal_can *c = can_of(dev);
+	unsigned p, run = 0;
+
+	irdm_can_master_enable(&c->m, false);
+	for (p = 0; p < periods && run < IRDM_HAL_CAN_STEADY_PERIODS; p++) {
+		int rc;
+
+		send_hold(dev);
+		c->link->idle(dev);
+		rc = receive(dev);
+		if (rc == IRDM_EHW)
+			return periods + 1;
+		run = rc == IRDM_OK ? run + 1 : 0;
+	}
+	return run < IRDM_HAL_CAN_STEADY_PERIODS ? periods + 1 : p;
+}
+
 int irdm_hal_can_start(struct irdm_hal_dev *dev)
 {
 	struct irdm_hal_can *c = can_of(dev);
 	unsigned periods = (unsigned)((c->opts.enable_timeout_ms * 1000ull + c->m.cfg.period_us - 1) /
 				      c->m.cfg.period_us);
+	unsigned used;
 	int k;
 
 	if (c->state == HAL_CAN_CLOSED)
 		return IRDM_EINVAL;
 	if (c->m.faulted)
 		return faulted(dev);
+	used = steady(dev, periods);
+	if (c->m.faulted)
+		return faulted(dev);
+	if (used > periods) {
+		k = irdm_can_master_first_stale(&c->m);
+		if (k >= 0)
+			snprintf(dev->why, sizeof(dev->why), "drive %d (node %u): no TPDO1 to the "
+				 "disabled SYNCs before enabling (%u ms)", k + 1,
+				 c->m.cfg.axis[k].node, (unsigned)c->opts.enable_timeout_ms);
+		else
+			snprintf(dev->why, sizeof(dev->why), "CAN: fewer than %d SYNCs answered in "
+				 "a row before enabling, within %u ms", IRDM_HAL_CAN_STEADY_PERIODS,
+				 (unsigned)c->opts.enable_timeout_ms);
+		irdm_can_master_safe_off(&c->m);
+		pump(dev);
+		return IRDM_ETIMEDOUT;
+	}
 	irdm_can_master_enable(&c->m, true);
-	for (unsigned p = 0; p < periods && !irdm_can_master_all_enabled(&c->m); p++) {
+	for (unsigned p = used; p < periods && !irdm_can_master_all_enabled(&c->m); p++) {
 		send_hold(dev);
 		c->link->idle(dev);
 		if (receive(dev) == IRDM_EHW)
@@ -247,6 +302,15 @@ void irdm_hal_can_close(struct irdm_hal_dev *dev)
 	pump(dev);
 	c->link->close(dev);
 	c->state = HAL_CAN_CLOSED;
+}
+
+int irdm_hal_can_emergency_off(struct irdm_hal_dev *dev)
+{
+	struct irdm_hal_can *c = can_of(dev);
+
+	if (c->state == HAL_CAN_CLOSED)
+		return IRDM_OK;
+	return irdm_can_master_emergency_off(&c->m);
 }
 
 void irdm_hal_can_reset_faults(struct irdm_hal_dev *dev)

@@ -17,6 +17,8 @@ static void defaults(struct irdm_hal_can_opts *o)
 	o->sdo_timeout_ms = 100;
 	o->enable_timeout_ms = 100;
 	o->substeps = 10;
+	o->master_node = 127;
+	o->rpdo_timeout_ms = 0;         /* 0: three periods, rounded up to ms */
 }
 
 static int bad(char *err, size_t errlen, const char *key, const char *why)
@@ -80,6 +82,8 @@ static const struct scalar scalars[] = {
 	{ "sdo_timeout_ms", 1, 60000, "1..60000 ms" },
 	{ "enable_timeout_ms", 1, 60000, "1..60000 ms" },
 	{ "substeps", 1, 100, "1..100" },
+	{ "master_node", 1, 127, "1..127" },
+	{ "rpdo_timeout_ms", 1, 65535, "1..65535 ms" },
 };
 
 static void store_scalar(struct irdm_hal_can_opts *o, size_t i, uint32_t v)
@@ -91,7 +95,9 @@ static void store_scalar(struct irdm_hal_can_opts *o, size_t i, uint32_t v)
 	case 3: o->tpdo_missing_periods = v; break;
 	case 4: o->sdo_timeout_ms = v; break;
 	case 5: o->enable_timeout_ms = v; break;
-	default: o->substeps = v; break;
+	case 6: o->substeps = v; break;
+	case 7: o->master_node = v; break;
+	default: o->rpdo_timeout_ms = v; break;
 	}
 }
 
@@ -198,5 +204,8 @@ int irdm_hal_can_parse(const char *options, unsigned extra, struct irdm_hal_can_
 		return bad(err, errlen, "rated_torque_mnm", "missing (the drives' rated torque)");
 	if (o->heartbeat_timeout_ms <= o->heartbeat_ms)
 		return bad(err, errlen, "heartbeat_timeout_ms", "must exceed heartbeat_ms");
+	for (unsigned k = 0; k < o->n_nodes; k++)
+		if (o->nodes[k] == o->master_node)
+			return bad(err, errlen, "master_node", "is a drive's node id");
 	return IRDM_OK;
 }

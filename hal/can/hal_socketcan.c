@@ -71,7 +71,7 @@ static int socketcan_open(struct irdm_hal_dev *dev)
 	return irdm_hal_can_open(dev, &socketcan_link, IRDM_HAL_CAN_IFACE);
 }
 
-static const struct irdm_hal_ops socketcan_ops = IRDM_HAL_CAN_OPS(socketcan_open);
+static const struct irdm_hal_ops socketcan_ops = IRDM_HAL_CAN_OPS(socketcan_open, irdm_hal_can_emergency_off);
 
 const struct irdm_hal_backend irdm_hal_socketcan_backend = {
 	.name = "socketcan",

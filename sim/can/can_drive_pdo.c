@@ -14,6 +14,8 @@
 void irdm_can_pdo_boot(struct irdm_can_pdo *p, uint32_t id, const uint32_t *map)
 {
 	p->cob_id = id;
+	p->no_rtr = (id & IRDM_CAN_PDO_NO_RTR) != 0;
+	p->event_timer_ms = 0;
 	p->transmission = IRDM_CAN_PDO_ASYNC;
 	p->n_mapped = IRDM_CAN_PDO_ENTRIES;
 	p->map = map;
@@ -33,8 +35,11 @@ uint32_t irdm_can_pdo_write_comm(struct irdm_can_pdo *p, uint8_t sub, uint32_t v
 	case 1:
 		if (size != 4)
 			return AB_LENGTH;
-		/* the identifier is the default one: only bit 31 may change */
-		if ((v & ~IRDM_CAN_PDO_INVALID) != (p->cob_id & ~IRDM_CAN_PDO_INVALID))
+		/* the identifier is the default one (11 bits, not extended) */
+		if ((v & (IRDM_CAN_PDO_EXTENDED | 0x1FFFFFFFu)) != (p->cob_id & 0x7FFu))
+			return AB_INVALID_VALUE;
+		/* no RTR served: a TPDO that would allow it is refused */
+		if (p->no_rtr && !(v & IRDM_CAN_PDO_NO_RTR))
 			return AB_INVALID_VALUE;
 		p->cob_id = v;
 		return 0;
@@ -44,6 +49,11 @@ uint32_t irdm_can_pdo_write_comm(struct irdm_can_pdo *p, uint8_t sub, uint32_t v
 		if (v != IRDM_CAN_PDO_SYNC_EVERY)
 			return AB_INVALID_VALUE;
 		p->transmission = (uint8_t)v;
+		return 0;
+	case 5:
+		if (size != 2)
+			return AB_LENGTH;
+		p->event_timer_ms = (uint16_t)v;
 		return 0;
 	default:
 		return AB_NO_SUB;

@@ -7,6 +7,16 @@
 #include "irdm/error.h"
 
 #define MODE_CST 10
+#define DEVICE_TYPE 0x00020192u         /* 0x1000: CiA 402 (0x0192), servo drive */
+#define VENDOR_ID 0x00000000u           /* 0x1018:01: none registered (an emulator) */
+#define PRODUCT_CODE 0x00000402u
+#define REVISION 0x00010000u
+#define ABORT_FAULT 1                   /* 0x6007 (CiA 402): its default */
+#define ABORT_DISABLE_VOLTAGE 2
+#define ABORT_QUICK_STOP 3
+#define EMCY_SYNC_LENGTH 0x8240u        /* unexpected SYNC data length */
+#define EMCY_HEARTBEAT 0x8130u          /* heartbeat (life guard) lost */
+#define EMCY_RPDO_TIMEOUT 0x8250u       /* RPDO time-out */
 /* the CST mapping the master writes: RPDO1 0x6040 + 0x6071, TPDO1 0x6041 + 0x6064 */
 static const uint32_t rpdo_map[IRDM_CAN_PDO_ENTRIES] = { 0x60400010, 0x60710010 };
 static const uint32_t tpdo_map[IRDM_CAN_PDO_ENTRIES] = { 0x60410010, 0x60640020 };
@@ -35,9 +45,90 @@ static void boot(struct irdm_can_drives *dr, struct irdm_can_drive *d)
 	irdm_cia402_drive_init(&d->fsa);
 	/* a reset restores the communication objects from the stored configuration */
 	irdm_can_pdo_boot(&d->rpdo1, IRDM_CO_RPDO1 + d->node, rpdo_map);
-	irdm_can_pdo_boot(&d->tpdo1, IRDM_CO_TPDO1 + d->node, tpdo_map);
+	irdm_can_pdo_boot(&d->tpdo1, IRDM_CAN_PDO_NO_RTR | (IRDM_CO_TPDO1 + d->node), tpdo_map);
 	d->rpdo_cw = 0;
 	d->rpdo_torque_permille = 0;
+	d->cycle_us = 0;
+	d->sync_overflow = 0;
+	d->hb_consumer = 0;
+	d->abort_option = ABORT_FAULT;
+	d->master_beat_seen = false;
+	d->rpdo_seen = false;
+	d->lost_code = 0;
+}
+
+/* The clock the deadlines run on: the heartbeats' (SYNCs' or the wall's). */
+static uint64_t deadline_now(const struct irdm_can_drives *dr)
+{
+	return dr->wall_heartbeat ? dr->wall_us : dr->now_us;
+}
+
+/*
+ * The connection to the master is lost (code: which deadline): say so by
+ * EMCY (bytes 3-4: the torque applied from now on, per mille) and take
+ * the reaction 0x6007 names; all but "none" zero the torque at once.
+ */
+static void connection_lost(struct irdm_can_drives *dr, struct irdm_can_drive *d, uint16_t code)
+{
+	struct irdm_can_frame f = { .id = IRDM_CO_EMCY + d->node, .dlc = 8 };
+	uint16_t cw = d->rpdo_cw;
+
+	d->lost_code = code;
+	d->lost_at_us = deadline_now(dr);
+	switch (d->abort_option) {
+	case ABORT_FAULT:
+		irdm_cia402_drive_fault(&d->fsa);
+		irdm_cia402_drive_settle(&d->fsa);
+		cw = IRDM_CIA402_CW_DISABLE_VOLTAGE;
+		break;
+	case ABORT_DISABLE_VOLTAGE:
+		cw = IRDM_CIA402_CW_DISABLE_VOLTAGE;
+		irdm_cia402_drive_command(&d->fsa, cw);
+		break;
+	case ABORT_QUICK_STOP:
+		cw = IRDM_CIA402_CW_QUICK_STOP;
+		irdm_cia402_drive_command(&d->fsa, cw);
+		break;
+	default:
+		break;                          /* 0: no reaction, the torque stays */
+	}
+	if (d->abort_option != 0) {
+		d->rpdo_cw = cw;
+		d->rpdo_torque_permille = 0;
+	}
+	f.data[0] = (uint8_t)code;
+	f.data[1] = (uint8_t)(code >> 8);
+	f.data[2] = 0x11;                       /* error register: generic + communication */
+	f.data[3] = (uint8_t)(uint16_t)d->rpdo_torque_permille;
+	f.data[4] = (uint8_t)((uint16_t)d->rpdo_torque_permille >> 8);
+	send(dr, &f);
+}
+
+/* The master's heartbeat and RPDO1 deadlines of drive d at now_us; the
+ * next time one falls due (UINT64_MAX: none). */
+static uint64_t watch(struct irdm_can_drives *dr, struct irdm_can_drive *d, uint64_t now_us)
+{
+	uint64_t hb_us = 1000ull * (d->hb_consumer & 0xFFFFu), ev_us = 1000ull * d->rpdo1.event_timer_ms;
+	uint64_t next = UINT64_MAX;
+
+	if (d->lost_code || d->nmt == IRDM_CO_STATE_STOPPED)
+		return next;
+	if (hb_us && d->master_beat_seen) {
+		if (now_us > d->master_beat_us + hb_us) {
+			connection_lost(dr, d, EMCY_HEARTBEAT);
+			return next;
+		}
+		next = d->master_beat_us + hb_us + 1;
+	}
+	if (ev_us && d->rpdo_seen && d->nmt == IRDM_CO_STATE_OPERATIONAL) {
+		if (now_us > d->rpdo_us + ev_us) {
+			connection_lost(dr, d, EMCY_RPDO_TIMEOUT);
+			return UINT64_MAX;
+		}
+		if (d->rpdo_us + ev_us + 1 < next)
+			next = d->rpdo_us + ev_us + 1;
+	}
+	return next;
 }
 
 int irdm_can_drives_init(struct irdm_can_drives *dr, const struct irdm_can_port *port,
@@ -115,9 +206,52 @@ static uint32_t object_read(struct irdm_can_drives *dr, struct irdm_can_drive *d
 {
 	int32_t counts[3] = { 0, 0, 0 };
 
+	if (index == 0x1018) {
+		static const uint32_t identity[5] = { 4, VENDOR_ID, PRODUCT_CODE, REVISION, 0 };
+
+		if (sub > 4)
+			return 0x06090011;
+		*v = sub == 4 ? d->node : identity[sub], *size = sub == 0 ? 1 : 4;
+		return 0;
+	}
+	if (index == 0x1400 || index == 0x1800) {
+		const struct irdm_can_pdo *p = index == 0x1400 ? &d->rpdo1 : &d->tpdo1;
+
+		switch (sub) {
+		case 1:
+			*v = p->cob_id, *size = 4;
+			return 0;
+		case 2:
+			*v = p->transmission, *size = 1;
+			return 0;
+		case 5:
+			*v = p->event_timer_ms, *size = 2;
+			return 0;
+		default:
+			return 0x06090011;
+		}
+	}
+	if (index == 0x1016) {
+		if (sub > 1)
+			return 0x06090011;
+		*v = sub == 0 ? 1 : d->hb_consumer, *size = sub == 0 ? 1 : 4;
+		return 0;
+	}
 	if (sub != 0)
 		return 0x06090011;
 	switch (index) {
+	case 0x1000:
+		*v = DEVICE_TYPE, *size = 4;
+		return 0;
+	case 0x1006:
+		*v = d->cycle_us, *size = 4;
+		return 0;
+	case 0x1019:
+		*v = d->sync_overflow, *size = 1;
+		return 0;
+	case 0x6007:
+		*v = (uint16_t)d->abort_option, *size = 2;
+		return 0;
 	case 0x6041:
 		*v = irdm_cia402_statusword(d->fsa.state), *size = 2;
 		return 0;
@@ -140,6 +274,22 @@ static uint32_t object_read(struct irdm_can_drives *dr, struct irdm_can_drive *d
 	}
 }
 
+/* 0x1016: one consumer entry (node << 16 | time ms; 0 off). */
+static uint32_t write_consumer(struct irdm_can_drive *d, uint8_t sub, uint32_t v, unsigned size)
+{
+	if (sub == 0)
+		return 0x06010002;
+	if (sub != 1)
+		return 0x06090011;
+	if (size != 4)
+		return 0x06070010;
+	if (v & 0xFF000000u || ((v >> 16) & 0xFF) > IRDM_CO_NODE_MAX)
+		return 0x06090030;
+	d->hb_consumer = v;
+	d->master_beat_seen = false;    /* runs from the next heartbeat heard */
+	return 0;
+}
+
 /* A download: the abort code, 0 when taken. */
 static uint32_t object_write(struct irdm_can_drive *d, uint16_t index, uint8_t sub, uint32_t v,
 			     unsigned size)
@@ -154,10 +304,38 @@ static uint32_t object_write(struct irdm_can_drive *d, uint16_t index, uint8_t s
 	case 0x1A00:
 		return irdm_can_pdo_write_map(&d->tpdo1, sub, v, size);
 	}
+	if (index == 0x1016)
+		return write_consumer(d, sub, v, size);
+	if (index == 0x1018 || index == 0x1000)
+		return 0x06010002;
 	if (sub != 0)
-		return index == 0x6060 || index == 0x1017 || index == 0x6076 ? 0x06090011
-									      : 0x06020000;
+		return index == 0x6060 || index == 0x1017 || index == 0x6076 || index == 0x1006 ||
+			       index == 0x1019 || index == 0x6007
+			       ? 0x06090011
+			       : 0x06020000;
 	switch (index) {
+	case 0x1006:
+		if (size != 4)
+			return 0x06070010;
+		d->cycle_us = v;
+		return 0;
+	case 0x1019:
+		if (size != 1)
+			return 0x06070010;
+		/* CiA 301: only while no cycle period is set */
+		if (d->cycle_us != 0)
+			return 0x08000022;
+		if (v == 1 || v > 240)
+			return 0x06090030;
+		d->sync_overflow = (uint8_t)v;
+		return 0;
+	case 0x6007:
+		if (size != 2)
+			return 0x06070010;
+		if ((int16_t)v < 0 || (int16_t)v > ABORT_QUICK_STOP)
+			return 0x06090030;      /* no vendor reactions here */
+		d->abort_option = (int16_t)v;
+		return 0;
 	case 0x6060:
 		if (size != 1)
 			return 0x06070010;
@@ -296,12 +474,38 @@ static void tpdo_out(struct irdm_can_drives *dr, struct irdm_can_drive *d,
 	dr->tpdos_sent++;
 }
 
+/*
+ * Does drive d take a SYNC of dlc bytes?  Its 0x1019 says the length; any
+ * other is answered as CiA 301 says: EMCY 0x8240, and the drive leaves
+ * operation for pre-operational (its PDOs stop).
+ */
+static bool sync_accepted(struct irdm_can_drives *dr, struct irdm_can_drive *d, uint8_t dlc)
+{
+	struct irdm_can_frame f = { .id = IRDM_CO_EMCY + d->node, .dlc = 8 };
+
+	if (dlc == (d->sync_overflow ? 1 : 0))
+		return true;
+	if (d->nmt == IRDM_CO_STATE_STOPPED)
+		return false;
+	dr->sync_length_errors++;
+	f.data[0] = (uint8_t)EMCY_SYNC_LENGTH;
+	f.data[1] = (uint8_t)(EMCY_SYNC_LENGTH >> 8);
+	f.data[2] = 0x11;                       /* error register: generic + communication */
+	f.data[3] = dlc;
+	send(dr, &f);
+	d->nmt = IRDM_CO_STATE_PRE_OPERATIONAL;
+	return false;
+}
+
 /* SYNC: sample and send TPDOs, apply the set-points, move the arm a period. */
-static void sync(struct irdm_can_drives *dr)
+static void sync(struct irdm_can_drives *dr, uint8_t dlc)
 {
 	int32_t counts[3] = { 0, 0, 0 };
 	double tau[3] = { 0, 0, 0 };
+	bool taken[IRDM_CAN_DRIVES_MAX];
 
+	for (unsigned k = 0; k < dr->n; k++)
+		taken[k] = sync_accepted(dr, &dr->d[k], dlc);
 	dr->syncs++;
 	for (unsigned k = 0; k < dr->n_faults; k++)
 		if (dr->fault[k].at_sync == dr->syncs)
@@ -313,14 +517,14 @@ static void sync(struct irdm_can_drives *dr)
 		uint16_t sw;
 
 		irdm_cia402_drive_settle(&d->fsa);
-		if (d->nmt == IRDM_CO_STATE_OPERATIONAL)
+		if (d->nmt == IRDM_CO_STATE_OPERATIONAL && taken[k])
 			irdm_cia402_drive_command(&d->fsa, d->rpdo_cw);
 		sw = irdm_cia402_statusword(d->fsa.state);
 		f.data[0] = (uint8_t)sw;
 		f.data[1] = (uint8_t)(sw >> 8);
 		for (int b = 0; b < 4; b++)
 			f.data[2 + b] = (uint8_t)((uint32_t)counts[k] >> (8 * b));
-		if (d->nmt == IRDM_CO_STATE_OPERATIONAL && irdm_can_pdo_live(&d->tpdo1))
+		if (d->nmt == IRDM_CO_STATE_OPERATIONAL && taken[k] && irdm_can_pdo_live(&d->tpdo1))
 			tpdo_out(dr, d, &f);
 		tau[k] = joint_torque(dr, k);
 	}
@@ -332,9 +536,26 @@ static void sync(struct irdm_can_drives *dr)
 	if (!dr->docked)
 		irdm_sim_device_step(&dr->arm, dr->period_s);
 	dr->now_us += (uint64_t)llround(dr->period_s * 1e6);
-	for (unsigned k = 0; k < dr->n && !dr->wall_heartbeat; k++)
+	for (unsigned k = 0; k < dr->n && !dr->wall_heartbeat; k++) {
 		if (dr->d[k].heartbeat_ms && dr->now_us >= dr->d[k].heartbeat_next_us)
 			heartbeat(dr, &dr->d[k]);
+		(void)watch(dr, &dr->d[k], dr->now_us);
+	}
+}
+
+/* A heartbeat on the bus: the master's, for each drive that consumes it. */
+static void master_beat(struct irdm_can_drives *dr, const struct irdm_can_frame *f)
+{
+	unsigned node = f->id - IRDM_CO_HEARTBEAT;
+
+	for (unsigned k = 0; k < dr->n; k++) {
+		struct irdm_can_drive *d = &dr->d[k];
+
+		if (f->dlc != 1 || !(d->hb_consumer & 0xFFFFu) || ((d->hb_consumer >> 16) & 0xFF) != node)
+			continue;
+		d->master_beat_seen = true;
+		d->master_beat_us = deadline_now(dr);
+	}
 }
 
 static void frame_in(struct irdm_can_drives *dr, const struct irdm_can_frame *f)
@@ -343,19 +564,24 @@ static void frame_in(struct irdm_can_drives *dr, const struct irdm_can_frame *f)
 
 	if (f->id == IRDM_CO_NMT && f->dlc == 2) {
 		nmt(dr, f);
-	} else if (f->id == IRDM_CO_SYNC && f->dlc <= 1) {
+	} else if (f->id == IRDM_CO_SYNC && f->dlc <= 8) {
 		dr->sync_counter = f->dlc ? f->data[0] : 0;
-		sync(dr);
+		sync(dr, f->dlc);
 	} else if ((d = drive_of(dr, irdm_co_node_of(f, IRDM_CO_SDO_RX)))) {
 		sdo(dr, d, f);
 	} else if ((d = drive_of(dr, irdm_co_node_of(f, IRDM_CO_RPDO1))) && f->dlc == 4) {
 		/* latest wins; a PDO not valid is not listened to */
-		if (d->nmt == IRDM_CO_STATE_OPERATIONAL && irdm_can_pdo_live(&d->rpdo1)) {
+		if (d->nmt == IRDM_CO_STATE_OPERATIONAL && irdm_can_pdo_live(&d->rpdo1) &&
+		    !d->lost_code) {
 			d->rpdo_cw = (uint16_t)(f->data[0] | (f->data[1] << 8));
 			d->rpdo_torque_permille = (int16_t)(f->data[2] | (f->data[3] << 8));
+			d->rpdo_seen = true;
+			d->rpdo_us = deadline_now(dr);
 		}
-	} else if (!irdm_co_node_of(f, IRDM_CO_TPDO1) && !irdm_co_node_of(f, IRDM_CO_HEARTBEAT) &&
-		   !irdm_co_node_of(f, IRDM_CO_SDO_TX) && !irdm_co_node_of(f, IRDM_CO_EMCY)) {
+	} else if (irdm_co_node_of(f, IRDM_CO_HEARTBEAT)) {
+		master_beat(dr, f);     /* (our own drives' beats are not ours to watch) */
+	} else if (!irdm_co_node_of(f, IRDM_CO_TPDO1) && !irdm_co_node_of(f, IRDM_CO_SDO_TX) &&
+		   !irdm_co_node_of(f, IRDM_CO_EMCY)) {
 		dr->bad_frames++;                               /* nothing of ours */
 	}
 }
@@ -374,7 +600,7 @@ int irdm_can_drives_poll(struct irdm_can_drives *dr)
 
 uint64_t irdm_can_drives_wall(struct irdm_can_drives *dr, uint64_t now_us)
 {
-	uint64_t next = UINT64_MAX;
+	uint64_t next = UINT64_MAX, due;
 
 	dr->wall_us = now_us;
 	for (unsigned k = 0; k < dr->n; k++) {
@@ -386,7 +612,12 @@ uint64_t irdm_can_drives_wall(struct irdm_can_drives *dr, uint64_t now_us)
 		}
 		if (d->held && d->held_due_us < next)
 			next = d->held_due_us;
-		if (!dr->wall_heartbeat || !d->heartbeat_ms)
+		if (!dr->wall_heartbeat)
+			continue;
+		due = watch(dr, d, now_us);
+		if (due < next)
+			next = due;
+		if (!d->heartbeat_ms)
 			continue;
 		if (now_us >= d->heartbeat_next_us)
 			heartbeat(dr, d);

@@ -42,6 +42,9 @@ static int link_open(struct irdm_hal_dev *dev, struct irdm_can_port *port, char 
 		snprintf(err, errlen, "canemu: the emulated arm refuses this board's arm");
 		return IRDM_EINVAL;
 	}
+	/* as the arm of irdm-candrives: at rest in its dock until the first
+	 * torque, not sagging through the start-up's disabled SYNCs */
+	d->drives.docked = true;
 	return IRDM_OK;
 }
 
@@ -77,13 +80,30 @@ static const struct irdm_hal_can_link canemu_link = {
 	.close = link_close,
 };
 
+/*
+ * From a signal handler: the in-memory bus is not safe to touch there (the
+ * handler may have interrupted a send), so the emulated drives drop their
+ * set-points and the arm its torque directly, with plain stores.
+ */
+static int canemu_emergency_off(struct irdm_hal_dev *dev)
+{
+	struct canemu_data *d = data_of(dev);
+
+	for (unsigned k = 0; k < d->drives.n; k++) {
+		d->drives.d[k].rpdo_cw = 0;
+		d->drives.d[k].rpdo_torque_permille = 0;
+	}
+	irdm_sim_device_torque_off(&d->drives.arm);
+	return IRDM_OK;
+}
+
 static int canemu_open(struct irdm_hal_dev *dev)
 {
 	data_of(dev)->emcy_done = false;
 	return irdm_hal_can_open(dev, &canemu_link, IRDM_HAL_CAN_SUBSTEPS | IRDM_HAL_CAN_EMCY_AT);
 }
 
-static const struct irdm_hal_ops canemu_ops = IRDM_HAL_CAN_OPS(canemu_open);
+static const struct irdm_hal_ops canemu_ops = IRDM_HAL_CAN_OPS(canemu_open, canemu_emergency_off);
 
 const struct irdm_hal_backend irdm_hal_canemu_backend = {
 	.name = "canemu",

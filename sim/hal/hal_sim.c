@@ -158,6 +158,13 @@ static int sim_safe_off(struct irdm_hal_dev *dev)
 	return IRDM_OK;
 }
 
+/* Plain stores: the arm's commanded torque zero (async-signal-safe). */
+static int sim_emergency_off(struct irdm_hal_dev *dev)
+{
+	irdm_sim_device_torque_off(&data_of(dev)->arm);
+	return IRDM_OK;
+}
+
 static int sim_poll(struct irdm_hal_dev *dev, uint32_t *faults)
 {
 	struct sim_data *d = data_of(dev);
@@ -184,6 +191,7 @@ static const struct irdm_hal_ops sim_ops = {
 	.safe_off = sim_safe_off,
 	.poll = sim_poll,
 	.close = sim_close,
+	.emergency_off = sim_emergency_off,
 };
 
 const struct irdm_hal_backend irdm_hal_sim_backend = {

@@ -182,6 +182,8 @@ static int run(struct cd *cd)
 			timeout_ms = (int)((next - t + 999u) / 1000u);
 		if (poll(&pfd, 1, next <= t ? 0 : timeout_ms) < 0 && errno != EINTR)
 			return fail(CD_EXIT_LINK, "poll on the CAN socket failed");
+		/* what arrives is stamped now: the deadlines count from it */
+		(void)irdm_can_drives_wall(&cd->dr, now_us());
 		if (irdm_can_drives_poll(&cd->dr) == IRDM_EIO) {
 			snprintf(cd->err, sizeof(cd->err), "%s: the link went down (%s) at SYNC %llu",
 				 cd->args.ifname, cd->sock.bus_off ? "bus-off" : "interface down",

@@ -2,7 +2,8 @@
 /*
  * libFuzzer target: the CANopen master's receive path (hal/can/can_master.c)
  * in the operational state, on arbitrary frames.  A fake port confirms
- * every SDO of the set-up, then hands the master the input's frames:
+ * every SDO download of the set-up and answers its uploads as a CiA 402
+ * drive, then hands the master the input's frames:
  * 2 bytes of identifier (11 bits used), 1 of length (any), 8 of data, and
  * one control byte (bit 0: end the period here - receive, then send with
  * torque); repeated.  Invariants: once faulted, every RPDO sent is disable
@@ -27,10 +28,19 @@ static int fake_send(void *ctx, const struct irdm_can_frame *f)
 {
 	(void)ctx;
 	if (f->id >= 0x601 && f->id <= 0x67F) {         /* confirm every download */
+		uint16_t index = (uint16_t)(f->data[1] | f->data[2] << 8);
+
 		sdo_answer = *f;
 		sdo_answer.id = f->id - 0x80;
 		sdo_answer.data[0] = 0x60;
 		memset(sdo_answer.data + 4, 0, 4);
+		if (f->data[0] == 0x40) {               /* an upload: as a CiA 402 drive */
+			sdo_answer.data[0] = 0x43;
+			if (index == 0x1000)
+				sdo_answer.data[4] = 0x92, sdo_answer.data[5] = 0x01;
+			if (index == 0x6061)
+				sdo_answer.data[4] = 10;
+		}
 		have_answer = 1;
 	}
 	if (watched && f->id >= 0x201 && f->id <= 0x203 && f->dlc == 4) {
@@ -73,7 +83,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 	struct irdm_can_master_cfg cfg = {
 		.n_axes = 3, .period_us = 1000, .bitrate = 1000000, .sync_counter = true,
 		.heartbeat_ms = 10, .heartbeat_timeout_ms = 50, .tpdo_missing_periods = 3,
-		.sdo_timeout_polls = 2, .idle = idle,
+		.master_node = 127, .rpdo_timeout_ms = 3, .sdo_timeout_polls = 2, .idle = idle,
 	};
 	const double tau[3] = { 0.5, -0.5, 0.25 };
 	char err[160];

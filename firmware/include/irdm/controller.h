@@ -114,7 +114,7 @@ enum irdm_ctrl_cmd {
 	IRDM_CTRL_CMD_DISABLE = 1u << 1,        /* ENABLED -> READY */
 	IRDM_CTRL_CMD_RESET = 1u << 2,          /* FAULT -> READY once the causes are gone */
 	IRDM_CTRL_CMD_SHUTDOWN = 1u << 3,       /* -> OFF */
-	IRDM_CTRL_CMD_SIGNAL = 1u << 4,         /* SIGINT/SIGTERM received: fault SIGNAL */
+	IRDM_CTRL_CMD_SIGNAL = 1u << 4,         /* a signal asked the process to end: fault SIGNAL */
 	IRDM_CTRL_CMD_CALIBRATE = 1u << 5,      /* INIT -> READY: the device is at its calibration pose */
 	/* set by the loop from the HAL's return codes */
 	IRDM_CTRL_CMD_HAL_READ_FAILED = 1u << 6,        /* this tick's read failed: counts unusable */

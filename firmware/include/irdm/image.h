@@ -66,15 +66,17 @@ struct irdm_image {
 };
 
 /*
- * Map and validate the image at path.  Populates the mapping (no page fault
- * later) and, with IRDM_IMAGE_MAP_LOCK, locks it.  On failure img is zeroed,
+ * Copy the image at path into private memory, read-only, and validate it.
+ * A copy, not a mapping of the file: the bytes a running loop reads cannot
+ * change or vanish when the file is truncated or replaced.  Populates the
+ * copy (no page fault later) and, with IRDM_IMAGE_MAP_LOCK, locks it.  On failure img is zeroed,
  * nothing stays mapped, and err holds "path: reason" on one line.
  *
  * Return: IRDM_OK;
  * IRDM_EINVAL if flags has a bit other than IRDM_IMAGE_MAP_LOCK;
- * IRDM_EIO if the file cannot be opened, stat'ed, mapped or locked, is not
- * a regular file or is too large to map;
- * IRDM_ETRUNC if it is shorter than an image header;
+ * IRDM_EIO if the file cannot be opened, stat'ed, read, copied or locked, is
+ * not a regular file, is too large to map or grew while it was read;
+ * IRDM_ETRUNC if it is shorter than an image header or shrank while read;
  * otherwise any error of irdm_image_parse().
  */
 int irdm_image_map(const char *path, unsigned flags, struct irdm_image *img,

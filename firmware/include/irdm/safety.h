@@ -38,7 +38,7 @@ enum irdm_safety_fault {
 	IRDM_FAULT_OVERRUN = 1u << 4,           /* K consecutive overruns */
 	IRDM_FAULT_ENCODER_NAN = 1u << 5,       /* encoder not a number (or a non-finite pose) */
 	IRDM_FAULT_ENCODER_RANGE = 1u << 6,     /* encoder count outside its range */
-	IRDM_FAULT_SIGNAL = 1u << 7,            /* SIGINT/SIGTERM received */
+	IRDM_FAULT_SIGNAL = 1u << 7,            /* a signal asked the process to end */
 	IRDM_FAULT_HAL_READ = 1u << 8,          /* the HAL read failed */
 	IRDM_FAULT_HAL_WRITE = 1u << 9,         /* the HAL write failed */
 	IRDM_FAULT_HAL_FAULT = 1u << 10,        /* the HAL polled an asynchronous fault */

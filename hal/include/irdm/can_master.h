@@ -44,6 +44,8 @@ struct irdm_can_master_cfg {
 	uint16_t heartbeat_ms;          /* written to each drive's 0x1017 (> 0) */
 	uint32_t heartbeat_timeout_ms;  /* no heartbeat for longer: lost (> heartbeat_ms) */
 	unsigned tpdo_missing_periods;  /* this many periods in a row without a TPDO: lost */
+	unsigned master_node;           /* 1..127, not a drive's: the master's heartbeat */
+	uint16_t rpdo_timeout_ms;       /* each drive's RPDO1 deadline, 0x1400:05 (> 0) */
 	unsigned sdo_timeout_polls;     /* idle() calls to wait for one SDO answer (> 0) */
 	void (*idle)(void *ctx);        /* set-up's wait (a sleep, or the emulator's turn) */
 	void *idle_ctx;
@@ -61,6 +63,9 @@ struct irdm_can_master_axis {
 	enum irdm_co_nmt_state nmt;     /* as the last heartbeat said */
 	enum irdm_cia402_state state;
 	bool was_enabled;               /* reached operation enabled since enable */
+	uint32_t device_type;           /* 0x1000, read at set-up */
+	uint32_t identity[4];           /* 0x1018:01..04: vendor, product, revision, serial */
+	uint16_t abort_option;          /* 0x6007 as written (2, or 1 if refused) */
 };
 
 struct irdm_can_master {
@@ -68,12 +73,14 @@ struct irdm_can_master {
 	struct irdm_can_port port;
 	struct irdm_can_master_axis ax[IRDM_CAN_AXES_MAX];
 	uint64_t period;                /* cycles sent */
+	uint64_t beats;                 /* heartbeats the master produced */
 	unsigned sync_count;            /* the last SYNC counter sent (0: none yet) */
 	bool enable;                    /* drive the axes toward operation enabled */
 	bool reset_request;             /* fault reset asked for (operator) */
 	bool faulted;                   /* latched: torque off until a reset */
 	bool link_lost;                 /* the fault is the link's, not a drive's */
 	char why[IRDM_CAN_WHY_MAX];     /* the first fault, one line */
+	struct irdm_can_frame off[IRDM_CAN_AXES_MAX];   /* each axis's torque-off RPDO1 */
 	uint64_t bad_frames;            /* malformed frames of ours (wrong DLC, content) */
 	uint64_t unknown_frames;        /* identifiers we do not expect */
 	uint64_t sdo_stragglers;        /* SDO answers after set-up */
@@ -147,6 +154,9 @@ void irdm_can_master_enable(struct irdm_can_master *m, bool on);
 /* Every axis reports operation enabled (from its latest TPDO). */
 bool irdm_can_master_all_enabled(const struct irdm_can_master *m);
 
+/* The first axis without a TPDO1 in the last receive, or -1. */
+int irdm_can_master_first_stale(const struct irdm_can_master *m);
+
 /* The first axis not operation enabled, or -1. */
 int irdm_can_master_first_not_enabled(const struct irdm_can_master *m);
 
@@ -163,6 +173,15 @@ int irdm_can_master_safe_off(struct irdm_can_master *m);
  */
 void irdm_can_master_lose(struct irdm_can_master *m, int axis, const char *reason);
 
+/*
+ * Torque off from a signal handler: the disable-voltage, zero-torque RPDO1
+ * of every axis (built at init) and a SYNC, each one irdm_can_send(), and
+ * nothing else: async-signal-safe when the port's send is (SocketCAN's is
+ * one write(2)).  Touches no other state of the master.
+ * Return: IRDM_OK; IRDM_EHW if a frame could not be sent.
+ */
+int irdm_can_master_emergency_off(const struct irdm_can_master *m);
+
 /* The operator's fault reset: clear the latch and send fault reset
  * (bit 7's rising edge) to faulted drives; they then re-enable only if
  * enabled again. */
@@ -171,6 +190,12 @@ void irdm_can_master_reset_faults(struct irdm_can_master *m);
 /* Joint torque -> per mille of an axis's rated motor torque, rounded,
  * clamped to int16; not finite -> 0. */
 int16_t irdm_can_torque_permille(const struct irdm_can_axis_cfg *a, double tau_joint_nm);
+
+/* Drive k's identity as read at set-up, one line: "drive 1 (node 1): CiA
+ * 402 device type 0x00020192, vendor 0x..., product 0x..., revision 0x...,
+ * serial 0x...". */
+void irdm_can_master_identity_line(const struct irdm_can_master *m, unsigned k, char *line,
+				   size_t len);
 
 /* Frames the NMT stop command to every node (at close). */
 void irdm_can_master_stop(struct irdm_can_master *m);

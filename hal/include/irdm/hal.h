@@ -21,6 +21,8 @@
  *           by a back-end on its own).
  *   poll    asynchronous faults (drive, link, e-stop): latched until close.
  *   close   torque off, disconnect.
+ *   emergency_off  zero torque from a signal handler (optional): the way
+ *           out of a process that is about to end.
  * read, write, safe_off and poll run in the force tick: they must not
  * allocate, block beyond the back-end's own I/O, or print.
  *
@@ -42,10 +44,12 @@
 #include <stdint.h>
 
 #include "irdm/device.h"
+#include "irdm/error.h"
 
 #define IRDM_HAL_JOINTS IRDM_DEVICE_JOINTS
 #define IRDM_HAL_BACKENDS_MAX 8
 #define IRDM_HAL_WHY_MAX 192    /* bytes of a back-end's one-line reason */
+#define IRDM_HAL_INFO_MAX 640   /* bytes of what to print after open (lines) */
 
 /* Asynchronous fault bits (poll); a back-end sets the ones it can detect. */
 enum irdm_hal_fault {
@@ -125,6 +129,16 @@ struct irdm_hal_ops {
 
 	/* Torque off, disconnect; the instance may be opened again. */
 	void (*close)(struct irdm_hal_dev *dev);
+
+	/*
+	 * Optional (NULL: none).  Zero the torque from a signal handler that
+	 * may have interrupted any other op, in any thread, just before the
+	 * process ends: async-signal-safe (no lock, no allocation, no stdio;
+	 * write(2) of frames built at open, or plain stores), and leaves the
+	 * instance unusable but for close.
+	 * Return: IRDM_OK; IRDM_EHW if the torque-off could not be sent.
+	 */
+	int (*emergency_off)(struct irdm_hal_dev *dev);
 };
 
 struct irdm_hal_backend {
@@ -143,10 +157,11 @@ struct irdm_hal_dev {
 	 *       naming the part and the cause ("drive 2 (node 2): SDO abort
 	 *       0x06020000 ... writing 0x6060:00"); set where the error is
 	 *       returned (open, start) or the fault latched (poll, read).
-	 * info  what the caller should print once after open (e.g. a bus load).
+	 * info  what the caller should print once after open (e.g. a bus load,
+	 *       the drives found), one or more lines separated by '\n'.
 	 */
 	char why[IRDM_HAL_WHY_MAX];
-	char info[IRDM_HAL_WHY_MAX];
+	char info[IRDM_HAL_INFO_MAX];
 };
 
 /*
@@ -204,6 +219,14 @@ static inline int irdm_hal_poll(struct irdm_hal_dev *dev, uint32_t *faults)
 static inline void irdm_hal_close(struct irdm_hal_dev *dev)
 {
 	dev->backend->ops->close(dev);
+}
+
+/* Async-signal-safe; IRDM_ENOTSUP if the back-end has no emergency_off. */
+static inline int irdm_hal_emergency_off(struct irdm_hal_dev *dev)
+{
+	const struct irdm_hal_ops *o = dev->backend->ops;
+
+	return o->emergency_off ? o->emergency_off(dev) : IRDM_ENOTSUP;
 }
 
 #endif /* IRDM_HAL_H */

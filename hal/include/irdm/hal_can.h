@@ -11,7 +11,9 @@
  * HAL ops on the master:
  *   open      parse the options, open the port, SDO set-up, NMT start;
  *             dev->info: the bus load; dev->why: the reason of a failure
- *   start     enable every drive, bounded (enable_timeout_ms)
+ *   start     the cycle with the drives disabled until every drive has
+ *             answered IRDM_HAL_CAN_STEADY_PERIODS SYNCs in a row, then
+ *             enable every drive; both within enable_timeout_ms
  *   read      receive and judge; a period nobody wrote is closed first
  *             (zero torque, the SYNC) so every period has its SYNC
  *   write     RPDO1 per axis, then the SYNC
@@ -30,6 +32,7 @@
 #include "irdm/hal.h"
 
 #define IRDM_HAL_CAN_IFNAME_MAX 16
+#define IRDM_HAL_CAN_STEADY_PERIODS 5   /* start: disabled SYNCs answered in a row first */
 
 /* The board's hal_options, parsed. */
 struct irdm_hal_can_opts {
@@ -45,6 +48,8 @@ struct irdm_hal_can_opts {
 	uint32_t sdo_timeout_ms;
 	uint32_t enable_timeout_ms;
 	unsigned substeps;              /* canemu only: the emulated arm's steps a period */
+	unsigned master_node;           /* the master's own node id (its heartbeat) */
+	uint32_t rpdo_timeout_ms;       /* each drive's RPDO1 deadline (0: 3 periods) */
 	unsigned emcy_drive;            /* canemu only: drive (1..) that faults, 0: none */
 	uint32_t emcy_at_ms;            /*   at this virtual time, with EMCY 0x2310 */
 };
@@ -101,13 +106,17 @@ int irdm_hal_can_write(struct irdm_hal_dev *dev, const double tau_nm[IRDM_HAL_JO
 int irdm_hal_can_safe_off(struct irdm_hal_dev *dev);
 int irdm_hal_can_poll(struct irdm_hal_dev *dev, uint32_t *faults);
 void irdm_hal_can_close(struct irdm_hal_dev *dev);
+/* emergency_off on a port whose send is one write(2) (SocketCAN): the
+ * master's frames built at open, irdm_can_master_emergency_off(). */
+int irdm_hal_can_emergency_off(struct irdm_hal_dev *dev);
 
 /* A CAN back-end's ops table: its own open, the shared rest. */
-#define IRDM_HAL_CAN_OPS(open_fn)                                                              \
+#define IRDM_HAL_CAN_OPS(open_fn, emergency_fn)                                                \
 	{                                                                                      \
 		.open = (open_fn), .start = irdm_hal_can_start, .read = irdm_hal_can_read,     \
 		.write = irdm_hal_can_write, .safe_off = irdm_hal_can_safe_off,                \
 		.poll = irdm_hal_can_poll, .close = irdm_hal_can_close,                        \
+		.emergency_off = (emergency_fn),                                               \
 	}
 
 /* The operator's fault reset (tests; the controller has no such command yet). */

@@ -14,7 +14,20 @@
  * real bus: a master that stops sending SYNC still hears heartbeats).
  * Faults a test injects: stop the heartbeat, drop or delay TPDOs, answer
  * SDOs wrongly, raise an EMCY and fault, flood the bus; set by hand or on
- * a schedule counted in SYNCs (irdm/can_faults.h).  A hook may act on the
+ * a schedule counted in SYNCs (irdm/can_faults.h).
+ *
+ * As strict as a standard device at its defaults (CiA 301 / 402,
+ * docs/canopen.md): a SYNC whose length does not match its 0x1019 (0: no
+ * counter, DLC 0; 2..240: DLC 1) is answered with EMCY 0x8240 and the
+ * drive drops to pre-operational; 0x1019 is written only while 0x1006 is
+ * 0 (else abort 0x08000022); a TPDO COB-ID allowing RTR is refused
+ * (0x06090030).  It runs the deadlines it is given, each from the first
+ * frame it watches: the consumer heartbeat (0x1016:01, the master's node
+ * and time) and the RPDO1 event timer (0x1400:05); on a time-out it sends
+ * EMCY 0x8130 or 0x8250 (bytes 3-4: the torque it applies from then on,
+ * per mille: 0) and takes the reaction 0x6007 names (0 none, 1 fault,
+ * 2 disable voltage, 3 quick stop; each but 0 zero torque at once).  The
+ * deadlines run on the clock the heartbeats do (SYNCs', or the wall's).  A hook may act on the
  * arm before each SYNC's step (the virtual user's hand).  No allocation
  * after init; the caller owns the struct.
  */
@@ -41,6 +54,14 @@ struct irdm_can_drive {
 	uint32_t rated_torque_mnm;      /* 0x6076: motor side, mN m */
 	struct irdm_can_pdo rpdo1;      /* 0x1400, 0x1600: controlword + target torque */
 	struct irdm_can_pdo tpdo1;      /* 0x1800, 0x1A00: statusword + position */
+	uint32_t cycle_us;              /* 0x1006: communication cycle period (0: none) */
+	uint8_t sync_overflow;          /* 0x1019: 0 SYNC without counter; 2..240 with */
+	uint32_t hb_consumer;           /* 0x1016:01: node << 16 | time ms (0: off) */
+	int16_t abort_option;           /* 0x6007: reaction to a lost connection */
+	bool master_beat_seen, rpdo_seen;       /* deadlines run from the first frame */
+	uint64_t master_beat_us, rpdo_us;       /* the last one (deadline clock) */
+	uint16_t lost_code;             /* the time-out taken (EMCY code), 0: none */
+	uint64_t lost_at_us;
 	uint16_t rpdo_cw;               /* the latest RPDO1 */
 	int16_t rpdo_torque_permille;
 	uint64_t heartbeat_next_us;
@@ -67,7 +88,7 @@ struct irdm_can_drives {
 	double period_s;
 	uint64_t now_us;
 	uint8_t sync_counter;           /* the last SYNC's counter byte (0: none) */
-	uint64_t syncs, bad_frames;
+	uint64_t syncs, bad_frames, sync_length_errors;
 	uint64_t tpdos_sent, tpdos_dropped, tpdos_delayed, flood_sent, faults_fired;
 	bool wall_heartbeat;            /* heartbeats on irdm_can_drives_wall()'s clock */
 	bool docked;                    /* the arm rests in its calibration dock (no

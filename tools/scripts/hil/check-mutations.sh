@@ -3,6 +3,8 @@
 # check guards, in a copy of a passing run's results, and hil-check.py
 # must then fail on exactly that check.  Run by make hil after the checks.
 #   tools/scripts/hil/check-mutations.sh RESULTS_DIR CHECK_ARGS...
+# (the kill's EMCYs moved later keep their order in the file: the check
+# reads times, not positions)
 set -euo pipefail
 results=$1
 shift
@@ -24,6 +26,11 @@ late_off() {        # the first three torque-off windows after the EMCY keep the
 weak_force() { awk -F, -v OFS=, 'NR == 1 { for (i = 1; i <= NF; i++) if ($i ~ /^d0_f[xyz]_n$/) c[i] = 1; print; next }
 	{ for (i in c) $i = $i * 1.5; print }' "$results/base.csv" > "$work/r/base.csv"; }
 no_rt() { sed -i 's/PREEMPT_RT/PREEMPT_DYNAMIC/' "$work/r/kernel.txt"; }
+no_overflow() { sed -i '/ 60[123]#2F191000/d' "$work/r/base.candump"; }
+late_stop() {       # the drives' EMCYs after the kill one second later
+	awk '$3 ~ /^08[123]#/ { t = substr($1, 2, length($1) - 2) + 1.0; $1 = sprintf("(%.6f)", t) } { print }' \
+		"$results/kill.candump" > "$work/r/kill.candump"
+}
 no_reason() { sed -i '1s/drive 2 (node 2)/a drive/' "$work/r/sdo.fw.txt"; }
 
 args=("$@")
@@ -46,4 +53,6 @@ mutate "the torque-off delayed 3 periods" "emcy: every axis RPDO1 00 00 00 00" l
 mutate "forces 1.5 times the reference's" "forces: hold means" weak_force
 mutate "a kernel without PREEMPT_RT" "PREEMPT_RT" no_rt
 mutate "the start-up failure unnamed" "sdo: start-up refused" no_reason
+mutate "0x1019 never written" "base: node 1: 0x1019" no_overflow
+mutate "the drives stop 1 s later after the kill" "kill: node 1 at zero torque within" late_stop
 exit $failed

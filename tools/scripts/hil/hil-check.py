@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """make hil's checks, on the host, of what the VM sent back (docs/hil.md).
 
-    hil-check.py RESULTS_DIR PERIOD_US TPDO_MISSING HEARTBEAT_TIMEOUT_MS FAULT_AT
+    hil-check.py RESULTS_DIR PERIOD_US TPDO_MISSING HEARTBEAT_TIMEOUT_MS FAULT_AT \
+                 RPDO_TIMEOUT_MS MASTER_NODE
 
 RESULTS_DIR holds, per scenario NAME: NAME.candump (candump -L of vcan0),
 NAME.fw.txt / NAME.fw.rc (irdm-fw's output and exit code), NAME.cd.txt /
@@ -31,6 +32,17 @@ Checked (a failure makes the exit code 1):
   flood        1000 frames of id 0x001 at once: all on the bus, as many as
                the emulator says it sent; tolerated, ran to the end
   sdo          start-up refused: non-zero exit, the drive and object named
+  set-up       on each drive: 0x1019, 0x1016:01, 0x1400:05, 0x6007 written
+               and confirmed; 0x6061, 0x1000 (a CiA 402 drive), 0x1018:01-04
+               read; no EMCY in the base run (the strict drives took the
+               SYNCs)
+  nocounter    sync_counter=no: 0x1019 = 0 written, every SYNC without
+               data, no EMCY, ran to the end
+  kill         irdm-fw killed with SIGKILL while the drives applied torque:
+               every drive sends its time-out EMCY (0x8250 RPDO or 0x8130
+               heartbeat, bytes 3-4 the torque it applies from then: 0)
+               within RPDO_TIMEOUT_MS + KILL_SLACK_MS of the master's last
+               frame, none before it
 Reported, not checked: the SYNC period's distribution (TCG's timing).
 """
 import csv
@@ -46,6 +58,7 @@ HOLD_S = (1.5, 3.0)
 ALIGN_MAX = 25          # ticks either way
 AXES = (1, 2, 3)
 SYNC = 0x080
+KILL_SLACK_MS = 300     # TCG stalls a vCPU for up to 260 ms (docs/hil.md)
 
 failures = []
 
@@ -249,6 +262,92 @@ def fault_scenario(d, name, kind, args):
         print(f"  the link is gone: no frame can carry the torque off (last frame "
               f"{last[1]:03X}#{last[2].hex()} at its end)" if last else "  no frames")
         check("link" in reason, f"{name}: the reason says the link")
+        syncs = sum(1 for f in fr if f[1] == SYNC)
+        check(syncs > 0, f"{name}: the link went down mid-run ({syncs} SYNCs before)")
+
+
+def sdo_transfers(fr, node):
+    """{(index, sub): (request command, answer command, answer value, request value)}
+    of node's SDOs."""
+    out, pending = {}, {}
+    for f in fr:
+        if len(f[2]) != 8:
+            continue
+        key = (f[2][1] | f[2][2] << 8, f[2][3])
+        value = int.from_bytes(f[2][4:8], "little")
+        if f[1] == 0x600 + node:
+            pending[key] = (f[2][0], value)
+        elif f[1] == 0x580 + node and key in pending:
+            cmd, req = pending.pop(key)
+            out[key] = (cmd, f[2][0], value, req)
+    return out
+
+
+def setup_checks(name, fr, sync_counter):
+    """The objects the master must write and read on each drive."""
+    writes = ((0x1019, 0), (0x1016, 1), (0x1400, 5), (0x6007, 0))
+    reads = ((0x6061, 0), (0x1000, 0), (0x1018, 1), (0x1018, 2), (0x1018, 3), (0x1018, 4))
+    for node in AXES:
+        t = sdo_transfers(fr, node)
+        ok_w = all(k in t and t[k][0] & 0xE0 == 0x20 and t[k][1] == 0x60 for k in writes)
+        ok_r = all(k in t and t[k][0] == 0x40 and t[k][1] & 0xF3 == 0x43 for k in reads)
+        check(ok_w and ok_r, f"{name}: node {node}: 0x1019, 0x1016:01, 0x1400:05, 0x6007 "
+                             f"written, 0x6061, 0x1000, 0x1018:01-04 read")
+        if not (ok_w and ok_r):
+            continue
+        print(f"  node {node}: 0x1000 = 0x{t[(0x1000, 0)][2]:08X}, 0x1018 = "
+              + ", ".join(f"0x{t[(0x1018, s)][2]:08X}" for s in (1, 2, 3, 4))
+              + f", 0x6061 = {t[(0x6061, 0)][2] & 0xFF}")
+        check(t[(0x1000, 0)][2] & 0xFFFF == 0x0192 and t[(0x6061, 0)][2] & 0xFF == 10,
+              f"{name}: node {node}: a CiA 402 drive in cyclic synchronous torque")
+    emcy = [f for f in fr if 0x081 <= f[1] <= 0x0FF]
+    check(not emcy, f"{name}: no EMCY on the bus ({len(emcy)})")
+    dlcs = {len(f[2]) for f in fr if f[1] == SYNC}
+    check(dlcs == ({1} if sync_counter else {0}),
+          f"{name}: every SYNC {'with' if sync_counter else 'without'} the counter "
+          f"(lengths {sorted(dlcs)})")
+
+
+def kill_checks(d, rpdo_timeout_ms, master_node):
+    fr = frames(os.path.join(d, "kill.candump"))
+    rc = read(os.path.join(d, "kill.fw.rc"), "?").strip()
+    print(f"== kill: irdm-fw killed (exit {rc}), {len(fr)} frames")
+    ours = [i for i, f in enumerate(fr) if f[1] in (0x000, SYNC, 0x700 + master_node) or
+            0x201 <= f[1] <= 0x27F or 0x601 <= f[1] <= 0x67F]
+    if not check(ours, "kill: the master's frames are on the bus"):
+        return
+    last = ours[-1]
+    t_last = fr[last][0]
+    rp = {}
+    for f in fr[:last + 1]:
+        r = rpdo(f)
+        if r:
+            rp[r[0]] = (f[0], r)
+    check(rc == "137", f"kill: irdm-fw ended by SIGKILL (exit {rc})")
+    check(all(a in rp and rp[a][1][1] == 0x0F for a in AXES) and
+          any(rp[a][1][2] != 0 for a in AXES if a in rp),
+          "kill: every drive commanded operation enabled, torque on, when irdm-fw died "
+          f"({', '.join(f'{a}: {rp[a][1][2]}' for a in AXES if a in rp)} per mille)")
+    early = [f for f in fr[:last + 1] if 0x081 <= f[1] <= 0x0FF]
+    check(not early, f"kill: no EMCY while the master ran ({len(early)})")
+    worst = 0.0
+    for a in AXES:
+        em = [f for f in fr[last + 1:] if f[1] == 0x080 + a and len(f[2]) == 8]
+        if not check(em, f"kill: node {a} sends an EMCY after the master's last frame"):
+            continue
+        code = em[0][2][0] | em[0][2][1] << 8
+        torque = int.from_bytes(em[0][2][3:5], "little", signed=True)
+        dt = (em[0][0] - t_last) * 1e3
+        dt_rpdo = (em[0][0] - rp[a][0]) * 1e3 if a in rp else float("nan")
+        worst = max(worst, dt)
+        print(f"  node {a}: EMCY 0x{code:04X}, torque {torque} per mille, {dt:.1f} ms after "
+              f"the master's last frame ({dt_rpdo:.1f} ms after its last RPDO1)")
+        check(code in (0x8250, 0x8130) and torque == 0 and
+              dt <= rpdo_timeout_ms + KILL_SLACK_MS,
+              f"kill: node {a} at zero torque within {rpdo_timeout_ms} + {KILL_SLACK_MS} ms "
+              f"of the master's last frame (EMCY 0x{code:04X} at {dt:.1f} ms)")
+    print(f"  kill: every drive at zero torque {worst:.1f} ms after the master's last frame "
+          f"(deadline {rpdo_timeout_ms} ms)")
 
 
 def tolerated_scenarios(d):
@@ -271,9 +370,9 @@ def tolerated_scenarios(d):
 
 
 def main():
-    if len(sys.argv) != 6:
+    if len(sys.argv) != 8:
         sys.exit("usage: hil-check.py RESULTS_DIR PERIOD_US TPDO_MISSING HEARTBEAT_TIMEOUT_MS "
-                 "FAULT_AT")
+                 "FAULT_AT RPDO_TIMEOUT_MS MASTER_NODE")
     d = sys.argv[1]
     period_ms = int(sys.argv[2]) / 1000
     args = (period_ms, int(sys.argv[3]), int(sys.argv[4]), int(sys.argv[5]))
@@ -308,6 +407,21 @@ def main():
         counts[kind] = counts.get(kind, 0) + 1
     print(f"  frame counts: {counts}")
     force_checks(os.path.join(d, "base.csv"), os.path.join(d, "reference.csv"), period_ms)
+    setup_checks("base", fr, True)
+
+    fr = frames(os.path.join(d, "nocounter.candump"))
+    rc = read(os.path.join(d, "nocounter.fw.rc"), "?").strip()
+    print(f"== nocounter: sync_counter=no, irdm-fw exit {rc}, {len(fr)} frames")
+    check(rc == "0", "nocounter: irdm-fw ran to the end")
+    setup_checks("nocounter", fr, False)
+    overflow = [v for (k, v) in sdo_transfers(fr, 1).items() if k == (0x1019, 0)]
+    check(overflow and overflow[0][0] == 0x2F and overflow[0][3] == 0,
+          "nocounter: 0x1019 = 0 written")
+    seen = states_reached(fr)
+    check(all("operation enabled" in seen[a] for a in AXES),
+          "nocounter: every drive reached operation enabled")
+
+    kill_checks(d, int(sys.argv[6]), int(sys.argv[7]))
 
     for name, kind in (("heartbeat", "heartbeat"), ("emcy", "emcy"), ("fault", "fault"),
                        ("drop", "drop"), ("busoff", "busoff")):

@@ -35,6 +35,8 @@ step "kernel"
 
 period_us=${HIL_PERIOD_US:-10000}
 tpdo_missing=50         # the VM board's tpdo_missing_periods (below)
+rpdo_timeout_ms=1000    # the VM board's drives' RPDO deadline (below)
+master_node=127         # the master's node id (the default)
 dt_s=$(awk -v p="$period_us" 'BEGIN { printf "%g", p / 1e6 }')
 img=$out/default-$period_us.img
 step "the default scene (cuboid-top) at dt = $dt_s s (cached)"
@@ -57,31 +59,41 @@ cp scenes/users/press-hold-release.user "$stage/"
 cp "$img" "$stage/default.img"
 # faults mid-hold, 1.5 s into the run
 fault_at=$((1500000 / period_us))
-echo "FAULT_AT=$fault_at TPDO_MISSING=$tpdo_missing" > "$stage/params.sh"
+# after a kill -9 of irdm-fw, the drives' deadline and 0.5 s more
+kill_wait=$(awk -v t="$rpdo_timeout_ms" 'BEGIN { printf "%g", t / 1000 + 0.5 }')
+echo "FAULT_AT=$fault_at TPDO_MISSING=$tpdo_missing KILL_WAIT=$kill_wait" > "$stage/params.sh"
 # the board, for the VM: vcan0; the period; heartbeats every 5 periods,
 # lost after 100; a TPDO1 lost after 50 missing periods (TCG stalls a vCPU
 # for up to 260 ms now and then, measured, and the loop catches up after,
 # so silences counted in periods run ahead of the wall clock); no deformed
 # surface (the minimal build has none); overruns tolerated (TCG's clock is the
 # emulator's, not the RT kernel's: a late tick there says nothing about
-# the controller)
+# the controller); the drives' RPDO deadline rpdo_timeout_ms (a vCPU stall
+# of 260 ms must not trip it; their heartbeat consumer is the master's
+# tolerance, 100 periods); start's disabled exchange and enabling within
+# 2 s (5 SYNCs answered in a row, then the enable sequence: 10 periods
+# would leave no room for one late TPDO1)
 vm_board() {
 	sed -e 's/iface=can0/iface=vcan0/' -e 's/^deform_rate_hz *= *[0-9.]*/deform_rate_hz = 0/' \
 		-e "s/heartbeat_ms=[0-9]*/heartbeat_ms=$((period_us * 5 / 1000))/" \
 		-e "s/heartbeat_timeout_ms=[0-9]*/heartbeat_timeout_ms=$((period_us * 100 / 1000))/" \
 		-e "s/tpdo_missing_periods=[0-9]*/tpdo_missing_periods=$tpdo_missing/" \
 		-e "s/^period_us *= *[0-9]*/period_us = $period_us/" \
+		-e "s/^\(hal_options *=.*\)$/\1 rpdo_timeout_ms=$rpdo_timeout_ms enable_timeout_ms=2000/" \
 		-e 's/^overrun_fault_count *= *[0-9]*/overrun_fault_count = 1000/' \
 		-e 's/^watchdog_us *= *[0-9]*/watchdog_us = 1000000/' "$1"
 }
 vm_board boards/can-3dof.board > "$stage/can-3dof-vm.board"
 grep -q 'iface=vcan0' "$stage/can-3dof-vm.board" || { echo "hil: boards/can-3dof.board has no iface=can0 to replace" >&2; exit 1; }
+grep -q 'sync_counter=yes' "$stage/can-3dof-vm.board" || { echo "hil: boards/can-3dof.board has no sync_counter=yes" >&2; exit 1; }
+# the same without the SYNC counter: the drives' 0x1019 = 0, SYNCs of no data
+sed 's/sync_counter=yes/sync_counter=no/' "$stage/can-3dof-vm.board" > "$stage/can-3dof-vm-nocounter.board"
 "$here/initramfs.sh" "$out/initramfs.cpio.gz" "$out/kernel" "$stage"
 
 step "boot the VM (qemu TCG, PREEMPT_RT) and run the scenarios"
 rm -rf "$out/results" && mkdir -p "$out/results"
 rm -f "$out/results.disk" && truncate -s 64M "$out/results.disk"
-timeout 240 qemu-system-x86_64 -accel tcg -cpu max -m 512 -smp 2 -nographic -no-reboot \
+timeout 300 qemu-system-x86_64 -accel tcg -cpu max -m 512 -smp 2 -nographic -no-reboot \
 	-kernel "$out/kernel/vmlinux" -initrd "$out/initramfs.cpio.gz" \
 	-drive "file=$out/results.disk,format=raw,if=virtio" \
 	-append "console=ttyS0 quiet panic=-1" < /dev/null > "$out/console.log" 2>&1 || true
@@ -104,7 +116,8 @@ done
 
 step "checks"
 opt() { sed -n "s/^hal_options.*[ =]$1=\([0-9]*\).*/\1/p" "$stage/can-3dof-vm.board"; }
-check_args=("$period_us" "$(opt tpdo_missing_periods)" "$(opt heartbeat_timeout_ms)" "$fault_at")
+check_args=("$period_us" "$(opt tpdo_missing_periods)" "$(opt heartbeat_timeout_ms)" "$fault_at"
+	    "$(opt rpdo_timeout_ms)" "$master_node")
 python3 "$here/hil-check.py" "$out/results" "${check_args[@]}"
 step "the checks' own test: each mutation of the results must fail a check"
 "$here/check-mutations.sh" "$out/results" "${check_args[@]}"
