@@ -75,7 +75,8 @@ B=$H/can-3dof-vm-nocounter.board
 scenario nocounter 2.5
 B=$H/can-3dof-vm.board
 scenario_kill
-scenario heartbeat 2.5 heartbeat-stop:2:$FAULT_AT
+# the heartbeat is lost 200 periods after it stops (at 1.5 s): a longer run
+scenario heartbeat 4.5 heartbeat-stop:2:$FAULT_AT
 scenario emcy 2.5 emcy:3:$FAULT_AT:0x2310
 scenario fault 2.5 fault:1:$FAULT_AT
 scenario drop 2.5 drop:2:$FAULT_AT:$((TPDO_MISSING + 5))
