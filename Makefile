@@ -96,11 +96,19 @@ LDFLAGS += -fsanitize=address,undefined
 endif
 
 FW_SRC    := $(filter-out firmware/main/% $(FEATURE_OFF_SRC),$(wildcard firmware/*/*.c))
-FWMAIN_SRC := $(wildcard firmware/main/*.c)
+# The live view (docs/view.md): its server and page in tools/view/, linked
+# into irdm-fw (fw_view.c) and irdm; the trimmed builds leave it out
+# (fw_view_none.c) and need no libwebsockets.
+VIEW    := $(if $(CONFIG),,1)
+FWMAIN_SRC := $(filter-out firmware/main/$(if $(VIEW),fw_view_none.c,fw_view.c),\
+  $(wildcard firmware/main/*.c))
 HAL_SRC   := $(wildcard hal/*/*.c)
 SIM_SRC   := $(filter-out sim/main/%,$(wildcard sim/*/*.c))
 CDMAIN_SRC := $(wildcard sim/main/*.c)
 TOOL_SRC  := $(filter-out tools/irdm/%,$(wildcard tools/*/*.c))
+VIEW_PAGE := $(wildcard tools/view/page/*)
+VIEW_OBJ   = $(call obj,$(wildcard tools/view/*.c)) $(BUILD)/obj/gen/view_page.o
+VIEW_LIBS := -lwebsockets
 CLI_SRC   := $(wildcard tools/irdm/*.c)
 PLUGIN_SRC := $(wildcard tools/dist/plugin/*.c)
 TEST_SRC  := $(wildcard tests/test_*.c)
@@ -131,6 +139,8 @@ $(BUILD)/obj/firmware/%.o: LAYER_INC = $(FW_INC)
 # irdm-fw's main() is the composition root: it alone sees every layer below
 # the tools (it registers the HAL back-ends, the simulator's among them).
 $(BUILD)/obj/firmware/main/%.o: LAYER_INC = $(SIM_INC)
+# its publisher alone also sees the view's server (tools/view/)
+$(BUILD)/obj/firmware/main/fw_view.o: LAYER_INC = $(SIM_INC) -Itools
 $(BUILD)/obj/hal/%.o:      LAYER_INC = $(HAL_INC)
 $(BUILD)/obj/sim/%.o:      LAYER_INC = $(SIM_INC)
 $(BUILD)/obj/tools/%.o:    LAYER_INC = $(TOOL_INC)
@@ -149,10 +159,19 @@ $(BUILD)/lib%.a:
 $(FW_LIB):   $(call obj,$(FW_SRC))
 $(HAL_LIB):  $(call obj,$(HAL_SRC))
 $(SIM_LIB):  $(call obj,$(SIM_SRC))
-$(TOOL_LIB): $(call obj,$(TOOL_SRC))
+$(TOOL_LIB): $(call obj,$(TOOL_SRC)) $(BUILD)/obj/gen/view_page.o
+
+# The page's files as byte arrays (tools/view/embed.sh)
+$(BUILD)/gen/view_page.c: $(VIEW_PAGE) tools/view/embed.sh
+	@mkdir -p $(dir $@)
+	tools/view/embed.sh $(VIEW_PAGE) > $@.tmp
+	mv $@.tmp $@
+$(BUILD)/obj/gen/view_page.o: $(BUILD)/gen/view_page.c
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $(TOOL_INC) -c $< -o $@
 
 $(IRDM): $(call obj,$(CLI_SRC)) $(TOOL_LIB) $(FW_LIB) | $(SLEPC_PLUGIN)
-	$(CC) $(LDFLAGS) $^ -o $@ $(LDLIBS)
+	$(CC) $(LDFLAGS) $^ -o $@ $(LDLIBS) $(VIEW_LIBS)
 
 # The slepc plugin: position-independent, only its entry point exported.
 $(BUILD)/obj/tools/dist/plugin/%.o: tools/dist/plugin/%.c
@@ -165,8 +184,9 @@ $(BUILD)/irdm-slepc.so: $(call obj,$(PLUGIN_SRC))
 TEST_LIBS := $(TOOL_LIB) $(SIM_LIB) $(HAL_LIB) $(FW_LIB)
 
 # BLAS only for the deformation worker
-$(IRDM_FW): $(call obj,$(FWMAIN_SRC)) $(SIM_LIB) $(HAL_LIB) $(FW_LIB)
-	$(CC) $(LDFLAGS) $^ -o $@ $(if $(call feature,DEFORM),-lopenblas) -lpthread -lm
+$(IRDM_FW): $(call obj,$(FWMAIN_SRC)) $(if $(VIEW),$(VIEW_OBJ)) $(SIM_LIB) $(HAL_LIB) $(FW_LIB)
+	$(CC) $(LDFLAGS) $^ -o $@ $(if $(call feature,DEFORM),-lopenblas) $(if $(VIEW),$(VIEW_LIBS)) \
+	  -lpthread -lm
 
 # The drive emulator: the simulator, the HAL's CAN code, the firmware's arm.
 $(IRDM_CD): $(call obj,$(CDMAIN_SRC)) $(SIM_LIB) $(HAL_LIB) $(FW_LIB)
@@ -180,6 +200,9 @@ $(TICK_TESTS): $(BUILD)/tests/test_tick_%: $(BUILD)/obj/tests/test_tick_%.o $(FW
 $(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(call obj,$(TESTSUP_SRC)) $(TEST_LIBS) | $(SLEPC_PLUGIN)
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) $^ -o $@ $(LDLIBS) -lcmocka
+
+# the view's test drives its server and decodes the browser's screenshots
+$(BUILD)/tests/test_view: LDLIBS += $(VIEW_LIBS) -lpng
 
 # benches share the test fixtures, which report through cmocka
 $(BUILD)/bench/%: $(BUILD)/obj/tests/bench/%.o $(call obj,$(TESTSUP_SRC)) $(TEST_LIBS)

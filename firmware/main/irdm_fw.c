@@ -217,6 +217,9 @@ static int start(struct fw *fw)
 	rc = fw_log_open(fw);
 	if (rc)
 		return fail(FW_EXIT_SETUP, rc, "%s: %s", fw->args.log ? fw->args.log : "log", fw->err);
+	rc = fw_view_open(fw);
+	if (rc)
+		return fail(rc == IRDM_EINVAL ? FW_EXIT_USAGE : FW_EXIT_SETUP, rc, "%s%s", "", fw->err);
 	memset(&sa, 0, sizeof(sa));
 	sa.sa_handler = on_signal;
 	sigaction(SIGINT, &sa, NULL);
@@ -226,6 +229,8 @@ static int start(struct fw *fw)
 		return rc;
 	/* after the real-time set-up: the thread goes one level below it */
 	rc = fw_frame_start(fw);
+	if (!rc)
+		rc = fw_view_start(fw);
 	if (rc)
 		return fail(FW_EXIT_SETUP, rc, "%s%s", "", fw->err);
 	return FW_EXIT_OK;
@@ -239,6 +244,7 @@ static int stop(struct fw *fw, int rc)
 		if (fw->hal_open[i])
 			irdm_hal_safe_off(&fw->hal[i]);
 	fw_frame_stop(fw);
+	fw_view_close(fw);
 	if (rc == FW_EXIT_OK || rc == FW_EXIT_FAULT) {
 		int wrc = fw_frame_write(fw);
 		/* a fault's exit code says more than the frame it cut short */

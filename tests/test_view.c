@@ -1,0 +1,396 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * The live view (docs/view.md) end to end: irdm-fw with --view on the
+ * simulated arm in real time, the page in headless Chromium (driven over
+ * the DevTools pipe, tests/support/cdp.c), and what its screenshots show:
+ *  - the object is drawn: the surface's colour where the object's centre
+ *    projects, the background's in a corner;
+ *  - the surface around the pressing tool turns from the colour scale's
+ *    bottom (blue: no displacement) towards its top between a frame before
+ *    contact and one during the hold (the hand presses 1 cm; the fixed
+ *    scale tops at 1 cm);
+ *  - the strip chart's force and compute-time lines and the state text
+ *    ("enabled") are there, in their colours;
+ *  - the page's own counters: frames received per second and the latency.
+ * And bad requests: unknown paths, other methods, garbage and malformed
+ * WebSocket frames, a client that talks, one from another site and one
+ * that never reads are refused or dropped while a good client keeps
+ * receiving and the run ends normally.
+ *
+ * Chromium absent: the browser test is skipped, saying so (CI installs it:
+ * tools/scripts/install-deps.sh); the server's tests still run.
+ */
+#include <arpa/inet.h>
+#include <errno.h>
+#include <math.h>
+#include <netinet/in.h>
+#include <poll.h>
+#include <setjmp.h>
+#include <signal.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/socket.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#include <cmocka.h>
+#include <png.h>
+
+#include "support/cdp.h"
+#include "support/run_prog.h"
+#include "support/test_files.h"
+
+#define BOARD "boards/sim-phantom.board"
+#define W 1000
+#define H 600
+
+static char dir[256], image[320], board[320], user[320], out_text[16384], err_text[8192];
+
+static const char *env_or(const char *name, const char *dflt)
+{
+	const char *p = getenv(name);
+
+	return p ? p : dflt;
+}
+
+static double now_s(void)
+{
+	struct timespec t;
+
+	clock_gettime(CLOCK_MONOTONIC, &t);
+	return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static void sleep_s(double s)
+{
+	struct timespec t = { (time_t)s, (long)((s - floor(s)) * 1e9) };
+
+	nanosleep(&t, NULL);
+}
+
+/* irdm-fw with the view on any free loopback port; returns the port once
+ * the server listens (its first line on stdout). */
+static unsigned start_fw(pid_t *pid, const char *duration)
+{
+	char path[300], text[4096];
+	unsigned port = 0;
+	double t0 = now_s();
+
+	*pid = rp_spawn(dir, env_or("IRDM_FW", "build/irdm-fw"), (const char *const[]){
+		"--board", board, "--image", image, "--user", user, "--duration", duration,
+		"--view", "0", NULL });
+	snprintf(path, sizeof(path), "%s/stdout", dir);
+	while (now_s() - t0 < 20) {
+		FILE *f = fopen(path, "r");
+		const char *p;
+
+		if (f) {
+			size_t n = fread(text, 1, sizeof(text) - 1, f);
+			text[n] = '\0';
+			fclose(f);
+			p = strstr(text, "view: http://127.0.0.1:");
+			if (p && sscanf(p, "view: http://127.0.0.1:%u/", &port) == 1 && port)
+				return port;
+		}
+		if (waitpid(*pid, NULL, WNOHANG) == *pid)
+			fail_msg("irdm-fw ended before its view listened");
+		sleep_s(0.02);
+	}
+	fail_msg("irdm-fw's view did not listen within 20 s");
+	return 0;
+}
+
+static int finish_fw(pid_t pid)
+{
+	return rp_finish(dir, pid, out_text, sizeof(out_text), err_text, sizeof(err_text));
+}
+
+/* ---- screenshots ---- */
+
+struct shot {
+	unsigned char *rgb;
+	int w, h;
+};
+
+static void decode(struct shot *s, const unsigned char *png, size_t len)
+{
+	png_image im;
+
+	memset(&im, 0, sizeof(im));
+	im.version = PNG_IMAGE_VERSION;
+	assert_true(png_image_begin_read_from_memory(&im, png, len));
+	im.format = PNG_FORMAT_RGB;
+	s->rgb = malloc(PNG_IMAGE_SIZE(im));
+	assert_non_null(s->rgb);
+	assert_true(png_image_finish_read(&im, NULL, s->rgb, 0, NULL));
+	s->w = (int)im.width;
+	s->h = (int)im.height;
+}
+
+static void screenshot(struct cdp *c, struct shot *s, const char *name)
+{
+	size_t len;
+	unsigned char *png = cdp_screenshot(c, &len);
+	char path[300];
+	FILE *f;
+
+	decode(s, png, len);
+	/* kept beside the test's other files for a look when it fails */
+	snprintf(path, sizeof(path), "%s/%s.png", dir, name);
+	f = fopen(path, "wb");
+	if (f) {
+		fwrite(png, 1, len, f);
+		fclose(f);
+	}
+	free(png);
+}
+
+/* Mean colour of the (2r+1)^2 patch at (x, y). */
+static void patch(const struct shot *s, double x, double y, int r, double rgb[3])
+{
+	int n = 0, cx = (int)lround(x), cy = (int)lround(y);
+
+	rgb[0] = rgb[1] = rgb[2] = 0;
+	for (int j = cy - r; j <= cy + r; j++)
+		for (int i = cx - r; i <= cx + r; i++) {
+			if (i < 0 || j < 0 || i >= s->w || j >= s->h)
+				continue;
+			for (int k = 0; k < 3; k++)
+				rgb[k] += s->rgb[3 * ((size_t)j * (size_t)s->w + (size_t)i) + k];
+			n++;
+		}
+	assert_true(n > 0);
+	for (int k = 0; k < 3; k++)
+		rgb[k] /= n;
+}
+
+/* Pixels of the box within tol (sum of channel differences) of colour. */
+static int count_colour(const struct shot *s, const int box[4], const int colour[3], int tol)
+{
+	int n = 0;
+
+	for (int j = box[1]; j < box[1] + box[3] && j < s->h; j++)
+		for (int i = box[0]; i < box[0] + box[2] && i < s->w; i++) {
+			const unsigned char *p = s->rgb + 3 * ((size_t)j * (size_t)s->w + (size_t)i);
+			if (abs(p[0] - colour[0]) + abs(p[1] - colour[1]) + abs(p[2] - colour[2]) <= tol)
+				n++;
+		}
+	return n;
+}
+
+/* ---- the page ---- */
+
+struct report {
+	int connected, frames, fps;
+	double t, latency_ms;
+	char state[32];
+};
+
+static void report(struct cdp *c, struct report *r)
+{
+	char out[512];
+
+	if (!cdp_eval(c, "window.irdmReport ? irdmReport() : 'loading'", out, sizeof(out)) ||
+	    sscanf(out, "connected=%d frames=%d fps=%d t=%lf latency=%lf state=%31s", &r->connected,
+		   &r->frames, &r->fps, &r->t, &r->latency_ms, r->state) != 6)
+		memset(r, 0, sizeof(*r));
+}
+
+/* Wait (at most 30 s) until the page shows the run at t >= t_s. */
+static void wait_page_time(struct cdp *c, double t_s, struct report *r)
+{
+	double t0 = now_s();
+
+	for (;;) {
+		report(c, r);
+		if (r->connected && r->t >= t_s)
+			return;
+		if (now_s() - t0 > 30)
+			fail_msg("the page did not reach t = %g s (at %g s, %d frames)", t_s, r->t,
+				 r->frames);
+		sleep_s(0.05);
+	}
+}
+
+static void eval_ok(struct cdp *c, const char *expr, char *out, size_t len)
+{
+	if (!cdp_eval(c, expr, out, len))
+		fail_msg("page: %s: %s", expr, out);
+}
+
+static void project(struct cdp *c, double x, double y, double z, double px[2])
+{
+	char expr[128], out[64];
+
+	snprintf(expr, sizeof(expr), "irdmProject(%g, %g, %g)", x, y, z);
+	eval_ok(c, expr, out, sizeof(out));
+	assert_int_equal(sscanf(out, "%lf %lf", &px[0], &px[1]), 2);
+}
+
+static void rect(struct cdp *c, const char *id, int box[4])
+{
+	char expr[128], out[64];
+
+	snprintf(expr, sizeof(expr), "irdmRect('%s')", id);
+	eval_ok(c, expr, out, sizeof(out));
+	assert_int_equal(sscanf(out, "%d %d %d %d", &box[0], &box[1], &box[2], &box[3]), 4);
+}
+
+/* Around the top centre the hand presses: 1.2 cm from it on the top face,
+ * beside the tool, its proxy and the force arrow (drawn up from the proxy). */
+static const double ring[3][3] = {
+	{ 0.062, 0.05, 0.2 }, { 0.038, 0.05, 0.2 }, { 0.05, 0.038, 0.2 },
+};
+
+/* Red minus blue: the colour scale runs from blue (0) to red (its top). */
+static double warmth(const struct shot *s, const double px[3][2])
+{
+	double sum = 0, rgb[3];
+
+	for (int i = 0; i < 3; i++) {
+		patch(s, px[i][0], px[i][1], 2, rgb);
+		sum += rgb[0] - rgb[2];
+	}
+	return sum / 3;
+}
+
+static void test_live_view_in_chromium(void **state)
+{
+	static const int background[3] = { 0xf4, 0xf4, 0xf4 }, force_col[3] = { 0xe0, 0x70, 0 };
+	static const int compute_col[3] = { 0x99, 0x99, 0x99 }, enabled_col[3] = { 0, 0x66, 0 };
+	struct report r0, r1, r2;
+	struct shot before, hold;
+	double centre[2], px[3][2], rgb[3], w_before, w_hold, fps;
+	int chart[4], st[4], corner[4] = { 5, 5, 20, 20 };
+	char url[64], out[256];
+	struct cdp *c;
+	unsigned port;
+	pid_t pid;
+
+	(void)state;
+	if (!cdp_browser()) {
+		print_message("test_view: SKIPPED the browser test: no chromium (Debian: apt-get "
+			      "install chromium; or IRDM_CHROMIUM=PATH)\n");
+		skip();
+	}
+	port = start_fw(&pid, "9");
+	snprintf(url, sizeof(url), "http://127.0.0.1:%u/", port);
+	c = cdp_open(dir, url, W, H);
+	/* before contact: the hand rests 1 cm above the top until 3 s */
+	wait_page_time(c, 1.0, &r0);
+	assert_string_equal(r0.state, "enabled");
+	eval_ok(c, "irdmPause(true), 'paused'", out, sizeof(out));
+	screenshot(c, &before, "before");
+	project(c, 0.05, 0.05, 0.1, centre);
+	for (int i = 0; i < 3; i++)
+		project(c, ring[i][0], ring[i][1], ring[i][2], px[i]);
+	/* the object is drawn: blue (no displacement) at its centre, the
+	 * background in the corner */
+	patch(&before, centre[0], centre[1], 3, rgb);
+	print_message("object centre at (%.0f, %.0f): rgb %.0f %.0f %.0f\n", centre[0], centre[1],
+		      rgb[0], rgb[1], rgb[2]);
+	assert_true(rgb[2] > rgb[0] + 60 && rgb[2] > 100);
+	assert_true(count_colour(&before, corner, background, 6) == corner[2] * corner[3]);
+	w_before = warmth(&before, px);
+	/* holding: pressed 1 cm from 4.2 s to 7.2 s */
+	eval_ok(c, "irdmPause(false), 'resumed'", out, sizeof(out));
+	wait_page_time(c, 5.0, &r1);
+	eval_ok(c, "irdmPause(true), 'paused'", out, sizeof(out));
+	screenshot(c, &hold, "hold");
+	w_hold = warmth(&hold, px);
+	print_message("around the tool: red - blue %.0f before contact, %.0f holding\n", w_before,
+		      w_hold);
+	assert_true(w_before < -60);
+	assert_true(w_hold > w_before + 100);
+	/* the chart's lines and the state, in their colours */
+	rect(c, "chart", chart);
+	rect(c, "state", st);
+	print_message("chart: %d force pixels, %d compute-time pixels; state: %d text pixels\n",
+		      count_colour(&hold, chart, force_col, 60), count_colour(&hold, chart, compute_col, 30),
+		      count_colour(&hold, st, enabled_col, 60));
+	assert_true(count_colour(&hold, chart, force_col, 60) >= 50);
+	assert_true(count_colour(&hold, chart, compute_col, 30) >= 50);
+	assert_true(count_colour(&hold, st, enabled_col, 60) >= 30);
+	eval_ok(c, "document.getElementById('state').textContent", out, sizeof(out));
+	assert_string_equal(out, "enabled");
+	/* the page's counters while it runs: frames received per second */
+	eval_ok(c, "irdmPause(false), 'resumed'", out, sizeof(out));
+	report(c, &r1);
+	sleep_s(1.5);
+	report(c, &r2);
+	fps = (r2.frames - r1.frames) / 1.5;
+	print_message("page: %d frames/s by its counter, %.1f over 1.5 s; %.1f ms behind the loop\n",
+		      r2.fps, fps, r2.latency_ms);
+	/* published at 50/s: a live stream, even on a loaded machine */
+	assert_true(r2.fps >= 10 && fps >= 10);
+	assert_true(r2.latency_ms >= 0 && r2.latency_ms < 2000);
+	cdp_close(c);
+	assert_int_equal(finish_fw(pid), 0);
+	assert_non_null(strstr(out_text, "state: off"));
+	assert_non_null(strstr(out_text, " 1 pages opened"));
+	free(before.rgb);
+	free(hold.rgb);
+}
+
+static int setup(void **state)
+{
+	pid_t pid;
+	char text[16384], out[16384] = "", *line, *save;
+
+	(void)state;
+	if (tf_tmpdir(dir, sizeof(dir), "view"))
+		return -1;
+	snprintf(image, sizeof(image), "%s/cuboid.img", dir);
+	snprintf(user, sizeof(user), "%s/slow.user", dir);
+	snprintf(board, sizeof(board), "%s/relaxed.board", dir);
+	/* the hand rests 1 cm above the top centre for 3 s (time for the page
+	 * to connect), comes down, presses 1 cm and holds 3 s */
+	tf_write_text(user, "at 0.0 place 1 at 0.05,0.05,0.21\n"
+			    "at 3.0 move 1 to 0.05,0.05,0.20 over 0.5\n"
+			    "at 4.0 move 1 to 0.05,0.05,0.19 over 0.2\n"
+			    "hold 1 for 3.0\nrelease 1\nhold 1 for 1.0\n");
+	/* overruns and the watchdog relaxed: a loaded host (a browser beside
+	 * the controller) may overrun, and this test is about the view */
+	tf_read_text(BOARD, text, sizeof(text));
+	for (line = strtok_r(text, "\n", &save); line; line = strtok_r(NULL, "\n", &save)) {
+		if (!strncmp(line, "overrun_fault_count", 19))
+			line = "overrun_fault_count = 1000";
+		else if (!strncmp(line, "watchdog_us", 11))
+			line = "watchdog_us = 1000000";
+		strncat(out, line, sizeof(out) - strlen(out) - 2);
+		strcat(out, "\n");
+	}
+	tf_write_text(board, out);
+	/* the paper's cuboid at 4 x 4 x 8 cells, its whole surface displayed */
+	pid = rp_spawn(dir, env_or("IRDM", "build/irdm"), (const char *const[]){
+		"precompute", "-q", "--mesh", "cuboid", "--resolution", "4,4,8", "--fixed", "z<=0",
+		"--touch", "z>=0.2", "--display", "surface", "--representation", "modal:40",
+		"--static_correction", "yes", "-o", image, NULL });
+	return finish_fw(pid) == 0 ? 0 : -1;
+}
+
+static int teardown(void **state)
+{
+	(void)state;
+	/* IRDM_VIEW_KEEP=1: keep the screenshots and logs to look at */
+	if (getenv("IRDM_VIEW_KEEP")) {
+		print_message("test_view: kept %s\n", dir);
+		return 0;
+	}
+	return tf_rmdir(dir);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_live_view_in_chromium),
+	};
+
+	signal(SIGPIPE, SIG_IGN);
+	return cmocka_run_group_tests(tests, setup, teardown);
+}
