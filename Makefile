@@ -13,6 +13,7 @@
 #   make report     docs/report.md and its plots: every representation against
 #                   the exact model (irdm report; REPORT_CONFIGS, <= 10 min)
 #   make run        the main job: the built-in default scene, end to end
+#   make view-shots after make run: its run in the browser view, docs/view/*.png
 #   make jitter     irdm-fw's wake-up latency beside cyclictest's (JITTER_SECONDS)
 #   make hil        the CAN back-end end to end in a PREEMPT_RT VM (docs/hil.md)
 #   make docs       docs/scene-format.md from the scene key table
@@ -107,7 +108,7 @@ SIM_SRC   := $(filter-out sim/main/%,$(wildcard sim/*/*.c))
 CDMAIN_SRC := $(wildcard sim/main/*.c)
 TOOL_SRC  := $(filter-out tools/irdm/%,$(wildcard tools/*/*.c))
 VIEW_PAGE := $(wildcard tools/view/page/*)
-VIEW_OBJ   = $(call obj,$(wildcard tools/view/*.c)) $(BUILD)/obj/gen/view_page.o
+VIEW_OBJ   = $(call obj,tools/view/view_server.c tools/view/view_msg.c) $(BUILD)/obj/gen/view_page.o
 VIEW_LIBS := -lwebsockets
 CLI_SRC   := $(wildcard tools/irdm/*.c)
 PLUGIN_SRC := $(wildcard tools/dist/plugin/*.c)
@@ -130,7 +131,7 @@ TESTS    := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 TICK_TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TICK_TEST_SRC))
 BENCHES  := $(patsubst tests/bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC))
 
-.PHONY: all test san fuzz bench bench-precompute bench-mpi run render stability report jitter check deps clean docs cfg-fws sizes hil
+.PHONY: all test san fuzz bench bench-precompute bench-mpi run render view-shots stability report jitter check deps clean docs cfg-fws sizes hil
 .SECONDARY:
 all: $(if $(CONFIG),,$(IRDM) $(SLEPC_PLUGIN)) $(FW_LIB) $(HAL_LIB) $(SIM_LIB) $(if $(FWMAIN_SRC),$(IRDM_FW)) \
   $(if $(CDMAIN_SRC),$(IRDM_CD))
@@ -335,6 +336,14 @@ check: deps
 run: deps
 	$(MAKE) $(IRDM) $(IRDM_FW)
 	tools/scripts/run-default-scene.sh $(IRDM) $(IRDM_FW)
+
+# The recorded run of make run in the view's page (irdm view) at three
+# moments: pressing, holding, ringing after the release (docs/view.md)
+VIEW_SHOT_TIMES ?= 1.1 2.5 3.4
+view-shots: $(IRDM)
+	@test -f out/run.log -a -f out/default.img || { echo "view-shots: needs out/run.log: make run first"; exit 1; }
+	/usr/bin/python3 tools/scripts/view-shots.py $(IRDM) out/run.log boards/sim-phantom.board \
+	  out/default.img docs/view/run-playback.png $(VIEW_SHOT_TIMES)
 
 # The default scene's deformed surface as VTK frames, PNGs and force plots
 # (irdm render; out/render-*; after make run it also renders that run's log)

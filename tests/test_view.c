@@ -25,15 +25,19 @@
 #include <math.h>
 #include <netinet/in.h>
 #include <poll.h>
+#include <pthread.h>
 #include <setjmp.h>
 #include <signal.h>
+#include <stdatomic.h>
 #include <stdarg.h>
 #include <stddef.h>
+#include <stdbool.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/socket.h>
+#include <sys/time.h>
 #include <sys/wait.h>
 #include <time.h>
 #include <unistd.h>
@@ -41,11 +45,13 @@
 #include <cmocka.h>
 #include <png.h>
 
+#include "irdm/telemetry.h"
 #include "support/cdp.h"
 #include "support/run_prog.h"
 #include "support/test_files.h"
 
 #define BOARD "boards/sim-phantom.board"
+#define VIEW_CLIENTS 8          /* the server's limit (tools/view/view_server.h) */
 #define W 1000
 #define H 600
 
@@ -73,9 +79,9 @@ static void sleep_s(double s)
 	nanosleep(&t, NULL);
 }
 
-/* irdm-fw with the view on any free loopback port; returns the port once
- * the server listens (its first line on stdout). */
-static unsigned start_fw(pid_t *pid, const char *duration)
+/* irdm-fw with the view on any free loopback port (and a log unless
+ * NULL); returns the port once the server listens (its line on stdout). */
+static unsigned start_fw_log(pid_t *pid, const char *duration, const char *log)
 {
 	char path[300], text[4096];
 	unsigned port = 0;
@@ -83,7 +89,7 @@ static unsigned start_fw(pid_t *pid, const char *duration)
 
 	*pid = rp_spawn(dir, env_or("IRDM_FW", "build/irdm-fw"), (const char *const[]){
 		"--board", board, "--image", image, "--user", user, "--duration", duration,
-		"--view", "0", NULL });
+		"--view", "0", log ? "--log" : NULL, log, NULL });
 	snprintf(path, sizeof(path), "%s/stdout", dir);
 	while (now_s() - t0 < 20) {
 		FILE *f = fopen(path, "r");
@@ -103,6 +109,11 @@ static unsigned start_fw(pid_t *pid, const char *duration)
 	}
 	fail_msg("irdm-fw's view did not listen within 20 s");
 	return 0;
+}
+
+static unsigned start_fw(pid_t *pid, const char *duration)
+{
+	return start_fw_log(pid, duration, NULL);
 }
 
 static int finish_fw(pid_t pid)
@@ -337,6 +348,271 @@ static void test_live_view_in_chromium(void **state)
 	free(hold.rgb);
 }
 
+/* ---- raw clients for the bad requests ---- */
+
+static int tcp_connect(unsigned port, int rcvbuf)
+{
+	struct sockaddr_in a = { .sin_family = AF_INET, .sin_port = htons((uint16_t)port) };
+	struct timeval tv = { 5, 0 };
+	int fd = socket(AF_INET, SOCK_STREAM, 0);
+
+	assert_true(fd >= 0);
+	if (rcvbuf)
+		setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &rcvbuf, sizeof(rcvbuf));
+	setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof(tv));
+	a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+	assert_int_equal(connect(fd, (struct sockaddr *)&a, sizeof(a)), 0);
+	return fd;
+}
+
+static void send_all(int fd, const void *buf, size_t n)
+{
+	/* the server may close first: that is an answer too */
+	while (n) {
+		ssize_t w = send(fd, buf, n, MSG_NOSIGNAL);
+		if (w <= 0)
+			return;
+		buf = (const char *)buf + w;
+		n -= (size_t)w;
+	}
+}
+
+/* Send req; the status of the reply, 0 if the server closed without one. */
+static int http_status(unsigned port, const void *req, size_t n)
+{
+	char reply[256] = "";
+	int fd = tcp_connect(port, 0), status = 0;
+	ssize_t r;
+
+	send_all(fd, req, n);
+	r = recv(fd, reply, sizeof(reply) - 1, 0);
+	if (r > 0) {
+		reply[r] = '\0';
+		if (sscanf(reply, "HTTP/1.%*d %d", &status) != 1)
+			status = -1;
+	}
+	close(fd);
+	return status;
+}
+
+static int http_get(unsigned port, const char *path)
+{
+	char req[512];
+
+	snprintf(req, sizeof(req), "GET %s HTTP/1.1\r\nHost: 127.0.0.1:%u\r\n\r\n", path, port);
+	return http_status(port, req, strlen(req));
+}
+
+/* A WebSocket handshake (Origin: origin unless NULL); the socket if the
+ * server switched protocols, else -(the reply's status or 1). */
+static int ws_open(unsigned port, const char *origin, int rcvbuf)
+{
+	char req[512], reply[2048];
+	int fd = tcp_connect(port, rcvbuf), status = 0;
+	size_t n = 0;
+
+	snprintf(req, sizeof(req), "GET / HTTP/1.1\r\nHost: 127.0.0.1:%u\r\nUpgrade: websocket\r\n"
+		 "Connection: Upgrade\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n"
+		 "Sec-WebSocket-Version: 13\r\nSec-WebSocket-Protocol: irdm-view\r\n%s%s%s\r\n",
+		 port, origin ? "Origin: " : "", origin ? origin : "", origin ? "\r\n" : "");
+	send_all(fd, req, strlen(req));
+	/* byte by byte to the blank line: what follows is the first frame */
+	while (n < sizeof(reply) - 1 && recv(fd, reply + n, 1, 0) == 1) {
+		n++;
+		reply[n] = '\0';
+		if (n >= 4 && !strcmp(reply + n - 4, "\r\n\r\n"))
+			break;
+	}
+	if (sscanf(reply, "HTTP/1.1 %d", &status) == 1 && status == 101)
+		return fd;
+	close(fd);
+	return -(status ? status : 1);
+}
+
+static bool recv_all(int fd, void *buf, size_t n)
+{
+	while (n) {
+		ssize_t r = recv(fd, buf, n, 0);
+		if (r <= 0)
+			return false;
+		buf = (char *)buf + r;
+		n -= (size_t)r;
+	}
+	return true;
+}
+
+/* The next frame from the server: its opcode (-1: closed or timed out);
+ * the first 8 bytes of its payload (magic, kind) into head. */
+static int ws_frame(int fd, uint32_t head[2])
+{
+	unsigned char h[2], ext[8], skip[4096];
+	uint64_t len;
+	size_t got = 0;
+
+	if (!recv_all(fd, h, 2))
+		return -1;
+	len = h[1] & 0x7f;
+	if (len == 126 || len == 127) {
+		size_t k = len == 126 ? 2 : 8;
+		if (!recv_all(fd, ext, k))
+			return -1;
+		len = 0;
+		for (size_t i = 0; i < k; i++)
+			len = len << 8 | ext[i];
+	}
+	head[0] = head[1] = 0;
+	while (got < len) {
+		size_t n = len - got < sizeof(skip) ? (size_t)(len - got) : sizeof(skip);
+		if (!recv_all(fd, skip, n))
+			return -1;
+		if (!got && n >= 8)
+			memcpy(head, skip, 8);
+		got += n;
+	}
+	return h[0] & 0x0f;
+}
+
+/* The server hangs up on fd within 5 s (a close frame first is fine). */
+static bool hung_up(int fd)
+{
+	uint32_t head[2];
+	double t0 = now_s();
+	int op;
+
+	while ((op = ws_frame(fd, head)) >= 0)
+		if (now_s() - t0 > 5)
+			return false;
+	return true;
+}
+
+/* A client frame as a client must send it: FIN, opcode, masked payload. */
+static void ws_send(int fd, unsigned char first, const char *payload)
+{
+	unsigned char f[256];
+	size_t n = strlen(payload);
+
+	f[0] = first;
+	f[1] = (unsigned char)(0x80 | n);
+	memcpy(f + 2, "\x11\x22\x33\x44", 4);
+	for (size_t i = 0; i < n; i++)
+		f[6 + i] = (unsigned char)payload[i] ^ f[2 + i % 4];
+	send_all(fd, f, 6 + n);
+}
+
+/* The good client: reads every frame in a thread of its own while the
+ * test plays the bad ones, so that it is never the slow one. */
+struct reader {
+	int fd;
+	pthread_t tid;
+	atomic_int frames;
+	atomic_bool lost, stop;
+};
+
+static void *read_frames(void *arg)
+{
+	struct reader *r = arg;
+	uint32_t head[2];
+
+	while (!atomic_load(&r->stop)) {
+		if (ws_frame(r->fd, head) != 2) {
+			atomic_store(&r->lost, true);
+			break;
+		}
+		if (head[0] == 0x56445249u && head[1] == 2)
+			atomic_fetch_add(&r->frames, 1);
+	}
+	return NULL;
+}
+
+static void test_bad_requests_leave_the_controller_alone(void **state)
+{
+	static const unsigned char unmasked[] = { 0x81, 0x02, 'h', 'i' };
+	static const unsigned char rsv[] = { 0xc1, 0x82, 1, 2, 3, 4, 'h' ^ 1, 'i' ^ 2 };
+	static const unsigned char huge[] = { 0x82, 0xff, 0xff, 0xff, 0xff, 0xff, 0xff, 0xff, 0xff,
+					      0xff, 1, 2, 3, 4 };
+	char log[320], req[600], err[256];
+	struct irdm_log_reader *lr;
+	uint32_t head[2], seed = 12345;
+	struct reader good = { 0 };
+	int mute, fd, extra[VIEW_CLIENTS], n;
+	unsigned port;
+	pid_t pid;
+
+	(void)state;
+	snprintf(log, sizeof(log), "%s/bad.log", dir);
+	port = start_fw_log(&pid, "6", log);
+	good.fd = ws_open(port, NULL, 0);
+	assert_true(good.fd >= 0);
+	assert_int_equal(ws_frame(good.fd, head), 2);
+	assert_true(head[0] == 0x56445249u && head[1] == 1);    /* the hello first */
+	assert_int_equal(pthread_create(&good.tid, NULL, read_frames, &good), 0);
+	/* unknown paths, other methods, garbage: refused, never served */
+	assert_int_equal(http_get(port, "/nope"), 404);
+	assert_int_not_equal(http_get(port, "/../../etc/passwd"), 200);
+	assert_int_not_equal(http_get(port, "/index.html/../../../etc/passwd"), 200);
+	snprintf(req, sizeof(req), "POST / HTTP/1.1\r\nHost: x\r\nContent-Length: 3\r\n\r\nabc");
+	assert_int_not_equal(http_status(port, req, strlen(req)), 200);
+	snprintf(req, sizeof(req), "GARBAGE\r\n\r\n");
+	assert_int_not_equal(http_status(port, req, strlen(req)), 200);
+	for (int k = 0; k < 100; k++) {
+		unsigned char junk[512];
+		size_t len = 1 + (seed = seed * 1103515245u + 12345u) % sizeof(junk);
+
+		for (size_t i = 0; i < len; i++)
+			junk[i] = (unsigned char)((seed = seed * 1103515245u + 12345u) >> 16);
+		assert_int_not_equal(http_status(port, junk, len), 200);
+	}
+	/* malformed WebSocket frames, and a client that talks: hung up on */
+	fd = ws_open(port, NULL, 0);
+	send_all(fd, unmasked, sizeof(unmasked));
+	assert_true(hung_up(fd));
+	close(fd);
+	fd = ws_open(port, NULL, 0);
+	send_all(fd, rsv, sizeof(rsv));
+	assert_true(hung_up(fd));
+	close(fd);
+	fd = ws_open(port, NULL, 0);
+	send_all(fd, huge, sizeof(huge));
+	assert_true(hung_up(fd));
+	close(fd);
+	fd = ws_open(port, NULL, 0);
+	ws_send(fd, 0x81, "enable");   /* the page only watches */
+	assert_true(hung_up(fd));
+	close(fd);
+	/* another site's page: no socket */
+	assert_true(ws_open(port, "http://evil.example", 0) < 0);
+	/* a client that never reads, and clients up to the limit: the one
+	 * past it is turned away */
+	mute = ws_open(port, NULL, 4096);
+	assert_true(mute >= 0);
+	for (n = 0; n < VIEW_CLIENTS - 2; n++)
+		extra[n] = ws_open(port, NULL, 0);
+	fd = ws_open(port, NULL, 0);
+	assert_true(fd < 0 || hung_up(fd));
+	if (fd >= 0)
+		close(fd);
+	for (int i = 0; i < n; i++)
+		close(extra[i]);
+	/* the good client still gets its frames (50 a second are published) */
+	n = atomic_load(&good.frames);
+	sleep_s(2.0);
+	n = atomic_load(&good.frames) - n;
+	print_message("good client: %d frames in 2 s beside a client that never reads\n", n);
+	assert_true(n >= 20);
+	assert_int_equal(http_get(port, "/"), 200);
+	assert_false(atomic_load(&good.lost));
+	atomic_store(&good.stop, true);
+	pthread_join(good.tid, NULL);   /* its next frame, or the run's end, wakes it */
+	close(good.fd);
+	close(mute);
+	/* the controller ran to its end, every tick logged */
+	assert_int_equal(finish_fw(pid), 0);
+	assert_non_null(strstr(out_text, "state: off"));
+	assert_int_equal(irdm_log_open(&lr, log, err, sizeof(err)), 0);
+	assert_int_equal(irdm_log_header(lr)->record_count, 6000);
+	irdm_log_close(lr);
+}
+
 static int setup(void **state)
 {
 	pid_t pid;
@@ -388,6 +664,7 @@ static int teardown(void **state)
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_bad_requests_leave_the_controller_alone),
 		cmocka_unit_test(test_live_view_in_chromium),
 	};
 

@@ -162,7 +162,7 @@ static int send_hello(struct fw_view *v)
 		ext = fminf(ext, hi[k] - lo[k]);
 	h = (struct view_hello){ VIEW_MODE_LIVE, n, img->meta->n_tris, v->fw->board.devices,
 				 (float)(v->fw->board.period_us * 1e-6),
-				 ext > 0 && isfinite(ext) ? 0.1f * ext : 0.01f, 0.0f,
+				 ext > 0 && isfinite(ext) ? 0.1f * ext : 0.01f, 0.0f, 0,
 				 v->fw->board.name, rest, img->tris };
 	rc = view_server_set_hello(v->srv, buf, view_hello_write(buf, &h));
 out:
@@ -174,19 +174,11 @@ out:
 /* "[ADDR:]PORT" */
 static int parse_view(struct fw *fw, char *addr, size_t addrlen, unsigned *port)
 {
-	const char *a = fw->args.view, *colon = strrchr(a, ':'), *p = colon ? colon + 1 : a;
-	char *end;
-	unsigned long v = strtoul(p, &end, 10);
-
-	if (!*p || *end || v > 65535 || (colon && (size_t)(colon - a) >= addrlen) || colon == a) {
-		snprintf(fw->err, sizeof(fw->err), "--view '%s': expected [ADDR:]PORT, PORT 0..65535",
-			 a);
-		return IRDM_EINVAL;
-	}
-	snprintf(addr, addrlen, "%.*s", colon ? (int)(colon - a) : (int)strlen(VIEW_DEFAULT_ADDR),
-		 colon ? a : VIEW_DEFAULT_ADDR);
-	*port = (unsigned)v;
-	return IRDM_OK;
+	if (!view_parse_listen(fw->args.view, addr, addrlen, port))
+		return IRDM_OK;
+	snprintf(fw->err, sizeof(fw->err), "--view '%s': expected [ADDR:]PORT, PORT 0..65535",
+		 fw->args.view);
+	return IRDM_EINVAL;
 }
 
 static int alloc_buffers(struct fw_view *v)

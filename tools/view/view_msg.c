@@ -53,6 +53,7 @@ size_t view_hello_write(unsigned char *buf, const struct view_hello *h)
 	p = put_f32(p, h->period_s);
 	p = put_f32(p, h->scale_m);
 	p = put_f32(p, h->duration_s);
+	p = put_u32(p, h->n_frames);
 	p = put(p, name, sizeof(name));
 	p = put(p, h->rest_m, 12 * (size_t)h->n_nodes);
 	p = put(p, h->tris, 12 * (size_t)h->n_tris);

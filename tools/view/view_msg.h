@@ -22,7 +22,7 @@
 #define VIEW_MODE_LIVE 0u
 #define VIEW_MODE_PLAYBACK 1u
 #define VIEW_DEVICES 2u                 /* a frame always holds two device slots */
-#define VIEW_HELLO_HEAD 104u
+#define VIEW_HELLO_HEAD 108u
 #define VIEW_FRAME_HEAD 200u
 #define VIEW_SAMPLE_BYTES 16u
 #define VIEW_FRAME_POSITIONS 1u         /* frame flag: node positions follow */
@@ -30,6 +30,7 @@
 struct view_hello {
 	uint32_t mode, n_nodes, n_tris, n_dev;
 	float period_s, scale_m, duration_s;
+	uint32_t n_frames;              /* playback: the recording's frames (0 live) */
 	const char *name;               /* the board's; cut to 63 bytes */
 	const float *rest_m;            /* 3 n_nodes */
 	const uint32_t *tris;           /* 3 n_tris, each < n_nodes */

@@ -266,6 +266,23 @@ io:
 	return IRDM_EIO;
 }
 
+int view_parse_listen(const char *spec, char *addr, size_t addrlen, unsigned *port)
+{
+	const char *colon = strrchr(spec, ':'), *p = colon ? colon + 1 : spec;
+	char *end;
+	unsigned long v;
+
+	if (!*p || *p < '0' || *p > '9' || colon == spec)
+		return IRDM_EINVAL;
+	v = strtoul(p, &end, 10);
+	if (*end || v > 65535 || (colon && (size_t)(colon - spec) >= addrlen))
+		return IRDM_EINVAL;
+	snprintf(addr, addrlen, "%.*s", colon ? (int)(colon - spec) : (int)strlen(VIEW_DEFAULT_ADDR),
+		 colon ? spec : VIEW_DEFAULT_ADDR);
+	*port = (unsigned)v;
+	return IRDM_OK;
+}
+
 static int check_config(const struct view_server_config *c, char *err, size_t errlen)
 {
 	struct in_addr a;

@@ -48,6 +48,10 @@ struct view_server_stats {
 	unsigned clients;                       /* open WebSockets now */
 };
 
+/* "[ADDR:]PORT" (ADDR default VIEW_DEFAULT_ADDR, PORT 0..65535, 0: any):
+ * IRDM_OK or IRDM_EINVAL. */
+int view_parse_listen(const char *spec, char *addr, size_t addrlen, unsigned *port);
+
 /*
  * Bind and listen; nothing runs until view_server_run().
  * Return: IRDM_OK; IRDM_EINVAL (bad address, port, rate or size);

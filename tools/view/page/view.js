@@ -5,7 +5,7 @@
 'use strict';
 
 var MAGIC = 0x56445249, HELLO = 1, FRAME = 2, PLAYBACK = 1;
-var HELLO_HEAD = 104, FRAME_HEAD = 200, SAMPLE = 16, DEV = 64;
+var HELLO_HEAD = 108, FRAME_HEAD = 200, SAMPLE = 16, DEV = 64;
 var STATES = ['init', 'ready', 'enabled', 'fault', 'off'];
 var FAULTS = ['clamp', 'workspace', 'velocity', 'watchdog', 'overrun', 'encoder NaN',
 	'encoder range', 'signal', 'HAL read', 'HAL write', 'HAL fault', 'engine'];
@@ -24,7 +24,7 @@ var frames = [];                        // playback: every frame, in order
 var samples = [];                       // the chart: {t, f0, f1, c}
 var orbit = { theta: -1.1, phi: 0.95, dist: 1, target: new THREE.Vector3() };
 var stats = { frames: 0, times: [], fps: 0, latency_ms: NaN, state: 'connecting', t: 0,
-	dropped: 0, connected: false, probe: null };
+	dropped: 0, connected: false, probe: null, loaded: false };
 var paused = false, playing = false, playT = 0, lastWall = 0;
 window.irdmStats = stats;
 
@@ -46,11 +46,11 @@ function ramp(x, out, k) {
 // ---- messages ----
 function readHello(dv) {
 	var n = dv.getUint32(16, true), m = dv.getUint32(20, true), name = '';
-	for (var i = 0; i < 64 && dv.getUint8(40 + i); i++)
-		name += String.fromCharCode(dv.getUint8(40 + i));
+	for (var i = 0; i < 64 && dv.getUint8(44 + i); i++)
+		name += String.fromCharCode(dv.getUint8(44 + i));
 	var h = { mode: dv.getUint32(12, true), n: n, m: m, ndev: dv.getUint32(24, true),
 		period: dv.getFloat32(28, true), scale: dv.getFloat32(32, true),
-		duration: dv.getFloat32(36, true), name: name,
+		duration: dv.getFloat32(36, true), nframes: dv.getUint32(40, true), name: name,
 		rest: new Float32Array(dv.buffer.slice(HELLO_HEAD, HELLO_HEAD + 12 * n)),
 		tris: new Uint32Array(dv.buffer.slice(HELLO_HEAD + 12 * n, HELLO_HEAD + 12 * n + 12 * m)) };
 	return h;
@@ -261,7 +261,7 @@ function showStats() {
 	var s = stats.fps + ' frames/s, ' + (isNaN(stats.latency_ms) ? '-' :
 		stats.latency_ms.toFixed(0) + ' ms') + ' behind the loop';
 	if (model && model.mode === PLAYBACK)
-		s = frames.length + ' frames recorded';
+		s = frames.length + (stats.loaded ? '' : ' of ' + model.nframes) + ' frames recorded';
 	else if (stats.dropped)
 		s += ', ' + stats.dropped + ' records dropped';
 	el('stats').textContent = s;
@@ -283,8 +283,11 @@ function onRecorded(f) {
 	frames.push(f);
 	Array.prototype.push.apply(samples, f.samples);
 	stats.frames = frames.length;
-	if (frames.length === 1)
+	// the whole recording is there: show the time the address asks for
+	if (frames.length === model.nframes) {
+		stats.loaded = true;
 		seek(parseFloat(params.get('t')) || 0);
+	}
 }
 
 function frameAt(t) {
@@ -342,7 +345,8 @@ window.irdmRect = function (id) {
 window.irdmReport = function () {
 	return 'connected=' + (stats.connected ? 1 : 0) + ' frames=' + stats.frames + ' fps=' +
 		stats.fps + ' t=' + stats.t.toFixed(3) + ' latency=' +
-		(isNaN(stats.latency_ms) ? -1 : stats.latency_ms.toFixed(1)) + ' state=' + stats.state;
+		(isNaN(stats.latency_ms) ? -1 : stats.latency_ms.toFixed(1)) + ' state=' + stats.state +
+		' loaded=' + (stats.loaded ? 1 : 0);
 };
 
 // ---- the socket: reconnects by itself (the controller may restart) ----
@@ -357,7 +361,7 @@ function connect() {
 		var kind = dv.getUint32(4, true);
 		if (kind === HELLO) {
 			model = readHello(dv);
-			frames = []; samples = []; stats.frames = 0;
+			frames = []; samples = []; stats.frames = 0; stats.loaded = false;
 			build(model);
 		} else if (kind === FRAME && model) {
 			var f = readFrame(dv);
