@@ -377,14 +377,17 @@ static void send_all(int fd, const void *buf, size_t n)
 	}
 }
 
-/* Send req; the status of the reply, 0 if the server closed without one. */
-static int http_status(unsigned port, const void *req, size_t n)
+/* Send req (then end the stream when eof); the status of the reply, 0 if
+ * the server closed without one. */
+static int http_status(unsigned port, const void *req, size_t n, bool eof)
 {
 	char reply[256] = "";
 	int fd = tcp_connect(port, 0), status = 0;
 	ssize_t r;
 
 	send_all(fd, req, n);
+	if (eof)
+		shutdown(fd, SHUT_WR);
 	r = recv(fd, reply, sizeof(reply) - 1, 0);
 	if (r > 0) {
 		reply[r] = '\0';
@@ -400,7 +403,7 @@ static int http_get(unsigned port, const char *path)
 	char req[512];
 
 	snprintf(req, sizeof(req), "GET %s HTTP/1.1\r\nHost: 127.0.0.1:%u\r\n\r\n", path, port);
-	return http_status(port, req, strlen(req));
+	return http_status(port, req, strlen(req), false);
 }
 
 /* A WebSocket handshake (Origin: origin unless NULL); the socket if the
@@ -429,33 +432,42 @@ static int ws_open(unsigned port, const char *origin, int rcvbuf)
 	return -(status ? status : 1);
 }
 
-static bool recv_all(int fd, void *buf, size_t n)
+#define WS_CLOSED (-1)
+#define WS_TIMEOUT (-2)
+
+/* 0, WS_CLOSED (end of stream, reset) or WS_TIMEOUT (SO_RCVTIMEO). */
+static int recv_all(int fd, void *buf, size_t n)
 {
 	while (n) {
 		ssize_t r = recv(fd, buf, n, 0);
+		if (r < 0 && errno == EINTR)
+			continue;
+		if (r < 0 && (errno == EAGAIN || errno == EWOULDBLOCK))
+			return WS_TIMEOUT;
 		if (r <= 0)
-			return false;
+			return WS_CLOSED;
 		buf = (char *)buf + r;
 		n -= (size_t)r;
 	}
-	return true;
+	return 0;
 }
 
-/* The next frame from the server: its opcode (-1: closed or timed out);
+/* The next frame from the server: its opcode, or WS_CLOSED / WS_TIMEOUT;
  * the first 8 bytes of its payload (magic, kind) into head. */
 static int ws_frame(int fd, uint32_t head[2])
 {
 	unsigned char h[2], ext[8], skip[4096];
 	uint64_t len;
 	size_t got = 0;
+	int rc;
 
-	if (!recv_all(fd, h, 2))
-		return -1;
+	if ((rc = recv_all(fd, h, 2)))
+		return rc;
 	len = h[1] & 0x7f;
 	if (len == 126 || len == 127) {
 		size_t k = len == 126 ? 2 : 8;
-		if (!recv_all(fd, ext, k))
-			return -1;
+		if ((rc = recv_all(fd, ext, k)))
+			return rc;
 		len = 0;
 		for (size_t i = 0; i < k; i++)
 			len = len << 8 | ext[i];
@@ -463,8 +475,8 @@ static int ws_frame(int fd, uint32_t head[2])
 	head[0] = head[1] = 0;
 	while (got < len) {
 		size_t n = len - got < sizeof(skip) ? (size_t)(len - got) : sizeof(skip);
-		if (!recv_all(fd, skip, n))
-			return -1;
+		if ((rc = recv_all(fd, skip, n)))
+			return rc;
 		if (!got && n >= 8)
 			memcpy(head, skip, 8);
 		got += n;
@@ -472,7 +484,8 @@ static int ws_frame(int fd, uint32_t head[2])
 	return h[0] & 0x0f;
 }
 
-/* The server hangs up on fd within 5 s (a close frame first is fine). */
+/* The server hangs up on fd within 5 s (a close frame first is fine);
+ * frames still coming or silence are not a hang-up. */
 static bool hung_up(int fd)
 {
 	uint32_t head[2];
@@ -482,7 +495,7 @@ static bool hung_up(int fd)
 	while ((op = ws_frame(fd, head)) >= 0)
 		if (now_s() - t0 > 5)
 			return false;
-	return true;
+	return op == WS_CLOSED;
 }
 
 /* A client frame as a client must send it: FIN, opcode, masked payload. */
@@ -535,12 +548,16 @@ static void test_bad_requests_leave_the_controller_alone(void **state)
 	uint32_t head[2], seed = 12345;
 	struct reader good = { 0 };
 	int mute, fd, extra[VIEW_CLIENTS], n;
+	double t0 = now_s();
+	uint64_t ticks = 0;
+	const char *p;
 	unsigned port;
 	pid_t pid;
 
 	(void)state;
 	snprintf(log, sizeof(log), "%s/bad.log", dir);
-	port = start_fw_log(&pid, "6", log);
+	/* long enough for a loaded machine; stopped by SIGTERM once done */
+	port = start_fw_log(&pid, "60", log);
 	good.fd = ws_open(port, NULL, 0);
 	assert_true(good.fd >= 0);
 	assert_int_equal(ws_frame(good.fd, head), 2);
@@ -551,16 +568,16 @@ static void test_bad_requests_leave_the_controller_alone(void **state)
 	assert_int_not_equal(http_get(port, "/../../etc/passwd"), 200);
 	assert_int_not_equal(http_get(port, "/index.html/../../../etc/passwd"), 200);
 	snprintf(req, sizeof(req), "POST / HTTP/1.1\r\nHost: x\r\nContent-Length: 3\r\n\r\nabc");
-	assert_int_not_equal(http_status(port, req, strlen(req)), 200);
+	assert_int_not_equal(http_status(port, req, strlen(req), false), 200);
 	snprintf(req, sizeof(req), "GARBAGE\r\n\r\n");
-	assert_int_not_equal(http_status(port, req, strlen(req)), 200);
+	assert_int_not_equal(http_status(port, req, strlen(req), false), 200);
 	for (int k = 0; k < 100; k++) {
 		unsigned char junk[512];
 		size_t len = 1 + (seed = seed * 1103515245u + 12345u) % sizeof(junk);
 
 		for (size_t i = 0; i < len; i++)
 			junk[i] = (unsigned char)((seed = seed * 1103515245u + 12345u) >> 16);
-		assert_int_not_equal(http_status(port, junk, len), 200);
+		assert_int_not_equal(http_status(port, junk, len, true), 200);
 	}
 	/* malformed WebSocket frames, and a client that talks: hung up on */
 	fd = ws_open(port, NULL, 0);
@@ -605,12 +622,159 @@ static void test_bad_requests_leave_the_controller_alone(void **state)
 	pthread_join(good.tid, NULL);   /* its next frame, or the run's end, wakes it */
 	close(good.fd);
 	close(mute);
-	/* the controller ran to its end, every tick logged */
+	/* the controller ran on until told to stop, every tick logged */
+	print_message("bad requests: %.1f s\n", now_s() - t0);
+	kill(pid, SIGTERM);
 	assert_int_equal(finish_fw(pid), 0);
-	assert_non_null(strstr(out_text, "state: off"));
+	assert_non_null(strstr(err_text, "stopped by signal 15: torque off"));
+	p = strstr(out_text, "ticks: ");
+	assert_non_null(p);
+	ticks = strtoull(p + 7, NULL, 10);
+	assert_true(ticks > 1000);
 	assert_int_equal(irdm_log_open(&lr, log, err, sizeof(err)), 0);
-	assert_int_equal(irdm_log_header(lr)->record_count, 6000);
+	assert_int_equal(irdm_log_header(lr)->record_count, ticks);
+	assert_int_equal(irdm_log_header(lr)->dropped, 0);
 	irdm_log_close(lr);
+}
+
+/* One line on stderr naming what is wrong, and the exit code. */
+static void expect_error(int rc, int code, const char *needle)
+{
+	if (rc != code || !strstr(err_text, needle) ||
+	    strchr(err_text, '\n') != err_text + strlen(err_text) - 1)
+		fail_msg("expected exit %d with one line naming '%s'; got %d: %s", code, needle, rc,
+			 err_text);
+}
+
+static int run_fw(const char *view)
+{
+	return finish_fw(rp_spawn(dir, env_or("IRDM_FW", "build/irdm-fw"), (const char *const[]){
+		"--board", board, "--image", image, "--duration", "0.2", "--view", view, NULL }));
+}
+
+static void test_view_arguments(void **state)
+{
+	struct sockaddr_in a = { .sin_family = AF_INET };
+	socklen_t alen = sizeof(a);
+	char taken[32];
+	int fd;
+
+	(void)state;
+	expect_error(run_fw("http"), 2, "--view 'http'");
+	expect_error(run_fw("127.0.0.1:65536"), 2, "--view '127.0.0.1:65536'");
+	expect_error(run_fw(":80"), 2, "--view ':80'");
+	expect_error(run_fw("localhost:0"), 2, "'localhost': not a numeric IPv4 address");
+	/* a port someone else listens on */
+	fd = socket(AF_INET, SOCK_STREAM, 0);
+	a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+	assert_int_equal(bind(fd, (struct sockaddr *)&a, sizeof(a)), 0);
+	assert_int_equal(listen(fd, 1), 0);
+	assert_int_equal(getsockname(fd, (struct sockaddr *)&a, &alen), 0);
+	snprintf(taken, sizeof(taken), "%u", ntohs(a.sin_port));
+	expect_error(run_fw(taken), 4, "cannot listen on 127.0.0.1:");
+	close(fd);
+	/* another address than 127.0.0.1: served, with a warning */
+	assert_int_equal(run_fw("127.0.0.2:0"), 0);
+	assert_non_null(strstr(err_text, "warning: the view listens on 127.0.0.2:"));
+	assert_non_null(strstr(out_text, "view: http://127.0.0.2:"));
+}
+
+/* irdm view on a log of the slow press, made in virtual time. */
+static unsigned start_playback(pid_t *pid, char *log, size_t loglen)
+{
+	char path[300], text[4096];
+	unsigned port = 0;
+	double t0 = now_s();
+
+	snprintf(log, loglen, "%s/play.log", dir);
+	assert_int_equal(finish_fw(rp_spawn(dir, env_or("IRDM_FW", "build/irdm-fw"),
+		(const char *const[]){ "--board", board, "--image", image, "--user", user,
+				       "--clock", "virtual", "--log", log, "-q", NULL })), 0);
+	*pid = rp_spawn(dir, env_or("IRDM", "build/irdm"), (const char *const[]){
+		"view", log, "--board", board, "--image", image, "--listen", "0", NULL });
+	snprintf(path, sizeof(path), "%s/stdout", dir);
+	while (now_s() - t0 < 60) {
+		FILE *f = fopen(path, "r");
+		const char *p;
+
+		if (f) {
+			size_t n = fread(text, 1, sizeof(text) - 1, f);
+			text[n] = '\0';
+			fclose(f);
+			p = strstr(text, "view: http://127.0.0.1:");
+			if (p && sscanf(p, "view: http://127.0.0.1:%u/", &port) == 1 && port)
+				return port;
+		}
+		if (waitpid(*pid, NULL, WNOHANG) == *pid)
+			fail_msg("irdm view ended before it served");
+		sleep_s(0.05);
+	}
+	fail_msg("irdm view did not serve within 60 s");
+	return 0;
+}
+
+static void test_playback(void **state)
+{
+	char log[320], url[96], out[256];
+	struct shot before, hold;
+	struct report r;
+	double px[3][2], w_before, w_hold;
+	uint32_t head[2];
+	unsigned port;
+	int fd, frames = 0;
+	struct cdp *c;
+	pid_t pid;
+
+	(void)state;
+	port = start_playback(&pid, log, sizeof(log));
+	/* 9.2 s run at 20 ms a frame: the hello, then the whole recording */
+	fd = ws_open(port, NULL, 0);
+	assert_true(fd >= 0);
+	assert_int_equal(ws_frame(fd, head), 2);
+	assert_true(head[0] == 0x56445249u && head[1] == 1);
+	while (frames < 460 && ws_frame(fd, head) == 2 && head[1] == 2)
+		frames++;
+	assert_int_equal(frames, 460);
+	close(fd);
+	if (!cdp_browser()) {
+		print_message("test_view: SKIPPED the playback's browser part: no chromium\n");
+		kill(pid, SIGTERM);
+		assert_int_equal(finish_fw(pid), 0);
+		return;
+	}
+	snprintf(url, sizeof(url), "http://127.0.0.1:%u/?t=1.0", port);
+	c = cdp_open(dir, url, W, H);
+	for (double t0 = now_s();; sleep_s(0.1)) {
+		char line[512];
+
+		if (cdp_eval(c, "window.irdmReport ? irdmReport() : ''", line, sizeof(line)) &&
+		    strstr(line, "loaded=1"))
+			break;
+		if (now_s() - t0 > 30)
+			fail_msg("the page did not load the recording: %s", line);
+	}
+	report(c, &r);
+	assert_int_equal(r.frames, 460);
+	sleep_s(0.3);
+	screenshot(c, &before, "play-before");
+	for (int i = 0; i < 3; i++)
+		project(c, ring[i][0], ring[i][1], ring[i][2], px[i]);
+	eval_ok(c, "irdmSeek(5.0), document.getElementById('ptime').textContent", out, sizeof(out));
+	assert_string_equal(out, "5.000 s");
+	sleep_s(0.3);
+	screenshot(c, &hold, "play-hold");
+	w_before = warmth(&before, px);
+	w_hold = warmth(&hold, px);
+	print_message("playback, around the tool: red - blue %.0f at 1 s, %.0f at 5 s\n", w_before,
+		      w_hold);
+	assert_true(w_before < -60);
+	assert_true(w_hold > w_before + 100);
+	cdp_close(c);
+	kill(pid, SIGTERM);
+	assert_int_equal(finish_fw(pid), 0);
+	assert_non_null(strstr(out_text, "460 frames; replayed forces within 0 N of the log's"));
+	free(before.rgb);
+	free(hold.rgb);
 }
 
 static int setup(void **state)
@@ -664,7 +828,9 @@ static int teardown(void **state)
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_view_arguments),
 		cmocka_unit_test(test_bad_requests_leave_the_controller_alone),
+		cmocka_unit_test(test_playback),
 		cmocka_unit_test(test_live_view_in_chromium),
 	};
 

@@ -319,7 +319,8 @@ static int make_context(struct view_server *s, char *err, size_t errlen)
 	info.options = LWS_SERVER_OPTION_DISABLE_IPV6 | LWS_SERVER_OPTION_VALIDATE_UTF8;
 	info.timeout_secs = 10;
 	info.max_http_header_pool = 16;
-	lws_set_log_level(LLL_ERR, NULL);
+	/* its messages are not one line; ours say what failed */
+	lws_set_log_level(0, NULL);
 	s->ctx = lws_create_context(&info);
 	vh = s->ctx ? lws_get_vhost_by_name(s->ctx, "default") : NULL;
 	if (!vh || lws_get_vhost_listen_port(vh) <= 0) {
