@@ -15,6 +15,7 @@
 #   make run        the main job: the built-in default scene, end to end
 #   make view-shots after make run: its run in the browser view, docs/view/*.png
 #   make jitter     irdm-fw's wake-up latency beside cyclictest's (JITTER_SECONDS)
+#   make jitter-view the same loop with and without a browser on its live view
 #   make hil        the CAN back-end end to end in a PREEMPT_RT VM (docs/hil.md)
 #   make docs       docs/scene-format.md from the scene key table
 #   make sizes      irdm-fw built with each configs/*.config (CONFIG=FILE: one)
@@ -131,7 +132,7 @@ TESTS    := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 TICK_TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TICK_TEST_SRC))
 BENCHES  := $(patsubst tests/bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC))
 
-.PHONY: all test san fuzz bench bench-precompute bench-mpi run render view-shots stability report jitter check deps clean docs cfg-fws sizes hil
+.PHONY: all test san fuzz bench bench-precompute bench-mpi run render view-shots jitter-view stability report jitter check deps clean docs cfg-fws sizes hil
 .SECONDARY:
 all: $(if $(CONFIG),,$(IRDM) $(SLEPC_PLUGIN)) $(FW_LIB) $(HAL_LIB) $(SIM_LIB) $(if $(FWMAIN_SRC),$(IRDM_FW)) \
   $(if $(CDMAIN_SRC),$(IRDM_CD))
@@ -358,6 +359,11 @@ $(JITTER_IMAGE): $(IRDM) scenes/cuboid-top.scene
 	$(IRDM) precompute -q --scene scenes/cuboid-top.scene -o $@
 jitter: deps $(IRDM) $(IRDM_FW) $(JITTER_IMAGE)
 	tools/scripts/jitter.sh $(IRDM) $(IRDM_FW) $(JITTER_IMAGE)
+
+# The same loop with and without a browser on its live view, alternating
+# (JITTER_ROUNDS pairs of JITTER_SECONDS, default 3 x 20 s; docs/view.md)
+jitter-view: deps $(IRDM_FW) $(JITTER_IMAGE)
+	tools/scripts/jitter-view.sh $(IRDM_FW) $(JITTER_IMAGE)
 
 # Hardware in the loop without the hardware: Debian's PREEMPT_RT kernel
 # under qemu (TCG), vcan0, irdm-candrives and irdm-fw (the minimal build)
