@@ -81,7 +81,7 @@ static void sleep_s(double s)
 
 /* irdm-fw with the view on any free loopback port (and a log unless
  * NULL); returns the port once the server listens (its line on stdout). */
-static unsigned start_fw_log(pid_t *pid, const char *duration, const char *log)
+static unsigned start_fw_at(pid_t *pid, const char *duration, const char *log, const char *view)
 {
 	char path[300], text[4096];
 	unsigned port = 0;
@@ -89,7 +89,7 @@ static unsigned start_fw_log(pid_t *pid, const char *duration, const char *log)
 
 	*pid = rp_spawn(dir, env_or("IRDM_FW", "build/irdm-fw"), (const char *const[]){
 		"--board", board, "--image", image, "--user", user, "--duration", duration,
-		"--view", "0", log ? "--log" : NULL, log, NULL });
+		"--view", view, log ? "--log" : NULL, log, NULL });
 	snprintf(path, sizeof(path), "%s/stdout", dir);
 	while (now_s() - t0 < 20) {
 		FILE *f = fopen(path, "r");
@@ -109,6 +109,11 @@ static unsigned start_fw_log(pid_t *pid, const char *duration, const char *log)
 	}
 	fail_msg("irdm-fw's view did not listen within 20 s");
 	return 0;
+}
+
+static unsigned start_fw_log(pid_t *pid, const char *duration, const char *log)
+{
+	return start_fw_at(pid, duration, log, "0");
 }
 
 static unsigned start_fw(pid_t *pid, const char *duration)
@@ -340,10 +345,23 @@ static void test_live_view_in_chromium(void **state)
 	/* published at 50/s: a live stream, even on a loaded machine */
 	assert_true(r2.fps >= 10 && fps >= 10);
 	assert_true(r2.latency_ms >= 0 && r2.latency_ms < 2000);
-	cdp_close(c);
 	assert_int_equal(finish_fw(pid), 0);
 	assert_non_null(strstr(out_text, "state: off"));
 	assert_non_null(strstr(out_text, " 1 pages opened"));
+	/* the controller gone, then back on the same port: the page says so,
+	 * then reconnects by itself and shows the new run from its start */
+	for (double t0 = now_s(); report(c, &r2), r2.connected; sleep_s(0.05))
+		if (now_s() - t0 > 10)
+			fail_msg("the page did not notice the controller's end");
+	eval_ok(c, "document.getElementById('state').textContent", out, sizeof(out));
+	assert_string_equal(out, "disconnected: retrying");
+	snprintf(out, sizeof(out), "%u", port);
+	assert_int_equal(start_fw_at(&pid, "4", NULL, out), port);
+	wait_page_time(c, 0.5, &r2);
+	assert_true(r2.t < 4.0);
+	assert_string_equal(r2.state, "enabled");
+	cdp_close(c);
+	assert_int_equal(finish_fw(pid), 0);
 	free(before.rgb);
 	free(hold.rgb);
 }

@@ -8,11 +8,14 @@
  */
 #include <arpa/inet.h>
 #include <errno.h>
+#include <netinet/in.h>
 #include <stdatomic.h>
 #include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/socket.h>
+#include <unistd.h>
 
 #include <libwebsockets.h>
 
@@ -304,6 +307,28 @@ static int check_config(const struct view_server_config *c, char *err, size_t er
 	return IRDM_OK;
 }
 
+/*
+ * Whether addr:port can be bound, asked of the kernel before libwebsockets
+ * is: its context, refused the address, leaves an allocation behind.
+ */
+static int probe(const char *addr, unsigned port, char *err, size_t errlen)
+{
+	struct sockaddr_in a = { .sin_family = AF_INET, .sin_port = htons((uint16_t)port) };
+	int fd = socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0), one = 1, e = 0;
+
+	if (fd < 0 || inet_pton(AF_INET, addr, &a.sin_addr) != 1)
+		e = fd < 0 ? errno : EINVAL;
+	else if (setsockopt(fd, SOL_SOCKET, SO_REUSEADDR, &one, sizeof(one)) ||
+		 bind(fd, (struct sockaddr *)&a, sizeof(a)))
+		e = errno;
+	if (fd >= 0)
+		close(fd);
+	if (!e)
+		return IRDM_OK;
+	snprintf(err, errlen, "view: cannot listen on %s:%u: %s", addr, port, strerror(e));
+	return IRDM_EIO;
+}
+
 static int make_context(struct view_server *s, char *err, size_t errlen)
 {
 	struct lws_context_creation_info info;
@@ -314,6 +339,8 @@ static int make_context(struct view_server *s, char *err, size_t errlen)
 						  0, NULL, 0 };
 	info.port = (int)s->cfg.port;
 	info.iface = s->cfg.addr ? s->cfg.addr : VIEW_DEFAULT_ADDR;
+	if (probe(info.iface, s->cfg.port, err, errlen))
+		return IRDM_EIO;
 	info.protocols = s->protocols;
 	info.user = s;
 	info.options = LWS_SERVER_OPTION_DISABLE_IPV6 | LWS_SERVER_OPTION_VALIDATE_UTF8;

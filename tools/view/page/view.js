@@ -361,7 +361,7 @@ function connect() {
 		var kind = dv.getUint32(4, true);
 		if (kind === HELLO) {
 			model = readHello(dv);
-			frames = []; samples = []; stats.frames = 0; stats.loaded = false;
+			frames = []; samples = []; stats.frames = 0; stats.loaded = false; stats.t = 0;
 			build(model);
 		} else if (kind === FRAME && model) {
 			var f = readFrame(dv);
@@ -370,6 +370,7 @@ function connect() {
 	};
 	ws.onclose = function () {
 		stats.connected = false;
+		stats.t = 0;
 		stats.state = 'disconnected';
 		el('state').textContent = 'disconnected: retrying';
 		el('state').className = '';
