@@ -16,7 +16,6 @@
  * The loop itself does no network or file I/O and takes no lock for the
  * view; a page that is slow or gone only makes the server skip frames.
  */
-#include <math.h>
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
@@ -137,36 +136,15 @@ static void publish(void *ctx, struct view_server *srv)
 	view_server_publish(srv, v->msg, len);
 }
 
-/* The image at rest, and a colour scale fixed for the run: a tenth of the
- * object's smallest extent (a deformation as large is off the scale). */
 static int send_hello(struct fw_view *v)
 {
-	const struct irdm_image *img = v->fw->s->img;
-	uint32_t n = img->meta->n_nodes;
-	float *rest = malloc(12 * (size_t)(n ? n : 1));
-	unsigned char *buf = malloc(view_hello_size(n, img->meta->n_tris));
-	float lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
-	float ext = INFINITY;
-	struct view_hello h;
-	int rc = IRDM_ENOMEM;
+	struct view_hello h = { .mode = VIEW_MODE_LIVE, .n_dev = v->fw->board.devices,
+				.period_s = (float)(v->fw->board.period_us * 1e-6),
+				.name = v->fw->board.name };
+	unsigned char *buf;
+	size_t len = view_hello_image(&buf, v->fw->s->img, &h);
+	int rc = len ? view_server_set_hello(v->srv, buf, len) : IRDM_ENOMEM;
 
-	if (!rest || !buf)
-		goto out;
-	for (uint32_t i = 0; i < n; i++)
-		for (int k = 0; k < 3; k++) {
-			rest[3 * i + k] = img->nodes[i].pos_m[k];
-			lo[k] = fminf(lo[k], rest[3 * i + k]);
-			hi[k] = fmaxf(hi[k], rest[3 * i + k]);
-		}
-	for (int k = 0; k < 3; k++)
-		ext = fminf(ext, hi[k] - lo[k]);
-	h = (struct view_hello){ VIEW_MODE_LIVE, n, img->meta->n_tris, v->fw->board.devices,
-				 (float)(v->fw->board.period_us * 1e-6),
-				 ext > 0 && isfinite(ext) ? 0.1f * ext : 0.01f, 0.0f, 0,
-				 v->fw->board.name, rest, img->tris };
-	rc = view_server_set_hello(v->srv, buf, view_hello_write(buf, &h));
-out:
-	free(rest);
 	free(buf);
 	return rc;
 }

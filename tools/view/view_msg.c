@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* The view's messages, byte by byte (view_msg.h; docs/view.md). */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "view/view_msg.h"
@@ -58,6 +59,41 @@ size_t view_hello_write(unsigned char *buf, const struct view_hello *h)
 	p = put(p, h->rest_m, 12 * (size_t)h->n_nodes);
 	p = put(p, h->tris, 12 * (size_t)h->n_tris);
 	return (size_t)(p - buf);
+}
+
+size_t view_hello_image(unsigned char **buf, const struct irdm_image *img, struct view_hello *h)
+{
+	uint32_t n = img->meta->n_nodes;
+	float *rest = malloc(12 * (size_t)(n ? n : 1));
+	float lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
+	float ext = INFINITY;
+	size_t len = 0;
+
+	*buf = malloc(view_hello_size(n, img->meta->n_tris));
+	if (!rest || !*buf)
+		goto out;
+	for (uint32_t i = 0; i < n; i++)
+		for (int k = 0; k < 3; k++) {
+			rest[3 * i + k] = img->nodes[i].pos_m[k];
+			lo[k] = fminf(lo[k], rest[3 * i + k]);
+			hi[k] = fmaxf(hi[k], rest[3 * i + k]);
+		}
+	for (int k = 0; k < 3; k++)
+		ext = fminf(ext, hi[k] - lo[k]);
+	h->n_nodes = n;
+	h->n_tris = img->meta->n_tris;
+	h->scale_m = ext > 0 && isfinite(ext) ? 0.1f * ext : 0.01f;
+	h->rest_m = rest;
+	h->tris = img->tris;
+	len = view_hello_write(*buf, h);
+	h->rest_m = NULL;
+out:
+	free(rest);
+	if (!len) {
+		free(*buf);
+		*buf = NULL;
+	}
+	return len;
 }
 
 size_t view_frame_size(uint32_t n_nodes, uint32_t n_samples)

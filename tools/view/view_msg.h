@@ -13,6 +13,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "irdm/image.h"
 #include "irdm/telemetry.h"
 
 #define VIEW_MAGIC 0x56445249u          /* "IRDV" */
@@ -61,6 +62,13 @@ struct view_frame {
 };
 
 size_t view_hello_size(uint32_t n_nodes, uint32_t n_tris);
+/*
+ * The hello of an image (malloc'd into *buf, its length returned; 0: out
+ * of memory): h's mode, devices, period, duration, frames and name, the
+ * image's rest positions and triangles, and the colour scale fixed for
+ * the run: a tenth of the object's smallest extent.
+ */
+size_t view_hello_image(unsigned char **buf, const struct irdm_image *img, struct view_hello *h);
 /* buf holds view_hello_size(); returns the bytes written. */
 size_t view_hello_write(unsigned char *buf, const struct view_hello *h);
 

@@ -66,35 +66,16 @@ close:
 
 static int hello(struct playback *pb, const struct irdm_image *img, char *err, size_t errlen)
 {
-	uint32_t n = img->meta->n_nodes;
-	unsigned char *buf = malloc(view_hello_size(n, img->meta->n_tris));
-	float *rest = malloc(12 * (size_t)(n ? n : 1));
-	float lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
-	float ext = INFINITY;
-	struct view_hello h;
-	int rc = IRDM_ENOMEM;
+	struct view_hello h = { .mode = VIEW_MODE_PLAYBACK, .n_dev = pb->board.devices,
+				.period_s = (float)pb->dt, .duration_s = (float)(pb->n_rec * pb->dt),
+				.n_frames = (uint32_t)(pb->n_rec / pb->every), .name = pb->board.name };
+	unsigned char *buf;
+	size_t len = view_hello_image(&buf, img, &h);
+	int rc = len ? view_server_set_hello(pb->srv, buf, len) : IRDM_ENOMEM;
 
-	if (!buf || !rest)
-		goto out;
-	for (uint32_t i = 0; i < n; i++)
-		for (int k = 0; k < 3; k++) {
-			rest[3 * i + k] = img->nodes[i].pos_m[k];
-			lo[k] = fminf(lo[k], rest[3 * i + k]);
-			hi[k] = fmaxf(hi[k], rest[3 * i + k]);
-		}
-	for (int k = 0; k < 3; k++)
-		ext = fminf(ext, hi[k] - lo[k]);
-	/* the same fixed scale as the live view's (fw_view.c) */
-	h = (struct view_hello){ VIEW_MODE_PLAYBACK, n, img->meta->n_tris, pb->board.devices,
-				 (float)pb->dt, ext > 0 && isfinite(ext) ? 0.1f * ext : 0.01f,
-				 (float)(pb->n_rec * pb->dt), (uint32_t)(pb->n_rec / pb->every),
-				 pb->board.name, rest, img->tris };
-	rc = view_server_set_hello(pb->srv, buf, view_hello_write(buf, &h));
-out:
 	if (rc)
-		snprintf(err, errlen, "out of memory for the mesh of %u nodes", n);
+		snprintf(err, errlen, "out of memory for the mesh of %u nodes", img->meta->n_nodes);
 	free(buf);
-	free(rest);
 	return rc;
 }
 
