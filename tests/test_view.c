@@ -37,6 +37,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/socket.h>
+#include <sys/stat.h>
 #include <sys/time.h>
 #include <sys/wait.h>
 #include <time.h>
@@ -799,6 +800,74 @@ static void test_playback(void **state)
 	free(hold.rgb);
 }
 
+/* irdm view DIR: a directory irdm render wrote, served as it is; one that
+ * is not refused, naming the file. */
+static void test_render_directory(void **state)
+{
+	char log[320], rdir[320], path[400], bad_dir[320];
+	uint32_t head[2];
+	unsigned port = 0;
+	int fd, frames = 0;
+	pid_t pid;
+	double t0 = now_s();
+
+	(void)state;
+	snprintf(log, sizeof(log), "%s/play.log", dir);
+	snprintf(rdir, sizeof(rdir), "%s/render", dir);
+	assert_int_equal(finish_fw(rp_spawn(dir, env_or("IRDM_FW", "build/irdm-fw"),
+		(const char *const[]){ "--board", board, "--image", image, "--user", user,
+				       "--clock", "virtual", "--log", log, "-q", NULL })), 0);
+	assert_int_equal(finish_fw(rp_spawn(dir, env_or("IRDM", "build/irdm"), (const char *const[]){
+		"render", "--image", image, "--log", log, "--board", board, "-o", rdir, "--every",
+		"0.1", NULL })), 0);
+	pid = rp_spawn(dir, env_or("IRDM", "build/irdm"), (const char *const[]){
+		"view", rdir, "--listen", "0", NULL });
+	snprintf(path, sizeof(path), "%s/stdout", dir);
+	while (!port && now_s() - t0 < 30) {
+		char text[1024] = "";
+		FILE *f = fopen(path, "r");
+		const char *p;
+
+		if (f) {
+			text[fread(text, 1, sizeof(text) - 1, f)] = '\0';
+			fclose(f);
+		}
+		p = strstr(text, "view: http://127.0.0.1:");
+		if (!p || sscanf(p, "view: http://127.0.0.1:%u/", &port) != 1)
+			sleep_s(0.05);
+	}
+	assert_true(port > 0);
+	/* 10.2 s at 0.1 s a frame */
+	fd = ws_open(port, NULL, 0);
+	assert_true(fd >= 0);
+	assert_int_equal(ws_frame(fd, head), 2);
+	assert_true(head[0] == 0x56445249u && head[1] == 1);
+	while (frames < 102 && ws_frame(fd, head) == 2 && head[1] == 2)
+		frames++;
+	assert_int_equal(frames, 102);
+	close(fd);
+	kill(pid, SIGTERM);
+	assert_int_equal(finish_fw(pid), 0);
+	assert_non_null(strstr(out_text, "102 frames to 10.200 s"));
+	/* not what irdm render writes: a frame outside DIR, a frame missing */
+	snprintf(bad_dir, sizeof(bad_dir), "%s/bad-render", dir);
+	assert_int_equal(mkdir(bad_dir, 0755), 0);
+	snprintf(path, sizeof(path), "%s/frames.pvd", bad_dir);
+	tf_write_text(path, "<DataSet timestep=\"0.1\" group=\"\" part=\"0\" file=\"../render/frame_00000.vtu\"/>\n");
+	assert_int_equal(finish_fw(rp_spawn(dir, env_or("IRDM", "build/irdm"), (const char *const[]){
+		"view", bad_dir, "--listen", "0", NULL })), 1);
+	assert_non_null(strstr(err_text, "frames.pvd: a frame outside DIR"));
+	tf_write_text(path, "<DataSet timestep=\"0.1\" group=\"\" part=\"0\" file=\"frame_00000.vtu\"/>\n");
+	assert_int_equal(finish_fw(rp_spawn(dir, env_or("IRDM", "build/irdm"), (const char *const[]){
+		"view", bad_dir, "--listen", "0", NULL })), 1);
+	assert_non_null(strstr(err_text, "bad-render/frame_00000.vtu: cannot open"));
+	snprintf(path, sizeof(path), "%s/frame_00000.vtu", bad_dir);
+	tf_write_text(path, "<Piece NumberOfPoints=\"3\" NumberOfCells=\"1\">\n");
+	assert_int_equal(finish_fw(rp_spawn(dir, env_or("IRDM", "build/irdm"), (const char *const[]){
+		"view", bad_dir, "--listen", "0", NULL })), 1);
+	assert_non_null(strstr(err_text, "frame_00000.vtu: no or bad sizes"));
+}
+
 static int setup(void **state)
 {
 	pid_t pid;
@@ -853,6 +922,7 @@ int main(void)
 		cmocka_unit_test(test_view_arguments),
 		cmocka_unit_test(test_bad_requests_leave_the_controller_alone),
 		cmocka_unit_test(test_playback),
+		cmocka_unit_test(test_render_directory),
 		cmocka_unit_test(test_live_view_in_chromium),
 	};
 

@@ -1,9 +1,11 @@
 /* SPDX-License-Identifier: MIT */
 /* irdm view: a recorded irdm-fw run played back in the browser. */
 #include <signal.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "cli.h"
 #include "irdm/error.h"
@@ -13,12 +15,16 @@
 static const char usage[] =
 	"usage: irdm view RUN.log --board BOARD --image IMAGE [--listen [ADDR:]PORT]\n"
 	"                 [--every S]\n"
+	"       irdm view DIR [--listen [ADDR:]PORT]\n"
 	"\n"
 	"Plays a run of irdm-fw (its --log) back in the browser: the page of\n"
 	"irdm-fw --view (docs/view.md) with a time slider, play and a speed\n"
 	"(0.1x to 4x).  The log holds the controller's side of each tick; the\n"
 	"deformed surface is replayed on IMAGE and BOARD, the ones the run used\n"
 	"(as irdm replay --log does), a frame every S seconds (default 0.02).\n"
+	"DIR: a directory irdm render wrote (frames.pvd): its frames as they are,\n"
+	"the surface and each contact's point and force, without the controller's\n"
+	"state.\n"
 	"Serves on ADDR:PORT (default 127.0.0.1:8080; PORT 0: any free port; an\n"
 	"address other than 127.0.0.1 is served with a warning) until SIGINT or\n"
 	"SIGTERM; prints the page's address first.  The page only watches.\n"
@@ -38,6 +44,13 @@ static void noop(void *ctx, struct view_server *s)
 {
 	(void)ctx;
 	(void)s;
+}
+
+static bool is_dir(const char *path)
+{
+	struct stat st;
+
+	return !stat(path, &st) && S_ISDIR(st.st_mode);
 }
 
 struct args {
@@ -89,8 +102,17 @@ static int parse(struct args *a, int argc, char **argv)
 			return 2;
 		}
 	}
+	if (a->pb.log && is_dir(a->pb.log)) {
+		if (a->pb.board || a->pb.image) {
+			fprintf(stderr, "irdm view: %s is a render directory: it needs no --board "
+				"or --image\n", a->pb.log);
+			return 2;
+		}
+		return 0;
+	}
 	if (!a->pb.log || !a->pb.board || !a->pb.image) {
-		fprintf(stderr, "irdm view: needs RUN.log, --board BOARD and --image IMAGE (see --help)\n");
+		fprintf(stderr, "irdm view: needs RUN.log, --board BOARD and --image IMAGE, or a "
+			"render directory (see --help)\n");
 		return 2;
 	}
 	return 0;
@@ -135,15 +157,21 @@ int irdm_cmd_view(int argc, char **argv)
 		irdm_cli_fail("view", rc, err);
 		return 1;
 	}
-	rc = view_playback_load(s, &a.pb, &sum, err, sizeof(err));
+	if (is_dir(a.pb.log))
+		rc = view_render_dir_load(s, a.pb.log, &sum, err, sizeof(err));
+	else
+		rc = view_playback_load(s, &a.pb, &sum, err, sizeof(err));
 	if (rc) {
 		irdm_cli_fail("view", rc, err);
 		view_server_close(s);
 		return 1;
 	}
-	printf("view: %s: %zu ticks (%.3f s), %zu frames; replayed forces within %.3g N of the "
-	       "log's (peak %.3g N)\n", a.pb.log, sum.records, sum.duration_s, sum.frames,
-	       sum.log_max_diff_n, sum.log_peak_n);
+	if (is_dir(a.pb.log))
+		printf("view: %s: %zu frames to %.3f s\n", a.pb.log, sum.frames, sum.duration_s);
+	else
+		printf("view: %s: %zu ticks (%.3f s), %zu frames; replayed forces within %.3g N of "
+		       "the log's (peak %.3g N)\n", a.pb.log, sum.records, sum.duration_s, sum.frames,
+		       sum.log_max_diff_n, sum.log_peak_n);
 	rc = serve(s, addr);
 	view_server_close(s);
 	return rc ? 1 : 0;

@@ -61,28 +61,35 @@ size_t view_hello_write(unsigned char *buf, const struct view_hello *h)
 	return (size_t)(p - buf);
 }
 
+float view_colour_scale(const float *rest_m, uint32_t n)
+{
+	float lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
+	float ext = INFINITY;
+
+	for (size_t i = 0; i < 3 * (size_t)n; i++) {
+		lo[i % 3] = fminf(lo[i % 3], rest_m[i]);
+		hi[i % 3] = fmaxf(hi[i % 3], rest_m[i]);
+	}
+	for (int k = 0; k < 3; k++)
+		ext = fminf(ext, hi[k] - lo[k]);
+	return ext > 0 && isfinite(ext) ? 0.1f * ext : 0.01f;
+}
+
 size_t view_hello_image(unsigned char **buf, const struct irdm_image *img, struct view_hello *h)
 {
 	uint32_t n = img->meta->n_nodes;
 	float *rest = malloc(12 * (size_t)(n ? n : 1));
-	float lo[3] = { INFINITY, INFINITY, INFINITY }, hi[3] = { -INFINITY, -INFINITY, -INFINITY };
-	float ext = INFINITY;
 	size_t len = 0;
 
 	*buf = malloc(view_hello_size(n, img->meta->n_tris));
 	if (!rest || !*buf)
 		goto out;
 	for (uint32_t i = 0; i < n; i++)
-		for (int k = 0; k < 3; k++) {
+		for (int k = 0; k < 3; k++)
 			rest[3 * i + k] = img->nodes[i].pos_m[k];
-			lo[k] = fminf(lo[k], rest[3 * i + k]);
-			hi[k] = fmaxf(hi[k], rest[3 * i + k]);
-		}
-	for (int k = 0; k < 3; k++)
-		ext = fminf(ext, hi[k] - lo[k]);
 	h->n_nodes = n;
 	h->n_tris = img->meta->n_tris;
-	h->scale_m = ext > 0 && isfinite(ext) ? 0.1f * ext : 0.01f;
+	h->scale_m = view_colour_scale(rest, n);
 	h->rest_m = rest;
 	h->tris = img->tris;
 	len = view_hello_write(*buf, h);

@@ -27,6 +27,7 @@
 #define VIEW_FRAME_HEAD 200u
 #define VIEW_SAMPLE_BYTES 16u
 #define VIEW_FRAME_POSITIONS 1u         /* frame flag: node positions follow */
+#define VIEW_STATE_NONE 255u            /* a frame without the controller (irdm render's) */
 
 struct view_hello {
 	uint32_t mode, n_nodes, n_tris, n_dev;
@@ -69,6 +70,8 @@ size_t view_hello_size(uint32_t n_nodes, uint32_t n_tris);
  * the run: a tenth of the object's smallest extent.
  */
 size_t view_hello_image(unsigned char **buf, const struct irdm_image *img, struct view_hello *h);
+/* That scale for n rest positions (3 n floats). */
+float view_colour_scale(const float *rest_m, uint32_t n);
 /* buf holds view_hello_size(); returns the bytes written. */
 size_t view_hello_write(unsigned char *buf, const struct view_hello *h);
 

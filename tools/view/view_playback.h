@@ -29,4 +29,14 @@ struct view_playback_summary {
 int view_playback_load(struct view_server *s, const struct view_playback_opts *o,
 		       struct view_playback_summary *sum, char *err, size_t errlen);
 
+/*
+ * irdm view DIR: a directory irdm render wrote (frames.pvd and its .vtu
+ * frames) as s's hello and recording: the surface and each contact's point
+ * and force, no controller state (view_render_dir.c).  Return: IRDM_OK;
+ * IRDM_EIO (a file unreadable), IRDM_EFORMAT (not what irdm render
+ * writes), IRDM_ENOMEM; err names the file.
+ */
+int view_render_dir_load(struct view_server *s, const char *dir,
+			 struct view_playback_summary *sum, char *err, size_t errlen);
+
 #endif

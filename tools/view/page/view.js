@@ -6,7 +6,7 @@
 
 var MAGIC = 0x56445249, HELLO = 1, FRAME = 2, PLAYBACK = 1;
 var HELLO_HEAD = 108, FRAME_HEAD = 200, SAMPLE = 16, DEV = 64;
-var STATES = ['init', 'ready', 'enabled', 'fault', 'off'];
+var STATES = ['init', 'ready', 'enabled', 'fault', 'off'], STATE_NONE = 255;
 var FAULTS = ['clamp', 'workspace', 'velocity', 'watchdog', 'overrun', 'encoder NaN',
 	'encoder range', 'signal', 'HAL read', 'HAL write', 'HAL fault', 'engine'];
 var CHART_S = 5;                        // seconds the strip chart shows
@@ -171,9 +171,12 @@ function showDevices(f) {
 		var p = on ? proxyPoint(dev, pos) : null;
 		view.proxies[d].visible = !!p;
 		view.arrows[d].visible = false;
-		if (!p)
+		if (p)
+			view.proxies[d].position.copy(p);
+		else if (on)
+			p = view.tips[d].position.clone();     // no site: the force at the tip
+		else
 			continue;
-		view.proxies[d].position.copy(p);
 		if (d === 0)
 			stats.probe = project(p);
 		// the force on the tool: the reaction of the force on the object
@@ -194,6 +197,8 @@ function project(p) {
 }
 
 function stateText(f) {
+	if (f.state === STATE_NONE)
+		return 'surface only';
 	var s = STATES[f.state] || ('state ' + f.state);
 	if (f.state === 3) {
 		var why = [];
@@ -210,7 +215,7 @@ function showFrame(f) {
 	var st = el('state');
 	st.textContent = stateText(f);
 	st.className = STATES[f.state] || '';
-	stats.state = STATES[f.state] || '';
+	stats.state = f.state === STATE_NONE ? 'surface-only' : STATES[f.state] || '';
 	stats.t = f.t;
 }
 
