@@ -31,19 +31,20 @@ static const char usage[] =
 	"Exit: 0 stopped by a signal, 1 bad log, board or image, or the address\n"
 	"cannot be served, 2 usage.\n";
 
-static struct view_server *serving;
+static volatile sig_atomic_t signalled;
 
 static void on_signal(int sig)
 {
-	(void)sig;
-	if (serving)
-		view_server_stop(serving);
+	signalled = sig;
 }
 
-static void noop(void *ctx, struct view_server *s)
+/* In the server's thread, 10 times a second: a signal stops it (the
+ * handler itself only sets the flag). */
+static void watch_signal(void *ctx, struct view_server *s)
 {
 	(void)ctx;
-	(void)s;
+	if (signalled)
+		view_server_stop(s);
 }
 
 static bool is_dir(const char *path)
@@ -129,7 +130,6 @@ static int serve(struct view_server *s, const char *addr)
 	fflush(stdout);
 	memset(&sa, 0, sizeof(sa));
 	sa.sa_handler = on_signal;
-	serving = s;
 	sigaction(SIGINT, &sa, NULL);
 	sigaction(SIGTERM, &sa, NULL);
 	return view_server_run(s);
@@ -138,7 +138,7 @@ static int serve(struct view_server *s, const char *addr)
 int irdm_cmd_view(int argc, char **argv)
 {
 	struct args a = { 0 };
-	struct view_server_config c = { .rate_hz = 1, .tick = noop, .max_frame = 1 };
+	struct view_server_config c = { .rate_hz = 10, .tick = watch_signal, .max_frame = 1 };
 	struct view_playback_summary sum;
 	struct view_server *s;
 	char addr[64], err[1024];

@@ -111,7 +111,7 @@ static int sizes(struct rdir *r, uint32_t *n, uint32_t *m, uint32_t *nc)
 
 	if (!p || sscanf(p, "<Piece NumberOfPoints=\"%u\" NumberOfCells=\"%u\"", n, m) != 2 ||
 	    !c || sscanf(c, "Name=\"contact\" NumberOfTuples=\"%u\"", nc) != 1 || !*n ||
-	    *n > (1u << 24) || *m > (1u << 25) || *nc > 64)
+	    *n > (1u << 22) || *m > (1u << 23) || *nc > 64)
 		return bad(r, "no or bad sizes");
 	return IRDM_OK;
 }
