@@ -16,7 +16,9 @@
 #   make report     docs/report.md and its plots: every representation against
 #                   the exact model (irdm report; REPORT_CONFIGS, <= 10 min)
 #   make run        the main job: the built-in default scene, end to end
+#   make view-shots after make run: its run in the browser view, docs/view/*.png
 #   make jitter     irdm-fw's wake-up latency beside cyclictest's (JITTER_SECONDS)
+#   make jitter-view the same loop with and without a browser on its live view
 #   make hil        the CAN back-end end to end in a PREEMPT_RT VM (docs/hil.md)
 #   make docs       docs/scene-format.md from the scene key table
 #   make sizes      irdm-fw built with each configs/*.config (CONFIG=FILE: one)
@@ -99,11 +101,19 @@ LDFLAGS += -fsanitize=address,undefined
 endif
 
 FW_SRC    := $(filter-out firmware/main/% $(FEATURE_OFF_SRC),$(wildcard firmware/*/*.c))
-FWMAIN_SRC := $(wildcard firmware/main/*.c)
+# The live view (docs/view.md): its server and page in tools/view/, linked
+# into irdm-fw (fw_view.c) and irdm; the trimmed builds leave it out
+# (fw_view_none.c) and need no libwebsockets.
+VIEW    := $(if $(CONFIG),,1)
+FWMAIN_SRC := $(filter-out firmware/main/$(if $(VIEW),fw_view_none.c,fw_view.c),\
+  $(wildcard firmware/main/*.c))
 HAL_SRC   := $(wildcard hal/*/*.c)
 SIM_SRC   := $(filter-out sim/main/%,$(wildcard sim/*/*.c))
 CDMAIN_SRC := $(wildcard sim/main/*.c)
 TOOL_SRC  := $(filter-out tools/irdm/%,$(wildcard tools/*/*.c))
+VIEW_PAGE := $(wildcard tools/view/page/*)
+VIEW_OBJ   = $(call obj,tools/view/view_server.c tools/view/view_msg.c) $(BUILD)/obj/gen/view_page.o
+VIEW_LIBS := -lwebsockets
 CLI_SRC   := $(wildcard tools/irdm/*.c)
 PLUGIN_SRC := $(wildcard tools/dist/plugin/*.c)
 TEST_SRC  := $(wildcard tests/test_*.c)
@@ -125,7 +135,7 @@ TESTS    := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
 TICK_TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TICK_TEST_SRC))
 BENCHES  := $(patsubst tests/bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC))
 
-.PHONY: all test test-variants san fuzz bench bench-precompute bench-mpi run render stability report jitter check deps clean docs cfg-fws sizes hil
+.PHONY: all test test-variants san fuzz bench bench-precompute bench-mpi run render view-shots jitter-view stability report jitter check deps clean docs cfg-fws sizes hil
 .SECONDARY:
 all: $(if $(CONFIG),,$(IRDM) $(SLEPC_PLUGIN)) $(FW_LIB) $(HAL_LIB) $(SIM_LIB) $(if $(FWMAIN_SRC),$(IRDM_FW)) \
   $(if $(CDMAIN_SRC),$(IRDM_CD))
@@ -134,6 +144,8 @@ $(BUILD)/obj/firmware/%.o: LAYER_INC = $(FW_INC)
 # irdm-fw's main() is the composition root: it alone sees every layer below
 # the tools (it registers the HAL back-ends, the simulator's among them).
 $(BUILD)/obj/firmware/main/%.o: LAYER_INC = $(SIM_INC)
+# its publisher alone also sees the view's server (tools/view/)
+$(BUILD)/obj/firmware/main/fw_view.o: LAYER_INC = $(SIM_INC) -Itools
 $(BUILD)/obj/hal/%.o:      LAYER_INC = $(HAL_INC)
 $(BUILD)/obj/sim/%.o:      LAYER_INC = $(SIM_INC)
 $(BUILD)/obj/tools/%.o:    LAYER_INC = $(TOOL_INC)
@@ -152,10 +164,19 @@ $(BUILD)/lib%.a:
 $(FW_LIB):   $(call obj,$(FW_SRC))
 $(HAL_LIB):  $(call obj,$(HAL_SRC))
 $(SIM_LIB):  $(call obj,$(SIM_SRC))
-$(TOOL_LIB): $(call obj,$(TOOL_SRC))
+$(TOOL_LIB): $(call obj,$(TOOL_SRC)) $(BUILD)/obj/gen/view_page.o
+
+# The page's files as byte arrays (tools/view/embed.sh)
+$(BUILD)/gen/view_page.c: $(VIEW_PAGE) tools/view/embed.sh
+	@mkdir -p $(dir $@)
+	tools/view/embed.sh $(VIEW_PAGE) > $@.tmp
+	mv $@.tmp $@
+$(BUILD)/obj/gen/view_page.o: $(BUILD)/gen/view_page.c
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $(TOOL_INC) -c $< -o $@
 
 $(IRDM): $(call obj,$(CLI_SRC)) $(TOOL_LIB) $(FW_LIB) | $(SLEPC_PLUGIN)
-	$(CC) $(LDFLAGS) $^ -o $@ $(LDLIBS)
+	$(CC) $(LDFLAGS) $^ -o $@ $(LDLIBS) $(VIEW_LIBS)
 
 # The slepc plugin: position-independent, only its entry point exported.
 $(BUILD)/obj/tools/dist/plugin/%.o: tools/dist/plugin/%.c
@@ -168,8 +189,9 @@ $(BUILD)/irdm-slepc.so: $(call obj,$(PLUGIN_SRC))
 TEST_LIBS := $(TOOL_LIB) $(SIM_LIB) $(HAL_LIB) $(FW_LIB)
 
 # BLAS only for the deformation worker
-$(IRDM_FW): $(call obj,$(FWMAIN_SRC)) $(SIM_LIB) $(HAL_LIB) $(FW_LIB)
-	$(CC) $(LDFLAGS) $^ -o $@ $(if $(call feature,DEFORM),-lopenblas) -lpthread -lm
+$(IRDM_FW): $(call obj,$(FWMAIN_SRC)) $(if $(VIEW),$(VIEW_OBJ)) $(SIM_LIB) $(HAL_LIB) $(FW_LIB)
+	$(CC) $(LDFLAGS) $^ -o $@ $(if $(call feature,DEFORM),-lopenblas) $(if $(VIEW),$(VIEW_LIBS)) \
+	  -lpthread -lm
 
 # The drive emulator: the simulator, the HAL's CAN code, the firmware's arm.
 $(IRDM_CD): $(call obj,$(CDMAIN_SRC)) $(SIM_LIB) $(HAL_LIB) $(FW_LIB)
@@ -183,6 +205,9 @@ $(TICK_TESTS): $(BUILD)/tests/test_tick_%: $(BUILD)/obj/tests/test_tick_%.o $(FW
 $(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(call obj,$(TESTSUP_SRC)) $(TEST_LIBS) | $(SLEPC_PLUGIN)
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) $^ -o $@ $(LDLIBS) -lcmocka
+
+# the view's test drives its server and decodes the browser's screenshots
+$(BUILD)/tests/test_view: LDLIBS += $(VIEW_LIBS) -lpng
 
 # benches share the test fixtures, which report through cmocka
 $(BUILD)/bench/%: $(BUILD)/obj/tests/bench/%.o $(call obj,$(TESTSUP_SRC)) $(TEST_LIBS)
@@ -328,6 +353,14 @@ run: deps
 	$(MAKE) $(IRDM) $(IRDM_FW)
 	tools/scripts/run-default-scene.sh $(IRDM) $(IRDM_FW)
 
+# The recorded run of make run in the view's page (irdm view) at three
+# moments: pressing, holding, ringing after the release (docs/view.md)
+VIEW_SHOT_TIMES ?= 1.1 2.5 3.4
+view-shots: $(IRDM)
+	@test -f out/run.log -a -f out/default.img || { echo "view-shots: needs out/run.log: make run first"; exit 1; }
+	/usr/bin/python3 tools/scripts/view-shots.py $(IRDM) out/run.log boards/sim-phantom.board \
+	  out/default.img docs/view/run-playback.png $(VIEW_SHOT_TIMES)
+
 # The default scene's deformed surface as VTK frames, PNGs and force plots
 # (irdm render; out/render-*; after make run it also renders that run's log)
 render: deps
@@ -341,6 +374,11 @@ $(JITTER_IMAGE): $(IRDM) scenes/cuboid-top.scene
 	$(IRDM) precompute -q --scene scenes/cuboid-top.scene -o $@
 jitter: deps $(IRDM) $(IRDM_FW) $(JITTER_IMAGE)
 	tools/scripts/jitter.sh $(IRDM) $(IRDM_FW) $(JITTER_IMAGE)
+
+# The same loop with and without a browser on its live view, alternating
+# (JITTER_ROUNDS pairs of JITTER_SECONDS, default 3 x 20 s; docs/view.md)
+jitter-view: deps $(IRDM_FW) $(JITTER_IMAGE)
+	tools/scripts/jitter-view.sh $(IRDM_FW) $(JITTER_IMAGE)
 
 # Hardware in the loop without the hardware: Debian's PREEMPT_RT kernel
 # under qemu (TCG), vcan0, irdm-candrives and irdm-fw (the minimal build)

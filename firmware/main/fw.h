@@ -44,6 +44,7 @@ struct fw_args {
 	const char *log;
 	const char *frame_out;          /* --frame-out: the VTK --frame-at writes */
 	const char *frames_out;         /* --frames-out: the directory of the series */
+	const char *view;               /* --view [ADDR:]PORT: the live view (fw_view.c) */
 	double duration_s;              /* 0: the user script's end + 1 s, else 5 s */
 	double frame_at_s;              /* --frame-at: 0 none */
 	double frames_every_s;          /* --frames-every: 0 none */
@@ -86,6 +87,7 @@ struct fw_frame_slot {
  */
 struct fw_frame {
 	struct irdm_deform_thread *th;  /* real time only */
+	struct fw_view *view;           /* --view: offered every frame (fw_view_offer) */
 	unsigned every_ticks;           /* engine ticks between snapshots (publish_every) */
 	uint64_t last_update_tick;      /* virtual time: the last engine tick updated at */
 	uint32_t rows;
@@ -126,6 +128,8 @@ struct fw {
 	void *ring_mem;
 	struct irdm_log_writer *writer;         /* real time: a thread drains the ring */
 	struct irdm_log_file *logf;             /* virtual time: the loop drains it */
+	struct fw_view *view;                   /* --view */
+	struct irdm_telem_ring *view_ring;      /* --view: the same records, for the view */
 	struct irdm_hist latency;               /* ns, real time only (0 in virtual time) */
 	struct irdm_hist compute_measured;      /* ns, measured in both clocks; limit: the period */
 	uint32_t watch_row;             /* the image node whose ringing is measured */
@@ -181,6 +185,16 @@ int fw_frame_write(struct fw *fw);
 int fw_frame_write_series(struct fw *fw);
 void fw_frame_summary(const struct fw *fw);
 void fw_frame_free(struct fw *fw);
+
+/* fw_view.c: --view's server and publisher (fw_view_none.c in the trimmed
+ * builds: no view).  fw_view_open() after fw_frame_open(), fw_view_start()
+ * after the real-time set-up, fw_view_close() after fw_frame_stop();
+ * fw_view_offer() from the deformation worker's side (NULL: no view). */
+struct fw_view;
+int fw_view_open(struct fw *fw);
+int fw_view_start(struct fw *fw);
+void fw_view_offer(struct fw_view *v, const double *pos_m, uint64_t tick);
+void fw_view_close(struct fw *fw);
 
 /* fw_summary.c */
 int fw_trace_alloc(struct fw_trace *t, uint64_t ticks);

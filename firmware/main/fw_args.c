@@ -45,6 +45,8 @@ static const struct irdm_opt fw_opts[] = {
 	{ .name = "frames-out", .type = IRDM_OPT_STRING, FA_REF(frames_out), .metavar = "DIR",
 	  .help = "where --frames-every writes: frame_NNNNN.vtk and frames.vtk.series (ParaView "
 		  "opens the series with time); replaced as a whole" },
+	{ .name = "view", .type = IRDM_OPT_STRING, FA_REF(view), .metavar = "[ADDR:]PORT",
+	  .help = "serve the live view (docs/view.md) on ADDR (default 127.0.0.1), PORT (0: any)" },
 	{ .name = "clock", .type = IRDM_OPT_ENUM, FA(clock), .names = clock_names,
 	  .metavar = "real | virtual",
 	  .help = "real time paced at the board's period, or virtual time (deterministic, fast)" },
@@ -67,7 +69,7 @@ void fw_args_usage(FILE *f)
 	fputs("usage: irdm-fw --board BOARD --image IMAGE [--user SCRIPT] [--duration S]\n"
 	      "               [--log FILE] [--frame-at S --frame-out FILE]\n"
 	      "               [--frames-every S --frames-out DIR]\n"
-	      "               [--clock real|virtual] [--require-rt]\n"
+	      "               [--clock real|virtual] [--require-rt] [--view [ADDR:]PORT]\n"
 	      "\n"
 	      "Runs the force loop on a board's device: HAL read, encoders, kinematics,\n"
 	      "proxy on the deformed surface, force engine, J^T and limits, HAL write,\n"

@@ -209,6 +209,7 @@ static void on_frame(void *ctx, const double *pos_m, uint64_t tick)
 	struct timespec now;
 
 	frame_offer(fr, pos_m, tick);
+	fw_view_offer(fr->view, pos_m, tick);
 	clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
 	/* the first frame also paid for the thread's start: not counted */
 	if (fr->cpu_started)
@@ -273,6 +274,7 @@ static void virtual_update(struct fw *fw, uint64_t eng_tick)
 	clock_gettime(CLOCK_MONOTONIC, &t1);
 	cpu_add(fr, ts_ns(&t1) - ts_ns(&t0));
 	frame_offer(fr, fr->scratch_m, tick);
+	fw_view_offer(fr->view, fr->scratch_m, tick);
 }
 
 void fw_frame_tick(struct fw *fw, const struct irdm_ctrl_output *out)

@@ -60,7 +60,7 @@ void fw_log_record(struct fw *fw, const struct irdm_ctrl_output *out, int64_t la
 	struct irdm_tick_record r;
 
 	irdm_hist_add(&fw->latency, latency_ns);
-	if (!fw->ring)
+	if (!fw->ring && !fw->view_ring)
 		return;
 	memset(&r, 0, sizeof(r));
 	r.tick = out->tick - 1;
@@ -71,7 +71,10 @@ void fw_log_record(struct fw *fw, const struct irdm_ctrl_output *out, int64_t la
 	r.n_devices = (uint8_t)out->n_devices;
 	for (unsigned i = 0; i < out->n_devices && i < IRDM_TELEM_MAX_DEVICES; i++)
 		fill_dev(&r.dev[i], &out->dev[i]);
-	irdm_telem_ring_push(fw->ring, &r);
+	if (fw->ring)
+		irdm_telem_ring_push(fw->ring, &r);
+	if (fw->view_ring)
+		irdm_telem_ring_push(fw->view_ring, &r);
 	if (fw->logf)
 		drain(fw, IRDM_LOG_WRITER_CHUNK);
 }

@@ -235,11 +235,16 @@ static int start(struct fw *fw)
 	rc = fw_log_open(fw);
 	if (rc)
 		return fail(FW_EXIT_SETUP, rc, "%s: %s", fw->args.log ? fw->args.log : "log", fw->err);
+	rc = fw_view_open(fw);
+	if (rc)
+		return fail(rc == IRDM_EINVAL ? FW_EXIT_USAGE : FW_EXIT_SETUP, rc, "%s%s", "", fw->err);
 	rc = setup_realtime(fw);
 	if (rc)
 		return rc;
 	/* after the real-time set-up: the thread goes one level below it */
 	rc = fw_frame_start(fw);
+	if (!rc)
+		rc = fw_view_start(fw);
 	if (rc)
 		return fail(FW_EXIT_SETUP, rc, "%s%s", "", fw->err);
 	return start_devices(fw);
@@ -253,6 +258,7 @@ static int stop(struct fw *fw, int rc)
 		if (fw->hal_open[i])
 			irdm_hal_safe_off(&fw->hal[i]);
 	fw_frame_stop(fw);
+	fw_view_close(fw);
 	if (rc == FW_EXIT_OK || rc == FW_EXIT_FAULT || rc == FW_EXIT_NEVER_ENABLED) {
 		int wrc = fw_frame_write(fw);
 		/* a fault's exit code says more than the frame it cut short */

@@ -22,6 +22,7 @@ int irdm_cmd_replay(int argc, char **argv);
 int irdm_cmd_log(int argc, char **argv);
 int irdm_cmd_report(int argc, char **argv);
 int irdm_cmd_render(int argc, char **argv);
+int irdm_cmd_view(int argc, char **argv);
 
 /*
  * The inputs irdm replay and irdm render share (cmd_replay.c): --image,

@@ -16,6 +16,7 @@ static const char usage[] =
 	"  replay       run the force engine on a prescribed displacement trajectory\n"
 	"  render       the deformed surface of a replay or an irdm-fw run: VTK frames, CSV\n"
 	"  log export   write an irdm-fw telemetry log as CSV\n"
+	"  view         play an irdm-fw run back in the browser (the live view's page)\n"
 	"  report       accuracy, tick time and size of representations against the exact model\n"
 	"\n"
 	"'irdm COMMAND --help' for each.  Version: " IRDM_TOOL_VERSION "\n";
@@ -40,6 +41,8 @@ int main(int argc, char **argv)
 		return irdm_cmd_render(argc - 1, argv + 1);
 	if (!strcmp(argv[1], "report"))
 		return irdm_cmd_report(argc - 1, argv + 1);
+	if (!strcmp(argv[1], "view"))
+		return irdm_cmd_view(argc - 1, argv + 1);
 	if (!strcmp(argv[1], "log"))
 		return irdm_cmd_log(argc - 1, argv + 1);
 	fprintf(stderr, "irdm: unknown command '%s' (see irdm --help)\n", argv[1]);

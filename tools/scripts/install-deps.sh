@@ -4,7 +4,8 @@
 set -euo pipefail
 packages=(build-essential clang libclang-rt-14-dev libopenblas-dev libsuitesparse-dev
 	  libarpack2-dev libcmocka-dev tetgen python3-matplotlib rt-tests
-	  petsc-dev slepc-dev libopenmpi-dev openmpi-bin)
+	  petsc-dev slepc-dev libopenmpi-dev openmpi-bin
+	  libwebsockets-dev libjs-three chromium libpng-dev)
 missing=()
 for p in "${packages[@]}"; do
 	dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed' || missing+=("$p")

@@ -28,6 +28,8 @@ echo "run: irdm-fw on boards/sim-phantom.board, scenes/users/press-hold-release.
 	--user scenes/users/press-hold-release.user --clock virtual --log out/run.log \
 	--frame-at 1.5 --frame-out out/run-frame.vtk --frames-every 0.1 --frames-out out/run-frames
 "$irdm" log export out/run.log -o out/run.csv
+echo "run: to watch this run in the browser (docs/view.md), serve it and open http://127.0.0.1:8080/:"
+echo "  $irdm view out/run.log --board boards/sim-phantom.board --image out/default.img"
 
 if $py -c 'import matplotlib' 2>/dev/null; then
 	$py tools/scripts/plot-response.py out/default-response.csv out/default-response.png
