@@ -334,8 +334,10 @@ int main(int argc, char **argv)
 		say_end(fw, rc);
 	}
 	rc = stop(fw, rc);
-	if ((rc == FW_EXIT_OK || rc == FW_EXIT_FAULT || rc == FW_EXIT_NEVER_ENABLED) &&
-	    !fw->args.quiet)
+	/* a run stopped by a signal ended cleanly too: what it did is worth
+	 * the same summary */
+	if ((rc == FW_EXIT_OK || rc == FW_EXIT_FAULT || rc == FW_EXIT_NEVER_ENABLED ||
+	     rc == FW_EXIT_SIGNAL) && !fw->args.quiet)
 		fw_summary_print(fw);
 	fw_trace_free(&fw->trace);
 	free(fw);
