@@ -21,6 +21,7 @@
 #include "irdm/clock.h"
 #include "irdm/controller.h"
 #include "irdm/hal.h"
+#include "irdm/outdir.h"
 #include "irdm/session.h"
 #include "irdm/sim_user.h"
 #include "irdm/telemetry.h"
@@ -46,6 +47,7 @@ struct fw_args {
 	double frames_every_s;          /* --frames-every: 0 none */
 	int clock;                      /* enum irdm_clock_mode */
 	bool require_rt;
+	bool force;                     /* --force: replace a --frames-out DIR we did not write */
 	bool quiet;
 	bool help;
 };
@@ -118,6 +120,7 @@ struct fw {
 	struct irdm_clock clock;
 	struct fw_trace trace;
 	struct fw_frame frame;
+	struct irdm_outdir frames_dir;  /* --frames-out's, claimed before the run */
 	/* telemetry: per-tick records through a ring to the log (--log) */
 	struct irdm_telem_ring *ring;
 	void *ring_mem;
@@ -159,7 +162,9 @@ int fw_log_close(struct fw *fw);
  * length) and fw_frame_open() (worker, buffers) after the controller;
  * fw_frame_start() after the real-time set-up (the thread, real time only);
  * fw_frame_tick() in the loop after each tick; fw_frame_stop() (join) and
- * fw_frame_write() before the session closes; fw_frame_summary() after. */
+ * fw_frame_write() before the session closes; fw_frame_summary() after.
+ * fw_frame_claim_series() before the run: --frames-out's directory
+ * (irdm/outdir.h); fw_frame_free() removes it unless written. */
 void fw_frame_config(struct fw *fw, struct irdm_session_config *sc);
 int fw_frame_check_args(struct fw *fw, uint64_t run_ticks);
 int fw_frame_open(struct fw *fw);
@@ -167,6 +172,7 @@ int fw_frame_start(struct fw *fw);
 void fw_frame_tick(struct fw *fw, const struct irdm_ctrl_output *out);
 void fw_frame_stop(struct fw *fw);
 int fw_frame_write(struct fw *fw);
+int fw_frame_claim_series(struct fw *fw);
 int fw_frame_write_series(struct fw *fw);
 void fw_frame_summary(const struct fw *fw);
 void fw_frame_free(struct fw *fw);

@@ -44,7 +44,10 @@ static const struct irdm_opt fw_opts[] = {
 		  "(at most 1000 frames)" },
 	{ .name = "frames-out", .type = IRDM_OPT_STRING, FA_REF(frames_out), .metavar = "DIR",
 	  .help = "where --frames-every writes: frame_NNNNN.vtk and frames.vtk.series (ParaView "
-		  "opens the series with time); replaced as a whole" },
+		  "opens the series with time); replaced as a whole, and only if irdm-fw wrote it" },
+	{ .name = "force", .type = IRDM_OPT_FLAG, FA(force),
+	  .help = "replace --frames-out DIR even if irdm-fw did not write it (a directory of "
+		  "files only)" },
 	{ .name = "clock", .type = IRDM_OPT_ENUM, FA(clock), .names = clock_names,
 	  .metavar = "real | virtual",
 	  .help = "real time paced at the board's period, or virtual time (deterministic, fast)" },
@@ -66,7 +69,7 @@ void fw_args_usage(FILE *f)
 {
 	fputs("usage: irdm-fw --board BOARD --image IMAGE [--user SCRIPT] [--duration S]\n"
 	      "               [--log FILE] [--frame-at S --frame-out FILE]\n"
-	      "               [--frames-every S --frames-out DIR]\n"
+	      "               [--frames-every S --frames-out DIR [--force]]\n"
 	      "               [--clock real|virtual] [--require-rt]\n"
 	      "\n"
 	      "Runs the force loop on a board's device: HAL read, encoders, kinematics,\n"

@@ -314,6 +314,7 @@ void fw_frame_free(struct fw *fw)
 		free(fw->frame.slot[k].pos_m);
 	free(fw->frame.slot);
 	free(fw->frame.scratch_m);
+	irdm_outdir_abort(&fw->frames_dir);
 }
 
 void fw_frame_summary(const struct fw *fw)

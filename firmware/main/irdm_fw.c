@@ -208,8 +208,10 @@ static int start(struct fw *fw)
 	if (fw_trace_alloc(&fw->trace, run_ticks(fw)))
 		return fail(FW_EXIT_SETUP, IRDM_ENOMEM, "%s%s", "", "out of memory for the run's trace");
 	rc = fw_frame_check_args(fw, run_ticks(fw));
+	if (!rc)
+		rc = fw_frame_claim_series(fw);
 	if (rc)
-		return fail(FW_EXIT_USAGE, rc, "%s%s", "", fw->err);
+		return fail(rc == IRDM_EIO ? FW_EXIT_SETUP : FW_EXIT_USAGE, rc, "%s%s", "", fw->err);
 	rc = fw_frame_open(fw);
 	if (rc)
 		return fail(rc == IRDM_EINVAL ? FW_EXIT_INPUT : FW_EXIT_SETUP, rc, "%s: %s",
