@@ -17,6 +17,7 @@
  */
 #define _GNU_SOURCE
 #include <fcntl.h>
+#include <glob.h>
 #include <math.h>
 #include <setjmp.h>
 #include <signal.h>
@@ -34,6 +35,7 @@
 #include <cmocka.h>
 
 #include "irdm/image.h"
+#include "irdm/outdir.h"
 #include "irdm/vec3.h"
 #include "irdm/safety.h"
 #include "irdm/telemetry.h"
@@ -494,6 +496,7 @@ static void test_frame_at_writes_the_deformed_surface(void **state)
 static void test_frames_series(void **state)
 {
 	char img_path[320], out[320], single[320], path[400], stray[400], line[256];
+	glob_t g;
 	char *a, *b;
 	size_t la, lb;
 	unsigned n = 0;
@@ -504,19 +507,26 @@ static void test_frames_series(void **state)
 	snprintf(out, sizeof(out), "%s/series", dir);
 	snprintf(single, sizeof(single), "%s/single.vtk", dir);
 	snprintf(stray, sizeof(stray), "%s/stray.txt", out);
-	for (int run = 0; run < 2; run++) {
-		assert_int_equal(run_fw((const char *const[]){
+	/* a second run replaces its own series; a file it did not write stops
+	 * it before the run (the file kept) unless --force */
+	for (int run = 0; run < 4; run++) {
+		int rc = run_fw((const char *const[]){
 			"--board", BOARD, "--image", img_path, "--user", PRESS, "--clock", "virtual",
 			"--frames-every", "0.5", "--frames-out", out, "--frame-at", "1.5",
-			"--frame-out", single, "-q", NULL }), 0);
-		if (run == 0)
-			tf_write_text(stray, "left from an older series\n");
+			"--frame-out", single, "-q", run == 3 ? "--force" : NULL, NULL });
+
+		if (run == 2) {
+			expect_error(rc, 2, "series/stray.txt: not written by irdm-fw");
+			assert_int_equal(access(stray, F_OK), 0);
+			continue;
+		}
+		assert_int_equal(rc, 0);
+		if (run == 1)
+			tf_write_text(stray, "the user's\n");
 	}
 	assert_int_equal(access(stray, F_OK), -1);         /* replaced as a whole */
-	snprintf(path, sizeof(path), "%s.tmp", out);
-	assert_int_equal(access(path, F_OK), -1);
-	snprintf(path, sizeof(path), "%s.old", out);
-	assert_int_equal(access(path, F_OK), -1);
+	snprintf(path, sizeof(path), "%s" IRDM_OUTDIR_TMP "*", out);
+	assert_int_equal(glob(path, 0, NULL, &g), GLOB_NOMATCH);   /* nothing left beside */
 	snprintf(path, sizeof(path), "%s/frames.vtk.series", out);
 	idx = fopen(path, "r");
 	assert_non_null(idx);
@@ -566,7 +576,7 @@ static void test_frames_series(void **state)
 	expect_error(run_fw((const char *const[]){ "--board", BOARD, "--image", img_path, "--clock",
 						   "virtual", "--duration", "0.5", "--frames-every",
 						   "0.1", "--frames-out", "/nonexistent/series", NULL }),
-		     4, "/nonexistent/series.tmp");
+		     4, "/nonexistent/series.irdm-tmp.");
 	expect_error(run_fw((const char *const[]){ "--board", BOARD, "--image", img_path,
 						   "--frames-every", "0.1", NULL }),
 		     2, "--frames-every needs --frames-out DIR");

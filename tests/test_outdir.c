@@ -162,6 +162,7 @@ static void test_foreign_directory(void **state)
 	expect_refused(rc, &od, "mixed/notes.txt: not written by tool-a");
 	expect_text(at(p, "mixed/notes.txt"), "mine");
 	/* another tool's output is not this tool's to replace */
+	assert_int_equal(unlink(at(p, "mixed/notes.txt")), 0);
 	rc = write_out(out, "tool-b", false, (const char *const[]){ "a", NULL }, &od);
 	expect_refused(rc, &od, "not written by tool-b");
 	expect_text(at(p, "mixed/a"), "a");
@@ -205,6 +206,12 @@ static void test_force(void **state)
 	assert_int_equal(write_out(out, "tool-a", true, (const char *const[]){ "a", NULL }, &od), 0);
 	expect_text(at(p, "forced/a"), "a");
 	assert_false(exists(at(p, "forced/old.txt")));
+	assert_int_equal(beside_dirs(), 0);
+	/* the tool's own output with a file added: --force takes both */
+	put(at(p, "forced/added"), "added");
+	assert_int_equal(write_out(out, "tool-a", true, (const char *const[]){ "b", NULL }, &od), 0);
+	assert_false(exists(at(p, "forced/added")));
+	assert_false(exists(at(p, "forced/a")));
 	assert_int_equal(beside_dirs(), 0);
 	/* a directory inside: not even --force removes a tree */
 	at(out, "tree");

@@ -710,6 +710,18 @@ static void test_bad_input(void **state)
 	expect_refusal((const char *const[]){ "render", "--image", "/nonexistent.img", "--contact",
 					      "212", "--displacement", traj, "-o", outdir, NULL },
 		       1, "EIO", outdir);
+	/* -o naming a user's file, even with --force: refused before the replay, kept */
+	for (int force = 0; force < 2; force++) {
+		int rc = run_irdm((const char *const[]){ "render", "--image", image, "--contact",
+							 "212", "--displacement", traj, "-o", bad,
+							 force ? "--force" : NULL, NULL });
+		char text[64];
+
+		if (rc != 1 || !strstr(err_text, "bad.csv: exists and is not a directory"))
+			fail_msg("-o FILE: expected exit 1 naming it; got %d: %s", rc, err_text);
+		tf_read_text(bad, text, sizeof(text));
+		assert_string_equal(text, "t,ux,uy,uz\n0,0.001,0,0\n0.002,0.001,0,0\n");
+	}
 }
 
 /* An image that displays the touched top only: rendered, and said. */

@@ -167,14 +167,16 @@ static int check_entries(struct irdm_outdir *od, DIR *h, const struct marker *m,
 			continue;
 		if (!plain) {
 			say(od, "%s/%s: a directory inside the output (%s writes files only); "
-				 "%s not replaced", od->dir, d->d_name, od->tool, od->dir);
+			    "%s not replaced", od->dir, d->d_name, od->tool, od->dir);
 			return IRDM_EEXIST;
 		}
 		if (!od->force) {
 			say(od, "%s/%s: not written by %s; %s not replaced (--force replaces it)",
-				 od->dir, d->d_name, od->tool, od->dir);
+			    od->dir, d->d_name, od->tool, od->dir);
 			return IRDM_EEXIST;
 		}
+		/* forced over a file we did not write: it goes with the rest */
+		od->replace_foreign = true;
 	}
 	return IRDM_OK;
 }
@@ -193,8 +195,8 @@ static int check_target(struct irdm_outdir *od, bool *exists)
 		return errno == ENOENT ? IRDM_OK : sys_fail(od, od->dir, "cannot stat", errno);
 	*exists = true;
 	if (!S_ISDIR(st.st_mode)) {
-		say(od, "%s: exists and is not a directory%s; not replaced",
-			 od->dir, S_ISLNK(st.st_mode) ? " (a symbolic link)" : "");
+		say(od, "%s: exists and is not a directory%s; not replaced", od->dir,
+		    S_ISLNK(st.st_mode) ? " (a symbolic link)" : "");
 		return IRDM_EEXIST;
 	}
 	ours = !marker_read(od->dir, &m) && m.complete && !strcmp(m.tool, od->tool);
@@ -203,10 +205,9 @@ static int check_target(struct irdm_outdir *od, bool *exists)
 		rc = sys_fail(od, od->dir, "cannot read", errno);
 		goto out_free;
 	}
+	od->replace_foreign = false;
 	rc = check_entries(od, h, &m, ours);
 	closedir(h);
-	/* force on a directory we did not write: its files go with it */
-	od->replace_foreign = !ours;
 out_free:
 	free(m.text);
 	return rc;
