@@ -582,7 +582,7 @@ static void test_long_line(void **state)
 
 	assert_int_equal(irdm_board_load(&board, "/nonexistent/x.board", err, sizeof(err)),
 			 IRDM_EIO);
-	assert_string_equal(err, "/nonexistent/x.board: cannot open");
+	assert_string_equal(err, "/nonexistent/x.board: cannot open: No such file or directory");
 }
 
 /* irdm_board_load and irdm_board_parse read the same board. */

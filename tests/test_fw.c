@@ -583,6 +583,36 @@ static void test_frames_series(void **state)
 }
 
 /*
+ * A log that cannot be written whole (a full disk, here the file size
+ * limit: the same failed write(), deterministic and without root): the
+ * run says so naming the log, exits 6, and leaves no log and no
+ * temporary, in virtual time (the loop writes) and real time (the writer
+ * thread does).
+ */
+static void test_log_write_failure(void **state)
+{
+	static const char *const clocks[] = { "virtual", "real" };
+	char log[320], pattern[400], board[320];
+	glob_t g;
+
+	(void)state;
+	snprintf(log, sizeof(log), "%s/full.log", dir);
+	relaxed_board(board, sizeof(board));        /* a busy host: no overrun fault */
+	for (int c = 0; c < 2; c++) {
+		int rc = finish(spawn("/bin/sh", (const char *const[]){
+			"-c", "trap '' XFSZ; ulimit -f 200 && exec \"$0\" \"$@\"",
+			env_or("IRDM_FW", "build/irdm-fw"), "--board", board, "--image", image,
+			"--user", PRESS, "--clock", clocks[c], "--duration", "1.5", "--log", log,
+			"-q", NULL }));
+
+		expect_error(rc, 6, "full.log: log not written: write failed after");
+		assert_int_equal(access(log, F_OK), -1);
+		snprintf(pattern, sizeof(pattern), "%s" IRDM_OUTDIR_TMP "*", log);
+		assert_int_equal(glob(pattern, 0, NULL, &g), GLOB_NOMATCH);
+	}
+}
+
+/*
  * Real time: the worker's thread draws the frames (about 100 in a second at
  * the board's 100 Hz; a loaded host may skip some) and holds the one
  * nearest the asked time.
@@ -653,6 +683,7 @@ int main(void)
 		cmocka_unit_test(test_sigterm_mid_contact_turns_torque_off),
 		cmocka_unit_test(test_frame_at_writes_the_deformed_surface),
 		cmocka_unit_test(test_frames_series),
+		cmocka_unit_test(test_log_write_failure),
 		cmocka_unit_test(test_frame_at_in_real_time),
 	};
 

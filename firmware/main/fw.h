@@ -33,6 +33,7 @@ enum fw_exit {
 	FW_EXIT_INPUT = 3,      /* board, image or user script refused */
 	FW_EXIT_SETUP = 4,      /* HAL, real time (--require-rt) or memory refused */
 	FW_EXIT_FAULT = 5,      /* the controller faulted: torque off, reason printed */
+	FW_EXIT_LOG = 6,        /* ran, but its --log could not be written (none left) */
 };
 
 struct fw_args {

@@ -78,7 +78,8 @@ void fw_args_usage(FILE *f)
 	irdm_opt_print_help(f, &fw_table, IRDM_OPT_STYLE_ARG);
 	fputs("\nexit codes: 0 ran to the end; 2 bad arguments; 3 board, image or user\n"
 	      "script refused; 4 HAL, real time (--require-rt) or memory refused;\n"
-	      "5 the controller faulted (torque off, reason printed)\n", f);
+	      "5 the controller faulted (torque off, reason printed); 6 the run ended but\n"
+	      "its --log could not be written (no log is left under its name)\n", f);
 }
 
 int fw_args_parse(struct fw_args *a, int argc, char **argv, char *err, size_t errlen)

@@ -11,13 +11,11 @@
 #define _GNU_SOURCE
 #include <errno.h>
 #include <stdio.h>
-#include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 #include "irdm/error.h"
 #include "irdm/outdir.h"
+#include "irdm/outfile.h"
 
 #include "fw.h"
 
@@ -87,14 +85,6 @@ static void write_vtk(FILE *f, const struct fw *fw, const struct fw_frame_slot *
 }
 
 /* One frame to path (no rename).  Return: 0, or errno. */
-static mode_t current_umask(void)
-{
-	mode_t m = umask(0);
-
-	umask(m);
-	return m;
-}
-
 /* Write and close f: 0, or errno. */
 static int write_file(const struct fw *fw, const struct fw_frame_slot *sl, FILE *f)
 {
@@ -121,59 +111,23 @@ static int io_error(struct fw *fw, const char *path, int e)
 	return IRDM_EIO;
 }
 
-/* FILE itself may be replaced only when it is a file (never a device, a
- * directory or a link someone pointed elsewhere). */
-static int check_single_target(struct fw *fw, const char *path)
-{
-	struct stat st;
-
-	if (lstat(path, &st) ? errno == ENOENT : S_ISREG(st.st_mode))
-		return IRDM_OK;
-	snprintf(fw->err, sizeof(fw->err), "%.400s: %s", path,
-		 errno == ENOENT || !errno ? "exists and is not a regular file; not replaced"
-					   : strerror(errno));
-	return IRDM_EEXIST;
-}
-
-/* Written beside FILE under a fresh name and renamed: a reader never sees
- * half a frame, and no file of that name is overwritten. */
+/* Written whole beside FILE and renamed (irdm/outfile.h): a reader never
+ * sees half a frame, and nothing but a file is replaced. */
 int fw_frame_write(struct fw *fw)
 {
 	const char *path = fw->args.frame_out;
-	char tmp[4096];
-	FILE *f;
-	int e = 0, fd;
+	struct irdm_outfile o;
+	int rc;
 
 	if (!path)
 		return IRDM_OK;
 	if (!fw->frame.slot[fw->frame.single_slot].held)
 		return no_frame(fw, path);
-	errno = 0;
-	if (check_single_target(fw, path))
-		return IRDM_EEXIST;
-	if ((size_t)snprintf(tmp, sizeof(tmp), "%s%sXXXXXX", path, IRDM_OUTDIR_TMP) >= sizeof(tmp)) {
-		snprintf(fw->err, sizeof(fw->err), "%.400s: path too long", path);
-		return IRDM_EINVAL;
-	}
-	fd = mkstemp(tmp);
-	f = fd < 0 ? NULL : fdopen(fd, "w");
-	if (!f) {
-		e = errno;
-		if (fd >= 0)
-			close(fd);
-		goto out_unlink;
-	}
-	fchmod(fd, 0666 & ~current_umask());
-	e = write_file(fw, &fw->frame.slot[fw->frame.single_slot], f);
-	if (!e && rename(tmp, path))
-		e = errno;
-out_unlink:
-	if (e) {
-		if (fd >= 0)
-			unlink(tmp);
-		return io_error(fw, path, e);
-	}
-	return IRDM_OK;
+	rc = irdm_outfile_open(&o, path, fw->err, sizeof(fw->err));
+	if (rc)
+		return rc;
+	write_vtk(o.f, fw, &fw->frame.slot[fw->frame.single_slot]);
+	return irdm_outfile_commit(&o, fw->err, sizeof(fw->err));
 }
 
 /* The frames and the index into dir.  Return: 0, or errno. */

@@ -255,8 +255,10 @@ static int stop(struct fw *fw, int rc)
 			irdm_hal_close(&fw->hal[i]);
 		free(fw->hal_mem[i]);
 	}
-	if (fw->ring && fw_log_close(fw))
-		fprintf(stderr, "irdm-fw: EIO: %s\n", fw->err);
+	/* a run whose log is lost says so in its exit code, not only in a line */
+	if (fw->ring && fw_log_close(fw) && fail(FW_EXIT_LOG, IRDM_EIO, "%s%s", "", fw->err) &&
+	    rc == FW_EXIT_OK)
+		rc = FW_EXIT_LOG;
 	free(fw->user);
 	fw_frame_free(fw);
 	irdm_session_close(fw->s);
@@ -292,7 +294,7 @@ int main(int argc, char **argv)
 				fw_hal_why(fw)[0] ? ": " : "", fw_hal_why(fw));
 	}
 	rc = stop(fw, rc);
-	if ((rc == FW_EXIT_OK || rc == FW_EXIT_FAULT) && !fw->args.quiet)
+	if ((rc == FW_EXIT_OK || rc == FW_EXIT_FAULT || rc == FW_EXIT_LOG) && !fw->args.quiet)
 		fw_summary_print(fw);
 	fw_trace_free(&fw->trace);
 	free(fw);

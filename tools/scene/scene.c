@@ -9,6 +9,7 @@
 
 #include "irdm/error.h"
 #include "irdm/options.h"
+#include "irdm/textfile.h"
 #include "modal/static_clusters.h"
 #include "modal/static_lowrank.h"
 #include "modal/static_sparse.h"
@@ -470,28 +471,20 @@ int irdm_scene_set(struct irdm_scene *sc, const char *key, const char *value,
 int irdm_scene_load(struct irdm_scene *sc, const char *path, char *err, size_t errlen)
 {
 	struct irdm_opt_file file = { .table = &irdm_scene_options, .obj = sc, .name = path };
-	FILE *f = fopen(path, "r");
+	struct irdm_text_file t;
 	char line[1024];
-	int ret = IRDM_OK;
+	int ret;
 
-	if (!f) {
-		snprintf(err, errlen, "%s: cannot open scene: %s", path, strerror(errno));
-		return IRDM_EIO;
-	}
-	while (!ret && fgets(line, sizeof(line), f)) {
+	ret = irdm_text_open(&t, path, IRDM_TEXT_MAX_BYTES, err, errlen);
+	if (ret)
+		return ret;
+	while ((ret = irdm_text_line(&t, line, sizeof(line), err, errlen)) > 0) {
 		file.line_no++;
-		if (!strchr(line, '\n') && !feof(f)) {
-			snprintf(err, errlen, "%s:%u: line too long", path, file.line_no);
-			ret = IRDM_EFORMAT;
-		} else {
-			ret = irdm_opt_parse_line(&file, line, err, errlen);
-		}
+		ret = irdm_opt_parse_line(&file, line, err, errlen);
+		if (ret)
+			break;
 	}
-	if (!ret && ferror(f)) {
-		snprintf(err, errlen, "%s: read error", path);
-		ret = IRDM_EIO;
-	}
-	fclose(f);
+	irdm_text_close(&t);
 	return ret;
 }
 
