@@ -144,6 +144,10 @@ long irdm_image_corr_block(const struct irdm_image *img, uint32_t col_force,
 void irdm_image_corr_value(const struct irdm_image *img, uint32_t col_force,
 			   uint32_t col_disp, double blk[9]);
 
+/* The largest spectral radius of the STABILITY table (0 with no column),
+ * which the loader has checked meta->max_spectral_radius repeats. */
+double irdm_image_max_radius(const struct irdm_image *img);
+
 /* CRC-32C (Castagnoli), reflected, init/xorout 0xFFFFFFFF. */
 uint32_t irdm_crc32c(const void *data, size_t len);
 
