@@ -410,6 +410,11 @@ out_abort:
 	return rc;
 }
 
+int irdm_outdir_remove_files(const char *dir)
+{
+	return remove_files(dir, NULL);
+}
+
 void irdm_outdir_abort(struct irdm_outdir *od)
 {
 	if (od->tmp[0])

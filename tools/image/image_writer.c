@@ -12,17 +12,21 @@
  * old image or the new one, never a mix, and a crash leaves at most a stray
  * temporary file.
  */
+#include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include "irdm/image.h"
+#include "irdm/outdir.h"
 #include "image/image_writer.h"
+#include "util/interrupt.h"
 
 #if defined(__BYTE_ORDER__) && defined(__ORDER_LITTLE_ENDIAN__) && \
 	__BYTE_ORDER__ != __ORDER_LITTLE_ENDIAN__
@@ -261,13 +265,53 @@ static int write_tmp(const struct irdm_image_writer *w, const struct layout *lo,
 	return close(fd);
 }
 
+/*
+ * Temporaries beside path left by killed runs: each writer holds a lock on
+ * its temporary until it is renamed or removed, so one that can be locked
+ * has no writer any more.  Removed and said, so the next run on the same
+ * image cleans what SIGKILL (or a power cut) left.
+ */
+static void remove_debris(const char *path)
+{
+	const char *slash = strrchr(path, '/');
+	const char *base = slash ? slash + 1 : path;
+	char dir[4096], prefix[512], victim[4600];
+	size_t plen;
+	struct dirent *d;
+	DIR *h;
+
+	snprintf(dir, sizeof(dir), "%.*s", slash ? (int)(slash - path + (slash == path)) : 1,
+		 slash ? path : ".");
+	plen = (size_t)snprintf(prefix, sizeof(prefix), "%s%s", base, IRDM_OUTDIR_TMP);
+	if (plen >= sizeof(prefix))
+		return;
+	h = opendir(dir);
+	while (h && (d = readdir(h))) {
+		int fd;
+
+		if (strncmp(d->d_name, prefix, plen) || strlen(d->d_name) != plen + 6)
+			continue;
+		fd = openat(dirfd(h), d->d_name, O_RDONLY | O_NONBLOCK | O_NOFOLLOW | O_CLOEXEC);
+		if (fd < 0)
+			continue;
+		if (!flock(fd, LOCK_EX | LOCK_NB) && !unlinkat(dirfd(h), d->d_name, 0)) {
+			snprintf(victim, sizeof(victim), "%s/%s", dir, d->d_name);
+			fprintf(stderr, "irdm: note: removed %s, left by an interrupted run\n",
+				victim);
+		}
+		close(fd);
+	}
+	if (h)
+		closedir(h);
+}
+
 int irdm_iw_write(const struct irdm_image_writer *w, const char *path,
 		  char *err, size_t errlen)
 {
-	static const char suffix[] = ".tmp.XXXXXX";
+	static const char suffix[] = IRDM_OUTDIR_TMP "XXXXXX";
 	struct layout *lo;
 	char *tmp = NULL;
-	int fd, ret;
+	int fd, lock_fd = -1, slot = -1, ret;
 
 	lo = malloc(sizeof(*lo));
 	if (!lo || plan(w, lo)) {
@@ -282,6 +326,7 @@ int irdm_iw_write(const struct irdm_image_writer *w, const char *path,
 		ret = IRDM_ENOMEM;
 		goto free_layout;
 	}
+	remove_debris(path);
 	/* from here on every failure is the file system's */
 	ret = IRDM_EIO;
 	strcpy(tmp, path);
@@ -292,6 +337,11 @@ int irdm_iw_write(const struct irdm_image_writer *w, const char *path,
 			 path, strerror(errno));
 		goto free_layout;
 	}
+	/* the lock says "a writer is alive" until the rename (remove_debris) */
+	lock_fd = dup(fd);
+	if (lock_fd >= 0)
+		flock(lock_fd, LOCK_EX);
+	slot = irdm_interrupt_add(IRDM_INTERRUPT_FILE, tmp, 0);
 	if (write_tmp(w, lo, fd)) {
 		snprintf(err, errlen, "%s: cannot write %s: %s", path, tmp,
 			 strerror(errno));
@@ -302,6 +352,8 @@ int irdm_iw_write(const struct irdm_image_writer *w, const char *path,
 			 tmp, strerror(errno));
 		goto unlink_tmp;
 	}
+	irdm_interrupt_del(slot);
+	slot = -1;
 	if (sync_dir(path)) {
 		/* Too late to keep the old image: it is replaced, not durable. */
 		snprintf(err, errlen, "%s: written, but cannot sync its directory: %s",
@@ -313,6 +365,9 @@ int irdm_iw_write(const struct irdm_image_writer *w, const char *path,
 unlink_tmp:
 	unlink(tmp);
 free_layout:
+	irdm_interrupt_del(slot);
+	if (lock_fd >= 0)
+		close(lock_fd);
 	free(tmp);
 	free(lo);
 	return ret;

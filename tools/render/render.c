@@ -15,6 +15,7 @@
 
 #include "irdm/outdir.h"
 #include "render/render.h"
+#include "util/interrupt.h"
 
 struct render {
 	const struct irdm_render_opts *o;
@@ -184,20 +185,23 @@ int irdm_render_run(const struct irdm_render_opts *o, struct irdm_render_summary
 		    char *err, size_t errlen)
 {
 	struct render rd = { .o = o, .sum = sum };
-	int ret;
+	int ret, slot;
 
 	memset(sum, 0, sizeof(*sum));
 	ret = irdm_outdir_begin(&rd.od, o->out_dir, "irdm render", o->force);
 	if (ret)
 		goto out_why;
 	sum->debris_removed = rd.od.debris_removed;
+	slot = irdm_interrupt_add(IRDM_INTERRUPT_DIR, rd.od.tmp, 0);
 	ret = run_into_tmp(&rd, err, errlen);
 	close_files(&rd);
 	if (ret) {
 		irdm_outdir_abort(&rd.od);
+		irdm_interrupt_del(slot);
 		return ret;
 	}
 	ret = irdm_outdir_commit(&rd.od);
+	irdm_interrupt_del(slot);
 	if (!ret)
 		return IRDM_OK;
 out_why:

@@ -56,7 +56,12 @@ int irdm_outdir_begin(struct irdm_outdir *od, const char *dir, const char *tool,
  */
 int irdm_outdir_commit(struct irdm_outdir *od);
 
-/* Remove od->tmp and the files in it (nothing if none). */
+/* Remove od->tmp and the files in it (nothing if none).  Async-signal-safe. */
 void irdm_outdir_abort(struct irdm_outdir *od);
+
+/* Remove the files in dir (not its subdirectories), then dir.  Only
+ * open(), getdents64, unlinkat(), close() and rmdir(): async-signal-safe,
+ * so a signal handler may call it.  0 when dir is gone. */
+int irdm_outdir_remove_files(const char *dir);
 
 #endif
