@@ -53,12 +53,22 @@ struct fw_args {
 	bool help;
 };
 
-/* Per-tick figures kept for the summary (allocated once, before the loop). */
+/*
+ * What the summary needs, in memory fixed at the start whatever the run's
+ * length (a day's run locks what a second's does): the force's peak and
+ * last value as they stream by, and the watched node's motion over the
+ * ringing window after the latest release (one window's samples).
+ */
 struct fw_trace {
-	uint64_t n, cap;
-	double *force_n;                /* |force on the object|, device 0 */
-	double *node_u_m;               /* the watched node's displacement along its normal */
-	uint8_t *contact;               /* device 0 in contact */
+	uint64_t n, cap;                /* ticks traced; ticks the run has */
+	double peak_n, final_n;         /* |force on the object|, device 0 */
+	uint64_t peak_at;
+	bool contact;                   /* device 0 in contact at the last tick */
+	bool released;                  /* a contact has ended */
+	uint64_t release_at;            /* the tick after the latest contact ended */
+	double *ring_u_m;               /* the watched node's displacement along its
+					 * normal from release_at on */
+	uint64_t ring_n, ring_max;      /* samples held; the window's length */
 };
 
 /*
@@ -178,8 +188,10 @@ int fw_frame_write_series(struct fw *fw);
 void fw_frame_summary(const struct fw *fw);
 void fw_frame_free(struct fw *fw);
 
-/* fw_summary.c */
-int fw_trace_alloc(struct fw_trace *t, uint64_t ticks);
+/* fw_summary.c: fw_trace_alloc() once before the loop (the window for a
+ * tick of period_us), fw_trace_add() every tick (no allocation). */
+int fw_trace_alloc(struct fw_trace *t, uint64_t ticks, uint32_t period_us);
+void fw_trace_add(struct fw_trace *t, double force_n, double node_u_m, bool contact);
 void fw_trace_free(struct fw_trace *t);
 void fw_summary_print(const struct fw *fw);
 /* The first open device's one-line reason (struct irdm_hal_dev's why), or "". */

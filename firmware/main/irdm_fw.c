@@ -205,7 +205,7 @@ static int start(struct fw *fw)
 	if (irdm_ctrl_init(&fw->ctrl, &fw->ccfg, fw->s))
 		return fail(FW_EXIT_INPUT, IRDM_EINVAL, "%s: %s", fw->args.image,
 			    "the controller cannot run on this image (no contact surface?)");
-	if (fw_trace_alloc(&fw->trace, run_ticks(fw)))
+	if (fw_trace_alloc(&fw->trace, run_ticks(fw), fw->board.period_us))
 		return fail(FW_EXIT_SETUP, IRDM_ENOMEM, "%s%s", "", "out of memory for the run's trace");
 	rc = fw_frame_check_args(fw, run_ticks(fw));
 	if (!rc)
