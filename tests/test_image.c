@@ -1397,6 +1397,7 @@ static void w_fir_elem(struct irdm_image_writer *w)
 
 FX(m_dt_zero, fx->meta.dt_s = 0)
 FX(m_dt_big, fx->meta.dt_s = 1.5)
+FX(m_dt_tiny, fx->meta.dt_s = 1e-300)
 FX(m_dt_nan, fx->meta.dt_s = NAN)
 FX(m_dt_one, fx->meta.dt_s = 1)
 FX(m_young, fx->meta.young_pa = 0)
@@ -1634,6 +1635,7 @@ struct sem_case {
 static const struct sem_case sem_cases[] = {
 	{ "dt 0", FIR, m_dt_zero, NULL, IRDM_EFORMAT, "dt_s is 0 s" },
 	{ "dt 1.5", FIR, m_dt_big, NULL, IRDM_EFORMAT, "dt_s is 1.5" },
+	{ "dt 1e-300", FIR, m_dt_tiny, NULL, IRDM_EFORMAT, "dt_s is 1e-300 s, must be in [1e-06, 1]" },
 	{ "dt NaN", FIR, m_dt_nan, NULL, IRDM_EFORMAT, "dt_s is not finite" },
 	{ "dt 1", FIR, m_dt_one, NULL, IRDM_OK, NULL },
 	{ "young", FIR, m_young, NULL, IRDM_EFORMAT, "young_pa" },

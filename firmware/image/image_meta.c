@@ -40,9 +40,10 @@ static int check_meta_numbers(struct parse *p)
 		if (!f64_finite(d[i].v))
 			return img_fail(p, IRDM_EFORMAT,
 					"meta %s is not finite", d[i].name);
-	if (!(m->dt_s > 0 && m->dt_s <= 1))
+	/* a microsecond at least: a 1 MHz force loop is beyond any device */
+	if (!(m->dt_s >= 1e-6 && m->dt_s <= 1))
 		return img_fail(p, IRDM_EFORMAT,
-				"meta dt_s is %g s, must be in (0, 1]", m->dt_s);
+				"meta dt_s is %g s, must be in [1e-06, 1]", m->dt_s);
 	if (!(m->young_pa > 0))
 		return img_fail(p, IRDM_EFORMAT,
 				"meta young_pa is %g, must be > 0", m->young_pa);

@@ -155,6 +155,10 @@ void fw_args_usage(FILE *f);
 /* fw_config.c: the board's arm, limits, placement and coupling, for the
  * controller; the session's engine configuration. */
 int fw_config_from_board(struct irdm_ctrl_config *c, const struct irdm_board *b);
+/* Why irdm_ctrl_init() refused, naming the board or the image (fw->err). */
+const char *fw_ctrl_init_why(struct fw *fw);
+/* Why --user cannot run on the board's back-end (fw->err). */
+const char *fw_user_hal_why(struct fw *fw);
 
 /* fw_loop.c: runs until the duration is over, a fault or a signal.
  * Returns FW_EXIT_OK or FW_EXIT_FAULT. */

@@ -102,7 +102,7 @@ static int open_inputs(struct fw *fw)
 		return FW_EXIT_OK;
 	if (!has_simulated_arm(fw->board.hal))
 		return fail(FW_EXIT_INPUT, IRDM_EINVAL, "--user %s: %s", fw->args.user,
-			    "a virtual user needs a back-end with a simulated arm (hal = sim or canemu)");
+			    fw_user_hal_why(fw));
 	fw->user = calloc(1, sizeof(*fw->user));
 	if (!fw->user)
 		return fail(FW_EXIT_SETUP, IRDM_ENOMEM, "%s%s", "", "out of memory for the user script");
@@ -138,9 +138,13 @@ static int open_devices(struct fw *fw)
 				   be->data_size);
 		if (!rc)
 			rc = irdm_hal_open(&fw->hal[i]);
-		if (rc)
-			return fail(FW_EXIT_SETUP, rc, "hal '%s': %s", fw->board.hal,
+		if (rc) {
+			/* the board's file: what the back-end refused is in it */
+			snprintf(fw->err, sizeof(fw->err), "%s: hal '%s'", fw->args.board,
+				 fw->board.hal);
+			return fail(FW_EXIT_SETUP, rc, "%s: %s", fw->err,
 				    fw->hal[i].why[0] ? fw->hal[i].why : "the device does not open");
+		}
 		fw->hal_open[i] = true;
 		if (fw->hal[i].info[0] && !fw->args.quiet)
 			printf("hal '%s': %s\n", fw->board.hal, fw->hal[i].info);
@@ -203,8 +207,7 @@ static int start(struct fw *fw)
 	if (rc)
 		return rc;
 	if (irdm_ctrl_init(&fw->ctrl, &fw->ccfg, fw->s))
-		return fail(FW_EXIT_INPUT, IRDM_EINVAL, "%s: %s", fw->args.image,
-			    "the controller cannot run on this image (no contact surface?)");
+		return fail(FW_EXIT_INPUT, IRDM_EINVAL, "%s%s", "", fw_ctrl_init_why(fw));
 	if (fw_trace_alloc(&fw->trace, run_ticks(fw), fw->board.period_us))
 		return fail(FW_EXIT_SETUP, IRDM_ENOMEM, "%s%s", "", "out of memory for the run's trace");
 	rc = fw_frame_check_args(fw, run_ticks(fw));
@@ -279,7 +282,9 @@ int main(int argc, char **argv)
 			free(fw);
 			return FW_EXIT_OK;
 		}
-		rc = fail(FW_EXIT_USAGE, rc, "%s%s (see irdm-fw --help)", "", fw->err);
+		/* the option table's messages point to --help already */
+		rc = fail(FW_EXIT_USAGE, rc, "%s%s", fw->err,
+			  strstr(fw->err, "--help") ? "" : " (see irdm-fw --help)");
 		free(fw);
 		return rc;
 	}

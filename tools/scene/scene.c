@@ -407,7 +407,7 @@ static const struct irdm_opt scene_opts[] = {
 	{ .name = "fixed", .type = IRDM_OPT_CUSTOM, .parse = set_region, SC(fixed), .metavar = REGION,
 	  .help = "fixed nodes, called REGION below (default z<=0)" },
 	{ .name = "dt", .type = IRDM_OPT_DOUBLE, SC(dt_s), .metavar = "SECONDS", .unit = "s",
-	  .range = IRDM_OPT_GT | IRDM_OPT_LE, .min = 0, .max = 1,
+	  .range = IRDM_OPT_GE | IRDM_OPT_LE, .min = 1e-6, .max = 1,
 	  .help = "sample period (default 0.001)" },
 	{ .name = "representation", .type = IRDM_OPT_CUSTOM, .parse = set_representation,
 	  .metavar = "modal:K | modal:all | fir:T",
@@ -470,7 +470,9 @@ int irdm_scene_set(struct irdm_scene *sc, const char *key, const char *value,
 
 int irdm_scene_load(struct irdm_scene *sc, const char *path, char *err, size_t errlen)
 {
-	struct irdm_opt_file file = { .table = &irdm_scene_options, .obj = sc, .name = path };
+	/* a key set twice is a mistake, not an override: say so */
+	struct irdm_opt_file file = { .table = &irdm_scene_options, .obj = sc, .name = path,
+				      .reject_duplicates = true };
 	struct irdm_text_file t;
 	char line[1024];
 	int ret;
