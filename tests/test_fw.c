@@ -80,6 +80,72 @@ static void expect_error(int rc, int code, const char *needle)
 			 err_text);
 }
 
+/* BOARD with one key's line replaced (key = value), into dir/NAME. */
+static const char *board_with(const char *name, const char *key, const char *value)
+{
+	static char path[320];
+	char text[16384], out[16384] = "", *line, *save;
+
+	tf_read_text(BOARD, text, sizeof(text));
+	/* line by line, empty ones kept: the messages' line numbers are BOARD's */
+	for (line = text; *line; line = save) {
+		char repl[256];
+
+		save = line + strcspn(line, "\n");
+		if (*save)
+			*save++ = 0;
+		if (!strncmp(line, key, strlen(key)) && line[strlen(key)] == ' ') {
+			snprintf(repl, sizeof(repl), "%s = %s", key, value);
+			line = repl;
+		}
+		strncat(out, line, sizeof(out) - strlen(out) - 2);
+		strcat(out, "\n");
+	}
+	snprintf(path, sizeof(path), "%s/%s", dir, name);
+	tf_write_text(path, out);
+	return path;
+}
+
+/*
+ * Each refusal names the thing, the place and the reason: the back-end's
+ * reason with the board's name, a value no device has at its line, a
+ * --user board whose back-end does not exist, a frame period shorter than
+ * the deformation's before the run, and --help hinted once.
+ */
+static void test_clear_messages(void **state)
+{
+	const char *b;
+
+	(void)state;
+	b = board_with("opts.board", "hal_options", "write_delay=0,frobnicate=3");
+	expect_error(run_fw((const char *const[]){ "--board", b, "--image", image, "--clock",
+						   "virtual", NULL }),
+		     4, "opts.board: hal 'sim': hal_options 'frobnicate=3': unknown");
+	b = board_with("delay.board", "hal_options", "write_delay=999");
+	expect_error(run_fw((const char *const[]){ "--board", b, "--image", image, "--clock",
+						   "virtual", NULL }),
+		     4, "delay.board: hal 'sim': hal_options 'write_delay=999': out of range");
+	b = board_with("gear.board", "gear_ratio", "1e-300,1e-300,1e-300");
+	expect_error(run_fw((const char *const[]){ "--board", b, "--image", image, "--clock",
+						   "virtual", NULL }),
+		     3, "gear.board:27: gear_ratio = 1e-300,1e-300,1e-300: joint 1: must be >= 0.01");
+	b = board_with("cpr.board", "counts_per_rev", "1e300,4000,4000");
+	expect_error(run_fw((const char *const[]){ "--board", b, "--image", image, "--clock",
+						   "virtual", NULL }),
+		     3, "cpr.board:26: counts_per_rev = 1e300,4000,4000: joint 1: must be <=");
+	b = board_with("nohal.board", "hal", "teleport");
+	expect_error(run_fw((const char *const[]){ "--board", b, "--image", image, "--user",
+						   PRESS, "--clock", "virtual", NULL }),
+		     3, "nohal.board: hal 'teleport': no such back-end in this build");
+	expect_error(run_fw((const char *const[]){ "--board", BOARD, "--image", image, "--clock",
+						   "virtual", "--frames-every", "0.001", "--frames-out",
+						   "/nonexistent/never", NULL }),
+		     2, "--frames-every 0.001: shorter than the deformation period, 0.01 s");
+	expect_error(run_fw((const char *const[]){ "--bogus", NULL }), 2,
+		     "--bogus: unknown option 'bogus' (see irdm-fw --help)");
+	assert_null(strstr(strstr(err_text, "--help") + 1, "--help"));
+}
+
 static void test_bad_input(void **state)
 {
 	char bad_board[320], img2[320];
@@ -570,8 +636,8 @@ static void test_frames_series(void **state)
 	free(b);
 	/* refused before the run: too many frames, a directory that cannot be made */
 	expect_error(run_fw((const char *const[]){ "--board", BOARD, "--image", img_path, "--clock",
-						   "virtual", "--duration", "5", "--frames-every",
-						   "0.001", "--frames-out", out, NULL }),
+						   "virtual", "--duration", "20", "--frames-every",
+						   "0.01", "--frames-out", out, NULL }),
 		     2, "more than 1000 frames");
 	expect_error(run_fw((const char *const[]){ "--board", BOARD, "--image", img_path, "--clock",
 						   "virtual", "--duration", "0.5", "--frames-every",
@@ -722,6 +788,7 @@ int main(void)
 		cmocka_unit_test(test_frame_at_writes_the_deformed_surface),
 		cmocka_unit_test(test_frames_series),
 		cmocka_unit_test(test_log_write_failure),
+		cmocka_unit_test(test_clear_messages),
 		cmocka_unit_test(test_memory_bounded),
 		cmocka_unit_test(test_frame_at_in_real_time),
 	};
