@@ -690,6 +690,18 @@ static void test_log_crash_leaves_no_final_file(void **state)
 	assert_int_equal(irdm_log_open(&rd, tmp, err, sizeof(err)), IRDM_ETRUNC);
 	assert_null(rd);
 	assert_non_null(strstr(err, "never closed"));
+	/* the next writer of the same log finds the dead one's temporary (no
+	 * lock on it) and removes it; its own is the only one while it writes */
+	{
+		struct irdm_log_file *lf;
+
+		assert_int_equal(irdm_log_file_open(&lf, path, &info2, err, sizeof(err)), IRDM_OK);
+		assert_false(exists(tmp));
+		assert_int_equal(temporaries("crash.log", NULL, 0), 1);
+		assert_int_equal(irdm_log_file_close(lf, 0, err, sizeof(err)), IRDM_OK);
+		assert_int_equal(temporaries("crash.log", NULL, 0), 0);
+		assert_int_equal(read_log_check(path, 0), 0);
+	}
 }
 
 /* Copy the first len bytes of src to dst, then patch `patch_len` bytes at `at` (if any). */

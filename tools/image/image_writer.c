@@ -12,7 +12,6 @@
  * old image or the new one, never a mix, and a crash leaves at most a stray
  * temporary file.
  */
-#include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <stdint.h>
@@ -25,6 +24,7 @@
 
 #include "irdm/image.h"
 #include "irdm/outdir.h"
+#include "irdm/outfile.h"
 #include "image/image_writer.h"
 #include "util/interrupt.h"
 
@@ -265,44 +265,11 @@ static int write_tmp(const struct irdm_image_writer *w, const struct layout *lo,
 	return close(fd);
 }
 
-/*
- * Temporaries beside path left by killed runs: each writer holds a lock on
- * its temporary until it is renamed or removed, so one that can be locked
- * has no writer any more.  Removed and said, so the next run on the same
- * image cleans what SIGKILL (or a power cut) left.
- */
-static void remove_debris(const char *path)
+/* A temporary of a killed writer, removed (irdm_outfile_remove_debris()): said. */
+static void said_removed(const char *victim, void *ctx)
 {
-	const char *slash = strrchr(path, '/');
-	const char *base = slash ? slash + 1 : path;
-	char dir[4096], prefix[512], victim[4600];
-	size_t plen;
-	struct dirent *d;
-	DIR *h;
-
-	snprintf(dir, sizeof(dir), "%.*s", slash ? (int)(slash - path + (slash == path)) : 1,
-		 slash ? path : ".");
-	plen = (size_t)snprintf(prefix, sizeof(prefix), "%s%s", base, IRDM_OUTDIR_TMP);
-	if (plen >= sizeof(prefix))
-		return;
-	h = opendir(dir);
-	while (h && (d = readdir(h))) {
-		int fd;
-
-		if (strncmp(d->d_name, prefix, plen) || strlen(d->d_name) != plen + 6)
-			continue;
-		fd = openat(dirfd(h), d->d_name, O_RDONLY | O_NONBLOCK | O_NOFOLLOW | O_CLOEXEC);
-		if (fd < 0)
-			continue;
-		if (!flock(fd, LOCK_EX | LOCK_NB) && !unlinkat(dirfd(h), d->d_name, 0)) {
-			snprintf(victim, sizeof(victim), "%s/%s", dir, d->d_name);
-			fprintf(stderr, "irdm: note: removed %s, left by an interrupted run\n",
-				victim);
-		}
-		close(fd);
-	}
-	if (h)
-		closedir(h);
+	(void)ctx;
+	fprintf(stderr, "irdm: note: removed %s, left by an interrupted run\n", victim);
 }
 
 int irdm_iw_write(const struct irdm_image_writer *w, const char *path,
@@ -326,7 +293,8 @@ int irdm_iw_write(const struct irdm_image_writer *w, const char *path,
 		ret = IRDM_ENOMEM;
 		goto free_layout;
 	}
-	remove_debris(path);
+	/* the same names and lock as irdm/outfile.h's: a killed writer's debris goes */
+	irdm_outfile_remove_debris(path, said_removed, NULL);
 	/* from here on every failure is the file system's */
 	ret = IRDM_EIO;
 	strcpy(tmp, path);

@@ -6,7 +6,10 @@
  * overwritten on the way), which is renamed onto PATH once every write,
  * the flush, the sync and the close succeeded.  PATH may be replaced only
  * when it is missing or a regular file.  Any failure removes the temporary
- * and leaves PATH as it was.  Init- and exit-time only (file system calls).
+ * and leaves PATH as it was.  The writer holds a lock (flock) on its
+ * temporary until the rename: one beside PATH that nobody holds was left by
+ * a killed writer, and the next open of PATH removes it.  Init- and
+ * exit-time only (file system calls).
  */
 #ifndef IRDM_OUTFILE_H
 #define IRDM_OUTFILE_H
@@ -17,6 +20,8 @@
 
 struct irdm_outfile {
 	FILE *f;                                /* write here; NULL when none */
+	int lock_fd;                            /* holds the temporary's lock; -1 when none */
+	unsigned debris_removed;                /* killed writers' temporaries removed at open */
 	char path[IRDM_OUTFILE_PATH_MAX];
 	char tmp[IRDM_OUTFILE_PATH_MAX + 32];
 };
@@ -38,5 +43,13 @@ int irdm_outfile_commit(struct irdm_outfile *o, char *err, size_t errlen);
 
 /* Close and remove the temporary; nothing if none. */
 void irdm_outfile_abort(struct irdm_outfile *o);
+
+/*
+ * Remove the temporaries beside path (PATH.irdm-tmp.XXXXXX, regular files)
+ * that no live writer holds locked; removed(path, ctx) for each if not
+ * NULL.  Return how many.
+ */
+unsigned irdm_outfile_remove_debris(const char *path, void (*removed)(const char *path, void *ctx),
+				    void *ctx);
 
 #endif
