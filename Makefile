@@ -267,12 +267,14 @@ FUZZ_BUILD := build-fuzz
 FUZZ_CFLAGS := -O1 -g -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=all
 fuzz:
 	$(MAKE) CC=clang BUILD=$(FUZZ_BUILD) OPT="$(FUZZ_CFLAGS)" \
-	  $(FUZZ_BUILD)/libirdmtools.a $(FUZZ_BUILD)/libirdmhal.a $(FUZZ_BUILD)/libirdmfw.a
+	  $(FUZZ_BUILD)/libirdmtools.a $(FUZZ_BUILD)/libirdmsim.a $(FUZZ_BUILD)/libirdmhal.a \
+	  $(FUZZ_BUILD)/libirdmfw.a
 	mkdir -p $(FUZZ_BUILD)/findings
 	for f in $(FUZZ_SRC); do \
 	  n=$$(basename $$f .c); \
-	  clang $(CSTD) $(WARN) -O1 -g $(TOOL_INC) -Ihal/include -fsanitize=fuzzer,address,undefined \
-	    -fno-sanitize-recover=all $$f $(FUZZ_BUILD)/libirdmtools.a $(FUZZ_BUILD)/libirdmhal.a \
+	  clang $(CSTD) $(WARN) -O1 -g $(TOOL_INC) -Ihal/include -Isim/include \
+	    -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all $$f \
+	    $(FUZZ_BUILD)/libirdmtools.a $(FUZZ_BUILD)/libirdmsim.a $(FUZZ_BUILD)/libirdmhal.a \
 	    $(FUZZ_BUILD)/libirdmfw.a -o $(FUZZ_BUILD)/$$n $(LDLIBS); \
 	  mkdir -p $(FUZZ_BUILD)/corpus/$$n; \
 	  seeds=tests/fuzz/seeds/$$n; [ -d $$seeds ] || seeds=; \

@@ -425,7 +425,23 @@ static void test_bad_values(void **state)
 		{ "object_rotation_deg = 400,0,0",
 		  "t.board:5: object_rotation_deg = 400,0,0: x: must be <= 360 deg" },
 		/* per joint */
-		{ "gear_ratio = 11.6,0,11.6", "t.board:5: gear_ratio = 11.6,0,11.6: joint 2: must be > 0" },
+		{ "gear_ratio = 11.6,0,11.6", "t.board:5: gear_ratio = 11.6,0,11.6: joint 2: must be >= 0.01" },
+		/* finite and positive is not enough: each within what a device can be */
+		{ "gear_ratio = 1e-300,11.6,11.6",
+		  "t.board:5: gear_ratio = 1e-300,11.6,11.6: joint 1: must be >= 0.01" },
+		{ "counts_per_rev = 1e-300,4000,4000",
+		  "t.board:5: counts_per_rev = 1e-300,4000,4000: joint 1: must be >= 1" },
+		{ "counts_per_rev = 1e300,4000,4000",
+		  "t.board:5: counts_per_rev = 1e300,4000,4000: joint 1: must be <= 1000000000" },
+		{ "torque_limit_nm = 1e-300,1.07,1.07",
+		  "t.board:5: torque_limit_nm = 1e-300,1.07,1.07: joint 1: must be >= 0.001 N m" },
+		{ "device_damping_ns_per_m = 1e-300",
+		  "t.board:5: device_damping_ns_per_m = 1e-300: must be >= 0.001 N s/m" },
+		{ "max_stiffness_n_per_m = 1e-300",
+		  "t.board:5: max_stiffness_n_per_m = 1e-300: must be >= 1 N/m" },
+		{ "max_tip_speed_m_per_s = 1e-300",
+		  "t.board:5: max_tip_speed_m_per_s = 1e-300: must be >= 0.001 m/s" },
+		{ "max_force_n = 1e-300", "t.board:5: max_force_n = 1e-300: must be >= 0.01 N" },
 		{ "torque_limit_nm = 1.07,1.07,200",
 		  "t.board:5: torque_limit_nm = 1.07,1.07,200: joint 3: must be <= 100 N m" },
 		{ "calibration_pose_rad = 0,0,4",
@@ -526,7 +542,9 @@ static void test_refused_boards(void **state)
 		       "t.board:5: device2_base_offset_m: only with devices = 2");
 	/* encoders */
 	expect_refused("count_max = 10,10,10\ncount_min = 0,11,0\n", IRDM_EINVAL,
-		       "t.board:6: count_min: must be <= count_max (line 5) on every joint; joint 2: 11 > 10");
+		       "t.board:6: count_min: must be < count_max (line 5) on every joint; joint 2: 11 >= 10");
+	expect_refused("count_max = 0,0,0\ncount_min = 0,0,0\n", IRDM_EINVAL,
+		       "t.board:6: count_min: must be < count_max (line 5) on every joint; joint 1: 0 >= 0");
 	/* loop */
 	expect_refused("watchdog_us = 1000\n", IRDM_EINVAL,
 		       "t.board:5: watchdog_us = 1000: must be > period_us = 1000 (default)");
@@ -582,7 +600,7 @@ static void test_long_line(void **state)
 
 	assert_int_equal(irdm_board_load(&board, "/nonexistent/x.board", err, sizeof(err)),
 			 IRDM_EIO);
-	assert_string_equal(err, "/nonexistent/x.board: cannot open");
+	assert_string_equal(err, "/nonexistent/x.board: cannot open: No such file or directory");
 }
 
 /* irdm_board_load and irdm_board_parse read the same board. */

@@ -191,6 +191,17 @@ static void test_bad_scene_values(void **state)
 	tf_write_text(path_in_dir("bad.scene"), "mass = heavy\n");
 	expect_failure(run("precompute", "--scene", path_in_dir("bad.scene"), "-o", img, NULL),
 		       "bad.scene:1: mass = heavy: expected lumped | consistent");
+	/* a key twice is refused, naming both lines (not: the last one wins) */
+	tf_write_text(path_in_dir("bad.scene"), "young = 2000\npoisson = 0.3\nyoung = 3000\n");
+	expect_failure(run("precompute", "--scene", path_in_dir("bad.scene"), "-o", img, NULL),
+		       "bad.scene:3: young");
+	assert_non_null(strstr(err_text, "line 1"));
+	/* a display region that holds no surface node is refused, not ignored */
+	expect_failure(run("precompute", SMALL, "--display", "z>=5", "-o", img, NULL),
+		       "'display = z>=5' selects no surface node");
+	/* a sample period no device could run */
+	expect_failure(run("precompute", SMALL, "--dt", "1e-300", "-o", img, NULL),
+		       "--dt 1e-300: must be >= 1e-06 s");
 	assert_false(exists(img));
 }
 

@@ -22,6 +22,7 @@
  */
 #define _GNU_SOURCE
 #include <fcntl.h>
+#include <glob.h>
 #include <math.h>
 #include <setjmp.h>
 #include <signal.h>
@@ -39,6 +40,7 @@
 #include <cmocka.h>
 
 #include "irdm/image.h"
+#include "irdm/outdir.h"
 #include "irdm/vec3.h"
 #include "irdm/safety.h"
 #include "irdm/telemetry.h"
@@ -81,6 +83,72 @@ static void expect_error(int rc, int code, const char *needle)
 	    strchr(err_text, '\n') != err_text + strlen(err_text) - 1)
 		fail_msg("expected exit %d with one line naming '%s'; got %d: %s", code, needle, rc,
 			 err_text);
+}
+
+/* BOARD with one key's line replaced (key = value), into dir/NAME. */
+static const char *board_with(const char *name, const char *key, const char *value)
+{
+	static char path[320];
+	char text[16384], out[16384] = "", *line, *save;
+
+	tf_read_text(BOARD, text, sizeof(text));
+	/* line by line, empty ones kept: the messages' line numbers are BOARD's */
+	for (line = text; *line; line = save) {
+		char repl[256];
+
+		save = line + strcspn(line, "\n");
+		if (*save)
+			*save++ = 0;
+		if (!strncmp(line, key, strlen(key)) && line[strlen(key)] == ' ') {
+			snprintf(repl, sizeof(repl), "%s = %s", key, value);
+			line = repl;
+		}
+		strncat(out, line, sizeof(out) - strlen(out) - 2);
+		strcat(out, "\n");
+	}
+	snprintf(path, sizeof(path), "%s/%s", dir, name);
+	tf_write_text(path, out);
+	return path;
+}
+
+/*
+ * Each refusal names the thing, the place and the reason: the back-end's
+ * reason with the board's name, a value no device has at its line, a
+ * --user board whose back-end does not exist, a frame period shorter than
+ * the deformation's before the run, and --help hinted once.
+ */
+static void test_clear_messages(void **state)
+{
+	const char *b;
+
+	(void)state;
+	b = board_with("opts.board", "hal_options", "write_delay=0,frobnicate=3");
+	expect_error(run_fw((const char *const[]){ "--board", b, "--image", image, "--clock",
+						   "virtual", NULL }),
+		     4, "opts.board: hal 'sim': hal_options 'frobnicate=3': unknown");
+	b = board_with("delay.board", "hal_options", "write_delay=999");
+	expect_error(run_fw((const char *const[]){ "--board", b, "--image", image, "--clock",
+						   "virtual", NULL }),
+		     4, "delay.board: hal 'sim': hal_options 'write_delay=999': out of range");
+	b = board_with("gear.board", "gear_ratio", "1e-300,1e-300,1e-300");
+	expect_error(run_fw((const char *const[]){ "--board", b, "--image", image, "--clock",
+						   "virtual", NULL }),
+		     3, "gear.board:27: gear_ratio = 1e-300,1e-300,1e-300: joint 1: must be >= 0.01");
+	b = board_with("cpr.board", "counts_per_rev", "1e300,4000,4000");
+	expect_error(run_fw((const char *const[]){ "--board", b, "--image", image, "--clock",
+						   "virtual", NULL }),
+		     3, "cpr.board:26: counts_per_rev = 1e300,4000,4000: joint 1: must be <=");
+	b = board_with("nohal.board", "hal", "teleport");
+	expect_error(run_fw((const char *const[]){ "--board", b, "--image", image, "--user",
+						   PRESS, "--clock", "virtual", NULL }),
+		     3, "nohal.board: hal 'teleport': no such back-end in this build");
+	expect_error(run_fw((const char *const[]){ "--board", BOARD, "--image", image, "--clock",
+						   "virtual", "--frames-every", "0.001", "--frames-out",
+						   "/nonexistent/never", NULL }),
+		     2, "--frames-every 0.001: shorter than the deformation period, 0.01 s");
+	expect_error(run_fw((const char *const[]){ "--bogus", NULL }), 2,
+		     "--bogus: unknown option 'bogus' (see irdm-fw --help)");
+	assert_null(strstr(strstr(err_text, "--help") + 1, "--help"));
 }
 
 static void test_bad_input(void **state)
@@ -670,6 +738,7 @@ static void test_frame_at_writes_the_deformed_surface(void **state)
 static void test_frames_series(void **state)
 {
 	char img_path[320], out[320], single[320], path[400], stray[400], line[256];
+	glob_t g;
 	char *a, *b;
 	size_t la, lb;
 	unsigned n = 0;
@@ -680,19 +749,26 @@ static void test_frames_series(void **state)
 	snprintf(out, sizeof(out), "%s/series", dir);
 	snprintf(single, sizeof(single), "%s/single.vtk", dir);
 	snprintf(stray, sizeof(stray), "%s/stray.txt", out);
-	for (int run = 0; run < 2; run++) {
-		assert_int_equal(run_fw((const char *const[]){
+	/* a second run replaces its own series; a file it did not write stops
+	 * it before the run (the file kept) unless --force */
+	for (int run = 0; run < 4; run++) {
+		int rc = run_fw((const char *const[]){
 			"--board", BOARD, "--image", img_path, "--user", PRESS, "--clock", "virtual",
 			"--frames-every", "0.5", "--frames-out", out, "--frame-at", "1.5",
-			"--frame-out", single, "-q", NULL }), 0);
-		if (run == 0)
-			tf_write_text(stray, "left from an older series\n");
+			"--frame-out", single, "-q", run == 3 ? "--force" : NULL, NULL });
+
+		if (run == 2) {
+			expect_error(rc, 2, "series/stray.txt: not written by irdm-fw");
+			assert_int_equal(access(stray, F_OK), 0);
+			continue;
+		}
+		assert_int_equal(rc, 0);
+		if (run == 1)
+			tf_write_text(stray, "the user's\n");
 	}
 	assert_int_equal(access(stray, F_OK), -1);         /* replaced as a whole */
-	snprintf(path, sizeof(path), "%s.tmp", out);
-	assert_int_equal(access(path, F_OK), -1);
-	snprintf(path, sizeof(path), "%s.old", out);
-	assert_int_equal(access(path, F_OK), -1);
+	snprintf(path, sizeof(path), "%s" IRDM_OUTDIR_TMP "*", out);
+	assert_int_equal(glob(path, 0, NULL, &g), GLOB_NOMATCH);   /* nothing left beside */
 	snprintf(path, sizeof(path), "%s/frames.vtk.series", out);
 	idx = fopen(path, "r");
 	assert_non_null(idx);
@@ -736,16 +812,84 @@ static void test_frames_series(void **state)
 	free(b);
 	/* refused before the run: too many frames, a directory that cannot be made */
 	expect_error(run_fw((const char *const[]){ "--board", BOARD, "--image", img_path, "--clock",
-						   "virtual", "--duration", "5", "--frames-every",
-						   "0.001", "--frames-out", out, NULL }),
+						   "virtual", "--duration", "20", "--frames-every",
+						   "0.01", "--frames-out", out, NULL }),
 		     2, "more than 1000 frames");
 	expect_error(run_fw((const char *const[]){ "--board", BOARD, "--image", img_path, "--clock",
 						   "virtual", "--duration", "0.5", "--frames-every",
 						   "0.1", "--frames-out", "/nonexistent/series", NULL }),
-		     4, "/nonexistent/series.tmp");
+		     4, "/nonexistent/series.irdm-tmp.");
 	expect_error(run_fw((const char *const[]){ "--board", BOARD, "--image", img_path,
 						   "--frames-every", "0.1", NULL }),
 		     2, "--frames-every needs --frames-out DIR");
+}
+
+/* The summary's "memory:" line: peak resident kB. */
+static long peak_resident_kb(void)
+{
+	const char *p = strstr(out_text, "memory: locked ");
+	long locked, peak;
+
+	assert_non_null(p);
+	assert_int_equal(sscanf(p, "memory: locked %ld kB, peak resident %ld kB", &locked, &peak),
+			 2);
+	return peak;
+}
+
+/*
+ * The summary's memory does not grow with the run: 3 s and 150 s of
+ * virtual time (150,000 ticks: a per-tick trace of 17 bytes would add
+ * 2.5 MB) peak at the same resident size, within allocator noise.
+ */
+static void test_memory_bounded(void **state)
+{
+	long short_kb, long_kb;
+
+	(void)state;
+	assert_int_equal(run_fw((const char *const[]){ "--board", BOARD, "--image", image,
+						       "--user", PRESS, "--clock", "virtual",
+						       "--duration", "3", NULL }), 0);
+	short_kb = peak_resident_kb();
+	assert_int_equal(run_fw((const char *const[]){ "--board", BOARD, "--image", image,
+						       "--user", PRESS, "--clock", "virtual",
+						       "--duration", "150", NULL }), 0);
+	long_kb = peak_resident_kb();
+	print_message("peak resident: %ld kB for 3 s, %ld kB for 150 s of virtual time\n",
+		      short_kb, long_kb);
+	assert_true(labs(long_kb - short_kb) < 1024);
+	/* the ringing after release is still found in the bounded window */
+	assert_non_null(strstr(out_text, "release ringing: ") &&
+			!strstr(out_text, "release ringing: none") ? out_text : NULL);
+}
+
+/*
+ * A log that cannot be written whole (a full disk, here the file size
+ * limit: the same failed write(), deterministic and without root): the
+ * run says so naming the log, exits 9, and leaves no log and no
+ * temporary, in virtual time (the loop writes) and real time (the writer
+ * thread does).
+ */
+static void test_log_write_failure(void **state)
+{
+	static const char *const clocks[] = { "virtual", "real" };
+	char log[320], pattern[400], board[320];
+	glob_t g;
+
+	(void)state;
+	snprintf(log, sizeof(log), "%s/full.log", dir);
+	relaxed_board(board, sizeof(board));        /* a busy host: no overrun fault */
+	for (int c = 0; c < 2; c++) {
+		int rc = finish(spawn("/bin/sh", (const char *const[]){
+			"-c", "trap '' XFSZ; ulimit -f 200 && exec \"$0\" \"$@\"",
+			env_or("IRDM_FW", "build/irdm-fw"), "--board", board, "--image", image,
+			"--user", PRESS, "--clock", clocks[c], "--duration", "1.5", "--log", log,
+			"-q", NULL }));
+
+		expect_error(rc, 9, "full.log: log not written: write failed after");
+		assert_int_equal(access(log, F_OK), -1);
+		snprintf(pattern, sizeof(pattern), "%s" IRDM_OUTDIR_TMP "*", log);
+		assert_int_equal(glob(pattern, 0, NULL, &g), GLOB_NOMATCH);
+	}
 }
 
 /*
@@ -825,6 +969,9 @@ int main(void)
 		cmocka_unit_test(test_never_enabled_exits_nonzero),
 		cmocka_unit_test(test_frame_at_writes_the_deformed_surface),
 		cmocka_unit_test(test_frames_series),
+		cmocka_unit_test(test_log_write_failure),
+		cmocka_unit_test(test_clear_messages),
+		cmocka_unit_test(test_memory_bounded),
 		cmocka_unit_test(test_frame_at_in_real_time),
 	};
 

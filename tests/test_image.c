@@ -1397,6 +1397,7 @@ static void w_fir_elem(struct irdm_image_writer *w)
 
 FX(m_dt_zero, fx->meta.dt_s = 0)
 FX(m_dt_big, fx->meta.dt_s = 1.5)
+FX(m_dt_tiny, fx->meta.dt_s = 1e-300)
 FX(m_dt_nan, fx->meta.dt_s = NAN)
 FX(m_dt_one, fx->meta.dt_s = 1)
 FX(m_young, fx->meta.young_pa = 0)
@@ -1438,6 +1439,34 @@ FX(m_stab_nan, fx->stability[1].spectral_radius = NAN)
 FX(m_stab_neg, fx->stability[0].spectral_radius = -0.5f)
 FX(m_stab_flag, fx->stability[1].flags |= IRDM_STAB_STABLE)
 FX(m_prov_nul, fx->provenance[10] = '\0')
+/* the table says unstable (1.0317), the meta's copy 0.5: checksums all valid */
+static void m_radius_forged(struct img_fixture *fx)
+{
+	for (uint32_t c = 0; c < fx->meta.n_cols; c++) {
+		fx->stability[c].spectral_radius = 1.0317f;
+		fx->stability[c].flags = 0;
+	}
+	fx->meta.max_spectral_radius = 0.5;
+}
+
+static void m_unstable_flag(struct img_fixture *fx)
+{
+	for (uint32_t c = 0; c < fx->meta.n_cols; c++) {
+		fx->stability[c].spectral_radius = 0.5f;
+		fx->stability[c].flags = 0;
+	}
+	fx->meta.max_spectral_radius = 0.5;
+}
+
+static void m_prov_rayleigh(struct img_fixture *fx)
+{
+	fx->meta.rayleigh_a_per_s = 2;
+	fx->provenance_len += (size_t)snprintf(fx->provenance + fx->provenance_len,
+					       sizeof(fx->provenance) - fx->provenance_len,
+					       "rayleigh_a_per_s=3\n");
+}
+
+FX(m_prov_tool, snprintf(fx->meta.tool_version, sizeof(fx->meta.tool_version), "irdm-test 0.2"))
 FX(m_floating, fx->meta.flags |= IRDM_META_FLOATING)
 FX(m_mass, fx->rigid.mass_kg = 0)
 FX(m_inertia, fx->rigid.inertia_kg_m2[4] = NAN)
@@ -1606,6 +1635,7 @@ struct sem_case {
 static const struct sem_case sem_cases[] = {
 	{ "dt 0", FIR, m_dt_zero, NULL, IRDM_EFORMAT, "dt_s is 0 s" },
 	{ "dt 1.5", FIR, m_dt_big, NULL, IRDM_EFORMAT, "dt_s is 1.5" },
+	{ "dt 1e-300", FIR, m_dt_tiny, NULL, IRDM_EFORMAT, "dt_s is 1e-300 s, must be in [1e-06, 1]" },
 	{ "dt NaN", FIR, m_dt_nan, NULL, IRDM_EFORMAT, "dt_s is not finite" },
 	{ "dt 1", FIR, m_dt_one, NULL, IRDM_OK, NULL },
 	{ "young", FIR, m_young, NULL, IRDM_EFORMAT, "young_pa" },
@@ -1642,6 +1672,14 @@ static const struct sem_case sem_cases[] = {
 	{ "stability NaN", FIR, m_stab_nan, NULL, IRDM_EFORMAT, "column 1: spectral radius" },
 	{ "stability < 0", FIR, m_stab_neg, NULL, IRDM_EFORMAT, "spectral radius -0.5" },
 	{ "stable flag", FIR, m_stab_flag, NULL, IRDM_EFORMAT, "flagged stable" },
+	{ "meta radius forged", FIR, m_radius_forged, NULL, IRDM_EFORMAT,
+	  "meta max_spectral_radius 0.5 disagrees with the STABILITY table, whose largest radius is 1.03170002 (column 0)" },
+	{ "unstable flag", FIR, m_unstable_flag, NULL, IRDM_EFORMAT,
+	  "column 0 is flagged unstable with spectral radius 0.5" },
+	{ "provenance copy", FIR, m_prov_rayleigh, NULL, IRDM_EFORMAT,
+	  "PROVENANCE rayleigh_a_per_s=3 disagrees with meta's 2" },
+	{ "provenance tool", FIR, m_prov_tool, NULL, IRDM_EFORMAT,
+	  "PROVENANCE tool=irdm-test 0.1 disagrees with meta's tool_version 'irdm-test 0.2'" },
 	{ "provenance NUL", FIR, m_prov_nul, NULL, IRDM_EFORMAT, "NUL byte at offset 10" },
 	{ "no META", FIR, NULL, w_no_meta, IRDM_EMISSING, "META is missing" },
 	{ "no PROVENANCE", FIR, NULL, w_no_prov, IRDM_EMISSING, "PROVENANCE is missing" },

@@ -272,6 +272,34 @@ static void test_stl_binary(void **state)
 						sizeof(err)), 0);
 	assert_cube_surface(&s);
 	irdm_surface_free(&s);
+	/* a count short of the whole records the file holds: a wrong count,
+	 * said as such (not "not closed" once two triangles are dropped) */
+	put_le32(bin + 80, 10);
+	assert_err(irdm_surface_parse_stl(bin, len, "short.stl", &s, err, sizeof(err)), err,
+		   "short.stl", "declares 10 triangles at byte 80 but holds 12 whole triangle records");
+	put_le32(bin + 80, 12);
+	/* a triangle of zero area (its third corner on its first edge) */
+	{
+		unsigned char *r = bin + 84 + 12;       /* triangle 1's corners */
+		float a[3], b[3], m[3];
+
+		for (int c = 0; c < 3; c++) {
+			uint32_t ua = (uint32_t)r[4 * c] | (uint32_t)r[4 * c + 1] << 8 |
+				      (uint32_t)r[4 * c + 2] << 16 | (uint32_t)r[4 * c + 3] << 24;
+			uint32_t ub = (uint32_t)r[12 + 4 * c] | (uint32_t)r[12 + 4 * c + 1] << 8 |
+				      (uint32_t)r[12 + 4 * c + 2] << 16 |
+				      (uint32_t)r[12 + 4 * c + 3] << 24;
+			uint32_t um;
+
+			memcpy(&a[c], &ua, 4);
+			memcpy(&b[c], &ub, 4);
+			m[c] = (a[c] + b[c]) / 2;
+			memcpy(&um, &m[c], 4);
+			put_le32(r + 24 + 4 * c, um);
+		}
+	}
+	assert_err(irdm_surface_parse_stl(bin, len, "flat.stl", &s, err, sizeof(err)), err,
+		   "flat.stl", "triangle 1 is degenerate (zero area: its vertices are collinear)");
 	free(bin);
 	irdm_surface_free(&ref);
 }

@@ -31,11 +31,13 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 #include <sys/stat.h>
 
 #include <cmocka.h>
 
 #include "irdm/image.h"
+#include "irdm/telemetry.h"
 #include "irdm/precision.h"
 #include "support/run_prog.h"
 #include "support/test_files.h"
@@ -609,6 +611,47 @@ static void test_from_log(void **state)
 	assert_true(worst < 1e-11 && peak > 1e-3);
 	free_frames(fr, n);
 	free(disp);
+	/* one bit flipped in block 3's records: replay and render refuse the
+	 * log naming the block, and write nothing */
+	{
+		const long at = IRDM_LOG_HEADER_SIZE + 3 * (IRDM_LOG_BLOCK_RECORDS *
+			IRDM_TICK_RECORD_SIZE + (long)sizeof(struct irdm_log_block_end)) + 1000;
+		char forces[320], flipped[320], *bytes;
+		unsigned char byte;
+		size_t len;
+		FILE *f;
+
+		/* a copy: the later tests use the log as it is */
+		snprintf(flipped, sizeof(flipped), "%s/flipped.log", dir);
+		bytes = tf_load(log, &len);
+		f = fopen(flipped, "wb");
+		assert_non_null(f);
+		assert_int_equal(fwrite(bytes, 1, len, f), len);
+		fclose(f);
+		free(bytes);
+		f = fopen(flipped, "r+b");
+		assert_non_null(f);
+		assert_int_equal(fseek(f, at, SEEK_SET), 0);
+		assert_int_equal(fread(&byte, 1, 1, f), 1);
+		byte ^= 1;
+		assert_int_equal(fseek(f, at, SEEK_SET), 0);
+		assert_int_equal(fwrite(&byte, 1, 1, f), 1);
+		fclose(f);
+		snprintf(forces, sizeof(forces), "%s/flipped.csv", dir);
+		assert_int_equal(run_irdm((const char *const[]){ "replay", "--image", image, "--log",
+								 flipped, "--board",
+								 "boards/sim-phantom.board", "-o",
+								 forces, NULL }), 1);
+		assert_non_null(strstr(err_text, "flipped.log: block 3 (records 768..1023): bad checksum"));
+		assert_int_not_equal(access(forces, F_OK), 0);
+		snprintf(outdir, sizeof(outdir), "%s/fromflipped", dir);
+		assert_int_equal(run_irdm((const char *const[]){ "render", "--image", image, "--log",
+								 flipped, "--board",
+								 "boards/sim-phantom.board", "-o",
+								 outdir, NULL }), 1);
+		assert_non_null(strstr(err_text, "block 3 (records 768..1023): bad checksum"));
+		assert_int_not_equal(access(outdir, F_OK), 0);
+	}
 }
 
 /* ---- replay's node limit, bad input ---- */
@@ -710,6 +753,18 @@ static void test_bad_input(void **state)
 	expect_refusal((const char *const[]){ "render", "--image", "/nonexistent.img", "--contact",
 					      "212", "--displacement", traj, "-o", outdir, NULL },
 		       1, "EIO", outdir);
+	/* -o naming a user's file, even with --force: refused before the replay, kept */
+	for (int force = 0; force < 2; force++) {
+		int rc = run_irdm((const char *const[]){ "render", "--image", image, "--contact",
+							 "212", "--displacement", traj, "-o", bad,
+							 force ? "--force" : NULL, NULL });
+		char text[64];
+
+		if (rc != 1 || !strstr(err_text, "bad.csv: exists and is not a directory"))
+			fail_msg("-o FILE: expected exit 1 naming it; got %d: %s", rc, err_text);
+		tf_read_text(bad, text, sizeof(text));
+		assert_string_equal(text, "t,ux,uy,uz\n0,0.001,0,0\n0.002,0.001,0,0\n");
+	}
 }
 
 /* An image that displays the touched top only: rendered, and said. */

@@ -15,6 +15,7 @@
 #define _GNU_SOURCE
 #include <errno.h>
 #include <fcntl.h>
+#include <glob.h>
 #include <math.h>
 #include <pthread.h>
 #include <sched.h>
@@ -32,6 +33,8 @@
 
 #include <cmocka.h>
 
+#include "irdm/image.h"
+#include "irdm/outdir.h"
 #include "irdm/telemetry.h"
 #include "support/test_files.h"
 
@@ -57,6 +60,24 @@ static bool exists(const char *path)
 	struct stat st;
 
 	return stat(path, &st) == 0;
+}
+
+/* How many temporaries beside name are there (NAME.irdm-tmp.XXXXXX)?  The
+ * first one's path into first (if any). */
+static size_t temporaries(const char *name, char *first, size_t len)
+{
+	char pattern[400];
+	size_t n;
+	glob_t g;
+
+	snprintf(pattern, sizeof(pattern), "%s/%s%s*", dir, name, IRDM_OUTDIR_TMP);
+	if (glob(pattern, 0, NULL, &g))
+		return 0;
+	n = g.gl_pathc;
+	if (first && n)
+		snprintf(first, len, "%s", g.gl_pathv[0]);
+	globfree(&g);
+	return n;
 }
 
 static uint64_t xorshift(uint64_t *s)
@@ -524,7 +545,7 @@ static void test_log_round_trip(void **state)
 
 	(void)state;
 	write_log(path, 1000, 17);
-	assert_false(exists(in_dir("sync.log.tmp")));
+	assert_int_equal(temporaries("sync.log", NULL, 0), 0);
 	assert_int_equal(read_log_check(path, 0), 1000);
 	assert_int_equal(irdm_log_open(&rd, path, err, sizeof(err)), IRDM_OK);
 	h = irdm_log_header(rd);
@@ -536,10 +557,14 @@ static void test_log_round_trip(void **state)
 	assert_string_equal(h->board, "sim-phantom");
 	assert_string_equal(h->image, "out/cuboid-1khz.img");
 	irdm_log_close(rd);
-	/* the file is the header and the records, nothing else */
+	/* the file is the header, four blocks of records with their ends, the
+	 * trailer: nothing else */
 	struct stat st;
 	assert_int_equal(stat(path, &st), 0);
-	assert_int_equal(st.st_size, IRDM_LOG_HEADER_SIZE + 1000 * IRDM_TICK_RECORD_SIZE);
+	assert_int_equal(st.st_size, IRDM_LOG_HEADER_SIZE + 1000 * IRDM_TICK_RECORD_SIZE +
+				     4 * sizeof(struct irdm_log_block_end) +
+				     sizeof(struct irdm_log_trailer));
+	assert_int_equal(st.st_size, irdm_log_size(1000));
 	/* bad arguments leave nothing on disk */
 	struct irdm_log_file *lf;
 	struct irdm_log_info bad = info2;
@@ -550,8 +575,8 @@ static void test_log_round_trip(void **state)
 	assert_int_equal(irdm_log_file_open(&lf, in_dir("bad.log"), &bad, err, sizeof(err)), IRDM_EINVAL);
 	assert_int_equal(irdm_log_file_open(&lf, in_dir("no/such/dir.log"), &info2, err, sizeof(err)),
 			 IRDM_EIO);
-	assert_non_null(strstr(err, "no/such/dir.log.tmp"));
-	assert_false(exists(in_dir("bad.log")) || exists(in_dir("bad.log.tmp")));
+	assert_non_null(strstr(err, "no/such/dir.log"));
+	assert_false(exists(in_dir("bad.log")) || temporaries("bad.log", NULL, 0));
 }
 
 #define THREAD_N 20000u
@@ -597,11 +622,11 @@ static void test_log_writer_thread(void **state)
 			assert_int_equal(threads_at_nice_19(), nice_19_before + 1);
 			/* while it is written, only the temporary name exists */
 			assert_false(exists(path));
-			assert_true(exists(in_dir("thread.log.tmp")));
+			assert_int_equal(temporaries("thread.log", NULL, 0), 1);
 		}
 	}
 	assert_int_equal(irdm_log_writer_stop(w, err, sizeof(err)), IRDM_OK);
-	assert_false(exists(in_dir("thread.log.tmp")));
+	assert_int_equal(temporaries("thread.log", NULL, 0), 0);
 	assert_int_equal(read_log_check(path, 0), THREAD_N);
 	free(mem);
 }
@@ -632,7 +657,7 @@ static void test_log_writer_records_drops(void **state)
 	free(mem);
 }
 
-/* A writer that dies before closing leaves only PATH.tmp, which the reader refuses. */
+/* A writer that dies before closing leaves only its temporary, which the reader refuses. */
 static void test_log_crash_leaves_no_final_file(void **state)
 {
 	const char *path = in_dir("crash.log");
@@ -658,18 +683,32 @@ static void test_log_crash_leaves_no_final_file(void **state)
 	}
 	assert_int_equal(waitpid(pid, &status, 0), pid);
 	assert_true(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+	char tmp[400];
+
 	assert_false(exists(path));
-	assert_true(exists(in_dir("crash.log.tmp")));
-	assert_int_equal(irdm_log_open(&rd, in_dir("crash.log.tmp"), err, sizeof(err)), IRDM_ETRUNC);
+	assert_int_equal(temporaries("crash.log", tmp, sizeof(tmp)), 1);
+	assert_int_equal(irdm_log_open(&rd, tmp, err, sizeof(err)), IRDM_ETRUNC);
 	assert_null(rd);
 	assert_non_null(strstr(err, "never closed"));
+	/* the next writer of the same log finds the dead one's temporary (no
+	 * lock on it) and removes it; its own is the only one while it writes */
+	{
+		struct irdm_log_file *lf;
+
+		assert_int_equal(irdm_log_file_open(&lf, path, &info2, err, sizeof(err)), IRDM_OK);
+		assert_false(exists(tmp));
+		assert_int_equal(temporaries("crash.log", NULL, 0), 1);
+		assert_int_equal(irdm_log_file_close(lf, 0, err, sizeof(err)), IRDM_OK);
+		assert_int_equal(temporaries("crash.log", NULL, 0), 0);
+		assert_int_equal(read_log_check(path, 0), 0);
+	}
 }
 
 /* Copy the first len bytes of src to dst, then patch `patch_len` bytes at `at` (if any). */
 static void copy_patched(const char *src, const char *dst, long len, long at, const void *patch,
 			 size_t patch_len)
 {
-	static char buf[IRDM_LOG_HEADER_SIZE + 20 * IRDM_TICK_RECORD_SIZE + 4096];
+	static char buf[IRDM_LOG_HEADER_SIZE + 700 * IRDM_TICK_RECORD_SIZE + 4096];
 	FILE *f = fopen(src, "rb");
 	size_t n;
 
@@ -702,38 +741,121 @@ static void expect_refused(const char *path, int code, const char *needle)
 	assert_null(rd);
 }
 
+/* Opens, then a record read fails: a block's checksum or its end. */
+static void expect_read_refused(const char *path, int code, const char *needle)
+{
+	struct irdm_log_reader *rd;
+	struct irdm_tick_record r;
+	char err[256] = "";
+	int rc = irdm_log_open(&rd, path, err, sizeof(err));
+	uint64_t n = 0;
+
+	if (rc)
+		fail_msg("%s: open: %s", path, err);
+	while ((rc = irdm_log_next(rd, &r, err, sizeof(err))) == 1)
+		n++;
+	irdm_log_close(rd);
+	if (rc != code || !strstr(err, needle))
+		fail_msg("%s: expected %s with '%s' after some records, got %s after %llu: %s",
+			 path, irdm_errname(code), needle, irdm_errname(rc), (unsigned long long)n,
+			 err);
+	/* no record of the bad block was handed out */
+	assert_int_equal(n % IRDM_LOG_BLOCK_RECORDS, 0);
+}
+
+/* Copy good to bad with len bytes of val at `at`, and the header's or the
+ * trailer's checksum made right again: a forgery that passes the CRC. */
+static void copy_forged(const char *good, const char *bad, long at, const void *val, size_t len,
+			bool trailer)
+{
+	static char buf[IRDM_LOG_HEADER_SIZE + 700 * IRDM_TICK_RECORD_SIZE + 4096];
+	FILE *f = fopen(good, "rb");
+	size_t n;
+
+	assert_non_null(f);
+	n = fread(buf, 1, sizeof(buf), f);
+	fclose(f);
+	memcpy(buf + at, val, len);
+	if (trailer) {
+		struct irdm_log_trailer *t = (void *)(buf + n - sizeof(*t));
+		t->crc32c = irdm_crc32c(t, offsetof(struct irdm_log_trailer, crc32c));
+	} else {
+		struct irdm_log_header *h = (void *)buf;
+		h->header_crc32c = irdm_crc32c(h, offsetof(struct irdm_log_header, header_crc32c));
+	}
+	f = fopen(bad, "wb");
+	assert_non_null(f);
+	assert_int_equal(fwrite(buf, 1, n, f), n);
+	fclose(f);
+}
+
 static void test_log_reader_refuses_bad_logs(void **state)
 {
-	const char *good = in_dir("ten.log"), *bad = in_dir("bad.log");
-	const long full = IRDM_LOG_HEADER_SIZE + 10 * IRDM_TICK_RECORD_SIZE;
-	const uint32_t v1 = 1, rs = 200;     /* v1: the log before the engine command */
+	const char *good = in_dir("many.log"), *bad = in_dir("bad.log");
+	const long full = (long)irdm_log_size(600);
+	const long block = IRDM_LOG_BLOCK_RECORDS * IRDM_TICK_RECORD_SIZE +
+			   sizeof(struct irdm_log_block_end);
+	const long trailer = full - (long)sizeof(struct irdm_log_trailer);
+	const uint32_t v2 = 2, rs = 200, period = 999;
+	const uint64_t count = 599;
 	const char wrong_magic[8] = "IRDMIMG";
+	const uint8_t flip = 0x10;
+	uint8_t byte;
 
 	(void)state;
-	write_log(good, 10, 0);
+	/* 600 records: blocks 0..255, 256..511 and 512..599 */
+	write_log(good, 600, 0);
 	copy_patched(good, bad, full, 0, NULL, 0);
-	assert_int_equal(read_log_check(bad, 0), 10);         /* the control: a copy reads */
+	assert_int_equal(read_log_check(bad, 0), 600);       /* the control: a copy reads */
 
-	copy_patched(good, bad, full - IRDM_TICK_RECORD_SIZE * 5, 0, NULL, 0);
-	expect_refused(bad, IRDM_ETRUNC, "truncated: the header says 10 records, the file holds 5 and 0 bytes");
-	copy_patched(good, bad, full - 100, 0, NULL, 0);
-	{
-		char want[64];
-
-		snprintf(want, sizeof(want), "the file holds 9 and %u bytes",
-			 IRDM_TICK_RECORD_SIZE - 100);
-		expect_refused(bad, IRDM_ETRUNC, want);
-	}
+	/* cut short: where it ends, named by block */
+	copy_patched(good, bad, IRDM_LOG_HEADER_SIZE + block + 100, 0, NULL, 0);
+	expect_refused(bad, IRDM_ETRUNC, "truncated: ends in block 1 of 3 (records 256..511;");
+	copy_patched(good, bad, IRDM_LOG_HEADER_SIZE + 2 * block + 5 * IRDM_TICK_RECORD_SIZE, 0,
+		     NULL, 0);
+	expect_refused(bad, IRDM_ETRUNC, "truncated: ends in block 2 of 3 (records 512..599;");
+	copy_patched(good, bad, full - 5, 0, NULL, 0);
+	expect_refused(bad, IRDM_ETRUNC, "truncated: ends in the trailer");
 	copy_patched(good, bad, 100, 0, NULL, 0);
 	expect_refused(bad, IRDM_ETRUNC, "truncated: 100 bytes");
 	copy_patched(good, bad, 0, 0, NULL, 0);
 	expect_refused(bad, IRDM_EMAGIC, "too short");
 	copy_patched(good, bad, full + 10, 0, NULL, 0);
-	expect_refused(bad, IRDM_EFORMAT, "holds more");
-	copy_patched(good, bad, full, offsetof(struct irdm_log_header, version), &v1, sizeof(v1));
-	expect_refused(bad, IRDM_EVERSION, "log version 1, this build reads version 2");
-	copy_patched(good, bad, full, offsetof(struct irdm_log_header, record_size), &rs, sizeof(rs));
+	expect_refused(bad, IRDM_EFORMAT, "holds more (10 bytes after the trailer)");
+
+	/* one bit flipped: in a record, a block end, the header, the trailer */
+	byte = 0;
+	copy_patched(good, bad, full, IRDM_LOG_HEADER_SIZE + block + 77 * IRDM_TICK_RECORD_SIZE + 40,
+		     NULL, 0);
+	{
+		FILE *f = fopen(bad, "r+b");
+		long at = IRDM_LOG_HEADER_SIZE + block + 77 * IRDM_TICK_RECORD_SIZE + 40;
+
+		assert_non_null(f);
+		assert_int_equal(fseek(f, at, SEEK_SET), 0);
+		assert_int_equal(fread(&byte, 1, 1, f), 1);
+		byte ^= flip;
+		assert_int_equal(fseek(f, at, SEEK_SET), 0);
+		assert_int_equal(fwrite(&byte, 1, 1, f), 1);
+		fclose(f);
+	}
+	expect_read_refused(bad, IRDM_ECRC, "bad.log: block 1 (records 256..511): bad checksum");
+	copy_patched(good, bad, full, IRDM_LOG_HEADER_SIZE + 2 * block - 12, &flip, 1);
+	expect_read_refused(bad, IRDM_EFORMAT, "block 1 (records 256..511): its end is not");
+	copy_patched(good, bad, full, offsetof(struct irdm_log_header, period_us), &period,
+		     sizeof(period));
+	expect_refused(bad, IRDM_ECRC, "header: bad checksum");
+	copy_patched(good, bad, full, trailer + 12, &flip, 1);
+	expect_refused(bad, IRDM_ECRC, "trailer: bad checksum");
+
+	/* forged with the checksum made right: the fields are still checked */
+	copy_forged(good, bad, offsetof(struct irdm_log_header, version), &v2, sizeof(v2), false);
+	expect_refused(bad, IRDM_EVERSION, "log version 2, this build reads version 3");
+	copy_forged(good, bad, offsetof(struct irdm_log_header, record_size), &rs, sizeof(rs), false);
 	expect_refused(bad, IRDM_EFORMAT, "record size 200");
+	copy_forged(good, bad, trailer + offsetof(struct irdm_log_trailer, record_count), &count,
+		    sizeof(count), true);
+	expect_refused(bad, IRDM_EFORMAT, "trailer: 599 records");
 	copy_patched(good, bad, full, 0, wrong_magic, sizeof(wrong_magic));
 	expect_refused(bad, IRDM_EMAGIC, "not an IRDM log");
 	expect_refused(in_dir("missing.log"), IRDM_EIO, "cannot open");
@@ -880,7 +1002,7 @@ static void test_cli_export_matches_records(void **state)
 	write_log(log, 120, 0);
 	assert_int_equal(irdm_run((const char *[]){ "log", "export", log, "-o", csv, NULL },
 				  err_text, sizeof(err_text)), 0);
-	assert_false(exists(in_dir("cli.csv.tmp")));
+	assert_int_equal(temporaries("cli.csv", NULL, 0), 0);
 	f = fopen(csv, "r");
 	assert_non_null(f);
 	assert_non_null(fgets(line, sizeof(line), f));
@@ -903,20 +1025,21 @@ static void test_cli_export_refuses_bad_logs(void **state)
 	(void)state;
 	write_log(good, 10, 0);
 	copy_patched(good, cut, IRDM_LOG_HEADER_SIZE + 7 * IRDM_TICK_RECORD_SIZE + 3, 0, NULL, 0);
+	/* (cut in block 0) */
 	rc = irdm_run((const char *[]){ "log", "export", cut, "-o", csv, NULL }, err_text,
 		      sizeof(err_text));
 	if (rc != 1 || strncmp(err_text, "irdm log export: ", 17) || !strstr(err_text, cut) ||
 	    !strstr(err_text, "truncated") || !strstr(err_text, ": ETRUNC: ") || strchr(err_text, '\n') != err_text + strlen(err_text) - 1)
 		fail_msg("exit %d, expected 1 and one line naming %s and 'truncated': %s", rc, cut,
 			 err_text);
-	assert_false(exists(csv) || exists(in_dir("out.csv.tmp")));
+	assert_false(exists(csv) || temporaries("out.csv", NULL, 0));
 	copy_patched(good, cut, -1, offsetof(struct irdm_log_header, version), &v9, sizeof(v9));
 	rc = irdm_run((const char *[]){ "log", "export", cut, "-o", csv, NULL }, err_text,
 		      sizeof(err_text));
 	assert_int_equal(rc, 1);
 	assert_non_null(strstr(err_text, "version 9"));
-	assert_false(exists(csv) || exists(in_dir("out.csv.tmp")));
-	/* a record found bad half way: no CSV, and one that was there stays as it was */
+	assert_false(exists(csv) || temporaries("out.csv", NULL, 0));
+	/* a block found bad half way: no CSV, and one that was there stays as it was */
 	const uint8_t seven = 7;
 	char old[64] = "";
 	FILE *f = fopen(csv, "w");
@@ -928,8 +1051,8 @@ static void test_cli_export_refuses_bad_logs(void **state)
 	rc = irdm_run((const char *[]){ "log", "export", cut, "-o", csv, NULL }, err_text,
 		      sizeof(err_text));
 	assert_int_equal(rc, 1);
-	assert_non_null(strstr(err_text, "record 5: n_devices 7"));
-	assert_false(exists(in_dir("out.csv.tmp")));
+	assert_non_null(strstr(err_text, "block 0 (records 0..9): bad checksum"));
+	assert_int_equal(temporaries("out.csv", NULL, 0), 0);
 	f = fopen(csv, "r");
 	assert_non_null(f);
 	assert_non_null(fgets(old, sizeof(old), f));

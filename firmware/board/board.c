@@ -9,6 +9,7 @@
 
 #include "board_priv.h"
 #include "irdm/error.h"
+#include "irdm/textfile.h"
 
 static void reader_init(struct irdm_opt_file *f, struct irdm_board *b, const char *name)
 {
@@ -56,26 +57,21 @@ int irdm_board_parse(struct irdm_board *b, const char *name, const char *text,
 
 int irdm_board_load(struct irdm_board *b, const char *path, char *err, size_t errlen)
 {
-	/* one more than a line may hold: a line that fills it is too long */
-	char buf[IRDM_BOARD_LINE_MAX + 1];
+	char buf[IRDM_BOARD_LINE_MAX];
+	struct irdm_text_file t;
 	struct irdm_opt_file f;
-	FILE *fp = fopen(path, "r");
-	int ret = IRDM_OK;
+	int ret;
 
-	if (!fp) {
-		snprintf(err, errlen, "%s: cannot open", path);
-		return IRDM_EIO;
-	}
 	reader_init(&f, b, path);
-	while (!ret && fgets(buf, sizeof(buf), fp)) {
-		size_t len = strlen(buf);
-		ret = read_line(&f, buf, len - (len && buf[len - 1] == '\n'), err, errlen);
+	ret = irdm_text_open(&t, path, IRDM_TEXT_MAX_BYTES, err, errlen);
+	if (ret)
+		return ret;
+	while ((ret = irdm_text_line(&t, buf, IRDM_BOARD_LINE_MAX, err, errlen)) > 0) {
+		ret = read_line(&f, buf, strlen(buf), err, errlen);
+		if (ret)
+			break;
 	}
-	if (!ret && ferror(fp)) {
-		snprintf(err, errlen, "%s: read error", path);
-		ret = IRDM_EIO;
-	}
-	fclose(fp);
+	irdm_text_close(&t);
 	if (!ret)
 		ret = irdm_board_finish(b, &f, err, errlen);
 	return ret;

@@ -114,9 +114,9 @@ static int check_arm(const struct check *c)
 	char buf[32];
 
 	for (int i = 0; i < IRDM_DEVICE_JOINTS; i++)
-		if (d->count_min[i] > d->count_max[i])
+		if (d->count_min[i] >= d->count_max[i])
 			return fail(c, IRDM_EINVAL, "count_min",
-				    ": must be <= count_max (%s) on every joint; joint %d: %ld > %ld",
+				    ": must be < count_max (%s) on every joint; joint %d: %ld >= %ld",
 				    line_text(c, "count_max", buf, sizeof(buf)), i + 1,
 				    (long)d->count_min[i], (long)d->count_max[i]);
 	/* every field has passed its own range and the counts are in order, so

@@ -181,9 +181,10 @@ static const struct irdm_opt board_opts[] = {
 	  .help = "the second arm's shoulder; required with devices = 2, refused otherwise" },
 
 	/* encoders, one value per joint */
-	{ .name = "counts_per_rev", JOINTS, DEV(counts_per_rev), RANGE(IRDM_OPT_GT, 0, 0),
+	{ .name = "counts_per_rev", JOINTS, DEV(counts_per_rev),
+	  RANGE(IRDM_OPT_GE | IRDM_OPT_LE, 1, 1e9),
 	  .help = "encoder counts per motor turn, after quadrature (default 4000,4000,4000)" },
-	{ .name = "gear_ratio", JOINTS, DEV(gear_ratio), GT0_LE(1000),
+	{ .name = "gear_ratio", JOINTS, DEV(gear_ratio), RANGE(IRDM_OPT_GE | IRDM_OPT_LE, 0.01, 1000),
 	  .help = "motor turns per joint turn (the capstan) (default 11.6,11.6,11.6)" },
 	{ .name = "angle_offset_rad", JOINTS, DEV(angle_offset_rad), .unit = "rad",
 	  WITHIN(ANGLE_MAX_RAD),
@@ -200,7 +201,8 @@ static const struct irdm_opt board_opts[] = {
 	  .help = "highest valid count (default 3101,2953,2584)" },
 
 	/* actuation and mass */
-	{ .name = "torque_limit_nm", JOINTS, DEV(torque_limit_nm), .unit = "N m", GT0_LE(100),
+	{ .name = "torque_limit_nm", JOINTS, DEV(torque_limit_nm), .unit = "N m",
+	  RANGE(IRDM_OPT_GE | IRDM_OPT_LE, 1e-3, 100),
 	  .help = "joint-side torque limit; the tick scales torques to keep the force's "
 		  "direction (default 1.07,1.07,1.07)" },
 	{ .name = "mass_kg", BODIES, DEV(mass_kg), .unit = "kg",
@@ -216,12 +218,12 @@ static const struct irdm_opt board_opts[] = {
 
 	/* limits */
 	{ .name = "max_force_n", .type = IRDM_OPT_DOUBLE, DEV(max_force_n), .unit = "N",
-	  GT0_LE(100), .help = "largest tip force; the engine faults above it (default 7.9)" },
+	  RANGE(IRDM_OPT_GE | IRDM_OPT_LE, 0.01, 100), .help = "largest tip force; the engine faults above it (default 7.9)" },
 	{ .name = "max_stiffness_n_per_m", .type = IRDM_OPT_DOUBLE, DEV(k_max_n_per_m),
-	  .unit = "N/m", GT0_LE(1e6),
+	  .unit = "N/m", RANGE(IRDM_OPT_GE | IRDM_OPT_LE, 1, 1e6),
 	  .help = "stiffest coupling the device renders (device.h: k_max_n_per_m) (default 1000)" },
 	{ .name = "device_damping_ns_per_m", .type = IRDM_OPT_DOUBLE, DEV(b_device_ns_per_m),
-	  .unit = "N s/m", GT0_LE(1e4),
+	  .unit = "N s/m", RANGE(IRDM_OPT_GE | IRDM_OPT_LE, 1e-3, 1e4),
 	  .help = "the device's damping margin, bounds the coupling (Colgate) "
 		  "(device.h: b_device_ns_per_m) (default 5)" },
 	{ .name = "workspace_min_m", XYZ, BF(workspace_min_m), .unit = "m", WITHIN(LENGTH_MAX_M),
@@ -229,7 +231,8 @@ static const struct irdm_opt board_opts[] = {
 	{ .name = "workspace_max_m", XYZ, BF(workspace_max_m), .unit = "m", WITHIN(LENGTH_MAX_M),
 	  .help = "high corner, > workspace_min_m on every axis (required)" },
 	{ .name = "max_tip_speed_m_per_s", .type = IRDM_OPT_DOUBLE, BF(max_tip_speed_m_per_s),
-	  .unit = "m/s", GT0_LE(10), .help = "a faster tip faults (default 2)" },
+	  .unit = "m/s", RANGE(IRDM_OPT_GE | IRDM_OPT_LE, 1e-3, 10),
+	  .help = "a faster tip faults (default 2)" },
 	{ .name = "overrun_fault_count", .type = IRDM_OPT_UNSIGNED, BF(overrun_fault_count),
 	  RANGE(IRDM_OPT_GE | IRDM_OPT_LE, 1, 1000),
 	  .help = "this many overruns in a row fault; one holds the last safe force (default 3)" },

@@ -30,6 +30,7 @@ static const struct err_text err_table[] = {
 	[-IRDM_ETIMEDOUT] = { "ETIMEDOUT", "timed out" },
 	[-IRDM_EHW] = { "EHW", "hardware fault" },
 	[-IRDM_ECHILD] = { "ECHILD", "external program failed" },
+	[-IRDM_EEXIST] = { "EEXIST", "exists, not replaced" },
 };
 
 _Static_assert(sizeof(err_table) / sizeof(err_table[0]) == 1 - IRDM_ERR_MIN,

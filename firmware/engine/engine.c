@@ -96,7 +96,8 @@ void irdm_engine_config_haptic(struct irdm_engine_config *cfg, double dt, double
  */
 static void fir_tail(struct irdm_engine *e, double *w)
 {
-	double rho = e->img->meta->max_spectral_radius, r = 1.0, stable = e->cfg.stable_radius;
+	/* from the table itself: the meta's copy is a summary for people */
+	double rho = irdm_image_max_radius(e->img), r = 1.0, stable = e->cfg.stable_radius;
 
 	if (stable == 0)
 		stable = 0.999;

@@ -384,8 +384,13 @@ static uint32_t load_le32(const uint8_t *p)
 
 uint32_t irdm_crc32c(const void *data, size_t len)
 {
+	return irdm_crc32c_update(0, data, len);
+}
+
+uint32_t irdm_crc32c_update(uint32_t crc0, const void *data, size_t len)
+{
 	const uint8_t *p = data;
-	uint32_t crc = 0xFFFFFFFFu;
+	uint32_t crc = crc0 ^ 0xFFFFFFFFu;
 
 	while (len >= 8) {
 		uint32_t lo = load_le32(p) ^ crc;

@@ -158,7 +158,8 @@ int irdm_image_map(const char *path, unsigned flags, struct irdm_image *img,
 				 "unknown map flags 0x%x", flags);
 		goto out_msg;
 	}
-	fd = open(path, O_RDONLY | O_CLOEXEC);
+	/* non-blocking: a FIFO at path must not hang the open (map_fd refuses it) */
+	fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
 	if (fd < 0) {
 		ret = img_report(msg, sizeof(msg), IRDM_EIO, "cannot open: %s",
 				 strerror(errno));

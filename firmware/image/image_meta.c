@@ -3,7 +3,10 @@
  * META and PROVENANCE: the values every other section is checked against,
  * and the text the firmware prints about where the image came from.
  */
+#include <math.h>
+#include <stdbool.h>
 #include <stdint.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "image_priv.h"
@@ -37,9 +40,10 @@ static int check_meta_numbers(struct parse *p)
 		if (!f64_finite(d[i].v))
 			return img_fail(p, IRDM_EFORMAT,
 					"meta %s is not finite", d[i].name);
-	if (!(m->dt_s > 0 && m->dt_s <= 1))
+	/* a microsecond at least: a 1 MHz force loop is beyond any device */
+	if (!(m->dt_s >= 1e-6 && m->dt_s <= 1))
 		return img_fail(p, IRDM_EFORMAT,
-				"meta dt_s is %g s, must be in (0, 1]", m->dt_s);
+				"meta dt_s is %g s, must be in [1e-06, 1]", m->dt_s);
 	if (!(m->young_pa > 0))
 		return img_fail(p, IRDM_EFORMAT,
 				"meta young_pa is %g, must be > 0", m->young_pa);
@@ -135,6 +139,88 @@ int img_check_meta(struct parse *p)
 	return check_meta_counts(p);
 }
 
+/* The value of "key=" at a line start in text (len bytes), copied into
+ * val (NUL-terminated); false when the key is not there. */
+static bool prov_value(const char *text, size_t len, const char *key, char *val, size_t vlen)
+{
+	size_t klen = strlen(key);
+
+	for (size_t i = 0; i + klen < len; i++) {
+		size_t n = 0;
+
+		if ((i && text[i - 1] != '\n') || memcmp(text + i, key, klen) || text[i + klen] != '=')
+			continue;
+		i += klen + 1;
+		while (i + n < len && text[i + n] != '\n' && n + 1 < vlen)
+			n++;
+		memcpy(val, text + i, n);
+		val[n] = 0;
+		return true;
+	}
+	return false;
+}
+
+/* field holds val, or val cut to the field's size (the text keeps it whole). */
+static bool same_text(const char *val, const char *field, size_t size)
+{
+	size_t n = strnlen(field, size);
+
+	return !strncmp(val, field, n) && (val[n] == 0 || n == size - 1);
+}
+
+static bool same_double(const char *s, double v, double rel)
+{
+	char *end;
+	double x = strtod(s, &end);
+
+	return end != s && !*end && fabs(x - v) <= rel * fabs(v);
+}
+
+/*
+ * PROVENANCE repeats meta values as text for people; a copy that
+ * disagrees means one of the two was changed after the image was written
+ * (docs/image-format.md lists the redundant fields).  A key that is not
+ * there is not a disagreement: the text is free-form beyond these.
+ */
+static int check_provenance_copies(struct parse *p, const char *text, size_t len)
+{
+	const struct irdm_meta *m = &p->meta;
+	const struct {
+		const char *key;
+		double v, rel;          /* the text's precision: %.17g exact, %.9g */
+	} d[] = {
+		{ "rayleigh_a_per_s", m->rayleigh_a_per_s, 0 },
+		{ "rayleigh_b_s", m->rayleigh_b_s, 0 },
+		{ "first_elastic_hz", m->first_elastic_hz, 1e-8 },
+		{ "mesh_nodes", m->mesh_nodes, 0 },
+		{ "mesh_tets", m->mesh_tets, 0 },
+	};
+	char val[128];
+
+	for (size_t i = 0; i < sizeof(d) / sizeof(d[0]); i++)
+		if (prov_value(text, len, d[i].key, val, sizeof(val)) &&
+		    !same_double(val, d[i].v, d[i].rel))
+			return img_fail(p, IRDM_EFORMAT,
+					"PROVENANCE %s=%s disagrees with meta's %.17g",
+					d[i].key, val, d[i].v);
+	if (prov_value(text, len, "mesh_hash", val, sizeof(val)) &&
+	    strtoull(val, NULL, 16) != m->mesh_hash)
+		return img_fail(p, IRDM_EFORMAT,
+				"PROVENANCE mesh_hash=%s disagrees with meta's %016llx", val,
+				(unsigned long long)m->mesh_hash);
+	if (prov_value(text, len, "tool", val, sizeof(val)) &&
+	    !same_text(val, m->tool_version, sizeof(m->tool_version)))
+		return img_fail(p, IRDM_EFORMAT,
+				"PROVENANCE tool=%s disagrees with meta's tool_version '%s'", val,
+				m->tool_version);
+	if (prov_value(text, len, "mesh_name", val, sizeof(val)) &&
+	    !same_text(val, m->mesh_name, sizeof(m->mesh_name)))
+		return img_fail(p, IRDM_EFORMAT,
+				"PROVENANCE mesh_name=%s disagrees with meta's mesh_name '%s'", val,
+				m->mesh_name);
+	return IRDM_OK;
+}
+
 int img_check_provenance(struct parse *p)
 {
 	const struct irdm_image_section *s = p->by_kind[IRDM_SEC_PROVENANCE];
@@ -151,5 +237,5 @@ int img_check_provenance(struct parse *p)
 				(const char *)memchr(text, 0, (size_t)s->size) - text);
 	p->img.provenance = text;
 	p->img.provenance_len = (size_t)s->size;
-	return IRDM_OK;
+	return check_provenance_copies(p, text, (size_t)s->size);
 }

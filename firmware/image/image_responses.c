@@ -9,9 +9,13 @@
 
 #include "image_priv.h"
 
+/* The table is the one truth about stability: the flag of each column and
+ * the meta's largest radius are copies, and must say what it says. */
 int img_check_stability(struct parse *p)
 {
 	const struct irdm_stability *st;
+	double max = 0;
+	uint32_t at = 0;
 	int ret;
 
 	ret = img_check_presence(p, IRDM_SEC_STABILITY, true, "always");
@@ -29,13 +33,31 @@ int img_check_stability(struct parse *p)
 			return img_fail(p, IRDM_EFORMAT,
 					"column %u: spectral radius %g is not a finite value >= 0",
 					i, (double)rho);
-		if ((st[i].flags & IRDM_STAB_STABLE) && !(rho < 1))
+		if (!(st[i].flags & IRDM_STAB_STABLE) != !(rho < 1))
 			return img_fail(p, IRDM_EFORMAT,
-					"column %u is flagged stable with spectral radius %g >= 1",
-					i, (double)rho);
+					"column %u is flagged %s with spectral radius %g",
+					i, rho < 1 ? "unstable" : "stable", (double)rho);
+		if (rho > max) {
+			max = rho;
+			at = i;
+		}
 	}
+	if (p->meta.max_spectral_radius != max)
+		return img_fail(p, IRDM_EFORMAT,
+				"meta max_spectral_radius %.9g disagrees with the STABILITY table, whose largest radius is %.9g (column %u)",
+				p->meta.max_spectral_radius, max, at);
 	p->img.stability = st;
 	return IRDM_OK;
+}
+
+double irdm_image_max_radius(const struct irdm_image *img)
+{
+	double max = 0;
+
+	for (uint32_t i = 0; img->stability && i < img->meta->n_cols; i++)
+		if (img->stability[i].spectral_radius > max)
+			max = img->stability[i].spectral_radius;
+	return max;
 }
 
 /* Index of the first non-finite element of an array, or count if none. */

@@ -21,6 +21,7 @@
 #include "irdm/clock.h"
 #include "irdm/controller.h"
 #include "irdm/hal.h"
+#include "irdm/outdir.h"
 #include "irdm/session.h"
 #include "irdm/sim_user.h"
 #include "irdm/telemetry.h"
@@ -35,6 +36,7 @@ enum fw_exit {
 	FW_EXIT_SIGNAL = 6,     /* stopped by a signal: torque off, state off, logged */
 	FW_EXIT_NEVER_ENABLED = 7,      /* ran, but a limit kept the torque off throughout */
 	FW_EXIT_EMERGENCY = 8,  /* a fatal (or second) signal: emergency torque off */
+	FW_EXIT_LOG = 9,        /* ran, but its --log could not be written (none left) */
 };
 
 struct fw_args {
@@ -50,16 +52,27 @@ struct fw_args {
 	double frames_every_s;          /* --frames-every: 0 none */
 	int clock;                      /* enum irdm_clock_mode */
 	bool require_rt;
+	bool force;                     /* --force: replace a --frames-out DIR we did not write */
 	bool quiet;
 	bool help;
 };
 
-/* Per-tick figures kept for the summary (allocated once, before the loop). */
+/*
+ * What the summary needs, in memory fixed at the start whatever the run's
+ * length (a day's run locks what a second's does): the force's peak and
+ * last value as they stream by, and the watched node's motion over the
+ * ringing window after the latest release (one window's samples).
+ */
 struct fw_trace {
-	uint64_t n, cap;
-	double *force_n;                /* |force on the object|, device 0 */
-	double *node_u_m;               /* the watched node's displacement along its normal */
-	uint8_t *contact;               /* device 0 in contact */
+	uint64_t n, cap;                /* ticks traced; ticks the run has */
+	double peak_n, final_n;         /* |force on the object|, device 0 */
+	uint64_t peak_at;
+	bool contact;                   /* device 0 in contact at the last tick */
+	bool released;                  /* a contact has ended */
+	uint64_t release_at;            /* the tick after the latest contact ended */
+	double *ring_u_m;               /* the watched node's displacement along its
+					 * normal from release_at on */
+	uint64_t ring_n, ring_max;      /* samples held; the window's length */
 };
 
 /*
@@ -123,6 +136,7 @@ struct fw {
 	struct irdm_clock clock;
 	struct fw_trace trace;
 	struct fw_frame frame;
+	struct irdm_outdir frames_dir;  /* --frames-out's, claimed before the run */
 	/* telemetry: per-tick records through a ring to the log (--log) */
 	struct irdm_telem_ring *ring;
 	void *ring_mem;
@@ -150,6 +164,10 @@ void fw_args_usage(FILE *f);
 /* fw_config.c: the board's arm, limits, placement and coupling, for the
  * controller; the session's engine configuration. */
 int fw_config_from_board(struct irdm_ctrl_config *c, const struct irdm_board *b);
+/* Why irdm_ctrl_init() refused, naming the board or the image (fw->err). */
+const char *fw_ctrl_init_why(struct fw *fw);
+/* Why --user cannot run on the board's back-end (fw->err). */
+const char *fw_user_hal_why(struct fw *fw);
 
 /* fw_loop.c: runs until the duration is over, a fault or a signal.
  * Returns FW_EXIT_OK, FW_EXIT_FAULT, FW_EXIT_SIGNAL or FW_EXIT_NEVER_ENABLED. */
@@ -174,7 +192,9 @@ int fw_log_close(struct fw *fw);
  * length) and fw_frame_open() (worker, buffers) after the controller;
  * fw_frame_start() after the real-time set-up (the thread, real time only);
  * fw_frame_tick() in the loop after each tick; fw_frame_stop() (join) and
- * fw_frame_write() before the session closes; fw_frame_summary() after. */
+ * fw_frame_write() before the session closes; fw_frame_summary() after.
+ * fw_frame_claim_series() before the run: --frames-out's directory
+ * (irdm/outdir.h); fw_frame_free() removes it unless written. */
 void fw_frame_config(struct fw *fw, struct irdm_session_config *sc);
 int fw_frame_check_args(struct fw *fw, uint64_t run_ticks);
 int fw_frame_open(struct fw *fw);
@@ -182,6 +202,7 @@ int fw_frame_start(struct fw *fw);
 void fw_frame_tick(struct fw *fw, const struct irdm_ctrl_output *out);
 void fw_frame_stop(struct fw *fw);
 int fw_frame_write(struct fw *fw);
+int fw_frame_claim_series(struct fw *fw);
 int fw_frame_write_series(struct fw *fw);
 void fw_frame_summary(const struct fw *fw);
 void fw_frame_free(struct fw *fw);
@@ -196,8 +217,10 @@ int fw_view_start(struct fw *fw);
 void fw_view_offer(struct fw_view *v, const double *pos_m, uint64_t tick);
 void fw_view_close(struct fw *fw);
 
-/* fw_summary.c */
-int fw_trace_alloc(struct fw_trace *t, uint64_t ticks);
+/* fw_summary.c: fw_trace_alloc() once before the loop (the window for a
+ * tick of period_us), fw_trace_add() every tick (no allocation). */
+int fw_trace_alloc(struct fw_trace *t, uint64_t ticks, uint32_t period_us);
+void fw_trace_add(struct fw_trace *t, double force_n, double node_u_m, bool contact);
 void fw_trace_free(struct fw_trace *t);
 void fw_summary_print(const struct fw *fw);
 /* The first open device's one-line reason (struct irdm_hal_dev's why), or "". */

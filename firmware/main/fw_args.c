@@ -44,7 +44,10 @@ static const struct irdm_opt fw_opts[] = {
 		  "(at most 1000 frames)" },
 	{ .name = "frames-out", .type = IRDM_OPT_STRING, FA_REF(frames_out), .metavar = "DIR",
 	  .help = "where --frames-every writes: frame_NNNNN.vtk and frames.vtk.series (ParaView "
-		  "opens the series with time); replaced as a whole" },
+		  "opens the series with time); replaced as a whole, and only if irdm-fw wrote it" },
+	{ .name = "force", .type = IRDM_OPT_FLAG, FA(force),
+	  .help = "replace --frames-out DIR even if irdm-fw did not write it (a directory of "
+		  "files only)" },
 	{ .name = "view", .type = IRDM_OPT_STRING, FA_REF(view), .metavar = "[ADDR:]PORT",
 	  .help = "serve the live view (docs/view.md) on ADDR (default 127.0.0.1), PORT (0: any)" },
 	{ .name = "clock", .type = IRDM_OPT_ENUM, FA(clock), .names = clock_names,
@@ -68,7 +71,7 @@ void fw_args_usage(FILE *f)
 {
 	fputs("usage: irdm-fw --board BOARD --image IMAGE [--user SCRIPT] [--duration S]\n"
 	      "               [--log FILE] [--frame-at S --frame-out FILE]\n"
-	      "               [--frames-every S --frames-out DIR]\n"
+	      "               [--frames-every S --frames-out DIR [--force]]\n"
 	      "               [--clock real|virtual] [--require-rt] [--view [ADDR:]PORT]\n"
 	      "\n"
 	      "Runs the force loop on a board's device: HAL read, encoders, kinematics,\n"
@@ -84,7 +87,8 @@ void fw_args_usage(FILE *f)
 	      "off and state off in the next tick, logged); 7 the torque was never\n"
 	      "enabled (the limit that refused it printed); 8 SIGSEGV, SIGBUS, SIGFPE,\n"
 	      "SIGILL, SIGABRT or a second signal: torque off at once by the emergency\n"
-	      "path, the log cut short\n", f);
+	      "path, the log cut short; 9 the run ended but its --log could not be\n"
+	      "written (no log is left under its name)\n", f);
 }
 
 int fw_args_parse(struct fw_args *a, int argc, char **argv, char *err, size_t errlen)

@@ -7,6 +7,7 @@
  */
 #include <string.h>
 
+#include "irdm/contact.h"
 #include "irdm/error.h"
 
 #include "fw.h"
@@ -46,4 +47,51 @@ int fw_config_from_board(struct irdm_ctrl_config *c, const struct irdm_board *b)
 	 * guards against a runaway (it faults), so it sits well above */
 	c->engine.max_force_n = 4 * lim->max_force_n;
 	return irdm_ctrl_config_check(c);
+}
+
+/*
+ * irdm_ctrl_init() says only EINVAL: find which input it was.  The image
+ * without a contact structure; else an encoder too fine for the velocity
+ * filter (the board); else the controller's configuration (the board).
+ */
+const char *fw_ctrl_init_why(struct fw *fw)
+{
+	struct irdm_contact_mesh cm;
+	struct irdm_velocity v;
+
+	if (irdm_contact_mesh_init(&cm, fw->s->img)) {
+		snprintf(fw->err, sizeof(fw->err), "%s: no contact structure (CONTACT_BVH): "
+			 "precompute with --touch and --display covering it", fw->args.image);
+		return fw->err;
+	}
+	for (unsigned j = 0; j < 3; j++)
+		if (irdm_velocity_init(&v, fw->board.period_us * 1e-6,
+				       irdm_device_rad_per_count(&fw->board.device, j),
+				       fw->ccfg.velocity_window)) {
+			snprintf(fw->err, sizeof(fw->err), "%s: joint %u: counts_per_rev x "
+				 "gear_ratio gives %g rad a count, which the velocity filter "
+				 "cannot use", fw->args.board, j + 1,
+				 irdm_device_rad_per_count(&fw->board.device, j));
+			return fw->err;
+		}
+	snprintf(fw->err, sizeof(fw->err), "%s: the controller refuses this board's arm, "
+		 "limits or placement (irdm_ctrl_config_check)", fw->args.board);
+	return fw->err;
+}
+
+const char *fw_user_hal_why(struct fw *fw)
+{
+	static const char *const known[] = { "sim", "canemu", "socketcan" };
+	bool found = false;
+
+	for (size_t i = 0; i < sizeof(known) / sizeof(known[0]); i++)
+		found |= !strcmp(fw->board.hal, known[i]);
+	if (!found)
+		snprintf(fw->err, sizeof(fw->err), "%s: hal '%s': no such back-end in this build "
+			 "(sim, canemu, socketcan)", fw->args.board, fw->board.hal);
+	else
+		snprintf(fw->err, sizeof(fw->err), "a virtual user needs a back-end with a "
+			 "simulated arm, and %s's hal '%s' has none (hal = sim or canemu)",
+			 fw->args.board, fw->board.hal);
+	return fw->err;
 }

@@ -89,6 +89,15 @@ int fw_frame_check_args(struct fw *fw, uint64_t run_ticks)
 	if (fw->args.frame_out && grid_tick(fw, fw->args.frame_at_s) > run_ticks)
 		return refuse(fw, "--frame-at", fw->args.frame_at_s, "after the run's end");
 	if (fw->args.frames_out) {
+		double period_s = fr->every_ticks * fw->board.period_us * 1e-6;
+
+		/* two frames in one deformation period would be the same snapshot */
+		if (fw->args.frames_every_s < period_s * (1 - 1e-9)) {
+			snprintf(fw->err, sizeof(fw->err), "--frames-every %g: shorter than the "
+				 "deformation period, %g s (the board's deform_rate_hz)",
+				 fw->args.frames_every_s, period_s);
+			return IRDM_EINVAL;
+		}
 		n = series_frames(fw, run_ticks);
 		if (n == 0)
 			return refuse(fw, "--frames-every", fw->args.frames_every_s,
@@ -316,6 +325,7 @@ void fw_frame_free(struct fw *fw)
 		free(fw->frame.slot[k].pos_m);
 	free(fw->frame.slot);
 	free(fw->frame.scratch_m);
+	irdm_outdir_abort(&fw->frames_dir);
 }
 
 void fw_frame_summary(const struct fw *fw)

@@ -4,8 +4,9 @@
  * file, and --frames-every's series, a directory of frame_NNNNN.vtk with a
  * frames.vtk.series index (ParaView's JSON file-series format: each file
  * and its time), so ParaView opens the series with its times.  Each is
- * written beside its destination and renamed into place: a reader never
- * sees half a frame or half a series (irdm/outdir.h).
+ * written beside its destination under a fresh name and renamed into
+ * place: a reader never sees half a frame or half a series, and nothing
+ * the tool did not write is replaced (irdm/outdir.h).
  */
 #define _GNU_SOURCE
 #include <errno.h>
@@ -14,6 +15,7 @@
 
 #include "irdm/error.h"
 #include "irdm/outdir.h"
+#include "irdm/outfile.h"
 
 #include "fw.h"
 
@@ -83,13 +85,11 @@ static void write_vtk(FILE *f, const struct fw *fw, const struct fw_frame_slot *
 }
 
 /* One frame to path (no rename).  Return: 0, or errno. */
-static int write_file(const struct fw *fw, const struct fw_frame_slot *sl, const char *path)
+/* Write and close f: 0, or errno. */
+static int write_file(const struct fw *fw, const struct fw_frame_slot *sl, FILE *f)
 {
-	FILE *f = fopen(path, "w");
 	int bad;
 
-	if (!f)
-		return errno;
 	write_vtk(f, fw, sl);
 	bad = ferror(f);
 	if (fclose(f) || bad)
@@ -111,29 +111,23 @@ static int io_error(struct fw *fw, const char *path, int e)
 	return IRDM_EIO;
 }
 
-/* Written to FILE.tmp and renamed: a reader never sees half a frame. */
+/* Written whole beside FILE and renamed (irdm/outfile.h): a reader never
+ * sees half a frame, and nothing but a file is replaced. */
 int fw_frame_write(struct fw *fw)
 {
 	const char *path = fw->args.frame_out;
-	char tmp[4096];
-	int e;
+	struct irdm_outfile o;
+	int rc;
 
 	if (!path)
 		return IRDM_OK;
 	if (!fw->frame.slot[fw->frame.single_slot].held)
 		return no_frame(fw, path);
-	if ((size_t)snprintf(tmp, sizeof(tmp), "%s.tmp", path) >= sizeof(tmp)) {
-		snprintf(fw->err, sizeof(fw->err), "%s: path too long", path);
-		return IRDM_EINVAL;
-	}
-	e = write_file(fw, &fw->frame.slot[fw->frame.single_slot], tmp);
-	if (!e && rename(tmp, path))
-		e = errno;
-	if (e) {
-		remove(tmp);
-		return io_error(fw, path, e);
-	}
-	return IRDM_OK;
+	rc = irdm_outfile_open(&o, path, fw->err, sizeof(fw->err));
+	if (rc)
+		return rc;
+	write_vtk(o.f, fw, &fw->frame.slot[fw->frame.single_slot]);
+	return irdm_outfile_commit(&o, fw->err, sizeof(fw->err));
 }
 
 /* The frames and the index into dir.  Return: 0, or errno. */
@@ -152,11 +146,13 @@ static int write_series_into(const struct fw *fw, const char *dir)
 	fprintf(idx, "{\n  \"file-series-version\" : \"1.0\",\n  \"files\" : [\n");
 	for (unsigned k = 0; k < fr->n_slots && !e; k++) {
 		const struct fw_frame_slot *sl = &fr->slot[k];
+		FILE *f;
 
 		if (k == fr->single_slot)
 			continue;
 		snprintf(path, sizeof(path), "%s/frame_%05u.vtk", dir, ++n);
-		e = write_file(fw, sl, path);
+		f = fopen(path, "w");
+		e = f ? write_file(fw, sl, f) : errno;
 		fprintf(idx, "%s    { \"name\" : \"frame_%05u.vtk\", \"time\" : %.17g }", n > 1 ? ",\n" : "",
 			n, (double)sl->held_tick * fw->board.period_us / 1e6);
 	}
@@ -168,12 +164,31 @@ static int write_series_into(const struct fw *fw, const char *dir)
 	return e;
 }
 
-/* The series into DIR.tmp, then swapped in for DIR (irdm/outdir.h). */
+/*
+ * The series' directory is claimed before the run (irdm/outdir.h): a DIR
+ * this tool did not write is refused then, not after the run.
+ */
+int fw_frame_claim_series(struct fw *fw)
+{
+	int rc;
+
+	if (!fw->args.frames_out)
+		return IRDM_OK;
+	rc = irdm_outdir_begin(&fw->frames_dir, fw->args.frames_out, "irdm-fw", fw->args.force);
+	if (rc)
+		snprintf(fw->err, sizeof(fw->err), "%.500s", fw->frames_dir.why);
+	else if (fw->frames_dir.debris_removed && !fw->args.quiet)
+		fprintf(stderr, "irdm-fw: note: %s: removed %u director%s left by interrupted runs\n",
+			fw->frames_dir.dir, fw->frames_dir.debris_removed,
+			fw->frames_dir.debris_removed == 1 ? "y" : "ies");
+	return rc;
+}
+
+/* The series into the claimed directory, then put in DIR's place. */
 int fw_frame_write_series(struct fw *fw)
 {
 	const struct fw_frame *fr = &fw->frame;
 	const char *dir = fw->args.frames_out;
-	char tmp[4096];
 	int e;
 
 	if (!dir)
@@ -181,17 +196,11 @@ int fw_frame_write_series(struct fw *fw)
 	for (unsigned k = 0; k < fr->n_slots; k++)
 		if (k != fr->single_slot && !fr->slot[k].held)
 			return no_frame(fw, dir);
-	e = irdm_outdir_begin(dir, tmp, sizeof(tmp));
-	if (e == ENAMETOOLONG) {
-		snprintf(fw->err, sizeof(fw->err), "%s: path too long", dir);
-		return IRDM_EINVAL;
-	}
+	e = write_series_into(fw, fw->frames_dir.tmp);
 	if (e)
-		return io_error(fw, tmp, e);
-	e = write_series_into(fw, tmp);
+		return io_error(fw, fw->frames_dir.tmp, e);
+	e = irdm_outdir_commit(&fw->frames_dir);
 	if (e)
-		irdm_outdir_remove(tmp);
-	else
-		e = irdm_outdir_commit(dir, tmp);
-	return e ? io_error(fw, dir, e) : IRDM_OK;
+		snprintf(fw->err, sizeof(fw->err), "%.500s", fw->frames_dir.why);
+	return e;
 }

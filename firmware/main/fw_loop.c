@@ -82,20 +82,14 @@ static void watch_contact_node(struct fw *fw, const struct irdm_ctrl_device_outp
 
 static void trace_tick(struct fw *fw, const struct irdm_ctrl_output *out)
 {
-	struct fw_trace *t = &fw->trace;
 	const struct irdm_ctrl_device_output *d = &out->dev[0];
 	double u[3] = { 0, 0, 0 };
-	uint64_t k = t->n;
 
-	if (k >= t->cap)
-		return;
 	watch_contact_node(fw, d);
 	if (fw->watching)
 		irdm_engine_node_disp(fw->s->eng, fw->watch_row, u);
-	t->force_n[k] = irdm_v3_norm(d->force_obj_n);
-	t->node_u_m[k] = irdm_v3_dot(u, fw->watch_normal);
-	t->contact[k] = d->contact;
-	t->n++;
+	fw_trace_add(&fw->trace, irdm_v3_norm(d->force_obj_n), irdm_v3_dot(u, fw->watch_normal),
+		     d->contact);
 }
 
 static double now_ns(void)

@@ -6,54 +6,64 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "irdm/rt.h"
 #include "irdm/safety.h"
 
 #include "fw.h"
 
-int fw_trace_alloc(struct fw_trace *t, uint64_t ticks)
+/*
+ * The ringing after release: the dominant frequency of the watched node's
+ * motion (mean removed) by a DFT scan from 0.5 to 200 Hz in 0.01 Hz steps:
+ * the ringing is a few modes, and a scan finer than the 1/T bins of an FFT
+ * places the peak without interpolation.  Only the first RINGING_WINDOW_S
+ * after the release are kept and scanned: the ringing has decayed by then,
+ * and the window is what bounds the trace's memory.
+ */
+#define RINGING_WINDOW_S 5.0
+
+int fw_trace_alloc(struct fw_trace *t, uint64_t ticks, uint32_t period_us)
 {
-	t->n = 0;
+	memset(t, 0, sizeof(*t));
 	t->cap = ticks;
-	t->force_n = calloc(ticks, sizeof(double));
-	t->node_u_m = calloc(ticks, sizeof(double));
-	t->contact = calloc(ticks, 1);
-	return t->force_n && t->node_u_m && t->contact ? 0 : -1;
+	t->ring_max = (uint64_t)(RINGING_WINDOW_S / (period_us * 1e-6));
+	if (t->ring_max < 1)
+		t->ring_max = 1;
+	t->ring_u_m = calloc(t->ring_max, sizeof(double));
+	return t->ring_u_m ? 0 : -1;
 }
 
 void fw_trace_free(struct fw_trace *t)
 {
-	free(t->force_n);
-	free(t->node_u_m);
-	free(t->contact);
+	free(t->ring_u_m);
+	t->ring_u_m = NULL;
 }
 
-/* The tick after the last contact ended, or t->n if none ended. */
-static uint64_t last_release(const struct fw_trace *t)
+void fw_trace_add(struct fw_trace *t, double force_n, double node_u_m, bool contact)
 {
-	for (uint64_t k = t->n; k-- > 1;)
-		if (t->contact[k - 1] && !t->contact[k])
-			return k;
-	return t->n;
+	if (t->n >= t->cap)
+		return;
+	if (force_n > t->peak_n) {
+		t->peak_n = force_n;
+		t->peak_at = t->n;
+	}
+	t->final_n = force_n;
+	/* a new release starts the window again: the latest one is reported */
+	if (t->n && t->contact && !contact) {
+		t->released = true;
+		t->release_at = t->n;
+		t->ring_n = 0;
+	}
+	if (t->released && t->ring_n < t->ring_max)
+		t->ring_u_m[t->ring_n++] = node_u_m;
+	t->contact = contact;
+	t->n++;
 }
-
-/*
- * Dominant frequency of x[0..n) (mean removed) by a DFT scan from 0.5 to
- * 200 Hz in 0.01 Hz steps: the ringing is a few modes, and a scan finer
- * than the 1/T bins of an FFT places the peak without interpolation.  Only
- * the first RINGING_WINDOW_S are scanned: the ringing has decayed by then,
- * and a long run (make jitter: a minute) would otherwise cost a billion
- * sin/cos pairs.
- */
-#define RINGING_WINDOW_S 5.0
 
 static double dominant_hz(const double *x, uint64_t n, double dt_s)
 {
 	double mean = 0, best = 0, best_hz = 0;
-
-	if ((double)n * dt_s > RINGING_WINDOW_S)
-		n = (uint64_t)(RINGING_WINDOW_S / dt_s);
 
 	for (uint64_t k = 0; k < n; k++)
 		mean += x[k] / (double)n;
@@ -69,6 +79,21 @@ static double dominant_hz(const double *x, uint64_t n, double dt_s)
 		}
 	}
 	return best_hz;
+}
+
+/* Locked and peak resident memory (kB, /proc/self/status), -1 if unknown. */
+static void memory_kb(long *locked, long *peak)
+{
+	char line[256];
+	FILE *f = fopen("/proc/self/status", "r");
+
+	*locked = *peak = -1;
+	while (f && fgets(line, sizeof(line), f)) {
+		sscanf(line, "VmLck: %ld kB", locked);
+		sscanf(line, "VmHWM: %ld kB", peak);
+	}
+	if (f)
+		fclose(f);
 }
 
 static void print_hist(const char *what, const struct irdm_hist *h)
@@ -92,25 +117,23 @@ const char *fw_hal_why(const struct fw *fw)
 void fw_summary_print(const struct fw *fw)
 {
 	const struct fw_trace *t = &fw->trace;
-	double dt_s = fw->board.period_us * 1e-6, peak = 0;
-	uint64_t at = 0, rel = last_release(t);
+	double dt_s = fw->board.period_us * 1e-6;
 	struct irdm_hist_summary cs;
+	long locked, peak;
 
-	for (uint64_t k = 0; k < t->n; k++)
-		if (t->force_n[k] > peak) {
-			peak = t->force_n[k];
-			at = k;
-		}
 	printf("ticks: %llu at %u us (%.3f s of %s time)\n", (unsigned long long)t->n,
 	       fw->board.period_us, (double)t->n * dt_s,
 	       fw->args.clock == IRDM_CLOCK_VIRTUAL ? "virtual" : "real");
-	printf("force: peak %.4f N at %.3f s, final %.4f N\n", peak, (double)at * dt_s,
-	       t->n ? t->force_n[t->n - 1] : 0.0);
-	if (rel + 100 <= t->n)
-		printf("release ringing: %.2f Hz\n",
-		       dominant_hz(t->node_u_m + rel, t->n - rel, dt_s));
+	printf("force: peak %.4f N at %.3f s, final %.4f N\n", t->peak_n,
+	       (double)t->peak_at * dt_s, t->final_n);
+	if (t->released && t->release_at + 100 <= t->n)
+		printf("release ringing: %.2f Hz\n", dominant_hz(t->ring_u_m, t->ring_n, dt_s));
 	else
 		printf("release ringing: none (no release followed by 0.1 s of motion)\n");
+	memory_kb(&locked, &peak);
+	printf("memory: locked %ld kB, peak resident %ld kB (the summary's trace: %llu kB, "
+	       "whatever the run's length)\n", locked, peak,
+	       (unsigned long long)((t->ring_max * sizeof(double) + 1023) / 1024));
 	if (fw->args.clock == IRDM_CLOCK_REAL)
 		print_hist("tick wake-up latency", &fw->latency);
 	else

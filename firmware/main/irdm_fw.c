@@ -97,7 +97,7 @@ static int open_inputs(struct fw *fw)
 		return FW_EXIT_OK;
 	if (!has_simulated_arm(fw->board.hal))
 		return fail(FW_EXIT_INPUT, IRDM_EINVAL, "--user %s: %s", fw->args.user,
-			    "a virtual user needs a back-end with a simulated arm (hal = sim or canemu)");
+			    fw_user_hal_why(fw));
 	fw->user = calloc(1, sizeof(*fw->user));
 	if (!fw->user)
 		return fail(FW_EXIT_SETUP, IRDM_ENOMEM, "%s%s", "", "out of memory for the user script");
@@ -144,9 +144,13 @@ static int open_devices(struct fw *fw)
 				   be->data_size);
 		if (!rc)
 			rc = irdm_hal_open(&fw->hal[i]);
-		if (rc)
-			return fail(FW_EXIT_SETUP, rc, "hal '%s': %s", fw->board.hal,
+		if (rc) {
+			/* the board's file: what the back-end refused is in it */
+			snprintf(fw->err, sizeof(fw->err), "%s: hal '%s'", fw->args.board,
+				 fw->board.hal);
+			return fail(FW_EXIT_SETUP, rc, "%s: %s", fw->err,
 				    fw->hal[i].why[0] ? fw->hal[i].why : "the device does not open");
+		}
 		fw->hal_open[i] = true;
 		if (fw->hal[i].info[0] && !fw->args.quiet)
 			print_info(fw->board.hal, fw->hal[i].info);
@@ -221,13 +225,14 @@ static int start(struct fw *fw)
 	if (rc)
 		return rc;
 	if (irdm_ctrl_init(&fw->ctrl, &fw->ccfg, fw->s))
-		return fail(FW_EXIT_INPUT, IRDM_EINVAL, "%s: %s", fw->args.image,
-			    "the controller cannot run on this image (no contact surface?)");
-	if (fw_trace_alloc(&fw->trace, run_ticks(fw)))
+		return fail(FW_EXIT_INPUT, IRDM_EINVAL, "%s%s", "", fw_ctrl_init_why(fw));
+	if (fw_trace_alloc(&fw->trace, run_ticks(fw), fw->board.period_us))
 		return fail(FW_EXIT_SETUP, IRDM_ENOMEM, "%s%s", "", "out of memory for the run's trace");
 	rc = fw_frame_check_args(fw, run_ticks(fw));
+	if (!rc)
+		rc = fw_frame_claim_series(fw);
 	if (rc)
-		return fail(FW_EXIT_USAGE, rc, "%s%s", "", fw->err);
+		return fail(rc == IRDM_EIO ? FW_EXIT_SETUP : FW_EXIT_USAGE, rc, "%s%s", "", fw->err);
 	rc = fw_frame_open(fw);
 	if (rc)
 		return fail(rc == IRDM_EINVAL ? FW_EXIT_INPUT : FW_EXIT_SETUP, rc, "%s: %s",
@@ -275,8 +280,10 @@ static int stop(struct fw *fw, int rc)
 			irdm_hal_close(&fw->hal[i]);
 		free(fw->hal_mem[i]);
 	}
-	if (fw->ring && fw_log_close(fw))
-		fprintf(stderr, "irdm-fw: EIO: %s\n", fw->err);
+	/* a run whose log is lost says so in its exit code, not only in a line */
+	if (fw->ring && fw_log_close(fw) && fail(FW_EXIT_LOG, IRDM_EIO, "%s%s", "", fw->err) &&
+	    rc == FW_EXIT_OK)
+		rc = FW_EXIT_LOG;
 	free(fw->user);
 	fw_frame_free(fw);
 	irdm_session_close(fw->s);
@@ -324,7 +331,9 @@ int main(int argc, char **argv)
 			free(fw);
 			return FW_EXIT_OK;
 		}
-		rc = fail(FW_EXIT_USAGE, rc, "%s%s (see irdm-fw --help)", "", fw->err);
+		/* the option table's messages point to --help already */
+		rc = fail(FW_EXIT_USAGE, rc, "%s%s", fw->err,
+			  strstr(fw->err, "--help") ? "" : " (see irdm-fw --help)");
 		free(fw);
 		return rc;
 	}
@@ -337,7 +346,7 @@ int main(int argc, char **argv)
 	/* a run stopped by a signal ended cleanly too: what it did is worth
 	 * the same summary */
 	if ((rc == FW_EXIT_OK || rc == FW_EXIT_FAULT || rc == FW_EXIT_NEVER_ENABLED ||
-	     rc == FW_EXIT_SIGNAL) && !fw->args.quiet)
+	     rc == FW_EXIT_SIGNAL || rc == FW_EXIT_LOG) && !fw->args.quiet)
 		fw_summary_print(fw);
 	fw_trace_free(&fw->trace);
 	free(fw);

@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* The sim back-end of the HAL (irdm/hal_sim.h). */
 #include <math.h>
+#include <stdio.h>
 #include <string.h>
 
 #include "irdm/error.h"
@@ -67,18 +68,49 @@ static int parse_token(const char *tok, size_t len, struct irdm_sim_params *p)
 	return rc;
 }
 
-static int parse_options(const char *s, struct irdm_sim_params *p)
+/* Each option, or the first one refused: its token and why, in why. */
+static int parse_options(const char *s, struct irdm_sim_params *p, char *why, size_t len)
 {
 	while (s && *s) {
-		size_t len = strcspn(s, " ,\t");
-		int rc = len ? parse_token(s, len, p) : IRDM_OK;
+		size_t n = strcspn(s, " ,\t"), eq = strcspn(s, "=");
+		int rc = n ? parse_token(s, n, p) : IRDM_OK;
 
-		if (rc != IRDM_OK)
+		if (rc != IRDM_OK) {
+			if (eq < n && (!strncmp(s, "write_delay", eq) || !strncmp(s, "read_delay", eq) ||
+				       !strncmp(s, "substeps", eq) || !strncmp(s, "end_stops", eq)))
+				snprintf(why, len, "hal_options '%.*s': out of range (delays 0..%d, "
+					 "substeps 1..%d, end_stops 0|1)", (int)n, s, IRDM_SIM_DELAY_MAX,
+					 IRDM_SIM_SUBSTEPS_MAX);
+			else
+				snprintf(why, len, "hal_options '%.*s': unknown (write_delay, "
+					 "read_delay, substeps, end_stops)", (int)n, s);
 			return rc;
-		s += len;
+		}
+		s += n;
 		s += strspn(s, " ,\t");
 	}
 	return IRDM_OK;
+}
+
+/* Why the simulated arm refuses this device (the board passed its own checks). */
+static void arm_why(const struct irdm_device_config *dev, const struct irdm_sim_params *p,
+		    char *why, size_t len)
+{
+	if (irdm_device_config_check(dev)) {
+		snprintf(why, len, "the arm is not valid (irdm_device_config_check)");
+		return;
+	}
+	for (unsigned i = 0; i < 3; i++) {
+		double span = fabs(irdm_device_rad_per_count(dev, i)) *
+			      ((double)dev->count_max[i] - dev->count_min[i] + 1.0);
+
+		if (p->end_stops && !(span > 2 * p->stop_inset_rad)) {
+			snprintf(why, len, "joint %u: count_min..count_max spans %.3g rad, end stops "
+				 "need > %.3g (end_stops=0)", i + 1, span, 2 * p->stop_inset_rad);
+			return;
+		}
+	}
+	snprintf(why, len, "the start pose is outside count_min..count_max");
 }
 
 static int sim_open(struct irdm_hal_dev *dev)
@@ -93,12 +125,14 @@ static int sim_open(struct irdm_hal_dev *dev)
 	if (!cfg->device || !(isfinite(cfg->period_s) && cfg->period_s > 0))
 		return IRDM_EINVAL;
 	irdm_sim_params_default(&p);
-	rc = parse_options(cfg->options, &p);
+	rc = parse_options(cfg->options, &p, dev->why, sizeof(dev->why));
 	if (rc != IRDM_OK)
 		return rc;
 	rc = irdm_sim_device_init(&d->arm, cfg->device, &p);
-	if (rc != IRDM_OK)
+	if (rc != IRDM_OK) {
+		arm_why(cfg->device, &p, dev->why, sizeof(dev->why));
 		return rc;
+	}
 	d->faults = 0;
 	d->seq = 0;
 	d->state = SIM_OPEN;

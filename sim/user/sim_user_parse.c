@@ -15,6 +15,7 @@
 #include <string.h>
 
 #include "irdm/error.h"
+#include "irdm/textfile.h"
 #include "irdm/sim_user.h"
 
 #define TOKENS_MAX 12
@@ -493,29 +494,24 @@ int irdm_sim_user_parse(struct irdm_sim_user *u, const char *name, const char *t
 
 int irdm_sim_user_load(struct irdm_sim_user *u, const char *path, char *err, size_t errlen)
 {
+	struct irdm_text_file t;
 	struct parser p;
 	char buf[IRDM_SIM_USER_LINE_MAX];
-	FILE *f;
-	int ret = IRDM_OK;
+	int ret;
 
 	if (!u || !path)
 		return IRDM_EINVAL;
 	parse_begin(&p, u, path, err, errlen);
-	f = fopen(path, "r");
-	if (!f) {
-		ret = fail(&p, IRDM_EIO, NULL, "cannot open: %s", strerror(errno));
-		goto out;
-	}
-	while (!ret && fgets(buf, sizeof(buf), f)) {
+	ret = irdm_text_open(&t, path, IRDM_TEXT_MAX_BYTES, err, errlen);
+	if (ret)
+		return parse_end(&p, ret);
+	/* one character short of the buffer: the reader's line, newline dropped */
+	while ((ret = irdm_text_line(&t, buf, LINE_CHARS + 1, err, errlen)) > 0) {
 		p.line++;
-		if (strlen(buf) > LINE_CHARS && buf[LINE_CHARS] != '\n')
-			ret = too_long(&p);
-		else
-			ret = parse_line(&p, buf);
+		ret = parse_line(&p, buf);
+		if (ret)
+			break;
 	}
-	if (!ret && ferror(f))
-		ret = fail(&p, IRDM_EIO, NULL, "read error");
-	fclose(f);
-out:
+	irdm_text_close(&t);
 	return parse_end(&p, ret);
 }

@@ -18,11 +18,15 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include "irdm/image.h"
+#include "irdm/outdir.h"
+#include "irdm/outfile.h"
 #include "image/image_writer.h"
+#include "util/interrupt.h"
 
 #if defined(__BYTE_ORDER__) && defined(__ORDER_LITTLE_ENDIAN__) && \
 	__BYTE_ORDER__ != __ORDER_LITTLE_ENDIAN__
@@ -261,13 +265,20 @@ static int write_tmp(const struct irdm_image_writer *w, const struct layout *lo,
 	return close(fd);
 }
 
+/* A temporary of a killed writer, removed (irdm_outfile_remove_debris()): said. */
+static void said_removed(const char *victim, void *ctx)
+{
+	(void)ctx;
+	fprintf(stderr, "irdm: note: removed %s, left by an interrupted run\n", victim);
+}
+
 int irdm_iw_write(const struct irdm_image_writer *w, const char *path,
 		  char *err, size_t errlen)
 {
-	static const char suffix[] = ".tmp.XXXXXX";
+	static const char suffix[] = IRDM_OUTDIR_TMP "XXXXXX";
 	struct layout *lo;
 	char *tmp = NULL;
-	int fd, ret;
+	int fd, lock_fd = -1, slot = -1, ret;
 
 	lo = malloc(sizeof(*lo));
 	if (!lo || plan(w, lo)) {
@@ -282,6 +293,8 @@ int irdm_iw_write(const struct irdm_image_writer *w, const char *path,
 		ret = IRDM_ENOMEM;
 		goto free_layout;
 	}
+	/* the same names and lock as irdm/outfile.h's: a killed writer's debris goes */
+	irdm_outfile_remove_debris(path, said_removed, NULL);
 	/* from here on every failure is the file system's */
 	ret = IRDM_EIO;
 	strcpy(tmp, path);
@@ -292,6 +305,11 @@ int irdm_iw_write(const struct irdm_image_writer *w, const char *path,
 			 path, strerror(errno));
 		goto free_layout;
 	}
+	/* the lock says "a writer is alive" until the rename (remove_debris) */
+	lock_fd = dup(fd);
+	if (lock_fd >= 0)
+		flock(lock_fd, LOCK_EX);
+	slot = irdm_interrupt_add(IRDM_INTERRUPT_FILE, tmp, 0);
 	if (write_tmp(w, lo, fd)) {
 		snprintf(err, errlen, "%s: cannot write %s: %s", path, tmp,
 			 strerror(errno));
@@ -302,6 +320,8 @@ int irdm_iw_write(const struct irdm_image_writer *w, const char *path,
 			 tmp, strerror(errno));
 		goto unlink_tmp;
 	}
+	irdm_interrupt_del(slot);
+	slot = -1;
 	if (sync_dir(path)) {
 		/* Too late to keep the old image: it is replaced, not durable. */
 		snprintf(err, errlen, "%s: written, but cannot sync its directory: %s",
@@ -313,6 +333,9 @@ int irdm_iw_write(const struct irdm_image_writer *w, const char *path,
 unlink_tmp:
 	unlink(tmp);
 free_layout:
+	irdm_interrupt_del(slot);
+	if (lock_fd >= 0)
+		close(lock_fd);
 	free(tmp);
 	free(lo);
 	return ret;

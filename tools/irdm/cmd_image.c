@@ -107,7 +107,7 @@ static int cmd_info(const char *path)
 		       "0..%u exact, %u..%u tapered, sum = static correction (hybrid)\n",
 		       m->n_modes_total - m->n_modes, m->head_samples / 2 - 1, m->head_samples / 2,
 		       m->head_samples - 1);
-	printf("dt            %g s (%.0f Hz)\n", m->dt_s, 1.0 / m->dt_s);
+	printf("dt            %g s (%g Hz)\n", m->dt_s, 1.0 / m->dt_s);
 	printf("material      E %g Pa, nu %g, rho %g kg/m^3, %s mass\n", m->young_pa, m->poisson,
 	       m->density_kg_m3, m->flags & IRDM_META_CONSISTENT_MASS ? "consistent" : "lumped");
 	printf("damping       C = %.6g M + %.6g K", m->rayleigh_a_per_s, m->rayleigh_b_s);

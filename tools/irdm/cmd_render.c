@@ -14,7 +14,7 @@
 static const char usage[] =
 	"usage: irdm render --image IMAGE --contact NODE|x,y,z [--contact ...]\n"
 	"                   --displacement TRAJ.csv -o DIR [--every S] [--nodes N,...|all]\n"
-	"                   [--push] ...\n"
+	"                   [--push] [--force] ...\n"
 	"       irdm render --image IMAGE --sites SITES.csv --displacement TRAJ.csv -o DIR ...\n"
 	"       irdm render --image IMAGE --log RUN.log --board BOARD -o DIR [--every S]\n"
 	"\n"
@@ -22,7 +22,9 @@ static const char usage[] =
 	"--push, --solve, --coupling, --passivity; --log replays an irdm-fw run on\n"
 	"the board it ran on).  Every S seconds of samples (default 0.02, rounded to\n"
 	"the image's dt; at most 5000 frames) the whole displayed surface is kept.\n"
-	"DIR (written whole or not at all):\n"
+	"DIR is written whole or not at all, and replaces an existing DIR only if\n"
+	"irdm render wrote it (its .irdm-output marker lists the files) or it is\n"
+	"empty; --force replaces any directory of files.  DIR holds:\n"
 	"  frame_NNNNN.vtu  VTK XML UnstructuredGrid: the image's nodes at their\n"
 	"                   deformed positions, the displayed surface's triangles,\n"
 	"                   point data displacement_m and mesh_node, field data\n"
@@ -55,6 +57,10 @@ static int render_option(struct irdm_render_opts *o, int argc, char **argv, int 
 {
 	const char *a = argv[*i];
 
+	if (!strcmp(a, "--force")) {
+		o->force = true;
+		return 1;
+	}
 	if (strcmp(a, "-o") && strcmp(a, "--every") && strcmp(a, "--nodes"))
 		return 0;
 	if (*i + 1 >= argc) {
@@ -124,6 +130,9 @@ int irdm_cmd_render(int argc, char **argv)
 		return 1;
 	}
 	surface_note(&o, &sum.surface);
+	if (sum.debris_removed)
+		fprintf(stderr, "irdm render: note: %s: removed %u director%s left by interrupted runs\n",
+			o.out_dir, sum.debris_removed, sum.debris_removed == 1 ? "y" : "ies");
 	printf("render: %zu frames every %zu samples of %zu -> %s/frames.pvd (%u nodes, %u triangles); "
 	       "largest displacement %.4g mm at t = %.3f s\n", sum.frames, sum.every_rows,
 	       sum.replay.rows, o.out_dir, sum.surface.nodes, sum.surface.tris,

@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "irdm/outfile.h"
 #include "irdm/telemetry.h"
 #include "log/log_csv.h"
 
@@ -123,43 +124,21 @@ static int write_rows(struct irdm_log_reader *r, FILE *f, char *err, size_t errl
 int irdm_log_export_csv(const char *log_path, const char *csv_path, char *err, size_t errlen)
 {
 	struct irdm_log_reader *r;
-	char tmp[4096];
-	FILE *f;
+	struct irdm_outfile o;
 	int ret;
 
 	ret = irdm_log_open(&r, log_path, err, errlen);
 	if (ret)
 		return ret;
-	if (snprintf(tmp, sizeof(tmp), "%s.tmp", csv_path) >= (int)sizeof(tmp)) {
-		snprintf(err, errlen, "%s: path too long", csv_path);
-		ret = IRDM_EINVAL;
-		goto out_close;
-	}
-	f = fopen(tmp, "w");
-	if (!f) {
-		snprintf(err, errlen, "%s: cannot create: %s", tmp, strerror(errno));
-		ret = IRDM_EIO;
-		goto out_close;
-	}
-	ret = write_rows(r, f, err, errlen);
-	if (ferror(f) && !ret) {
-		snprintf(err, errlen, "%s: write failed", tmp);
-		ret = IRDM_EIO;
-	}
-	if (fclose(f) && !ret) {
-		snprintf(err, errlen, "%s: write failed: %s", tmp, strerror(errno));
-		ret = IRDM_EIO;
-	}
+	ret = irdm_outfile_open(&o, csv_path, err, errlen);
 	if (ret)
-		goto out_remove;
-	if (rename(tmp, csv_path)) {
-		snprintf(err, errlen, "%s: cannot rename into place: %s", csv_path, strerror(errno));
-		ret = IRDM_EIO;
-		goto out_remove;
-	}
-	goto out_close;
-out_remove:
-	remove(tmp);
+		goto out_close;
+	/* a damaged block stops the rows: the CSV is then not written at all */
+	ret = write_rows(r, o.f, err, errlen);
+	if (ret)
+		irdm_outfile_abort(&o);
+	else
+		ret = irdm_outfile_commit(&o, err, errlen);
 out_close:
 	irdm_log_close(r);
 	return ret;

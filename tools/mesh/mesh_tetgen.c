@@ -22,10 +22,16 @@
 #define NODE_MIN_BYTES 7
 #define ELE_MIN_BYTES  9
 
-/* Reads "<count> <second>" from the first line; count must be positive. */
+#define ATTRS_MAX 1000      /* attributes a record may declare: far above tetgen's use */
+
+/*
+ * Reads "<count> <second> [<attributes> [<marker>]]" from the first line;
+ * count must be positive, attributes 0..ATTRS_MAX, the marker flag 0 or 1
+ * (both 0 when absent).  Each record must then hold what it declares.
+ */
 static int parse_header(struct mtext *t, const char *what, const char *kind,
 			size_t min_bytes, long long *count, long long *second,
-			char *err, size_t errlen)
+			long long extra[2], char *err, size_t errlen)
 {
 	struct mline l;
 
@@ -35,6 +41,15 @@ static int parse_header(struct mtext *t, const char *what, const char *kind,
 	}
 	if (mline_ll(&l, count) || mline_ll(&l, second)) {
 		mesh_err(err, errlen, what, "line %zu: bad %s header", l.lineno, kind);
+		return IRDM_EFORMAT;
+	}
+	extra[0] = extra[1] = 0;
+	if (!mline_ll(&l, &extra[0]))
+		mline_ll(&l, &extra[1]);
+	if (extra[0] < 0 || extra[0] > ATTRS_MAX || extra[1] < 0 || extra[1] > 1) {
+		mesh_err(err, errlen, what,
+			 "line %zu: %lld attributes and marker flag %lld per %s (0..%d and 0 or 1)",
+			 l.lineno, extra[0], extra[1], kind, ATTRS_MAX);
 		return IRDM_EFORMAT;
 	}
 	if (*count <= 0) {
@@ -53,6 +68,22 @@ static int parse_header(struct mtext *t, const char *what, const char *kind,
 			 *count, kind, t->len);
 		return IRDM_EFORMAT;
 	}
+	return 0;
+}
+
+/* The attributes (and marker) the header declared are on the record. */
+static int record_rest(struct mline *l, long long want, const char *kind, const char *what,
+		       char *err, size_t errlen)
+{
+	double v;
+
+	for (long long k = 0; k < want; k++)
+		if (mline_double(l, &v)) {
+			mesh_err(err, errlen, what,
+				 "line %zu: the header declares %lld attribute or marker value%s per %s, the line has %lld",
+				 l->lineno, want, want == 1 ? "" : "s", kind, k);
+			return IRDM_EFORMAT;
+		}
 	return 0;
 }
 
@@ -96,12 +127,12 @@ static int parse_nodes(const char *txt, size_t len, const char *what,
 {
 	struct mtext t;
 	struct mline l;
-	long long n, dim;
+	long long n, dim, extra[2];
 	size_t i;
 	int ret;
 
 	mtext_init(&t, txt, len, '#');
-	ret = parse_header(&t, what, "node", NODE_MIN_BYTES, &n, &dim, err, errlen);
+	ret = parse_header(&t, what, "node", NODE_MIN_BYTES, &n, &dim, extra, err, errlen);
 	if (ret)
 		return ret;
 	if (dim != 3) {
@@ -122,6 +153,8 @@ static int parse_nodes(const char *txt, size_t len, const char *what,
 		}
 		ret = parse_node_line(&l, i, base, m->pos_m + 3 * i,
 				      &lab->node_tag[i], what, err, errlen);
+		if (!ret)
+			ret = record_rest(&l, extra[0] + extra[1], "node", what, err, errlen);
 		if (ret)
 			return ret;
 	}
@@ -165,12 +198,12 @@ static int parse_eles(const char *txt, size_t len, const char *what,
 {
 	struct mtext t;
 	struct mline l;
-	long long n, npt;
+	long long n, npt, extra[2];
 	size_t i;
 	int ret;
 
 	mtext_init(&t, txt, len, '#');
-	ret = parse_header(&t, what, "element", ELE_MIN_BYTES, &n, &npt, err, errlen);
+	ret = parse_header(&t, what, "element", ELE_MIN_BYTES, &n, &npt, extra, err, errlen);
 	if (ret)
 		return ret;
 	if (npt != 4 && npt != 10) {
@@ -192,6 +225,8 @@ static int parse_eles(const char *txt, size_t len, const char *what,
 		}
 		ret = parse_ele_line(&l, m, i, base, &lab->tet_tag[i], what,
 				     err, errlen);
+		if (!ret)
+			ret = record_rest(&l, extra[0], "element", what, err, errlen);
 		if (ret)
 			return ret;
 	}

@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "irdm/error.h"
+#include "irdm/textfile.h"
 #include "mesh/mesh_priv.h"
 
 /* Long enough for any sane number ("-1.2345678901234567e-308" is 24). */
@@ -242,11 +243,9 @@ int mesh_read_file(const char *path, char **buf, size_t *len,
 
 	*buf = NULL;
 	*len = 0;
-	f = fopen(path, "rb");
-	if (!f) {
-		mesh_err(err, errlen, path, "cannot open: %s", strerror(errno));
-		return IRDM_EIO;
-	}
+	ret = irdm_file_fopen(path, MESH_MAX_FILE_BYTES, &f, err, errlen);
+	if (ret)
+		return ret;
 	do {
 		if (n == cap) {
 			if (cap >= MESH_MAX_FILE_BYTES) {

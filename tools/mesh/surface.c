@@ -46,6 +46,30 @@ int surface_add_tri(struct surface_build *b, uint32_t v0, uint32_t v1,
 	return 0;
 }
 
+/* Collinear corners: tetgen cannot mesh such a facet, and it would leave
+ * edges that look open ("not closed") instead of saying which triangle. */
+static bool zero_area(const struct irdm_surface *s, const uint32_t *t)
+{
+	const double *a = &s->pos_m[3 * (size_t)t[0]], *b = &s->pos_m[3 * (size_t)t[1]];
+	const double *c = &s->pos_m[3 * (size_t)t[2]];
+	double u[3], v[3], n[3], lu = 0, lv = 0, ln = 0;
+
+	for (int k = 0; k < 3; k++) {
+		u[k] = b[k] - a[k];
+		v[k] = c[k] - a[k];
+	}
+	n[0] = u[1] * v[2] - u[2] * v[1];
+	n[1] = u[2] * v[0] - u[0] * v[2];
+	n[2] = u[0] * v[1] - u[1] * v[0];
+	for (int k = 0; k < 3; k++) {
+		lu += u[k] * u[k];
+		lv += v[k] * v[k];
+		ln += n[k] * n[k];
+	}
+	/* |u x v| = |u| |v| sin(angle): below 1e-12 of |u| |v|, the angle is nil */
+	return ln <= 1e-24 * lu * lv;
+}
+
 int surface_check(const struct irdm_surface *s, const char *what,
 		  char *err, size_t errlen)
 {
@@ -78,6 +102,12 @@ int surface_check(const struct irdm_surface *s, const char *what,
 		if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) {
 			mesh_err(err, errlen, what,
 				 "triangle %zu is degenerate (a vertex repeats)", i + 1);
+			return IRDM_EFORMAT;
+		}
+		if (zero_area(s, t)) {
+			mesh_err(err, errlen, what,
+				 "triangle %zu is degenerate (zero area: its vertices are collinear)",
+				 i + 1);
 			return IRDM_EFORMAT;
 		}
 	}

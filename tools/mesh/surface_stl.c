@@ -265,8 +265,16 @@ int irdm_surface_parse_stl(const void *buf, size_t len, const char *what,
 		exact = fits && n == (len - STL_HEADER) / STL_RECORD &&
 			(len - STL_HEADER) % STL_RECORD == 0;
 	}
-	/* An exact size wins over "solid"; otherwise trailing bytes are allowed. */
-	if (exact || (fits && !looks_ascii(buf, len))) {
+	/* An exact size wins over "solid"; otherwise trailing bytes are allowed,
+	 * unless they are whole triangles the count leaves out (a wrong count,
+	 * whose dropped triangles would only show as "not closed" later). */
+	if (fits && !exact && !looks_ascii(buf, len) && (len - STL_HEADER) % STL_RECORD == 0) {
+		mesh_err(err, errlen, what,
+			 "binary STL declares %zu triangles at byte 80 but holds %zu whole "
+			 "triangle records: the count is wrong", n,
+			 (len - STL_HEADER) / STL_RECORD);
+		ret = IRDM_EFORMAT;
+	} else if (exact || (fits && !looks_ascii(buf, len))) {
 		ret = parse_binary(p, n, s, what, err, errlen);
 	} else if (looks_ascii(buf, len)) {
 		ret = parse_ascii(buf, len, s, what, err, errlen);

@@ -21,7 +21,9 @@
 #include <unistd.h>
 
 #include "irdm/error.h"
+#include "irdm/outdir.h"
 #include "mesh/mesh_priv.h"
+#include "util/interrupt.h"
 
 extern char **environ;
 
@@ -99,22 +101,7 @@ static int make_paths(struct tg_run *r, const char *what, char *err,
 /* Remove the private directory and whatever tetgen left in it. */
 static void remove_dir(const char *dir)
 {
-	char path[PATH_BYTES];
-	struct dirent *d;
-	DIR *dp;
-
-	dp = opendir(dir);
-	if (dp) {
-		while ((d = readdir(dp))) {
-			if (!strcmp(d->d_name, ".") || !strcmp(d->d_name, ".."))
-				continue;
-			if (snprintf(path, sizeof(path), "%s/%s", dir, d->d_name) <
-			    (int)sizeof(path))
-				unlink(path);
-		}
-		closedir(dp);
-	}
-	rmdir(dir);
+	irdm_outdir_remove_files(dir);
 }
 
 /*
@@ -201,9 +188,15 @@ static void last_log_line(const char *log, char *out, size_t outlen)
 	free(txt);
 }
 
+/*
+ * tetgen runs in a process group of its own: a terminal's Ctrl-C reaches
+ * irdm alone, whose handler (util/interrupt.h) stops the group and removes
+ * the directory, so no tetgen outlives an interrupted irdm.
+ */
 static int spawn_tetgen(const struct tg_run *r, const char *prog, pid_t *pid)
 {
 	posix_spawn_file_actions_t fa;
+	posix_spawnattr_t at;
 	char *argv[4];
 	int rc;
 
@@ -222,7 +215,15 @@ static int spawn_tetgen(const struct tg_run *r, const char *prog, pid_t *pid)
 	if (!rc)
 		rc = posix_spawn_file_actions_adddup2(&fa, 1, 2);
 	if (!rc)
-		rc = posix_spawnp(pid, prog, &fa, NULL, argv, environ);
+		rc = posix_spawnattr_init(&at);
+	if (!rc) {
+		rc = posix_spawnattr_setflags(&at, POSIX_SPAWN_SETPGROUP);
+		if (!rc)
+			rc = posix_spawnattr_setpgroup(&at, 0);
+		if (!rc)
+			rc = posix_spawnp(pid, prog, &fa, &at, argv, environ);
+		posix_spawnattr_destroy(&at);
+	}
 	posix_spawn_file_actions_destroy(&fa);
 	return rc;
 }
@@ -233,7 +234,7 @@ static int run_tetgen(const struct tg_run *r, const char *what, char *err,
 	const char *prog = getenv("IRDM_TETGEN");
 	char last[160];
 	pid_t pid;
-	int rc, status;
+	int rc, status, slot;
 
 	if (!prog || !*prog)
 		prog = "tetgen";
@@ -243,13 +244,16 @@ static int run_tetgen(const struct tg_run *r, const char *what, char *err,
 			 rc == ENOENT ? " (install Debian's tetgen package)" : "");
 		return IRDM_ECHILD;
 	}
+	slot = irdm_interrupt_add(IRDM_INTERRUPT_PGROUP, NULL, pid);
 	while (waitpid(pid, &status, 0) < 0) {
 		if (errno != EINTR) {
 			mesh_err(err, errlen, what, "waiting for %s: %s", prog,
 				 strerror(errno));
+			irdm_interrupt_del(slot);
 			return IRDM_ECHILD;
 		}
 	}
+	irdm_interrupt_del(slot);
 	if (WIFEXITED(status) && WEXITSTATUS(status) == 0)
 		return 0;
 	last_log_line(r->log, last, sizeof(last));
@@ -297,7 +301,7 @@ int irdm_surface_tetrahedralize(const struct irdm_surface *s, const char *switch
 				char *err, size_t errlen)
 {
 	struct tg_run *r;
-	int ret;
+	int ret, slot;
 
 	memset(m, 0, sizeof(*m));
 	if (!what)
@@ -317,12 +321,14 @@ int irdm_surface_tetrahedralize(const struct irdm_surface *s, const char *switch
 		ret = make_paths(r, what, err, errlen);
 	if (ret)
 		goto out_free;
+	slot = irdm_interrupt_add(IRDM_INTERRUPT_DIR, r->dir, 0);
 	ret = write_smesh(r, s, what, err, errlen);
 	if (!ret)
 		ret = run_tetgen(r, what, err, errlen);
 	if (!ret)
 		ret = read_result(r, m, what, err, errlen);
 	remove_dir(r->dir);
+	irdm_interrupt_del(slot);
 	if (!ret)
 		mesh_set_name(m, what);
 out_free:

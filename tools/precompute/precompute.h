@@ -3,9 +3,10 @@
 #ifndef IRDM_TOOLS_PRECOMPUTE_H
 #define IRDM_TOOLS_PRECOMPUTE_H
 
+#include "irdm/version.h"
 #include "precompute/model.h"
 
-#define IRDM_TOOL_VERSION "irdm 0.1.0"
+#define IRDM_TOOL_VERSION "irdm " IRDM_VERSION
 
 struct irdm_precompute_opts {
 	const char *out_path;        /* image to write (NULL with part_out) */

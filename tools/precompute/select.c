@@ -18,6 +18,17 @@ static int node_dofs(const struct irdm_model *m, uint32_t node, int64_t *dofs)
 	return 0;
 }
 
+/* Does the display region hold a surface node (a region that holds none
+ * would be silently ignored: the image would show the touch region only)? */
+static bool selects_surface(const struct irdm_scene *sc, const struct irdm_model *m)
+{
+	for (size_t i = 0; i < m->mesh.n_nodes; i++)
+		if (m->on_surface[i] &&
+		    irdm_region_contains(&sc->display, (uint32_t)i, &m->mesh.pos_m[3 * i], true))
+			return true;
+	return false;
+}
+
 int irdm_model_select(const struct irdm_scene *sc, struct irdm_model *m, char *err, size_t errlen)
 {
 	size_t n = m->mesh.n_nodes;
@@ -46,6 +57,10 @@ int irdm_model_select(const struct irdm_scene *sc, struct irdm_model *m, char *e
 	}
 	if (m->n_cols == 0) {
 		snprintf(err, errlen, "scene: 'touch = %s' selects no free surface node", sc->touch.text);
+		goto out_free;
+	}
+	if (sc->display.kind != IRDM_REGION_NONE && !selects_surface(sc, m)) {
+		snprintf(err, errlen, "scene: 'display = %s' selects no surface node", sc->display.text);
 		goto out_free;
 	}
 	m->rows = malloc(m->n_rows * sizeof(uint32_t));

@@ -7,6 +7,7 @@
 
 #include "image/image_writer.h"
 #include "irdm/image.h"
+#include "irdm/textfile.h"
 #include "precompute/td_part.h"
 
 #define PART_MAGIC "IRDMPART"
@@ -59,14 +60,12 @@ int irdm_td_part_write(const char *path, const struct irdm_td_part *p, char *err
 int irdm_td_part_read(const char *path, struct irdm_td_part *p, char *err, size_t errlen)
 {
 	struct part_header h;
-	FILE *f = fopen(path, "rb");
+	FILE *f;
 	int ret = IRDM_EFORMAT;
 
 	memset(p, 0, sizeof(*p));
-	if (!f) {
-		snprintf(err, errlen, "%s: cannot open part: %s", path, strerror(errno));
+	if (irdm_file_fopen(path, IRDM_DATA_MAX_BYTES, &f, err, errlen))
 		return IRDM_EIO;
-	}
 	if (fread(&h, sizeof(h), 1, f) != 1 || memcmp(h.magic, PART_MAGIC, 8) || h.version != 1 ||
 	    h.header_crc32c != irdm_crc32c(&h, offsetof(struct part_header, header_crc32c))) {
 		snprintf(err, errlen, "%s: not a time-domain part file (bad magic, version or header checksum)", path);

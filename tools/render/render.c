@@ -15,11 +15,12 @@
 
 #include "irdm/outdir.h"
 #include "render/render.h"
+#include "util/interrupt.h"
 
 struct render {
 	const struct irdm_render_opts *o;
 	struct irdm_render_summary *sum;
-	char tmp[4096];                 /* DIR.tmp, swapped in at the end */
+	struct irdm_outdir od;          /* the files go to od.tmp, put in DIR's place at the end */
 	char path[4400];                /* scratch: the file being opened */
 	char forces[4400];              /* the replay's output, DIR.tmp/forces.csv */
 	FILE *pvd, *csv;
@@ -112,7 +113,7 @@ static int frame(struct render *rd, struct irdm_replay *r, char *err, size_t err
 		return IRDM_EINVAL;
 	}
 	snprintf(file, sizeof(file), "frame_%05zu.vtu", rd->sum->frames);
-	snprintf(rd->path, sizeof(rd->path), "%s/%s", rd->tmp, file);
+	snprintf(rd->path, sizeof(rd->path), "%s/%s", rd->od.tmp, file);
 	e = irdm_render_write_vtu(rd->path, r, frame_time(r), pos);
 	if (e)
 		return io_error(rd->path, e, err, errlen);
@@ -139,7 +140,7 @@ static int on_tick(void *ctx, struct irdm_replay *r, char *err, size_t errlen)
 
 static FILE *open_in(struct render *rd, const char *name)
 {
-	snprintf(rd->path, sizeof(rd->path), "%s/%s", rd->tmp, name);
+	snprintf(rd->path, sizeof(rd->path), "%s/%s", rd->od.tmp, name);
 	return fopen(rd->path, "w");
 }
 
@@ -167,7 +168,7 @@ static int run_into_tmp(struct render *rd, char *err, size_t errlen)
 	if (!rd->pvd || !rd->csv)
 		return io_error(rd->path, errno, err, errlen);
 	irdm_render_pvd_begin(rd->pvd);
-	snprintf(rd->forces, sizeof(rd->forces), "%s/forces.csv", rd->tmp);
+	snprintf(rd->forces, sizeof(rd->forces), "%s/forces.csv", rd->od.tmp);
 	in.out = rd->forces;
 	in.deform = true;
 	in.on_tick = on_tick;
@@ -177,25 +178,33 @@ static int run_into_tmp(struct render *rd, char *err, size_t errlen)
 		return ret;
 	irdm_render_pvd_end(rd->pvd);
 	ret = close_files(rd);
-	return ret ? io_error(rd->tmp, ret, err, errlen) : IRDM_OK;
+	return ret ? io_error(rd->od.tmp, ret, err, errlen) : IRDM_OK;
 }
 
 int irdm_render_run(const struct irdm_render_opts *o, struct irdm_render_summary *sum,
 		    char *err, size_t errlen)
 {
 	struct render rd = { .o = o, .sum = sum };
-	int ret, e;
+	int ret, slot;
 
 	memset(sum, 0, sizeof(*sum));
-	e = irdm_outdir_begin(o->out_dir, rd.tmp, sizeof(rd.tmp));
-	if (e)
-		return io_error(e == ENAMETOOLONG ? o->out_dir : rd.tmp, e, err, errlen);
+	ret = irdm_outdir_begin(&rd.od, o->out_dir, "irdm render", o->force);
+	if (ret)
+		goto out_why;
+	sum->debris_removed = rd.od.debris_removed;
+	slot = irdm_interrupt_add(IRDM_INTERRUPT_DIR, rd.od.tmp, 0);
 	ret = run_into_tmp(&rd, err, errlen);
 	close_files(&rd);
 	if (ret) {
-		irdm_outdir_remove(rd.tmp);
+		irdm_outdir_abort(&rd.od);
+		irdm_interrupt_del(slot);
 		return ret;
 	}
-	e = irdm_outdir_commit(o->out_dir, rd.tmp);
-	return e ? io_error(o->out_dir, e, err, errlen) : IRDM_OK;
+	ret = irdm_outdir_commit(&rd.od);
+	irdm_interrupt_del(slot);
+	if (!ret)
+		return IRDM_OK;
+out_why:
+	snprintf(err, errlen, "%s", rd.od.why);
+	return ret;
 }

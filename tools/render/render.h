@@ -9,6 +9,7 @@
 #ifndef IRDM_TOOLS_RENDER_H
 #define IRDM_TOOLS_RENDER_H
 
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -20,6 +21,7 @@
 struct irdm_render_opts {
 	struct irdm_replay_opts in;     /* the inputs as irdm replay's (its out unused) */
 	const char *out_dir;
+	bool force;                     /* replace out_dir even if irdm render did not write it */
 	double every_s;                 /* a frame every every_s, rounded to samples (> 0) */
 };
 
@@ -35,6 +37,7 @@ struct irdm_render_summary {
 	struct irdm_render_surface surface;
 	size_t frames, every_rows;
 	double max_disp_m, max_disp_t_s;        /* over the frames' nodes */
+	unsigned debris_removed;        /* interrupted runs' directories beside DIR, removed */
 };
 
 int irdm_render_run(const struct irdm_render_opts *o, struct irdm_render_summary *sum,

@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "irdm/limits.h"
+#include "irdm/textfile.h"
 #include "replay/replay_priv.h"
 
 /* ---- trajectory CSV ---- */
@@ -52,17 +53,15 @@ static int parse_line(char *line, double *v, size_t want, size_t *got)
 static int read_table(const char *path, size_t n_cols, double dt, struct trajectory *tr,
 		      char *err, size_t errlen)
 {
-	FILE *f = fopen(path, "r");
+	FILE *f;
 	char line[4096];
 	size_t cap = 0, lineno = 0;
 	int ret = IRDM_EFORMAT;
 
 	memset(tr, 0, sizeof(*tr));
 	tr->n_cols = n_cols;
-	if (!f) {
-		snprintf(err, errlen, "%s: cannot open: %s", path, strerror(errno));
+	if (irdm_file_fopen(path, IRDM_DATA_MAX_BYTES, &f, err, errlen))
 		return IRDM_EIO;
-	}
 	while (fgets(line, sizeof(line), f)) {
 		double v[1 + 3 * IRDM_MAX_CONTACTS];
 		size_t got = 0;
@@ -185,14 +184,12 @@ int read_sites(const char *path, size_t n_contacts, double dt, uint32_t n_tris,
 
 int sites_contacts(const char *path, unsigned *n, char *err, size_t errlen)
 {
-	FILE *f = fopen(path, "r");
+	FILE *f;
 	char line[4096];
 	size_t cols = 0;
 
-	if (!f) {
-		snprintf(err, errlen, "%s: cannot open: %s", path, strerror(errno));
+	if (irdm_file_fopen(path, IRDM_DATA_MAX_BYTES, &f, err, errlen))
 		return IRDM_EIO;
-	}
 	while (fgets(line, sizeof(line), f)) {
 		double v[1 + 4 * IRDM_MAX_CONTACTS];
 		if (parse_line(line, v, 1 + 4 * IRDM_MAX_CONTACTS, &cols) == 0)

@@ -9,6 +9,7 @@
 
 #include "irdm/error.h"
 #include "irdm/options.h"
+#include "irdm/textfile.h"
 #include "modal/static_clusters.h"
 #include "modal/static_lowrank.h"
 #include "modal/static_sparse.h"
@@ -406,7 +407,7 @@ static const struct irdm_opt scene_opts[] = {
 	{ .name = "fixed", .type = IRDM_OPT_CUSTOM, .parse = set_region, SC(fixed), .metavar = REGION,
 	  .help = "fixed nodes, called REGION below (default z<=0)" },
 	{ .name = "dt", .type = IRDM_OPT_DOUBLE, SC(dt_s), .metavar = "SECONDS", .unit = "s",
-	  .range = IRDM_OPT_GT | IRDM_OPT_LE, .min = 0, .max = 1,
+	  .range = IRDM_OPT_GE | IRDM_OPT_LE, .min = 1e-6, .max = 1,
 	  .help = "sample period (default 0.001)" },
 	{ .name = "representation", .type = IRDM_OPT_CUSTOM, .parse = set_representation,
 	  .metavar = "modal:K | modal:all | fir:T",
@@ -469,29 +470,23 @@ int irdm_scene_set(struct irdm_scene *sc, const char *key, const char *value,
 
 int irdm_scene_load(struct irdm_scene *sc, const char *path, char *err, size_t errlen)
 {
-	struct irdm_opt_file file = { .table = &irdm_scene_options, .obj = sc, .name = path };
-	FILE *f = fopen(path, "r");
+	/* a key set twice is a mistake, not an override: say so */
+	struct irdm_opt_file file = { .table = &irdm_scene_options, .obj = sc, .name = path,
+				      .reject_duplicates = true };
+	struct irdm_text_file t;
 	char line[1024];
-	int ret = IRDM_OK;
+	int ret;
 
-	if (!f) {
-		snprintf(err, errlen, "%s: cannot open scene: %s", path, strerror(errno));
-		return IRDM_EIO;
-	}
-	while (!ret && fgets(line, sizeof(line), f)) {
+	ret = irdm_text_open(&t, path, IRDM_TEXT_MAX_BYTES, err, errlen);
+	if (ret)
+		return ret;
+	while ((ret = irdm_text_line(&t, line, sizeof(line), err, errlen)) > 0) {
 		file.line_no++;
-		if (!strchr(line, '\n') && !feof(f)) {
-			snprintf(err, errlen, "%s:%u: line too long", path, file.line_no);
-			ret = IRDM_EFORMAT;
-		} else {
-			ret = irdm_opt_parse_line(&file, line, err, errlen);
-		}
+		ret = irdm_opt_parse_line(&file, line, err, errlen);
+		if (ret)
+			break;
 	}
-	if (!ret && ferror(f)) {
-		snprintf(err, errlen, "%s: read error", path);
-		ret = IRDM_EIO;
-	}
-	fclose(f);
+	irdm_text_close(&t);
 	return ret;
 }
 

@@ -31,9 +31,10 @@ enum irdm_err {
 	IRDM_ETIMEDOUT = -18,   /* a deadline or a time-out passed */
 	IRDM_EHW = -19,         /* the hardware or its link reported a fault */
 	IRDM_ECHILD = -20,      /* an external program failed */
+	IRDM_EEXIST = -21,      /* an output's target exists and is not the tool's to replace */
 };
 
-#define IRDM_ERR_MIN IRDM_ECHILD
+#define IRDM_ERR_MIN IRDM_EEXIST
 
 /* Short description, e.g. "out of memory"; "unknown error" outside the space. */
 const char *irdm_strerror(int code);

@@ -146,7 +146,15 @@ long irdm_image_corr_block(const struct irdm_image *img, uint32_t col_force,
 void irdm_image_corr_value(const struct irdm_image *img, uint32_t col_force,
 			   uint32_t col_disp, double blk[9]);
 
+/* The largest spectral radius of the STABILITY table (0 with no column),
+ * which the loader has checked meta->max_spectral_radius repeats. */
+double irdm_image_max_radius(const struct irdm_image *img);
+
 /* CRC-32C (Castagnoli), reflected, init/xorout 0xFFFFFFFF. */
 uint32_t irdm_crc32c(const void *data, size_t len);
+
+/* The CRC-32C of a stream in pieces: crc is the previous pieces' (0 before
+ * the first); irdm_crc32c_update(irdm_crc32c(a), b) is the CRC of a then b. */
+uint32_t irdm_crc32c_update(uint32_t crc, const void *data, size_t len);
 
 #endif /* IRDM_IMAGE_H */

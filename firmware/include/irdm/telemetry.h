@@ -243,12 +243,22 @@ void irdm_hist_summarize(const struct irdm_hist *h, struct irdm_hist_summary *s)
 
 /* ---- the log file ---- */
 
+/*
+ * The layout (docs/log-format.md): the header; the records in blocks of
+ * block_records (the last block may be shorter, never empty), each block
+ * followed by its struct irdm_log_block_end (a CRC-32C of its records);
+ * then struct irdm_log_trailer (the record count again).  A log cut short,
+ * or with one bit changed, is refused naming the block.
+ */
 #define IRDM_LOG_MAGIC "IRDMLOG"        /* 8 bytes with its NUL */
-#define IRDM_LOG_VERSION 2u      /* 2: the engine's command (site, target) per device */
+#define IRDM_LOG_VERSION 3u      /* 3: blocks with CRC-32C, a trailer; 2: the engine's command */
 #define IRDM_LOG_HEADER_SIZE 256u
 #define IRDM_LOG_COUNT_OPEN UINT64_MAX  /* record_count of a log never closed */
 #define IRDM_LOG_NAME_LEN 64
 #define IRDM_LOG_IMAGE_LEN 128
+#define IRDM_LOG_BLOCK_RECORDS 256u     /* records per block (the last: fewer) */
+#define IRDM_LOG_BLOCK_MAGIC "BLK"      /* 4 bytes with its NUL */
+#define IRDM_LOG_TRAILER_MAGIC "IRDMEND"        /* 8 bytes with its NUL */
 
 struct irdm_log_header {
 	char magic[8];                  /* IRDM_LOG_MAGIC */
@@ -265,8 +275,29 @@ struct irdm_log_header {
 	uint32_t reserved;              /* zero */
 	char board[IRDM_LOG_NAME_LEN];  /* NUL-terminated, NUL-padded */
 	char image[IRDM_LOG_IMAGE_LEN]; /* NUL-terminated, NUL-padded */
-	uint8_t reserved_end[8];        /* zero */
+	uint32_t block_records;         /* IRDM_LOG_BLOCK_RECORDS */
+	uint32_t header_crc32c;         /* CRC-32C of bytes [0, 252) */
 };
+
+/* After each block's records. */
+struct irdm_log_block_end {
+	char magic[4];                  /* IRDM_LOG_BLOCK_MAGIC */
+	uint32_t index;                 /* the block's number, from 0 */
+	uint32_t n_records;             /* in this block: block_records, the last fewer */
+	uint32_t crc32c;                /* CRC-32C of the block's records and the 12 bytes above */
+};
+
+/* After the last block: the file's end. */
+struct irdm_log_trailer {
+	char magic[8];                  /* IRDM_LOG_TRAILER_MAGIC */
+	uint64_t record_count;          /* as the header's */
+	uint64_t dropped;               /* as the header's */
+	uint32_t n_blocks;
+	uint32_t crc32c;                /* CRC-32C of the 28 bytes above */
+};
+
+/* The size in bytes of a complete log of n records. */
+uint64_t irdm_log_size(uint64_t n);
 
 /* What the caller says about a run; names are cut to fit the header. */
 struct irdm_log_info {
@@ -281,37 +312,42 @@ struct irdm_log_info {
 struct irdm_log_file;
 
 /*
- * Create PATH.tmp and write the header (record_count IRDM_LOG_COUNT_OPEN).
+ * Create a temporary beside PATH (irdm/outfile.h) and write the header
+ * (record_count IRDM_LOG_COUNT_OPEN).
  * Init-time (allocates, opens a file).
  *
  * Return: IRDM_OK;
  * IRDM_EINVAL if an argument is NULL, period_us is 0 or n_devices too large;
  * IRDM_ENOMEM if out of memory;
- * IRDM_EIO if PATH.tmp cannot be created or written.
+ * IRDM_EEXIST if PATH is there and not a regular file;
+ * IRDM_EIO if the temporary cannot be created or written.
  * On error *lf is NULL, nothing is left on disk and err says why.
  */
 int irdm_log_file_open(struct irdm_log_file **lf, const char *path,
 		       const struct irdm_log_info *info, char *err, size_t errlen);
 
 /*
- * Append n records (one fwrite).
+ * Append n records, closing each block that fills.
  *
- * Return: IRDM_OK; IRDM_EIO if the write failed (err says why; the log
- * is then only good for irdm_log_file_abort()).
+ * Return: IRDM_OK; IRDM_EIO if a write failed (err says why).  The first
+ * failure sticks: later appends fail at once, and irdm_log_file_close()
+ * reports it and leaves nothing on disk.
  */
 int irdm_log_file_append(struct irdm_log_file *lf, const struct irdm_tick_record *rec,
 			 size_t n, char *err, size_t errlen);
 
 /*
- * Write record_count and `dropped` into the header, close, and rename
- * PATH.tmp to PATH.  Frees lf in every case.
+ * Close the last block, write the trailer, record_count and `dropped` into
+ * the header, flush, sync, close, and rename the temporary onto PATH.
+ * Frees lf in every case.
  *
- * Return: IRDM_OK; IRDM_EIO if a write, the close or the rename failed
- * (PATH.tmp is removed; PATH is untouched).
+ * Return: IRDM_OK; IRDM_EIO if any write (an earlier append's included),
+ * the flush, the sync, the close or the rename failed (the temporary is
+ * removed; PATH is untouched; err names PATH and the reason).
  */
 int irdm_log_file_close(struct irdm_log_file *lf, uint64_t dropped, char *err, size_t errlen);
 
-/* Close and remove PATH.tmp (PATH is untouched); frees lf.  NULL is fine. */
+/* Close and remove the temporary (PATH is untouched); frees lf.  NULL is fine. */
 void irdm_log_file_abort(struct irdm_log_file *lf);
 
 /* Records appended so far. */
@@ -368,22 +404,27 @@ uint64_t irdm_log_writer_count(const struct irdm_log_writer *w);
 struct irdm_log_reader;
 
 /*
- * Open a log and validate it whole before the first record: magic,
- * version, header and record size, n_devices, the strings, and that the
- * file holds exactly record_count records.  Init-time (allocates).
+ * Open a log and validate its frame before the first record: magic,
+ * version, the header's checksum and fields, the strings, that the file's
+ * length is that of record_count records in their blocks with the
+ * trailer, and the trailer.  Each block's checksum is checked as
+ * irdm_log_next() reaches it, before any of its records is returned: a
+ * consumer that commits nothing before the last record (irdm log export,
+ * irdm replay --log) never uses a damaged log.  Init-time (allocates).
  *
  * Return: IRDM_OK;
  * IRDM_EINVAL if an argument is NULL;
  * IRDM_ENOMEM if out of memory;
- * IRDM_EIO if the file cannot be opened or read;
+ * IRDM_EIO if the file cannot be opened or read, or is not a regular file;
  * IRDM_EMAGIC if it is not an IRDM log;
  * IRDM_EVERSION if its version is not IRDM_LOG_VERSION;
- * IRDM_EFORMAT if a header field is invalid (sizes, n_devices, strings)
- * or bytes follow the last record;
- * IRDM_ETRUNC if it is shorter than its header, holds fewer records than
- * it says (a partial last record included), or was never closed.
- * On error *r is NULL and err says why (e.g. "truncated: the header says
- * 1000 records, the file holds 999 and 120 bytes of the next").
+ * IRDM_ECRC if the header's or the trailer's checksum is wrong;
+ * IRDM_EFORMAT if a header field is invalid (sizes, n_devices, strings),
+ * the trailer disagrees with the header, or bytes follow the trailer;
+ * IRDM_ETRUNC if it is shorter than its header, was never closed, or ends
+ * early (err names the block it ends in: "truncated: ends in block 3 of
+ * 5 (records 768..1023)").
+ * On error *r is NULL and err says why.
  */
 int irdm_log_open(struct irdm_log_reader **r, const char *path, char *err, size_t errlen);
 
@@ -394,6 +435,9 @@ const struct irdm_log_header *irdm_log_header(const struct irdm_log_reader *r);
  *
  * Return: 1 if *rec holds the next record; 0 at the end (after
  * record_count records);
+ * IRDM_ECRC if the record's block fails its checksum, IRDM_EFORMAT if its
+ * block end is not the one expected (err: "block 2 (records 512..767):
+ * ...");
  * IRDM_EIO if the read failed or the file shrank since it was opened;
  * IRDM_EFORMAT if the record's n_devices is over IRDM_TELEM_MAX_DEVICES
  * (err says why).
