@@ -1,8 +1,13 @@
 /* SPDX-License-Identifier: MIT */
 /*
  * Contact detection on the deformed surface: closest point query over the
- * image's CONTACT_BVH and a frictionless god-object.  Runs in the force
- * loop: no allocation, no system call, no recursion, bounded work.
+ * image's CONTACT_BVH and a frictionless god-object: the constraint-plane
+ * god-object of Zilles and Salisbury (1995), kept local as Ruspini et al.'s
+ * virtual proxy is (a walk over the touchable triangles; the faces beyond
+ * convex edges and beyond the touchable area's rim end the contact, a
+ * concave edge holds the proxy; docs/architecture.md).  Runs in the force
+ * loop: no allocation, no system call, no recursion, bounded work (a rim
+ * neighbour's search is one pass over the surface's triangles).
  *
  * The BVH boxes bound the REST surface; the surface the device touches is
  * rest + u.  With |u| <= max_disp_m for every node, a box grown by
@@ -26,6 +31,9 @@ _Static_assert(IRDM_CONTACT_STACK > IRDM_BVH_MAX_DEPTH, "stack holds a root-leaf
 #define FAR_SLACK 1e-9
 /* sin^2 of the smallest angle of a triangle that still has a normal */
 #define DEGENERATE_SIN2 1e-24
+/* A barycentric within this of zero puts a point on the edge (rounding of
+ * the projection of a point on a shared edge is a few ulps either way). */
+#define ON_EDGE 1e-12
 
 static void disp_of(const struct irdm_contact_disp *d, uint32_t row, double u[3])
 {
@@ -405,7 +413,7 @@ static uint32_t next_tri(const struct irdm_contact_mesh *cm, uint32_t t, const d
 				order[j] = order[j + 1];
 				order[j + 1] = x;
 			}
-	for (unsigned k = 0; k < 3 && lam[order[k]] < 0; k++) {
+	for (unsigned k = 0; k < 3 && lam[order[k]] < -ON_EDGE; k++) {
 		uint32_t u = cm->adj[3 * (size_t)t + (order[k] + 1) % 3];
 
 		if (u != IRDM_BVH_NONE && u != from)
@@ -414,41 +422,215 @@ static uint32_t next_tri(const struct irdm_contact_mesh *cm, uint32_t t, const d
 	return IRDM_BVH_NONE;
 }
 
+static bool inside_tri(const double *lam)
+{
+	return lam[0] >= -ON_EDGE && lam[1] >= -ON_EDGE && lam[2] >= -ON_EDGE;
+}
+
+/*
+ * The SURFACE triangle other than t on edge e of t, touchable or not (the
+ * CONTACT_BVH's adjacency knows only touchable ones): on the touchable
+ * area's rim, a search of the surface, remembered in the proxy for the
+ * edges of its triangle, so a slide along the rim searches once per rim
+ * triangle.  IRDM_BVH_NONE for an edge of an open surface.
+ */
+static uint32_t face_beyond(const struct irdm_contact_mesh *cm, struct irdm_proxy *px,
+			    uint32_t t, unsigned e)
+{
+	const uint32_t *v = &cm->tris[3 * (size_t)t];
+	uint32_t a = v[e], b = v[(e + 1) % 3], u = cm->adj[3 * (size_t)t + e];
+
+	if (u != IRDM_BVH_NONE)
+		return u;
+	if (px->rim_tri != t) {
+		px->rim_tri = t;
+		px->rim_known = 0;
+	}
+	if (px->rim_known & (1u << e))
+		return px->rim_face[e];
+	for (u = 0; u < cm->n_tris; u++) {
+		const uint32_t *w = &cm->tris[3 * (size_t)u];
+		bool has_a = w[0] == a || w[1] == a || w[2] == a;
+		bool has_b = w[0] == b || w[1] == b || w[2] == b;
+
+		if (u != t && has_a && has_b)
+			break;
+	}
+	px->rim_known |= (uint8_t)(1u << e);
+	px->rim_face[e] = u < cm->n_tris ? u : IRDM_BVH_NONE;
+	return px->rim_face[e];
+}
+
+/*
+ * Outward normal of the face beyond edge e of t (vertices v, normal n):
+ * the neighbour's, or for an edge of an open surface a wall standing on
+ * the edge at right angles to t.  False for a degenerate neighbour.
+ */
+static bool normal_beyond(const struct irdm_contact_mesh *cm, const struct irdm_contact_disp *d,
+			  struct irdm_proxy *px, uint32_t t, unsigned e, const double v[3][3],
+			  const double *n, double *nu)
+{
+	uint32_t u = face_beyond(cm, px, t, e);
+	double w[3][3], ed[3], len;
+
+	if (u != IRDM_BVH_NONE) {
+		irdm_contact_tri_pos(cm, d, u, w);
+		return tri_normal(w, nu);
+	}
+	irdm_v3_sub(ed, v[(e + 1) % 3], v[e]);
+	irdm_v3_cross(nu, ed, n);       /* counter-clockwise: points away from t */
+	len = sqrt(irdm_v3_dot(nu, nu));
+	if (!(len > 0))
+		return false;
+	irdm_v3_scale(nu, 1 / len, nu);
+	return true;
+}
+
+/*
+ * Whether p, behind the plane of t, is outside the object by the face
+ * beyond one of t's edges: the edges p projects beyond (where the walk
+ * stopped), and the edges on the touchable area's rim, whose faces
+ * beyond are display-only and would otherwise never be looked at.  The
+ * constraint planes of the god-object (Zilles and Salisbury 1995): at a
+ * convex edge the object is the intersection of the two faces'
+ * half-spaces, so p in front of the neighbour's plane is outside and the
+ * contact ends; at a concave edge it is their union, and p behind t is
+ * inside: the proxy stays on t, or on the edge where both planes
+ * constrain it.
+ */
+static bool outside_beyond(const struct irdm_contact_mesh *cm, const struct irdm_contact_disp *d,
+			   struct irdm_proxy *px, uint32_t t, const double v[3][3],
+			   const double *n, const double *lam, const double *p)
+{
+	for (unsigned e = 0; e < 3; e++) {
+		unsigned opp = (e + 2) % 3;
+		bool rim = cm->adj[3 * (size_t)t + e] == IRDM_BVH_NONE;
+		double nu[3], to_opp[3], to_p[3];
+
+		if ((!rim && !(lam[opp] < -ON_EDGE)) || !normal_beyond(cm, d, px, t, e, v, n, nu))
+			continue;
+		irdm_v3_sub(to_opp, v[opp], v[e]);
+		irdm_v3_sub(to_p, p, v[e]);
+		if (irdm_v3_dot(nu, to_opp) <= 0 && irdm_v3_dot(nu, to_p) > 0)
+			return true;
+	}
+	return false;
+}
+
+/*
+ * The same point on a shared edge or vertex belongs to every triangle
+ * around it; the proxy takes the one of lowest index among those that
+ * hold p's projection, so the choice is a function of where p is, not of
+ * where the proxy came from (no hysteresis), and a stroke along an edge
+ * keeps one triangle, and so one engine site, as a stroke inside a
+ * triangle does.  Each step goes to a lower index: bounded.
+ */
+static uint32_t lowest_holder(const struct irdm_contact_mesh *cm,
+			      const struct irdm_contact_disp *d, uint32_t t, double v[3][3],
+			      double *lam, const double *p)
+{
+	for (unsigned pass = 0; pass < IRDM_CONTACT_MAX_WALK; pass++) {
+		uint32_t best = t;
+		double bv[3][3], bl[3];
+
+		for (unsigned i = 0; i < 3; i++) {
+			uint32_t u = cm->adj[3 * (size_t)t + (i + 1) % 3];
+			double w[3][3], l[3];
+
+			if (!(lam[i] <= ON_EDGE) || u == IRDM_BVH_NONE || u >= best)
+				continue;
+			irdm_contact_tri_pos(cm, d, u, w);
+			if (!plane_bary(w, p, l) || !inside_tri(l))
+				continue;
+			best = u;
+			memcpy(bv, w, sizeof(w));
+			memcpy(bl, l, sizeof(l));
+		}
+		if (best == t)
+			break;
+		t = best;
+		memcpy(v, bv, sizeof(bv));
+		memcpy(lam, bl, sizeof(bl));
+	}
+	return t;
+}
+
 static int proxy_release(struct irdm_proxy *px, int ret)
 {
 	px->active = false;
 	return ret;
 }
 
+/* Fill the proxy from its triangle t (vertices v) and weights lam. */
+static void proxy_set(struct irdm_proxy *px, uint32_t t, const double v[3][3], const double *lam,
+		      const double *p, unsigned steps)
+{
+	double n[3], pq[3];
+
+	tri_normal(v, n);
+	px->tri = t;
+	memcpy(px->bary, lam, sizeof(px->bary));
+	irdm_v3_bary(px->point_m, lam, v[0], v[1], v[2]);
+	memcpy(px->normal, n, sizeof(n));
+	irdm_v3_sub(pq, p, px->point_m);
+	px->depth_m = irdm_v3_dot(pq, n);
+	px->steps = steps;
+}
+
+/*
+ * A new contact: the device has crossed the surface at the closest point,
+ * unless it is outside the object by a face beyond the hit triangle's
+ * edges (beside an edge of the touchable area, where the closest
+ * touchable point is on the rim and its sign says nothing).
+ */
+static int proxy_touch(struct irdm_proxy *px, const struct irdm_contact_mesh *cm,
+		       const struct irdm_contact_disp *d, const struct irdm_proxy_config *cfg,
+		       const double p[3])
+{
+	struct irdm_contact_hit hit;
+	double v[3][3], lam[3], n[3];
+	uint32_t t;
+	int r = irdm_contact_closest(cm, d, cfg->max_disp_m, p, cfg->radius_m, &hit);
+
+	if (r < 0)
+		return r;
+	if (r == 0 || hit.dist_m > 0)
+		return IRDM_PROXY_FREE;
+	t = hit.tri;
+	irdm_contact_tri_pos(cm, d, t, v);
+	if (!plane_bary(v, p, lam) || !tri_normal(v, n))
+		return IRDM_PROXY_FREE;
+	if (outside_beyond(cm, d, px, t, v, n, lam, p))
+		return IRDM_PROXY_FREE;
+	px->active = true;
+	if (inside_tri(lam) && (t = lowest_holder(cm, d, t, v, lam, p)) != hit.tri) {
+		proxy_set(px, t, v, lam, p, 0);
+		return IRDM_PROXY_TOUCH;
+	}
+	px->tri = t;    /* as the query found it */
+	memcpy(px->bary, hit.bary, sizeof(px->bary));
+	memcpy(px->point_m, hit.point_m, sizeof(px->point_m));
+	memcpy(px->normal, hit.normal, sizeof(px->normal));
+	px->depth_m = hit.dist_m;
+	px->steps = 0;
+	return IRDM_PROXY_TOUCH;
+}
+
 int irdm_proxy_update(struct irdm_proxy *px, const struct irdm_contact_mesh *cm,
 		      const struct irdm_contact_disp *d, const struct irdm_proxy_config *cfg,
 		      const double p[3])
 {
-	double v[3][3], lam[3], n[3], pq[3];
+	double v[3][3], lam[3], n[3], q[3];
 	uint32_t t, from = IRDM_BVH_NONE;
 	unsigned steps = 0, max_walk;
+	bool outside = false;
 
 	if (!px || !cm || !cm->hdr || !cfg || !p)
 		return IRDM_EINVAL;
 	if (!irdm_v3_finite(p))
 		return proxy_release(px, IRDM_EINVAL);
-	if (!px->active) {
-		struct irdm_contact_hit hit;
-		int r = irdm_contact_closest(cm, d, cfg->max_disp_m, p, cfg->radius_m, &hit);
-
-		if (r < 0)
-			return r;
-		if (r == 0 || hit.dist_m > 0)
-			return IRDM_PROXY_FREE;
-		px->active = true;
-		px->tri = hit.tri;
-		memcpy(px->bary, hit.bary, sizeof(px->bary));
-		memcpy(px->point_m, hit.point_m, sizeof(px->point_m));
-		memcpy(px->normal, hit.normal, sizeof(px->normal));
-		px->depth_m = hit.dist_m;
-		px->steps = 0;
-		return IRDM_PROXY_TOUCH;
-	}
+	if (!px->active)
+		return proxy_touch(px, cm, d, cfg, p);
 	t = px->tri;
 	if (t >= cm->n_tris || !irdm_contact_tri_contactable(cm, t))
 		return proxy_release(px, IRDM_EINVAL);
@@ -459,26 +641,25 @@ int irdm_proxy_update(struct irdm_proxy *px, const struct irdm_contact_mesh *cm,
 		irdm_contact_tri_pos(cm, d, t, v);
 		if (!plane_bary(v, p, lam))     /* crushed flat: detect afresh */
 			return proxy_release(px, IRDM_PROXY_RELEASE);
-		if (lam[0] >= 0 && lam[1] >= 0 && lam[2] >= 0)
+		if (inside_tri(lam)) {
+			t = lowest_holder(cm, d, t, v, lam, p);
+			tri_normal(v, n);
+			outside = outside_beyond(cm, d, px, t, v, n, lam, p);
 			break;
+		}
 		u = steps < max_walk ? next_tri(cm, t, lam, from) : IRDM_BVH_NONE;
 		if (u == IRDM_BVH_NONE) {       /* boundary, crease or walked enough */
-			irdm_contact_closest_on_tri(v[0], v[1], v[2], p, lam, pq);
+			tri_normal(v, n);
+			outside = outside_beyond(cm, d, px, t, v, n, lam, p);
+			irdm_contact_closest_on_tri(v[0], v[1], v[2], p, lam, q);
 			break;
 		}
 		from = t;
 		t = u;
 		steps++;
 	}
-	tri_normal(v, n);
-	px->tri = t;
-	memcpy(px->bary, lam, sizeof(lam));
-	irdm_v3_bary(px->point_m, lam, v[0], v[1], v[2]);
-	memcpy(px->normal, n, sizeof(n));
-	irdm_v3_sub(pq, p, px->point_m);
-	px->depth_m = irdm_v3_dot(pq, n);
-	px->steps = steps;
-	if (px->depth_m > 0)
+	proxy_set(px, t, v, lam, p, steps);
+	if (outside || px->depth_m > 0)
 		return proxy_release(px, IRDM_PROXY_RELEASE);
 	return IRDM_PROXY_SLIDE;
 }

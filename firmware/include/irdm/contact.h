@@ -134,6 +134,11 @@ struct irdm_proxy {
 	double depth_m;                 /* signed distance of the device from that
 					 * plane (<= 0 while in contact) */
 	unsigned steps;                 /* edge crossings taken by the last update */
+	/* faces beyond the edges of rim_tri on the touchable area's rim,
+	 * found by a search (a memo: bit e of rim_known says rim_face[e]) */
+	uint32_t rim_tri;
+	uint32_t rim_face[3];
+	uint8_t rim_known;
 };
 
 enum irdm_proxy_event {
@@ -149,13 +154,17 @@ void irdm_proxy_reset(struct irdm_proxy *px);
 /*
  * One update with the device at p (object frame).  Inactive: when the
  * closest point within radius_m has signed distance <= 0 (the device has
- * crossed the surface) the proxy starts there.  Active: the device is
- * projected on the plane of the proxy's displaced triangle; while the
- * projection leaves the triangle the proxy walks to the neighbour across
- * the edge it left by (at most max_walk steps); at a boundary of the
- * contactable region (or a concave crease) it stops at the closest point
- * of its triangle.  The contact ends when the device is outside the plane
- * of the proxy's triangle (depth > 0).
+ * crossed the surface) and the device is not outside the object by a face
+ * beyond that triangle's edges, the proxy starts there.  Active: the
+ * device is projected on the plane of the proxy's displaced triangle;
+ * while the projection leaves the triangle the proxy walks to the
+ * neighbour across the edge it left by (at most max_walk steps); at a
+ * boundary of the touchable region (or a concave crease) it stops at the
+ * closest point of its triangle.  On a shared edge or vertex the triangle
+ * of lowest index that holds the projection is taken.  The contact ends
+ * when the device is outside the plane of the proxy's triangle (depth >
+ * 0), or in front of the face beyond a convex edge it projects past or
+ * beyond an edge of the touchable area's rim (that face touchable or not).
  *
  * Return: an enum irdm_proxy_event (>= 0);
  * IRDM_EINVAL if px, cm (or its BVH), cfg or p is NULL (px untouched), if
