@@ -937,6 +937,92 @@ static void test_proxy_rim_faces(void **state)
 	free(uh);
 }
 
+static int upd_mu(struct irdm_proxy *px, const struct box_image *b, double mu_s, double mu_d,
+		  const double *p)
+{
+	struct irdm_proxy_config cfg;
+
+	irdm_proxy_config_default(&cfg);
+	cfg.max_disp_m = 0.01;
+	cfg.mu_s = mu_s;
+	cfg.mu_d = mu_d;
+	return irdm_proxy_update(px, &b->cm, NULL, &cfg, p);
+}
+
+/* The coupling's spring energy / k: 0.5 |p - proxy|^2. */
+static double spring(const double *p, const double *proxy)
+{
+	double d = dist3(p, proxy);
+
+	return 0.5 * d * d;
+}
+
+/*
+ * Coulomb friction against the analytic stick/slip threshold on the flat
+ * top.  The device pressed 2 mm in is drawn along x in 1 um steps, then
+ * back: with the coupling a spring k (device - proxy), the force on the
+ * device is k (proxy - device), normal part k dn, tangential k |q - proxy|
+ * (q the device's projection).  The proxy sticks (its point does not
+ * move) until the tangential force reaches mu_s k dn: the largest ratio
+ * while stuck is mu_s to within one step (1 um of 1 mm: 0.1 %, asserted
+ * 1 %); after each slip the ratio is mu_d (the cone's rim); drawn back, it
+ * sticks again until the force has turned round to mu_s the other way
+ * (mu_d < mu_s: stick-slip, a slip each (mu_s - mu_d) dn of travel).
+ * Dissipation: no update ever raises the spring's energy at the device's
+ * new position (the proxy's move only takes energy out).
+ */
+static void test_proxy_friction(void **state)
+{
+	const struct box_image *b = &boxes[IMG_ALL];
+	const double top = b->hi[2], mu_s = 0.5, mu_d = 0.4, dn = 0.002, step = 1e-6;
+	double p[3] = { 0.5 * (b->lo[0] + b->hi[0]) - 0.02, 0.5 * (b->lo[1] + b->hi[1]) + 0.003,
+			top - dn };
+	double stuck_max = 0, back_max = 0, rim_err = 0, worst_gain = -INFINITY;
+	unsigned slips = 0, back_slips = 0;
+	struct irdm_proxy px;
+
+	(void)state;
+	irdm_proxy_reset(&px);
+	assert_int_equal(upd_mu(&px, b, mu_s, mu_d, p), IRDM_PROXY_TOUCH);
+	for (int k = 0; k < 6000; k++) {
+		double before[3], ratio;
+		bool back = k >= 3000;
+
+		memcpy(before, px.point_m, sizeof(before));
+		p[0] += back ? -step : step;
+		double e_old = spring(p, before);
+
+		assert_int_equal(upd_mu(&px, b, mu_s, mu_d, p), IRDM_PROXY_SLIDE);
+		assert_true(fabs(px.point_m[2] - top) < 1e-12);
+		assert_true(fabs(px.depth_m + dn) < 1e-12);
+		worst_gain = fmax(worst_gain, spring(p, px.point_m) - e_old);
+		ratio = hypot(p[0] - px.point_m[0], p[1] - px.point_m[1]) / dn;
+		if (dist3(before, px.point_m) == 0) {   /* stuck */
+			if (back)
+				back_max = back_slips ? back_max : fmax(back_max, ratio);
+			else
+				stuck_max = slips ? stuck_max : fmax(stuck_max, ratio);
+			assert_true(ratio <= mu_s * (1 + 1e-12));
+			continue;
+		}
+		rim_err = fmax(rim_err, fabs(ratio - mu_d));
+		slips += !back;
+		back_slips += back;
+	}
+	print_message("friction: stuck up to F_t / F_n = %.5f (mu_s %.2f), back %.5f; on the rim "
+		      "|ratio - mu_d| <= %.1e; %u + %u slips; largest energy gain %.1e (k = 1)\n",
+		      stuck_max, mu_s, back_max, rim_err, slips, back_slips, worst_gain);
+	assert_true(slips >= 5 && back_slips >= 5);     /* stick-slip: every 0.2 mm */
+	assert_true(fabs(stuck_max - mu_s) <= 0.01 * mu_s);
+	assert_true(fabs(back_max - mu_s) <= 0.01 * mu_s);
+	assert_true(rim_err <= 1e-9);
+	assert_true(worst_gain <= 1e-18);
+	/* frictionless (mu_s = 0): the proxy is the projection again */
+	p[0] += 0.001;
+	assert_int_equal(upd_mu(&px, b, 0, 0, p), IRDM_PROXY_SLIDE);
+	assert_true(fabs(px.point_m[0] - p[0]) < 1e-12);
+}
+
 /* The surface moved: contact is detected on the displaced surface, and the
  * engine's site carries the rest point with the same barycentrics. */
 static void test_proxy_displaced_site(void **state)
@@ -1278,6 +1364,7 @@ int main(void)
 		cmocka_unit_test(test_proxy_shared_edge),
 		cmocka_unit_test(test_proxy_creases),
 		cmocka_unit_test(test_proxy_rim_faces),
+		cmocka_unit_test(test_proxy_friction),
 		cmocka_unit_test(test_proxy_displaced_site),
 		cmocka_unit_test(test_loader_rejects),
 		cmocka_unit_test(test_fixture_images),

@@ -364,6 +364,8 @@ void irdm_proxy_config_default(struct irdm_proxy_config *cfg)
 	cfg->radius_m = 0.01;
 	cfg->max_disp_m = 0.05;
 	cfg->max_walk = 16;
+	cfg->mu_s = 0;
+	cfg->mu_d = 0;
 }
 
 void irdm_proxy_reset(struct irdm_proxy *px)
@@ -616,14 +618,107 @@ static int proxy_touch(struct irdm_proxy *px, const struct irdm_contact_mesh *cm
 	return IRDM_PROXY_TOUCH;
 }
 
+/*
+ * The projection of p on the displaced surface, walking from triangle t:
+ * the triangle, its vertices and p's weights on it (clamped to the
+ * max_walk steps: lam as the plane gives it, q not set).  Return: 1
+ * inside a triangle (q the point), 0 stopped at an edge, -1 a triangle
+ * crushed flat.
+ */
+static int walk(const struct irdm_contact_mesh *cm, const struct irdm_contact_disp *d,
+		unsigned max_walk, const double *p, uint32_t *tp, double v[3][3], double *lam,
+		double *q, unsigned *steps)
+{
+	uint32_t t = *tp, from = IRDM_BVH_NONE;
+
+	*steps = 0;
+	for (;;) {
+		uint32_t u;
+
+		irdm_contact_tri_pos(cm, d, t, v);
+		if (!plane_bary(v, p, lam))
+			return -1;
+		if (inside_tri(lam)) {
+			*tp = lowest_holder(cm, d, t, v, lam, p);
+			irdm_v3_bary(q, lam, v[0], v[1], v[2]);
+			return 1;
+		}
+		u = *steps < max_walk ? next_tri(cm, t, lam, from) : IRDM_BVH_NONE;
+		if (u == IRDM_BVH_NONE) {
+			*tp = t;
+			return 0;
+		}
+		from = t;
+		t = u;
+		(*steps)++;
+	}
+}
+
+/*
+ * Coulomb friction on the proxy: the friction cone of the god-object
+ * (Salisbury et al. 1995; Harwin and Melder 2002).  The proxy is a point
+ * of the surface (triangle and weights: it moves with the surface); the
+ * frictionless proxy q is the device's projection, depth dn behind the
+ * surface.  With the coupling a spring between the device and the proxy,
+ * the tangential force over the normal one is |q - proxy| / dn: while it
+ * is within mu_s the proxy sticks; beyond, it slides toward q until the
+ * ratio is mu_d, on the cone's rim.  The proxy only ever moves toward q,
+ * which shortens the spring: it never gives the device energy (passive by
+ * construction); what the move takes out of the spring is what friction
+ * dissipates.  Return: 0; -1 if the slid-to point cannot be placed.
+ */
+static int friction(struct irdm_proxy *px, const struct irdm_contact_mesh *cm,
+		    const struct irdm_contact_disp *d, const struct irdm_proxy_config *cfg,
+		    unsigned max_walk, uint32_t anchor_tri, const double *anchor_bary,
+		    double depth)
+{
+	double v[3][3], a[3], tv[3], lam[3], q[3], c[3], tl, dn = -depth;
+	uint32_t t;
+	unsigned steps;
+
+	irdm_contact_tri_pos(cm, d, anchor_tri, v);
+	irdm_v3_bary(a, anchor_bary, v[0], v[1], v[2]);
+	irdm_v3_sub(tv, px->point_m, a);
+	tl = sqrt(irdm_v3_dot(tv, tv));
+	if (tl <= cfg->mu_s * dn) {             /* stick */
+		px->tri = anchor_tri;
+		memcpy(px->bary, anchor_bary, sizeof(px->bary));
+		memcpy(px->point_m, a, sizeof(a));
+		tri_normal(v, px->normal);
+		return 0;
+	}
+	/* slide to the rim: c = q - mu_d dn (q - a) / |q - a| */
+	irdm_v3_scale(c, cfg->mu_d * dn / tl, tv);
+	irdm_v3_sub(c, px->point_m, c);
+	t = px->tri;
+	switch (walk(cm, d, max_walk, c, &t, v, lam, q, &steps)) {
+	case -1:
+		return -1;
+	case 0:
+		irdm_contact_closest_on_tri(v[0], v[1], v[2], c, lam, q);
+		break;
+	}
+	px->tri = t;
+	memcpy(px->bary, lam, sizeof(lam));
+	memcpy(px->point_m, q, sizeof(q));
+	tri_normal(v, px->normal);
+	return 0;
+}
+
+static bool friction_on(const struct irdm_proxy_config *cfg)
+{
+	return cfg->mu_s > 0;
+}
+
 int irdm_proxy_update(struct irdm_proxy *px, const struct irdm_contact_mesh *cm,
 		      const struct irdm_contact_disp *d, const struct irdm_proxy_config *cfg,
 		      const double p[3])
 {
-	double v[3][3], lam[3], n[3], q[3];
-	uint32_t t, from = IRDM_BVH_NONE;
-	unsigned steps = 0, max_walk;
-	bool outside = false;
+	double v[3][3], lam[3], n[3], q[3], anchor_bary[3];
+	uint32_t t, anchor_tri;
+	unsigned steps, max_walk;
+	bool outside;
+	int in;
 
 	if (!px || !cm || !cm->hdr || !cfg || !p)
 		return IRDM_EINVAL;
@@ -631,35 +726,23 @@ int irdm_proxy_update(struct irdm_proxy *px, const struct irdm_contact_mesh *cm,
 		return proxy_release(px, IRDM_EINVAL);
 	if (!px->active)
 		return proxy_touch(px, cm, d, cfg, p);
-	t = px->tri;
+	t = anchor_tri = px->tri;
+	memcpy(anchor_bary, px->bary, sizeof(anchor_bary));
 	if (t >= cm->n_tris || !irdm_contact_tri_contactable(cm, t))
 		return proxy_release(px, IRDM_EINVAL);
 	max_walk = cfg->max_walk < IRDM_CONTACT_MAX_WALK ? cfg->max_walk : IRDM_CONTACT_MAX_WALK;
-	for (;;) {
-		uint32_t u;
-
-		irdm_contact_tri_pos(cm, d, t, v);
-		if (!plane_bary(v, p, lam))     /* crushed flat: detect afresh */
-			return proxy_release(px, IRDM_PROXY_RELEASE);
-		if (inside_tri(lam)) {
-			t = lowest_holder(cm, d, t, v, lam, p);
-			tri_normal(v, n);
-			outside = outside_beyond(cm, d, px, t, v, n, lam, p);
-			break;
-		}
-		u = steps < max_walk ? next_tri(cm, t, lam, from) : IRDM_BVH_NONE;
-		if (u == IRDM_BVH_NONE) {       /* boundary, crease or walked enough */
-			tri_normal(v, n);
-			outside = outside_beyond(cm, d, px, t, v, n, lam, p);
-			irdm_contact_closest_on_tri(v[0], v[1], v[2], p, lam, q);
-			break;
-		}
-		from = t;
-		t = u;
-		steps++;
-	}
+	in = walk(cm, d, max_walk, p, &t, v, lam, q, &steps);
+	if (in < 0)                     /* crushed flat: detect afresh */
+		return proxy_release(px, IRDM_PROXY_RELEASE);
+	tri_normal(v, n);
+	outside = outside_beyond(cm, d, px, t, v, n, lam, p);
+	if (!in)
+		irdm_contact_closest_on_tri(v[0], v[1], v[2], p, lam, q);
 	proxy_set(px, t, v, lam, p, steps);
 	if (outside || px->depth_m > 0)
+		return proxy_release(px, IRDM_PROXY_RELEASE);
+	if (friction_on(cfg) &&
+	    friction(px, cm, d, cfg, max_walk, anchor_tri, anchor_bary, px->depth_m))
 		return proxy_release(px, IRDM_PROXY_RELEASE);
 	return IRDM_PROXY_SLIDE;
 }

@@ -121,6 +121,9 @@ struct irdm_proxy_config {
 	double radius_m;                /* detection radius of the closest point query */
 	double max_disp_m;              /* bound on |u| (see irdm_contact_closest) */
 	unsigned max_walk;              /* edge crossings per update, 1..IRDM_CONTACT_MAX_WALK */
+	/* Coulomb friction: static and dynamic coefficients, 0 <= mu_d <=
+	 * mu_s; mu_s = 0: frictionless (the default) */
+	double mu_s, mu_d;
 };
 
 /* State of one proxy: zero it (or irdm_proxy_reset) to start inactive. */
