@@ -93,6 +93,10 @@ static void trace_tick(struct fw *fw, const struct irdm_ctrl_output *out)
 	if (fw->watching)
 		irdm_engine_node_disp(fw->s->eng, fw->watch_row, u);
 	t->force_n[k] = irdm_v3_norm(d->force_obj_n);
+	if (out->state == IRDM_SAFETY_ENABLED && t->force_n[k] * d->scale > fw->rendered_peak_n) {
+		fw->rendered_peak_n = t->force_n[k] * d->scale;
+		fw->rendered_peak_tick = k;
+	}
 	t->node_u_m[k] = irdm_v3_dot(u, fw->watch_normal);
 	t->contact[k] = d->contact;
 	t->n++;
