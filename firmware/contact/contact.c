@@ -111,6 +111,17 @@ static bool tri_normal(const double v[3][3], double n[3])
 	return true;
 }
 
+bool irdm_contact_tri_normal(const struct irdm_contact_mesh *cm, const struct irdm_contact_disp *d,
+			     uint32_t t, double n[3])
+{
+	double v[3][3];
+
+	if (t >= cm->n_tris)
+		return false;
+	irdm_contact_tri_pos(cm, d, t, v);
+	return tri_normal(v, n);
+}
+
 /* Closest point on segment ab: parameter t of a + t (b - a). */
 static double seg_param(const double *a, const double *b, const double *p)
 {

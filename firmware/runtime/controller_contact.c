@@ -87,6 +87,7 @@ static int touch(struct irdm_ctrl *c, unsigned i, const struct irdm_proxy_config
 	struct irdm_ctrl_dev *d = &c->dev[i];
 	struct irdm_contact_site site;
 	double tip_own_m[3];
+	bool fresh;
 	int ev;
 
 	/* the proxy on the object as it is now: a floating one has moved */
@@ -98,11 +99,15 @@ static int touch(struct irdm_ctrl *c, unsigned i, const struct irdm_proxy_config
 	if (ev != IRDM_PROXY_TOUCH && ev != IRDM_PROXY_SLIDE)
 		return IRDM_OK;         /* FREE, or RELEASE: the command stays OFF */
 	proxy_out(c, &d->px, o);
+	fresh = irdm_engine_contact(c->s->eng, i)->mode == IRDM_CONTACT_OFF;
 	if (irdm_proxy_site(&d->px, &c->cm, &site) ||
 	    irdm_engine_contact_begin(c->s->eng, i, &site, IRDM_CONTACT_PUSH))
 		return IRDM_EFAULT;
-	if (ev == IRDM_PROXY_TOUCH && began_inside(c, &d->px) &&
-	    irdm_engine_contact_soften(c->s->eng, i))
+	/* a contact the engine starts afresh: a touch, or a slide whose
+	 * contact the push release ended (a soft start's first force is zero
+	 * to rounding, and may be taken for a pull) */
+	o->softened = fresh && began_inside(c, &d->px);
+	if (o->softened && irdm_engine_contact_soften(c->s->eng, i))
 		return IRDM_EFAULT;
 	d->cmd.mode = IRDM_CONTACT_PUSH;
 	irdm_v3_sub(d->cmd.target_m, o->tip_obj_m, site.rest_m);

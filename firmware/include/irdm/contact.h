@@ -91,6 +91,14 @@ void irdm_contact_tri_pos(const struct irdm_contact_mesh *cm, const struct irdm_
 			  uint32_t t, double v[3][3]);
 
 /*
+ * Outward unit normal of SURFACE triangle t displaced by d, computed as the
+ * proxy computes its own (irdm_proxy_site()'s normal), so a replay can
+ * hand the engine the same one.  False for a zero-area triangle.
+ */
+bool irdm_contact_tri_normal(const struct irdm_contact_mesh *cm, const struct irdm_contact_disp *d,
+			     uint32_t t, double n[3]);
+
+/*
  * Closest point to p on triangle (a, b, c) (Ericson, Real-Time Collision
  * Detection 5.1.5): writes the point q and the barycentric weights of
  * a, b, c; returns |p - q|^2.  Works for degenerate triangles too.
