@@ -22,7 +22,13 @@
  * the engine's target is the contact's displacement): the whole press run,
  * every tick in and out of contact, rebuilt from the log as per-tick sites
  * (the proxy slides across triangles) and targets, gives the same forces
- * (to 1e-12 of the peak; measured: identical).
+ * (to 1e-12 of the peak; measured: identical).  With the haptic coupling,
+ * irdm replay --log of every shipped script: identical too.
+ *
+ * And what the hand feels at boundaries and with two hands: the edge and
+ * corner slides end their contact past the sides and never pull; when one
+ * hand of the pinch-twist lets go, the other's force steps stay within
+ * what its motion explains.
  * Needs IRDM and IRDM_FW (make test sets them); runs from the repository root.
  */
 #define _GNU_SOURCE
