@@ -568,9 +568,16 @@ static uint32_t lowest_holder(const struct irdm_contact_mesh *cm,
 	return t;
 }
 
+void irdm_proxy_force(struct irdm_proxy *px, const double force_n[3])
+{
+	px->force_known = px->active && irdm_v3_finite(force_n);
+	memcpy(px->force_n, force_n, sizeof(px->force_n));
+}
+
 static int proxy_release(struct irdm_proxy *px, int ret)
 {
 	px->active = false;
+	px->force_known = false;
 	return ret;
 }
 
@@ -676,7 +683,9 @@ static int walk(const struct irdm_contact_mesh *cm, const struct irdm_contact_di
  * ratio is mu_d, on the cone's rim.  The proxy only ever moves toward q,
  * which shortens the spring: it never gives the device energy (passive by
  * construction); what the move takes out of the spring is what friction
- * dissipates.  Return: 0; -1 if the slid-to point cannot be placed.
+ * dissipates.  Given the force the contact made (irdm_proxy_force()), the
+ * same test is made on it: F_t / F_n in place of |q - proxy| / dn.
+ * Return: 0; -1 if the slid-to point cannot be placed.
  */
 static int friction(struct irdm_proxy *px, const struct irdm_contact_mesh *cm,
 		    const struct irdm_contact_disp *d, const struct irdm_proxy_config *cfg,
@@ -691,6 +700,17 @@ static int friction(struct irdm_proxy *px, const struct irdm_contact_mesh *cm,
 	irdm_v3_bary(a, anchor_bary, v[0], v[1], v[2]);
 	irdm_v3_sub(tv, px->point_m, a);
 	tl = sqrt(irdm_v3_dot(tv, tv));
+	if (px->force_known) {
+		/* the force itself: dn such that tl / dn = F_t / F_n, so the
+		 * test below is F_t <= mu_s F_n and a slip scales the offset
+		 * by mu_d F_n / F_t (none without a normal force) */
+		double fn = -irdm_v3_dot(px->force_n, px->normal), ft[3], ftl;
+
+		irdm_v3_scale(ft, fn, px->normal);
+		irdm_v3_add(ft, ft, px->force_n);
+		ftl = sqrt(irdm_v3_dot(ft, ft));
+		dn = !(fn > 0) ? 0 : ftl > 0 ? fn * tl / ftl : INFINITY;
+	}
 	if (tl <= cfg->mu_s * dn) {             /* stick */
 		px->tri = anchor_tri;
 		memcpy(px->bary, anchor_bary, sizeof(px->bary));

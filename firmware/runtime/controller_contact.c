@@ -115,6 +115,18 @@ static int touch(struct irdm_ctrl *c, unsigned i, const struct irdm_proxy_config
 	return IRDM_OK;
 }
 
+/* The engine's force, in the proxy's frame (a floating object's own), for
+ * friction's next judgement (irdm_proxy_force()). */
+static void proxy_force(const struct irdm_ctrl *c, struct irdm_proxy *px, const double f[3])
+{
+	double zero[3] = { 0, 0, 0 }, o[3], fo[3];
+
+	irdm_engine_world_to_object(c->s->eng, zero, o);
+	irdm_engine_world_to_object(c->s->eng, f, fo);
+	irdm_v3_sub(fo, fo, o);
+	irdm_proxy_force(px, fo);
+}
+
 void ctrl_contacts_end(struct irdm_ctrl *c)
 {
 	for (unsigned i = 0; i < c->cfg.n_devices; i++) {
@@ -147,6 +159,7 @@ int ctrl_contacts(struct irdm_ctrl *c, struct irdm_ctrl_output *out, bool on)
 
 		out->dev[i].contact = st->mode != IRDM_CONTACT_OFF;
 		memcpy(out->dev[i].force_obj_n, st->force_n, sizeof(st->force_n));
+		proxy_force(c, &c->dev[i].px, st->force_n);
 	}
 	return IRDM_OK;
 }

@@ -145,6 +145,11 @@ struct irdm_proxy {
 	double depth_m;                 /* signed distance of the device from that
 					 * plane (<= 0 while in contact) */
 	unsigned steps;                 /* edge crossings taken by the last update */
+	/* the force the coupling put on the object at the last update's
+	 * point, when the caller gave it (irdm_proxy_force()): friction's
+	 * cone is then judged on it */
+	bool force_known;
+	double force_n[3];
 	/* faces beyond the edges of rim_tri on the touchable area's rim,
 	 * found by a search (a memo: bit e of rim_known says rim_face[e]) */
 	uint32_t rim_tri;
@@ -186,6 +191,15 @@ void irdm_proxy_reset(struct irdm_proxy *px);
 int irdm_proxy_update(struct irdm_proxy *px, const struct irdm_contact_mesh *cm,
 		      const struct irdm_contact_disp *d, const struct irdm_proxy_config *cfg,
 		      const double p[3]);
+
+/*
+ * The force on the object (proxy's frame) that the contact at the last
+ * update's site gave: with friction, the next update judges the cone on
+ * it (the force the device renders, the coupling's damper and the
+ * object's compliance included) instead of on the coupling spring's
+ * geometry alone.  Forgotten when the proxy is released.
+ */
+void irdm_proxy_force(struct irdm_proxy *px, const double force_n[3]);
 
 /*
  * The engine's contact site of an active proxy: n_nodes 3, rows and
