@@ -457,6 +457,12 @@ static void test_bad_values(void **state)
 		{ "coupling = stiff", "t.board:5: coupling = stiff: expected auto | K,B" },
 		{ "coupling = -1,0", "t.board:5: coupling = -1,0: K: must be >= 0" },
 		{ "coupling = 100", "t.board:5: coupling = 100: expected auto | K,B" },
+		/* friction */
+		{ "friction = 0.5", "t.board:5: friction = 0.5: expected MU_S,MU_D" },
+		{ "friction = -0.1,0", "t.board:5: friction = -0.1,0: MU_S: must be >= 0" },
+		{ "friction = 0.4,0.5",
+		  "t.board:5: friction = 0.4,0.5: MU_D 0.5 is above MU_S 0.4: a sliding contact "
+		  "holds less than a stuck one" },
 		/* lines */
 		{ "l1_m 0.135", "t.board:5: expected 'key = value'" },
 	};

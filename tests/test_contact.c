@@ -27,7 +27,7 @@
 #include "precompute/precompute.h"
 #include "support/image_fixture.h"
 
-enum { IMG_ALL, IMG_TOP, IMG_COUNT };
+enum { IMG_ALL, IMG_TOP, IMG_HALF, IMG_COUNT };
 
 /* The test box: 10 x 10 x 20 cm, 2 x 2 x 4 hexes, bottom fixed. */
 struct box_image {
@@ -118,7 +118,8 @@ static int group_setup(void **state)
 	if (!mkdtemp(tmpdir))
 		return -1;
 	if (make_box(&boxes[IMG_ALL], "all", "surface") ||
-	    make_box(&boxes[IMG_TOP], "top", "z>=0.2"))
+	    make_box(&boxes[IMG_TOP], "top", "z>=0.2") ||
+	    make_box(&boxes[IMG_HALF], "half", "x<=0.05"))
 		return -1;
 	return 0;
 }
@@ -685,36 +686,341 @@ static void test_proxy_edges(void **state)
 	assert_true(xc + 0.0003 * k >= b->hi[0] || yc + 0.0003 * k >= b->hi[1]);
 }
 
-/* Only the top is touchable: past its rim the proxy holds at the rim. */
+/*
+ * Only the top is touchable, the sides are display-only: sliding off the
+ * top's rim below its plane, the tip is outside the object by the side's
+ * face: the contact ends at the first update past the side (no hold at
+ * the rim, which pulled the tool back) and no new contact begins there;
+ * over a corner the same; inside the rim the proxy follows the tip.
+ */
 static void test_proxy_boundary(void **state)
 {
 	const struct box_image *b = &boxes[IMG_TOP];
 	const double top = b->hi[2], xc = 0.5 * (b->lo[0] + b->hi[0]) + 0.002;
 	const double yc = 0.5 * (b->lo[1] + b->hi[1]) + 0.001;
 	struct irdm_proxy px;
+	int k;
 
 	(void)state;
 	irdm_proxy_reset(&px);
 	assert_int_equal(upd(&px, b, NULL, xc, yc, top - 0.002), IRDM_PROXY_TOUCH);
-	for (int k = 1; k <= 150; k++) {
+	for (k = 1; k <= 150; k++) {
 		double x = xc + 0.0005 * k;
+		int ev = upd(&px, b, NULL, x, yc, top - 0.002);
 
-		assert_int_equal(upd(&px, b, NULL, x, yc, top - 0.002), IRDM_PROXY_SLIDE);
-		assert_true(fabs(px.point_m[0] - fmin(x, b->hi[0])) < 1e-12);
-		assert_true(fabs(px.point_m[1] - yc) < 1e-12);
-		assert_true(fabs(px.point_m[2] - top) < 1e-12);
+		if (x <= b->hi[0]) {
+			assert_int_equal(ev, IRDM_PROXY_SLIDE);
+			assert_true(fabs(px.point_m[0] - x) < 1e-12);
+			assert_true(fabs(px.point_m[1] - yc) < 1e-12);
+			assert_true(fabs(px.point_m[2] - top) < 1e-12);
+			continue;
+		}
+		assert_int_equal(ev, IRDM_PROXY_RELEASE);
+		assert_false(px.active);
+		break;
 	}
-	/* a corner: clamped to the corner vertex */
+	assert_true(k <= 150);
+	/* outside, beside the rim and below the top: never touches */
+	for (k = 1; k <= 40; k++)
+		assert_int_equal(upd(&px, b, NULL, b->hi[0] + 0.0002 * k, yc, top - 0.0001 * k),
+				 IRDM_PROXY_FREE);
 	assert_int_equal(upd(&px, b, NULL, b->hi[0] + 0.05, b->hi[1] + 0.05, top - 0.002),
-			 IRDM_PROXY_SLIDE);
-	assert_true(fabs(px.point_m[0] - b->hi[0]) < 1e-12);
-	assert_true(fabs(px.point_m[1] - b->hi[1]) < 1e-12);
-	/* and back inside it follows again */
-	assert_int_equal(upd(&px, b, NULL, xc, yc, top - 0.002), IRDM_PROXY_SLIDE);
-	assert_true(fabs(px.point_m[0] - xc) < 1e-12 && fabs(px.point_m[1] - yc) < 1e-12);
+			 IRDM_PROXY_FREE);
+	/* back over the top from above, then diagonally off a corner */
+	assert_int_equal(upd(&px, b, NULL, xc, yc, top - 0.002), IRDM_PROXY_TOUCH);
+	for (k = 1; k < 400; k++) {
+		double x = xc + 0.0003 * k, y = yc + 0.0003 * k;
+		int ev = upd(&px, b, NULL, x, y, top - 0.002);
+
+		if (x <= b->hi[0] && y <= b->hi[1]) {
+			assert_int_equal(ev, IRDM_PROXY_SLIDE);
+			continue;
+		}
+		assert_int_equal(ev, IRDM_PROXY_RELEASE);
+		break;
+	}
+	assert_true(k < 400);
+	assert_int_equal(upd(&px, b, NULL, b->hi[0] + 0.001, b->hi[1] + 0.001, top - 0.002),
+			 IRDM_PROXY_FREE);
 	/* non-finite input releases */
+	assert_int_equal(upd(&px, b, NULL, xc, yc, top - 0.002), IRDM_PROXY_TOUCH);
 	assert_int_equal(upd(&px, b, NULL, NAN, yc, top), IRDM_EINVAL);
 	assert_false(px.active);
+}
+
+/* The two top triangles that share the edge of the top's grid at x = xe
+ * between y0 and y1, found by brute force: smaller index first. */
+static void edge_pair(const struct box_image *b, double xe, double y0, double y1, uint32_t *pair)
+{
+	unsigned n = 0;
+
+	for (uint32_t t = 0; t < b->cm.n_tris && n < 2; t++) {
+		const uint32_t *v = &b->img.tris[3 * t];
+		unsigned on = 0, top = 0;
+
+		for (unsigned k = 0; k < 3; k++) {
+			const float *x = b->img.nodes[v[k]].pos_m;
+
+			top += fabs(x[2] - b->hi[2]) < 1e-9;
+			on += fabs(x[0] - xe) < 1e-9 && x[1] > y0 - 1e-9 && x[1] < y1 + 1e-9;
+		}
+		if (top == 3 && on == 2)
+			pair[n++] = t;
+	}
+	assert_int_equal(n, 2);
+}
+
+/*
+ * A stroke exactly along an edge of the top's grid: the proxy keeps one
+ * triangle (the lower index of the two that share the edge) all along,
+ * whichever side it came from, without a walk; the same point gives the
+ * same triangle coming from either side (no hysteresis).
+ */
+static void test_proxy_shared_edge(void **state)
+{
+	const struct box_image *b = &boxes[IMG_ALL];
+	const double top = b->hi[2], xe = 0.5 * (b->lo[0] + b->hi[0]);
+	const double y0 = b->lo[1] + 0.004, y1 = 0.5 * (b->lo[1] + b->hi[1]) - 0.004;
+	uint32_t pair[2];
+
+	(void)state;
+	edge_pair(b, xe, b->lo[1], 0.5 * (b->lo[1] + b->hi[1]), pair);
+	for (int side = -1; side <= 1; side += 2) {
+		struct irdm_proxy px;
+
+		irdm_proxy_reset(&px);
+		assert_int_equal(upd(&px, b, NULL, xe + side * 0.01, y0, top - 0.002),
+				 IRDM_PROXY_TOUCH);
+		for (int k = 1; k <= 20; k++)   /* onto the edge */
+			assert_int_equal(upd(&px, b, NULL, xe + side * 0.01 * (1 - k / 20.0), y0,
+					     top - 0.002), IRDM_PROXY_SLIDE);
+		assert_int_equal(px.tri, pair[0]);
+		for (int k = 0; k <= 500; k++) {
+			double y = y0 + (y1 - y0) * k / 500.0;
+
+			assert_int_equal(upd(&px, b, NULL, xe, y, top - 0.002 - 1e-4 * sin(k)),
+					 IRDM_PROXY_SLIDE);
+			assert_int_equal(px.tri, pair[0]);
+			assert_int_equal(px.steps, 0);
+			assert_true(fabs(px.point_m[0] - xe) < 1e-12);
+			assert_true(fabs(px.point_m[1] - y) < 1e-12);
+		}
+	}
+}
+
+/* A V-shaped surface along x = xe (u_z = s (w - |x - xe|) within w of it,
+ * s > 0 a ridge, s < 0 a groove). */
+static void vee_disp(const struct box_image *b, double xe, double w, double s, double *u)
+{
+	for (uint32_t r = 0; r < b->img.meta->n_nodes; r++) {
+		const float *x = b->img.nodes[r].pos_m;
+		double a = w - fabs(x[0] - xe);
+
+		u[3 * r] = u[3 * r + 1] = 0;
+		u[3 * r + 2] = fabs(x[2] - b->hi[2]) < 1e-9 && a > 0 ? s * a : 0;
+	}
+}
+
+/*
+ * Constraint planes at creases of the surface.  A groove (concave edge):
+ * a tip pushed in past the crease, behind both faces, keeps the proxy on
+ * the crease, in contact.  A ridge (convex edge): a tip past the crest
+ * below the first face but in front of the second is outside: released.
+ */
+static void test_proxy_creases(void **state)
+{
+	const struct box_image *b = &boxes[IMG_ALL];
+	const struct irdm_meta *m = b->img.meta;
+	double *u = calloc(3 * (size_t)m->n_nodes, sizeof(double));
+	struct irdm_contact_disp d = { .u_m = u };
+	const double top = b->hi[2], xe = 0.5 * (b->lo[0] + b->hi[0]);
+	const double w = 0.05, yc = 0.5 * (b->lo[1] + b->hi[1]) + 0.013;
+	struct irdm_proxy px;
+	int ev;
+
+	(void)state;
+	assert_non_null(u);
+	/* groove 5 mm deep (slopes 0.1): from the left face to under the crease */
+	vee_disp(b, xe, w, -0.1, u);
+	irdm_proxy_reset(&px);
+	assert_int_equal(upd(&px, b, &d, xe - 0.02, yc, top - 0.004), IRDM_PROXY_TOUCH);
+	for (int k = 1; k <= 20; k++)
+		assert_int_equal(upd(&px, b, &d, xe - 0.02 + 0.00095 * k, yc,
+				     top - 0.004 - 0.00055 * k), IRDM_PROXY_SLIDE);
+	/* 10 mm under the crease, within 0.1 x 10 mm of it: behind both
+	 * faces, each projection beyond the other face: held on the crease */
+	for (int k = -9; k <= 9; k++) {
+		ev = upd(&px, b, &d, xe + 0.0001 * k, yc, top - 0.1 * w - 0.01);
+		assert_int_equal(ev, IRDM_PROXY_SLIDE);
+		assert_true(fabs(px.point_m[0] - xe) < 1e-9);
+		assert_true(fabs(px.point_m[1] - yc) < 1e-9);
+		assert_true(fabs(px.point_m[2] - (top - 0.1 * w)) < 1e-9);
+	}
+	/* further right, 1 mm behind the right face only: on that face */
+	ev = upd(&px, b, &d, xe + 0.01, yc, top - 0.1 * (w - 0.01) - 0.001);
+	assert_int_equal(ev, IRDM_PROXY_SLIDE);
+	assert_true(px.point_m[0] > xe + 0.009 && px.normal[0] < 0);
+	/* ridge 5 mm high: sliding down past the crest, below the first face */
+	vee_disp(b, xe, w, 0.1, u);
+	irdm_proxy_reset(&px);
+	assert_int_equal(upd(&px, b, &d, xe - 0.02, yc, top + 0.1 * (w - 0.02) - 0.001),
+			 IRDM_PROXY_TOUCH);
+	for (int k = 1; k <= 40; k++) {
+		double x = xe - 0.02 + 0.001 * k;
+		double first_face_z = top + 0.1 * (w - fabs(xe - 0.02 - xe)) + 0.1 * (x - xe + 0.02);
+		double second_face_z = top + 0.1 * (w - (x - xe));
+
+		ev = upd(&px, b, &d, x, yc, first_face_z - 0.001);
+		if (first_face_z - 0.001 <= second_face_z + 1e-9 || x <= xe) {
+			assert_int_equal(ev, IRDM_PROXY_SLIDE);
+			continue;
+		}
+		assert_true(x > xe + 0.005);
+		assert_int_equal(ev, IRDM_PROXY_RELEASE);
+		break;
+	}
+	assert_false(px.active);
+	free(u);
+}
+
+/*
+ * The face beyond the touchable area's rim is looked at even while the
+ * tip projects inside the rim triangle.  Top-only box whose x = hi side
+ * leans in under the top (an overhang: u_x = -0.2 (top - z)): a tip under
+ * the top, inside the rim, is in contact while it is behind the side and
+ * released (and not touched again) once it is in front of it.  Box
+ * touchable for x <= xe with a groove along x = xe (a concave rim): a tip
+ * behind the touchable face and in front of the display-only face's
+ * plane is inside the object: the contact stays.
+ */
+static void test_proxy_rim_faces(void **state)
+{
+	const struct box_image *b = &boxes[IMG_TOP], *h = &boxes[IMG_HALF];
+	double *u = calloc(3 * (size_t)b->img.meta->n_nodes, sizeof(double));
+	double *uh = calloc(3 * (size_t)h->img.meta->n_nodes, sizeof(double));
+	struct irdm_contact_disp d = { .u_m = u }, dh = { .u_m = uh };
+	const double top = b->hi[2], yc = 0.5 * (b->lo[1] + b->hi[1]) + 0.003;
+	const double xe = 0.5 * (h->lo[0] + h->hi[0]);
+	struct irdm_proxy px;
+
+	(void)state;
+	assert_non_null(u);
+	assert_non_null(uh);
+	for (uint32_t r = 0; r < b->img.meta->n_nodes; r++) {
+		const float *x = b->img.nodes[r].pos_m;
+
+		if (fabs(x[0] - b->hi[0]) < 1e-9)
+			u[3 * r] = -0.2 * (top - x[2]);
+	}
+	irdm_proxy_reset(&px);
+	assert_int_equal(upd(&px, b, &d, b->hi[0] - 0.02, yc, top - 0.002), IRDM_PROXY_TOUCH);
+	/* 2 mm down, 1 mm inside the rim: the side is 0.4 mm further out */
+	assert_int_equal(upd(&px, b, &d, b->hi[0] - 0.001, yc, top - 0.002), IRDM_PROXY_SLIDE);
+	assert_true(px.bary[0] > 0 && px.bary[1] > 0 && px.bary[2] > 0);
+	/* 10 mm down: the side is 2 mm in, the tip 1 mm in front of it */
+	assert_int_equal(upd(&px, b, &d, b->hi[0] - 0.001, yc, top - 0.01), IRDM_PROXY_RELEASE);
+	assert_int_equal(upd(&px, b, &d, b->hi[0] - 0.001, yc, top - 0.01), IRDM_PROXY_FREE);
+
+	/* the concave rim: 5 mm groove at x = xe, touchable on x <= xe */
+	vee_disp(h, xe, 0.05, -0.1, uh);
+	irdm_proxy_reset(&px);
+	assert_int_equal(upd(&px, h, &dh, xe - 0.02, yc, top - 0.004), IRDM_PROXY_TOUCH);
+	for (int k = 1; k <= 18; k++) {
+		double x = xe - 0.02 + 0.001 * k;
+		/* 0.2 mm under the touchable face, above the other's plane */
+		double z = top - 0.1 * (0.05 - (xe - x)) - 0.0002;
+
+		assert_int_equal(upd(&px, h, &dh, x, yc, z), IRDM_PROXY_SLIDE);
+		assert_true(fabs(px.point_m[0] - x) < 2e-5);
+	}
+	free(u);
+	free(uh);
+}
+
+static int upd_mu(struct irdm_proxy *px, const struct box_image *b, double mu_s, double mu_d,
+		  const double *p)
+{
+	struct irdm_proxy_config cfg;
+
+	irdm_proxy_config_default(&cfg);
+	cfg.max_disp_m = 0.01;
+	cfg.mu_s = mu_s;
+	cfg.mu_d = mu_d;
+	return irdm_proxy_update(px, &b->cm, NULL, &cfg, p);
+}
+
+/* The coupling's spring energy / k: 0.5 |p - proxy|^2. */
+static double spring(const double *p, const double *proxy)
+{
+	double d = dist3(p, proxy);
+
+	return 0.5 * d * d;
+}
+
+/*
+ * Coulomb friction against the analytic stick/slip threshold on the flat
+ * top.  The device pressed 2 mm in is drawn along x in 1 um steps, then
+ * back: with the coupling a spring k (device - proxy), the force on the
+ * device is k (proxy - device), normal part k dn, tangential k |q - proxy|
+ * (q the device's projection).  The proxy sticks (its point does not
+ * move) until the tangential force reaches mu_s k dn: the largest ratio
+ * while stuck is mu_s to within one step (1 um of 1 mm: 0.1 %, asserted
+ * 1 %); after each slip the ratio is mu_d (the cone's rim); drawn back, it
+ * sticks again until the force has turned round to mu_s the other way
+ * (mu_d < mu_s: stick-slip, a slip each (mu_s - mu_d) dn of travel).
+ * Dissipation: no update ever raises the spring's energy at the device's
+ * new position (the proxy's move only takes energy out).
+ */
+static void test_proxy_friction(void **state)
+{
+	const struct box_image *b = &boxes[IMG_ALL];
+	const double top = b->hi[2], mu_s = 0.5, mu_d = 0.4, dn = 0.002, step = 1e-6;
+	double p[3] = { 0.5 * (b->lo[0] + b->hi[0]) - 0.02, 0.5 * (b->lo[1] + b->hi[1]) + 0.003,
+			top - dn };
+	double stuck_max = 0, back_max = 0, rim_err = 0, worst_gain = -INFINITY;
+	unsigned slips = 0, back_slips = 0;
+	struct irdm_proxy px;
+
+	(void)state;
+	irdm_proxy_reset(&px);
+	assert_int_equal(upd_mu(&px, b, mu_s, mu_d, p), IRDM_PROXY_TOUCH);
+	for (int k = 0; k < 6000; k++) {
+		double before[3], ratio;
+		bool back = k >= 3000;
+
+		memcpy(before, px.point_m, sizeof(before));
+		p[0] += back ? -step : step;
+		double e_old = spring(p, before);
+
+		assert_int_equal(upd_mu(&px, b, mu_s, mu_d, p), IRDM_PROXY_SLIDE);
+		assert_true(fabs(px.point_m[2] - top) < 1e-12);
+		assert_true(fabs(px.depth_m + dn) < 1e-12);
+		worst_gain = fmax(worst_gain, spring(p, px.point_m) - e_old);
+		ratio = hypot(p[0] - px.point_m[0], p[1] - px.point_m[1]) / dn;
+		if (dist3(before, px.point_m) == 0) {   /* stuck */
+			if (back)
+				back_max = back_slips ? back_max : fmax(back_max, ratio);
+			else
+				stuck_max = slips ? stuck_max : fmax(stuck_max, ratio);
+			assert_true(ratio <= mu_s * (1 + 1e-12));
+			continue;
+		}
+		rim_err = fmax(rim_err, fabs(ratio - mu_d));
+		slips += !back;
+		back_slips += back;
+	}
+	print_message("friction: stuck up to F_t / F_n = %.5f (mu_s %.2f), back %.5f; on the rim "
+		      "|ratio - mu_d| <= %.1e; %u + %u slips; largest energy gain %.1e (k = 1)\n",
+		      stuck_max, mu_s, back_max, rim_err, slips, back_slips, worst_gain);
+	assert_true(slips >= 5 && back_slips >= 5);     /* stick-slip: every 0.2 mm */
+	assert_true(fabs(stuck_max - mu_s) <= 0.01 * mu_s);
+	assert_true(fabs(back_max - mu_s) <= 0.01 * mu_s);
+	assert_true(rim_err <= 1e-9);
+	assert_true(worst_gain <= 1e-18);
+	/* frictionless (mu_s = 0): the proxy is the projection again */
+	p[0] += 0.001;
+	assert_int_equal(upd_mu(&px, b, 0, 0, p), IRDM_PROXY_SLIDE);
+	assert_true(fabs(px.point_m[0] - p[0]) < 1e-12);
 }
 
 /* The surface moved: contact is detected on the displaced surface, and the
@@ -1055,6 +1361,10 @@ int main(void)
 		cmocka_unit_test(test_proxy_deep),
 		cmocka_unit_test(test_proxy_edges),
 		cmocka_unit_test(test_proxy_boundary),
+		cmocka_unit_test(test_proxy_shared_edge),
+		cmocka_unit_test(test_proxy_creases),
+		cmocka_unit_test(test_proxy_rim_faces),
+		cmocka_unit_test(test_proxy_friction),
 		cmocka_unit_test(test_proxy_displaced_site),
 		cmocka_unit_test(test_loader_rejects),
 		cmocka_unit_test(test_fixture_images),

@@ -297,6 +297,40 @@ static void test_release_ringing_is_the_dominant_mode(void **state)
 	assert_non_null(strstr(out_text, "state: off"));
 }
 
+/*
+ * The summary's force line gives both the force on the object and the one
+ * rendered on the tip: on a board whose max_force_n (0.2 N) is below the
+ * press's peak, the object-side peak is above it and the rendered one is
+ * the clamp's, to the printed digits.
+ */
+static void test_summary_rendered_force(void **state)
+{
+	char text[16384], out[16384] = "", *line, *save, path[320];
+	double obj, at_obj, rend, at_rend;
+	const char *p;
+
+	(void)state;
+	tf_read_text(BOARD, text, sizeof(text));
+	for (line = strtok_r(text, "\n", &save); line; line = strtok_r(NULL, "\n", &save)) {
+		if (!strncmp(line, "max_force_n", 11))
+			line = "max_force_n = 0.2";
+		strncat(out, line, sizeof(out) - strlen(out) - 2);
+		strcat(out, "\n");
+	}
+	snprintf(path, sizeof(path), "%s/weak.board", dir);
+	tf_write_text(path, out);
+	assert_int_equal(run_fw((const char *const[]){ "--board", path, "--image", image, "--user",
+						       PRESS, "--clock", "virtual", NULL }), 0);
+	p = strstr(out_text, "force: peak ");
+	assert_non_null(p);
+	assert_int_equal(sscanf(p, "force: peak %lf N at %lf s on the object, %lf N at %lf s rendered",
+				&obj, &at_obj, &rend, &at_rend), 4);
+	print_message("summary: %.4f N on the object, %.4f N rendered (max_force_n 0.2 N)\n", obj,
+		      rend);
+	assert_true(obj > 0.25);
+	assert_true(fabs(rend - 0.2) <= 5e-5);
+}
+
 static bool kernel_is_rt(void)
 {
 	char buf[64] = "";
@@ -960,6 +994,7 @@ int main(void)
 		cmocka_unit_test(test_bad_input),
 		cmocka_unit_test(test_virtual_runs_are_identical),
 		cmocka_unit_test(test_release_ringing_is_the_dominant_mode),
+		cmocka_unit_test(test_summary_rendered_force),
 		cmocka_unit_test(test_require_rt),
 		cmocka_unit_test(test_sigterm_mid_contact_turns_torque_off),
 		cmocka_unit_test(test_sighup_mid_contact_turns_torque_off),

@@ -143,6 +143,31 @@ static int parse_coupling(const struct irdm_opt *o, void *obj, const char *v, ch
 	return IRDM_OK;
 }
 
+/* "MU_S,MU_D", each >= 0 and MU_D <= MU_S (0,0: frictionless). */
+static int parse_friction(const struct irdm_opt *o, void *obj, const char *v, char *why,
+			  size_t len)
+{
+	static const char *const sd[] = { "MU_S", "MU_D" };
+	struct irdm_board *b = obj;
+	struct irdm_opt e = *o;
+	double val[2];
+	int ret;
+
+	e.range = IRDM_OPT_GE | IRDM_OPT_LE;
+	e.min = 0;
+	e.max = 10;
+	ret = parse_list(&e, val, v, 2, IRDM_OPT_DOUBLE, sizeof(double), sd, why, len);
+	if (ret)
+		return ret;
+	if (val[1] > val[0]) {
+		snprintf(why, len, "MU_D %g is above MU_S %g: a sliding contact holds less "
+			 "than a stuck one", val[1], val[0]);
+		return IRDM_EFORMAT;
+	}
+	memcpy(b->friction_mu, val, sizeof(val));
+	return IRDM_OK;
+}
+
 #define BF(member) IRDM_OPT_FIELD(struct irdm_board, member)
 #define DEV(member) IRDM_OPT_FIELD(struct irdm_board, device.member)
 #define RANGE(flags, lo, hi) .range = (flags), .min = (lo), .max = (hi)
@@ -262,6 +287,11 @@ static const struct irdm_opt board_opts[] = {
 		  "device_damping_ns_per_m (irdm_engine_config_haptic); K N/m, B N s/m with "
 		  "K period/2 + B < device_damping_ns_per_m and K <= max_stiffness_n_per_m; "
 		  "0,0 is rigid (default auto)" },
+	{ .name = "friction", .type = IRDM_OPT_CUSTOM, .parse = parse_friction,
+	  .metavar = "MU_S,MU_D",
+	  .help = "Coulomb friction on the proxy: it sticks while the tangential force is "
+		  "within MU_S times the normal one and slides on MU_D times it; "
+		  "0 <= MU_D <= MU_S <= 10; 0,0 is frictionless (default 0,0)" },
 
 	/* object placement and calibration */
 	{ .name = "object_offset_m", XYZ, BF(object_offset_m), .unit = "m", WITHIN(PLACE_MAX_M),

@@ -1,8 +1,13 @@
 /* SPDX-License-Identifier: MIT */
 /*
  * Contact detection on the deformed surface: closest point query over the
- * image's CONTACT_BVH and a frictionless god-object.  Runs in the force
- * loop: no allocation, no system call, no recursion, bounded work.
+ * image's CONTACT_BVH and a frictionless god-object: the constraint-plane
+ * god-object of Zilles and Salisbury (1995), kept local as Ruspini et al.'s
+ * virtual proxy is (a walk over the touchable triangles; the faces beyond
+ * convex edges and beyond the touchable area's rim end the contact, a
+ * concave edge holds the proxy; docs/architecture.md).  Runs in the force
+ * loop: no allocation, no system call, no recursion, bounded work (a rim
+ * neighbour's search is one pass over the surface's triangles).
  *
  * The BVH boxes bound the REST surface; the surface the device touches is
  * rest + u.  With |u| <= max_disp_m for every node, a box grown by
@@ -26,6 +31,9 @@ _Static_assert(IRDM_CONTACT_STACK > IRDM_BVH_MAX_DEPTH, "stack holds a root-leaf
 #define FAR_SLACK 1e-9
 /* sin^2 of the smallest angle of a triangle that still has a normal */
 #define DEGENERATE_SIN2 1e-24
+/* A barycentric within this of zero puts a point on the edge (rounding of
+ * the projection of a point on a shared edge is a few ulps either way). */
+#define ON_EDGE 1e-12
 
 static void disp_of(const struct irdm_contact_disp *d, uint32_t row, double u[3])
 {
@@ -101,6 +109,17 @@ static bool tri_normal(const double v[3][3], double n[3])
 		return false;
 	irdm_v3_scale(n, 1 / sqrt(nn), n);
 	return true;
+}
+
+bool irdm_contact_tri_normal(const struct irdm_contact_mesh *cm, const struct irdm_contact_disp *d,
+			     uint32_t t, double n[3])
+{
+	double v[3][3];
+
+	if (t >= cm->n_tris)
+		return false;
+	irdm_contact_tri_pos(cm, d, t, v);
+	return tri_normal(v, n);
 }
 
 /* Closest point on segment ab: parameter t of a + t (b - a). */
@@ -356,6 +375,8 @@ void irdm_proxy_config_default(struct irdm_proxy_config *cfg)
 	cfg->radius_m = 0.01;
 	cfg->max_disp_m = 0.05;
 	cfg->max_walk = 16;
+	cfg->mu_s = 0;
+	cfg->mu_d = 0;
 }
 
 void irdm_proxy_reset(struct irdm_proxy *px)
@@ -405,7 +426,7 @@ static uint32_t next_tri(const struct irdm_contact_mesh *cm, uint32_t t, const d
 				order[j] = order[j + 1];
 				order[j + 1] = x;
 			}
-	for (unsigned k = 0; k < 3 && lam[order[k]] < 0; k++) {
+	for (unsigned k = 0; k < 3 && lam[order[k]] < -ON_EDGE; k++) {
 		uint32_t u = cm->adj[3 * (size_t)t + (order[k] + 1) % 3];
 
 		if (u != IRDM_BVH_NONE && u != from)
@@ -414,71 +435,345 @@ static uint32_t next_tri(const struct irdm_contact_mesh *cm, uint32_t t, const d
 	return IRDM_BVH_NONE;
 }
 
+static bool inside_tri(const double *lam)
+{
+	return lam[0] >= -ON_EDGE && lam[1] >= -ON_EDGE && lam[2] >= -ON_EDGE;
+}
+
+/*
+ * The SURFACE triangle other than t on edge e of t, touchable or not (the
+ * CONTACT_BVH's adjacency knows only touchable ones): on the touchable
+ * area's rim, a search of the surface, remembered in the proxy for the
+ * edges of its triangle, so a slide along the rim searches once per rim
+ * triangle.  IRDM_BVH_NONE for an edge of an open surface.
+ */
+static uint32_t face_beyond(const struct irdm_contact_mesh *cm, struct irdm_proxy *px,
+			    uint32_t t, unsigned e)
+{
+	const uint32_t *v = &cm->tris[3 * (size_t)t];
+	uint32_t a = v[e], b = v[(e + 1) % 3], u = cm->adj[3 * (size_t)t + e];
+
+	if (u != IRDM_BVH_NONE)
+		return u;
+	if (px->rim_tri != t) {
+		px->rim_tri = t;
+		px->rim_known = 0;
+	}
+	if (px->rim_known & (1u << e))
+		return px->rim_face[e];
+	for (u = 0; u < cm->n_tris; u++) {
+		const uint32_t *w = &cm->tris[3 * (size_t)u];
+		bool has_a = w[0] == a || w[1] == a || w[2] == a;
+		bool has_b = w[0] == b || w[1] == b || w[2] == b;
+
+		if (u != t && has_a && has_b)
+			break;
+	}
+	px->rim_known |= (uint8_t)(1u << e);
+	px->rim_face[e] = u < cm->n_tris ? u : IRDM_BVH_NONE;
+	return px->rim_face[e];
+}
+
+/*
+ * Outward normal of the face beyond edge e of t (vertices v, normal n):
+ * the neighbour's, or for an edge of an open surface a wall standing on
+ * the edge at right angles to t.  False for a degenerate neighbour.
+ */
+static bool normal_beyond(const struct irdm_contact_mesh *cm, const struct irdm_contact_disp *d,
+			  struct irdm_proxy *px, uint32_t t, unsigned e, const double v[3][3],
+			  const double *n, double *nu)
+{
+	uint32_t u = face_beyond(cm, px, t, e);
+	double w[3][3], ed[3], len;
+
+	if (u != IRDM_BVH_NONE) {
+		irdm_contact_tri_pos(cm, d, u, w);
+		return tri_normal(w, nu);
+	}
+	irdm_v3_sub(ed, v[(e + 1) % 3], v[e]);
+	irdm_v3_cross(nu, ed, n);       /* counter-clockwise: points away from t */
+	len = sqrt(irdm_v3_dot(nu, nu));
+	if (!(len > 0))
+		return false;
+	irdm_v3_scale(nu, 1 / len, nu);
+	return true;
+}
+
+/*
+ * Whether p, behind the plane of t, is outside the object by the face
+ * beyond one of t's edges: the edges p projects beyond (where the walk
+ * stopped), and the edges on the touchable area's rim, whose faces
+ * beyond are display-only and would otherwise never be looked at.  The
+ * constraint planes of the god-object (Zilles and Salisbury 1995): at a
+ * convex edge the object is the intersection of the two faces'
+ * half-spaces, so p in front of the neighbour's plane is outside and the
+ * contact ends; at a concave edge it is their union, and p behind t is
+ * inside: the proxy stays on t, or on the edge where both planes
+ * constrain it.
+ */
+static bool outside_beyond(const struct irdm_contact_mesh *cm, const struct irdm_contact_disp *d,
+			   struct irdm_proxy *px, uint32_t t, const double v[3][3],
+			   const double *n, const double *lam, const double *p)
+{
+	for (unsigned e = 0; e < 3; e++) {
+		unsigned opp = (e + 2) % 3;
+		bool rim = cm->adj[3 * (size_t)t + e] == IRDM_BVH_NONE;
+		double nu[3], to_opp[3], to_p[3];
+
+		if ((!rim && !(lam[opp] < -ON_EDGE)) || !normal_beyond(cm, d, px, t, e, v, n, nu))
+			continue;
+		irdm_v3_sub(to_opp, v[opp], v[e]);
+		irdm_v3_sub(to_p, p, v[e]);
+		if (irdm_v3_dot(nu, to_opp) <= 0 && irdm_v3_dot(nu, to_p) > 0)
+			return true;
+	}
+	return false;
+}
+
+/*
+ * The same point on a shared edge or vertex belongs to every triangle
+ * around it; the proxy takes the one of lowest index among those that
+ * hold p's projection, so the choice is a function of where p is, not of
+ * where the proxy came from (no hysteresis), and a stroke along an edge
+ * keeps one triangle, and so one engine site, as a stroke inside a
+ * triangle does.  Each step goes to a lower index: bounded.
+ */
+static uint32_t lowest_holder(const struct irdm_contact_mesh *cm,
+			      const struct irdm_contact_disp *d, uint32_t t, double v[3][3],
+			      double *lam, const double *p)
+{
+	for (unsigned pass = 0; pass < IRDM_CONTACT_MAX_WALK; pass++) {
+		uint32_t best = t;
+		double bv[3][3], bl[3];
+
+		for (unsigned i = 0; i < 3; i++) {
+			uint32_t u = cm->adj[3 * (size_t)t + (i + 1) % 3];
+			double w[3][3], l[3];
+
+			if (!(lam[i] <= ON_EDGE) || u == IRDM_BVH_NONE || u >= best)
+				continue;
+			irdm_contact_tri_pos(cm, d, u, w);
+			if (!plane_bary(w, p, l) || !inside_tri(l))
+				continue;
+			best = u;
+			memcpy(bv, w, sizeof(w));
+			memcpy(bl, l, sizeof(l));
+		}
+		if (best == t)
+			break;
+		t = best;
+		memcpy(v, bv, sizeof(bv));
+		memcpy(lam, bl, sizeof(bl));
+	}
+	return t;
+}
+
+void irdm_proxy_force(struct irdm_proxy *px, const double force_n[3])
+{
+	px->force_known = px->active && irdm_v3_finite(force_n);
+	memcpy(px->force_n, force_n, sizeof(px->force_n));
+}
+
 static int proxy_release(struct irdm_proxy *px, int ret)
 {
 	px->active = false;
+	px->force_known = false;
 	return ret;
+}
+
+/* Fill the proxy from its triangle t (vertices v) and weights lam. */
+static void proxy_set(struct irdm_proxy *px, uint32_t t, const double v[3][3], const double *lam,
+		      const double *p, unsigned steps)
+{
+	double n[3], pq[3];
+
+	tri_normal(v, n);
+	px->tri = t;
+	memcpy(px->bary, lam, sizeof(px->bary));
+	irdm_v3_bary(px->point_m, lam, v[0], v[1], v[2]);
+	memcpy(px->normal, n, sizeof(n));
+	irdm_v3_sub(pq, p, px->point_m);
+	px->depth_m = irdm_v3_dot(pq, n);
+	px->steps = steps;
+}
+
+/*
+ * A new contact: the device has crossed the surface at the closest point,
+ * unless it is outside the object by a face beyond the hit triangle's
+ * edges (beside an edge of the touchable area, where the closest
+ * touchable point is on the rim and its sign says nothing).
+ */
+static int proxy_touch(struct irdm_proxy *px, const struct irdm_contact_mesh *cm,
+		       const struct irdm_contact_disp *d, const struct irdm_proxy_config *cfg,
+		       const double p[3])
+{
+	struct irdm_contact_hit hit;
+	double v[3][3], lam[3], n[3];
+	uint32_t t;
+	int r = irdm_contact_closest(cm, d, cfg->max_disp_m, p, cfg->radius_m, &hit);
+
+	if (r < 0)
+		return r;
+	if (r == 0 || hit.dist_m > 0)
+		return IRDM_PROXY_FREE;
+	t = hit.tri;
+	irdm_contact_tri_pos(cm, d, t, v);
+	if (!plane_bary(v, p, lam) || !tri_normal(v, n))
+		return IRDM_PROXY_FREE;
+	if (outside_beyond(cm, d, px, t, v, n, lam, p))
+		return IRDM_PROXY_FREE;
+	px->active = true;
+	if (inside_tri(lam) && (t = lowest_holder(cm, d, t, v, lam, p)) != hit.tri) {
+		proxy_set(px, t, v, lam, p, 0);
+		return IRDM_PROXY_TOUCH;
+	}
+	px->tri = t;    /* as the query found it */
+	memcpy(px->bary, hit.bary, sizeof(px->bary));
+	memcpy(px->point_m, hit.point_m, sizeof(px->point_m));
+	memcpy(px->normal, hit.normal, sizeof(px->normal));
+	px->depth_m = hit.dist_m;
+	px->steps = 0;
+	return IRDM_PROXY_TOUCH;
+}
+
+/*
+ * The projection of p on the displaced surface, walking from triangle t:
+ * the triangle, its vertices and p's weights on it (clamped to the
+ * max_walk steps: lam as the plane gives it, q not set).  Return: 1
+ * inside a triangle (q the point), 0 stopped at an edge, -1 a triangle
+ * crushed flat.
+ */
+static int walk(const struct irdm_contact_mesh *cm, const struct irdm_contact_disp *d,
+		unsigned max_walk, const double *p, uint32_t *tp, double v[3][3], double *lam,
+		double *q, unsigned *steps)
+{
+	uint32_t t = *tp, from = IRDM_BVH_NONE;
+
+	*steps = 0;
+	for (;;) {
+		uint32_t u;
+
+		irdm_contact_tri_pos(cm, d, t, v);
+		if (!plane_bary(v, p, lam))
+			return -1;
+		if (inside_tri(lam)) {
+			*tp = lowest_holder(cm, d, t, v, lam, p);
+			irdm_v3_bary(q, lam, v[0], v[1], v[2]);
+			return 1;
+		}
+		u = *steps < max_walk ? next_tri(cm, t, lam, from) : IRDM_BVH_NONE;
+		if (u == IRDM_BVH_NONE) {
+			*tp = t;
+			return 0;
+		}
+		from = t;
+		t = u;
+		(*steps)++;
+	}
+}
+
+/*
+ * Coulomb friction on the proxy: the friction cone of the god-object
+ * (Salisbury et al. 1995; Harwin and Melder 2002).  The proxy is a point
+ * of the surface (triangle and weights: it moves with the surface); the
+ * frictionless proxy q is the device's projection, depth dn behind the
+ * surface.  With the coupling a spring between the device and the proxy,
+ * the tangential force over the normal one is |q - proxy| / dn: while it
+ * is within mu_s the proxy sticks; beyond, it slides toward q until the
+ * ratio is mu_d, on the cone's rim.  The proxy only ever moves toward q,
+ * which shortens the spring: it never gives the device energy (passive by
+ * construction); what the move takes out of the spring is what friction
+ * dissipates.  Given the force the contact made (irdm_proxy_force()), the
+ * same test is made on it: F_t / F_n in place of |q - proxy| / dn.
+ * Return: 0; -1 if the slid-to point cannot be placed.
+ */
+static int friction(struct irdm_proxy *px, const struct irdm_contact_mesh *cm,
+		    const struct irdm_contact_disp *d, const struct irdm_proxy_config *cfg,
+		    unsigned max_walk, uint32_t anchor_tri, const double *anchor_bary,
+		    double depth)
+{
+	double v[3][3], a[3], tv[3], lam[3], q[3], c[3], tl, dn = -depth;
+	uint32_t t;
+	unsigned steps;
+
+	irdm_contact_tri_pos(cm, d, anchor_tri, v);
+	irdm_v3_bary(a, anchor_bary, v[0], v[1], v[2]);
+	irdm_v3_sub(tv, px->point_m, a);
+	tl = sqrt(irdm_v3_dot(tv, tv));
+	if (px->force_known) {
+		/* the force itself: dn such that tl / dn = F_t / F_n, so the
+		 * test below is F_t <= mu_s F_n and a slip scales the offset
+		 * by mu_d F_n / F_t (none without a normal force) */
+		double fn = -irdm_v3_dot(px->force_n, px->normal), ft[3], ftl;
+
+		irdm_v3_scale(ft, fn, px->normal);
+		irdm_v3_add(ft, ft, px->force_n);
+		ftl = sqrt(irdm_v3_dot(ft, ft));
+		dn = !(fn > 0) ? 0 : ftl > 0 ? fn * tl / ftl : INFINITY;
+	}
+	if (tl <= cfg->mu_s * dn) {             /* stick */
+		px->tri = anchor_tri;
+		memcpy(px->bary, anchor_bary, sizeof(px->bary));
+		memcpy(px->point_m, a, sizeof(a));
+		tri_normal(v, px->normal);
+		return 0;
+	}
+	/* slide to the rim: c = q - mu_d dn (q - a) / |q - a| */
+	irdm_v3_scale(c, cfg->mu_d * dn / tl, tv);
+	irdm_v3_sub(c, px->point_m, c);
+	t = px->tri;
+	switch (walk(cm, d, max_walk, c, &t, v, lam, q, &steps)) {
+	case -1:
+		return -1;
+	case 0:
+		irdm_contact_closest_on_tri(v[0], v[1], v[2], c, lam, q);
+		break;
+	}
+	px->tri = t;
+	memcpy(px->bary, lam, sizeof(lam));
+	memcpy(px->point_m, q, sizeof(q));
+	tri_normal(v, px->normal);
+	return 0;
+}
+
+static bool friction_on(const struct irdm_proxy_config *cfg)
+{
+	return cfg->mu_s > 0;
 }
 
 int irdm_proxy_update(struct irdm_proxy *px, const struct irdm_contact_mesh *cm,
 		      const struct irdm_contact_disp *d, const struct irdm_proxy_config *cfg,
 		      const double p[3])
 {
-	double v[3][3], lam[3], n[3], pq[3];
-	uint32_t t, from = IRDM_BVH_NONE;
-	unsigned steps = 0, max_walk;
+	double v[3][3], lam[3], n[3], q[3], anchor_bary[3];
+	uint32_t t, anchor_tri;
+	unsigned steps, max_walk;
+	bool outside;
+	int in;
 
 	if (!px || !cm || !cm->hdr || !cfg || !p)
 		return IRDM_EINVAL;
 	if (!irdm_v3_finite(p))
 		return proxy_release(px, IRDM_EINVAL);
-	if (!px->active) {
-		struct irdm_contact_hit hit;
-		int r = irdm_contact_closest(cm, d, cfg->max_disp_m, p, cfg->radius_m, &hit);
-
-		if (r < 0)
-			return r;
-		if (r == 0 || hit.dist_m > 0)
-			return IRDM_PROXY_FREE;
-		px->active = true;
-		px->tri = hit.tri;
-		memcpy(px->bary, hit.bary, sizeof(px->bary));
-		memcpy(px->point_m, hit.point_m, sizeof(px->point_m));
-		memcpy(px->normal, hit.normal, sizeof(px->normal));
-		px->depth_m = hit.dist_m;
-		px->steps = 0;
-		return IRDM_PROXY_TOUCH;
-	}
-	t = px->tri;
+	if (!px->active)
+		return proxy_touch(px, cm, d, cfg, p);
+	t = anchor_tri = px->tri;
+	memcpy(anchor_bary, px->bary, sizeof(anchor_bary));
 	if (t >= cm->n_tris || !irdm_contact_tri_contactable(cm, t))
 		return proxy_release(px, IRDM_EINVAL);
 	max_walk = cfg->max_walk < IRDM_CONTACT_MAX_WALK ? cfg->max_walk : IRDM_CONTACT_MAX_WALK;
-	for (;;) {
-		uint32_t u;
-
-		irdm_contact_tri_pos(cm, d, t, v);
-		if (!plane_bary(v, p, lam))     /* crushed flat: detect afresh */
-			return proxy_release(px, IRDM_PROXY_RELEASE);
-		if (lam[0] >= 0 && lam[1] >= 0 && lam[2] >= 0)
-			break;
-		u = steps < max_walk ? next_tri(cm, t, lam, from) : IRDM_BVH_NONE;
-		if (u == IRDM_BVH_NONE) {       /* boundary, crease or walked enough */
-			irdm_contact_closest_on_tri(v[0], v[1], v[2], p, lam, pq);
-			break;
-		}
-		from = t;
-		t = u;
-		steps++;
-	}
+	in = walk(cm, d, max_walk, p, &t, v, lam, q, &steps);
+	if (in < 0)                     /* crushed flat: detect afresh */
+		return proxy_release(px, IRDM_PROXY_RELEASE);
 	tri_normal(v, n);
-	px->tri = t;
-	memcpy(px->bary, lam, sizeof(lam));
-	irdm_v3_bary(px->point_m, lam, v[0], v[1], v[2]);
-	memcpy(px->normal, n, sizeof(n));
-	irdm_v3_sub(pq, p, px->point_m);
-	px->depth_m = irdm_v3_dot(pq, n);
-	px->steps = steps;
-	if (px->depth_m > 0)
+	outside = outside_beyond(cm, d, px, t, v, n, lam, p);
+	if (!in)
+		irdm_contact_closest_on_tri(v[0], v[1], v[2], p, lam, q);
+	proxy_set(px, t, v, lam, p, steps);
+	if (outside || px->depth_m > 0)
+		return proxy_release(px, IRDM_PROXY_RELEASE);
+	if (friction_on(cfg) &&
+	    friction(px, cm, d, cfg, max_walk, anchor_tri, anchor_bary, px->depth_m))
 		return proxy_release(px, IRDM_PROXY_RELEASE);
 	return IRDM_PROXY_SLIDE;
 }

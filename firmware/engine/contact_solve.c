@@ -98,6 +98,7 @@ void tick_release_pulling(struct irdm_engine *e, struct system *s,
 			const double *F = &s->f[3 * i], *nrm = s->normal[i];
 			/* F acts on the object; pushing means F . n_out < 0 */
 			if (c->mode == IRDM_CONTACT_PUSH && irdm_v3_dot(F, nrm) > 0) {
+				tick_port_end(e, c);
 				memset(c, 0, sizeof(*c));
 				e->stats.releases++;
 				dropped = 1;

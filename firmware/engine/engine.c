@@ -244,6 +244,7 @@ void irdm_engine_reset(struct irdm_engine *e)
 		e->head_norm[s] = 0;
 	for (unsigned i = 0; i < IRDM_MAX_CONTACTS; i++)
 		irdm_engine_contact_end(e, i);
+	e->port_energy_left_j = 0;
 	e->faulted = false;
 	e->fault_why = NULL;
 }
@@ -362,8 +363,10 @@ int irdm_engine_contact_soften(struct irdm_engine *e, unsigned i)
 
 void irdm_engine_contact_end(struct irdm_engine *e, unsigned i)
 {
-	if (i < IRDM_MAX_CONTACTS)
-		memset(&e->c[i], 0, sizeof(e->c[i]));
+	if (i >= IRDM_MAX_CONTACTS)
+		return;
+	tick_port_end(e, &e->c[i]);
+	memset(&e->c[i], 0, sizeof(e->c[i]));
 }
 
 const struct irdm_contact_state *irdm_engine_contact(const struct irdm_engine *e, unsigned i)

@@ -48,6 +48,9 @@ struct irdm_engine {
 	bool head_wide;                     /* head sum by engine_head_avx2.c */
 	/* contacts and solve */
 	struct irdm_contact_state c[IRDM_MAX_CONTACTS];
+	/* passivity observer (passivity.c): the work done on the object
+	 * through ports that ended while others go on (zero once none is) */
+	double port_energy_left_j;
 	struct r0_table r0, r0_next;
 	struct irdm_force_tick last;        /* forces applied this tick */
 	struct irdm_engine_stats stats;
@@ -119,5 +122,9 @@ void irdm_bound_init(const struct irdm_engine *e, double *w);
  * Returns 1 if the system had to be regularised, 0 otherwise, -1 if it had
  * to be and the regularised F does not solve it (contradictory targets). */
 int irdm_solve_spd(double *a, double *rhs, int n);
+
+/* Contact c (a slot of e) ends: its port's energy stays with the object
+ * (passivity.c). */
+void tick_port_end(struct irdm_engine *e, struct irdm_contact_state *c);
 
 #endif

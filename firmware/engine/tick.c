@@ -150,6 +150,7 @@ int irdm_engine_tick(struct irdm_engine *e, const struct irdm_contact_cmd *cmd_i
 		tick_newton_floating(e, &s, cmd);
 		tick_passivity(e, &s);
 	}
+	tick_port_leak(e, s.m);
 	for (int i = 0; i < 3 * s.m; i++)
 		if (!isfinite(s.f[i]) ||
 		    (e->cfg.max_force_n > 0 && fabs(s.f[i]) > e->cfg.max_force_n))

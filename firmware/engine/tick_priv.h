@@ -118,5 +118,7 @@ void tick_release_pulling(struct irdm_engine *e, struct system *s, const struct 
 
 /* passivity.c */
 void tick_passivity(struct irdm_engine *e, struct system *s);
+/* After a tick with m ports active: none left, the observation ends. */
+void tick_port_leak(struct irdm_engine *e, int m);
 
 #endif

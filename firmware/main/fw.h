@@ -135,6 +135,8 @@ struct fw {
 	struct irdm_sim_user *user;     /* NULL without --user */
 	struct irdm_clock clock;
 	struct fw_trace trace;
+	double rendered_peak_n;         /* |force on tip 0| after the clamp and saturation */
+	uint64_t rendered_peak_tick;
 	struct fw_frame frame;
 	struct irdm_outdir frames_dir;  /* --frames-out's, claimed before the run */
 	/* telemetry: per-tick records through a ring to the log (--log) */

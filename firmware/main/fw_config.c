@@ -40,6 +40,8 @@ int fw_config_from_board(struct irdm_ctrl_config *c, const struct irdm_board *b)
 	lim->overrun_fault_count = b->overrun_fault_count;
 	lim->watchdog_us = b->watchdog_us;
 	c->period_us = b->period_us;
+	c->proxy.mu_s = b->friction_mu[0];
+	c->proxy.mu_d = b->friction_mu[1];
 	irdm_board_engine_config(b, &c->engine);
 	c->engine.max_contacts = b->devices > c->engine.max_contacts ? b->devices
 								     : c->engine.max_contacts;

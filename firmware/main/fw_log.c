@@ -28,6 +28,7 @@ static void fill_dev(struct irdm_tick_dev *r, const struct irdm_ctrl_device_outp
 	memcpy(r->force_n, d->force_obj_n, sizeof(r->force_n));
 	r->contact_tri = d->contact ? d->tri : IRDM_TELEM_NO_TRI;
 	r->proxy = (uint8_t)d->proxy_event;
+	r->softened = d->softened;
 	/* a proxy that touches or slides commanded the engine (controller_contact.c) */
 	r->site_tri = IRDM_TELEM_NO_TRI;
 	if (d->proxy_event == IRDM_PROXY_TOUCH || d->proxy_event == IRDM_PROXY_SLIDE) {

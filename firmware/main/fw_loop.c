@@ -90,6 +90,11 @@ static void trace_tick(struct fw *fw, const struct irdm_ctrl_output *out)
 		irdm_engine_node_disp(fw->s->eng, fw->watch_row, u);
 	fw_trace_add(&fw->trace, irdm_v3_norm(d->force_obj_n), irdm_v3_dot(u, fw->watch_normal),
 		     d->contact);
+	if (out->state == IRDM_SAFETY_ENABLED &&
+	    irdm_v3_norm(d->force_obj_n) * d->scale > fw->rendered_peak_n) {
+		fw->rendered_peak_n = irdm_v3_norm(d->force_obj_n) * d->scale;
+		fw->rendered_peak_tick = fw->trace.n - 1;
+	}
 }
 
 static double now_ns(void)

@@ -124,8 +124,9 @@ void fw_summary_print(const struct fw *fw)
 	printf("ticks: %llu at %u us (%.3f s of %s time)\n", (unsigned long long)t->n,
 	       fw->board.period_us, (double)t->n * dt_s,
 	       fw->args.clock == IRDM_CLOCK_VIRTUAL ? "virtual" : "real");
-	printf("force: peak %.4f N at %.3f s, final %.4f N\n", t->peak_n,
-	       (double)t->peak_at * dt_s, t->final_n);
+	printf("force: peak %.4f N at %.3f s on the object, %.4f N at %.3f s rendered (clamped, "
+	       "saturated), final %.4f N\n", t->peak_n, (double)t->peak_at * dt_s,
+	       fw->rendered_peak_n, (double)fw->rendered_peak_tick * dt_s, t->final_n);
 	if (t->released && t->release_at + 100 <= t->n)
 		printf("release ringing: %.2f Hz\n", dominant_hz(t->ring_u_m, t->ring_n, dt_s));
 	else

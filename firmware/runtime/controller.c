@@ -70,7 +70,8 @@ static int limits_check(const struct irdm_ctrl_limits *lim)
 static int proxy_check(const struct irdm_proxy_config *p)
 {
 	if (!positive(p->radius_m) || !isfinite(p->max_disp_m) || p->max_disp_m < 0 ||
-	    p->max_walk < 1 || p->max_walk > IRDM_CONTACT_MAX_WALK)
+	    p->max_walk < 1 || p->max_walk > IRDM_CONTACT_MAX_WALK || !(p->mu_s >= 0) ||
+	    !isfinite(p->mu_s) || !(p->mu_d >= 0) || !(p->mu_d <= p->mu_s))
 		return IRDM_EINVAL;
 	return IRDM_OK;
 }

@@ -87,6 +87,7 @@ static int touch(struct irdm_ctrl *c, unsigned i, const struct irdm_proxy_config
 	struct irdm_ctrl_dev *d = &c->dev[i];
 	struct irdm_contact_site site;
 	double tip_own_m[3];
+	bool fresh;
 	int ev;
 
 	/* the proxy on the object as it is now: a floating one has moved */
@@ -98,16 +99,32 @@ static int touch(struct irdm_ctrl *c, unsigned i, const struct irdm_proxy_config
 	if (ev != IRDM_PROXY_TOUCH && ev != IRDM_PROXY_SLIDE)
 		return IRDM_OK;         /* FREE, or RELEASE: the command stays OFF */
 	proxy_out(c, &d->px, o);
+	fresh = irdm_engine_contact(c->s->eng, i)->mode == IRDM_CONTACT_OFF;
 	if (irdm_proxy_site(&d->px, &c->cm, &site) ||
 	    irdm_engine_contact_begin(c->s->eng, i, &site, IRDM_CONTACT_PUSH))
 		return IRDM_EFAULT;
-	if (ev == IRDM_PROXY_TOUCH && began_inside(c, &d->px) &&
-	    irdm_engine_contact_soften(c->s->eng, i))
+	/* a contact the engine starts afresh: a touch, or a slide whose
+	 * contact the push release ended (a soft start's first force is zero
+	 * to rounding, and may be taken for a pull) */
+	o->softened = fresh && began_inside(c, &d->px);
+	if (o->softened && irdm_engine_contact_soften(c->s->eng, i))
 		return IRDM_EFAULT;
 	d->cmd.mode = IRDM_CONTACT_PUSH;
 	irdm_v3_sub(d->cmd.target_m, o->tip_obj_m, site.rest_m);
 	memcpy(o->target_m, d->cmd.target_m, sizeof(o->target_m));
 	return IRDM_OK;
+}
+
+/* The engine's force, in the proxy's frame (a floating object's own), for
+ * friction's next judgement (irdm_proxy_force()). */
+static void proxy_force(const struct irdm_ctrl *c, struct irdm_proxy *px, const double f[3])
+{
+	double zero[3] = { 0, 0, 0 }, o[3], fo[3];
+
+	irdm_engine_world_to_object(c->s->eng, zero, o);
+	irdm_engine_world_to_object(c->s->eng, f, fo);
+	irdm_v3_sub(fo, fo, o);
+	irdm_proxy_force(px, fo);
 }
 
 void ctrl_contacts_end(struct irdm_ctrl *c)
@@ -142,6 +159,7 @@ int ctrl_contacts(struct irdm_ctrl *c, struct irdm_ctrl_output *out, bool on)
 
 		out->dev[i].contact = st->mode != IRDM_CONTACT_OFF;
 		memcpy(out->dev[i].force_obj_n, st->force_n, sizeof(st->force_n));
+		proxy_force(c, &c->dev[i].px, st->force_n);
 	}
 	return IRDM_OK;
 }

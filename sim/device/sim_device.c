@@ -245,12 +245,22 @@ static int params_ok(const struct irdm_sim_params *p)
 }
 
 /* Sample the encoders into the read ring's slot for the current tick. */
+/*
+ * An incremental encoder counts on past the range the controller accepts
+ * (count_min..count_max is the controller's check, which reports it as
+ * its own cause): the sample is the count wherever it lies; only an angle
+ * with no int32 count (not finite, or beyond 2^31 counts) has none.
+ */
 static void sample(struct irdm_sim_device *s)
 {
 	unsigned slot = (unsigned)(s->ticks % RING);
+	struct irdm_device_config enc = s->dev;
 
-	s->count_status[slot] = irdm_device_counts_from_angles(&s->dev, s->q_rad,
-							       s->count_ring[slot]);
+	for (unsigned i = 0; i < 3; i++) {
+		enc.count_min[i] = INT32_MIN;
+		enc.count_max[i] = INT32_MAX;
+	}
+	s->count_status[slot] = irdm_device_counts_from_angles(&enc, s->q_rad, s->count_ring[slot]);
 }
 
 /*

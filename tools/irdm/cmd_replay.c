@@ -38,13 +38,16 @@ static const char usage[] =
 	"tri, b0, b1, b2 per contact: the contact's site that sample, a surface\n"
 	"triangle and barycentrics (tri -1: none; its displacement must be nan), as\n"
 	"irdm-fw logs them (irdm log export: dN_site_tri, dN_b0..2, and the targets\n"
-	"dN_tx_m.. for TRAJ.csv): a sliding contact replayed tick by tick.\n"
+	"dN_tx_m.. for TRAJ.csv): a sliding contact replayed tick by tick; the\n"
+	"site's normal is its triangle's on the surface as the engine has it, as\n"
+	"irdm-fw's proxy gives it.\n"
 	"--passivity turns on the engine's passivity control (a haptic board's).\n"
 	"--nodes all: every node of the image.\n"
 	"RUN.log (instead of --contact or --sites): an irdm-fw log (--log) and the\n"
 	"board it ran on: the engine configured as the controller did (the board's\n"
 	"coupling and passivity control, push contacts), each record's site and\n"
-	"target replayed, and how far the forces are from the logged ones said.\n";
+	"target replayed (a contact the record marks as begun softly begun so),\n"
+	"and how far the forces are from the logged ones said.\n";
 
 static int parse_contact(const char *s, struct irdm_replay_contact *c)
 {

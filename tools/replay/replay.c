@@ -48,11 +48,13 @@ struct irdm_replay {
 	struct trajectory tr;
 	struct trajectory sites;        /* --sites or --log: per-sample sites, else none */
 	struct trajectory logged;       /* --log: the controller's forces, else none */
+	struct trajectory softened;     /* --log: the contacts that began softly */
 	unsigned n_contacts;
 	enum irdm_contact_mode mode;
 	double *pos;                    /* every image node's position */
 	size_t pos_row;                 /* the sample pos holds, SIZE_MAX: none */
 	struct irdm_contact_site site[IRDM_MAX_CONTACTS];
+	struct irdm_contact_mesh cm;    /* for the sites' normals; hdr NULL: none */
 	uint32_t *rows, *mesh;          /* --nodes: image rows and their mesh nodes */
 	size_t n_nodes, row;
 	struct irdm_replay_summary *sum;
@@ -203,6 +205,7 @@ static int start_log(struct irdm_replay *r, const char *board_name, char *err, s
 	r->tr = lg.tr;
 	r->sites = lg.sites;
 	r->logged = lg.forces;
+	r->softened = lg.softened;
 	return IRDM_OK;
 }
 
@@ -252,6 +255,8 @@ static int start(struct irdm_replay *r, char *err, size_t errlen)
 		return ret;
 	r->img = r->s->img;
 	r->eng = r->s->eng;
+	if (irdm_contact_mesh_init(&r->cm, r->img))
+		memset(&r->cm, 0, sizeof(r->cm));       /* no BVH: sites keep the rest normal */
 	ret = o->log ? start_log(r, board_name, err, errlen) : start_inputs(r, err, errlen);
 	if (ret || !deform)
 		return ret;
@@ -279,6 +284,25 @@ static void header(struct irdm_replay *r)
 	fputc('\n', r->out);
 }
 
+static void engine_disp(const void *ctx, uint32_t row, double u[3])
+{
+	irdm_engine_node_disp(ctx, row, u);
+}
+
+/*
+ * The normal irdm-fw gives the engine with a site: its triangle's on the
+ * surface as the engine has it now (the proxy's, irdm_contact_tri_normal()),
+ * not at rest; the push release judges the force against it.
+ */
+static void deformed_normal(struct irdm_replay *r, uint32_t tri, struct irdm_contact_site *site)
+{
+	const struct irdm_contact_disp disp = { .fn = engine_disp, .ctx = r->eng };
+	double n[3];
+
+	if (r->cm.hdr && irdm_contact_tri_normal(&r->cm, &disp, tri, n))
+		memcpy(site->normal, n, sizeof(n));
+}
+
 /* This sample's commands; a contact whose sample has no site is an error. */
 static int commands(struct irdm_replay *r, const double *v, struct irdm_contact_cmd *cmd,
 		    char *err, size_t errlen)
@@ -298,7 +322,15 @@ static int commands(struct irdm_replay *r, const double *v, struct irdm_contact_
 					 "no site", r->o->log ? r->o->log : r->o->sites, r->row + 1, i + 1);
 				return IRDM_EINVAL;
 			}
+			deformed_normal(r, (uint32_t)st[0], &r->site[i]);
 			irdm_engine_contact_begin(r->eng, i, &r->site[i], r->mode);
+			if (r->softened.v &&
+			    r->softened.v[r->row * r->softened.n_cols + 1 + i] != 0 &&
+			    irdm_engine_contact_soften(r->eng, i)) {
+				snprintf(err, errlen, "%s: row %zu: contact %u began softly but is not "
+					 "new", r->o->log, r->row + 1, i + 1);
+				return IRDM_EINVAL;
+			}
 		} else if (irdm_engine_contact(r->eng, i)->mode == IRDM_CONTACT_OFF) {
 			irdm_engine_contact_begin(r->eng, i, &r->site[i], r->mode);
 		}
@@ -431,6 +463,7 @@ int irdm_replay_run(const struct irdm_replay_opts *o, struct irdm_replay_summary
 	irdm_trajectory_free(&r->tr);
 	irdm_trajectory_free(&r->sites);
 	irdm_trajectory_free(&r->logged);
+	irdm_trajectory_free(&r->softened);
 	free(r->pos);
 	free(r->rows);
 	free(r->mesh);

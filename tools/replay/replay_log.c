@@ -14,10 +14,11 @@
 
 static int alloc_tables(struct replay_log *lg, size_t n, unsigned dev)
 {
-	struct trajectory *t[3] = { &lg->tr, &lg->sites, &lg->forces };
-	size_t cols[3] = { 1 + 3 * (size_t)dev, 1 + 4 * (size_t)dev, 1 + 3 * (size_t)dev };
+	struct trajectory *t[4] = { &lg->tr, &lg->sites, &lg->forces, &lg->softened };
+	size_t cols[4] = { 1 + 3 * (size_t)dev, 1 + 4 * (size_t)dev, 1 + 3 * (size_t)dev,
+			   1 + (size_t)dev };
 
-	for (int k = 0; k < 3; k++) {
+	for (int k = 0; k < 4; k++) {
 		t[k]->n_rows = n;
 		t[k]->n_cols = cols[k];
 		t[k]->v = malloc((n ? n : 1) * cols[k] * sizeof(double));
@@ -33,8 +34,9 @@ static int put_record(struct replay_log *lg, size_t k, const struct irdm_tick_re
 {
 	double *u = &lg->tr.v[k * lg->tr.n_cols], *s = &lg->sites.v[k * lg->sites.n_cols];
 	double *f = &lg->forces.v[k * lg->forces.n_cols];
+	double *g = &lg->softened.v[k * lg->softened.n_cols];
 
-	u[0] = s[0] = f[0] = t;
+	u[0] = s[0] = f[0] = g[0] = t;
 	for (unsigned d = 0; d < lg->n_devices; d++) {
 		const struct irdm_tick_dev *dv = &rec->dev[d];
 		bool on = dv->site_tri != IRDM_TELEM_NO_TRI;
@@ -42,6 +44,7 @@ static int put_record(struct replay_log *lg, size_t k, const struct irdm_tick_re
 		if (on && dv->site_tri >= n_tris)
 			return -1;
 		s[1 + 4 * d] = on ? (double)dv->site_tri : -1.0;
+		g[1 + d] = on && dv->softened ? 1.0 : 0.0;
 		for (int a = 0; a < 3; a++) {
 			s[2 + 4 * d + a] = on ? dv->site_bary[a] : 0.0;
 			u[1 + 3 * d + a] = on ? dv->target_m[a] : NAN;
@@ -121,4 +124,5 @@ void replay_log_free(struct replay_log *lg)
 	irdm_trajectory_free(&lg->tr);
 	irdm_trajectory_free(&lg->sites);
 	irdm_trajectory_free(&lg->forces);
+	irdm_trajectory_free(&lg->softened);
 }

@@ -35,6 +35,7 @@ void irdm_trajectory_free(struct trajectory *tr);
  */
 struct replay_log {
 	struct trajectory tr, sites, forces;
+	struct trajectory softened;     /* t, then 1 or 0 per device: began softly */
 	unsigned n_devices;
 	char board[IRDM_LOG_NAME_LEN];
 };

@@ -75,6 +75,8 @@ struct irdm_board {
 	bool coupling_auto;
 	double coupling_k_n_per_m;              /* when !coupling_auto; 0,0 = rigid */
 	double coupling_b_ns_per_m;
+	/* Coulomb friction on the proxy: static, dynamic; 0,0 frictionless */
+	double friction_mu[2];
 
 	/* object placement (above) */
 	double object_offset_m[3];

@@ -91,6 +91,14 @@ void irdm_contact_tri_pos(const struct irdm_contact_mesh *cm, const struct irdm_
 			  uint32_t t, double v[3][3]);
 
 /*
+ * Outward unit normal of SURFACE triangle t displaced by d, computed as the
+ * proxy computes its own (irdm_proxy_site()'s normal), so a replay can
+ * hand the engine the same one.  False for a zero-area triangle.
+ */
+bool irdm_contact_tri_normal(const struct irdm_contact_mesh *cm, const struct irdm_contact_disp *d,
+			     uint32_t t, double n[3]);
+
+/*
  * Closest point to p on triangle (a, b, c) (Ericson, Real-Time Collision
  * Detection 5.1.5): writes the point q and the barycentric weights of
  * a, b, c; returns |p - q|^2.  Works for degenerate triangles too.
@@ -121,6 +129,9 @@ struct irdm_proxy_config {
 	double radius_m;                /* detection radius of the closest point query */
 	double max_disp_m;              /* bound on |u| (see irdm_contact_closest) */
 	unsigned max_walk;              /* edge crossings per update, 1..IRDM_CONTACT_MAX_WALK */
+	/* Coulomb friction: static and dynamic coefficients, 0 <= mu_d <=
+	 * mu_s; mu_s = 0: frictionless (the default) */
+	double mu_s, mu_d;
 };
 
 /* State of one proxy: zero it (or irdm_proxy_reset) to start inactive. */
@@ -134,6 +145,16 @@ struct irdm_proxy {
 	double depth_m;                 /* signed distance of the device from that
 					 * plane (<= 0 while in contact) */
 	unsigned steps;                 /* edge crossings taken by the last update */
+	/* the force the coupling put on the object at the last update's
+	 * point, when the caller gave it (irdm_proxy_force()): friction's
+	 * cone is then judged on it */
+	bool force_known;
+	double force_n[3];
+	/* faces beyond the edges of rim_tri on the touchable area's rim,
+	 * found by a search (a memo: bit e of rim_known says rim_face[e]) */
+	uint32_t rim_tri;
+	uint32_t rim_face[3];
+	uint8_t rim_known;
 };
 
 enum irdm_proxy_event {
@@ -149,13 +170,17 @@ void irdm_proxy_reset(struct irdm_proxy *px);
 /*
  * One update with the device at p (object frame).  Inactive: when the
  * closest point within radius_m has signed distance <= 0 (the device has
- * crossed the surface) the proxy starts there.  Active: the device is
- * projected on the plane of the proxy's displaced triangle; while the
- * projection leaves the triangle the proxy walks to the neighbour across
- * the edge it left by (at most max_walk steps); at a boundary of the
- * contactable region (or a concave crease) it stops at the closest point
- * of its triangle.  The contact ends when the device is outside the plane
- * of the proxy's triangle (depth > 0).
+ * crossed the surface) and the device is not outside the object by a face
+ * beyond that triangle's edges, the proxy starts there.  Active: the
+ * device is projected on the plane of the proxy's displaced triangle;
+ * while the projection leaves the triangle the proxy walks to the
+ * neighbour across the edge it left by (at most max_walk steps); at a
+ * boundary of the touchable region (or a concave crease) it stops at the
+ * closest point of its triangle.  On a shared edge or vertex the triangle
+ * of lowest index that holds the projection is taken.  The contact ends
+ * when the device is outside the plane of the proxy's triangle (depth >
+ * 0), or in front of the face beyond a convex edge it projects past or
+ * beyond an edge of the touchable area's rim (that face touchable or not).
  *
  * Return: an enum irdm_proxy_event (>= 0);
  * IRDM_EINVAL if px, cm (or its BVH), cfg or p is NULL (px untouched), if
@@ -166,6 +191,15 @@ void irdm_proxy_reset(struct irdm_proxy *px);
 int irdm_proxy_update(struct irdm_proxy *px, const struct irdm_contact_mesh *cm,
 		      const struct irdm_contact_disp *d, const struct irdm_proxy_config *cfg,
 		      const double p[3]);
+
+/*
+ * The force on the object (proxy's frame) that the contact at the last
+ * update's site gave: with friction, the next update judges the cone on
+ * it (the force the device renders, the coupling's damper and the
+ * object's compliance included) instead of on the coupling spring's
+ * geometry alone.  Forgotten when the proxy is released.
+ */
+void irdm_proxy_force(struct irdm_proxy *px, const double force_n[3]);
 
 /*
  * The engine's contact site of an active proxy: n_nodes 3, rows and

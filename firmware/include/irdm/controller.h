@@ -141,6 +141,8 @@ struct irdm_ctrl_device_output {
 	double force_n[3];              /* force rendered on the tip, device frame, after the clamp */
 	double scale;                   /* force clamp x torque saturation (1: none) */
 	int proxy_event;                /* enum irdm_proxy_event of this tick */
+	bool softened;                  /* the contact began softly this tick
+					 * (irdm_engine_contact_soften()) */
 	bool contact;                   /* the engine's contact is on after the tick */
 	/*
 	 * The proxy runs on the object as it is now (a floating object in its

@@ -90,7 +90,9 @@ struct irdm_tick_dev {
 	double force_n[3];              /* force on the object (the device renders -force_n) */
 	uint32_t contact_tri;           /* the proxy's SURFACE triangle, IRDM_TELEM_NO_TRI: none */
 	uint8_t proxy;                  /* enum irdm_proxy_event */
-	uint8_t reserved[3];            /* zero */
+	uint8_t softened;               /* 1: the contact began softly this tick
+					 * (irdm_engine_contact_soften()), 0 */
+	uint8_t reserved[2];            /* zero */
 	/*
 	 * The engine's command this tick, all that `irdm replay --sites`
 	 * needs to repeat it: the site (SURFACE triangle and barycentrics;

@@ -131,9 +131,11 @@ int irdm_sim_device_set_hand_force(struct irdm_sim_device *s, const double f_n[3
 int irdm_sim_device_step(struct irdm_sim_device *s, double dt_s);
 
 /*
- * The encoder counts the reader sees this tick (read_delay_ticks old).
- * Return: IRDM_OK; IRDM_EFAULT if that sample was outside the encoders'
- * range (counts untouched).
+ * The encoder counts the reader sees this tick (read_delay_ticks old),
+ * beyond count_min..count_max too: an encoder counts on past the range the
+ * controller accepts, and the controller's own check reports it.
+ * Return: IRDM_OK; IRDM_EFAULT if that sample had no count (an angle not
+ * finite or beyond 2^31 counts; counts untouched).
  */
 int irdm_sim_device_read_counts(const struct irdm_sim_device *s, int32_t counts[3]);
 
