@@ -268,18 +268,27 @@ def fault_scenario(d, name, kind, args):
 
 def sdo_transfers(fr, node):
     """{(index, sub): (request command, answer command, answer value, request value)}
-    of node's SDOs."""
-    out, pending = {}, {}
+    of node's SDOs.  A request and its answer are paired whichever candump
+    logged first: vcan hands frames on through per-CPU queues, so on a
+    2-CPU guest an answer now and then reaches candump before its request."""
+    out, requests, answers = {}, {}, {}
     for f in fr:
         if len(f[2]) != 8:
             continue
         key = (f[2][1] | f[2][2] << 8, f[2][3])
         value = int.from_bytes(f[2][4:8], "little")
         if f[1] == 0x600 + node:
-            pending[key] = (f[2][0], value)
-        elif f[1] == 0x580 + node and key in pending:
-            cmd, req = pending.pop(key)
-            out[key] = (cmd, f[2][0], value, req)
+            if key in answers:
+                cmd, ans = answers.pop(key)
+                out[key] = (f[2][0], cmd, ans, value)
+            else:
+                requests[key] = (f[2][0], value)
+        elif f[1] == 0x580 + node:
+            if key in requests:
+                cmd, req = requests.pop(key)
+                out[key] = (cmd, f[2][0], value, req)
+            else:
+                answers[key] = (f[2][0], value)
     return out
 
 
