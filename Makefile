@@ -317,7 +317,7 @@ bench: $(BENCHES) $(IRDM) bench-precompute
 REPORT_CONFIGS ?= sweep floating
 REPORT_MD ?= docs/report.md
 report: $(IRDM)
-	@mkdir -p out/report docs/report
+	@mkdir -p out docs/report
 	$(IRDM) report $(foreach c,$(REPORT_CONFIGS),--config $(c)) -o out/report \
 	  --md $(REPORT_MD) --plots report/report
 	for c in $(REPORT_CONFIGS); do \

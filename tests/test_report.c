@@ -16,6 +16,7 @@
  *     reference (tests/support/engine_fixture.c) and their own engine
  *     loop, agree with the report's to 1e-6.
  */
+#include <dirent.h>
 #include <math.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -37,6 +38,7 @@
 static char dir[256];
 static struct rfx_row rows[8];
 static int n_rows;
+static struct rfx_row rows_again[8];
 
 static const char *irdm_path(void)
 {
@@ -57,7 +59,7 @@ static int setup(void **state)
 static int teardown(void **state)
 {
 	(void)state;
-	return tf_rmdir(dir);
+	return rfx_remove(dir);
 }
 
 static const struct rfx_row *row_of(const char *repr)
@@ -136,7 +138,7 @@ static void test_bytes_are_file_sizes(void **state)
 		char path[512];
 		struct stat st;
 
-		snprintf(path, sizeof(path), "%s/tmp/%s", dir, files[i][1]);
+		snprintf(path, sizeof(path), "%s/%s", dir, files[i][1]);
 		assert_int_equal(stat(path, &st), 0);
 		assert_int_equal(row_of(files[i][0])->bytes, (size_t)st.st_size);
 	}
@@ -167,7 +169,7 @@ static void test_errors_recomputed(void **state)
 		target[3 * t] = target[3 * t + 1] = 0;
 		target[3 * t + 2] = -0.01;
 	}
-	snprintf(path, sizeof(path), "%s/tmp/tiny-reference-2ms.img", dir);
+	snprintf(path, sizeof(path), "%s/tiny-reference-2ms.img", dir);
 	assert_int_equal(irdm_image_map(path, 0, &ref, err, sizeof(err)), 0);
 	irdm_engine_config_default(&cfg);
 	ses = efx_session(&ref, &cfg);
@@ -178,7 +180,7 @@ static void test_errors_recomputed(void **state)
 		const struct rfx_row *r = row_of(reprs[i][0]);
 		double whole, first, after;
 
-		snprintf(path, sizeof(path), "%s/tmp/%s", dir, reprs[i][1]);
+		snprintf(path, sizeof(path), "%s/%s", dir, reprs[i][1]);
 		assert_int_equal(irdm_image_map(path, 0, &img, err, sizeof(err)), 0);
 		rfx_engine_grab(&img, top, target, N, F);
 		irdm_image_unmap(&img);
@@ -208,6 +210,71 @@ static void test_markdown(void **state)
 	assert_non_null(strstr(text, "**The paper's setting** (fir:100 at 2 ms)"));
 	assert_non_null(strstr(text, "(**unstable**)"));
 	assert_non_null(strstr(text, "| **fir:100 (paper)** | 2 ms | **no**"));
+}
+
+/* How many entries of d begin with prefix. */
+static int entries(const char *d, const char *prefix)
+{
+	DIR *dp = opendir(d);
+	struct dirent *e;
+	int n = 0;
+
+	assert_non_null(dp);
+	while ((e = readdir(dp)))
+		n += !strncmp(e->d_name, prefix, strlen(prefix));
+	closedir(dp);
+	return n;
+}
+
+/* irdm report -o DIR: a directory it did not write is refused, untouched,
+ * unless --force; what it wrote before is replaced; nothing beside DIR
+ * is touched.  --repr keeps the runs short. */
+static void test_output_dir(void **state)
+{
+	char base[320], foreign[400], mine[420], sibling[400], marker[420], csv[420], err[4096];
+	char text[64];
+	const char *args[] = { "report", "--config", "tiny", "--repr", "modal:20+sc", "-o", foreign,
+			       "-q", NULL, NULL };
+	struct stat st;
+
+	(void)state;
+	snprintf(base, sizeof(base), "%s", dir);
+	*strrchr(base, '/') = '\0';
+	snprintf(foreign, sizeof(foreign), "%s/foreign", base);
+	snprintf(mine, sizeof(mine), "%s/mine.txt", foreign);
+	snprintf(sibling, sizeof(sibling), "%s/sibling.txt", base);
+	snprintf(marker, sizeof(marker), "%s/.irdm-output", foreign);
+	snprintf(csv, sizeof(csv), "%s/report-tiny.csv", foreign);
+	assert_int_equal(mkdir(foreign, 0755), 0);
+	tf_write_text(mine, "a user's notes\n");
+	tf_write_text(sibling, "beside\n");
+	/* not irdm report's: refused before any work, naming the file */
+	assert_int_equal(rp_run(base, irdm_path(), args, NULL, 0, err, sizeof(err)), 1);
+	assert_non_null(strstr(err, "foreign/mine.txt: not written by irdm report"));
+	assert_ptr_equal(strchr(err, '\n'), err + strlen(err) - 1);
+	tf_read_text(mine, text, sizeof(text));
+	assert_string_equal(text, "a user's notes\n");
+	assert_int_not_equal(stat(csv, &st), 0);
+	assert_int_equal(entries(base, "foreign."), 0);
+	/* --force: replaced whole, the sibling kept */
+	args[8] = "--force";
+	if (rp_run(base, irdm_path(), args, NULL, 0, err, sizeof(err)))
+		fail_msg("irdm report --force: %s", err);
+	assert_int_not_equal(stat(mine, &st), 0);
+	assert_int_equal(stat(marker, &st), 0);
+	assert_int_equal(stat(csv, &st), 0);
+	tf_read_text(sibling, text, sizeof(text));
+	assert_string_equal(text, "beside\n");
+	/* its own output, again without --force: replaced */
+	args[8] = NULL;
+	tf_write_text(csv, "stale\n");
+	if (rp_run(base, irdm_path(), args, NULL, 0, err, sizeof(err)))
+		fail_msg("irdm report over its own output: %s", err);
+	assert_int_equal(rfx_read_csv(foreign, "tiny", rows_again, 8), 1);
+	assert_string_equal(rows_again[0].repr, "modal:20+sc");
+	tf_read_text(sibling, text, sizeof(text));
+	assert_string_equal(text, "beside\n");
+	assert_int_equal(entries(base, "foreign."), 0);
 }
 
 static void test_bad_config(void **state)
@@ -240,6 +307,7 @@ int main(void)
 		cmocka_unit_test(test_bytes_are_file_sizes),
 		cmocka_unit_test(test_errors_recomputed),
 		cmocka_unit_test(test_markdown),
+		cmocka_unit_test(test_output_dir),
 		cmocka_unit_test(test_bad_config),
 		cmocka_unit_test(test_bad_repr),
 	};

@@ -52,7 +52,7 @@ static int setup(void **state)
 static int teardown(void **state)
 {
 	(void)state;
-	return tf_rmdir(dir);
+	return rfx_remove(dir);
 }
 
 static const struct rfx_row *row_of(const char *repr, const char *scen)
@@ -121,7 +121,7 @@ static void map(const char *file, struct irdm_image *img)
 {
 	char path[512], err[512];
 
-	snprintf(path, sizeof(path), "%s/tmp/%s", dir, file);
+	snprintf(path, sizeof(path), "%s/%s", dir, file);
 	assert_int_equal(irdm_image_map(path, 0, img, err, sizeof(err)), 0);
 }
 

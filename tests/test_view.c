@@ -885,7 +885,21 @@ static void test_render_directory(void **state)
 	assert_non_null(strstr(err_text, "frames.pvd: a frame outside DIR"));
 	tf_write_text(path, "<DataSet timestep=\"0.1\" group=\"\" part=\"0\" file=\"frame_00000.vtu\"/>\n");
 	assert_int_equal(view_refuses(bad_dir), 1);
-	assert_non_null(strstr(err_text, "bad-render/frame_00000.vtu: cannot open"));
+	assert_non_null(strstr(err_text, "bad-render/frame_00000.vtu: cannot open: No such file"));
+	/* a FIFO for a frame or for frames.pvd: refused with the reason, where
+	 * opening it to read would wait for a writer that never comes */
+	snprintf(path, sizeof(path), "%s/frame_00000.vtu", bad_dir);
+	assert_int_equal(mkfifo(path, 0600), 0);
+	assert_int_equal(view_refuses(bad_dir), 1);
+	assert_non_null(strstr(err_text, "bad-render/frame_00000.vtu: not a regular file (a FIFO)"));
+	assert_int_equal(unlink(path), 0);
+	snprintf(path, sizeof(path), "%s/fifo-render", dir);
+	assert_int_equal(mkdir(path, 0755), 0);
+	snprintf(path, sizeof(path), "%s/fifo-render/frames.pvd", dir);
+	assert_int_equal(mkfifo(path, 0600), 0);
+	snprintf(path, sizeof(path), "%s/fifo-render", dir);
+	assert_int_equal(view_refuses(path), 1);
+	assert_non_null(strstr(err_text, "fifo-render/frames.pvd: not a regular file (a FIFO)"));
 	snprintf(path, sizeof(path), "%s/frame_00000.vtu", bad_dir);
 	tf_write_text(path, "<Piece NumberOfPoints=\"3\" NumberOfCells=\"1\">\n");
 	assert_int_equal(view_refuses(bad_dir), 1);

@@ -20,16 +20,33 @@
 int rfx_run(char *dir, size_t len, const char *config)
 {
 	const char *irdm = getenv("IRDM") ? getenv("IRDM") : "build/irdm";
-	const char *args[] = { "report", "--config", config, "-o", dir, "--keep-images", "-q", NULL };
-	char err[4096];
+	char base[256], out[320], err[4096];
+	const char *args[] = { "report", "--config", config, "-o", out, "--keep-images", "-q", NULL };
 	int rc;
 
-	if (tf_tmpdir(dir, len, "report"))
+	/* the report's own directory beside the run's stdout and stderr: it
+	 * replaces only a directory it wrote */
+	if (tf_tmpdir(base, sizeof(base), "report"))
 		return -1;
-	rc = rp_run(dir, irdm, args, NULL, 0, err, sizeof(err));
+	snprintf(out, sizeof(out), "%s/out", base);
+	snprintf(dir, len, "%s", out);
+	rc = rp_run(base, irdm, args, NULL, 0, err, sizeof(err));
 	if (rc)
 		fprintf(stderr, "irdm report --config %s: exit %d: %s\n", config, rc, err);
 	return rc ? -1 : 0;
+}
+
+int rfx_remove(const char *dir)
+{
+	char base[320];
+	char *slash;
+
+	snprintf(base, sizeof(base), "%s", dir);
+	slash = strrchr(base, '/');
+	if (!slash || strcmp(slash, "/out"))
+		return -1;
+	*slash = '\0';
+	return tf_rmdir(base);
 }
 
 /* config,repr,dt_ms,scenario,force_err,first10,after100,disp_err,median,p99,

@@ -21,9 +21,12 @@ struct rfx_row {
 };
 
 /* `irdm report --config config -o DIR --keep-images -q` ($IRDM, default
- * build/irdm) in a new /tmp/irdm-report-XXXXXX written to dir.
+ * build/irdm) into DIR = a new /tmp/irdm-report-XXXXXX/out, written to dir.
  * Return: 0, or -1 with the reason on stderr (for cmocka setups). */
 int rfx_run(char *dir, size_t len, const char *config);
+
+/* Remove what rfx_run made (dir and the directory around it). */
+int rfx_remove(const char *dir);
 
 /* The rows of DIR/report-CONFIG.csv, at most max; fails the test on a
  * row of another configuration or one it cannot parse.  Return: rows. */

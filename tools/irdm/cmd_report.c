@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* irdm report: accuracy, tick time and image size of every representation. */
 #include <errno.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -10,13 +11,15 @@
 
 #include "cli.h"
 #include "irdm/error.h"
+#include "irdm/outdir.h"
 #include "precompute/precompute.h"
 #include "report/report.h"
 #include "report/report_check.h"
+#include "util/interrupt.h"
 
 static const char usage[] =
-	"usage: irdm report [--config NAME]... [-o DIR] [--md FILE] [--plots PREFIX]\n"
-	"                   [--repr NAME] [--tmp DIR] [--keep-images] [-q]\n"
+	"usage: irdm report [--config NAME]... [-o DIR] [--force] [--md FILE]\n"
+	"                   [--plots PREFIX] [--repr NAME] [--tmp DIR] [--keep-images] [-q]\n"
 	"\n"
 	"For each representation of a model (scene keys), each sample period and\n"
 	"each scenario (prescribed contact trajectories): the relative RMS error of\n"
@@ -27,13 +30,18 @@ static const char usage[] =
 	"\n"
 	"  --config NAME   sweep (default), paper, floating (the floating cube's swing\n"
 	"                  and tap), tiny or tiny-floating (the tests'); repeatable\n"
-	"  -o DIR          CSV files DIR/report-NAME.csv (default out/report)\n"
-	"  --md FILE       the Markdown report (default DIR/report.md)\n"
+	"  -o DIR          CSV files DIR/report-NAME.csv (default out/report); DIR is\n"
+	"                  written whole at the end, in place of what irdm report wrote\n"
+	"                  there before; another directory is refused unless empty\n"
+	"  --force         replace DIR even if irdm report did not write it (a\n"
+	"                  directory of files only)\n"
+	"  --md FILE       the Markdown report (default DIR/report.md), replaced once\n"
+	"                  DIR is in place\n"
 	"  --plots PREFIX  plot links in the Markdown: PREFIX-NAME-{tick,bytes}.png\n"
 	"                  (default report; tools/scripts/plot-report.py draws them)\n"
 	"  --repr NAME     only this representation\n"
-	"  --tmp DIR       where images are built (default DIR/tmp)\n"
-	"  --keep-images   leave the images in --tmp\n"
+	"  --tmp DIR       where images are built (default: in -o DIR, while written)\n"
+	"  --keep-images   leave the images in --tmp (by default, in -o DIR)\n"
 	"  -q              no progress\n";
 
 #define MAX_CONFIGS 4
@@ -43,6 +51,8 @@ struct report_args {
 	size_t n_cfg;
 	const char *dir, *md, *plots, *repr, *tmp;
 	int keep, quiet;
+	bool force;
+	struct irdm_outdir od;          /* the CSVs go to od.tmp, put in dir's place at the end */
 };
 
 static int parse(struct report_args *a, int argc, char **argv)
@@ -50,6 +60,10 @@ static int parse(struct report_args *a, int argc, char **argv)
 	for (int i = 1; i < argc; i++) {
 		const char *o = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
 
+		if (!strcmp(o, "--force")) {
+			a->force = true;
+			continue;
+		}
 		if (!strcmp(o, "--keep-images") || !strcmp(o, "-q")) {
 			*(o[1] == 'q' ? &a->quiet : &a->keep) = 1;
 			continue;
@@ -97,10 +111,17 @@ static void csv_row(void *ctx, const struct irdm_report_row *r)
 	fflush(ctx);
 }
 
-static int make_dir(const char *d)
+/* A --tmp the user named: made if missing (and then removed at the end
+ * when empty), never removed if it was there before. */
+static int make_tmp(const char *d, bool *made)
 {
-	if (mkdir(d, 0777) && errno != EEXIST) {
-		fprintf(stderr, "irdm report: EIO: %s: %s\n", d, strerror(errno));
+	*made = false;
+	if (!mkdir(d, 0777)) {
+		*made = true;
+		return 0;
+	}
+	if (errno != EEXIST) {
+		fprintf(stderr, "irdm report: EIO: --tmp %s: %s\n", d, strerror(errno));
 		return -1;
 	}
 	return 0;
@@ -165,14 +186,14 @@ static void header(FILE *f, const double load[3], const double load_end[3], doub
 static int run_config(const struct report_args *a, const struct irdm_report_config *cfg,
 		      struct irdm_cli_progress *prog, struct irdm_report_result *res)
 {
-	char path[1024], err[1024];
+	char path[IRDM_OUTDIR_PATH_MAX + 128], err[1024];
 	struct irdm_report_opts o = { .cfg = cfg, .tmp_dir = a->tmp, .only_repr = a->repr,
 				      .keep_images = a->keep, .progress = irdm_cli_progress,
 				      .ctx = prog, .row_done = csv_row };
 	FILE *csv;
 	int rc;
 
-	snprintf(path, sizeof(path), "%s/report-%s.csv", a->dir, cfg->name);
+	snprintf(path, sizeof(path), "%s/report-%s.csv", a->od.tmp, cfg->name);
 	csv = fopen(path, "w");
 	if (!csv) {
 		fprintf(stderr, "irdm report: EIO: %s: %s\n", path, strerror(errno));
@@ -192,16 +213,61 @@ static int run_config(const struct report_args *a, const struct irdm_report_conf
 	return 0;
 }
 
+/* The Markdown, aside (part) until the CSVs are in place. */
+static int write_md(const struct report_args *a, const char *part, const double load[3],
+		    const double load_end[3], double seconds, const struct irdm_report_result *res)
+{
+	FILE *f = fopen(part, "w");
+
+	if (!f) {
+		fprintf(stderr, "irdm report: EIO: %s: %s\n", part, strerror(errno));
+		return 1;
+	}
+	header(f, load, load_end, seconds);
+	for (size_t i = 0; i < a->n_cfg; i++)
+		irdm_report_markdown(f, a->cfg[i], &res[i], a->plots);
+	if (fclose(f)) {
+		fprintf(stderr, "irdm report: EIO: %s: write failed\n", part);
+		unlink(part);
+		return 1;
+	}
+	return 0;
+}
+
+/* The configurations into a.od.tmp, then the Markdown; 0 or the exit code. */
+static int run_all(struct report_args *a, const char *part, double *seconds_out)
+{
+	struct irdm_report_result res[MAX_CONFIGS];
+	struct irdm_cli_progress prog = { .quiet = a->quiet };
+	double load[3] = { 0 }, load_end[3] = { 0 }, seconds = 0;
+	size_t done = 0;
+	int rc = 0;
+
+	getloadavg(load, 3);
+	for (; done < a->n_cfg && !rc; done++) {
+		rc = run_config(a, a->cfg[done], &prog, &res[done]);
+		seconds += rc ? 0 : res[done].seconds;
+	}
+	if (rc) {
+		done--;
+		goto out_res;
+	}
+	getloadavg(load_end, 3);
+	rc = write_md(a, part, load, load_end, seconds, res);
+	*seconds_out = seconds;
+out_res:
+	for (size_t i = 0; i < done; i++)
+		irdm_report_result_free(&res[i]);
+	return rc;
+}
+
 int irdm_cmd_report(int argc, char **argv)
 {
-	struct report_args a = { .dir = "out/report", .plots = "report" };
-	struct irdm_report_result res[MAX_CONFIGS];
-	struct irdm_cli_progress prog = { 0 };
-	char md[1024], tmp[1024], part[1100];
-	double load[3] = { 0 }, load_end[3] = { 0 }, seconds = 0;
-	FILE *f;
-	int rc = 0;
-	size_t done = 0;
+	static struct report_args a = { .dir = "out/report", .plots = "report" };
+	char part[IRDM_OUTDIR_PATH_MAX + 64];
+	bool made_tmp = false;
+	double seconds = 0;
+	int rc, ret, slot;
 
 	for (int i = 1; i < argc; i++)
 		if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
@@ -219,47 +285,51 @@ int irdm_cmd_report(int argc, char **argv)
 				a.repr, a.cfg[i]->name);
 			return 2;
 		}
-	snprintf(md, sizeof(md), "%s/report.md", a.dir);
-	snprintf(tmp, sizeof(tmp), "%s/tmp", a.dir);
-	if (!a.md)
-		a.md = md;
-	if (!a.tmp)
-		a.tmp = tmp;
-	if (make_dir(a.dir) || make_dir(a.tmp))
+	if (a.tmp && make_tmp(a.tmp, &made_tmp))
 		return 1;
-	prog.quiet = a.quiet;
-	getloadavg(load, 3);
-	for (; done < a.n_cfg && !rc; done++) {
-		rc = run_config(&a, a.cfg[done], &prog, &res[done]);
-		seconds += rc ? 0 : res[done].seconds;
-	}
-	if (rc) {
-		done--;
-		goto out_res;
-	}
-	getloadavg(load_end, 3);
-	/* written aside and renamed: never a half-written report */
-	snprintf(part, sizeof(part), "%s.part", a.md);
-	f = fopen(part, "w");
-	if (!f) {
-		fprintf(stderr, "irdm report: EIO: %s: %s\n", part, strerror(errno));
+	ret = irdm_outdir_begin(&a.od, a.dir, "irdm report", a.force);
+	if (ret) {
+		irdm_cli_fail("report", ret, a.od.why);
 		rc = 1;
-		goto out_res;
+		goto out_tmp;
 	}
-	header(f, load, load_end, seconds);
-	for (size_t i = 0; i < a.n_cfg; i++)
-		irdm_report_markdown(f, a.cfg[i], &res[i], a.plots);
-	if (fclose(f) || rename(part, a.md)) {
-		fprintf(stderr, "irdm report: EIO: %s: write failed\n", a.md);
+	if (a.od.debris_removed)
+		fprintf(stderr, "irdm report: note: %s: removed %u director%s left by interrupted runs\n",
+			a.dir, a.od.debris_removed, a.od.debris_removed == 1 ? "y" : "ies");
+	slot = irdm_interrupt_add(IRDM_INTERRUPT_DIR, a.od.tmp, 0);
+	if (!a.tmp)
+		a.tmp = a.od.tmp;
+	/* --md FILE is written aside and renamed once DIR is in place: never a
+	 * half-written report, nor one beside CSVs that are not there */
+	if (a.md)
+		snprintf(part, sizeof(part), "%s.part", a.md);
+	else
+		snprintf(part, sizeof(part), "%s/report.md", a.od.tmp);
+	rc = run_all(&a, part, &seconds);
+	if (rc) {
+		irdm_outdir_abort(&a.od);
+		irdm_interrupt_del(slot);
+		goto out_tmp;
+	}
+	ret = irdm_outdir_commit(&a.od);
+	irdm_interrupt_del(slot);
+	if (ret) {
+		irdm_cli_fail("report", ret, a.od.why);
+		rc = 1;
+		if (a.md)
+			unlink(part);
+		goto out_tmp;
+	}
+	if (a.md && rename(part, a.md)) {
+		fprintf(stderr, "irdm report: EIO: %s: %s\n", a.md, strerror(errno));
 		unlink(part);
 		rc = 1;
 	}
 	if (!rc && !a.quiet)
-		printf("report: %s and %s/report-*.csv (%.0f s)\n", a.md, a.dir, seconds);
-out_res:
-	for (size_t i = 0; i < done; i++)
-		irdm_report_result_free(&res[i]);
-	if (!a.keep)
+		printf("report: %s%s and %s/report-*.csv (%.0f s)\n", a.md ? a.md : a.dir,
+		       a.md ? "" : "/report.md", a.dir, seconds);
+out_tmp:
+	if (made_tmp && !a.keep)
 		rmdir(a.tmp);
 	return rc;
 }

@@ -39,7 +39,8 @@ if $py -c 'import matplotlib' 2>/dev/null; then
 		"irdm-fw, simulated PHANToM: press the top centre, hold 2 s, release"
 	$py tools/scripts/plot-surface.py out/run-frame.vtk out/run-frame.png \
 		"irdm-fw, simulated PHANToM: the deformed surface mid-hold"
-	# pressing in, holding, and ringing after the release at 3.2 s
+	# frame N is at N x 0.1 s: pressing in (1.1 s), the hold's start and
+	# end (1.3 s, 3.0 s), ringing 0.1 s after the release at 3.2 s (3.3 s)
 	$py tools/scripts/plot-surface.py out/run-frames/frame_000{11,13,30,33}.vtk \
 		out/run-frames.png "irdm-fw: press, hold, release"
 	echo "run: plots out/default-response.png out/default-forces.png out/run-force.png out/run-latency.png out/run-compute.png out/run-frame.png out/run-frames.png"

@@ -8,12 +8,14 @@
  * Only what irdm render writes is read; anything else is refused, naming
  * the file and what is wrong.
  */
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "irdm/error.h"
+#include "irdm/textfile.h"
 #include "view/view_msg.h"
 #include "view/view_playback.h"
 
@@ -39,29 +41,47 @@ static int bad(struct rdir *r, const char *what)
 	return IRDM_EFORMAT;
 }
 
+/*
+ * A whole file, NUL-terminated.  Opened without blocking and refused
+ * unless a regular file within FILE_MAX, so a FIFO or a device named like
+ * a frame fails at once with the reason instead of hanging the view.
+ */
 static int slurp(struct rdir *r, const char *name, char **out)
 {
 	FILE *f;
 	long n;
+	int ret;
 
 	snprintf(r->path, sizeof(r->path), "%s/%s", r->dir, name);
-	f = fopen(r->path, "rb");
 	free(*out);
 	*out = NULL;
-	if (!f) {
-		snprintf(r->err, r->errlen, "%s: cannot open", r->path);
-		return IRDM_EIO;
-	}
+	ret = irdm_file_fopen(r->path, FILE_MAX, &f, r->err, r->errlen);
+	if (ret)
+		return ret;
+	ret = IRDM_EIO;
 	if (fseek(f, 0, SEEK_END) || (n = ftell(f)) < 0 || (unsigned long)n > FILE_MAX ||
-	    fseek(f, 0, SEEK_SET) || !(*out = malloc((size_t)n + 1)) ||
-	    fread(*out, 1, (size_t)n, f) != (size_t)n) {
-		fclose(f);
-		snprintf(r->err, r->errlen, "%s: cannot read (or over 512 MB)", r->path);
-		return IRDM_EIO;
+	    fseek(f, 0, SEEK_SET)) {
+		snprintf(r->err, r->errlen, "%s: cannot read: %s", r->path, strerror(errno));
+		goto out_close;
+	}
+	*out = malloc((size_t)n + 1);
+	if (!*out) {
+		snprintf(r->err, r->errlen, "%s: %ld bytes: out of memory", r->path, n);
+		ret = IRDM_ENOMEM;
+		goto out_close;
+	}
+	if (fread(*out, 1, (size_t)n, f) != (size_t)n) {
+		snprintf(r->err, r->errlen, "%s: cannot read: %s", r->path,
+			 ferror(f) ? strerror(errno) : "shorter than its size");
+		free(*out);
+		*out = NULL;
+		goto out_close;
 	}
 	(*out)[n] = '\0';
+	ret = IRDM_OK;
+out_close:
 	fclose(f);
-	return IRDM_OK;
+	return ret;
 }
 
 /* count numbers of the DataArray named name, after its '>'. */
