@@ -9,9 +9,12 @@
  *    static amplitude at the touched node), not at one the loop invents;
  *  - --require-rt refuses a kernel that is not PREEMPT_RT (checked here
  *    independently) and runs on one that is;
- *  - SIGTERM, SIGHUP, SIGQUIT mid-contact: torque off and state off in the
- *    next tick, the reason logged, exit 6; SIGSEGV: the emergency path,
- *    exit 8;
+ *  - SIGTERM, SIGHUP, SIGQUIT, SIGUSR1, SIGALRM, a real-time signal
+ *    mid-contact: torque off and state off in the next tick, the reason
+ *    logged, exit 6; SIGXFSZ ignored; SIGSEGV, SIGSYS: the emergency path,
+ *    exit 8; signals pending at start: the run ends in the set-up, exit 6,
+ *    no drive enabled, no escalation (tests/test_fw_signals.c has every
+ *    signal, and the escalation, in detail);
  *  - the image file truncated or written over under a running loop: the
  *    run goes on to its end on its own copy;
  *  - a run whose limits never let the torque on exits 7 naming the limit;

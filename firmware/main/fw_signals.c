@@ -64,6 +64,7 @@ static volatile sig_atomic_t *loop_flag;
 static volatile sig_atomic_t escalate;  /* set while the loop runs */
 static char alt_stack[ALT_STACK_BYTES];
 static char rt_names[RT_SIGNALS_MAX][RT_NAME_BYTES];    /* built before arming */
+static int rt_min = 1, rt_max = 0;      /* SIGRTMIN, SIGRTMAX read once, before arming */
 
 static const struct {
 	int sig;
@@ -83,9 +84,10 @@ static const struct {
 #endif
 };
 
+/* Plain reads: the emergency path names the signal from a handler. */
 static bool is_rt(int sig)
 {
-	return sig >= SIGRTMIN && sig <= SIGRTMAX && sig - SIGRTMIN < (int)RT_SIGNALS_MAX;
+	return sig >= rt_min && sig <= rt_max && sig - rt_min < (int)RT_SIGNALS_MAX;
 }
 
 static const char *signal_name(int sig)
@@ -93,8 +95,8 @@ static const char *signal_name(int sig)
 	for (size_t i = 0; i < sizeof(names) / sizeof(names[0]); i++)
 		if (names[i].sig == sig)
 			return names[i].name;
-	if (is_rt(sig) && rt_names[sig - SIGRTMIN][0])
-		return rt_names[sig - SIGRTMIN];
+	if (is_rt(sig) && rt_names[sig - rt_min][0])
+		return rt_names[sig - rt_min];
 	return "signal";
 }
 
@@ -184,10 +186,12 @@ static int install(const int *sigs, size_t n, void (*fn)(int), int flags, sigset
 /* The real-time signals' names, then their handlers. */
 static int install_rt(sigset_t *handled)
 {
-	for (int sig = SIGRTMIN; sig <= SIGRTMAX; sig++) {
+	rt_min = SIGRTMIN;
+	rt_max = SIGRTMAX;
+	for (int sig = rt_min; sig <= rt_max; sig++) {
 		if (!is_rt(sig))
 			return IRDM_EIO;
-		snprintf(rt_names[sig - SIGRTMIN], RT_NAME_BYTES, "SIGRTMIN+%d", sig - SIGRTMIN);
+		snprintf(rt_names[sig - rt_min], RT_NAME_BYTES, "SIGRTMIN+%d", sig - rt_min);
 		if (install_one(sig, on_soft, 0, handled))
 			return IRDM_EIO;
 	}
