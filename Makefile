@@ -206,6 +206,9 @@ $(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(call obj,$(TESTSUP_SRC)) $(TEST_LIBS)
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) $^ -o $@ $(LDLIBS) -lcmocka
 
+# irdm-fw's signal handlers alone, raised in a child process
+$(BUILD)/tests/test_fw_signals: $(call obj,firmware/main/fw_signals.c)
+
 # the view's test drives its server and decodes the browser's screenshots
 $(BUILD)/tests/test_view: LDLIBS += $(VIEW_LIBS) -lpng
 

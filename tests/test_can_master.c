@@ -18,12 +18,17 @@
 #include <stddef.h>
 #include <stdint.h>
 #include <string.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <cmocka.h>
 
 #include "irdm/can_drives.h"
 #include "irdm/can_master.h"
 #include "irdm/can_membus.h"
+#include "irdm/error.h"
+
+#include "support/strict_mode.h"
 
 #define LOG_MAX 8192
 
@@ -924,10 +929,121 @@ static void test_master_dies_drives_stop(void **state)
 	assert_true(us > 20000 && us <= 30100);
 }
 
+/*
+ * The emergency path (a signal handler's): a port like SocketCAN's, one
+ * write(2) per frame (here into a pipe), and the master mid-run.  In
+ * seccomp strict mode (any system call but read, write, _exit and
+ * sigreturn kills the child) it sends, per CiA 402, each axis's RPDO1
+ * with controlword 0x0000 (disable voltage: bit 1 clear) and target torque
+ * (0x6071) 0, then a SYNC whose counter follows the last one sent (CiA
+ * 301: 1..240), and receives nothing and changes nothing in the master.
+ */
+#define EMERGENCY_MAGIC 0x454d4f46u
+struct emergency_result {
+	unsigned magic;
+	int rc;
+	unsigned recvs;         /* recv calls: must stay 0 */
+	int state_changed;      /* the master differs from before */
+};
+
+static int frames_fd = -1;
+static unsigned emergency_recvs;
+
+static int pipe_send(void *ctx, const struct irdm_can_frame *f)
+{
+	(void)ctx;
+	return write(frames_fd, f, sizeof(*f)) == (ssize_t)sizeof(*f) ? IRDM_OK : IRDM_EIO;
+}
+
+static int pipe_recv(void *ctx, struct irdm_can_frame *f)
+{
+	(void)ctx;
+	(void)f;
+	emergency_recvs++;
+	return 0;
+}
+
+static const struct irdm_can_port_ops pipe_ops = { pipe_send, pipe_recv };
+
+static void emergency_child(void *arg, int fd)
+{
+	struct emergency_result res = { .magic = EMERGENCY_MAGIC };
+	const struct irdm_can_master *before = arg;
+	static struct irdm_can_master mine;
+
+	mine = m;
+	mine.port = (struct irdm_can_port){ &pipe_ops, NULL };
+	if (strict_enter())
+		strict_exit(fd, &res, sizeof(res), STRICT_UNAVAILABLE);
+	res.rc = irdm_can_master_emergency_off(&mine);
+	res.recvs = emergency_recvs;
+	mine.port = before->port;
+	res.state_changed = memcmp(&mine, before, sizeof(mine)) != 0;
+	strict_exit(fd, &res, sizeof(res), 0);
+}
+
+static void test_emergency_off_frames(void **state)
+{
+	struct irdm_can_master_cfg c = cfg_3axes();
+	double tau[3] = { 0.3, -0.2, 0.1 };
+	static struct irdm_can_master before;
+	struct irdm_can_frame f[8];
+	struct emergency_result res;
+	uint8_t off[4] = { 0, 0, 0, 0 };
+	int fds[2], status;
+	size_t got;
+	ssize_t n;
+
+	(void)state;
+	c.sync_counter = true;
+	run_up(&c);
+	for (int p = 0; p < 245; p++)   /* past the counter's wrap: 240 -> 1 */
+		assert_int_equal(period(tau), IRDM_OK);
+	assert_int_equal(dr.d[0].rpdo_torque_permille, irdm_can_torque_permille(&c.axis[0], 0.3));
+	assert_int_not_equal(dr.d[0].rpdo_torque_permille, 0);
+	before = m;
+	assert_int_equal(pipe(fds), 0);
+	frames_fd = fds[1];
+	status = strict_run(emergency_child, &before, &res, sizeof(res), &got);
+	close(fds[1]);
+	if (WIFEXITED(status) && WEXITSTATUS(status) == STRICT_UNAVAILABLE) {
+		close(fds[0]);
+		skip();
+	}
+	if (WIFSIGNALED(status))
+		fail_msg("the emergency path died of signal %d (SIGKILL: a system call other "
+			 "than write)", WTERMSIG(status));
+	assert_int_equal(WEXITSTATUS(status), 0);
+	assert_int_equal(got, sizeof(res));
+	assert_int_equal(res.magic, EMERGENCY_MAGIC);
+	assert_int_equal(res.rc, IRDM_OK);
+	assert_int_equal(res.recvs, 0);
+	assert_int_equal(res.state_changed, 0);
+	n = read(fds[0], f, sizeof(f));
+	close(fds[0]);
+	assert_int_equal(n, 4 * (ssize_t)sizeof(f[0]));         /* 3 RPDO1 + SYNC, nothing more */
+	n_sent = 0;
+	for (unsigned k = 0; k < 4; k++)
+		sent[n_sent++] = (struct logged){ f[k], m.period };
+	for (unsigned k = 0; k < 3; k++)
+		expect_frame(k, 0x201 + k, 4, off);
+	expect_frame(3, 0x080, 1, (const uint8_t[]){ (uint8_t)(m.sync_count % 240 + 1) });
+	/* the emulated CiA 402 drives take them: no torque, not enabled */
+	for (unsigned k = 0; k < 4; k++)
+		assert_int_equal(irdm_can_send(&master_port, &f[k]), IRDM_OK);
+	irdm_can_drives_poll(&dr);
+	for (unsigned k = 0; k < 3; k++) {
+		assert_int_equal(dr.d[k].rpdo_torque_permille, 0);
+		assert_int_not_equal(dr.d[k].fsa.state, IRDM_CIA402_OPERATION_ENABLED);
+	}
+	assert_int_equal(dr.sync_length_errors, 0);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_setup_sequence),
+		cmocka_unit_test(test_emergency_off_frames),
 		cmocka_unit_test(test_setup_sync_counter),
 		cmocka_unit_test(test_setup_pdo_refused_named),
 		cmocka_unit_test(test_setup_aborts_named),

@@ -9,9 +9,12 @@
  *    static amplitude at the touched node), not at one the loop invents;
  *  - --require-rt refuses a kernel that is not PREEMPT_RT (checked here
  *    independently) and runs on one that is;
- *  - SIGTERM, SIGHUP, SIGQUIT mid-contact: torque off and state off in the
- *    next tick, the reason logged, exit 6; SIGSEGV: the emergency path,
- *    exit 8;
+ *  - SIGTERM, SIGHUP, SIGQUIT, SIGUSR1, SIGALRM, a real-time signal
+ *    mid-contact: torque off and state off in the next tick, the reason
+ *    logged, exit 6; SIGXFSZ ignored; SIGSEGV, SIGSYS: the emergency path,
+ *    exit 8; signals pending at start: the run ends in the set-up, exit 6,
+ *    no drive enabled, no escalation (tests/test_fw_signals.c has every
+ *    signal, and the escalation, in detail);
  *  - the image file truncated or written over under a running loop: the
  *    run goes on to its end on its own copy;
  *  - a run whose limits never let the torque on exits 7 naming the limit;
@@ -470,26 +473,136 @@ static void test_sigquit_mid_contact_turns_torque_off(void **state)
 	signal_mid_contact(SIGQUIT, "SIGQUIT");
 }
 
+/* Signals whose default action ends the process, handled as a request. */
+static void test_sigusr1_mid_contact_turns_torque_off(void **state)
+{
+	(void)state;
+	signal_mid_contact(SIGUSR1, "SIGUSR1");
+}
+
+static void test_sigalrm_mid_contact_turns_torque_off(void **state)
+{
+	(void)state;
+	signal_mid_contact(SIGALRM, "SIGALRM");
+}
+
+static void test_realtime_signal_mid_contact_turns_torque_off(void **state)
+{
+	(void)state;
+	signal_mid_contact(SIGRTMIN + 3, "SIGRTMIN+3");
+}
+
 /*
- * A fatal signal (here sent, as a crash would raise it) takes the
- * emergency path: torque off on the device, one line, exit 8.
+ * SIGXFSZ is ignored (a write past the file-size limit fails instead and
+ * the log's loss path answers it): sent mid-contact, the run goes on to
+ * its end and exits 0, its log whole.
  */
-static void test_sigsegv_takes_the_emergency_path(void **state)
+static void test_sigxfsz_is_ignored(void **state)
 {
 	struct timespec t = { 1, 200000000 };
-	char board[320];
+	char board[320], log[320];
+	struct irdm_tick_record last;
+	uint64_t contact_ticks;
 	pid_t pid;
 	int rc;
 
 	(void)state;
+	snprintf(log, sizeof(log), "%s/xfsz.log", dir);
+	relaxed_board(board, sizeof(board));
+	pid = spawn(env_or("IRDM_FW", "build/irdm-fw"), (const char *const[]){
+		"--board", board, "--image", image, "--user", PRESS, "--clock", "real",
+		"--duration", "2.5", "--log", log, "-q", NULL });
+	nanosleep(&t, NULL);
+	kill(pid, SIGXFSZ);
+	rc = finish(pid);
+	if (rc != 0)
+		fail_msg("SIGXFSZ: expected the run to go on to exit 0, got %d: %s", rc, err_text);
+	/* 2.5 s at the board's 1 kHz, every tick logged */
+	assert_int_equal(read_log(log, 0, &contact_ticks, &last), 2500);
+	assert_false(last.fault_flags & IRDM_FAULT_SIGNAL);
+}
+
+/*
+ * A fatal signal (here sent, as a crash would raise it) takes the
+ * emergency path: torque off on the device, one line, exit 8.
+ */
+static void emergency_signal(int sig, const char *name)
+{
+	struct timespec t = { 1, 200000000 };
+	char board[320], line[128];
+	pid_t pid;
+	int rc;
+
 	relaxed_board(board, sizeof(board));
 	pid = spawn(env_or("IRDM_FW", "build/irdm-fw"), (const char *const[]){
 		"--board", board, "--image", image, "--user", PRESS, "--clock", "real", NULL });
 	nanosleep(&t, NULL);
-	kill(pid, SIGSEGV);
+	kill(pid, sig);
 	rc = finish(pid);
-	if (rc != 8 || !strstr(err_text, "SIGSEGV (signal 11): emergency torque off on 1 of 1 device\n"))
-		fail_msg("expected exit 8 and the emergency line; got %d: %s", rc, err_text);
+	snprintf(line, sizeof(line), "%s (signal %d): emergency torque off on 1 of 1 device\n", name,
+		 sig);
+	if (rc != 8 || !strstr(err_text, line))
+		fail_msg("%s: expected exit 8 and the emergency line; got %d: %s", name, rc, err_text);
+}
+
+static void test_sigsegv_takes_the_emergency_path(void **state)
+{
+	(void)state;
+	emergency_signal(SIGSEGV, "SIGSEGV");
+}
+
+/* SIGSYS: a bad system call, or a seccomp filter's kill: a bug. */
+static void test_sigsys_takes_the_emergency_path(void **state)
+{
+	(void)state;
+	emergency_signal(SIGSYS, "SIGSYS");
+}
+
+/*
+ * Signals that came before irdm-fw could answer them (here: blocked and
+ * pending when it starts, two different ones): arming unblocks them, both
+ * arrive during the set-up.  The run ends there, cleanly: exit 6, no drive
+ * enabled and not one tick run (the log has no record), and the second
+ * signal, outside the loop, does not escalate to the emergency exit 8.
+ */
+static void test_signals_during_setup_enable_nothing(void **state)
+{
+	char log[320], out_path[300], err_path[300];
+	struct irdm_tick_record last;
+	uint64_t contact_ticks;
+	const char *prog = env_or("IRDM_FW", "build/irdm-fw");
+	pid_t pid;
+	int rc;
+
+	(void)state;
+	snprintf(log, sizeof(log), "%s/setup-sig.log", dir);
+	snprintf(out_path, sizeof(out_path), "%s/stdout", dir);
+	snprintf(err_path, sizeof(err_path), "%s/stderr", dir);
+	pid = fork();
+	assert_true(pid >= 0);
+	if (pid == 0) {
+		sigset_t set;
+		int fd_out = open(out_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+		int fd_err = open(err_path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+
+		if (fd_out < 0 || fd_err < 0 || dup2(fd_out, 1) < 0 || dup2(fd_err, 2) < 0)
+			_exit(120);
+		sigemptyset(&set);
+		sigaddset(&set, SIGTERM);
+		sigaddset(&set, SIGINT);
+		sigprocmask(SIG_BLOCK, &set, NULL);
+		raise(SIGTERM);         /* pending across exec */
+		raise(SIGINT);
+		execl(prog, prog, "--board", BOARD, "--image", image, "--user", PRESS, "--clock",
+		      "virtual", "--log", log, (char *)NULL);
+		_exit(121);
+	}
+	rc = finish(pid);
+	if (rc != 6)
+		fail_msg("expected exit 6 (stopped during the set-up), got %d: %s", rc, err_text);
+	assert_non_null(strstr(err_text, "stopped by SIG"));
+	assert_non_null(strstr(err_text, "at tick 0: torque off, state off"));
+	assert_int_equal(read_log(log, 0, &contact_ticks, &last), 0);
 }
 
 /* Copy src to dst (the image a run reads, which the test then damages). */
@@ -915,7 +1028,7 @@ static void test_log_write_failure(void **state)
 	relaxed_board(board, sizeof(board));        /* a busy host: no overrun fault */
 	for (int c = 0; c < 2; c++) {
 		int rc = finish(spawn("/bin/sh", (const char *const[]){
-			"-c", "trap '' XFSZ; ulimit -f 200 && exec \"$0\" \"$@\"",
+			"-c", "ulimit -f 200 && exec \"$0\" \"$@\"",
 			env_or("IRDM_FW", "build/irdm-fw"), "--board", board, "--image", image,
 			"--user", PRESS, "--clock", clocks[c], "--duration", "1.5", "--log", log,
 			"-q", NULL }));
@@ -999,7 +1112,13 @@ int main(void)
 		cmocka_unit_test(test_sigterm_mid_contact_turns_torque_off),
 		cmocka_unit_test(test_sighup_mid_contact_turns_torque_off),
 		cmocka_unit_test(test_sigquit_mid_contact_turns_torque_off),
+		cmocka_unit_test(test_sigusr1_mid_contact_turns_torque_off),
+		cmocka_unit_test(test_sigalrm_mid_contact_turns_torque_off),
+		cmocka_unit_test(test_realtime_signal_mid_contact_turns_torque_off),
+		cmocka_unit_test(test_sigxfsz_is_ignored),
 		cmocka_unit_test(test_sigsegv_takes_the_emergency_path),
+		cmocka_unit_test(test_sigsys_takes_the_emergency_path),
+		cmocka_unit_test(test_signals_during_setup_enable_nothing),
 		cmocka_unit_test(test_image_truncated_under_run),
 		cmocka_unit_test(test_image_overwritten_under_run),
 		cmocka_unit_test(test_never_enabled_exits_nonzero),

@@ -9,6 +9,7 @@
  * a fault among them, in seccomp strict mode with the allocator counted:
  * no system call, no allocation.
  */
+#include <math.h>
 #include <setjmp.h>
 #include <signal.h>
 #include <stdalign.h>
@@ -415,11 +416,81 @@ static void test_tick_ops_no_system_call_no_allocation(void **state)
 	assert_int_equal(WTERMSIG(status), SIGKILL);
 }
 
+/*
+ * canemu's emergency op, mid-run with torque on, as a signal handler runs
+ * it (strict mode: no system call): the in-memory bus may be mid-send
+ * there, so it sends no frame; every emulated drive holds controlword
+ * 0x0000 (CiA 402 disable voltage) and target torque 0 as if it had
+ * received the off RPDO1, and the arm's torque is zero at once.
+ */
+#define EMERGENCY_MAGIC 0x454d4f46u
+struct emergency_result {
+	uint32_t magic;
+	int rc;
+	unsigned frames;                /* frames on the bus during the call */
+	uint16_t cw[3];
+	int16_t torque[3];
+	double arm_nm;                  /* sum of |command| and |motor| torques */
+};
+
+static void emergency_child(void *arg, int fd)
+{
+	struct emergency_result res = { .magic = EMERGENCY_MAGIC };
+	struct irdm_can_drives *dr = irdm_hal_canemu_drives(&dev);
+	unsigned mark = n_log;
+
+	(void)arg;
+	if (strict_enter())
+		strict_exit(fd, &res, sizeof(res), STRICT_UNAVAILABLE);
+	res.rc = irdm_hal_emergency_off(&dev);
+	res.frames = n_log - mark;
+	for (unsigned k = 0; k < 3; k++) {
+		res.cw[k] = dr->d[k].rpdo_cw;
+		res.torque[k] = dr->d[k].rpdo_torque_permille;
+		res.arm_nm += fabs(dr->arm.cmd_nm[k]) + fabs(dr->arm.motor_nm[k]);
+	}
+	strict_exit(fd, &res, sizeof(res), 0);
+}
+
+static void test_canemu_emergency_off(void **state)
+{
+	double tau[3] = { 0.05, 0.098, -0.05 };
+	struct irdm_can_drives *dr;
+	struct emergency_result res;
+	size_t got;
+	int status, bad = 0;
+
+	(void)state;
+	assert_int_equal(open_as("canemu", OPTS), IRDM_OK);
+	assert_int_equal(irdm_hal_start(&dev), IRDM_OK);
+	run_ticks(50, tau, &bad);
+	assert_int_equal(bad, 0);
+	dr = irdm_hal_canemu_drives(&dev);
+	assert_int_equal(dr->d[1].rpdo_torque_permille, 84);    /* as test_canemu_runs_and_faults */
+	assert_int_equal(dr->d[1].rpdo_cw, 0x0F);               /* enable operation */
+	status = strict_run(emergency_child, NULL, &res, sizeof(res), &got);
+	irdm_hal_close(&dev);
+	if (WIFEXITED(status) && WEXITSTATUS(status) == STRICT_UNAVAILABLE)
+		skip();
+	if (WIFSIGNALED(status))
+		fail_msg("canemu's emergency op died of signal %d", WTERMSIG(status));
+	assert_int_equal(got, sizeof(res));
+	assert_int_equal(res.magic, EMERGENCY_MAGIC);
+	assert_int_equal(res.rc, IRDM_OK);
+	assert_int_equal(res.frames, 0);
+	for (unsigned k = 0; k < 3; k++) {
+		assert_int_equal(res.cw[k], 0x0000);
+		assert_int_equal(res.torque[k], 0);
+	}
+	assert_true(res.arm_nm == 0.0);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_options_refused_by_name),
 		cmocka_unit_test(test_socketcan_without_interface),
+		cmocka_unit_test(test_canemu_emergency_off),
 		cmocka_unit_test(test_socketcan_bus_off_loses_link),
 		cmocka_unit_test(test_canemu_runs_and_faults),
 		cmocka_unit_test(test_one_sync_per_tick),

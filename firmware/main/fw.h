@@ -178,6 +178,9 @@ int fw_loop_run(struct fw *fw, volatile sig_atomic_t *signalled);
 /* fw_signals.c: every signal's way out turns the torque off (armed before
  * any device opens; disarmed once they are closed).  flag: the loop's. */
 int fw_signals_arm(struct fw *fw, volatile sig_atomic_t *flag);
+/* A second signal escalates to the emergency path only while the loop
+ * runs (true just before it, false as soon as it returns). */
+void fw_signals_loop(bool running);
 void fw_signals_disarm(void);
 const char *fw_signal_name(int sig);
 

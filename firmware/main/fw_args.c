@@ -83,12 +83,15 @@ void fw_args_usage(FILE *f)
 	fputs("\nexit codes: 0 ran to the end with the torque enabled; 2 bad arguments;\n"
 	      "3 board, image or user script refused; 4 HAL, real time (--require-rt) or\n"
 	      "memory refused; 5 the controller faulted (torque off, reason printed);\n"
-	      "6 stopped by SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGPIPE or SIGXCPU (torque\n"
-	      "off and state off in the next tick, logged); 7 the torque was never\n"
-	      "enabled (the limit that refused it printed); 8 SIGSEGV, SIGBUS, SIGFPE,\n"
-	      "SIGILL, SIGABRT or a second signal: torque off at once by the emergency\n"
-	      "path, the log cut short; 9 the run ended but its --log could not be\n"
-	      "written (no log is left under its name)\n", f);
+	      "6 stopped by SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGPIPE, SIGXCPU, SIGUSR1,\n"
+	      "SIGUSR2, SIGALRM, SIGVTALRM, SIGPROF, SIGPWR, SIGSTKFLT or a real-time\n"
+	      "signal (torque off and state off in the next tick, logged; during the\n"
+	      "set-up: no drive enabled); 7 the torque was never enabled (the limit\n"
+	      "that refused it printed); 8 SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT,\n"
+	      "SIGTRAP, SIGSYS or a second signal while the loop runs: torque off at\n"
+	      "once by the emergency path, the log cut short; 9 the run ended but its\n"
+	      "--log could not be written (no log is left under its name; SIGXFSZ is\n"
+	      "ignored, so a log past the file-size limit ends here)\n", f);
 }
 
 int fw_args_parse(struct fw_args *a, int argc, char **argv, char *err, size_t errlen)

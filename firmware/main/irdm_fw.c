@@ -159,12 +159,16 @@ static int open_devices(struct fw *fw)
 }
 
 /* Enable the drives: last, once real time is set up and every thread runs
- * (a drive's deadline must not see the set-up's silences). */
+ * (a drive's deadline must not see the set-up's silences).  A signal that
+ * came during the set-up ends the run here, no drive enabled (one after
+ * the check is the loop's first tick's to answer). */
 static int start_devices(struct fw *fw)
 {
 	int rc;
 
 	for (unsigned i = 0; i < fw->board.devices; i++) {
+		if (signalled)
+			return FW_EXIT_SIGNAL;
 		rc = irdm_hal_start(&fw->hal[i]);
 		if (rc)
 			return fail(FW_EXIT_SETUP, rc, "hal '%s': %s", fw->board.hal,
@@ -339,8 +343,12 @@ int main(int argc, char **argv)
 	}
 	rc = start(fw);
 	if (!rc) {
+		fw_signals_loop(true);
 		rc = fw_loop_run(fw, &signalled);
+		fw_signals_loop(false);
 		say_end(fw, rc);
+	} else if (rc == FW_EXIT_SIGNAL) {
+		say_end(fw, rc);        /* during the set-up, no drive enabled */
 	}
 	rc = stop(fw, rc);
 	/* a run stopped by a signal ended cleanly too: what it did is worth

@@ -304,7 +304,9 @@ static size_t sync_items(const struct irdm_can_master *m, struct sdo_item *it)
  * 0x6007, the drive's reaction to a lost master (a heartbeat or an RPDO
  * deadline missed): disable voltage, the torque off at once whatever
  * 0x605E says; a drive that takes only the default (abort 0x06090030)
- * gets "fault" (1), which also ends in no torque.
+ * gets "fault" (1): it ends with the drive function disabled, but only
+ * after the fault reaction 0x605E names (not written here: the drive's
+ * default, which may be a braking ramp under torque).
  */
 static int abort_option(struct irdm_can_master *m, unsigned k, char *err, size_t errlen)
 {
