@@ -56,7 +56,7 @@ static const int soft_signals[] = {
 };
 static const int fatal_signals[] = { SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT, SIGTRAP, SIGSYS };
 
-#define RT_NAME_BYTES 12u               /* "SIGRTMIN+NN" */
+#define RT_NAME_BYTES 24u               /* "SIGRTMIN+NN", room for any int */
 #define RT_SIGNALS_MAX 64u
 
 static struct fw *armed;                /* the devices the emergency path turns off */
