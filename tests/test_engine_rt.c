@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /*
  * The force tick is hard real time (docs/architecture.md, "Memory and
- * threading"), proven rather than claimed.  Issue must-show: "Allocation-free and fault-free, proven".
+ * threading"), proven rather than claimed.
  *
  *  - No allocation: this executable interposes the allocator (malloc,
  *    calloc, realloc, reallocarray, free, aligned_alloc, posix_memalign,

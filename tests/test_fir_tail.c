@@ -169,7 +169,7 @@ static void print_figures(const char *what, const struct figures *g, double firs
 		      g->second, g->all, g->held_pct, g->max_abs);
 }
 
-/* Must-show: bounded over 12 s of a held step, the first T ticks exact,
+/* The target: bounded over 12 s of a held step, the first T ticks exact,
  * the held force the static one; the old r^s beside it. */
 static void test_window_hold(void **state)
 {

@@ -8,7 +8,7 @@
  * responses for the deformation, classical RK4 with 64 sub-steps for the
  * rigid motion under the same zero-order-held force and torque, and a
  * finite-difference Newton solve of the exact end-of-tick position.
- * Must-show 1 of issue 3: relative RMS force error <= 1e-4.
+ * The target: relative RMS force error <= 1e-4.
  */
 #include <math.h>
 #include <setjmp.h>

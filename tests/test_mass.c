@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /*
  * A floating body's mass, centre and inertia come from the mass matrix the
- * model uses (issue 11: they came from the lumped masses even under a
+ * model uses (they came from the lumped masses even under a
  * consistent M, and an off-centre push spun the cube too slowly).
  *
  * Reference: a uniform box a x b x c of density rho, m = rho a b c, centre

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * Sizing a surface's tetrahedralisation (issue 11) on two surfaces built
+ * Sizing a surface's tetrahedralisation on two surfaces built
  * here: a CAD-like part (binary STL in mm: a 60 x 40 x 16 box with 0.5 mm
  * fillets, 972 triangles), whose fillets tetgen's quality bound refines
  * around (-pq1.414: about 36,000 nodes), and a box whose top face has a

@@ -18,7 +18,7 @@
  * at 2 cm, haptic coupling): one port hands on energy the other put in.
  * The object as a whole is passive, so the controller must stay quiet; run
  * per port it took the handing-on port for an active one and its damping
- * grew without bound as the node settled (3e91 N, issue 10).
+ * grew without bound as the node settled (3e91 N).
  */
 #include <math.h>
 #include <setjmp.h>

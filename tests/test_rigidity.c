@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * Rigid modes on any mesh (issue 11): which modes are rigid is decided by
+ * Rigid modes on any mesh: which modes are rigid is decided by
  * the mesh's connectivity and geometry (irdm_mesh_check_rigidity()), not by
  * an eigenvalue threshold scaled by the stiffest element.
  *

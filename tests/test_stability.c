@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * Issue 3, must-show 3: with the default (haptic) coupling, the step
+ * With the default (haptic) coupling, the step
  * scenario -- a device pushed 1 cm into the top of the paper's cuboid and
  * held -- stays bounded and passive for 60 s of simulated time: for FIR
  * images with T = 50, 100, 250, 500 (whose bare force recursions are
@@ -28,7 +28,7 @@
 static char dir[64];
 
 /*
- * The must-show is 60 s of simulated time, run by the plain build.  Under
+ * The target is 60 s of simulated time, run by the plain build.  Under
  * AddressSanitizer every instrumented tick is ~30x slower (9 minutes for
  * this file), and that build is there to catch memory errors, which 6 s
  * exercise just as well.

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * A closed surface with about 2,500 touchable nodes (issue 11): a torus
+ * A closed surface with about 2,500 touchable nodes: a torus
  * surface written here as OFF, floating, modal:300 with the clustered
  * static correction (static_correction_cluster = 256, tol 8e-4),
  * precomputed by `irdm precompute` within a time, peak memory and image

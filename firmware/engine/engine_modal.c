@@ -14,7 +14,7 @@
  * A mode let go decays geometrically (|A_k| < 1) through the subnormal
  * range, where a multiply-add on a subnormal operand can cost a hundred
  * cycles on x86 (microcode assist); a released cuboid handed 10^6
- * subnormal displacements to the contact query in 600 s (issue 10).
+ * subnormal displacements to the contact query in 600 s.
  * A state below 1e-200 (metres, metres per second) is no physics any
  * more: it is set to zero, where it stays until a force excites the mode.
  */

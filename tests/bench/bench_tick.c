@@ -329,7 +329,7 @@ int main(void)
 		"representation", "fir:500", "touch", "box:0.035,0.035,0.199,0.065,0.065,0.201",
 		"display", "touch", NULL,
 	};
-	/* the hybrid (issue 10): 300 modes and the other 9204's exact head of
+	/* the hybrid: 300 modes and the other 9204's exact head of
 	 * 128 samples (+ 128 tapered) at the same patch as the FIR, 1 ms */
 	static const char *const hybrid_kv[] = {
 		"name", "cuboid-hybrid128-patch", "resolution", "11,11,22", "representation", "modal:300",

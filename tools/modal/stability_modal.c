@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * The modal stability certificate by the argument principle (issue 11).
+ * The modal stability certificate by the argument principle.
  *
  * det(zI - A_cl) = det(zI - A) det H(z) / det R0 (node_tf.h), so the
  * closed-loop poles inside |z| < r number

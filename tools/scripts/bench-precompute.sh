@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Precompute benchmark: paper-scale scenes end to end (precompute + verify),
 # wall time, peak memory and image size beside the paper's Table 1 (the
-# torus of issue 11 has no paper figures).  Prints a Markdown table and
+# torus has no paper figures).  Prints a Markdown table and
 # keeps the logs in out/bench/.
 #   tools/scripts/bench-precompute.sh [IRDM]
 set -euo pipefail

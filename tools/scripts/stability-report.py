@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: MIT
-"""The stability suite's table and plot (make stability, issue 10).
+"""The stability suite's table and plot (make stability).
 
 Reads DIR/cases.tsv and DIR/trace-*.tsv that the stability tests write with
 IRDM_STAB_OUT=DIR, prints a Markdown table of every case (also DIR/table.md)

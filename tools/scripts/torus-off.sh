@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # A torus surface as OFF: ring radius 1, tube radius 0.4, NU x NV vertices,
-# two outward triangles per quad (the closed surface of issue 11: 65 x 33
+# two outward triangles per quad (a closed surface: 65 x 33
 # is 2,145 vertices, about 2,500 touchable nodes after tetgen).
 #   tools/scripts/torus-off.sh NU NV > torus.off
 set -euo pipefail

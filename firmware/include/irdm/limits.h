@@ -13,7 +13,7 @@
  * Largest contact target the engine takes (metres, per axis).  A device
  * reports positions within a metre or two; a target of 1e300 m is a broken
  * input, not a position, and its finite force (6e304 N under a rigid
- * coupling) overflowed the energy observer's F . du (issue 10).
+ * coupling) overflowed the energy observer's F . du.
  */
 #define IRDM_MAX_TARGET_M 1e6
 
