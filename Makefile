@@ -100,21 +100,21 @@ CFLAGS  += -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-re
 LDFLAGS += -fsanitize=address,undefined
 endif
 
-FW_SRC    := $(filter-out firmware/main/% $(FEATURE_OFF_SRC),$(wildcard firmware/*/*.c))
+FW_SRC    := $(filter-out $(FEATURE_OFF_SRC),$(wildcard firmware/*/*.c))
 # The live view (docs/view.md): its server and page in tools/view/, linked
 # into irdm-fw (fw_view.c) and irdm; the trimmed builds leave it out
 # (fw_view_none.c) and need no libwebsockets.
 VIEW    := $(if $(CONFIG),,1)
-FWMAIN_SRC := $(filter-out firmware/main/$(if $(VIEW),fw_view_none.c,fw_view.c),\
-  $(wildcard firmware/main/*.c))
+FWMAIN_SRC := $(filter-out apps/irdm-fw/$(if $(VIEW),fw_view_none.c,fw_view.c),\
+  $(wildcard apps/irdm-fw/*.c))
 HAL_SRC   := $(wildcard hal/*/*.c)
-SIM_SRC   := $(filter-out sim/main/%,$(wildcard sim/*/*.c))
-CDMAIN_SRC := $(wildcard sim/main/*.c)
-TOOL_SRC  := $(filter-out tools/irdm/%,$(wildcard tools/*/*.c))
+SIM_SRC   := $(wildcard sim/*/*.c)
+CDMAIN_SRC := $(wildcard apps/irdm-candrives/*.c)
+TOOL_SRC  := $(wildcard tools/*/*.c)
 VIEW_PAGE := $(wildcard tools/view/page/*)
 VIEW_OBJ   = $(call obj,tools/view/view_server.c tools/view/view_msg.c) $(BUILD)/obj/gen/view_page.o
 VIEW_LIBS := -lwebsockets
-CLI_SRC   := $(wildcard tools/irdm/*.c)
+CLI_SRC   := $(wildcard apps/irdm/*.c)
 PLUGIN_SRC := $(wildcard tools/dist/plugin/*.c)
 TEST_SRC  := $(wildcard tests/test_*.c)
 TICK_TEST_SRC := $(wildcard tests/test_tick_*.c)
@@ -143,9 +143,11 @@ all: $(if $(CONFIG),,$(IRDM) $(SLEPC_PLUGIN)) $(FW_LIB) $(HAL_LIB) $(SIM_LIB) $(
 $(BUILD)/obj/firmware/%.o: LAYER_INC = $(FW_INC)
 # irdm-fw's main() is the composition root: it alone sees every layer below
 # the tools (it registers the HAL back-ends, the simulator's among them).
-$(BUILD)/obj/firmware/main/%.o: LAYER_INC = $(SIM_INC)
+$(BUILD)/obj/apps/irdm-fw/%.o: LAYER_INC = $(SIM_INC)
 # its publisher alone also sees the view's server (tools/view/)
-$(BUILD)/obj/firmware/main/fw_view.o: LAYER_INC = $(SIM_INC) -Itools
+$(BUILD)/obj/apps/irdm-fw/fw_view.o: LAYER_INC = $(SIM_INC) -Itools
+$(BUILD)/obj/apps/irdm-candrives/%.o: LAYER_INC = $(SIM_INC)
+$(BUILD)/obj/apps/irdm/%.o: LAYER_INC = $(TOOL_INC)
 $(BUILD)/obj/hal/%.o:      LAYER_INC = $(HAL_INC)
 $(BUILD)/obj/sim/%.o:      LAYER_INC = $(SIM_INC)
 $(BUILD)/obj/tools/%.o:    LAYER_INC = $(TOOL_INC)
@@ -207,7 +209,7 @@ $(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(call obj,$(TESTSUP_SRC)) $(TEST_LIBS)
 	$(CC) $(LDFLAGS) $^ -o $@ $(LDLIBS) -lcmocka
 
 # irdm-fw's signal handlers alone, raised in a child process
-$(BUILD)/tests/test_fw_signals: $(call obj,firmware/main/fw_signals.c)
+$(BUILD)/tests/test_fw_signals: $(call obj,apps/irdm-fw/fw_signals.c)
 
 # the view's test drives its server and decodes the browser's screenshots
 $(BUILD)/tests/test_view: LDLIBS += $(VIEW_LIBS) -lpng

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * irdm-fw's signal handlers alone (firmware/main/fw_signals.c), each case
+ * irdm-fw's signal handlers alone (apps/irdm-fw/fw_signals.c), each case
  * in a child process that raises the signals itself: raise() delivers
  * before it returns, so which signal came first, and whether the loop ran
  * then, is exact, not a race with a running controller.
@@ -23,7 +23,7 @@
 
 #include <cmocka.h>
 
-#include "../firmware/main/fw.h"
+#include "../apps/irdm-fw/fw.h"
 
 #define CHILD_ALIVE 42  /* the child came back from every signal */
 #define CHILD_WRONG 43  /* the flag did not say what it should */

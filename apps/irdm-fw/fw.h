@@ -5,7 +5,7 @@
  * on the image, registers and opens the HAL back-ends, sets up real time
  * (irdm/rt.h), maps the board onto the controller's configuration
  * (fw_config.c), runs the loop (fw_loop.c) and prints the summary
- * (fw_summary.c).  Private to firmware/main.
+ * (fw_summary.c).  Private to apps/irdm-fw.
  */
 #ifndef IRDM_FW_H
 #define IRDM_FW_H

@@ -3,7 +3,7 @@
  * irdm-candrives: N CiA 402 drives (sim/can) as one process on a SocketCAN
  * interface, the arm of a board file behind them, optionally pushed by a
  * virtual user's script (time = SYNC count x period).  Internal header of
- * sim/main.
+ * apps/irdm-candrives.
  */
 #ifndef IRDM_CANDRIVES_H
 #define IRDM_CANDRIVES_H
