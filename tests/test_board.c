@@ -32,8 +32,8 @@
 #include "irdm/device.h"
 #include "irdm/engine.h"
 #include "irdm/error.h"
-#include "irdm/hal.h"
-#include "irdm/hal_sim.h"
+#include "irdm/hal/hal.h"
+#include "irdm/sim/hal_sim.h"
 #include "irdm/options_doc.h"
 
 #define SHIPPED "boards/sim-phantom.board"

@@ -34,7 +34,7 @@
 #include "support/tick_image.h"
 
 #include "irdm/controller.h"
-#include "irdm/sim_device.h"
+#include "irdm/sim/sim_device.h"
 #include "irdm/vec3.h"
 #include "support/alloc_count.h"
 #include "support/device_ik.h"

@@ -29,8 +29,8 @@
 
 #include "irdm/device.h"
 #include "irdm/error.h"
-#include "irdm/hal.h"
-#include "irdm/hal_sim.h"
+#include "irdm/hal/hal.h"
+#include "irdm/sim/hal_sim.h"
 
 #define TICKS 2000
 

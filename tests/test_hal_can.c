@@ -24,9 +24,9 @@
 #include <cmocka.h>
 
 #include "irdm/error.h"
-#include "irdm/hal_can.h"
-#include "irdm/hal_canemu.h"
-#include "irdm/hal_socketcan.h"
+#include "irdm/hal/hal_can.h"
+#include "irdm/sim/hal_canemu.h"
+#include "irdm/hal/hal_socketcan.h"
 
 #include "support/alloc_count.h"
 #include "support/strict_mode.h"

@@ -22,8 +22,8 @@
 
 #include "irdm/device.h"
 #include "irdm/error.h"
-#include "irdm/hal.h"
-#include "irdm/hal_sim.h"
+#include "irdm/hal/hal.h"
+#include "irdm/sim/hal_sim.h"
 
 #define PERIOD_S 1e-3
 

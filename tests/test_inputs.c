@@ -23,7 +23,7 @@
 #include "irdm/board.h"
 #include "irdm/error.h"
 #include "irdm/image.h"
-#include "irdm/sim_user.h"
+#include "irdm/sim/sim_user.h"
 #include "irdm/textfile.h"
 #include "scene/scene.h"
 #include "support/test_files.h"

@@ -11,7 +11,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
-#include "irdm/can_faults.h"
+#include "irdm/sim/can_faults.h"
 
 enum {
 	CD_EXIT_OK = 0,         /* stopped by --syncs, --seconds or a signal */

@@ -18,10 +18,10 @@
 #include <time.h>
 
 #include "irdm/board.h"
-#include "irdm/can_drives.h"
+#include "irdm/sim/can_drives.h"
 #include "irdm/error.h"
-#include "irdm/sim_user_push.h"
-#include "irdm/socketcan.h"
+#include "irdm/sim/sim_user_push.h"
+#include "irdm/hal/socketcan.h"
 
 #include "candrives.h"
 

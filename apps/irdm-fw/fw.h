@@ -20,10 +20,10 @@
 #include "irdm/board.h"
 #include "irdm/clock.h"
 #include "irdm/controller.h"
-#include "irdm/hal.h"
+#include "irdm/hal/hal.h"
 #include "irdm/outdir.h"
 #include "irdm/session.h"
-#include "irdm/sim_user.h"
+#include "irdm/sim/sim_user.h"
 #include "irdm/telemetry.h"
 
 /* Exit codes (irdm-fw --help lists them). */

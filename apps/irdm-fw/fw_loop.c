@@ -11,9 +11,9 @@
 
 #include "irdm/device.h"
 #include "irdm/error.h"
-#include "irdm/hal_sim.h"
+#include "irdm/sim/hal_sim.h"
 #include "irdm/rt.h"
-#include "irdm/sim_user_push.h"
+#include "irdm/sim/sim_user_push.h"
 #include "irdm/vec3.h"
 
 #include "fw.h"

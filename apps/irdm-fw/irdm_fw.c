@@ -15,9 +15,9 @@
 #include <sys/prctl.h>
 
 #include "irdm/error.h"
-#include "irdm/hal_canemu.h"
-#include "irdm/hal_sim.h"
-#include "irdm/hal_socketcan.h"
+#include "irdm/sim/hal_canemu.h"
+#include "irdm/sim/hal_sim.h"
+#include "irdm/hal/hal_socketcan.h"
 #include "irdm/rt.h"
 
 #include "fw.h"

@@ -5,7 +5,7 @@
 #include <string.h>
 
 #include "irdm/error.h"
-#include "irdm/hal_can.h"
+#include "irdm/hal/hal_can.h"
 
 static struct irdm_hal_can *can_of(struct irdm_hal_dev *dev)
 {

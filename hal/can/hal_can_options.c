@@ -4,7 +4,7 @@
 #include <string.h>
 
 #include "irdm/error.h"
-#include "irdm/hal_can.h"
+#include "irdm/hal/hal_can.h"
 
 static void defaults(struct irdm_hal_can_opts *o)
 {

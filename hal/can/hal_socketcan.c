@@ -9,9 +9,9 @@
 #include <time.h>
 
 #include "irdm/error.h"
-#include "irdm/hal_can.h"
-#include "irdm/hal_socketcan.h"
-#include "irdm/socketcan.h"
+#include "irdm/hal/hal_can.h"
+#include "irdm/hal/hal_socketcan.h"
+#include "irdm/hal/socketcan.h"
 
 struct socketcan_data {
 	struct irdm_hal_can can;        /* first: the shared code's view */

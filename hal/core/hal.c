@@ -7,7 +7,7 @@
 #include <string.h>
 
 #include "irdm/error.h"
-#include "irdm/hal.h"
+#include "irdm/hal/hal.h"
 
 static const struct irdm_hal_backend *table[IRDM_HAL_BACKENDS_MAX];
 

@@ -14,7 +14,7 @@
 #include <string.h>
 
 #include "irdm/error.h"
-#include "irdm/sim_device.h"
+#include "irdm/sim/sim_device.h"
 
 #define RING (IRDM_SIM_DELAY_MAX + 1)
 

@@ -3,8 +3,8 @@
 #include <stdio.h>
 
 #include "irdm/error.h"
-#include "irdm/hal_can.h"
-#include "irdm/hal_canemu.h"
+#include "irdm/hal/hal_can.h"
+#include "irdm/sim/hal_canemu.h"
 
 struct canemu_data {
 	struct irdm_hal_can can;        /* first: the shared code's view */

@@ -5,8 +5,8 @@
 #include <string.h>
 
 #include "irdm/error.h"
-#include "irdm/hal_canemu.h"
-#include "irdm/hal_sim.h"
+#include "irdm/sim/hal_canemu.h"
+#include "irdm/sim/hal_sim.h"
 
 enum sim_state { SIM_CLOSED = 0, SIM_OPEN, SIM_RUNNING, SIM_OFF };
 

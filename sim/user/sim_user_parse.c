@@ -16,7 +16,7 @@
 
 #include "irdm/error.h"
 #include "irdm/textfile.h"
-#include "irdm/sim_user.h"
+#include "irdm/sim/sim_user.h"
 
 #define TOKENS_MAX 12
 

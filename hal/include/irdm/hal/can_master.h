@@ -20,8 +20,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "irdm/can_port.h"
-#include "irdm/cia402.h"
+#include "irdm/hal/can_port.h"
+#include "irdm/hal/cia402.h"
 
 #define IRDM_CAN_AXES_MAX 3
 #define IRDM_CAN_WHY_MAX 160

@@ -25,7 +25,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "irdm/can_port.h"
+#include "irdm/hal/can_port.h"
 
 #define IRDM_SOCKETCAN_IFNAME_MAX 16    /* IFNAMSIZ */
 

@@ -9,9 +9,9 @@
 #ifndef IRDM_HAL_SOCKETCAN_H
 #define IRDM_HAL_SOCKETCAN_H
 
-#include "irdm/can_master.h"
-#include "irdm/hal.h"
-#include "irdm/socketcan.h"
+#include "irdm/hal/can_master.h"
+#include "irdm/hal/hal.h"
+#include "irdm/hal/socketcan.h"
 
 extern const struct irdm_hal_backend irdm_hal_socketcan_backend;
 

@@ -11,8 +11,8 @@
 #define IRDM_SIM_USER_PUSH_H
 
 #include "irdm/board.h"
-#include "irdm/sim_device.h"
-#include "irdm/sim_user.h"
+#include "irdm/sim/sim_device.h"
+#include "irdm/sim/sim_user.h"
 
 /*
  * Hand `hand` of u pushes arm sim (placed by board b) at time t_s.

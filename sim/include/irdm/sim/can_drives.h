@@ -37,11 +37,11 @@
 #include <stdbool.h>
 #include <stdint.h>
 
-#include "irdm/can_drive_pdo.h"
-#include "irdm/can_faults.h"
-#include "irdm/can_port.h"
-#include "irdm/cia402.h"
-#include "irdm/sim_device.h"
+#include "irdm/sim/can_drive_pdo.h"
+#include "irdm/sim/can_faults.h"
+#include "irdm/hal/can_port.h"
+#include "irdm/hal/cia402.h"
+#include "irdm/sim/sim_device.h"
 
 #define IRDM_CAN_DRIVES_MAX 3
 

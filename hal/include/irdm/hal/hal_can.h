@@ -28,8 +28,8 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "irdm/can_master.h"
-#include "irdm/hal.h"
+#include "irdm/hal/can_master.h"
+#include "irdm/hal/hal.h"
 
 #define IRDM_HAL_CAN_IFNAME_MAX 16
 #define IRDM_HAL_CAN_STEADY_PERIODS 5   /* start: disabled SYNCs answered in a row first */

@@ -18,8 +18,8 @@
 
 #include <stdint.h>
 
-#include "irdm/hal.h"
-#include "irdm/sim_device.h"
+#include "irdm/hal/hal.h"
+#include "irdm/sim/sim_device.h"
 
 extern const struct irdm_hal_backend irdm_hal_sim_backend;
 

@@ -17,10 +17,10 @@
 #ifndef IRDM_HAL_CANEMU_H
 #define IRDM_HAL_CANEMU_H
 
-#include "irdm/can_drives.h"
-#include "irdm/can_membus.h"
-#include "irdm/hal.h"
-#include "irdm/sim_device.h"
+#include "irdm/sim/can_drives.h"
+#include "irdm/sim/can_membus.h"
+#include "irdm/hal/hal.h"
+#include "irdm/sim/sim_device.h"
 
 extern const struct irdm_hal_backend irdm_hal_canemu_backend;
 

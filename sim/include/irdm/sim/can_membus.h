@@ -11,7 +11,7 @@
 
 #include <stdint.h>
 
-#include "irdm/can_port.h"
+#include "irdm/hal/can_port.h"
 
 #define IRDM_CAN_MEMBUS_FRAMES 1024
 #define IRDM_CAN_MEMBUS_ENDPOINTS 4

@@ -8,7 +8,7 @@
 #ifndef IRDM_CAN_PORT_H
 #define IRDM_CAN_PORT_H
 
-#include "irdm/canopen.h"
+#include "irdm/hal/canopen.h"
 
 struct irdm_can_port_ops {
 	/* Return: IRDM_OK; IRDM_EBUSY if the transmit queue is full; IRDM_EIO
