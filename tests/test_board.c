@@ -33,8 +33,9 @@
 #include "irdm/engine.h"
 #include "irdm/error.h"
 #include "irdm/hal/hal.h"
+#include "irdm/posix/board_file.h"
 #include "irdm/sim/hal_sim.h"
-#include "irdm/options_doc.h"
+#include "irdm/posix/options_doc.h"
 
 #define SHIPPED "boards/sim-phantom.board"
 #define DOC "docs/boards.md"

@@ -71,23 +71,24 @@ static int sh(const char *cmd)
 
 static void test_left_out_features_are_absent(void **state)
 {
-	char cmd[1024];
+	char cmd[2048];
 
 	(void)state;
-	/* in the binary, and in its firmware library (left out of the build,
-	 * not merely unlinked) */
+	/* in the binary, and in its libraries, core and platform (left out of
+	 * the build, not merely unlinked) */
 	for (int b = 0; b < N_BUILDS; b++)
 		for (int f = 0; f < N_FEATURES; f++)
 			for (int lib = 0; lib < 2; lib++) {
 				snprintf(cmd, sizeof(cmd), "nm %s | grep -c ' T %s$' || true", fw[b],
 					 feature_symbol[f]);
 				if (lib)
-					snprintf(cmd, sizeof(cmd), "nm $(dirname %s)/libirdmfw.a | "
-						 "grep -c ' T %s$' || true", fw[b], feature_symbol[f]);
+					snprintf(cmd, sizeof(cmd), "d=$(dirname %s); nm $d/libirdmfw.a "
+						 "$d/libirdmposix.a | grep -c ' T %s$' || true", fw[b],
+						 feature_symbol[f]);
 				assert_int_equal(sh(cmd), 0);
 				if ((atoi(out) == 1) != on[b][f])
 					fail_msg("%s build's %s: %s (%s) is %s", build_name[b],
-						 lib ? "libirdmfw.a" : "irdm-fw", feature_name[f],
+						 lib ? "libirdmfw.a + libirdmposix.a" : "irdm-fw", feature_name[f],
 						 feature_symbol[f], on[b][f] ? "missing" : "still there");
 			}
 	/* BLAS only with the deformed surface */

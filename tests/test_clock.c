@@ -14,7 +14,7 @@
 
 #include <cmocka.h>
 
-#include "irdm/clock.h"
+#include "irdm/posix/clock.h"
 #include "irdm/error.h"
 
 static double now_s(void)

@@ -34,6 +34,8 @@
 #include "support/tick_image.h"
 
 #include "irdm/controller.h"
+#include "irdm/posix/image_map.h"
+#include "irdm/posix/session.h"
 #include "irdm/sim/sim_device.h"
 #include "irdm/vec3.h"
 #include "support/alloc_count.h"

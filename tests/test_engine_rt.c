@@ -55,9 +55,11 @@
 
 #include <cmocka.h>
 
-#include "irdm/deform_worker.h"
+#include "irdm/posix/deform_worker.h"
 #include "irdm/engine.h"
-#include "irdm/rt.h"
+#include "irdm/posix/image_map.h"
+#include "irdm/posix/rt.h"
+#include "irdm/posix/session.h"
 #include "irdm/session.h"
 #include "support/engine_fixture.h"
 #include "support/strict_mode.h"
@@ -912,7 +914,7 @@ static int setup(void **state)
 	int rc = irdm_rt_lock_memory();
 
 	/* the deformation thread's BLAS threads, as a caller of
-	 * irdm_deform_update() sets them (irdm/deform_worker.h) */
+	 * irdm_deform_update() sets them (irdm/posix/deform_worker.h) */
 	openblas_set_num_threads(IRDM_DEFORM_BLAS_THREADS);
 
 	locked = rc == IRDM_OK;

@@ -43,7 +43,9 @@
 #include <cmocka.h>
 
 #include "irdm/image.h"
-#include "irdm/outdir.h"
+#include "irdm/posix/image_map.h"
+#include "irdm/posix/outdir.h"
+#include "irdm/posix/telemetry_log.h"
 #include "irdm/vec3.h"
 #include "irdm/safety.h"
 #include "irdm/telemetry.h"

@@ -41,6 +41,7 @@
 
 #include <cmocka.h>
 
+#include "irdm/posix/telemetry_log.h"
 #include "irdm/safety.h"
 #include "irdm/telemetry.h"
 #include "support/run_prog.h"

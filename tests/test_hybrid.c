@@ -30,6 +30,7 @@
 #include "precompute/precompute.h"
 #include "scene/scene.h"
 #include "support/engine_fixture.h"
+#include "irdm/posix/image_map.h"
 
 #define H_EXACT 32              /* scene key exact_head */
 #define N_TICKS 1500            /* 3 s at 2 ms */

@@ -40,6 +40,7 @@
 #include "support/engine_fixture.h"
 #include "support/run_prog.h"
 #include "support/test_files.h"
+#include "irdm/posix/image_map.h"
 
 /* The budgets for the full torus.  Time is printed, not asserted (a
  * unit test on a shared machine cannot hold a time; the figure is the

@@ -6,7 +6,7 @@
 
 #include "irdm/error.h"
 #include "irdm/options.h"
-#include "irdm/options_doc.h"
+#include "irdm/posix/options_doc.h"
 
 #include "candrives.h"
 

@@ -18,6 +18,7 @@
 #include <time.h>
 
 #include "irdm/board.h"
+#include "irdm/posix/board_file.h"
 #include "irdm/sim/can_drives.h"
 #include "irdm/error.h"
 #include "irdm/sim/sim_user_push.h"

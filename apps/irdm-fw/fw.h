@@ -3,7 +3,7 @@
  * irdm-fw: the controller program.  main() (irdm_fw.c) is the composition
  * root: it reads the arguments (fw_args.c) and the board, opens the session
  * on the image, registers and opens the HAL back-ends, sets up real time
- * (irdm/rt.h), maps the board onto the controller's configuration
+ * (irdm/posix/rt.h), maps the board onto the controller's configuration
  * (fw_config.c), runs the loop (fw_loop.c) and prints the summary
  * (fw_summary.c).  Private to apps/irdm-fw.
  */
@@ -18,10 +18,11 @@
 #include <time.h>
 
 #include "irdm/board.h"
-#include "irdm/clock.h"
+#include "irdm/posix/clock.h"
 #include "irdm/controller.h"
 #include "irdm/hal/hal.h"
-#include "irdm/outdir.h"
+#include "irdm/posix/outdir.h"
+#include "irdm/posix/telemetry_log.h"
 #include "irdm/session.h"
 #include "irdm/sim/sim_user.h"
 #include "irdm/telemetry.h"
@@ -199,7 +200,7 @@ int fw_log_close(struct fw *fw);
  * fw_frame_tick() in the loop after each tick; fw_frame_stop() (join) and
  * fw_frame_write() before the session closes; fw_frame_summary() after.
  * fw_frame_claim_series() before the run: --frames-out's directory
- * (irdm/outdir.h); fw_frame_free() removes it unless written. */
+ * (irdm/posix/outdir.h); fw_frame_free() removes it unless written. */
 void fw_frame_config(struct fw *fw, struct irdm_session_config *sc);
 int fw_frame_check_args(struct fw *fw, uint64_t run_ticks);
 int fw_frame_open(struct fw *fw);

@@ -4,10 +4,10 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "irdm/clock.h"
+#include "irdm/posix/clock.h"
 #include "irdm/error.h"
 #include "irdm/options.h"
-#include "irdm/options_doc.h"
+#include "irdm/posix/options_doc.h"
 
 #include "fw.h"
 

@@ -4,7 +4,7 @@
  * it keeps (--frame-at's one, --frames-every's series; fw_frame_vtk.c
  * writes them).
  *
- * Real time: the worker's thread (irdm/deform_worker.h) runs one priority
+ * Real time: the worker's thread (irdm/posix/deform_worker.h) runs one priority
  * level below the force loop at the board's deform_rate_hz; its frame
  * callback counts frames, measures its own CPU time and holds, for each
  * slot, the frame nearest the slot's time.  It is the only writer of that
@@ -25,8 +25,9 @@
 #include <time.h>
 
 #include "irdm/build_config.h"
-#include "irdm/deform_worker.h"
+#include "irdm/posix/deform_worker.h"
 #include "irdm/error.h"
+#include "irdm/posix/session.h"
 
 #include "fw.h"
 

@@ -6,7 +6,7 @@
  * and its time), so ParaView opens the series with its times.  Each is
  * written beside its destination under a fresh name and renamed into
  * place: a reader never sees half a frame or half a series, and nothing
- * the tool did not write is replaced (irdm/outdir.h).
+ * the tool did not write is replaced (irdm/posix/outdir.h).
  */
 #define _GNU_SOURCE
 #include <errno.h>
@@ -14,8 +14,8 @@
 #include <string.h>
 
 #include "irdm/error.h"
-#include "irdm/outdir.h"
-#include "irdm/outfile.h"
+#include "irdm/posix/outdir.h"
+#include "irdm/posix/outfile.h"
 
 #include "fw.h"
 
@@ -111,7 +111,7 @@ static int io_error(struct fw *fw, const char *path, int e)
 	return IRDM_EIO;
 }
 
-/* Written whole beside FILE and renamed (irdm/outfile.h): a reader never
+/* Written whole beside FILE and renamed (irdm/posix/outfile.h): a reader never
  * sees half a frame, and nothing but a file is replaced. */
 int fw_frame_write(struct fw *fw)
 {
@@ -165,7 +165,7 @@ static int write_series_into(const struct fw *fw, const char *dir)
 }
 
 /*
- * The series' directory is claimed before the run (irdm/outdir.h): a DIR
+ * The series' directory is claimed before the run (irdm/posix/outdir.h): a DIR
  * this tool did not write is refused then, not after the run.
  */
 int fw_frame_claim_series(struct fw *fw)

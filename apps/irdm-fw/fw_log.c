@@ -13,7 +13,8 @@
 #include <time.h>
 
 #include "irdm/error.h"
-#include "irdm/rt.h"
+#include "irdm/posix/rt.h"
+#include "irdm/posix/telemetry_log.h"
 
 #include "fw.h"
 

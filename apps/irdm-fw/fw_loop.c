@@ -12,7 +12,7 @@
 #include "irdm/device.h"
 #include "irdm/error.h"
 #include "irdm/sim/hal_sim.h"
-#include "irdm/rt.h"
+#include "irdm/posix/rt.h"
 #include "irdm/sim/sim_user_push.h"
 #include "irdm/vec3.h"
 

@@ -8,7 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "irdm/rt.h"
+#include "irdm/posix/rt.h"
 #include "irdm/safety.h"
 
 #include "fw.h"

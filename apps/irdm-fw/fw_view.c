@@ -25,7 +25,7 @@
 #include <unistd.h>
 
 #include "irdm/error.h"
-#include "irdm/rt.h"
+#include "irdm/posix/rt.h"
 #include "view/view_msg.h"
 #include "view/view_server.h"
 

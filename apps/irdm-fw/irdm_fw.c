@@ -15,10 +15,12 @@
 #include <sys/prctl.h>
 
 #include "irdm/error.h"
+#include "irdm/posix/board_file.h"
+#include "irdm/posix/session.h"
 #include "irdm/sim/hal_canemu.h"
 #include "irdm/sim/hal_sim.h"
 #include "irdm/hal/hal_socketcan.h"
-#include "irdm/rt.h"
+#include "irdm/posix/rt.h"
 
 #include "fw.h"
 

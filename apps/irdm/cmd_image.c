@@ -11,7 +11,8 @@
 #include "irdm/error.h"
 #include "irdm/image.h"
 #include "irdm/options.h"
-#include "irdm/options_doc.h"
+#include "irdm/posix/image_map.h"
+#include "irdm/posix/options_doc.h"
 
 static const char usage[] =
 	"usage: irdm image info IMAGE\n"

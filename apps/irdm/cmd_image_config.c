@@ -13,6 +13,8 @@
 #include "cli.h"
 #include "irdm/board.h"
 #include "irdm/image.h"
+#include "irdm/posix/board_file.h"
+#include "irdm/posix/image_map.h"
 
 static void line(const char *feature, bool on)
 {

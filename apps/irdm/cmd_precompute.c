@@ -11,7 +11,7 @@
 #include "dist/dist.h"
 #include "irdm/error.h"
 #include "irdm/options.h"
-#include "irdm/options_doc.h"
+#include "irdm/posix/options_doc.h"
 #include "precompute/precompute.h"
 
 /* Touchable columns from which the dropped-block correction gets a note */

@@ -11,7 +11,7 @@
 
 #include "cli.h"
 #include "irdm/error.h"
-#include "irdm/outdir.h"
+#include "irdm/posix/outdir.h"
 #include "precompute/precompute.h"
 #include "report/report.h"
 #include "report/report_check.h"

@@ -10,7 +10,7 @@
 
 #include "board_priv.h"
 #include "irdm/board.h"
-#include "irdm/deform_worker.h"         /* IRDM_DEFORM_MAX_RATE_HZ */
+#include "irdm/deform.h"         /* IRDM_DEFORM_MAX_RATE_HZ */
 #include "irdm/error.h"
 
 /* A little over pi, so that any angle in [-pi, pi] is accepted and the range

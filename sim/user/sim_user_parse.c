@@ -15,7 +15,7 @@
 #include <string.h>
 
 #include "irdm/error.h"
-#include "irdm/textfile.h"
+#include "irdm/posix/textfile.h"
 #include "irdm/sim/sim_user.h"
 
 #define TOKENS_MAX 12

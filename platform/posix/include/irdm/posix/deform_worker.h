@@ -29,7 +29,6 @@
 #include "irdm/error.h"
 
 #define IRDM_DEFORM_BLAS_THREADS 1
-#define IRDM_DEFORM_MAX_RATE_HZ 10000.0
 
 struct irdm_deform_worker;   /* opaque, in caller memory */
 

@@ -17,7 +17,26 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-#include "image_priv.h"
+#include <stdarg.h>
+
+#include "irdm/error.h"
+#include "irdm/image_format.h"
+#include "irdm/posix/image_map.h"
+
+/* A one-line reason into msg (if any); returns code. */
+static int map_report(char *msg, size_t len, int code, const char *fmt, ...)
+	__attribute__((format(printf, 4, 5)));
+
+static int map_report(char *msg, size_t len, int code, const char *fmt, ...)
+{
+	va_list ap;
+
+	va_start(ap, fmt);
+	if (msg && len)
+		vsnprintf(msg, len, fmt, ap);
+	va_end(ap);
+	return code;
+}
 
 static void format_size(char *buf, size_t len, size_t bytes)
 {
@@ -55,7 +74,7 @@ static int lock_pages(struct irdm_image *raw, char *msg, size_t msglen)
 	}
 	e = errno;
 	format_size(sz, sizeof(sz), raw->size);
-	return img_report(msg, msglen, IRDM_EIO, "cannot lock %s: %s%s", sz,
+	return map_report(msg, msglen, IRDM_EIO, "cannot lock %s: %s%s", sz,
 			  strerror(e), e == EPERM || e == ENOMEM ?
 			  " (raise RLIMIT_MEMLOCK or run with CAP_IPC_LOCK)" : "");
 }
@@ -75,15 +94,15 @@ static int read_all(int fd, uint8_t *base, size_t size, char *msg, size_t msglen
 		if (n < 0 && errno == EINTR)
 			continue;
 		if (n < 0)
-			return img_report(msg, msglen, IRDM_EIO, "cannot read: %s", strerror(errno));
+			return map_report(msg, msglen, IRDM_EIO, "cannot read: %s", strerror(errno));
 		if (n == 0)
-			return img_report(msg, msglen, IRDM_ETRUNC,
+			return map_report(msg, msglen, IRDM_ETRUNC,
 					  "image is truncated: the file shrank to %zu bytes while "
 					  "it was read (%zu expected)", done, size);
 		done += (size_t)n;
 	}
 	if (pread(fd, &extra, 1, (off_t)size) > 0)
-		return img_report(msg, msglen, IRDM_EIO,
+		return map_report(msg, msglen, IRDM_EIO,
 				  "the file grew past %zu bytes while it was read", size);
 	return IRDM_OK;
 }
@@ -104,23 +123,23 @@ static int map_fd(int fd, unsigned flags, struct irdm_image *raw,
 	int ret;
 
 	if (fstat(fd, &st))
-		return img_report(msg, msglen, IRDM_EIO, "cannot stat: %s",
+		return map_report(msg, msglen, IRDM_EIO, "cannot stat: %s",
 				  strerror(errno));
 	if (!S_ISREG(st.st_mode))
-		return img_report(msg, msglen, IRDM_EIO, "not a regular file");
-	if ((uintmax_t)st.st_size < HEADER_SIZE)
-		return img_report(msg, msglen, IRDM_ETRUNC,
+		return map_report(msg, msglen, IRDM_EIO, "not a regular file");
+	if ((uintmax_t)st.st_size < sizeof(struct irdm_image_header))
+		return map_report(msg, msglen, IRDM_ETRUNC,
 				  "image is truncated: file has %jd bytes, the header alone needs %zu",
-				  (intmax_t)st.st_size, HEADER_SIZE);
+				  (intmax_t)st.st_size, sizeof(struct irdm_image_header));
 	if ((uintmax_t)st.st_size > SIZE_MAX)
-		return img_report(msg, msglen, IRDM_EIO,
+		return map_report(msg, msglen, IRDM_EIO,
 				  "too large to map (%jd bytes)", (intmax_t)st.st_size);
 #ifdef MAP_POPULATE
 	mflags |= MAP_POPULATE;
 #endif
 	base = mmap(NULL, (size_t)st.st_size, PROT_READ | PROT_WRITE, mflags, -1, 0);
 	if (base == MAP_FAILED)
-		return img_report(msg, msglen, IRDM_EIO, "cannot map: %s",
+		return map_report(msg, msglen, IRDM_EIO, "cannot map: %s",
 				  strerror(errno));
 	raw->base = base;
 	raw->size = (size_t)st.st_size;
@@ -128,7 +147,7 @@ static int map_fd(int fd, unsigned flags, struct irdm_image *raw,
 	if (ret)
 		goto unmap;
 	if (mprotect(base, raw->size, PROT_READ)) {
-		ret = img_report(msg, msglen, IRDM_EIO, "cannot protect the copy: %s",
+		ret = map_report(msg, msglen, IRDM_EIO, "cannot protect the copy: %s",
 				 strerror(errno));
 		goto unmap;
 	}
@@ -154,14 +173,14 @@ int irdm_image_map(const char *path, unsigned flags, struct irdm_image *img,
 
 	memset(img, 0, sizeof(*img));
 	if (flags & ~(unsigned)IRDM_IMAGE_MAP_LOCK) {
-		ret = img_report(msg, sizeof(msg), IRDM_EINVAL,
+		ret = map_report(msg, sizeof(msg), IRDM_EINVAL,
 				 "unknown map flags 0x%x", flags);
 		goto out_msg;
 	}
 	/* non-blocking: a FIFO at path must not hang the open (map_fd refuses it) */
 	fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
 	if (fd < 0) {
-		ret = img_report(msg, sizeof(msg), IRDM_EIO, "cannot open: %s",
+		ret = map_report(msg, sizeof(msg), IRDM_EIO, "cannot open: %s",
 				 strerror(errno));
 		goto out_msg;
 	}

@@ -5,7 +5,7 @@
  * stdio and allocation live here, never in telemetry_ring.c or
  * telemetry_hist.c.
  *
- * A log is written under a fresh name beside PATH (irdm/outfile.h) and
+ * A log is written under a fresh name beside PATH (irdm/posix/outfile.h) and
  * renamed to PATH only once it is complete (every write, the flush and the
  * sync checked, the trailer and the record count written), so a crash or
  * a full disk leaves no half log under the final name.  Its blocks carry
@@ -23,9 +23,10 @@
 
 #include "irdm/error.h"
 #include "irdm/image.h"
-#include "irdm/outfile.h"
+#include "irdm/posix/outfile.h"
+#include "irdm/posix/telemetry_log.h"
 #include "irdm/telemetry.h"
-#include "irdm/textfile.h"
+#include "irdm/posix/textfile.h"
 
 /* ---- the layout is the file format: pin it ---- */
 
@@ -93,34 +94,6 @@ static uint32_t header_crc(const struct irdm_log_header *h)
 static uint32_t trailer_crc(const struct irdm_log_trailer *t)
 {
 	return irdm_crc32c(t, offsetof(struct irdm_log_trailer, crc32c));
-}
-
-/* ---- names ---- */
-
-const char *irdm_telem_state_name(unsigned state)
-{
-	static const char *const names[IRDM_TELEM_N_STATES] = {
-		"init", "ready", "enabled", "fault", "off",
-	};
-
-	return state < IRDM_TELEM_N_STATES ? names[state] : "?";
-}
-
-const char *irdm_telem_proxy_name(unsigned proxy)
-{
-	static const char *const names[IRDM_TELEM_N_PROXY] = { "free", "touch", "slide", "release" };
-
-	return proxy < IRDM_TELEM_N_PROXY ? names[proxy] : "?";
-}
-
-const char *irdm_telem_fault_name(unsigned bit)
-{
-	static const char *const names[IRDM_TELEM_N_FAULTS] = {
-		"clamp", "workspace", "velocity", "watchdog", "overrun", "encoder_nan",
-		"encoder_range", "signal", "hal_read", "hal_write", "hal_fault", "engine",
-	};
-
-	return bit < IRDM_TELEM_N_FAULTS ? names[bit] : "?";
 }
 
 /* ---- errors ---- */

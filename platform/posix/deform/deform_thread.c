@@ -13,7 +13,7 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "irdm/rt.h"
+#include "irdm/posix/rt.h"
 
 #include "worker_priv.h"
 

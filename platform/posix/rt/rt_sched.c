@@ -10,7 +10,7 @@
 #include <sched.h>
 #include <unistd.h>
 
-#include "irdm/rt.h"
+#include "irdm/posix/rt.h"
 
 /* A pthread error number in the project's space; `other` for the rest. */
 static int from_errno(int e, int other)

@@ -5,7 +5,7 @@
  */
 #include <errno.h>
 
-#include "irdm/rt.h"
+#include "irdm/posix/rt.h"
 
 #define NSEC_PER_SEC 1000000000L
 

@@ -13,7 +13,7 @@
 #include <string.h>
 #include <sys/utsname.h>
 
-#include "irdm/rt.h"
+#include "irdm/posix/rt.h"
 
 /*
  * The kernel's special mappings ([vvar], [vdso]: 32 kB on x86-64 today)

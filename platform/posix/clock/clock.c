@@ -1,10 +1,10 @@
 /* SPDX-License-Identifier: MIT */
-/* The force loop's clock: real (absolute sleeps) or virtual (irdm/clock.h). */
+/* The force loop's clock: real (absolute sleeps) or virtual (irdm/posix/clock.h). */
 #include <string.h>
 
-#include "irdm/clock.h"
+#include "irdm/posix/clock.h"
 #include "irdm/error.h"
-#include "irdm/rt.h"
+#include "irdm/posix/rt.h"
 
 int irdm_clock_start(struct irdm_clock *c, enum irdm_clock_mode mode, uint32_t period_us)
 {

@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* Input files that cannot hang or mislead a reader (irdm/textfile.h). */
+/* Input files that cannot hang or mislead a reader (irdm/posix/textfile.h). */
 #include <errno.h>
 #include <fcntl.h>
 #include <stdio.h>
@@ -8,7 +8,7 @@
 #include <unistd.h>
 
 #include "irdm/error.h"
-#include "irdm/textfile.h"
+#include "irdm/posix/textfile.h"
 
 static const char *kind(mode_t m)
 {

@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* Output directories written whole, never over what is not ours (irdm/outdir.h). */
+/* Output directories written whole, never over what is not ours (irdm/posix/outdir.h). */
 #define _GNU_SOURCE
 #include <dirent.h>
 #include <errno.h>
@@ -14,7 +14,7 @@
 #include <unistd.h>
 
 #include "irdm/error.h"
-#include "irdm/outdir.h"
+#include "irdm/posix/outdir.h"
 #include "irdm/version.h"
 
 #define MARKER_MAGIC "irdm-output 1\n"

@@ -9,8 +9,8 @@
 #include <stdatomic.h>
 #include <time.h>
 
-#include "channel_priv.h"
-#include "irdm/deform_worker.h"
+#include "irdm/deform_channel.h"
+#include "irdm/posix/deform_worker.h"
 
 struct irdm_deform_thread {
 	pthread_t tid;

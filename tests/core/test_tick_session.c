@@ -1,9 +1,12 @@
 /* SPDX-License-Identifier: MIT */
 /*
  * The force tick alone, as the controller will run it: open a session on an
- * image, begin a contact, tick, close.  This binary links the firmware
- * library, libm and cmocka only (Makefile: tests/test_tick_*.c): that it
- * links at all shows the session and the tick need neither BLAS nor threads.
+ * image, begin a contact, tick, close.  This binary links the firmware core
+ * library, libm and cmocka only (Makefile: tests/core/): that it links at
+ * all shows the session and the tick need no platform service (no file
+ * mapping, BLAS or threads).  The image file is read here, with stdio, and
+ * handed to the core's session as the platform's mapping would be
+ * (irdm_session_open_with()).
  *
  * The image comes from the environment, IRDM_TICK_IMAGE (a test without it
  * fails: it must not pass by skipping).  make test makes it with
@@ -22,6 +25,7 @@
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -30,11 +34,53 @@
 #include "support/tick_image.h"
 
 #include "irdm/engine.h"
+#include "irdm/error.h"
+#include "irdm/image.h"
 #include "irdm/precision.h"
 #include "irdm/session.h"
 
 #define N_TICKS 1000
 #define STEP_M 0.001
+#define IMAGE_MAX_BYTES (64u << 20)
+
+/* The platform's part, done by the test: the file into aligned memory,
+ * then the core's parser.  unmaps counts the releases. */
+static int unmaps;
+
+static int test_map(const char *path, unsigned flags, struct irdm_image *img, char *err,
+		    size_t errlen)
+{
+	FILE *f = fopen(path, "rb");
+	void *buf = NULL;
+	long n = -1;
+	int rc;
+
+	(void)flags;
+	memset(img, 0, sizeof(*img));
+	if (f && !fseek(f, 0, SEEK_END))
+		n = ftell(f);
+	if (n > 0 && n <= (long)IMAGE_MAX_BYTES && !fseek(f, 0, SEEK_SET))
+		buf = aligned_alloc(64, ((size_t)n + 63) & ~(size_t)63);
+	if (!buf || fread(buf, 1, (size_t)n, f) != (size_t)n) {
+		snprintf(err, errlen, "%s: cannot read", path);
+		free(buf);
+		if (f)
+			fclose(f);
+		return IRDM_EIO;
+	}
+	fclose(f);
+	rc = irdm_image_parse(buf, (size_t)n, img, err, errlen);
+	if (rc)
+		free(buf);
+	return rc;
+}
+
+static void test_unmap(struct irdm_image *img)
+{
+	free((void *)img->base);
+	memset(img, 0, sizeof(*img));
+	unmaps++;
+}
 
 /* Mode shape k at image node row, axis i. */
 static double phi(const struct irdm_image *img, uint32_t row, int i, size_t k)
@@ -109,7 +155,8 @@ static void test_step_at_a_node(void **state)
 	(void)state;
 	irdm_engine_config_default(&sc.engine);
 	sc.engine.max_contacts = 1;
-	if (irdm_session_open(&s, tick_image_path(), &sc, err, sizeof(err)))
+	if (irdm_session_open_with(&s, tick_image_path(), &sc, test_map, test_unmap, err,
+				   sizeof(err)))
 		fail_msg("session: %s", err);
 	assert_null(s->deform);
 	assert_true(s->img->meta->n_cols > 0);
@@ -148,7 +195,9 @@ static void test_step_at_a_node(void **state)
 		}
 	}
 	assert_int_equal(irdm_engine_stats(s->eng)->ticks, N_TICKS);
+	unmaps = 0;
 	irdm_session_close(s);
+	assert_int_equal(unmaps, 1);    /* the session gave its image back */
 }
 
 static void test_open_errors(void **state)
@@ -160,14 +209,17 @@ static void test_open_errors(void **state)
 	(void)state;
 	irdm_engine_config_default(&sc.engine);
 	/* no such file: the loader's error, nothing left behind */
-	assert_int_not_equal(irdm_session_open(&s, "/nonexistent/irdm-tick.img", &sc, err,
-					       sizeof(err)), IRDM_OK);
+	assert_int_equal(irdm_session_open_with(&s, "/nonexistent/irdm-tick.img", &sc, test_map,
+						test_unmap, err, sizeof(err)), IRDM_EIO);
 	assert_null(s);
 	assert_true(err[0] != '\0');
-	/* a configuration the engine refuses */
+	/* a configuration the engine refuses: the image goes back too */
 	sc.engine.max_contacts = IRDM_MAX_CONTACTS + 1;
-	assert_int_equal(irdm_session_open(&s, tick_image_path(), &sc, err, sizeof(err)), IRDM_EINVAL);
+	unmaps = 0;
+	assert_int_equal(irdm_session_open_with(&s, tick_image_path(), &sc, test_map, test_unmap,
+						err, sizeof(err)), IRDM_EINVAL);
 	assert_null(s);
+	assert_int_equal(unmaps, 1);
 	irdm_session_close(NULL);
 }
 

@@ -23,7 +23,7 @@
 
 #include <cmocka.h>
 
-#include "../apps/irdm-fw/fw.h"
+#include "fw.h"
 
 #define CHILD_ALIVE 42  /* the child came back from every signal */
 #define CHILD_WRONG 43  /* the flag did not say what it should */

@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* Output files written whole, under a fresh name, then renamed (irdm/outfile.h). */
+/* Output files written whole, under a fresh name, then renamed (irdm/posix/outfile.h). */
 #include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
@@ -11,8 +11,8 @@
 #include <unistd.h>
 
 #include "irdm/error.h"
-#include "irdm/outdir.h"
-#include "irdm/outfile.h"
+#include "irdm/posix/outdir.h"
+#include "irdm/posix/outfile.h"
 
 /* A missing path or a regular file may be replaced; nothing else. */
 static int check_target(const char *path, char *err, size_t errlen)

@@ -10,7 +10,7 @@
 #include <stdint.h>
 #include <sys/mman.h>
 
-#include "irdm/rt.h"
+#include "irdm/posix/rt.h"
 
 #if IRDM_RT_ASAN
 #include <sanitizer/asan_interface.h>

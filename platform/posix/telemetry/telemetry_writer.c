@@ -19,7 +19,8 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "irdm/rt.h"
+#include "irdm/posix/rt.h"
+#include "irdm/posix/telemetry_log.h"
 #include "irdm/telemetry.h"
 
 struct irdm_log_writer {

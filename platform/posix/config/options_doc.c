@@ -2,7 +2,7 @@
 /* --help lines and Markdown from an option table. */
 #include <string.h>
 
-#include "irdm/options_doc.h"
+#include "irdm/posix/options_doc.h"
 
 #define HELP_COLUMN 28
 #define LINE_WIDTH 79
