@@ -13,7 +13,7 @@
  *    mid-contact: torque off and state off in the next tick, the reason
  *    logged, exit 6; SIGXFSZ ignored; SIGSEGV, SIGSYS: the emergency path,
  *    exit 8; signals pending at start: the run ends in the set-up, exit 6,
- *    no drive enabled, no escalation (tests/test_fw_signals.c has every
+ *    no drive enabled, no escalation (tests/apps/irdm-fw/test_fw_signals.c has every
  *    signal, and the escalation, in detail);
  *  - the image file truncated or written over under a running loop: the
  *    run goes on to its end on its own copy;

@@ -13,8 +13,9 @@
  *                      (image_static_corr.c, its far field image_corr_lowrank.c)
  *   image_bvh.c        CONTACT_BVH
  *
- * image_parse.c is the entry point (irdm_image_parse) and
- * image_map_posix.c the only file that calls the operating system.
+ * image_parse.c is the entry point (irdm_image_parse); the platform's
+ * image_map_posix.c (platform/posix/image/) is the only loader file that
+ * calls the operating system.
  * Every check returns IRDM_OK or an irdm_err and leaves its reason in
  * the parse's err buffer (img_fail).
  */

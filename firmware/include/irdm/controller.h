@@ -12,7 +12,7 @@
  * torques and feeds telemetry.  All its memory is struct irdm_ctrl, owned by
  * the caller; the engine and image are an already-open session's.
  *
- * The tick, in order (one file in firmware/runtime/ each):
+ * The tick, in order (one file in firmware/controller/ each):
  *  1. timing: watchdog and overruns                 controller_limits.c
  *  2. commands that fault: signal, HAL flags         controller.c
  *  3. counts -> angles -> tip -> velocity            controller_input.c
