@@ -272,11 +272,13 @@ cfg-fws:
 	$(foreach c,$(CFG_NAMES),$(MAKE) --no-print-directory CONFIG=configs/$(c).config \
 	  BUILD=$(BUILD)/cfg-$(c) all;)
 
-# What each configuration costs: irdm-fw's sections and its libraries.
+# What each configuration costs: irdm-fw's sections and its libraries (the
+# core's and the platform's).
 sizes: all cfg-fws
 	@for b in $(IRDM_FW) $(foreach c,$(CFG_NAMES),$(BUILD)/cfg-$(c)/irdm-fw); do \
 	  size $$b | tail -n 1; \
-	  echo "  firmware library text: $$(size -t $$(dirname $$b)/libirdmfw.a | tail -n 1 | awk '{print $$1}') bytes"; \
+	  echo "  firmware core library text: $$(size -t $$(dirname $$b)/libirdmfw.a | tail -n 1 | awk '{print $$1}') bytes"; \
+	  echo "  platform library text: $$(size -t $$(dirname $$b)/libirdmposix.a | tail -n 1 | awk '{print $$1}') bytes"; \
 	  echo "  needs: $$(readelf -d $$b | sed -n 's/.*Shared library: \[\(.*\)\]/\1/p' | tr '\n' ' ')"; \
 	done
 
