@@ -32,7 +32,8 @@
 #   sim/main/*.c    -> irdm-candrives (the CAN drive emulator; not in the library)
 #   tools/*/*.c     -> libirdmtools.a  sees firmware/include, tools/ (not tools/irdm)
 #   tools/irdm/*.c  -> irdm
-#   firmware/main/*.c -> irdm-fw (the controller; sees firmware, hal and sim headers)
+#   firmware/main/*.c -> irdm-fw (the controller; sees firmware and hal headers,
+#                      its simulated back-ends' files the sim headers too)
 #   tests/test_*.c  -> one binary each; tests/test_tick_*.c link the firmware
 #                      library alone (no BLAS, no threads: the force tick's
 #                      dependencies, checked by tests/test_layers.c)
@@ -47,6 +48,10 @@ SHELL   := bash
 # builds the firmware alone (irdm-fw and its libraries) into build/cfg-NAME.
 CONFIG  ?=
 FEATURES := MODAL FIR FLOATING DEFORM
+# irdm-fw's HAL back-ends (firmware/main/fw_backend_<name>.c); one a config
+# file leaves unsaid is built.  Without SIM and CANEMU, irdm-fw does not
+# link the simulator.
+HAL_BACKENDS := SIM CANEMU SOCKETCAN
 ifneq ($(CONFIG),)
 include $(CONFIG)
 BUILD   ?= build/cfg-$(basename $(notdir $(CONFIG)))
@@ -54,6 +59,8 @@ $(foreach f,$(FEATURES),$(if $(filter y n,$(CONFIG_IRDM_$(f))),,\
   $(error $(CONFIG): CONFIG_IRDM_$(f) must be y or n, got '$(CONFIG_IRDM_$(f))')))
 $(if $(filter y,$(CONFIG_IRDM_MODAL) $(CONFIG_IRDM_FIR)),,\
   $(error $(CONFIG): CONFIG_IRDM_MODAL and CONFIG_IRDM_FIR are both n: the engine needs one))
+$(foreach b,$(HAL_BACKENDS),$(if $(filter y n,$(or $(CONFIG_IRDM_HAL_$(b)),y)),,\
+  $(error $(CONFIG): CONFIG_IRDM_HAL_$(b) must be y or n, got '$(CONFIG_IRDM_HAL_$(b))')))
 endif
 feature = $(if $(CONFIG),$(filter y,$(CONFIG_IRDM_$(1))),y)
 FEATURE_SRC_MODAL    = firmware/engine/engine_modal.c
@@ -61,6 +68,11 @@ FEATURE_SRC_FIR      = firmware/engine/engine_fir.c firmware/engine/fir_sum.c fi
 FEATURE_SRC_FLOATING = firmware/engine/floating.c $(wildcard firmware/rigid/*.c)
 FEATURE_SRC_DEFORM   = $(wildcard firmware/deform/*.c) firmware/session/session_deform.c
 FEATURE_OFF_SRC := $(foreach f,$(FEATURES),$(if $(call feature,$(f)),,$(FEATURE_SRC_$(f))))
+hal_backend = $(if $(CONFIG),$(filter y,$(or $(CONFIG_IRDM_HAL_$(1)),y)),y)
+FW_SIM := $(or $(call hal_backend,SIM),$(call hal_backend,CANEMU))
+HAL_OFF_SRC := $(foreach b,$(HAL_BACKENDS),$(if $(call hal_backend,$(b)),,\
+  firmware/main/fw_backend_$(subst SIM,sim,$(subst CANEMU,canemu,$(subst SOCKETCAN,socketcan,$(b)))).c)) \
+  firmware/main/$(if $(FW_SIM),fw_user_none.c,fw_user.c)
 
 CC      ?= cc
 BUILD   ?= build
@@ -72,6 +84,7 @@ WARN     = -Wall -Wextra -Werror -Wshadow -Wstrict-prototypes -Wvla -Wundef
 OPT     ?= -O2 -g
 CFLAGS  += $(CSTD) $(WARN) $(OPT) -MMD -MP
 CFLAGS  += $(foreach f,$(FEATURES),-DIRDM_CONFIG_$(f)=$(if $(call feature,$(f)),1,0))
+CFLAGS  += $(foreach b,$(HAL_BACKENDS),-DIRDM_CONFIG_HAL_$(b)=$(if $(call hal_backend,$(b)),1,0))
 LDLIBS   = -lcholmod -larpack -lopenblas -lpthread -ldl -lm
 
 # The distributed eigensolver (eigensolver = slepc, tools/dist/): PETSc and
@@ -105,7 +118,7 @@ FW_SRC    := $(filter-out firmware/main/% $(FEATURE_OFF_SRC),$(wildcard firmware
 # into irdm-fw (fw_view.c) and irdm; the trimmed builds leave it out
 # (fw_view_none.c) and need no libwebsockets.
 VIEW    := $(if $(CONFIG),,1)
-FWMAIN_SRC := $(filter-out firmware/main/$(if $(VIEW),fw_view_none.c,fw_view.c),\
+FWMAIN_SRC := $(filter-out firmware/main/$(if $(VIEW),fw_view_none.c,fw_view.c) $(HAL_OFF_SRC),\
   $(wildcard firmware/main/*.c))
 HAL_SRC   := $(wildcard hal/*/*.c)
 SIM_SRC   := $(filter-out sim/main/%,$(wildcard sim/*/*.c))
@@ -141,11 +154,13 @@ all: $(if $(CONFIG),,$(IRDM) $(SLEPC_PLUGIN)) $(FW_LIB) $(HAL_LIB) $(SIM_LIB) $(
   $(if $(CDMAIN_SRC),$(IRDM_CD))
 
 $(BUILD)/obj/firmware/%.o: LAYER_INC = $(FW_INC)
-# irdm-fw's main() is the composition root: it alone sees every layer below
-# the tools (it registers the HAL back-ends, the simulator's among them).
-$(BUILD)/obj/firmware/main/%.o: LAYER_INC = $(SIM_INC)
+# irdm-fw sees the firmware and the HAL; its simulated back-ends' files
+# alone also see the simulator's headers (the loop cannot include them)
+$(BUILD)/obj/firmware/main/%.o: LAYER_INC = $(HAL_INC)
+$(addprefix $(BUILD)/obj/firmware/main/,fw_backend_sim.o fw_backend_canemu.o fw_user.o): \
+  LAYER_INC = $(SIM_INC)
 # its publisher alone also sees the view's server (tools/view/)
-$(BUILD)/obj/firmware/main/fw_view.o: LAYER_INC = $(SIM_INC) -Itools
+$(BUILD)/obj/firmware/main/fw_view.o: LAYER_INC = $(HAL_INC) -Itools
 $(BUILD)/obj/hal/%.o:      LAYER_INC = $(HAL_INC)
 $(BUILD)/obj/sim/%.o:      LAYER_INC = $(SIM_INC)
 $(BUILD)/obj/tools/%.o:    LAYER_INC = $(TOOL_INC)
@@ -188,8 +203,9 @@ $(BUILD)/irdm-slepc.so: $(call obj,$(PLUGIN_SRC))
 
 TEST_LIBS := $(TOOL_LIB) $(SIM_LIB) $(HAL_LIB) $(FW_LIB)
 
-# BLAS only for the deformation worker
-$(IRDM_FW): $(call obj,$(FWMAIN_SRC)) $(if $(VIEW),$(VIEW_OBJ)) $(SIM_LIB) $(HAL_LIB) $(FW_LIB)
+# BLAS only for the deformation worker; the simulator only with a simulated back-end
+$(IRDM_FW): $(call obj,$(FWMAIN_SRC)) $(if $(VIEW),$(VIEW_OBJ)) $(if $(FW_SIM),$(SIM_LIB)) \
+  $(HAL_LIB) $(FW_LIB)
 	$(CC) $(LDFLAGS) $^ -o $@ $(if $(call feature,DEFORM),-lopenblas) $(if $(VIEW),$(VIEW_LIBS)) \
 	  -lpthread -lm
 
@@ -241,7 +257,7 @@ test-variants: $(STAB_TESTS) $(IRDM) $(TICK_IMAGE)
 
 # The firmware built with the shipped trimmed configurations, beside the
 # full one (test_build_config checks what they leave out and refuse).
-CFG_NAMES := default minimal
+CFG_NAMES := default minimal can
 cfg-fws:
 	$(foreach c,$(CFG_NAMES),$(MAKE) --no-print-directory CONFIG=configs/$(c).config \
 	  BUILD=$(BUILD)/cfg-$(c) all;)

@@ -23,8 +23,9 @@
 #include "irdm/hal.h"
 #include "irdm/outdir.h"
 #include "irdm/session.h"
-#include "irdm/sim_user.h"
 #include "irdm/telemetry.h"
+
+struct irdm_sim_user;   /* the virtual user's script: fw_user.c alone reads it */
 
 /* Exit codes (irdm-fw --help lists them). */
 enum fw_exit {
@@ -168,8 +169,37 @@ void fw_args_usage(FILE *f);
 int fw_config_from_board(struct irdm_ctrl_config *c, const struct irdm_board *b);
 /* Why irdm_ctrl_init() refused, naming the board or the image (fw->err). */
 const char *fw_ctrl_init_why(struct fw *fw);
-/* Why --user cannot run on the board's back-end (fw->err). */
+
+/*
+ * fw_backends.c: the HAL back-ends this build carries, each from its own
+ * file (fw_backend_<name>.c) as the build configuration says.
+ * fw_backends_register() fills the HAL core's table with them;
+ * fw_backend_of() is NULL for a name unknown or not built;
+ * fw_backend_check_built() refuses (IRDM_ENOTSUP, fw->err: the board's
+ * file and line, the CONFIG_ switch) a board whose back-end this build
+ * left out; fw_user_hal_why() says why --user cannot run on the board's.
+ */
+struct fw_backend {
+	const struct irdm_hal_backend *hal;
+	bool simulated_arm;             /* a virtual user (--user) can push its arm */
+};
+
+void fw_backends_register(void);
+const struct fw_backend *fw_backend_of(const char *name);
+int fw_backend_check_built(struct fw *fw);
 const char *fw_user_hal_why(struct fw *fw);
+
+/*
+ * fw_user.c (fw_user_none.c without a simulated back-end): --user's
+ * script.  fw_user_open() reads it and meets it with the board (fw->user;
+ * fw->err: the whole message) before any device opens; fw_user_attach()
+ * hands device i's hand to its open back-end; fw_user_end_s() is when the
+ * script ends.
+ */
+int fw_user_open(struct fw *fw);
+int fw_user_attach(struct fw *fw, unsigned device);
+double fw_user_end_s(const struct fw *fw);
+void fw_user_free(struct fw *fw);
 
 /* fw_loop.c: runs until the duration is over, a fault or a signal.
  * Returns FW_EXIT_OK, FW_EXIT_FAULT, FW_EXIT_SIGNAL or FW_EXIT_NEVER_ENABLED. */

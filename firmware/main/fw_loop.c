@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * The force loop around the controller's tick: wait for the period, let the
- * virtual user push the simulated arm, read the HAL, tick, write the HAL.
+ * The force loop around the controller's tick: wait for the period, read
+ * the HAL, tick, write the HAL.
  * Nothing here allocates, prints or locks; on a fault the torque goes off
  * (safe_off on every device) in the same period, before anything else.
  */
@@ -11,21 +11,11 @@
 
 #include "irdm/device.h"
 #include "irdm/error.h"
-#include "irdm/hal_sim.h"
+#include "irdm/hal.h"
 #include "irdm/rt.h"
-#include "irdm/sim_user_push.h"
 #include "irdm/vec3.h"
 
 #include "fw.h"
-
-/* The virtual user's hand on arm h: its force from the arm's true state. */
-static void push_hand(struct fw *fw, unsigned h, double t_s)
-{
-	struct irdm_sim_device *sim = irdm_hal_sim_device(&fw->hal[h]);
-
-	if (sim)
-		irdm_sim_user_push(fw->user, h, &fw->board, sim, t_s);
-}
 
 static void safe_off_all(struct fw *fw)
 {
@@ -162,13 +152,10 @@ int fw_loop_run(struct fw *fw, volatile sig_atomic_t *signalled)
 	irdm_clock_start(&fw->clock, (enum irdm_clock_mode)fw->args.clock, fw->board.period_us);
 	for (uint64_t k = 0; k < n_ticks; k++) {
 		int64_t latency_ns = irdm_clock_wait(&fw->clock);
-		double t_s = irdm_clock_time_s(&fw->clock), t0 = now_ns(), compute_ns;
+		double t0 = now_ns(), compute_ns;
 		bool sig = *signalled != 0;
 
 		memset(&in, 0, sizeof(in));
-		if (fw->user)
-			for (unsigned h = 0; h < fw->user->hands && h < fw->board.devices; h++)
-				push_hand(fw, h, t_s);
 		read_devices(fw, &in);
 		in.cmd |= carry | run_commands(k, n_ticks - 1, sig, fw->enabled_once);
 		in.prev_latency_ns = prev_lat;

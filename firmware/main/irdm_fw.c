@@ -15,9 +15,6 @@
 #include <sys/prctl.h>
 
 #include "irdm/error.h"
-#include "irdm/hal_canemu.h"
-#include "irdm/hal_sim.h"
-#include "irdm/hal_socketcan.h"
 #include "irdm/rt.h"
 
 #include "fw.h"
@@ -35,38 +32,20 @@ static int fail(int exit_code, int rc, const char *fmt, const char *what, const 
 	return exit_code;
 }
 
-/*
- * The script meets the board: one device per hand, and each hand's 'home'
- * is where its tip rests at the start, the calibration pose (checked
- * before any device opens).
- */
-static int meet_user(struct fw *fw)
+/* The virtual user's script, met with the board (fw_user.c). */
+static int open_user(struct fw *fw)
 {
-	if (fw->user->hands > fw->board.devices) {
-		snprintf(fw->err, sizeof(fw->err), "the script uses %u hands, the board has %u device%s",
-			 fw->user->hands, fw->board.devices, fw->board.devices == 1 ? "" : "s");
-		return fail(FW_EXIT_INPUT, IRDM_EINVAL, "--user %s: %s", fw->args.user, fw->err);
-	}
-	for (unsigned h = 0; h < fw->user->hands; h++) {
-		struct irdm_device_config dev;
-		double tip[3], home[3];
-		int rc;
+	const struct fw_backend *be = fw_backend_of(fw->board.hal);
+	int rc;
 
-		irdm_board_device(&fw->board, h, &dev);
-		irdm_device_fk(&dev, fw->board.calibration_pose_rad, tip);
-		irdm_board_device_to_object(&fw->board, tip, home);
-		rc = irdm_sim_user_start(fw->user, h, home, fw->args.user, fw->err,
-					 sizeof(fw->err));
-		if (rc)
-			return fail(FW_EXIT_INPUT, rc, "%s%s", "", fw->err);
-	}
+	if (!be || !be->simulated_arm)
+		return fail(FW_EXIT_INPUT, IRDM_EINVAL, "--user %s: %s", fw->args.user,
+			    fw_user_hal_why(fw));
+	rc = fw_user_open(fw);
+	if (rc)
+		return fail(rc == IRDM_ENOMEM ? FW_EXIT_SETUP : FW_EXIT_INPUT, rc, "%s%s", "",
+			    fw->err);
 	return FW_EXIT_OK;
-}
-
-/* The back-ends whose arm the virtual user can push (irdm_hal_sim_device). */
-static bool has_simulated_arm(const char *hal)
-{
-	return !strcmp(hal, irdm_hal_sim_backend.name) || !strcmp(hal, irdm_hal_canemu_backend.name);
 }
 
 static int open_inputs(struct fw *fw)
@@ -76,6 +55,8 @@ static int open_inputs(struct fw *fw)
 	int rc;
 
 	rc = irdm_board_load(&fw->board, fw->args.board, fw->err, sizeof(fw->err));
+	if (!rc)
+		rc = fw_backend_check_built(fw);
 	if (rc)
 		return fail(FW_EXIT_INPUT, rc, "%s%s", "", fw->err);
 	rc = fw_config_from_board(&fw->ccfg, &fw->board);
@@ -93,18 +74,7 @@ static int open_inputs(struct fw *fw)
 			 dt_us, fw->board.period_us);
 		return fail(FW_EXIT_INPUT, IRDM_EINVAL, "%s: %s", fw->args.image, fw->err);
 	}
-	if (!fw->args.user)
-		return FW_EXIT_OK;
-	if (!has_simulated_arm(fw->board.hal))
-		return fail(FW_EXIT_INPUT, IRDM_EINVAL, "--user %s: %s", fw->args.user,
-			    fw_user_hal_why(fw));
-	fw->user = calloc(1, sizeof(*fw->user));
-	if (!fw->user)
-		return fail(FW_EXIT_SETUP, IRDM_ENOMEM, "%s%s", "", "out of memory for the user script");
-	rc = irdm_sim_user_load(fw->user, fw->args.user, fw->err, sizeof(fw->err));
-	if (rc)
-		return fail(FW_EXIT_INPUT, rc, "%s%s", "", fw->err);
-	return meet_user(fw);
+	return fw->args.user ? open_user(fw) : FW_EXIT_OK;
 }
 
 /* A device's info, each line as "hal 'NAME': line". */
@@ -123,9 +93,7 @@ static int open_devices(struct fw *fw)
 	const struct irdm_hal_backend *be;
 	int rc;
 
-	irdm_hal_register(&irdm_hal_sim_backend);
-	irdm_hal_register(&irdm_hal_canemu_backend);
-	irdm_hal_register(&irdm_hal_socketcan_backend);
+	fw_backends_register();
 	be = irdm_hal_find(fw->board.hal);
 	if (!be)
 		return fail(FW_EXIT_SETUP, IRDM_ENOTSUP, "hal '%s': %s", fw->board.hal,
@@ -144,6 +112,9 @@ static int open_devices(struct fw *fw)
 				   be->data_size);
 		if (!rc)
 			rc = irdm_hal_open(&fw->hal[i]);
+		fw->hal_open[i] = !rc;
+		if (!rc)
+			rc = fw_user_attach(fw, i);
 		if (rc) {
 			/* the board's file: what the back-end refused is in it */
 			snprintf(fw->err, sizeof(fw->err), "%s: hal '%s'", fw->args.board,
@@ -151,7 +122,6 @@ static int open_devices(struct fw *fw)
 			return fail(FW_EXIT_SETUP, rc, "%s: %s", fw->err,
 				    fw->hal[i].why[0] ? fw->hal[i].why : "the device does not open");
 		}
-		fw->hal_open[i] = true;
 		if (fw->hal[i].info[0] && !fw->args.quiet)
 			print_info(fw->board.hal, fw->hal[i].info);
 	}
@@ -213,7 +183,7 @@ static uint64_t run_ticks(const struct fw *fw)
 	double s = fw->args.duration_s;
 
 	if (s <= 0)
-		s = fw->user ? fw->user->end_s + 1.0 : 5.0;
+		s = fw->user ? fw_user_end_s(fw) + 1.0 : 5.0;
 	return (uint64_t)llround(s * 1e6 / fw->board.period_us);
 }
 
@@ -288,7 +258,7 @@ static int stop(struct fw *fw, int rc)
 	if (fw->ring && fw_log_close(fw) && fail(FW_EXIT_LOG, IRDM_EIO, "%s%s", "", fw->err) &&
 	    rc == FW_EXIT_OK)
 		rc = FW_EXIT_LOG;
-	free(fw->user);
+	fw_user_free(fw);
 	fw_frame_free(fw);
 	irdm_session_close(fw->s);
 	return rc;
