@@ -200,9 +200,10 @@ static int start(struct fw *fw)
 		return rc;
 	if (irdm_ctrl_init(&fw->ctrl, &fw->ccfg, fw->s))
 		return fail(FW_EXIT_INPUT, IRDM_EINVAL, "%s%s", "", fw_ctrl_init_why(fw));
-	if (fw_trace_alloc(&fw->trace, run_ticks(fw), fw->board.period_us))
+	fw->run_ticks = run_ticks(fw);
+	if (fw_trace_alloc(&fw->trace, fw->run_ticks, fw->board.period_us))
 		return fail(FW_EXIT_SETUP, IRDM_ENOMEM, "%s%s", "", "out of memory for the run's trace");
-	rc = fw_frame_check_args(fw, run_ticks(fw));
+	rc = fw_frame_check_args(fw, fw->run_ticks);
 	if (!rc)
 		rc = fw_frame_claim_series(fw);
 	if (rc)
@@ -211,6 +212,9 @@ static int start(struct fw *fw)
 	if (rc)
 		return fail(rc == IRDM_EINVAL ? FW_EXIT_INPUT : FW_EXIT_SETUP, rc, "%s: %s",
 			    fw->args.image, fw->err);
+	rc = fw_monitor_open(fw);
+	if (rc)
+		return fail(FW_EXIT_SETUP, rc, "%s%s", "", fw->err);
 	rc = fw_log_open(fw);
 	if (rc)
 		return fail(FW_EXIT_SETUP, rc, "%s: %s", fw->args.log ? fw->args.log : "log", fw->err);
@@ -223,6 +227,8 @@ static int start(struct fw *fw)
 	/* after the real-time set-up: the thread goes one level below it */
 	rc = fw_frame_start(fw);
 	if (!rc)
+		rc = fw_monitor_start(fw);
+	if (!rc)
 		rc = fw_view_start(fw);
 	if (rc)
 		return fail(FW_EXIT_SETUP, rc, "%s%s", "", fw->err);
@@ -230,12 +236,15 @@ static int start(struct fw *fw)
 }
 
 /* Torque off first, then everything else.  The frame (--frame-at) is
- * written once the worker is joined and while the image is still mapped. */
+ * written once the monitor and the worker are joined and while the image
+ * is still mapped. */
 static int stop(struct fw *fw, int rc)
 {
 	for (unsigned i = 0; i < IRDM_BOARD_DEVICES_MAX; i++)
 		if (fw->hal_open[i])
 			irdm_hal_safe_off(&fw->hal[i]);
+	/* the monitor's last samples hold the frames' last contacts */
+	fw_monitor_stop(fw);
 	fw_frame_stop(fw);
 	fw_view_close(fw);
 	if (rc == FW_EXIT_OK || rc == FW_EXIT_FAULT || rc == FW_EXIT_NEVER_ENABLED) {
@@ -259,6 +268,7 @@ static int stop(struct fw *fw, int rc)
 	    rc == FW_EXIT_OK)
 		rc = FW_EXIT_LOG;
 	fw_user_free(fw);
+	fw_monitor_free(fw);
 	fw_frame_free(fw);
 	irdm_session_close(fw->s);
 	return rc;
