@@ -34,7 +34,8 @@
 #                                            virtual user's script file)
 #   tools/*/*.c           -> libirdmtools.a  core + posix + tools/
 #   apps/irdm/*.c         -> irdm            (the host tool: tools, posix, core)
-#   apps/irdm-fw/*.c      -> irdm-fw         (the controller: sim, hal, posix, core)
+#   apps/irdm-fw/*.c      -> irdm-fw         (the controller: hal, posix, core; only
+#                                            its simulated back-ends' files see sim)
 #   apps/irdm-candrives/*.c -> irdm-candrives (the CAN drive emulator: sim, hal, posix, core)
 #   tests/test_*.c        -> one binary each, every library
 #   tests/core/test_*.c   -> the core library alone, libm and cmocka (no
@@ -51,6 +52,10 @@ SHELL   := bash
 # builds the firmware alone (irdm-fw and its libraries) into build/cfg-NAME.
 CONFIG  ?=
 FEATURES := MODAL FIR FLOATING DEFORM
+# irdm-fw's HAL back-ends (apps/irdm-fw/fw_backend_<name>.c); one a config
+# file leaves unsaid is built.  Without SIM and CANEMU, irdm-fw does not
+# link the simulator.
+HAL_BACKENDS := SIM CANEMU SOCKETCAN
 ifneq ($(CONFIG),)
 include $(CONFIG)
 BUILD   ?= build/cfg-$(basename $(notdir $(CONFIG)))
@@ -58,6 +63,8 @@ $(foreach f,$(FEATURES),$(if $(filter y n,$(CONFIG_IRDM_$(f))),,\
   $(error $(CONFIG): CONFIG_IRDM_$(f) must be y or n, got '$(CONFIG_IRDM_$(f))')))
 $(if $(filter y,$(CONFIG_IRDM_MODAL) $(CONFIG_IRDM_FIR)),,\
   $(error $(CONFIG): CONFIG_IRDM_MODAL and CONFIG_IRDM_FIR are both n: the engine needs one))
+$(foreach b,$(HAL_BACKENDS),$(if $(filter y n,$(or $(CONFIG_IRDM_HAL_$(b)),y)),,\
+  $(error $(CONFIG): CONFIG_IRDM_HAL_$(b) must be y or n, got '$(CONFIG_IRDM_HAL_$(b))')))
 endif
 feature = $(if $(CONFIG),$(filter y,$(CONFIG_IRDM_$(1))),y)
 FEATURE_SRC_MODAL    = firmware/engine/engine_modal.c
@@ -66,6 +73,11 @@ FEATURE_SRC_FLOATING = firmware/engine/floating.c $(wildcard firmware/rigid/*.c)
 FEATURE_SRC_DEFORM   = $(wildcard firmware/deform/*.c platform/posix/deform/*.c) \
   platform/posix/session/session_deform.c
 FEATURE_OFF_SRC := $(foreach f,$(FEATURES),$(if $(call feature,$(f)),,$(FEATURE_SRC_$(f))))
+hal_backend = $(if $(CONFIG),$(filter y,$(or $(CONFIG_IRDM_HAL_$(1)),y)),y)
+FW_SIM := $(or $(call hal_backend,SIM),$(call hal_backend,CANEMU))
+HAL_OFF_SRC := $(foreach b,$(HAL_BACKENDS),$(if $(call hal_backend,$(b)),,\
+  apps/irdm-fw/fw_backend_$(subst SIM,sim,$(subst CANEMU,canemu,$(subst SOCKETCAN,socketcan,$(b)))).c)) \
+  apps/irdm-fw/$(if $(FW_SIM),fw_user_none.c,fw_user.c)
 
 CC      ?= cc
 BUILD   ?= build
@@ -77,6 +89,7 @@ WARN     = -Wall -Wextra -Werror -Wshadow -Wstrict-prototypes -Wvla -Wundef
 OPT     ?= -O2 -g
 CFLAGS  += $(CSTD) $(WARN) $(OPT) -MMD -MP
 CFLAGS  += $(foreach f,$(FEATURES),-DIRDM_CONFIG_$(f)=$(if $(call feature,$(f)),1,0))
+CFLAGS  += $(foreach b,$(HAL_BACKENDS),-DIRDM_CONFIG_HAL_$(b)=$(if $(call hal_backend,$(b)),1,0))
 LDLIBS   = -lcholmod -larpack -lopenblas -lpthread -ldl -lm
 
 # The distributed eigensolver (eigensolver = slepc, tools/dist/): PETSc and
@@ -100,6 +113,7 @@ HAL_INC   = $(FW_INC) -Ihal/include
 # the virtual user's script is read through the platform's text files
 SIM_INC   = $(HAL_INC) -Iplatform/posix/include -Isim/include
 TOOL_INC  = $(POSIX_INC) -Itools -I/usr/include/suitesparse
+FWAPP_INC = $(HAL_INC) -Iplatform/posix/include
 TEST_INC  = $(SIM_INC) -Itools -I/usr/include/suitesparse
 CORE_TEST_INC = $(FW_INC) -Itests
 
@@ -114,7 +128,7 @@ POSIX_SRC := $(filter-out $(FEATURE_OFF_SRC),$(wildcard platform/posix/*/*.c))
 # into irdm-fw (fw_view.c) and irdm; the trimmed builds leave it out
 # (fw_view_none.c) and need no libwebsockets.
 VIEW    := $(if $(CONFIG),,1)
-FWMAIN_SRC := $(filter-out apps/irdm-fw/$(if $(VIEW),fw_view_none.c,fw_view.c),\
+FWMAIN_SRC := $(filter-out apps/irdm-fw/$(if $(VIEW),fw_view_none.c,fw_view.c) $(HAL_OFF_SRC),\
   $(wildcard apps/irdm-fw/*.c))
 HAL_SRC   := $(wildcard hal/*/*.c)
 SIM_SRC   := $(wildcard sim/*/*.c)
@@ -154,11 +168,13 @@ all: $(if $(CONFIG),,$(IRDM) $(SLEPC_PLUGIN)) $(FW_LIB) $(POSIX_LIB) $(HAL_LIB) 
 
 $(BUILD)/obj/firmware/%.o: LAYER_INC = $(FW_INC)
 $(BUILD)/obj/platform/posix/%.o: LAYER_INC = $(POSIX_INC)
-# irdm-fw's main() is the composition root: it alone sees every layer below
-# the tools (it registers the HAL back-ends, the simulator's among them).
-$(BUILD)/obj/apps/irdm-fw/%.o: LAYER_INC = $(SIM_INC)
+# irdm-fw sees the core, the platform and the HAL; its simulated back-ends'
+# files alone also see the simulator's headers (the loop cannot include them)
+$(BUILD)/obj/apps/irdm-fw/%.o: LAYER_INC = $(FWAPP_INC)
+$(addprefix $(BUILD)/obj/apps/irdm-fw/,fw_backend_sim.o fw_backend_canemu.o fw_user.o): \
+  LAYER_INC = $(SIM_INC)
 # its publisher alone also sees the view's server (tools/view/)
-$(BUILD)/obj/apps/irdm-fw/fw_view.o: LAYER_INC = $(SIM_INC) -Itools
+$(BUILD)/obj/apps/irdm-fw/fw_view.o: LAYER_INC = $(FWAPP_INC) -Itools
 $(BUILD)/obj/apps/irdm-candrives/%.o: LAYER_INC = $(SIM_INC)
 $(BUILD)/obj/apps/irdm/%.o: LAYER_INC = $(TOOL_INC)
 $(BUILD)/obj/hal/%.o:      LAYER_INC = $(HAL_INC)
@@ -208,8 +224,9 @@ $(BUILD)/irdm-slepc.so: $(call obj,$(PLUGIN_SRC))
 
 TEST_LIBS := $(TOOL_LIB) $(SIM_LIB) $(HAL_LIB) $(POSIX_LIB) $(FW_LIB)
 
-# BLAS only for the deformation worker
-$(IRDM_FW): $(call obj,$(FWMAIN_SRC)) $(if $(VIEW),$(VIEW_OBJ)) $(SIM_LIB) $(HAL_LIB) $(POSIX_LIB) $(FW_LIB)
+# BLAS only for the deformation worker; the simulator only with a simulated back-end
+$(IRDM_FW): $(call obj,$(FWMAIN_SRC)) $(if $(VIEW),$(VIEW_OBJ)) $(if $(FW_SIM),$(SIM_LIB)) \
+  $(HAL_LIB) $(POSIX_LIB) $(FW_LIB)
 	$(CC) $(LDFLAGS) $^ -o $@ $(if $(call feature,DEFORM),-lopenblas) $(if $(VIEW),$(VIEW_LIBS)) \
 	  -lpthread -lm
 
@@ -267,7 +284,7 @@ test-variants: $(STAB_TESTS) $(IRDM) $(TICK_IMAGE)
 
 # The firmware built with the shipped trimmed configurations, beside the
 # full one (test_build_config checks what they leave out and refuse).
-CFG_NAMES := default minimal
+CFG_NAMES := default minimal can
 cfg-fws:
 	$(foreach c,$(CFG_NAMES),$(MAKE) --no-print-directory CONFIG=configs/$(c).config \
 	  BUILD=$(BUILD)/cfg-$(c) all;)

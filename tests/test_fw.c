@@ -119,8 +119,9 @@ static const char *board_with(const char *name, const char *key, const char *val
 /*
  * Each refusal names the thing, the place and the reason: the back-end's
  * reason with the board's name, a value no device has at its line, a
- * --user board whose back-end does not exist, a frame period shorter than
- * the deformation's before the run, and --help hinted once.
+ * --user board whose back-end does not exist or has no simulated arm, a
+ * frame period shorter than the deformation's before the run, and --help
+ * hinted once.
  */
 static void test_clear_messages(void **state)
 {
@@ -147,6 +148,12 @@ static void test_clear_messages(void **state)
 	expect_error(run_fw((const char *const[]){ "--board", b, "--image", image, "--user",
 						   PRESS, "--clock", "virtual", NULL }),
 		     3, "nohal.board: hal 'teleport': no such back-end in this build");
+	/* a back-end without a simulated arm has nothing for a hand to push */
+	expect_error(run_fw((const char *const[]){ "--board", "boards/can-3dof.board", "--image",
+						   image, "--user", PRESS, "--clock", "virtual",
+						   NULL }),
+		     3, "--user " PRESS ": a virtual user needs a back-end with a simulated arm, "
+			"and boards/can-3dof.board's hal 'socketcan' has none (hal = sim or canemu)");
 	expect_error(run_fw((const char *const[]){ "--board", BOARD, "--image", image, "--clock",
 						   "virtual", "--frames-every", "0.001", "--frames-out",
 						   "/nonexistent/never", NULL }),

@@ -2,14 +2,18 @@
 /*
  * irdm-fw: the controller program.  main() (irdm_fw.c) is the composition
  * root: it reads the arguments (fw_args.c) and the board, opens the session
- * on the image, registers and opens the HAL back-ends, sets up real time
- * (irdm/posix/rt.h), maps the board onto the controller's configuration
- * (fw_config.c), runs the loop (fw_loop.c) and prints the summary
- * (fw_summary.c).  Private to apps/irdm-fw.
+ * on the image, registers the HAL back-ends this build carries
+ * (fw_backends.c) and opens them, hands --user's script to the simulated
+ * ones (fw_user.c), sets up real time (irdm/posix/rt.h), maps the board onto
+ * the controller's configuration (fw_config.c), runs the loop (fw_loop.c:
+ * the HAL and the tick only; fw_monitor.c takes what the summary and the
+ * frames need off it) and prints the summary (fw_summary.c).  Private to
+ * apps/irdm-fw.
  */
 #ifndef IRDM_FW_H
 #define IRDM_FW_H
 
+#include <pthread.h>
 #include <signal.h>
 #include <stdatomic.h>
 #include <stdbool.h>
@@ -24,8 +28,9 @@
 #include "irdm/posix/outdir.h"
 #include "irdm/posix/telemetry_log.h"
 #include "irdm/session.h"
-#include "irdm/sim/sim_user.h"
 #include "irdm/telemetry.h"
+
+struct irdm_sim_user;   /* the virtual user's script: fw_user.c alone reads it */
 
 /* Exit codes (irdm-fw --help lists them). */
 enum fw_exit {
@@ -78,8 +83,8 @@ struct fw_trace {
 
 /*
  * A frame to keep: the snapshot nearest target_tick (engine ticks).  The
- * worker (real time) or the loop (virtual) fills the frame; the loop fills
- * the contact at target_tick.
+ * worker (real time) or the monitor (virtual) fills the frame; the monitor
+ * fills the contact at target_tick.
  */
 struct fw_frame_slot {
 	uint64_t target_tick, held_tick;
@@ -95,7 +100,8 @@ struct fw_frame_slot {
  * The deformation worker's side of the run (fw_frame.c).  Real time: its
  * thread is the single writer of the frames (pos_m, held*) and of the
  * counters below until it is joined; the loop never reads them.  Virtual
- * time: the loop runs the update itself, every every_ticks engine ticks.
+ * time: the monitor (fw_monitor.c) runs the update in the loop's thread,
+ * every every_ticks engine ticks.
  * Slots are in target order: the --frames-every series (if any), and
  * --frame-at's slot among them at single_slot.
  */
@@ -107,19 +113,46 @@ struct fw_frame {
 	uint32_t rows;
 	struct fw_frame_slot *slot;
 	unsigned n_slots, single_slot;  /* single_slot: n_slots if no --frame-at */
-	unsigned contact_next;          /* the loop's: the next slot to take a contact */
+	unsigned contact_next;          /* the monitor's: the next slot to take a contact */
 	/* --frame-at's frame for the summary, copied at stop (the slots are
 	 * freed before the summary prints) */
 	bool single_held;
 	uint64_t single_held_tick;
 	double *scratch_m;              /* 3 rows: virtual time's update target */
-	/* ---- written by the worker's thread (real) or the loop (virtual) */
+	/* ---- written by the worker's thread (real) or the monitor (virtual) */
 	unsigned next;                  /* the first slot still looking for its frame */
 	uint64_t frames;
 	double cpu_sum_ns, cpu_max_ns;
 	uint64_t cpu_n;
 	struct timespec cpu_prev;
 	bool cpu_started;
+};
+
+/* One tick as the run's monitor sees it (fw_monitor.c): device 0. */
+struct fw_sample {
+	uint64_t eng_tick;              /* the engine's ticks after this one (the frames' clock) */
+	int state;                      /* enum irdm_safety_state after the tick */
+	bool contact;
+	double force_obj_n[3];
+	double scale;                   /* force clamp x torque saturation */
+	double proxy_m[3];
+	double node_u_m;                /* the watched node along its contact's normal */
+};
+
+/*
+ * The run's monitor (fw_monitor.c): the watched node (the loop's side),
+ * and in real time the samples' ring to the consumer thread.
+ */
+struct fw_monitor {
+	uint32_t watch_row;             /* the image node whose ringing is measured */
+	bool watching;
+	double watch_normal[3];
+	struct fw_sample *ring;         /* real time only */
+	_Atomic uint64_t head, tail;    /* written by the loop; by the consumer */
+	atomic_bool stop;
+	pthread_t tid;
+	bool running;
+	uint64_t lost;                  /* samples a full ring lost */
 };
 
 struct fw {
@@ -149,9 +182,8 @@ struct fw {
 	struct irdm_telem_ring *view_ring;      /* --view: the same records, for the view */
 	struct irdm_hist latency;               /* ns, real time only (0 in virtual time) */
 	struct irdm_hist compute_measured;      /* ns, measured in both clocks; limit: the period */
-	uint32_t watch_row;             /* the image node whose ringing is measured */
-	bool watching;
-	double watch_normal[3];
+	struct fw_monitor monitor;
+	uint64_t run_ticks;             /* the run's length, ticks */
 	uint64_t ticks;
 	bool enabled_once;              /* the state was ENABLED in some tick */
 	uint32_t enable_blocked;        /* the conditions that refused the last enable */
@@ -169,8 +201,37 @@ void fw_args_usage(FILE *f);
 int fw_config_from_board(struct irdm_ctrl_config *c, const struct irdm_board *b);
 /* Why irdm_ctrl_init() refused, naming the board or the image (fw->err). */
 const char *fw_ctrl_init_why(struct fw *fw);
-/* Why --user cannot run on the board's back-end (fw->err). */
+
+/*
+ * fw_backends.c: the HAL back-ends this build carries, each from its own
+ * file (fw_backend_<name>.c) as the build configuration says.
+ * fw_backends_register() fills the HAL core's table with them;
+ * fw_backend_of() is NULL for a name unknown or not built;
+ * fw_backend_check_built() refuses (IRDM_ENOTSUP, fw->err: the board's
+ * file and line, the CONFIG_ switch) a board whose back-end this build
+ * left out; fw_user_hal_why() says why --user cannot run on the board's.
+ */
+struct fw_backend {
+	const struct irdm_hal_backend *hal;
+	bool simulated_arm;             /* a virtual user (--user) can push its arm */
+};
+
+void fw_backends_register(void);
+const struct fw_backend *fw_backend_of(const char *name);
+int fw_backend_check_built(struct fw *fw);
 const char *fw_user_hal_why(struct fw *fw);
+
+/*
+ * fw_user.c (fw_user_none.c without a simulated back-end): --user's
+ * script.  fw_user_open() reads it and meets it with the board (fw->user;
+ * fw->err: the whole message) before any device opens; fw_user_attach()
+ * hands device i's hand to its open back-end; fw_user_end_s() is when the
+ * script ends.
+ */
+int fw_user_open(struct fw *fw);
+int fw_user_attach(struct fw *fw, unsigned device);
+double fw_user_end_s(const struct fw *fw);
+void fw_user_free(struct fw *fw);
 
 /* fw_loop.c: runs until the duration is over, a fault or a signal.
  * Returns FW_EXIT_OK, FW_EXIT_FAULT, FW_EXIT_SIGNAL or FW_EXIT_NEVER_ENABLED. */
@@ -185,6 +246,17 @@ void fw_signals_loop(bool running);
 void fw_signals_disarm(void);
 const char *fw_signal_name(int sig);
 
+/* fw_monitor.c: what the summary and the frames take from each tick, off
+ * the loop.  fw_monitor_open() before the real-time set-up,
+ * fw_monitor_start() after it (the consumer thread, real time only),
+ * fw_monitor_tick() in the loop after each tick, fw_monitor_stop() (join,
+ * drain) before the frames are written, fw_monitor_free() at the end. */
+int fw_monitor_open(struct fw *fw);
+int fw_monitor_start(struct fw *fw);
+void fw_monitor_tick(struct fw *fw, const struct irdm_ctrl_output *out);
+void fw_monitor_stop(struct fw *fw);
+void fw_monitor_free(struct fw *fw);
+
 /* fw_log.c: open the log (--log) before the loop, drain and close after. */
 int fw_log_open(struct fw *fw);
 void fw_log_record(struct fw *fw, const struct irdm_ctrl_output *out, int64_t latency_ns,
@@ -197,7 +269,8 @@ int fw_log_close(struct fw *fw);
  * rate); fw_frame_check_args() (--frame-at against the board and the run's
  * length) and fw_frame_open() (worker, buffers) after the controller;
  * fw_frame_start() after the real-time set-up (the thread, real time only);
- * fw_frame_tick() in the loop after each tick; fw_frame_stop() (join) and
+ * fw_frame_sample() from the run's monitor for each tick, in order (the
+ * contact at a frame's tick; virtual time's update); fw_frame_stop() (join) and
  * fw_frame_write() before the session closes; fw_frame_summary() after.
  * fw_frame_claim_series() before the run: --frames-out's directory
  * (irdm/posix/outdir.h); fw_frame_free() removes it unless written. */
@@ -205,7 +278,7 @@ void fw_frame_config(struct fw *fw, struct irdm_session_config *sc);
 int fw_frame_check_args(struct fw *fw, uint64_t run_ticks);
 int fw_frame_open(struct fw *fw);
 int fw_frame_start(struct fw *fw);
-void fw_frame_tick(struct fw *fw, const struct irdm_ctrl_output *out);
+void fw_frame_sample(struct fw *fw, const struct fw_sample *s);
 void fw_frame_stop(struct fw *fw);
 int fw_frame_write(struct fw *fw);
 int fw_frame_claim_series(struct fw *fw);

@@ -80,20 +80,3 @@ const char *fw_ctrl_init_why(struct fw *fw)
 		 "limits or placement (irdm_ctrl_config_check)", fw->args.board);
 	return fw->err;
 }
-
-const char *fw_user_hal_why(struct fw *fw)
-{
-	static const char *const known[] = { "sim", "canemu", "socketcan" };
-	bool found = false;
-
-	for (size_t i = 0; i < sizeof(known) / sizeof(known[0]); i++)
-		found |= !strcmp(fw->board.hal, known[i]);
-	if (!found)
-		snprintf(fw->err, sizeof(fw->err), "%s: hal '%s': no such back-end in this build "
-			 "(sim, canemu, socketcan)", fw->args.board, fw->board.hal);
-	else
-		snprintf(fw->err, sizeof(fw->err), "a virtual user needs a back-end with a "
-			 "simulated arm, and %s's hal '%s' has none (hal = sim or canemu)",
-			 fw->args.board, fw->board.hal);
-	return fw->err;
-}

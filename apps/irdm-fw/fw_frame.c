@@ -8,9 +8,11 @@
  * level below the force loop at the board's deform_rate_hz; its frame
  * callback counts frames, measures its own CPU time and holds, for each
  * slot, the frame nearest the slot's time.  It is the only writer of that
- * state until it is joined, so nothing is locked.  Virtual time: no thread; the loop runs
- * irdm_deform_update() itself on the snapshot grid, so the frames (and the
- * VTK) are the same every run.
+ * state until it is joined, so nothing is locked.  Virtual time: no
+ * thread; the run's monitor (fw_monitor.c) runs irdm_deform_update() in the
+ * loop's thread on the snapshot grid, so the frames (and the VTK) are the
+ * same every run.  The contact at a frame's tick comes from the monitor's
+ * samples too (fw_frame_sample()).
  *
  * Frame times are engine ticks: the snapshot after engine tick k is the
  * surface at t = k * period.  The engine publishes every every_ticks ticks
@@ -254,14 +256,12 @@ int fw_frame_start(struct fw *fw)
 #endif
 }
 
-static void contact_capture(struct fw_frame_slot *sl, const struct irdm_ctrl_output *out)
+static void contact_capture(struct fw_frame_slot *sl, const struct fw_sample *s)
 {
-	const struct irdm_ctrl_device_output *d = &out->dev[0];
-
 	sl->contact_seen = true;
-	sl->contact_on = d->contact;
-	memcpy(sl->contact_m, d->proxy_m, sizeof(sl->contact_m));
-	memcpy(sl->force_obj_n, d->force_obj_n, sizeof(sl->force_obj_n));
+	sl->contact_on = s->contact;
+	memcpy(sl->contact_m, s->proxy_m, sizeof(sl->contact_m));
+	memcpy(sl->force_obj_n, s->force_obj_n, sizeof(sl->force_obj_n));
 }
 
 /* Virtual time: the update on the snapshot grid, timed outside the tick. */
@@ -287,22 +287,20 @@ static void virtual_update(struct fw *fw, uint64_t eng_tick)
 	fw_view_offer(fr->view, fr->scratch_m, tick);
 }
 
-void fw_frame_tick(struct fw *fw, const struct irdm_ctrl_output *out)
+void fw_frame_sample(struct fw *fw, const struct fw_sample *s)
 {
 	struct fw_frame *fr = &fw->frame;
-	uint64_t eng_tick;
 
 	if (!fr->every_ticks)
 		return;
-	eng_tick = irdm_engine_stats(fw->s->eng)->ticks;
 	while (fr->contact_next < fr->n_slots &&
-	       fr->slot[fr->contact_next].target_tick <= eng_tick) {
-		if (fr->slot[fr->contact_next].target_tick == eng_tick)
-			contact_capture(&fr->slot[fr->contact_next], out);
+	       fr->slot[fr->contact_next].target_tick <= s->eng_tick) {
+		if (fr->slot[fr->contact_next].target_tick == s->eng_tick)
+			contact_capture(&fr->slot[fr->contact_next], s);
 		fr->contact_next++;
 	}
 	if (fw->args.clock != IRDM_CLOCK_REAL)
-		virtual_update(fw, eng_tick);
+		virtual_update(fw, s->eng_tick);
 }
 
 void fw_frame_stop(struct fw *fw)

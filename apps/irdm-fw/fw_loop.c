@@ -1,31 +1,19 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * The force loop around the controller's tick: wait for the period, let the
- * virtual user push the simulated arm, read the HAL, tick, write the HAL.
+ * The force loop around the controller's tick: wait for the period, read
+ * the HAL, tick, write the HAL.
  * Nothing here allocates, prints or locks; on a fault the torque goes off
  * (safe_off on every device) in the same period, before anything else.
  */
-#include <math.h>
 #include <string.h>
 #include <time.h>
 
 #include "irdm/device.h"
 #include "irdm/error.h"
-#include "irdm/sim/hal_sim.h"
+#include "irdm/hal/hal.h"
 #include "irdm/posix/rt.h"
-#include "irdm/sim/sim_user_push.h"
-#include "irdm/vec3.h"
 
 #include "fw.h"
-
-/* The virtual user's hand on arm h: its force from the arm's true state. */
-static void push_hand(struct fw *fw, unsigned h, double t_s)
-{
-	struct irdm_sim_device *sim = irdm_hal_sim_device(&fw->hal[h]);
-
-	if (sim)
-		irdm_sim_user_push(fw->user, h, &fw->board, sim, t_s);
-}
 
 static void safe_off_all(struct fw *fw)
 {
@@ -62,39 +50,6 @@ static uint32_t write_devices(struct fw *fw, const struct irdm_ctrl_output *out)
 		if (irdm_hal_write(&fw->hal[i], out->dev[i].torque_nm))
 			failed = IRDM_CTRL_CMD_HAL_WRITE_FAILED;
 	return failed;
-}
-
-/* The node whose motion after release is the "ringing": the vertex of the
- * contact triangle that carries most of the contact. */
-static void watch_contact_node(struct fw *fw, const struct irdm_ctrl_device_output *d)
-{
-	unsigned best = 0;
-
-	if (!d->contact || d->tri >= fw->s->img->meta->n_tris)
-		return;
-	for (unsigned k = 1; k < 3; k++)
-		if (d->bary[k] > d->bary[best])
-			best = k;
-	fw->watch_row = fw->s->img->tris[3 * (size_t)d->tri + best];
-	memcpy(fw->watch_normal, d->normal, sizeof(fw->watch_normal));
-	fw->watching = true;
-}
-
-static void trace_tick(struct fw *fw, const struct irdm_ctrl_output *out)
-{
-	const struct irdm_ctrl_device_output *d = &out->dev[0];
-	double u[3] = { 0, 0, 0 };
-
-	watch_contact_node(fw, d);
-	if (fw->watching)
-		irdm_engine_node_disp(fw->s->eng, fw->watch_row, u);
-	fw_trace_add(&fw->trace, irdm_v3_norm(d->force_obj_n), irdm_v3_dot(u, fw->watch_normal),
-		     d->contact);
-	if (out->state == IRDM_SAFETY_ENABLED &&
-	    irdm_v3_norm(d->force_obj_n) * d->scale > fw->rendered_peak_n) {
-		fw->rendered_peak_n = irdm_v3_norm(d->force_obj_n) * d->scale;
-		fw->rendered_peak_tick = fw->trace.n - 1;
-	}
 }
 
 static double now_ns(void)
@@ -153,7 +108,7 @@ static int run_end(const struct fw *fw, const struct irdm_ctrl_output *out, bool
 
 int fw_loop_run(struct fw *fw, volatile sig_atomic_t *signalled)
 {
-	uint64_t n_ticks = fw->trace.cap, prev_lat = 0, prev_comp = 0;
+	uint64_t n_ticks = fw->run_ticks, prev_lat = 0, prev_comp = 0;
 	uint32_t carry = 0;
 	struct irdm_ctrl_input in;
 	struct irdm_ctrl_output out;
@@ -162,13 +117,10 @@ int fw_loop_run(struct fw *fw, volatile sig_atomic_t *signalled)
 	irdm_clock_start(&fw->clock, (enum irdm_clock_mode)fw->args.clock, fw->board.period_us);
 	for (uint64_t k = 0; k < n_ticks; k++) {
 		int64_t latency_ns = irdm_clock_wait(&fw->clock);
-		double t_s = irdm_clock_time_s(&fw->clock), t0 = now_ns(), compute_ns;
+		double t0 = now_ns(), compute_ns;
 		bool sig = *signalled != 0;
 
 		memset(&in, 0, sizeof(in));
-		if (fw->user)
-			for (unsigned h = 0; h < fw->user->hands && h < fw->board.devices; h++)
-				push_hand(fw, h, t_s);
 		read_devices(fw, &in);
 		in.cmd |= carry | run_commands(k, n_ticks - 1, sig, fw->enabled_once);
 		in.prev_latency_ns = prev_lat;
@@ -185,9 +137,8 @@ int fw_loop_run(struct fw *fw, volatile sig_atomic_t *signalled)
 			prev_comp = (uint64_t)irdm_clock_elapsed_ns(&fw->clock);
 		}
 		watch_enable(fw, &in, &out);
-		trace_tick(fw, &out);
-		/* after the tick's timing: virtual time's update is not the tick's */
-		fw_frame_tick(fw, &out);
+		/* after the tick's timing: what the monitor does is not the tick's */
+		fw_monitor_tick(fw, &out);
 		irdm_hist_add(&fw->compute_measured, (int64_t)compute_ns);
 		fw_log_record(fw, &out, fw->args.clock == IRDM_CLOCK_REAL ? latency_ns : 0,
 			      (int64_t)prev_comp);

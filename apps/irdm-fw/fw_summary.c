@@ -144,6 +144,9 @@ void fw_summary_print(const struct fw *fw)
 	printf("overruns: %llu (longest run %llu)\n", (unsigned long long)cs.overruns,
 	       (unsigned long long)cs.longest_run);
 	fw_frame_summary(fw);
+	if (fw->monitor.lost)
+		printf("monitor: %llu ticks lost to this summary and the frames (its thread fell "
+		       "4 s behind)\n", (unsigned long long)fw->monitor.lost);
 	if (fw->last_state == IRDM_SAFETY_FAULT)
 		printf("state: fault: %s (torque off)%s%s\n", irdm_safety_fault_name(fw->last_cause),
 		       fw_hal_why(fw)[0] ? ": " : "", fw_hal_why(fw));

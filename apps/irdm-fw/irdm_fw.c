@@ -16,11 +16,8 @@
 
 #include "irdm/error.h"
 #include "irdm/posix/board_file.h"
-#include "irdm/posix/session.h"
-#include "irdm/sim/hal_canemu.h"
-#include "irdm/sim/hal_sim.h"
-#include "irdm/hal/hal_socketcan.h"
 #include "irdm/posix/rt.h"
+#include "irdm/posix/session.h"
 
 #include "fw.h"
 
@@ -37,38 +34,20 @@ static int fail(int exit_code, int rc, const char *fmt, const char *what, const 
 	return exit_code;
 }
 
-/*
- * The script meets the board: one device per hand, and each hand's 'home'
- * is where its tip rests at the start, the calibration pose (checked
- * before any device opens).
- */
-static int meet_user(struct fw *fw)
+/* The virtual user's script, met with the board (fw_user.c). */
+static int open_user(struct fw *fw)
 {
-	if (fw->user->hands > fw->board.devices) {
-		snprintf(fw->err, sizeof(fw->err), "the script uses %u hands, the board has %u device%s",
-			 fw->user->hands, fw->board.devices, fw->board.devices == 1 ? "" : "s");
-		return fail(FW_EXIT_INPUT, IRDM_EINVAL, "--user %s: %s", fw->args.user, fw->err);
-	}
-	for (unsigned h = 0; h < fw->user->hands; h++) {
-		struct irdm_device_config dev;
-		double tip[3], home[3];
-		int rc;
+	const struct fw_backend *be = fw_backend_of(fw->board.hal);
+	int rc;
 
-		irdm_board_device(&fw->board, h, &dev);
-		irdm_device_fk(&dev, fw->board.calibration_pose_rad, tip);
-		irdm_board_device_to_object(&fw->board, tip, home);
-		rc = irdm_sim_user_start(fw->user, h, home, fw->args.user, fw->err,
-					 sizeof(fw->err));
-		if (rc)
-			return fail(FW_EXIT_INPUT, rc, "%s%s", "", fw->err);
-	}
+	if (!be || !be->simulated_arm)
+		return fail(FW_EXIT_INPUT, IRDM_EINVAL, "--user %s: %s", fw->args.user,
+			    fw_user_hal_why(fw));
+	rc = fw_user_open(fw);
+	if (rc)
+		return fail(rc == IRDM_ENOMEM ? FW_EXIT_SETUP : FW_EXIT_INPUT, rc, "%s%s", "",
+			    fw->err);
 	return FW_EXIT_OK;
-}
-
-/* The back-ends whose arm the virtual user can push (irdm_hal_sim_device). */
-static bool has_simulated_arm(const char *hal)
-{
-	return !strcmp(hal, irdm_hal_sim_backend.name) || !strcmp(hal, irdm_hal_canemu_backend.name);
 }
 
 static int open_inputs(struct fw *fw)
@@ -78,6 +57,8 @@ static int open_inputs(struct fw *fw)
 	int rc;
 
 	rc = irdm_board_load(&fw->board, fw->args.board, fw->err, sizeof(fw->err));
+	if (!rc)
+		rc = fw_backend_check_built(fw);
 	if (rc)
 		return fail(FW_EXIT_INPUT, rc, "%s%s", "", fw->err);
 	rc = fw_config_from_board(&fw->ccfg, &fw->board);
@@ -95,18 +76,7 @@ static int open_inputs(struct fw *fw)
 			 dt_us, fw->board.period_us);
 		return fail(FW_EXIT_INPUT, IRDM_EINVAL, "%s: %s", fw->args.image, fw->err);
 	}
-	if (!fw->args.user)
-		return FW_EXIT_OK;
-	if (!has_simulated_arm(fw->board.hal))
-		return fail(FW_EXIT_INPUT, IRDM_EINVAL, "--user %s: %s", fw->args.user,
-			    fw_user_hal_why(fw));
-	fw->user = calloc(1, sizeof(*fw->user));
-	if (!fw->user)
-		return fail(FW_EXIT_SETUP, IRDM_ENOMEM, "%s%s", "", "out of memory for the user script");
-	rc = irdm_sim_user_load(fw->user, fw->args.user, fw->err, sizeof(fw->err));
-	if (rc)
-		return fail(FW_EXIT_INPUT, rc, "%s%s", "", fw->err);
-	return meet_user(fw);
+	return fw->args.user ? open_user(fw) : FW_EXIT_OK;
 }
 
 /* A device's info, each line as "hal 'NAME': line". */
@@ -125,9 +95,7 @@ static int open_devices(struct fw *fw)
 	const struct irdm_hal_backend *be;
 	int rc;
 
-	irdm_hal_register(&irdm_hal_sim_backend);
-	irdm_hal_register(&irdm_hal_canemu_backend);
-	irdm_hal_register(&irdm_hal_socketcan_backend);
+	fw_backends_register();
 	be = irdm_hal_find(fw->board.hal);
 	if (!be)
 		return fail(FW_EXIT_SETUP, IRDM_ENOTSUP, "hal '%s': %s", fw->board.hal,
@@ -146,6 +114,9 @@ static int open_devices(struct fw *fw)
 				   be->data_size);
 		if (!rc)
 			rc = irdm_hal_open(&fw->hal[i]);
+		fw->hal_open[i] = !rc;
+		if (!rc)
+			rc = fw_user_attach(fw, i);
 		if (rc) {
 			/* the board's file: what the back-end refused is in it */
 			snprintf(fw->err, sizeof(fw->err), "%s: hal '%s'", fw->args.board,
@@ -153,7 +124,6 @@ static int open_devices(struct fw *fw)
 			return fail(FW_EXIT_SETUP, rc, "%s: %s", fw->err,
 				    fw->hal[i].why[0] ? fw->hal[i].why : "the device does not open");
 		}
-		fw->hal_open[i] = true;
 		if (fw->hal[i].info[0] && !fw->args.quiet)
 			print_info(fw->board.hal, fw->hal[i].info);
 	}
@@ -215,7 +185,7 @@ static uint64_t run_ticks(const struct fw *fw)
 	double s = fw->args.duration_s;
 
 	if (s <= 0)
-		s = fw->user ? fw->user->end_s + 1.0 : 5.0;
+		s = fw->user ? fw_user_end_s(fw) + 1.0 : 5.0;
 	return (uint64_t)llround(s * 1e6 / fw->board.period_us);
 }
 
@@ -232,9 +202,10 @@ static int start(struct fw *fw)
 		return rc;
 	if (irdm_ctrl_init(&fw->ctrl, &fw->ccfg, fw->s))
 		return fail(FW_EXIT_INPUT, IRDM_EINVAL, "%s%s", "", fw_ctrl_init_why(fw));
-	if (fw_trace_alloc(&fw->trace, run_ticks(fw), fw->board.period_us))
+	fw->run_ticks = run_ticks(fw);
+	if (fw_trace_alloc(&fw->trace, fw->run_ticks, fw->board.period_us))
 		return fail(FW_EXIT_SETUP, IRDM_ENOMEM, "%s%s", "", "out of memory for the run's trace");
-	rc = fw_frame_check_args(fw, run_ticks(fw));
+	rc = fw_frame_check_args(fw, fw->run_ticks);
 	if (!rc)
 		rc = fw_frame_claim_series(fw);
 	if (rc)
@@ -243,6 +214,9 @@ static int start(struct fw *fw)
 	if (rc)
 		return fail(rc == IRDM_EINVAL ? FW_EXIT_INPUT : FW_EXIT_SETUP, rc, "%s: %s",
 			    fw->args.image, fw->err);
+	rc = fw_monitor_open(fw);
+	if (rc)
+		return fail(FW_EXIT_SETUP, rc, "%s%s", "", fw->err);
 	rc = fw_log_open(fw);
 	if (rc)
 		return fail(FW_EXIT_SETUP, rc, "%s: %s", fw->args.log ? fw->args.log : "log", fw->err);
@@ -255,6 +229,8 @@ static int start(struct fw *fw)
 	/* after the real-time set-up: the thread goes one level below it */
 	rc = fw_frame_start(fw);
 	if (!rc)
+		rc = fw_monitor_start(fw);
+	if (!rc)
 		rc = fw_view_start(fw);
 	if (rc)
 		return fail(FW_EXIT_SETUP, rc, "%s%s", "", fw->err);
@@ -262,12 +238,15 @@ static int start(struct fw *fw)
 }
 
 /* Torque off first, then everything else.  The frame (--frame-at) is
- * written once the worker is joined and while the image is still mapped. */
+ * written once the monitor and the worker are joined and while the image
+ * is still mapped. */
 static int stop(struct fw *fw, int rc)
 {
 	for (unsigned i = 0; i < IRDM_BOARD_DEVICES_MAX; i++)
 		if (fw->hal_open[i])
 			irdm_hal_safe_off(&fw->hal[i]);
+	/* the monitor's last samples hold the frames' last contacts */
+	fw_monitor_stop(fw);
 	fw_frame_stop(fw);
 	fw_view_close(fw);
 	if (rc == FW_EXIT_OK || rc == FW_EXIT_FAULT || rc == FW_EXIT_NEVER_ENABLED) {
@@ -290,7 +269,8 @@ static int stop(struct fw *fw, int rc)
 	if (fw->ring && fw_log_close(fw) && fail(FW_EXIT_LOG, IRDM_EIO, "%s%s", "", fw->err) &&
 	    rc == FW_EXIT_OK)
 		rc = FW_EXIT_LOG;
-	free(fw->user);
+	fw_user_free(fw);
+	fw_monitor_free(fw);
 	fw_frame_free(fw);
 	irdm_session_close(fw->s);
 	return rc;

@@ -8,6 +8,8 @@
 #include "irdm/sim/hal_canemu.h"
 #include "irdm/sim/hal_sim.h"
 
+#include "hal_sim_hand.h"
+
 enum sim_state { SIM_CLOSED = 0, SIM_OPEN, SIM_RUNNING, SIM_OFF };
 
 struct sim_data {
@@ -15,6 +17,7 @@ struct sim_data {
 	enum sim_state state;
 	uint32_t faults;
 	uint64_t seq;
+	struct sim_hand hand;           /* the virtual user's, if one holds the arm */
 };
 
 static struct sim_data *data_of(struct irdm_hal_dev *dev)
@@ -135,6 +138,7 @@ static int sim_open(struct irdm_hal_dev *dev)
 	}
 	d->faults = 0;
 	d->seq = 0;
+	d->hand.user = NULL;
 	d->state = SIM_OPEN;
 	return IRDM_OK;
 }
@@ -159,6 +163,7 @@ static int sim_read(struct irdm_hal_dev *dev, struct irdm_hal_joint_state *st)
 
 	if (d->state == SIM_CLOSED)
 		return IRDM_EINVAL;
+	sim_hand_push(&d->hand, &d->arm);
 	if (d->faults)
 		return IRDM_EHW;
 	rc = irdm_sim_device_step(&d->arm, dev->config->period_s);
@@ -256,4 +261,15 @@ struct irdm_sim_device *irdm_hal_sim_device(struct irdm_hal_dev *dev)
 	if (emulated)
 		return &emulated->arm;  /* the arm behind the emulated CAN drives */
 	return is_open_sim(dev) ? &data_of(dev)->arm : NULL;
+}
+
+int irdm_hal_sim_attach_user(struct irdm_hal_dev *dev, const struct irdm_sim_user *u,
+			     unsigned hand, const struct irdm_board *b)
+{
+	struct sim_hand *h = is_open_sim(dev) ? &data_of(dev)->hand : irdm_hal_canemu_hand(dev);
+
+	if (!h || !u || !b || hand >= IRDM_SIM_USER_HANDS)
+		return IRDM_EINVAL;
+	sim_hand_attach(h, u, hand, b);
+	return IRDM_OK;
 }

@@ -31,7 +31,8 @@
  *
  * Registration: a static table of IRDM_HAL_BACKENDS_MAX entries that the
  * composition root (irdm-fw's main, a test) fills once at start with
- * irdm_hal_register(), before any thread runs.  The table cannot name the
+ * irdm_hal_register(), before any thread runs; irdm-fw registers the
+ * back-ends its build configuration carries (CONFIG_IRDM_HAL_<NAME>).  The table cannot name the
  * back-ends itself: the simulator's back-end lives in sim/, above hal/ in
  * the layers (the Makefile links sim before hal, and hal/ may not include
  * sim/ headers), and a build without a back-end simply does not register

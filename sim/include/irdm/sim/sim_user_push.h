@@ -3,8 +3,9 @@
  * The virtual user's hand on a simulated arm: its force from the arm's true
  * state (tip and tip velocity through the arm's kinematics, turned into the
  * object frame the script speaks), turned back into the device frame and
- * put on the arm.  Shared by irdm-fw's loop (the in-process arm) and the
- * CAN drive emulator (the arm behind its drives), so both push alike.
+ * put on the arm.  Shared by the simulated HAL back-ends' reads
+ * (sim/hal/hal_sim_hand.c: irdm-fw's arms) and the CAN drive emulator
+ * (irdm-candrives: the arm behind its drives), so both push alike.
  * Pure arithmetic: no allocation, no system call.
  */
 #ifndef IRDM_SIM_USER_PUSH_H
