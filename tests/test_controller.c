@@ -342,6 +342,12 @@ static void test_transitions_through_the_tick(void **state)
 
 /* ---- safety cases: each ends with zero torque within one tick ---- */
 
+/* The tip speed limit, m/s. */
+static void slow_limit(struct irdm_ctrl_config *cfg, double v)
+{
+	cfg->limits.max_tip_speed_m_per_s = v;
+}
+
 /* Enabled, device 0 pressed 1.5 mm into the top face for 100 ticks. */
 static void contact_rig(struct rig *r, void (*tweak)(struct irdm_ctrl_config *, double), double v)
 {
@@ -452,7 +458,8 @@ static void test_enable_inside_fades_in(void **state)
 	double held, f_prev = 0, max_step = 0;
 	(void)state;
 
-	contact_rig(&r, NULL, 0);
+	/* at 1 m/s a period's travel is 1 mm: 1.5 mm deep cannot come from outside */
+	contact_rig(&r, slow_limit, 1.0);
 	for (int k = 0; k < 2000; k++)          /* settle: the held force */
 		assert_int_equal(tick(&r), IRDM_OK);
 	held = irdm_v3_norm(r.out.dev[0].force_obj_n);
@@ -599,11 +606,6 @@ static void test_workspace(void **state)
 	assert_true(k < 400);
 	assert_faulted(&r, IRDM_FAULT_WORKSPACE);
 	rig_close(&r);
-}
-
-static void slow_limit(struct irdm_ctrl_config *cfg, double v)
-{
-	cfg->limits.max_tip_speed_m_per_s = v;
 }
 
 /*

@@ -283,6 +283,24 @@ int irdm_opt_set(const struct irdm_opt_table *t, void *obj, const char *where, c
 	return set_entry(o, obj, where, value, err, errlen);
 }
 
+int irdm_opt_set_defaults(const struct irdm_opt_table *t, void *obj, char *err, size_t errlen)
+{
+	char why[256];
+	int ret;
+
+	for (size_t i = 0; i < t->n_opts; i++) {
+		const struct irdm_opt *o = &t->opts[i];
+		if (!o->def)
+			continue;
+		ret = irdm_opt_parse_value(o, obj, o->def, why, sizeof(why));
+		if (ret) {
+			snprintf(err, errlen, "default of %s: %s", o->name, why);
+			return ret;
+		}
+	}
+	return IRDM_OK;
+}
+
 char *irdm_opt_trim(char *s)
 {
 	char *e;

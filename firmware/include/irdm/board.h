@@ -86,7 +86,8 @@ struct irdm_board {
 	double calibration_pose_rad[IRDM_DEVICE_JOINTS];        /* encoders zeroed here */
 };
 
-/* The defaults of every key (docs/boards.md); name and hal empty. */
+/* The defaults of every key, the .def of its entry in irdm_board_options()
+ * (docs/boards.md); name, hal and the workspace box empty. */
 void irdm_board_default(struct irdm_board *b);
 
 /* The key table the parser uses, for help and docs/boards.md. */
