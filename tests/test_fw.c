@@ -115,8 +115,8 @@ static const char *board_with(const char *name, const char *key, const char *val
 }
 
 /*
- * Each refusal names the thing, the place and the reason: the back-end's
- * reason with the board's name, a value no device has at its line, a
+ * Each refusal names the thing, the place and the reason: a hal_options
+ * word the back-end's option table refuses, at the board's line, a value no device has at its line, a
  * --user board whose back-end does not exist, a frame period shorter than
  * the deformation's before the run, and --help hinted once.
  */
@@ -128,11 +128,12 @@ static void test_clear_messages(void **state)
 	b = board_with("opts.board", "hal_options", "write_delay=0,frobnicate=3");
 	expect_error(run_fw((const char *const[]){ "--board", b, "--image", image, "--clock",
 						   "virtual", NULL }),
-		     4, "opts.board: hal 'sim': hal_options 'frobnicate=3': unknown");
+		     4, "opts.board:16: hal_options: unknown sim option 'frobnicate' "
+			"(see docs/hal-options.md)\n");
 	b = board_with("delay.board", "hal_options", "write_delay=999");
 	expect_error(run_fw((const char *const[]){ "--board", b, "--image", image, "--clock",
 						   "virtual", NULL }),
-		     4, "delay.board: hal 'sim': hal_options 'write_delay=999': out of range");
+		     4, "delay.board:16: hal_options: write_delay = 999: must be <= 16\n");
 	b = board_with("gear.board", "gear_ratio", "1e-300,1e-300,1e-300");
 	expect_error(run_fw((const char *const[]){ "--board", b, "--image", image, "--clock",
 						   "virtual", NULL }),

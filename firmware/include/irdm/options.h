@@ -130,6 +130,17 @@ int irdm_opt_set(const struct irdm_opt_table *t, void *obj, const char *where, c
  */
 int irdm_opt_set_defaults(const struct irdm_opt_table *t, void *obj, char *err, size_t errlen);
 
+/*
+ * "key=value" words, separated by any character of seps (" ,\t": a HAL
+ * back-end's options), each set through t.  Messages: those of
+ * irdm_opt_set() ("WHERE: key = value: reason", "WHERE: unknown <what>
+ * 'key' (see <see>)"), and "WHERE: 'word': expected key=value".
+ * Return: IRDM_OK; IRDM_EINVAL for an unknown key, a word without '=' or
+ * one longer than 255 characters; IRDM_EFORMAT for an invalid value.
+ */
+int irdm_opt_parse_words(const struct irdm_opt_table *t, void *obj, const char *where,
+			 const char *text, const char *seps, char *err, size_t errlen);
+
 /* s without its leading white space; trailing white space is cut in place. */
 char *irdm_opt_trim(char *s);
 
