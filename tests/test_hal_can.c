@@ -75,27 +75,29 @@ static void test_options_refused_by_name(void **state)
 	static const struct {
 		const char *options, *why;
 	} cases[] = {
-		{ "nodes=1,2,3", "hal_options rated_torque_mnm: missing (the drives' rated torque)" },
-		{ "rated_torque_mnm=100", "hal_options nodes: missing (one node id per joint, e.g. "
+		{ "nodes=1,2,3", "hal_options: rated_torque_mnm: missing (the drives' rated torque)" },
+		{ "rated_torque_mnm=100", "hal_options: nodes: missing (one node id per joint, e.g. "
 					  "nodes=1,2,3)" },
-		{ "nodes=1,2 rated_torque_mnm=100", "hal_options nodes: 2 node(s) given, the arm has 3 joints" },
-		{ "nodes=1,2,300 rated_torque_mnm=100", "hal_options nodes: expected 1 to 3 node ids "
-							"1..127, e.g. 1,2,3" },
-		{ "nodes=1,2,3, rated_torque_mnm=100", "hal_options nodes: expected 1 to 3 node ids "
-						       "1..127, e.g. 1,2,3" },
-		{ OPTS " bitrate=2000000", "hal_options bitrate: 10000..1000000 bit/s" },
+		{ "nodes=1,2 rated_torque_mnm=100",
+		  "hal_options: nodes: 2 node(s) given, the arm has 3 joints" },
+		{ "nodes=1,2,300 rated_torque_mnm=100",
+		  "hal_options: nodes = 1,2,300: expected 1 to 3 node ids 1..127, e.g. 1,2,3" },
+		{ "nodes=1,2,3, rated_torque_mnm=100",
+		  "hal_options: nodes = 1,2,3,: expected 1 to 3 node ids 1..127, e.g. 1,2,3" },
+		{ OPTS " bitrate=2000000", "hal_options: bitrate = 2000000: must be <= 1000000 bit/s" },
 		{ OPTS " bitrate=500000", "bitrate: one cycle needs 695 bits worst case, 1000 us at "
 					  "500000 bit/s carries 500" },
-		{ OPTS " sync_counter=maybe", "hal_options sync_counter: expected yes or no" },
-		{ OPTS " iface=can0", "hal_options iface: unknown option for this back-end" },
-		{ OPTS " speed", "hal_options speed: expected key=value" },
-		{ OPTS " heartbeat_timeout_ms=5", "hal_options heartbeat_timeout_ms: must exceed "
+		{ OPTS " sync_counter=maybe", "hal_options: sync_counter = maybe: expected yes | no" },
+		{ OPTS " iface=can0",
+		  "hal_options: unknown canemu option 'iface' (see docs/hal-options.md)" },
+		{ OPTS " speed", "hal_options: 'speed': expected key=value" },
+		{ OPTS " heartbeat_timeout_ms=5", "hal_options: heartbeat_timeout_ms: must exceed "
 						  "heartbeat_ms" },
-		{ "nodes=1,3,4 rated_torque_mnm=100", "hal_options nodes: the emulator's nodes are "
+		{ "nodes=1,3,4 rated_torque_mnm=100", "hal_options: nodes: the emulator's nodes are "
 						      "consecutive (e.g. 1,2,3)" },
-		{ OPTS " master_node=2", "hal_options master_node: is a drive's node id" },
-		{ OPTS " master_node=128", "hal_options master_node: 1..127" },
-		{ OPTS " rpdo_timeout_ms=0", "hal_options rpdo_timeout_ms: 1..65535 ms" },
+		{ OPTS " master_node=2", "hal_options: master_node: is a drive's node id" },
+		{ OPTS " master_node=128", "hal_options: master_node = 128: must be <= 127" },
+		{ OPTS " rpdo_timeout_ms=0", "hal_options: rpdo_timeout_ms = 0: must be >= 1 ms" },
 	};
 
 	(void)state;
@@ -104,7 +106,7 @@ static void test_options_refused_by_name(void **state)
 		assert_string_equal(dev.why, cases[i].why);
 	}
 	assert_int_equal(open_as("socketcan", OPTS), IRDM_EINVAL);
-	assert_string_equal(dev.why, "hal_options iface: missing (the CAN interface, e.g. iface=can0)");
+	assert_string_equal(dev.why, "hal_options: iface: missing (the CAN interface, e.g. iface=can0)");
 }
 
 static void test_socketcan_without_interface(void **state)
