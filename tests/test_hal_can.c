@@ -16,6 +16,7 @@
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <string.h>
 #include <sys/syscall.h>
 #include <sys/wait.h>
@@ -26,10 +27,12 @@
 #include "irdm/error.h"
 #include "irdm/hal_can.h"
 #include "irdm/hal_canemu.h"
+#include "irdm/hal_sim.h"
 #include "irdm/hal_socketcan.h"
 
 #include "support/alloc_count.h"
 #include "support/strict_mode.h"
+#include "support/test_files.h"
 
 #define OPTS "nodes=1,2,3 rated_torque_mnm=100 heartbeat_ms=10 heartbeat_timeout_ms=50 " \
 	     "tpdo_missing_periods=3 sync_counter=yes"
@@ -68,6 +71,65 @@ static int open_as(const char *backend, const char *options)
 		irdm_hal_canemu_bus(&dev)->tap = tap;
 	}
 	return rc;
+}
+
+/*
+ * Each back-end's check_options, as irdm-fw calls it before opening: the
+ * message names the board file and line it is given, the key and the
+ * reason, exactly; docs/hal-options.md shows three of them as they are.
+ */
+static void test_check_options_name_the_line(void **state)
+{
+	static const struct {
+		const struct irdm_hal_backend *be;
+		const char *options, *why;
+		bool in_doc;
+	} cases[] = {
+		{ &irdm_hal_sim_backend, "write_delay=999",
+		  "boards/x.board:16: hal_options: write_delay = 999: must be <= 16", true },
+		{ &irdm_hal_sim_backend, "substeps=10,delay=1",
+		  "boards/x.board:16: hal_options: unknown sim option 'delay' "
+		  "(see docs/hal-options.md)", true },
+		{ &irdm_hal_sim_backend, "end_stops",
+		  "boards/x.board:16: hal_options: 'end_stops': expected key=value", false },
+		{ &irdm_hal_canemu_backend, "rated_torque_mnm=100",
+		  "boards/x.board:22: hal_options: nodes: missing (one node id per joint, "
+		  "e.g. nodes=1,2,3)", true },
+		{ &irdm_hal_canemu_backend, "nodes=1,2,3 rated_torque_mnm=100 emcy_at=4:10",
+		  "boards/x.board:22: hal_options: emcy_at = 4:10: expected DRIVE:MS, drive 1..3, "
+		  "0..3600000 ms", false },
+		{ &irdm_hal_socketcan_backend, "iface=can0 nodes=1,2,3 rated_torque_mnm=100 bitrate=5",
+		  "boards/x.board:23: hal_options: bitrate = 5: must be >= 10000 bit/s", false },
+		{ &irdm_hal_socketcan_backend, "iface=can0 nodes=1,2,3 rated_torque_mnm=100 substeps=2",
+		  "boards/x.board:23: hal_options: unknown socketcan option 'substeps' "
+		  "(see docs/hal-options.md)", false },
+		{ &irdm_hal_socketcan_backend, "nodes=1,2,3 rated_torque_mnm=100",
+		  "boards/x.board:23: hal_options: iface: missing (the CAN interface, e.g. "
+		  "iface=can0)", false },
+	};
+	static char doc[16384];
+	char err[256], where[64];
+	(void)state;
+
+	tf_read_text("docs/hal-options.md", doc, sizeof(doc));
+	for (size_t i = 0; i < sizeof(cases) / sizeof(cases[0]); i++) {
+		const struct irdm_hal_backend *be = cases[i].be;
+
+		snprintf(where, sizeof(where), "boards/x.board:%s: hal_options",
+			 be == &irdm_hal_sim_backend ? "16" : be == &irdm_hal_canemu_backend ? "22"
+											   : "23");
+		assert_non_null(be->check_options);
+		assert_int_equal(be->check_options(cases[i].options, where, err, sizeof(err)),
+				 IRDM_EINVAL);
+		assert_string_equal(err, cases[i].why);
+		if (cases[i].in_doc && !strstr(doc, cases[i].why))
+			fail_msg("docs/hal-options.md does not show '%s'", cases[i].why);
+	}
+	/* the shipped boards' options pass */
+	assert_int_equal(irdm_hal_sim_backend.check_options("write_delay=0,read_delay=0,substeps=10",
+							    "s", err, sizeof(err)), IRDM_OK);
+	assert_int_equal(irdm_hal_canemu_backend.check_options(OPTS, "c", err, sizeof(err)),
+			 IRDM_OK);
 }
 
 static void test_options_refused_by_name(void **state)
@@ -490,6 +552,7 @@ static void test_canemu_emergency_off(void **state)
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_check_options_name_the_line),
 		cmocka_unit_test(test_options_refused_by_name),
 		cmocka_unit_test(test_socketcan_without_interface),
 		cmocka_unit_test(test_canemu_emergency_off),

@@ -188,7 +188,8 @@ static const struct irdm_opt board_opts[] = {
 	{ .name = "hal", .type = IRDM_OPT_STRING, BF(hal), .metavar = "BACKEND",
 	  .help = "HAL back-end by its registered name, e.g. sim (required)" },
 	{ .name = "hal_options", .type = IRDM_OPT_STRING, BF(hal_options), .metavar = "TEXT",
-	  .help = "handed to the back-end as is; sim: write_delay=K,read_delay=K,substeps=N",
+	  .help = "handed to the back-end as is: key=value words, its keys in "
+		  "docs/hal-options.md (irdm-fw --help-board)",
 	  .def = "" },
 	{ .name = "devices", .type = IRDM_OPT_UNSIGNED, BF(devices),
 	  RANGE(IRDM_OPT_GE | IRDM_OPT_LE, 1, IRDM_BOARD_DEVICES_MAX),

@@ -118,6 +118,13 @@ static void print_info(const char *hal, const char *info)
 	}
 }
 
+void fw_register_backends(void)
+{
+	irdm_hal_register(&irdm_hal_sim_backend);
+	irdm_hal_register(&irdm_hal_canemu_backend);
+	irdm_hal_register(&irdm_hal_socketcan_backend);
+}
+
 /* The board's hal_options, refused with the file and line they came from. */
 static int check_hal_options(struct fw *fw, const struct irdm_hal_backend *be)
 {
@@ -142,9 +149,7 @@ static int open_devices(struct fw *fw)
 	const struct irdm_hal_backend *be;
 	int rc;
 
-	irdm_hal_register(&irdm_hal_sim_backend);
-	irdm_hal_register(&irdm_hal_canemu_backend);
-	irdm_hal_register(&irdm_hal_socketcan_backend);
+	fw_register_backends();
 	be = irdm_hal_find(fw->board.hal);
 	if (!be)
 		return fail(FW_EXIT_SETUP, IRDM_ENOTSUP, "hal '%s': %s", fw->board.hal,
@@ -351,9 +356,14 @@ int main(int argc, char **argv)
 	if (!fw)
 		return fail(FW_EXIT_SETUP, IRDM_ENOMEM, "%s%s", "", "out of memory");
 	rc = fw_args_parse(&fw->args, argc - 1, argv + 1, fw->err, sizeof(fw->err));
-	if (rc || fw->args.help) {
-		if (fw->args.help) {
-			fw_args_usage(stdout);
+	if (rc || fw->args.help || fw->args.help_board || fw->args.doc) {
+		if (fw->args.help || !rc) {
+			if (fw->args.help)
+				fw_args_usage(stdout);
+			else if (fw->args.help_board)
+				fw_help_board(stdout);
+			else
+				fw_write_doc(stdout, (enum fw_doc)fw->args.doc);
 			free(fw);
 			return FW_EXIT_OK;
 		}

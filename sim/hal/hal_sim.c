@@ -41,7 +41,8 @@ static const struct irdm_opt sim_opts[] = {
 	  .help = "integration (RK4) steps of the arm per tick",
 	  IRDM_OPT_DEFAULT(IRDM_SIM_DEFAULT_SUBSTEPS) },
 	{ .name = "end_stops", .type = IRDM_OPT_INT, SP(end_stops), UPTO(0, 1), .metavar = "0 | 1",
-	  .help = "the arm's mechanical stops just inside count_min..count_max",
+	  .help = "the arm's mechanical stops just inside count_min..count_max; 0: an arm "
+		  "that can leave its encoders' range (a test of that fault)",
 	  IRDM_OPT_DEFAULT(IRDM_SIM_DEFAULT_END_STOPS) },
 };
 

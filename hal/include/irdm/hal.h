@@ -189,6 +189,10 @@ int irdm_hal_register(const struct irdm_hal_backend *backend);
 /* The back-end of that name, or NULL. */
 const struct irdm_hal_backend *irdm_hal_find(const char *name);
 
+/* The i-th back-end registered (from 0), or NULL past the last: for help
+ * and docs listing every back-end of a build. */
+const struct irdm_hal_backend *irdm_hal_backend_at(unsigned i);
+
 /*
  * Bind an instance of the back-end `name` to cfg and to the caller's memory
  * (cleared here); then call irdm_hal_open().
