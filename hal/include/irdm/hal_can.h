@@ -19,7 +19,8 @@
  *   write     RPDO1 per axis, then the SYNC
  *   safe_off  disable voltage + zero torque to every axis and a SYNC, now
  *   poll      the master's latched fault as LINK or DRIVE, dev->why
- * Options: docs/hal-options.md (the tables), docs/canopen.md (what they do).
+ * Options: irdm_hal_socketcan_options, irdm_hal_canemu_options (below;
+ * docs/hal-options.md is written from them).
  */
 #ifndef IRDM_HAL_CAN_H
 #define IRDM_HAL_CAN_H
