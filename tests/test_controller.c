@@ -33,6 +33,7 @@
 
 #include "support/tick_image.h"
 
+#include "irdm/board.h"
 #include "irdm/controller.h"
 #include "irdm/sim_device.h"
 #include "irdm/vec3.h"
@@ -229,6 +230,28 @@ static void press(struct rig *r, unsigned i, double dx, double depth_m, int n)
 }
 
 /* ---- configuration ---- */
+
+/*
+ * The controller's defaults are a default board's: the arm, its force
+ * limit, the tip speed, overrun count, watchdog and period a board file
+ * that leaves those keys out gives irdm-fw.
+ */
+static void test_defaults_are_the_board_defaults(void **state)
+{
+	struct irdm_ctrl_config c;
+	struct irdm_board b;
+	(void)state;
+
+	irdm_board_default(&b);
+	irdm_ctrl_config_default(&c);
+	assert_memory_equal(&c.device[0].dev, &b.device, sizeof(b.device));
+	assert_true(c.limits.max_force_n == b.device.max_force_n);
+	assert_true(c.limits.max_tip_speed_m_per_s == b.max_tip_speed_m_per_s);
+	assert_int_equal(c.limits.overrun_fault_count, b.overrun_fault_count);
+	assert_int_equal(c.limits.watchdog_us, b.watchdog_us);
+	assert_int_equal(c.period_us, b.period_us);
+	assert_true(c.engine.max_force_n == IRDM_CTRL_ENGINE_FORCE_GUARD * b.device.max_force_n);
+}
 
 static void test_config_errors(void **state)
 {
@@ -1387,6 +1410,7 @@ static int remove_images(void **state)
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_defaults_are_the_board_defaults),
 		cmocka_unit_test(test_config_errors),
 		cmocka_unit_test(test_transitions_through_the_tick),
 		cmocka_unit_test(test_signal_mid_contact),
