@@ -252,6 +252,9 @@ $(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(call obj,$(TESTSUP_SRC)) $(TEST_LIBS)
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) $^ -o $@ $(LDLIBS) -lcmocka
 
+# the board table's defaults: every caller in the library gets the test's table
+$(BUILD)/tests/test_board_defaults: LDFLAGS += -Wl,--wrap=irdm_board_options
+
 # the view's test drives its server and decodes the browser's screenshots
 $(BUILD)/tests/test_view: LDLIBS += $(VIEW_LIBS) -lpng
 

@@ -117,11 +117,46 @@ static const char *board_with(const char *name, const char *key, const char *val
 }
 
 /*
- * Each refusal names the thing, the place and the reason: the back-end's
- * reason with the board's name, a value no device has at its line, a
- * --user board whose back-end does not exist or has no simulated arm, a
- * frame period shorter than the deformation's before the run, and --help
- * hinted once.
+ * docs/hal-options.md is what `irdm-fw --doc hal-options` writes from the
+ * back-ends' option tables, the key table of docs/boards.md what
+ * `--doc boards` writes; --help-board lists the board keys and every
+ * back-end's options with their defaults.
+ */
+static void test_generated_docs_current(void **state)
+{
+	static char doc[16384];
+	static const char begin[] = "<!-- begin board keys -->\n";
+	char *a, *b;
+
+	(void)state;
+	tf_read_text("docs/hal-options.md", doc, sizeof(doc));
+	assert_int_equal(run_fw((const char *const[]){ "--doc", "hal-options", NULL }), 0);
+	if (strcmp(out_text, doc))
+		fail_msg("docs/hal-options.md is not what `irdm-fw --doc hal-options` writes");
+	tf_read_text("docs/boards.md", doc, sizeof(doc));
+	a = strstr(doc, begin);
+	b = a ? strstr(a, "<!-- end board keys -->") : NULL;
+	assert_non_null(b);
+	*b = 0;
+	assert_int_equal(run_fw((const char *const[]){ "--doc", "boards", NULL }), 0);
+	if (strcmp(out_text, a + strlen(begin)))
+		fail_msg("docs/boards.md's key table is not what `irdm-fw --doc boards` writes");
+	assert_int_equal(run_fw((const char *const[]){ "--help-board", NULL }), 0);
+	assert_non_null(strstr(out_text, "  watchdog_us = N           one tick longer than this "
+				   "faults; > period_us\n                            "
+				   "(default 5000); 1 <= watchdog_us <= 1000000 us\n"));
+	assert_non_null(strstr(out_text, "hal_options of hal = sim (key=value words; "
+				   "docs/hal-options.md):\n  write_delay = K"));
+	assert_non_null(strstr(out_text, "hal_options of hal = canemu"));
+	assert_non_null(strstr(out_text, "hal_options of hal = socketcan"));
+}
+
+/*
+ * Each refusal names the thing, the place and the reason: a hal_options
+ * word the back-end's option table refuses, at the board's line, a value
+ * no device has at its line, a --user board whose back-end does not exist
+ * or has no simulated arm, a frame period shorter than the deformation's
+ * before the run, and --help hinted once.
  */
 static void test_clear_messages(void **state)
 {
@@ -131,11 +166,12 @@ static void test_clear_messages(void **state)
 	b = board_with("opts.board", "hal_options", "write_delay=0,frobnicate=3");
 	expect_error(run_fw((const char *const[]){ "--board", b, "--image", image, "--clock",
 						   "virtual", NULL }),
-		     4, "opts.board: hal 'sim': hal_options 'frobnicate=3': unknown");
+		     4, "opts.board:16: hal_options: unknown sim option 'frobnicate' "
+			"(see docs/hal-options.md)\n");
 	b = board_with("delay.board", "hal_options", "write_delay=999");
 	expect_error(run_fw((const char *const[]){ "--board", b, "--image", image, "--clock",
 						   "virtual", NULL }),
-		     4, "delay.board: hal 'sim': hal_options 'write_delay=999': out of range");
+		     4, "delay.board:16: hal_options: write_delay = 999: must be <= 16\n");
 	b = board_with("gear.board", "gear_ratio", "1e-300,1e-300,1e-300");
 	expect_error(run_fw((const char *const[]){ "--board", b, "--image", image, "--clock",
 						   "virtual", NULL }),
@@ -1134,6 +1170,7 @@ int main(void)
 		cmocka_unit_test(test_frame_at_writes_the_deformed_surface),
 		cmocka_unit_test(test_frames_series),
 		cmocka_unit_test(test_log_write_failure),
+		cmocka_unit_test(test_generated_docs_current),
 		cmocka_unit_test(test_clear_messages),
 		cmocka_unit_test(test_memory_bounded),
 		cmocka_unit_test(test_frame_at_in_real_time),

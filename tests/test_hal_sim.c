@@ -77,8 +77,8 @@ static int nop(struct irdm_hal_dev *d)
 static void test_registry(void **state)
 {
 	static const struct irdm_hal_ops half = { .open = nop };
-	static const struct irdm_hal_backend incomplete = { "half", &half, 0 };
-	static const struct irdm_hal_backend impostor = { "sim", NULL, 0 };
+	static const struct irdm_hal_backend incomplete = { .name = "half", .ops = &half };
+	static const struct irdm_hal_backend impostor = { .name = "sim" };
 	struct irdm_hal_backend twin = irdm_hal_sim_backend;
 	(void)state;
 

@@ -61,6 +61,14 @@ struct fw_args {
 	bool force;                     /* --force: replace a --frames-out DIR we did not write */
 	bool quiet;
 	bool help;
+	bool help_board;                /* --help-board: the board keys, hal_options */
+	int doc;                        /* --doc: enum fw_doc, 0 none */
+};
+
+/* The documents irdm-fw writes from its option tables (fw_docs.c). */
+enum fw_doc {
+	FW_DOC_BOARDS = 1,      /* the key table of docs/boards.md */
+	FW_DOC_HAL_OPTIONS,     /* docs/hal-options.md */
 };
 
 /*
@@ -199,6 +207,12 @@ void fw_args_usage(FILE *f);
 /* fw_config.c: the board's arm, limits, placement and coupling, for the
  * controller; the session's engine configuration. */
 int fw_config_from_board(struct irdm_ctrl_config *c, const struct irdm_board *b);
+
+/* --help-board: the board keys, then each back-end's hal_options. */
+void fw_help_board(FILE *f);
+
+/* --doc: that document, as Markdown. */
+void fw_write_doc(FILE *f, enum fw_doc doc);
 /* Why irdm_ctrl_init() refused, naming the board or the image (fw->err). */
 const char *fw_ctrl_init_why(struct fw *fw);
 

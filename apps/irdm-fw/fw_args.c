@@ -20,6 +20,12 @@ static const struct irdm_opt_name clock_names[] = {
 	{ NULL, 0 },
 };
 
+static const struct irdm_opt_name doc_names[] = {
+	{ "boards", FW_DOC_BOARDS },
+	{ "hal-options", FW_DOC_HAL_OPTIONS },
+	{ NULL, 0 },
+};
+
 static const struct irdm_opt fw_opts[] = {
 	{ .name = "board", .short_name = 'b', .type = IRDM_OPT_STRING, FA_REF(board),
 	  .metavar = "BOARD", .help = "the board file (docs/boards.md); required" },
@@ -58,6 +64,13 @@ static const struct irdm_opt fw_opts[] = {
 	{ .name = "quiet", .short_name = 'q', .type = IRDM_OPT_FLAG, FA(quiet),
 	  .help = "no summary" },
 	{ .name = "help", .short_name = 'h', .type = IRDM_OPT_FLAG, FA(help), .help = "this text" },
+	{ .name = "help-board", .type = IRDM_OPT_FLAG, FA(help_board),
+	  .help = "the board file's keys and each HAL back-end's hal_options, with their "
+		  "defaults" },
+	{ .name = "doc", .type = IRDM_OPT_ENUM, FA(doc), .names = doc_names,
+	  .metavar = "boards | hal-options",
+	  .help = "write a generated document to stdout: the key table of docs/boards.md, "
+		  "or docs/hal-options.md" },
 };
 
 static const struct irdm_opt_table fw_table = {
@@ -102,7 +115,7 @@ int fw_args_parse(struct fw_args *a, int argc, char **argv, char *err, size_t er
 	memset(a, 0, sizeof(*a));
 	a->clock = IRDM_CLOCK_REAL;
 	rc = irdm_opt_parse_args(&set, 1, argc, argv, NULL, NULL, err, errlen);
-	if (rc || a->help)
+	if (rc || a->help || a->help_board || a->doc)
 		return rc;
 	if (!a->board || !a->image) {
 		snprintf(err, errlen, "%s", !a->board ? "missing --board BOARD" : "missing --image IMAGE");

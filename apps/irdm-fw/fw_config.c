@@ -45,9 +45,7 @@ int fw_config_from_board(struct irdm_ctrl_config *c, const struct irdm_board *b)
 	irdm_board_engine_config(b, &c->engine);
 	c->engine.max_contacts = b->devices > c->engine.max_contacts ? b->devices
 								     : c->engine.max_contacts;
-	/* the controller clamps the rendered force; the engine's own limit only
-	 * guards against a runaway (it faults), so it sits well above */
-	c->engine.max_force_n = 4 * lim->max_force_n;
+	c->engine.max_force_n = IRDM_CTRL_ENGINE_FORCE_GUARD * lim->max_force_n;
 	return irdm_ctrl_config_check(c);
 }
 

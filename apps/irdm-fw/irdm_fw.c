@@ -90,6 +90,25 @@ static void print_info(const char *hal, const char *info)
 	}
 }
 
+/* The board's hal_options, refused with the file and line they came from. */
+static int check_hal_options(struct fw *fw, const struct irdm_hal_backend *be)
+{
+	char where[320];
+	int rc;
+
+	if (!be->check_options)
+		return FW_EXIT_OK;
+	if (fw->board.hal_options_line)
+		snprintf(where, sizeof(where), "%s:%u: hal_options", fw->args.board,
+			 fw->board.hal_options_line);
+	else    /* not in the file: a back-end that needs options names them */
+		snprintf(where, sizeof(where), "%s: hal_options", fw->args.board);
+	rc = be->check_options(fw->board.hal_options, where, fw->err, sizeof(fw->err));
+	if (rc)
+		return fail(FW_EXIT_SETUP, rc, "%s%s", "", fw->err);
+	return FW_EXIT_OK;
+}
+
 static int open_devices(struct fw *fw)
 {
 	const struct irdm_hal_backend *be;
@@ -100,6 +119,9 @@ static int open_devices(struct fw *fw)
 	if (!be)
 		return fail(FW_EXIT_SETUP, IRDM_ENOTSUP, "hal '%s': %s", fw->board.hal,
 			    "no such back-end in this build");
+	rc = check_hal_options(fw, be);
+	if (rc)
+		return rc;
 	for (unsigned i = 0; i < fw->board.devices; i++) {
 		irdm_board_device(&fw->board, i, &fw->dev[i]);
 		fw->hcfg[i] = (struct irdm_hal_config){ &fw->dev[i], fw->board.hal_options,
@@ -311,9 +333,14 @@ int main(int argc, char **argv)
 	if (!fw)
 		return fail(FW_EXIT_SETUP, IRDM_ENOMEM, "%s%s", "", "out of memory");
 	rc = fw_args_parse(&fw->args, argc - 1, argv + 1, fw->err, sizeof(fw->err));
-	if (rc || fw->args.help) {
-		if (fw->args.help) {
-			fw_args_usage(stdout);
+	if (rc || fw->args.help || fw->args.help_board || fw->args.doc) {
+		if (fw->args.help || !rc) {
+			if (fw->args.help)
+				fw_args_usage(stdout);
+			else if (fw->args.help_board)
+				fw_help_board(stdout);
+			else
+				fw_write_doc(stdout, (enum fw_doc)fw->args.doc);
 			free(fw);
 			return FW_EXIT_OK;
 		}

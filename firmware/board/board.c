@@ -10,6 +10,17 @@
 #include "board_priv.h"
 #include "irdm/error.h"
 
+void irdm_board_default(struct irdm_board *b)
+{
+	char why[256];
+
+	memset(b, 0, sizeof(*b));
+	/* every default is the table's: a default it refused would be a broken
+	 * table, which tests/test_board.c rules out entry by entry */
+	(void)irdm_opt_set_defaults(irdm_board_options(), b, why, sizeof(why));
+	irdm_board_set_rotation(b);
+}
+
 void irdm_board_read_begin(struct irdm_opt_file *f, struct irdm_board *b, const char *name)
 {
 	irdm_board_default(b);

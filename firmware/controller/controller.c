@@ -27,15 +27,14 @@ void irdm_ctrl_config_default(struct irdm_ctrl_config *cfg)
 		lim->workspace_min_m[a] = -0.08;
 		lim->workspace_max_m[a] = 0.08;
 	}
-	lim->max_tip_speed_m_per_s = 1.0;
-	lim->overrun_fault_count = 3;
-	lim->watchdog_us = 2000;
-	cfg->period_us = 1000;
-	irdm_engine_config_haptic(&cfg->engine, 1e-3, cfg->device[0].dev.k_max_n_per_m,
+	lim->max_tip_speed_m_per_s = IRDM_CTRL_DEFAULT_MAX_TIP_SPEED_M_PER_S;
+	lim->overrun_fault_count = IRDM_CTRL_DEFAULT_OVERRUN_FAULT_COUNT;
+	lim->watchdog_us = IRDM_CTRL_DEFAULT_WATCHDOG_US;
+	cfg->period_us = IRDM_CTRL_DEFAULT_PERIOD_US;
+	irdm_engine_config_haptic(&cfg->engine, cfg->period_us * 1e-6,
+				  cfg->device[0].dev.k_max_n_per_m,
 				  cfg->device[0].dev.b_device_ns_per_m, lim->max_force_n);
-	/* the controller clamps the rendered force; the engine's own limit is
-	 * a guard against a runaway (it faults), so it sits well above */
-	cfg->engine.max_force_n = 4 * lim->max_force_n;
+	cfg->engine.max_force_n = IRDM_CTRL_ENGINE_FORCE_GUARD * lim->max_force_n;
 	irdm_proxy_config_default(&cfg->proxy);
 	cfg->velocity_window = 32;
 }

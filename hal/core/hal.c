@@ -27,6 +27,11 @@ const struct irdm_hal_backend *irdm_hal_find(const char *name)
 	return NULL;
 }
 
+const struct irdm_hal_backend *irdm_hal_backend_at(unsigned i)
+{
+	return i < IRDM_HAL_BACKENDS_MAX ? table[i] : NULL;
+}
+
 int irdm_hal_register(const struct irdm_hal_backend *b)
 {
 	const struct irdm_hal_backend *same;

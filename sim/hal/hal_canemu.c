@@ -31,7 +31,7 @@ static int link_open(struct irdm_hal_dev *dev, struct irdm_can_port *port, char 
 
 	for (unsigned k = 1; k < o->n_nodes; k++)
 		if (o->nodes[k] != o->nodes[0] + k) {
-			snprintf(err, errlen, "hal_options nodes: the emulator's nodes are "
+			snprintf(err, errlen, "hal_options: nodes: the emulator's nodes are "
 				 "consecutive (e.g. 1,2,3)");
 			return IRDM_EINVAL;
 		}
@@ -128,10 +128,19 @@ static const struct irdm_hal_ops canemu_ops = {
 	.emergency_off = canemu_emergency_off,
 };
 
+static int canemu_check_options(const char *options, const char *where, char *err,
+				size_t errlen)
+{
+	return irdm_hal_can_check(options, IRDM_HAL_CAN_SUBSTEPS | IRDM_HAL_CAN_EMCY_AT, where, err,
+				  errlen);
+}
+
 const struct irdm_hal_backend irdm_hal_canemu_backend = {
 	.name = "canemu",
 	.ops = &canemu_ops,
 	.data_size = sizeof(struct canemu_data),
+	.options = &irdm_hal_canemu_options,
+	.check_options = canemu_check_options,
 };
 
 static struct canemu_data *open_canemu(struct irdm_hal_dev *dev)

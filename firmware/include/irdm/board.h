@@ -47,6 +47,8 @@ struct irdm_board {
 	char name[IRDM_BOARD_NAME_MAX];
 	char hal[IRDM_BOARD_HAL_MAX];                   /* back-end name (irdm_hal_find) */
 	char hal_options[IRDM_BOARD_HAL_OPTIONS_MAX];   /* handed to the back-end as is */
+	unsigned hal_options_line;      /* its line in the file (0: not given), for
+					 * the back-end's messages; set by the loader */
 	unsigned devices;                               /* 1 or 2 */
 
 	/*
@@ -86,7 +88,8 @@ struct irdm_board {
 	double calibration_pose_rad[IRDM_DEVICE_JOINTS];        /* encoders zeroed here */
 };
 
-/* The defaults of every key (docs/boards.md); name and hal empty. */
+/* The defaults of every key, the .def of its entry in irdm_board_options()
+ * (docs/boards.md); name, hal and the workspace box empty. */
 void irdm_board_default(struct irdm_board *b);
 
 /* The key table the parser uses, for help and docs/boards.md. */

@@ -30,6 +30,15 @@ static void metavar(const struct irdm_opt *o, char *buf, size_t len)
 		at += (size_t)snprintf(buf + at, len - at, "%s%s", at ? " | " : "", n->name);
 }
 
+/* The help and, when the entry has one, its default: "help (default X)". */
+static void help_text(const struct irdm_opt *o, char *buf, size_t len)
+{
+	if (!o->def)
+		snprintf(buf, len, "%s", o->help);
+	else
+		snprintf(buf, len, "%s (default %s)", o->help, o->def[0] ? o->def : "none");
+}
+
 /* Go to a new indented line before n more characters would pass LINE_WIDTH. */
 static size_t make_room(FILE *f, size_t col, size_t n)
 {
@@ -67,11 +76,12 @@ static void print_wrapped(FILE *f, const char *text, const char *range)
 
 void irdm_opt_print_help(FILE *f, const struct irdm_opt_table *t, enum irdm_opt_style style)
 {
-	char syntax[256], mv[192], range[128];
+	char syntax[256], mv[192], range[128], help[640];
 
 	for (size_t i = 0; i < t->n_opts; i++) {
 		const struct irdm_opt *o = &t->opts[i];
 		metavar(o, mv, sizeof(mv));
+		help_text(o, help, sizeof(help));
 		if (style == IRDM_OPT_STYLE_KEY)
 			snprintf(syntax, sizeof(syntax), "  %s = %s", o->name, mv);
 		else if (o->short_name)
@@ -84,7 +94,7 @@ void irdm_opt_print_help(FILE *f, const struct irdm_opt_table *t, enum irdm_opt_
 			fprintf(f, "%s\n%*s", syntax, HELP_COLUMN, "");
 		else
 			fprintf(f, "%-*s", HELP_COLUMN, syntax);
-		print_wrapped(f, o->help, range);
+		print_wrapped(f, help, range);
 	}
 }
 
@@ -100,7 +110,7 @@ static void print_cell(FILE *f, const char *s)
 
 void irdm_opt_print_markdown(FILE *f, const struct irdm_opt_table *t)
 {
-	char mv[192], range[128];
+	char mv[192], range[128], help[640];
 
 	fprintf(f, "| Key | Value | Range | Description |\n|---|---|---|---|\n");
 	for (size_t i = 0; i < t->n_opts; i++) {
@@ -112,7 +122,8 @@ void irdm_opt_print_markdown(FILE *f, const struct irdm_opt_table *t)
 		fputs("` | ", f);
 		print_cell(f, range);
 		fputs(" | ", f);
-		print_cell(f, o->help);
+		help_text(o, help, sizeof(help));
+		print_cell(f, help);
 		fputs(" |\n", f);
 	}
 }

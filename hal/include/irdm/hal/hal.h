@@ -46,6 +46,7 @@
 
 #include "irdm/device.h"
 #include "irdm/error.h"
+#include "irdm/options.h"
 
 #define IRDM_HAL_JOINTS IRDM_DEVICE_JOINTS
 #define IRDM_HAL_BACKENDS_MAX 8
@@ -146,6 +147,19 @@ struct irdm_hal_backend {
 	const char *name;                       /* as the board file names it */
 	const struct irdm_hal_ops *ops;
 	size_t data_size;                       /* bytes of mutable state per instance */
+	/*
+	 * Its hal_options keys, for help and docs/hal-options.md (NULL: it
+	 * takes none).  open parses config->options through this table.
+	 */
+	const struct irdm_opt_table *options;
+	/*
+	 * Optional: parse options as open would, without opening, so that the
+	 * caller can name where they came from ("boards/x.board:3:
+	 * hal_options").  Return: IRDM_OK; IRDM_EINVAL with err = "WHERE:
+	 * key = value: reason", "WHERE: unknown ... 'key'" or "WHERE: key:
+	 * missing (...)".
+	 */
+	int (*check_options)(const char *options, const char *where, char *err, size_t errlen);
 };
 
 struct irdm_hal_dev {
@@ -175,6 +189,10 @@ int irdm_hal_register(const struct irdm_hal_backend *backend);
 
 /* The back-end of that name, or NULL. */
 const struct irdm_hal_backend *irdm_hal_find(const char *name);
+
+/* The i-th back-end registered (from 0), or NULL past the last: for help
+ * and docs listing every back-end of a build. */
+const struct irdm_hal_backend *irdm_hal_backend_at(unsigned i);
 
 /*
  * Bind an instance of the back-end `name` to cfg and to the caller's memory

@@ -19,7 +19,8 @@
  *   write     RPDO1 per axis, then the SYNC
  *   safe_off  disable voltage + zero torque to every axis and a SYNC, now
  *   poll      the master's latched fault as LINK or DRIVE, dev->why
- * Options: docs/canopen.md ("Board options").
+ * Options: irdm_hal_socketcan_options, irdm_hal_canemu_options (below;
+ * docs/hal-options.md is written from them).
  */
 #ifndef IRDM_HAL_CAN_H
 #define IRDM_HAL_CAN_H
@@ -61,14 +62,23 @@ enum irdm_hal_can_extra {
 	IRDM_HAL_CAN_EMCY_AT = 1u << 2, /* emcy_at=DRIVE:MS (an injected fault) */
 };
 
+/* The options each back-end takes (docs/hal-options.md). */
+extern const struct irdm_opt_table irdm_hal_socketcan_options;
+extern const struct irdm_opt_table irdm_hal_canemu_options;
+
 /*
  * Parse "key=value key=value" (whitespace between options, commas inside a
- * list) into o, defaults first.  Return: IRDM_OK; IRDM_EINVAL with err
- * naming the option and the reason (unknown, malformed, out of range,
- * missing).
+ * list) into o, the table's defaults first: socketcan's table with
+ * IRDM_HAL_CAN_IFACE in extra, canemu's otherwise.  Return: IRDM_OK;
+ * IRDM_EINVAL with err = "WHERE: key = value: reason", "WHERE: unknown
+ * ... 'key'" or "WHERE: key: missing (...)".
  */
-int irdm_hal_can_parse(const char *options, unsigned extra, struct irdm_hal_can_opts *o,
-		       char *err, size_t errlen);
+int irdm_hal_can_parse(const char *options, unsigned extra, const char *where,
+		       struct irdm_hal_can_opts *o, char *err, size_t errlen);
+
+/* The same without a struct to keep: a back-end's check_options. */
+int irdm_hal_can_check(const char *options, unsigned extra, const char *where, char *err,
+		       size_t errlen);
 
 struct irdm_hal_can_link {
 	/* Open the port; IRDM_OK or an error with err set. */

@@ -7,10 +7,10 @@
  * runs inside the HAL ops, right after the master sends (its turn): a SYNC
  * steps the arm one period, so the whole bus runs in virtual time on a
  * host without CAN, and makes no system call and no allocation.
- * Options: the "socketcan" back-end's without iface (docs/canopen.md), plus
- * substeps=N (the arm's integration steps a period) and emcy_at=DRIVE:MS
- * (drive DRIVE raises EMCY 0x2310 and faults at MS ms of emulated time: a
- * fault run of irdm-fw).  The nodes must be
+ * Options: irdm_hal_canemu_options (docs/hal-options.md): the "socketcan"
+ * back-end's without iface, plus substeps=N (the arm's integration steps a
+ * period) and emcy_at=D:MS (drive D raises EMCY 0x2310 and faults at MS ms
+ * of emulated time: a fault run of irdm-fw).  The nodes must be
  * consecutive (the emulator numbers its drives from the first).
  * Register it with irdm_hal_register(&irdm_hal_canemu_backend).
  */

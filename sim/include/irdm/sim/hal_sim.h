@@ -6,14 +6,14 @@
  *
  * Each read advances the arm by config->period_s (the simulated time between
  * two ticks), then samples its encoders: a torque written in one tick acts
- * over the next.  Options (config->options, space or comma separated):
- *   write_delay=K  read_delay=K   bus delay in ticks, 0..IRDM_SIM_DELAY_MAX
- *   substeps=N                    integration steps per tick
- *   end_stops=0|1                 the arm's mechanical stops (default 1)
- * everything else from irdm_sim_params_default(), starting at rest in the
- * home pose.  No I/O and no system call: the tick stays free of them.
+ * over the next.  Options (config->options, "key=value" words separated by
+ * spaces or commas): write_delay, read_delay, substeps and end_stops, the
+ * back-end's option table (irdm_hal_sim_backend.options,
+ * docs/hal-options.md); everything else from irdm_sim_params_default(),
+ * starting at rest in the home pose.  No I/O and no system call: the tick
+ * stays free of them.
  *
- * The virtual user (irdm/sim_user.h): once attached, its hand pushes the
+ * The virtual user (irdm/sim/sim_user.h): once attached, its hand pushes the
  * arm at the start of every read (of a "sim" or "canemu" instance), at the
  * time of that read's tick: the caller above the HAL only reads.
  */

@@ -50,6 +50,10 @@
 
 #define IRDM_SIM_DELAY_MAX 16           /* ticks, either direction */
 #define IRDM_SIM_SUBSTEPS_MAX 1000
+/* irdm_sim_params_default()'s, and the sim back-end's option defaults */
+#define IRDM_SIM_DEFAULT_SUBSTEPS 10
+#define IRDM_SIM_DEFAULT_END_STOPS 1
+#define IRDM_SIM_DEFAULT_DELAY_TICKS 0
 
 struct irdm_sim_params {
 	double joint_inertia_kg_m2[3];          /* added to the mass matrix's diagonal, > 0 */

@@ -17,10 +17,10 @@ enum irdm_opt_style {
 	IRDM_OPT_STYLE_ARG,     /* "  --dt SECONDS    help" (arguments) */
 };
 
-/* One line per entry (two if the syntax is long): syntax, help, range. */
+/* One line per entry (two if the syntax is long): syntax, help, default, range. */
 void irdm_opt_print_help(FILE *f, const struct irdm_opt_table *t, enum irdm_opt_style style);
 
-/* A Markdown table: key, value syntax, range and unit, description. */
+/* A Markdown table: key, value syntax, range and unit, description and default. */
 void irdm_opt_print_markdown(FILE *f, const struct irdm_opt_table *t);
 
 #endif
