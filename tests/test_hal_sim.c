@@ -29,6 +29,7 @@
 #include "irdm/sim/hal_sim.h"
 #include "irdm/sim/sim_user.h"
 #include "irdm/sim/sim_user_push.h"
+#include "irdm/posix/board_file.h"
 
 #define PERIOD_S 1e-3
 
