@@ -8,7 +8,10 @@
  *                proxy's closest-point query every tick);
  *  - slide/1:    pressed 3 mm in and sliding 50 um per tick, so the
  *                contact site (triangle or barycentrics) changes every tick;
- *  - slide/10:   the same path, the tip moved every 10th tick only.
+ *  - slide/10:   the same path, the tip moved every 10th tick only;
+ *  - edge:       slide/1's stroke along the line of mesh edges nearest
+ *                it (a row of the top face's grid): the contact point on
+ *                an edge shared by two triangles.
  * The encoder counts are computed (inverse kinematics) outside the timed
  * region.  Prints figures; never fails on time.
  *
@@ -19,7 +22,11 @@
  * tick can remove (on this VM an interrupt costs 40-90 us).
  *
  * Run from the repository root; the image is reused from out/bench/ and
- * made there when missing, or given as the first argument.
+ * made there when missing, or given as the first argument.  Instructions
+ * per tick, independent of the host's load (bench_util.h):
+ *   valgrind --tool=callgrind --collect-atstart=no \
+ *     --toggle-collect=irdm_ctrl_tick build/bench/bench_ctrl
+ * with IRDM_BENCH_TICKS=2000 and IRDM_BENCH_ONLY=hover,edge to shorten it.
  */
 #define _GNU_SOURCE
 #include <math.h>
@@ -53,11 +60,14 @@ struct bench {
 	struct irdm_ctrl_input in;
 	struct irdm_ctrl_output out;
 	double cx, cy, top_z;
+	double edge_y;          /* y of the top face's grid row nearest cy */
 };
 
-enum kase { C_HOVER, C_SLIDE1, C_SLIDE10, C_COUNT };
+enum kase { C_HOVER, C_SLIDE1, C_SLIDE10, C_EDGE, C_COUNT };
 
-static const char *const kase_name[C_COUNT] = { "hover   ", "slide/1 ", "slide/10" };
+static const char *const kase_name[C_COUNT] = { "hover   ", "slide/1 ", "slide/10",
+						"edge    " };
+static long n_ticks;
 
 static double *samples, *spins;
 static long spin_n;             /* spin() iterations for SPIN_US */
@@ -129,7 +139,7 @@ static int tick(struct bench *b, uint32_t cmd)
 static void top_of(struct bench *b)
 {
 	const struct irdm_image *img = b->s->img;
-	double lo[2] = { INFINITY, INFINITY }, hi[2] = { -INFINITY, -INFINITY };
+	double lo[2] = { INFINITY, INFINITY }, hi[2] = { -INFINITY, -INFINITY }, best = INFINITY;
 
 	b->top_z = -INFINITY;
 	for (uint32_t k = 0; k < img->meta->n_nodes; k++) {
@@ -141,6 +151,14 @@ static void top_of(struct bench *b)
 	}
 	b->cx = 0.5 * (lo[0] + hi[0]);
 	b->cy = 0.5 * (lo[1] + hi[1]);
+	for (uint32_t k = 0; k < img->meta->n_nodes; k++) {
+		const float *x = img->nodes[k].pos_m;
+
+		if (x[2] == b->top_z && fabs(x[1] - b->cy) < best) {
+			best = fabs(x[1] - b->cy);
+			b->edge_y = x[1];
+		}
+	}
 }
 
 static int open_bench(struct bench *b, const char *path)
@@ -182,7 +200,7 @@ static void path(const struct bench *b, enum kase k, long step, double p[3])
 	double x = s < 2 * SLIDE_HALF_M ? s - SLIDE_HALF_M : 3 * SLIDE_HALF_M - s;
 
 	p[0] = b->cx + x;
-	p[1] = b->cy;
+	p[1] = k == C_EDGE ? b->edge_y : b->cy;
 	p[2] = b->top_z + (k == C_HOVER ? 0.001 : -0.003);
 }
 
@@ -214,7 +232,8 @@ static int run_case(const char *path_img, enum kase k)
 		return -1;
 	if (approach(&b, k))
 		goto fault;
-	for (long i = 0; i < N_TICKS; i++) {
+	bench_count_begin();
+	for (long i = 0; i < n_ticks; i++) {
 		path(&b, k, i, p);
 		if (put(&b, p))
 			goto fault;
@@ -231,11 +250,12 @@ static int run_case(const char *path_img, enum kase k)
 			last_tri = b.out.dev[0].tri;
 		}
 	}
-	bench_stats(samples, N_TICKS, &st);
+	bench_count_end(kase_name[k]);
+	bench_stats(samples, n_ticks, &st);
 	printf("ctrl  %s median %7.2f us  p99 %7.2f us  p99.9 %7.2f us  max %8.2f us  (in contact "
 	       "%5.1f%%, triangle changes %ld)\n", kase_name[k], st.median, st.p99, st.p999, st.max,
-	       100.0 * (double)contact / N_TICKS, tri_changes);
-	bench_stats(spins, N_TICKS, &st);
+	       100.0 * (double)contact / n_ticks, tri_changes);
+	bench_stats(spins, n_ticks, &st);
 	printf("ctrl    spin   median %7.2f us  p99 %7.2f us  p99.9 %7.2f us  max %8.2f us  "
 	       "(beside each tick: the host's share)\n", st.median, st.p99, st.p999, st.max);
 	irdm_session_close(b.s);
@@ -253,7 +273,8 @@ static void realtime(void)
 	char line[256];
 	int cpu = sysconf(_SC_NPROCESSORS_ONLN) > BENCH_CPU ? BENCH_CPU : 0, rc;
 
-	rc = irdm_rt_set_self(&(struct irdm_rt_sched){ SCHED_FIFO, FIFO_PRIO, cpu });
+	rc = bench_counting() ? IRDM_EINVAL :
+	     irdm_rt_set_self(&(struct irdm_rt_sched){ SCHED_FIFO, FIFO_PRIO, cpu });
 	if (rc)
 		printf("ctrl  scheduling: SCHED_FIFO %d on CPU %d refused: %s\n", FIFO_PRIO, cpu,
 		       irdm_strerror(rc));
@@ -272,17 +293,19 @@ int main(int argc, char **argv)
 
 	if (argc < 2 && bench_ensure_image("ctrl", img, "scenes/cuboid-top.scene", NULL))
 		return 1;
-	samples = malloc(N_TICKS * sizeof(*samples));
-	spins = malloc(N_TICKS * sizeof(*spins));
+	n_ticks = bench_ticks(N_TICKS);
+	samples = malloc(n_ticks * sizeof(*samples));
+	spins = malloc(n_ticks * sizeof(*spins));
 	if (!samples || !spins)
 		return 1;
 	realtime();
 	calibrate_spin();
-	printf("ctrl  whole controller tick (irdm_ctrl_tick), %s, %d ticks a case, one device, "
+	printf("ctrl  whole controller tick (irdm_ctrl_tick), %s, %ld ticks a case, one device, "
 	       "slide %.0f um/tick over +-%.0f mm (timer overhead included)\n",
-	       img, N_TICKS, SLIDE_M_PER_TICK * 1e6, SLIDE_HALF_M * 1e3);
+	       img, n_ticks, SLIDE_M_PER_TICK * 1e6, SLIDE_HALF_M * 1e3);
 	for (int k = 0; k < C_COUNT; k++)
-		rc |= run_case(img, (enum kase)k);
+		if (bench_selected(kase_name[k]))
+			rc |= run_case(img, (enum kase)k);
 	free(samples);
 	free(spins);
 	return rc ? 1 : 0;

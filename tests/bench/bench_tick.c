@@ -11,7 +11,10 @@
  * Itanium2 times; never fails on time.
  *
  * Run from the repository root: images are reused from out/bench/ and made
- * there when missing.  Runs under SCHED_FIFO on CPU 1 with mlockall when it
+ * there when missing.  IRDM_BENCH_ONLY and IRDM_BENCH_TICKS select cases
+ * and shorten them, for instructions per tick under callgrind
+ * (bench_util.h; --toggle-collect=irdm_engine_tick), e.g.
+ * IRDM_BENCH_ONLY=hybrid,fir-500 (2 ms).  Runs under SCHED_FIFO on CPU 1 with mlockall when it
  * may, and says so in the header when it may not.
  */
 #define _GNU_SOURCE
@@ -136,6 +139,7 @@ static void pick_sites(const struct irdm_image *img, struct sites *s)
 /* ---- one case ---- */
 
 static double *samples;
+static long n_ticks;
 
 static struct figures bench_case(const char *scene, const char *repr, const struct irdm_image *img,
 				 const struct sites *st, enum kase k)
@@ -151,6 +155,11 @@ static struct figures bench_case(const char *scene, const char *repr, const stru
 	char err[512];
 	int rc = 0;
 
+	char name[64];
+
+	snprintf(name, sizeof(name), "%s %s", repr, kase_name[k]);
+	if (!bench_selected(name))
+		return fig;
 	if (k == K_TRI && !st->have_tri) {
 		printf("tick  %-14s %-16s %s  skipped: no triangle with all vertices touchable\n",
 		       scene, repr, kase_name[k]);
@@ -181,7 +190,7 @@ static struct figures bench_case(const char *scene, const char *repr, const stru
 		cmd[i].mode = IRDM_CONTACT_GRAB;
 	}
 	/* a first contact needs a history: settle it in before timing */
-	for (long t = -N_WARMUP; t < N_TICKS && !rc; t++) {
+	for (long t = -N_WARMUP; t < n_ticks && !rc; t++) {
 		struct timespec t0, t1;
 		double ph = 2 * M_PI * (double)(t + N_WARMUP) * img->meta->dt_s;
 		for (unsigned i = 0; i < n_contacts; i++) {
@@ -191,6 +200,8 @@ static struct figures bench_case(const char *scene, const char *repr, const stru
 				cmd[i].target_m[a] = -depth * site[i].normal[a];
 			cmd[i].target_m[0] += 0.001 * sin(ph);
 		}
+		if (t == 0)
+			bench_count_begin();
 		if (t >= 0 && t % PAUSE_EVERY == 0)
 			pause_untimed();
 		clock_gettime(CLOCK_MONOTONIC, &t0);
@@ -199,13 +210,14 @@ static struct figures bench_case(const char *scene, const char *repr, const stru
 		if (t >= 0)
 			samples[t] = bench_elapsed_ns(&t0, &t1) * 1e-3;
 	}
+	bench_count_end(name);
 	if (rc) {
 		printf("tick  %-14s %-16s %s  the engine faulted (%d): no figures\n", scene, repr,
 		       kase_name[k], rc);
 		irdm_session_close(ses);
 		return fig;
 	}
-	bench_stats(samples, N_TICKS, &bs);
+	bench_stats(samples, n_ticks, &bs);
 	fig.median = bs.median;
 	fig.p99 = bs.p99;
 	fig.max = bs.max;
@@ -274,7 +286,8 @@ static void header(void)
 	       rep.preempt_rt ? "PREEMPT_RT" : "not PREEMPT_RT: latency figures are not real-time claims",
 	       ncpu, model);
 
-	rc = irdm_rt_set_self(&(struct irdm_rt_sched){ SCHED_FIFO, FIFO_PRIO, cpu });
+	rc = bench_counting() ? IRDM_EINVAL :
+	     irdm_rt_set_self(&(struct irdm_rt_sched){ SCHED_FIFO, FIFO_PRIO, cpu });
 	if (rc)
 		printf("tick  scheduling: SCHED_FIFO %d on CPU %d refused: %s\n", FIFO_PRIO, cpu,
 		       irdm_strerror(rc));
@@ -296,18 +309,18 @@ static void header(void)
 
 	/* the timer's own cost, which every figure below includes */
 	struct timespec a, b;
-	for (int i = 0; i < N_TICKS; i++) {
+	for (int i = 0; i < n_ticks; i++) {
 		clock_gettime(CLOCK_MONOTONIC, &a);
 		clock_gettime(CLOCK_MONOTONIC, &b);
 		samples[i] = bench_elapsed_ns(&a, &b) * 1e-3;
 	}
 	struct bench_stats st;
-	bench_stats(samples, N_TICKS, &st);
+	bench_stats(samples, n_ticks, &st);
 	printf("tick  timer overhead (two clock_gettime): median %.3f us, max %.2f us\n",
 	       st.median, st.max);
-	printf("tick  %d ticks timed one by one after %d warm-up ticks; %ld us pause every %d ticks (untimed); "
+	printf("tick  %ld ticks timed one by one after %d warm-up ticks; %ld us pause every %d ticks (untimed); "
 	       "haptic coupling %.0f N/m + passivity control, grab contacts\n",
-	       N_TICKS, N_WARMUP, PAUSE_NS / 1000, PAUSE_EVERY, DEVICE_K);
+	       n_ticks, N_WARMUP, PAUSE_NS / 1000, PAUSE_EVERY, DEVICE_K);
 	fflush(stdout);
 }
 
@@ -346,7 +359,8 @@ int main(void)
 	struct figures bunny[K_COUNT] = { 0 }, hybrid[K_COUNT] = { 0 };
 	uint32_t mall_modes = 1;
 
-	samples = malloc(N_TICKS * sizeof(*samples));
+	n_ticks = bench_ticks(N_TICKS);
+	samples = malloc(n_ticks * sizeof(*samples));
 	if (!samples)
 		return 1;
 	/*

@@ -5,6 +5,13 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#if defined(__has_include)
+#if __has_include(<valgrind/callgrind.h>)
+#include <valgrind/callgrind.h>
+#define HAVE_CALLGRIND 1
+#endif
+#endif
+
 #include "irdm/posix/rt.h"
 
 #include "bench_util.h"
@@ -82,4 +89,58 @@ int bench_ensure_image(const char *tag, const char *path, const char *scene_file
 fail:
 	fprintf(stderr, "%s  %s: %s\n", tag, path, err);
 	return -1;
+}
+
+long bench_ticks(long dflt)
+{
+	const char *s = getenv("IRDM_BENCH_TICKS");
+	long n = s ? strtol(s, NULL, 10) : 0;
+
+	return n > 0 ? n : dflt;
+}
+
+bool bench_selected(const char *name)
+{
+	const char *s = getenv("IRDM_BENCH_ONLY");
+	char word[64];
+
+	if (!s || !*s)
+		return true;
+	while (*s) {
+		size_t n = strcspn(s, ",");
+
+		if (n && n < sizeof(word)) {
+			memcpy(word, s, n);
+			word[n] = '\0';
+			if (strstr(name, word))
+				return true;
+		}
+		s += n + (s[n] == ',');
+	}
+	return false;
+}
+
+bool bench_counting(void)
+{
+#ifdef HAVE_CALLGRIND
+	return RUNNING_ON_VALGRIND;
+#else
+	return false;
+#endif
+}
+
+void bench_count_begin(void)
+{
+#ifdef HAVE_CALLGRIND
+	CALLGRIND_ZERO_STATS;
+#endif
+}
+
+void bench_count_end(const char *name)
+{
+#ifdef HAVE_CALLGRIND
+	CALLGRIND_DUMP_STATS_AT(name);
+#else
+	(void)name;
+#endif
 }

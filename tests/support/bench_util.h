@@ -35,4 +35,23 @@ bool bench_file_exists(const char *path);
 int bench_ensure_image(const char *tag, const char *path, const char *scene_file,
 		       const char *const *kv);
 
+/*
+ * Selection and counting, for running a few cases under callgrind:
+ * IRDM_BENCH_TICKS sets the number of timed ticks (default dflt);
+ * IRDM_BENCH_ONLY, a comma-separated list of words, selects the cases
+ * whose name contains one of them (unset: every case).  bench_count_begin()
+ * and bench_count_end() bracket a case's timed loop: under callgrind
+ * (valgrind --tool=callgrind --collect-atstart=no
+ * --toggle-collect=irdm_ctrl_tick) each case is a dump of its own, named
+ * after it, whose total is the instructions of its timed ticks; elsewhere
+ * they do nothing.
+ */
+long bench_ticks(long dflt);
+/* Under valgrind: time means nothing there, and a real-time priority
+ * held that long would starve the CPU's other work. */
+bool bench_counting(void);
+bool bench_selected(const char *name);
+void bench_count_begin(void);
+void bench_count_end(const char *name);
+
 #endif
