@@ -35,6 +35,8 @@ struct box_image {
 	char path[600];
 	struct irdm_image img;
 	struct irdm_contact_mesh cm;
+	uint32_t *beyond;               /* cm's face-beyond table */
+	uint32_t rim_searched;          /* its build's searches */
 	double lo[3], hi[3];            /* bounds of the rest nodes */
 };
 
@@ -99,6 +101,10 @@ static int make_box(struct box_image *b, const char *name, const char *touch)
 	}
 	if (irdm_contact_mesh_init(&b->cm, &b->img))
 		return -1;
+	b->beyond = malloc(irdm_contact_beyond_size(&b->cm));
+	if (!b->beyond)
+		return -1;
+	b->rim_searched = irdm_contact_beyond_build(&b->cm, b->beyond);
 	for (unsigned a = 0; a < 3; a++) {
 		b->lo[a] = INFINITY;
 		b->hi[a] = -INFINITY;
@@ -130,6 +136,7 @@ static int group_teardown(void **state)
 	(void)state;
 	for (unsigned i = 0; i < IMG_COUNT; i++) {
 		irdm_image_unmap(&boxes[i].img);
+		free(boxes[i].beyond);
 		unlink(boxes[i].path);
 	}
 	rmdir(tmpdir);
@@ -293,6 +300,51 @@ static void test_adjacency(void **state)
 		}
 		assert_true(linked > 0);
 		assert_true(boundary > 0);      /* the region is open at the bottom / top rim */
+	}
+}
+
+/*
+ * The face-beyond table: the adjacency where it knows the neighbour; on
+ * the touchable area's rim the lowest-index other surface triangle on the
+ * edge (counted independently); one search per rim edge at the build.
+ */
+static void test_beyond_table(void **state)
+{
+	(void)state;
+	for (unsigned i = 0; i < IMG_COUNT; i++) {
+		const struct irdm_contact_mesh *cm = &boxes[i].cm;
+		uint32_t rim = 0, display_only = 0;
+
+		assert_ptr_equal(cm->beyond, boxes[i].beyond);
+		for (uint32_t t = 0; t < cm->n_tris; t++) {
+			const uint32_t *v = &cm->tris[3 * t];
+			bool touchable = irdm_contact_tri_contactable(cm, t);
+
+			for (unsigned e = 0; e < 3; e++) {
+				uint32_t a = v[e], b = v[(e + 1) % 3], u = cm->adj[3 * t + e];
+				uint32_t first = IRDM_BVH_NONE;
+
+				if (u != IRDM_BVH_NONE || !touchable) {
+					assert_int_equal(cm->beyond[3 * t + e], u);
+					continue;
+				}
+				rim++;
+				for (uint32_t s = cm->n_tris; s-- > 0;) {
+					const uint32_t *w = &cm->tris[3 * s];
+					bool has_a = w[0] == a || w[1] == a || w[2] == a;
+					bool has_b = w[0] == b || w[1] == b || w[2] == b;
+
+					if (s != t && has_a && has_b)
+						first = s;
+				}
+				assert_int_equal(cm->beyond[3 * t + e], first);
+				display_only += first != IRDM_BVH_NONE &&
+						!irdm_contact_tri_contactable(cm, first);
+			}
+		}
+		assert_int_equal(boxes[i].rim_searched, rim);
+		if (i != IMG_ALL)
+			assert_true(display_only > 0);
 	}
 }
 
@@ -938,6 +990,43 @@ static void test_proxy_rim_faces(void **state)
 	free(uh);
 }
 
+/*
+ * The update reads the set-up's table and searches nothing: the overhang
+ * of test_proxy_rim_faces on a copy of the mesh whose table says the rim
+ * edges are open (a wall at right angles to the top) keeps the contact
+ * the side face would end.
+ */
+static void test_proxy_reads_beyond_table(void **state)
+{
+	struct box_image b = boxes[IMG_TOP];
+	const struct irdm_contact_mesh *cm = &boxes[IMG_TOP].cm;
+	double *u = calloc(3 * (size_t)b.img.meta->n_nodes, sizeof(double));
+	uint32_t *open = malloc(irdm_contact_beyond_size(cm));
+	struct irdm_contact_disp d = { .u_m = u };
+	const double top = b.hi[2], yc = 0.5 * (b.lo[1] + b.hi[1]) + 0.003;
+	struct irdm_proxy px;
+
+	(void)state;
+	assert_non_null(u);
+	assert_non_null(open);
+	for (uint32_t k = 0; k < 3 * cm->n_tris; k++)
+		open[k] = cm->adj[k];
+	b.cm.beyond = open;
+	for (uint32_t r = 0; r < b.img.meta->n_nodes; r++) {
+		const float *x = b.img.nodes[r].pos_m;
+
+		if (fabs(x[0] - b.hi[0]) < 1e-9)
+			u[3 * r] = -0.2 * (top - x[2]);
+	}
+	irdm_proxy_reset(&px);
+	assert_int_equal(upd(&px, &b, &d, b.hi[0] - 0.02, yc, top - 0.002), IRDM_PROXY_TOUCH);
+	assert_int_equal(upd(&px, &b, &d, b.hi[0] - 0.001, yc, top - 0.002), IRDM_PROXY_SLIDE);
+	/* the tip 1 mm in front of the side face, behind the open edge's wall */
+	assert_int_equal(upd(&px, &b, &d, b.hi[0] - 0.001, yc, top - 0.01), IRDM_PROXY_SLIDE);
+	free(open);
+	free(u);
+}
+
 static int upd_mu(struct irdm_proxy *px, const struct box_image *b, double mu_s, double mu_d,
 		  const double *p)
 {
@@ -1365,6 +1454,8 @@ int main(void)
 		cmocka_unit_test(test_proxy_shared_edge),
 		cmocka_unit_test(test_proxy_creases),
 		cmocka_unit_test(test_proxy_rim_faces),
+		cmocka_unit_test(test_proxy_reads_beyond_table),
+		cmocka_unit_test(test_beyond_table),
 		cmocka_unit_test(test_proxy_friction),
 		cmocka_unit_test(test_proxy_displaced_site),
 		cmocka_unit_test(test_loader_rejects),

@@ -103,8 +103,9 @@ int irdm_ctrl_init(struct irdm_ctrl *c, const struct irdm_ctrl_config *cfg,
 	memset(c, 0, sizeof(*c));
 	c->cfg = *cfg;
 	c->s = s;
-	if (irdm_contact_mesh_init(&c->cm, s->img))
+	if (!s->cm.hdr)
 		return IRDM_EINVAL;
+	c->cm = s->cm;          /* with the session's face-beyond table */
 	for (unsigned i = 0; i < cfg->n_devices; i++)
 		for (unsigned j = 0; j < 3; j++)
 			if (irdm_velocity_init(&c->dev[i].vel[j], period_s,

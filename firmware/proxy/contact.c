@@ -6,8 +6,9 @@
  * virtual proxy is (a walk over the touchable triangles; the faces beyond
  * convex edges and beyond the touchable area's rim end the contact, a
  * concave edge holds the proxy; docs/architecture.md).  Runs in the force
- * loop: no allocation, no system call, no recursion, bounded work (a rim
- * neighbour's search is one pass over the surface's triangles).
+ * loop: no allocation, no system call, no recursion, bounded work (the
+ * faces beyond the touchable area's rim are a table made at set-up:
+ * irdm_contact_beyond_build()).
  *
  * The BVH boxes bound the REST surface; the surface the device touches is
  * rest + u.  With |u| <= max_disp_m for every node, a box grown by
@@ -69,6 +70,48 @@ int irdm_contact_mesh_init(struct irdm_contact_mesh *cm, const struct irdm_image
 	cm->n_tris = img->meta->n_tris;
 	cm->n_rows = img->meta->n_nodes;
 	return IRDM_OK;
+}
+
+size_t irdm_contact_beyond_size(const struct irdm_contact_mesh *cm)
+{
+	return 3 * (size_t)cm->n_tris * sizeof(uint32_t);
+}
+
+/* The lowest-index SURFACE triangle other than t with vertices a and b. */
+static uint32_t search_beyond(const struct irdm_contact_mesh *cm, uint32_t t, uint32_t a,
+			      uint32_t b)
+{
+	for (uint32_t u = 0; u < cm->n_tris; u++) {
+		const uint32_t *w = &cm->tris[3 * (size_t)u];
+		bool has_a = w[0] == a || w[1] == a || w[2] == a;
+		bool has_b = w[0] == b || w[1] == b || w[2] == b;
+
+		if (u != t && has_a && has_b)
+			return u;
+	}
+	return IRDM_BVH_NONE;
+}
+
+uint32_t irdm_contact_beyond_build(struct irdm_contact_mesh *cm, uint32_t *table)
+{
+	uint32_t searched = 0;
+
+	for (uint32_t t = 0; t < cm->n_tris; t++) {
+		const uint32_t *v = &cm->tris[3 * (size_t)t];
+		bool touchable = irdm_contact_tri_contactable(cm, t);
+
+		for (unsigned e = 0; e < 3; e++) {
+			uint32_t u = cm->adj[3 * (size_t)t + e];
+
+			if (u == IRDM_BVH_NONE && touchable) {
+				u = search_beyond(cm, t, v[e], v[(e + 1) % 3]);
+				searched++;
+			}
+			table[3 * (size_t)t + e] = u;
+		}
+	}
+	cm->beyond = table;
+	return searched;
 }
 
 bool irdm_contact_tri_contactable(const struct irdm_contact_mesh *cm, uint32_t t)
@@ -441,37 +484,12 @@ static bool inside_tri(const double *lam)
 }
 
 /*
- * The SURFACE triangle other than t on edge e of t, touchable or not (the
- * CONTACT_BVH's adjacency knows only touchable ones): on the touchable
- * area's rim, a search of the surface, remembered in the proxy for the
- * edges of its triangle, so a slide along the rim searches once per rim
- * triangle.  IRDM_BVH_NONE for an edge of an open surface.
+ * The SURFACE triangle other than t on edge e of t, touchable or not:
+ * the set-up's table (IRDM_BVH_NONE for an edge of an open surface).
  */
-static uint32_t face_beyond(const struct irdm_contact_mesh *cm, struct irdm_proxy *px,
-			    uint32_t t, unsigned e)
+static uint32_t face_beyond(const struct irdm_contact_mesh *cm, uint32_t t, unsigned e)
 {
-	const uint32_t *v = &cm->tris[3 * (size_t)t];
-	uint32_t a = v[e], b = v[(e + 1) % 3], u = cm->adj[3 * (size_t)t + e];
-
-	if (u != IRDM_BVH_NONE)
-		return u;
-	if (px->rim_tri != t) {
-		px->rim_tri = t;
-		px->rim_known = 0;
-	}
-	if (px->rim_known & (1u << e))
-		return px->rim_face[e];
-	for (u = 0; u < cm->n_tris; u++) {
-		const uint32_t *w = &cm->tris[3 * (size_t)u];
-		bool has_a = w[0] == a || w[1] == a || w[2] == a;
-		bool has_b = w[0] == b || w[1] == b || w[2] == b;
-
-		if (u != t && has_a && has_b)
-			break;
-	}
-	px->rim_known |= (uint8_t)(1u << e);
-	px->rim_face[e] = u < cm->n_tris ? u : IRDM_BVH_NONE;
-	return px->rim_face[e];
+	return cm->beyond ? cm->beyond[3 * (size_t)t + e] : cm->adj[3 * (size_t)t + e];
 }
 
 /*
@@ -480,10 +498,10 @@ static uint32_t face_beyond(const struct irdm_contact_mesh *cm, struct irdm_prox
  * the edge at right angles to t.  False for a degenerate neighbour.
  */
 static bool normal_beyond(const struct irdm_contact_mesh *cm, const struct irdm_contact_disp *d,
-			  struct irdm_proxy *px, uint32_t t, unsigned e, const double v[3][3],
-			  const double *n, double *nu)
+			  uint32_t t, unsigned e, const double v[3][3], const double *n,
+			  double *nu)
 {
-	uint32_t u = face_beyond(cm, px, t, e);
+	uint32_t u = face_beyond(cm, t, e);
 	double w[3][3], ed[3], len;
 
 	if (u != IRDM_BVH_NONE) {
@@ -512,15 +530,15 @@ static bool normal_beyond(const struct irdm_contact_mesh *cm, const struct irdm_
  * constrain it.
  */
 static bool outside_beyond(const struct irdm_contact_mesh *cm, const struct irdm_contact_disp *d,
-			   struct irdm_proxy *px, uint32_t t, const double v[3][3],
-			   const double *n, const double *lam, const double *p)
+			   uint32_t t, const double v[3][3], const double *n, const double *lam,
+			   const double *p)
 {
 	for (unsigned e = 0; e < 3; e++) {
 		unsigned opp = (e + 2) % 3;
 		bool rim = cm->adj[3 * (size_t)t + e] == IRDM_BVH_NONE;
 		double nu[3], to_opp[3], to_p[3];
 
-		if ((!rim && !(lam[opp] < -ON_EDGE)) || !normal_beyond(cm, d, px, t, e, v, n, nu))
+		if ((!rim && !(lam[opp] < -ON_EDGE)) || !normal_beyond(cm, d, t, e, v, n, nu))
 			continue;
 		irdm_v3_sub(to_opp, v[opp], v[e]);
 		irdm_v3_sub(to_p, p, v[e]);
@@ -620,7 +638,7 @@ static int proxy_touch(struct irdm_proxy *px, const struct irdm_contact_mesh *cm
 	irdm_contact_tri_pos(cm, d, t, v);
 	if (!plane_bary(v, p, lam) || !tri_normal(v, n))
 		return IRDM_PROXY_FREE;
-	if (outside_beyond(cm, d, px, t, v, n, lam, p))
+	if (outside_beyond(cm, d, t, v, n, lam, p))
 		return IRDM_PROXY_FREE;
 	px->active = true;
 	if (inside_tri(lam) && (t = lowest_holder(cm, d, t, v, lam, p)) != hit.tri) {
@@ -766,7 +784,7 @@ int irdm_proxy_update(struct irdm_proxy *px, const struct irdm_contact_mesh *cm,
 	if (in < 0)                     /* crushed flat: detect afresh */
 		return proxy_release(px, IRDM_PROXY_RELEASE);
 	tri_normal(v, n);
-	outside = outside_beyond(cm, d, px, t, v, n, lam, p);
+	outside = outside_beyond(cm, d, t, v, n, lam, p);
 	if (!in)
 		irdm_contact_closest_on_tri(v[0], v[1], v[2], p, lam, q);
 	proxy_set(px, t, v, lam, p, steps);

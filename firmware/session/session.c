@@ -58,6 +58,24 @@ static int open_deform(struct irdm_session *s, char *err, size_t errlen)
 }
 
 /*
+ * The contact surface, when the image has one: its face-beyond table is
+ * made here so that the force loop never searches the surface.
+ */
+static int open_contact(struct irdm_session *s, char *err, size_t errlen)
+{
+	int rc;
+
+	if (irdm_contact_mesh_init(&s->cm, s->img))
+		return IRDM_OK;         /* no CONTACT_BVH: the engine alone */
+	rc = irdm_session_part_mem(&s->contact_mem, irdm_contact_beyond_size(&s->cm), "contact",
+				   err, errlen);
+	if (rc)
+		return rc;
+	irdm_contact_beyond_build(&s->cm, s->contact_mem);
+	return IRDM_OK;
+}
+
+/*
  * The parts on s->img; then s is the caller's.  On error everything goes,
  * the mapping too if the session made it.
  */
@@ -66,6 +84,8 @@ static int open_parts(struct irdm_session **sp, struct irdm_session *s,
 {
 	int rc = open_engine(s, &cfg->engine, err, errlen);
 
+	if (!rc)
+		rc = open_contact(s, err, errlen);
 	if (!rc && cfg->deform)
 		rc = open_deform(s, err, errlen);
 	if (rc) {
@@ -136,6 +156,7 @@ void irdm_session_close(struct irdm_session *s)
 	free(s->worker_mem);
 	free(s->deform_mem);
 	free(s->eng_mem);
+	free(s->contact_mem);
 	if (s->img == &s->mapped && s->unmap)
 		s->unmap(&s->mapped);
 	free(s);

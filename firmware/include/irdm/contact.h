@@ -18,6 +18,7 @@
 #define IRDM_CONTACT_H
 
 #include <stdbool.h>
+#include <stddef.h>
 #include <stdint.h>
 
 #include "irdm/error.h"
@@ -52,6 +53,12 @@ struct irdm_contact_mesh {
 	const struct irdm_node *rest;   /* NODES */
 	uint32_t n_tris;                /* SURFACE triangles */
 	uint32_t n_rows;
+	/* [n_tris][3]: the SURFACE triangle beyond each edge of a touchable
+	 * triangle, touchable or not (adj knows only touchable ones), or
+	 * IRDM_BVH_NONE on an open surface's edge; built at set-up by
+	 * irdm_contact_beyond_build().  NULL: not built, and the proxy
+	 * takes every edge of the touchable area's rim for an open edge. */
+	const uint32_t *beyond;
 };
 
 /*
@@ -82,6 +89,18 @@ struct irdm_contact_hit {
  * IRDM_EINVAL if img is NULL, has no metadata or has no CONTACT_BVH.
  */
 int irdm_contact_mesh_init(struct irdm_contact_mesh *cm, const struct irdm_image *img);
+
+/* Bytes of cm's face-beyond table: 3 words a SURFACE triangle. */
+size_t irdm_contact_beyond_size(const struct irdm_contact_mesh *cm);
+
+/*
+ * Fill table (irdm_contact_beyond_size() bytes, the caller's) and point
+ * cm->beyond at it.  At set-up, never in the force loop: an edge of the
+ * touchable area's rim costs a pass over the surface's triangles (the
+ * lowest-index other triangle on that edge is taken), so the proxy's
+ * update then reads one word.  Returns the number of rim edges searched.
+ */
+uint32_t irdm_contact_beyond_build(struct irdm_contact_mesh *cm, uint32_t *table);
 
 /* True when every vertex of SURFACE triangle t is a column. */
 bool irdm_contact_tri_contactable(const struct irdm_contact_mesh *cm, uint32_t t);
@@ -150,11 +169,6 @@ struct irdm_proxy {
 	 * cone is then judged on it */
 	bool force_known;
 	double force_n[3];
-	/* faces beyond the edges of rim_tri on the touchable area's rim,
-	 * found by a search (a memo: bit e of rim_known says rim_face[e]) */
-	uint32_t rim_tri;
-	uint32_t rim_face[3];
-	uint8_t rim_known;
 };
 
 enum irdm_proxy_event {

@@ -28,6 +28,7 @@
 #include <stdbool.h>
 #include <stddef.h>
 
+#include "irdm/contact.h"
 #include "irdm/deform.h"
 #include "irdm/engine.h"
 #include "irdm/error.h"
@@ -50,11 +51,14 @@ struct irdm_session {
 	struct irdm_engine *eng;
 	struct irdm_deform *deform;         /* NULL unless config.deform */
 	struct irdm_deform_worker *worker;  /* NULL until irdm_session_deform_open() */
+	/* the image's contact surface with its face-beyond table, made at
+	 * open; cm.hdr NULL: the image has no CONTACT_BVH */
+	struct irdm_contact_mesh cm;
 
 	/* private */
 	struct irdm_image mapped;
 	void (*unmap)(struct irdm_image *img);      /* of mapped; NULL: borrowed image */
-	void *eng_mem, *deform_mem, *worker_mem;
+	void *eng_mem, *deform_mem, *worker_mem, *contact_mem;
 };
 
 /*
