@@ -74,14 +74,11 @@ void irdm_bound_init(const struct irdm_engine *e, double *w)
 
 static double modal_bound(const struct irdm_engine *e)
 {
-	const struct irdm_mode *m = e->img->modes;
 	double b = 0;
 
 	for (uint32_t k = 0; k < e->K; k++) {
-		/* the same combination irdm_engine_node_disp() uses */
-		double yq = m[k].a[0] * e->x[2 * k] + m[k].a[1] * e->x[2 * k + 1];
-
-		b += e->bound_w[k] * fabs(yq);
+		/* the free evolution irdm_engine_node_disp() reads: A x */
+		b += e->bound_w[k] * fabs(e->y[2 * k]);
 	}
 	return b;
 }

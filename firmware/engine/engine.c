@@ -238,6 +238,7 @@ void irdm_engine_reset(struct irdm_engine *e)
 		start_rigid(e);
 	for (uint32_t k = 0; k < 2 * e->K; k++)
 		e->x[k] = e->y[k] = 0;
+	memset(e->free_memo, 0, sizeof(e->free_memo));
 	for (uint32_t s = 0; s < e->ring.T; s++)
 		e->ring.tick[s].n = 0;
 	for (uint32_t s = 0; s < e->H; s++)

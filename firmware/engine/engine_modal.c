@@ -7,7 +7,14 @@
  * and R[0] (sum_k phi_v,k phi_e,k^T b_k,q + D).  Infinite memory at
  * O(modes) per tick; double precision throughout (float history sums
  * lose to cancellation: docs/architecture.md, "Numerical hazards").
+ * y = A x is made as soon as x is (irdm_modal_apply()): between ticks it
+ * gives the free response the proxy's surface is read from, and the tick
+ * starts from it.  A column's free displacement is remembered until the
+ * state changes: the proxy and the contacts' history term ask for the
+ * same nodes.
  */
+#include <string.h>
+
 #include "engine_priv.h"
 
 /*
@@ -25,65 +32,90 @@ static double flush_tiny(double x)
 	return fabs(x) < STATE_FLUSH ? 0.0 : x;
 }
 
-void irdm_modal_begin_tick(struct irdm_engine *e)
+/* y = A x for mode k: the free evolution of the state x just set. */
+static void evolve(struct irdm_engine *e, const struct irdm_mode *m, uint32_t k)
 {
-	const struct irdm_mode *m = e->img->modes;
+	double q = e->x[2 * k], v = e->x[2 * k + 1];
 
-	for (uint32_t k = 0; k < e->K; k++) {
-		double q = e->x[2 * k], v = e->x[2 * k + 1];
-		e->y[2 * k] = m[k].a[0] * q + m[k].a[1] * v;
-		e->y[2 * k + 1] = m[k].a[2] * q + m[k].a[3] * v;
-	}
+	e->y[2 * k] = m[k].a[0] * q + m[k].a[1] * v;
+	e->y[2 * k + 1] = m[k].a[2] * q + m[k].a[3] * v;
 }
 
 void irdm_modal_free_disp(const struct irdm_engine *e, uint32_t col, double u[3])
 {
-	const double *phi = &e->phi[(size_t)col * 3 * e->K];
+	/* a memo: the engine's state is the caller's to change, never here */
+	struct free_memo *mm = (struct free_memo *)&e->free_memo[col % FREE_MEMO];
+	const uint32_t K = e->K;
+	const double *p0 = &e->phi[(size_t)col * 3 * K], *p1 = p0 + K, *p2 = p1 + K;
+	const double *y = e->y;
+	double s0 = 0, s1 = 0, s2 = 0;
 
-	for (int i = 0; i < 3; i++) {
-		const double *p = &phi[(size_t)i * e->K];
-		double s = 0;
-		for (uint32_t k = 0; k < e->K; k++)
-			s += p[k] * e->y[2 * k];
-		u[i] = s;
+	if (mm->stamp == e->tick + 1 && mm->col == col) {
+		memcpy(u, mm->u, sizeof(mm->u));
+		return;
 	}
+	/* three sums side by side, each in the order of k */
+	for (uint32_t k = 0; k < K; k++) {
+		double yk = y[2 * k];
+
+		s0 += p0[k] * yk;
+		s1 += p1[k] * yk;
+		s2 += p2[k] * yk;
+	}
+	u[0] = s0;
+	u[1] = s1;
+	u[2] = s2;
 	if (e->H)
 		irdm_head_free_disp(e, col, u);
+	mm->stamp = e->tick + 1;
+	mm->col = col;
+	memcpy(mm->u, u, sizeof(mm->u));
 }
 
 void irdm_modal_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp, double blk[9])
 {
 	const struct irdm_mode *m = e->img->modes;
-	const double *pd = &e->phi[(size_t)col_disp * 3 * e->K];
-	const double *pf = &e->phi[(size_t)col_force * 3 * e->K];
+	const uint32_t K = e->K;
+	const double *pd = &e->phi[(size_t)col_disp * 3 * K];
+	const double *pf = &e->phi[(size_t)col_force * 3 * K];
+	double s[9] = { 0 };
 
 	/* the static correction: kept block (zero where dropped) + far field;
 	 * a hybrid image's kept blocks take the head's first sample instead
 	 * (the head's samples sum to the whole block, far field included) */
 	if (!e->H || !irdm_head_r0(e, col_force, col_disp, blk))
 		irdm_image_corr_value(e->img, col_force, col_disp, blk);
-	for (int i = 0; i < 3; i++)
-		for (int j = 0; j < 3; j++) {
-			double s = 0;
-			for (uint32_t k = 0; k < e->K; k++)
-				s += pd[(size_t)i * e->K + k] * pf[(size_t)j * e->K + k] * m[k].b[0];
-			blk[3 * i + j] += s;
-		}
+	/* the nine sums side by side (a site change computes up to nine
+	 * blocks in one tick), each in the order of k */
+	for (uint32_t k = 0; k < K; k++) {
+		double b = m[k].b[0];
+		double d[3] = { pd[k], pd[K + k], pd[2 * (size_t)K + k] };
+		double f[3] = { pf[k], pf[K + k], pf[2 * (size_t)K + k] };
+
+		for (int i = 0; i < 3; i++)
+			for (int j = 0; j < 3; j++)
+				s[3 * i + j] += d[i] * f[j] * b;
+	}
+	for (int i = 0; i < 9; i++)
+		blk[i] += s[i];
 }
 
 void irdm_modal_apply(struct irdm_engine *e, const struct irdm_force_tick *f)
 {
 	const struct irdm_mode *m = e->img->modes;
+	const uint32_t K = e->K, nf = f->n;
+	const double *p[IRDM_MAX_FORCE_NODES];
 
-	for (uint32_t k = 0; k < e->K; k++) {
+	for (uint32_t n = 0; n < nf; n++)
+		p[n] = &e->phi[(size_t)f->col[n] * 3 * K];
+	for (uint32_t k = 0; k < K; k++) {
 		double g = 0;
-		for (uint32_t n = 0; n < f->n; n++) {
-			const double *p = &e->phi[(size_t)f->col[n] * 3 * e->K];
-			g += p[k] * f->f_n[n][0] + p[e->K + k] * f->f_n[n][1]
-			     + p[2 * (size_t)e->K + k] * f->f_n[n][2];
-		}
+		for (uint32_t n = 0; n < nf; n++)
+			g += p[n][k] * f->f_n[n][0] + p[n][K + k] * f->f_n[n][1]
+			     + p[n][2 * (size_t)K + k] * f->f_n[n][2];
 		e->x[2 * k] = flush_tiny(e->y[2 * k] + m[k].b[0] * g);
 		e->x[2 * k + 1] = flush_tiny(e->y[2 * k + 1] + m[k].b[1] * g);
+		evolve(e, m, k);
 	}
 	if (e->H)
 		irdm_head_apply(e, f);

@@ -24,6 +24,8 @@ struct r0_table {
 	double blk[IRDM_MAX_FORCE_NODES][IRDM_MAX_FORCE_NODES][9];
 };
 
+#define FREE_MEMO 16                /* entries, direct-mapped by column */
+
 struct irdm_engine {
 	const struct irdm_image *img;
 	struct irdm_engine_config cfg;
@@ -35,7 +37,9 @@ struct irdm_engine {
 	/* modal */
 	const double *phi;                  /* [col][3][K], converted at init */
 	double *x;                          /* 2K: (q, q') per mode, x[t] */
-	double *y;                          /* 2K: A x[t], the free evolution */
+	double *y;                          /* 2K: A x[t], the free evolution: kept
+					     * with x (irdm_modal_apply()), so it is
+					     * current between ticks too */
 	/* FIR, and a modal image's exact head (ring of H ticks) */
 	struct irdm_fir_ring ring;
 	const double *tail_w;               /* T: r^s tail damping (1 when stable) */
@@ -55,6 +59,14 @@ struct irdm_engine {
 	struct irdm_force_tick last;        /* forces applied this tick */
 	struct irdm_engine_stats stats;
 	uint64_t tick;
+	/* modal: free displacements of columns computed since the state last
+	 * changed (stamp tick + 1; 0 empty): the proxy's surface and the
+	 * contacts' history term ask for the same nodes in one tick */
+	struct free_memo {
+		uint64_t stamp;
+		uint32_t col;
+		double u[3];
+	} free_memo[FREE_MEMO];
 	bool faulted;
 	const char *fault_why;              /* the fault's reason, a constant string */
 	struct irdm_deform *deform;
@@ -65,7 +77,6 @@ struct irdm_engine {
 };
 
 /* engine_modal.c / engine_fir.c: the history term and the R[0] blocks. */
-void irdm_modal_begin_tick(struct irdm_engine *e);
 void irdm_modal_free_disp(const struct irdm_engine *e, uint32_t col, double u[3]);
 void irdm_modal_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp, double blk[9]);
 void irdm_modal_apply(struct irdm_engine *e, const struct irdm_force_tick *f);

@@ -17,16 +17,6 @@ static inline bool repr_is_modal(const struct irdm_engine *e)
 	return IRDM_CONFIG_MODAL && (!IRDM_CONFIG_FIR || e->repr == IRDM_REPR_MODAL);
 }
 
-static inline void repr_begin_tick(struct irdm_engine *e)
-{
-#if IRDM_CONFIG_MODAL
-	if (repr_is_modal(e))
-		irdm_modal_begin_tick(e);
-#else
-	(void)e;
-#endif
-}
-
 static inline void repr_free_disp(const struct irdm_engine *e, uint32_t col, double u[3])
 {
 #if IRDM_CONFIG_MODAL

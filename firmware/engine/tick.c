@@ -137,7 +137,6 @@ int irdm_engine_tick(struct irdm_engine *e, const struct irdm_contact_cmd *cmd_i
 			return fault(e, "a contact target is not finite or beyond IRDM_MAX_TARGET_M");
 		s.idx[s.m++] = i;
 	}
-	repr_begin_tick(e);
 	if (s.m) {
 		tick_history_terms(e, &s);
 		tick_assemble(e, &s);
@@ -180,17 +179,7 @@ void irdm_engine_node_disp(const struct irdm_engine *e, uint32_t row, double u[3
 	irdm_v3_zero(u);
 	if (col == NO_COL)
 		return;
-	if (!repr_is_modal(e)) {
-		repr_free_disp(e, col, u);
-		return;
-	}
-	const struct irdm_mode *m = e->img->modes;
-	const double *phi = &e->phi[(size_t)col * 3 * e->K];
-	for (uint32_t k = 0; k < e->K; k++) {
-		double yq = m[k].a[0] * e->x[2 * k] + m[k].a[1] * e->x[2 * k + 1];
-		for (int i = 0; i < 3; i++)
-			u[i] += phi[(size_t)i * e->K + k] * yq;
-	}
-	if (e->H)
-		irdm_head_free_disp(e, col, u);
+	/* a modal image's y = A x is kept current between ticks: the next
+	 * tick's free displacement, the one its contacts will be given */
+	repr_free_disp(e, col, u);
 }
