@@ -792,6 +792,57 @@ static void test_errors(void **state)
 	irdm_session_close(ses);
 }
 
+/*
+ * A node's displacement read between ticks (the proxy's surface) is the
+ * free displacement the next tick starts from, remembered only until the
+ * state changes: an engine read at every tick ends, bit for bit, where one
+ * never read does; a reset reads zero at once.
+ */
+static void one_run(struct irdm_engine *e, const struct irdm_contact_site *site, uint32_t row,
+		    bool read, double *u)
+{
+	struct irdm_contact_cmd cmd[IRDM_MAX_CONTACTS];
+
+	memset(cmd, 0, sizeof(cmd));
+	cmd[0].mode = IRDM_CONTACT_GRAB;
+	assert_int_equal(irdm_engine_contact_begin(e, 0, site, IRDM_CONTACT_GRAB), IRDM_OK);
+	for (int t = 0; t < 50; t++) {
+		cmd[0].target_m[2] = -0.0002 * t;
+		if (read)
+			irdm_engine_node_disp(e, row, u);
+		assert_int_equal(irdm_engine_tick(e, cmd), IRDM_OK);
+	}
+	irdm_engine_node_disp(e, row, u);
+}
+
+static void test_node_disp_between_ticks(void **state)
+{
+	const double top[3] = { 0.05, 0.05, 0.2 };
+	struct irdm_engine_config cfg;
+	struct irdm_contact_site site;
+	struct irdm_image *imgs[2] = { &exact, &hybrid };
+	double ur[3], un[3], z[3];
+
+	(void)state;
+	irdm_engine_config_default(&cfg);
+	for (int i = 0; i < 2; i++) {
+		struct irdm_session *a = efx_session(imgs[i], &cfg), *b = efx_session(imgs[i], &cfg);
+		uint32_t row;
+
+		node_site(imgs[i], top, &site);
+		row = site.row[0];
+		one_run(a->eng, &site, row, true, ur);
+		one_run(b->eng, &site, row, false, un);
+		assert_true(ur[2] < 0);
+		assert_memory_equal(ur, un, sizeof(ur));
+		irdm_engine_reset(a->eng);
+		irdm_engine_node_disp(a->eng, row, z);
+		assert_true(z[0] == 0 && z[1] == 0 && z[2] == 0);
+		irdm_session_close(a);
+		irdm_session_close(b);
+	}
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -805,6 +856,7 @@ int main(void)
 		cmocka_unit_test(test_push_release),
 		cmocka_unit_test(test_stroke),
 		cmocka_unit_test(test_errors),
+		cmocka_unit_test(test_node_disp_between_ticks),
 	};
 
 	return cmocka_run_group_tests(tests, setup, teardown);
