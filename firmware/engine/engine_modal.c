@@ -78,7 +78,7 @@ void irdm_modal_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col
 	const uint32_t K = e->K;
 	const double *pd = &e->phi[(size_t)col_disp * 3 * K];
 	const double *pf = &e->phi[(size_t)col_force * 3 * K];
-	double s[9] = { 0 };
+	double s0 = 0, s1 = 0, s2 = 0, s3 = 0, s4 = 0, s5 = 0, s6 = 0, s7 = 0, s8 = 0;
 
 	/* the static correction: kept block (zero where dropped) + far field;
 	 * a hybrid image's kept blocks take the head's first sample instead
@@ -89,15 +89,16 @@ void irdm_modal_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col
 	 * blocks in one tick), each in the order of k */
 	for (uint32_t k = 0; k < K; k++) {
 		double b = m[k].b[0];
-		double d[3] = { pd[k], pd[K + k], pd[2 * (size_t)K + k] };
-		double f[3] = { pf[k], pf[K + k], pf[2 * (size_t)K + k] };
+		double d0 = pd[k], d1 = pd[K + k], d2 = pd[2 * (size_t)K + k];
+		double f0 = pf[k], f1 = pf[K + k], f2 = pf[2 * (size_t)K + k];
 
-		for (int i = 0; i < 3; i++)
-			for (int j = 0; j < 3; j++)
-				s[3 * i + j] += d[i] * f[j] * b;
+		s0 += d0 * f0 * b, s1 += d0 * f1 * b, s2 += d0 * f2 * b;
+		s3 += d1 * f0 * b, s4 += d1 * f1 * b, s5 += d1 * f2 * b;
+		s6 += d2 * f0 * b, s7 += d2 * f1 * b, s8 += d2 * f2 * b;
 	}
-	for (int i = 0; i < 9; i++)
-		blk[i] += s[i];
+	blk[0] += s0, blk[1] += s1, blk[2] += s2;
+	blk[3] += s3, blk[4] += s4, blk[5] += s5;
+	blk[6] += s6, blk[7] += s7, blk[8] += s8;
 }
 
 void irdm_modal_apply(struct irdm_engine *e, const struct irdm_force_tick *f)

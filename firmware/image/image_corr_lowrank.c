@@ -93,18 +93,24 @@ static void add_far_field(const struct irdm_image *img, uint32_t col_force, uint
 	size_t r = img->corr_rank, d = 3 * (size_t)col_disp * r, f = 3 * (size_t)col_force * r;
 	uint32_t prec = img->meta->precision;
 	const void *u = img->corr_u;
+	/* the nine sums in registers (blk may alias nothing the loop reads,
+	 * but the compiler cannot know), each in the order of k */
+	double a0 = blk[0], a1 = blk[1], a2 = blk[2], a3 = blk[3], a4 = blk[4];
+	double a5 = blk[5], a6 = blk[6], a7 = blk[7], a8 = blk[8];
 
 	for (size_t k = 0; k < r; k++) {
 		double l = irdm_elem_get(img->corr_lambda, prec, k);
-		double ud[3], uf[3];
-		for (size_t i = 0; i < 3; i++) {
-			ud[i] = irdm_elem_get(u, prec, d + i * r + k);
-			uf[i] = irdm_elem_get(u, prec, f + i * r + k);
-		}
-		for (size_t i = 0; i < 3; i++)
-			for (size_t j = 0; j < 3; j++)
-				blk[3 * i + j] += (ud[i] * uf[j]) * l;
+		double d0 = irdm_elem_get(u, prec, d + k), f0 = irdm_elem_get(u, prec, f + k);
+		double d1 = irdm_elem_get(u, prec, d + r + k), f1 = irdm_elem_get(u, prec, f + r + k);
+		double d2 = irdm_elem_get(u, prec, d + 2 * r + k);
+		double f2 = irdm_elem_get(u, prec, f + 2 * r + k);
+
+		a0 += (d0 * f0) * l, a1 += (d0 * f1) * l, a2 += (d0 * f2) * l;
+		a3 += (d1 * f0) * l, a4 += (d1 * f1) * l, a5 += (d1 * f2) * l;
+		a6 += (d2 * f0) * l, a7 += (d2 * f1) * l, a8 += (d2 * f2) * l;
 	}
+	blk[0] = a0, blk[1] = a1, blk[2] = a2, blk[3] = a3, blk[4] = a4;
+	blk[5] = a5, blk[6] = a6, blk[7] = a7, blk[8] = a8;
 }
 
 void irdm_image_corr_value(const struct irdm_image *img, uint32_t col_force,
