@@ -107,17 +107,6 @@ void irdm_modal_apply(struct irdm_engine *e, const struct irdm_force_tick *f)
 	const uint32_t K = e->K, nf = f->n;
 	const double *p[IRDM_MAX_FORCE_NODES];
 
-	if (!nf) {
-		/* no force: y + b 0 is y (flush_tiny takes -0 and +0 alike) */
-		for (uint32_t k = 0; k < K; k++) {
-			e->x[2 * k] = flush_tiny(e->y[2 * k]);
-			e->x[2 * k + 1] = flush_tiny(e->y[2 * k + 1]);
-			evolve(e, m, k);
-		}
-		if (e->H)
-			irdm_head_apply(e, f);
-		return;
-	}
 	for (uint32_t n = 0; n < nf; n++)
 		p[n] = &e->phi[(size_t)f->col[n] * 3 * K];
 	for (uint32_t k = 0; k < K; k++) {
