@@ -55,6 +55,7 @@ struct fw_args {
 	bool force;                     /* --force: replace a --frames-out DIR we did not write */
 	bool quiet;
 	bool help;
+	bool help_board_markdown;       /* print the board keys' table (make docs) */
 };
 
 /*

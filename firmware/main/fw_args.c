@@ -58,6 +58,8 @@ static const struct irdm_opt fw_opts[] = {
 	{ .name = "quiet", .short_name = 'q', .type = IRDM_OPT_FLAG, FA(quiet),
 	  .help = "no summary" },
 	{ .name = "help", .short_name = 'h', .type = IRDM_OPT_FLAG, FA(help), .help = "this text" },
+	{ .name = "help-board-markdown", .type = IRDM_OPT_FLAG, FA(help_board_markdown),
+	  .help = "the board file's keys as a Markdown table (docs/boards.md; make docs)" },
 };
 
 static const struct irdm_opt_table fw_table = {
@@ -102,7 +104,7 @@ int fw_args_parse(struct fw_args *a, int argc, char **argv, char *err, size_t er
 	memset(a, 0, sizeof(*a));
 	a->clock = IRDM_CLOCK_REAL;
 	rc = irdm_opt_parse_args(&set, 1, argc, argv, NULL, NULL, err, errlen);
-	if (rc || a->help)
+	if (rc || a->help || a->help_board_markdown)
 		return rc;
 	if (!a->board || !a->image) {
 		snprintf(err, errlen, "%s", !a->board ? "missing --board BOARD" : "missing --image IMAGE");

@@ -14,10 +14,12 @@
 #include <string.h>
 #include <sys/prctl.h>
 
+#include "irdm/board.h"
 #include "irdm/error.h"
 #include "irdm/hal_canemu.h"
 #include "irdm/hal_sim.h"
 #include "irdm/hal_socketcan.h"
+#include "irdm/options_doc.h"
 #include "irdm/rt.h"
 
 #include "fw.h"
@@ -329,6 +331,11 @@ int main(int argc, char **argv)
 	if (!fw)
 		return fail(FW_EXIT_SETUP, IRDM_ENOMEM, "%s%s", "", "out of memory");
 	rc = fw_args_parse(&fw->args, argc - 1, argv + 1, fw->err, sizeof(fw->err));
+	if (!rc && fw->args.help_board_markdown) {
+		irdm_opt_print_markdown(stdout, irdm_board_options());
+		free(fw);
+		return FW_EXIT_OK;
+	}
 	if (rc || fw->args.help) {
 		if (fw->args.help) {
 			fw_args_usage(stdout);
