@@ -42,7 +42,7 @@ static struct irdm_image exact, bare, win, win500;
  * said: first T ticks 3.0e-14 (the same f64 taps summed in double either
  * way: rounding); the whole 12 s 5.4e-3 (the window's own error once the
  * head has passed; limit 2x); held force 1e-5 of the static one (limit
- * 1e-4, the issue asks 5e-3); sum of taps vs S 1.1e-12 (floating cube
+ * 1e-4, against 5e-3 required); sum of taps vs S 1.1e-12 (floating cube
  * 4e-14); the engine vs the convolution with the stored taps 9.2e-14.
  */
 #define TOL_HEAD 1.5e-13

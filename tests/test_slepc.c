@@ -37,7 +37,7 @@
 #include "support/test_files.h"
 
 /* Measured: eigenvalues within 3e-13 relative, responses within 2e-12 of
- * max |R| (np = 2, 1); the issue's bounds are 1e-9 and 1e-8. */
+ * max |R| (np = 2, 1); the bounds are 1e-9 and 1e-8. */
 #define EIG_REL_TOL 1e-9
 #define RESP_REL_TOL 1e-8
 /* a run's bound (s): a rank that hangs fails the test, not the suite */

@@ -51,14 +51,14 @@
 /*
  * IRDM_TORUS_CLUSTER=0: force error of the compressed correction (kept
  * blocks + the far field of rank 96) vs the dense one, with the far node: 9.3e-4
- * measured, the issue's 1e-3 the limit (7 % margin; 2.2e-3 with the blocks
+ * measured, the required 1e-3 the limit (7 % margin; 2.2e-3 with the blocks
  * alone).  It is not monotone in the rank: rank 192 fits that node's
  * blocks better (ratio left 0.0017 against 0.0024) and yet gives 1.6e-3,
  * so the fit itself is held too: the far block's ratio left over the one
  * dropped, 0.73 measured, limit 0.8 (1.0 without a far field).
  * For the nearest dropped node, in units of the tolerance: the force error
  * is about the dropped block's ratio, 0.95 tol measured (1.05 with the
- * blocks alone), limit 1.2 tol.  The issue's 1e-3 there is out of reach
+ * blocks alone), limit 1.2 tol.  The required 1e-3 there is out of reach
  * of a low-rank term: that block is local (23 mm away); it needs tol near
  * 1e-3, which keeps most blocks (docs/image-format.md).
  */
@@ -73,7 +73,7 @@
  * largest block error against the independent dense blocks 0.25 tol
  * (limit 1.01: f32 storage rounds); the force errors of the three chosen
  * triples 2.0e-4, 2.5e-5 and 3.0e-5, of the random ones 4.4e-5 to 8.2e-5;
- * the issue's 1e-3 the limit (MAX_FORCE_RMS, 4.9x margin).  With 128
+ * the required 1e-3 the limit (MAX_FORCE_RMS, 4.9x margin).  With 128
  * nodes per cluster on the 2277-column torus, the plain per-block bound
  * (no conditioning share) gave 1.5e-3 for three nodes 3.3 mm apart
  * across two clusters.
