@@ -22,7 +22,8 @@
 #   make jitter-view the same loop with and without a browser on its live view
 #   make hil        the CAN back-end end to end in a PREEMPT_RT VM (docs/hil.md)
 #   make docs       every generated document (GEN_DOCS: scene-format.md, the
-#                   board keys in boards.md); make docs-check: fails if stale
+#                   board keys in boards.md, the test index in testing.md);
+#                   make docs-check: fails if one is stale
 #   make sizes      irdm-fw built with each configs/*.config (CONFIG=FILE: one)
 #
 # CC=clang works too.  The layers point one way and the include paths
@@ -267,10 +268,12 @@ sizes-run:
 # it into the directory $(1).  A new one: add its name and its gen-doc- line.
 # Whole files come from a --help-markdown; a block inside a hand-written
 # page is spliced between its markers (tools/scripts/splice-doc.sh).
-GEN_DOCS := scene-format.md boards.md
+GEN_DOCS := scene-format.md boards.md testing.md
 gen-doc-scene-format.md = $(IRDM) precompute --help-markdown > $(1)/scene-format.md
 gen-doc-boards.md = $(IRDM_FW) --help-board-markdown | \
   tools/scripts/splice-doc.sh docs/boards.md 'board keys' > $(1)/boards.md
+gen-doc-testing.md = tools/scripts/test-index.sh tests | \
+  tools/scripts/splice-doc.sh docs/testing.md 'test index' > $(1)/testing.md
 GEN_DOCS_TOOLS := $(IRDM) $(IRDM_FW)
 gen-docs = $(foreach d,$(GEN_DOCS),$(call gen-doc-$(d),$(1));)
 
@@ -375,7 +378,8 @@ bench-precompute: $(IRDM) $(BUILD)/data/bunny.off
 	$(MEASURE) -m bench-precompute 'make bench-precompute' -- tools/scripts/bench-precompute.sh $(IRDM)
 
 # The precompute over MPI ranks: a 100k-node cuboid, serial and slepc on
-# np = 1, 2 (README, "Beyond one machine"); bounded by TIMEOUT per run.
+# np = 1, 2 (docs/mpi.md); bounded by TIMEOUT per run; figures to
+# docs/measurements/bench-mpi.md.
 bench-mpi: $(IRDM) $(SLEPC_PLUGIN)
 	$(MEASURE) bench-mpi 'make bench-mpi' -- tools/scripts/bench-mpi.sh $(IRDM)
 

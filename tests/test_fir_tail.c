@@ -66,7 +66,7 @@ static int setup(void **state)
 		  "precision", "f64", "touch", "z>=0.2", "display", "touch", NULL);
 	/* the FIR images touch the top-centre node alone: the certificate of
 	 * 1500 taps costs seconds a column (every column of the top face:
-	 * bench figures in README) */
+	 * make bench_fir_tail) */
 	efx_image(&bare, p[1], "resolution", "4,4,8", "representation", "fir:500", "modes", "all",
 		  "dt", "0.002", "precision", "f64", "touch", TOP_NODE, "display", "touch", NULL);
 	efx_image(&win, p[2], "resolution", "4,4,8", "representation", "fir:500", "modes", "all",

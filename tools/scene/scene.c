@@ -450,7 +450,7 @@ static const struct irdm_opt scene_opts[] = {
 	  .help = "time-domain integration steps per sample (default 8)" },
 	{ .name = "eigensolver", .type = IRDM_OPT_ENUM, SC(eigensolver), .names = eig_names,
 	  .help = "eigenvalue solver (default auto: by size); slepc: SLEPc over MPI ranks "
-		  "(run under mpirun -np N; README, \"Beyond one machine\")" },
+		  "(run under mpirun -np N; docs/mpi.md)" },
 	{ .name = "threads", .type = IRDM_OPT_UNSIGNED, SC(threads), .metavar = "N",
 	  .range = IRDM_OPT_LE, .max = 256, .help = "worker threads (0: all cores)" },
 };
