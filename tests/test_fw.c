@@ -20,7 +20,9 @@
  *  - a run whose limits never let the torque on exits 7 naming the limit;
  *  - --frame-at: the deformed surface in VTK, checked physically (a dent
  *    at the pressed top centre, a still bottom) and byte-identical in
- *    virtual time.
+ *    virtual time;
+ *  - --help-board-markdown prints the board key table (what make docs
+ *    splices into docs/boards.md), exit 0, and runs nothing.
  * Needs IRDM and IRDM_FW (make test sets them); runs from the repository root.
  */
 #define _GNU_SOURCE
@@ -42,7 +44,9 @@
 
 #include <cmocka.h>
 
+#include "irdm/board.h"
 #include "irdm/image.h"
+#include "irdm/options_doc.h"
 #include "irdm/outdir.h"
 #include "irdm/vec3.h"
 #include "irdm/safety.h"
@@ -152,6 +156,27 @@ static void test_clear_messages(void **state)
 	expect_error(run_fw((const char *const[]){ "--bogus", NULL }), 2,
 		     "--bogus: unknown option 'bogus' (see irdm-fw --help)");
 	assert_null(strstr(strstr(err_text, "--help") + 1, "--help"));
+}
+
+/* The board keys, not irdm-fw's own options, and nothing else: no board or
+ * image is needed, none is read. */
+static void test_help_board_markdown(void **state)
+{
+	char *table = NULL;
+	size_t len = 0;
+	FILE *f;
+
+	(void)state;
+	assert_int_equal(run_fw((const char *const[]){ "--help-board-markdown", NULL }), 0);
+	assert_string_equal(err_text, "");
+	f = open_memstream(&table, &len);
+	assert_non_null(f);
+	irdm_opt_print_markdown(f, irdm_board_options());
+	fclose(f);
+	assert_true(len > 1000 && len < sizeof(out_text));
+	assert_string_equal(out_text, table);
+	assert_non_null(strstr(out_text, "| `hal_options` |"));
+	free(table);
 }
 
 static void test_bad_input(void **state)
@@ -1104,6 +1129,7 @@ static int teardown(void **state)
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_help_board_markdown),
 		cmocka_unit_test(test_bad_input),
 		cmocka_unit_test(test_virtual_runs_are_identical),
 		cmocka_unit_test(test_release_ringing_is_the_dominant_mode),
