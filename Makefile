@@ -14,6 +14,8 @@
 #   make bench-mpi  the precompute of a 100k-node model, serial and over MPI ranks
 #   make stability  the stability suite's long run (10^7-tick soak): a Markdown
 #                   table and a plot of the worst cases in out/stability/
+#   (the measuring targets write docs/measurements/NAME.md: the figures with
+#   the command, date, machine and load; tools/scripts/measure.sh)
 #   make report     docs/report.md and its plots: every representation against
 #                   the exact model (irdm report; REPORT_CONFIGS, <= 10 min)
 #   make run        the main job: the built-in default scene, end to end
@@ -258,6 +260,7 @@ cfg-fws:
 sizes: all cfg-fws
 	$(MEASURE) sizes 'make sizes' -- $(MAKE) --no-print-directory sizes-run
 sizes-run:
+	@size $(IRDM_FW) | head -n 1
 	@for b in $(IRDM_FW) $(foreach c,$(CFG_NAMES),$(BUILD)/cfg-$(c)/irdm-fw); do \
 	  size $$b | tail -n 1; \
 	  echo "  firmware library text: $$(size -t $$(dirname $$b)/libirdmfw.a | tail -n 1 | awk '{print $$1}') bytes"; \
@@ -431,11 +434,11 @@ jitter: deps $(IRDM) $(IRDM_FW) $(JITTER_IMAGE)
 
 # The same loop with and without a browser on its live view, alternating
 # (JITTER_ROUNDS pairs of JITTER_SECONDS, default 3 x 20 s; docs/view.md)
-jitter-view: deps $(IRDM_FW) $(JITTER_IMAGE)
+jitter-view: deps $(IRDM) $(IRDM_FW) $(JITTER_IMAGE)
 	$(MEASURE) jitter-view \
 	  'make jitter-view JITTER_SECONDS=$(or $(JITTER_SECONDS),20) JITTER_ROUNDS=$(or $(JITTER_ROUNDS),3)' -- \
 	  env JITTER_SECONDS=$(or $(JITTER_SECONDS),20) JITTER_ROUNDS=$(or $(JITTER_ROUNDS),3) \
-	  tools/scripts/jitter-view.sh $(IRDM_FW) $(JITTER_IMAGE)
+	  tools/scripts/jitter-view.sh $(IRDM) $(IRDM_FW) $(JITTER_IMAGE)
 
 # Hardware in the loop without the hardware: Debian's PREEMPT_RT kernel
 # under qemu (TCG), vcan0, irdm-candrives and irdm-fw (the minimal build)
