@@ -29,6 +29,14 @@ shift $((OPTIND - 1))
 }
 name=$1 typed=$2
 shift 3
+# make -n runs a recipe line that calls $(MAKE) (ours run the measurement
+# through a sub-make): then only the sub-make's dry run, and no file.
+flags=${MAKEFLAGS:-}
+flags=${flags%% *}
+case $flags in -*) flags= ;; esac
+case $flags in
+*n*) exec "$@" ;;
+esac
 dir=${MEASURE_DIR:-docs/measurements}
 mkdir -p "$dir"
 out=$dir/$name.md
