@@ -25,7 +25,7 @@
  */
 #define RIGID_GAP 1e3
 /* max(K_ii / M_ii) above this many times the median: a graded mesh (a
- * uniform one is within 10; test_rigidity's is 1.3e5). */
+ * uniform one is within 10; test_mesh_rigidity's is 1.3e5). */
 #define GRADED 1e3
 #define ZERO_TOL 1e-14
 
@@ -179,7 +179,7 @@ int irdm_modes_solve_kept(const struct irdm_fem *fem, size_t n_wanted, bool floa
 	/*
 	 * A dense solve resolves an eigenvalue to about eps max(K_ii/M_ii):
 	 * on a graded mesh (a tiny element beside large ones) that is far
-	 * from the low modes' (1e-6 relative measured on test_rigidity's),
+	 * from the low modes' (1e-6 relative measured on test_mesh_rigidity's),
 	 * where shift-and-invert Lanczos is exact to rounding.
 	 */
 	if (method == IRDM_EIG_AUTO)
