@@ -5,14 +5,14 @@
 Usage: tools/scripts/include-cycles.py [--root DIR] [-v]
 
 Reports, and exits 1 on, any circle
-  (a) between the files of one folder (a module) under firmware/, hal/
-      and sim/, such as firmware/image/;
+  (a) between the files of one folder (a module) under firmware/,
+      platform/, hal/, sim/ and apps/, such as firmware/image/;
   (b) between the folders of tools/ (tools/modal, tools/dist, ...; a
       subfolder such as tools/dist/plugin counts as its folder).
 
 The graph is built from `#include "..."` lines, resolved as the compiler
-does: beside the including file, then firmware/include, hal/include,
-sim/include and tools/.  Its nodes:
+does: beside the including file, then in the include folders (every
+folder named include under those above, and tools/).  Its nodes:
   - in (a), one node per file stem: foo.c and foo.h of one folder are one
     node, "foo";
   - in (b), one node per folder.
@@ -31,9 +31,8 @@ import os
 import re
 import sys
 
-FILE_SCOPES = ["firmware", "hal", "sim"]
+FILE_SCOPES = ["firmware", "platform", "hal", "sim", "apps"]
 FOLDER_SCOPE = "tools"
-INCLUDE_DIRS = ["firmware/include", "hal/include", "sim/include", "tools"]
 
 INCLUDE_RE = re.compile(r'^[ \t]*#[ \t]*include[ \t]*"([^"]+)"', re.M)
 IDENT_RE = re.compile(r"[A-Za-z_]\w*")
@@ -113,11 +112,24 @@ def called_in_bodies(text):
     return names
 
 
+def include_dirs(root):
+    """The -I folders: every include folder of the scopes, then tools/."""
+    found = []
+    for top in FILE_SCOPES:
+        for d, subdirs, _ in os.walk(os.path.join(root, top)):
+            subdirs.sort()
+            if os.path.basename(d) == "include":
+                found.append(os.path.relpath(d, root))
+                subdirs[:] = []
+    return found + [FOLDER_SCOPE]
+
+
 class Tree:
     def __init__(self, root):
         self.root = root
+        self.include_dirs = include_dirs(root)
         self.files = {}         # relative path -> text
-        for top in FILE_SCOPES + [FOLDER_SCOPE] + INCLUDE_DIRS:
+        for top in FILE_SCOPES + [FOLDER_SCOPE]:
             base = os.path.join(root, top)
             for d, subdirs, names in os.walk(base):
                 subdirs.sort()
@@ -142,7 +154,7 @@ class Tree:
         """The files path includes with "...", resolved."""
         out = []
         for inc in INCLUDE_RE.findall(strip_comments(self.files[path], literals=False)):
-            for d in [os.path.dirname(path)] + INCLUDE_DIRS:
+            for d in [os.path.dirname(path)] + self.include_dirs:
                 cand = os.path.normpath(os.path.join(d, inc))
                 if cand in self.files:
                     out.append(cand)
@@ -289,15 +301,16 @@ def main():
     tree = Tree(os.path.normpath(args.root))
     n = 0
     folders = sorted({os.path.dirname(p) for p in tree.files
-                      if p.split(os.sep)[0] in FILE_SCOPES and "/include" not in "/" + p})
+                      if p.split(os.sep)[0] in FILE_SCOPES and "/include/" not in "/" + p})
     for folder in folders:
         n += report(folder, tree.edges(file_node(folder)), args.verbose)
     n += report(FOLDER_SCOPE, tree.edges(folder_node), args.verbose)
     if n:
         print("include-cycles: %d circle(s)" % n)
         return 1
+    tops = sorted({f.split(os.sep)[0] + "/" for f in folders})
     print("include-cycles: no circle in %d folders of %s, nor between the folders of %s/"
-          % (len(folders), ", ".join(s + "/" for s in FILE_SCOPES), FOLDER_SCOPE))
+          % (len(folders), ", ".join(tops) or "none", FOLDER_SCOPE))
     return 0
 
 
