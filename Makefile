@@ -22,6 +22,8 @@
 #   make hil        the CAN back-end end to end in a PREEMPT_RT VM (docs/hil.md)
 #   make docs       docs/scene-format.md from the scene key table
 #   make sizes      irdm-fw built with each configs/*.config (CONFIG=FILE: one)
+#   make format-check  every C source and header against .clang-format
+#                   (clang-format 14); make format rewrites them
 #
 # CC=clang works too.  The layers point one way and the include paths
 # enforce it (docs/architecture.md, "Layers"); each folder's objects see
@@ -161,7 +163,7 @@ CORE_TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(CORE_TEST_SRC))
 FWAPP_TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(FWAPP_TEST_SRC))
 BENCHES  := $(patsubst tests/bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC))
 
-.PHONY: all test test-variants san fuzz bench bench-precompute bench-mpi run render view-shots jitter-view stability report jitter check deps clean docs cfg-fws sizes hil
+.PHONY: all test test-variants san fuzz bench bench-precompute bench-mpi run render view-shots jitter-view stability report jitter check deps clean docs cfg-fws sizes hil format format-check
 .SECONDARY:
 all: $(if $(CONFIG),,$(IRDM) $(SLEPC_PLUGIN)) $(FW_LIB) $(POSIX_LIB) $(HAL_LIB) $(SIM_LIB) $(if $(FWMAIN_SRC),$(IRDM_FW)) \
   $(if $(CDMAIN_SRC),$(IRDM_CD))
@@ -306,6 +308,17 @@ sizes: all cfg-fws
 docs: $(IRDM)
 	$(IRDM) precompute --help-markdown > docs/scene-format.md.tmp
 	mv docs/scene-format.md.tmp docs/scene-format.md
+
+# The style (.clang-format, clang-format 14: other versions lay some lines
+# out differently).  Every C source and header but the build trees and the
+# generated ones (crc32c.c's tables).
+CLANG_FORMAT ?= $(or $(shell command -v clang-format-14 2>/dev/null),clang-format)
+FORMAT_SRC = $(filter-out %/crc32c.c,$(shell find . \( -type d \( -name 'build*' -o -name out \
+  -o -name .git \) \) -prune -o \( -name '*.c' -o -name '*.h' \) -print | sed 's|^\./||' | sort))
+format-check:
+	$(CLANG_FORMAT) --dry-run -Werror $(FORMAT_SRC)
+format:
+	$(CLANG_FORMAT) -i $(FORMAT_SRC)
 
 san:
 	$(MAKE) BUILD=build-san SAN=1 OPT="-O1 -g" IRDM_SOAK_SECONDS=10 IRDM_TORUS=small test
