@@ -27,20 +27,27 @@
 #                   board keys in boards.md, the test index in testing.md);
 #                   make docs-check: fails if one is stale
 #   make sizes      irdm-fw built with each configs/*.config (CONFIG=FILE: one)
+#   make format-check  every C source and header against .clang-format
+#                   (clang-format 14); make format rewrites them
 #
 # CC=clang works too.  The layers point one way and the include paths
-# enforce it (docs/architecture.md):
+# enforce it (docs/architecture.md, "Layers"); each folder's objects see
+# only the include paths of the layers they use:
 #
-#   firmware/*/*.c  -> libirdmfw.a     sees firmware/include only
-#   hal/*/*.c       -> libirdmhal.a    sees firmware/include, hal/include
-#   sim/*/*.c       -> libirdmsim.a    sees firmware/include, hal/include, sim/include
-#   sim/main/*.c    -> irdm-candrives (the CAN drive emulator; not in the library)
-#   tools/*/*.c     -> libirdmtools.a  sees firmware/include, tools/ (not tools/irdm)
-#   tools/irdm/*.c  -> irdm
-#   firmware/main/*.c -> irdm-fw (the controller; sees firmware, hal and sim headers)
-#   tests/test_*.c  -> one binary each; tests/test_tick_*.c link the firmware
-#                      library alone (no BLAS, no threads: the force tick's
-#                      dependencies, checked by tests/test_layers.c)
+#   firmware/*/*.c        -> libirdmfw.a     the tick's portable core: firmware/include
+#   platform/posix/*/*.c  -> libirdmposix.a  Linux services: + platform/posix/include
+#   hal/*/*.c             -> libirdmhal.a    core + hal/include
+#   sim/*/*.c             -> libirdmsim.a    core + hal + sim/include (+ posix: the
+#                                            virtual user's script file)
+#   tools/*/*.c           -> libirdmtools.a  core + posix + tools/
+#   apps/irdm/*.c         -> irdm            (the host tool: tools, posix, core)
+#   apps/irdm-fw/*.c      -> irdm-fw         (the controller: hal, posix, core; only
+#                                            its simulated back-ends' files see sim)
+#   apps/irdm-candrives/*.c -> irdm-candrives (the CAN drive emulator: sim, hal, posix, core)
+#   tests/test_*.c        -> one binary each, every library
+#   tests/core/test_*.c   -> the core library alone, libm and cmocka (no
+#                            platform service: tests/test_layers.c checks it)
+#   tests/apps/irdm-fw/test_*.c -> irdm-fw's objects but its main's
 #
 # Adding a file needs no edit here.
 
@@ -52,6 +59,10 @@ SHELL   := bash
 # builds the firmware alone (irdm-fw and its libraries) into build/cfg-NAME.
 CONFIG  ?=
 FEATURES := MODAL FIR FLOATING DEFORM
+# irdm-fw's HAL back-ends (apps/irdm-fw/fw_backend_<name>.c); one a config
+# file leaves unsaid is built.  Without SIM and CANEMU, irdm-fw does not
+# link the simulator.
+HAL_BACKENDS := SIM CANEMU SOCKETCAN
 ifneq ($(CONFIG),)
 include $(CONFIG)
 BUILD   ?= build/cfg-$(basename $(notdir $(CONFIG)))
@@ -59,13 +70,21 @@ $(foreach f,$(FEATURES),$(if $(filter y n,$(CONFIG_IRDM_$(f))),,\
   $(error $(CONFIG): CONFIG_IRDM_$(f) must be y or n, got '$(CONFIG_IRDM_$(f))')))
 $(if $(filter y,$(CONFIG_IRDM_MODAL) $(CONFIG_IRDM_FIR)),,\
   $(error $(CONFIG): CONFIG_IRDM_MODAL and CONFIG_IRDM_FIR are both n: the engine needs one))
+$(foreach b,$(HAL_BACKENDS),$(if $(filter y n,$(or $(CONFIG_IRDM_HAL_$(b)),y)),,\
+  $(error $(CONFIG): CONFIG_IRDM_HAL_$(b) must be y or n, got '$(CONFIG_IRDM_HAL_$(b))')))
 endif
 feature = $(if $(CONFIG),$(filter y,$(CONFIG_IRDM_$(1))),y)
 FEATURE_SRC_MODAL    = firmware/engine/engine_modal.c
 FEATURE_SRC_FIR      = firmware/engine/engine_fir.c firmware/engine/fir_sum.c firmware/engine/fir_sum_avx2.c
 FEATURE_SRC_FLOATING = firmware/engine/floating.c $(wildcard firmware/rigid/*.c)
-FEATURE_SRC_DEFORM   = $(wildcard firmware/deform/*.c) firmware/session/session_deform.c
+FEATURE_SRC_DEFORM   = $(wildcard firmware/deform/*.c platform/posix/deform/*.c) \
+  platform/posix/session/session_deform.c
 FEATURE_OFF_SRC := $(foreach f,$(FEATURES),$(if $(call feature,$(f)),,$(FEATURE_SRC_$(f))))
+hal_backend = $(if $(CONFIG),$(filter y,$(or $(CONFIG_IRDM_HAL_$(1)),y)),y)
+FW_SIM := $(or $(call hal_backend,SIM),$(call hal_backend,CANEMU))
+HAL_OFF_SRC := $(foreach b,$(HAL_BACKENDS),$(if $(call hal_backend,$(b)),,\
+  apps/irdm-fw/fw_backend_$(subst SIM,sim,$(subst CANEMU,canemu,$(subst SOCKETCAN,socketcan,$(b)))).c)) \
+  apps/irdm-fw/$(if $(FW_SIM),fw_user_none.c,fw_user.c)
 
 CC      ?= cc
 BUILD   ?= build
@@ -77,6 +96,7 @@ WARN     = -Wall -Wextra -Werror -Wshadow -Wstrict-prototypes -Wvla -Wundef
 OPT     ?= -O2 -g
 CFLAGS  += $(CSTD) $(WARN) $(OPT) -MMD -MP
 CFLAGS  += $(foreach f,$(FEATURES),-DIRDM_CONFIG_$(f)=$(if $(call feature,$(f)),1,0))
+CFLAGS  += $(foreach b,$(HAL_BACKENDS),-DIRDM_CONFIG_HAL_$(b)=$(if $(call hal_backend,$(b)),1,0))
 LDLIBS   = -lcholmod -larpack -lopenblas -lpthread -ldl -lm
 
 # The distributed eigensolver (eigensolver = slepc, tools/dist/): PETSc and
@@ -95,34 +115,40 @@ PLUGIN_LIBS = $(shell pkg-config --libs slepc PETSc $(MPI_PC)) -lopenblas -lm
 
 # Include paths, one set per layer (target-specific: an object sees only its own).
 FW_INC    = -Ifirmware/include
+POSIX_INC = $(FW_INC) -Iplatform/posix/include
 HAL_INC   = $(FW_INC) -Ihal/include
-SIM_INC   = $(HAL_INC) -Isim/include
-TOOL_INC  = $(FW_INC) -Itools -I/usr/include/suitesparse
+# the virtual user's script is read through the platform's text files
+SIM_INC   = $(HAL_INC) -Iplatform/posix/include -Isim/include
+TOOL_INC  = $(POSIX_INC) -Itools -I/usr/include/suitesparse
+FWAPP_INC = $(HAL_INC) -Iplatform/posix/include
 TEST_INC  = $(SIM_INC) -Itools -I/usr/include/suitesparse
+CORE_TEST_INC = $(FW_INC) -Itests
 
 ifneq ($(SAN),)
 CFLAGS  += -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all
 LDFLAGS += -fsanitize=address,undefined
 endif
 
-FW_SRC    := $(filter-out firmware/main/% $(FEATURE_OFF_SRC),$(wildcard firmware/*/*.c))
+FW_SRC    := $(filter-out $(FEATURE_OFF_SRC),$(wildcard firmware/*/*.c))
+POSIX_SRC := $(filter-out $(FEATURE_OFF_SRC),$(wildcard platform/posix/*/*.c))
 # The live view (docs/view.md): its server and page in tools/view/, linked
 # into irdm-fw (fw_view.c) and irdm; the trimmed builds leave it out
 # (fw_view_none.c) and need no libwebsockets.
 VIEW    := $(if $(CONFIG),,1)
-FWMAIN_SRC := $(filter-out firmware/main/$(if $(VIEW),fw_view_none.c,fw_view.c),\
-  $(wildcard firmware/main/*.c))
+FWMAIN_SRC := $(filter-out apps/irdm-fw/$(if $(VIEW),fw_view_none.c,fw_view.c) $(HAL_OFF_SRC),\
+  $(wildcard apps/irdm-fw/*.c))
 HAL_SRC   := $(wildcard hal/*/*.c)
-SIM_SRC   := $(filter-out sim/main/%,$(wildcard sim/*/*.c))
-CDMAIN_SRC := $(wildcard sim/main/*.c)
-TOOL_SRC  := $(filter-out tools/irdm/%,$(wildcard tools/*/*.c))
+SIM_SRC   := $(wildcard sim/*/*.c)
+CDMAIN_SRC := $(wildcard apps/irdm-candrives/*.c)
+TOOL_SRC  := $(wildcard tools/*/*.c)
 VIEW_PAGE := $(wildcard tools/view/page/*)
 VIEW_OBJ   = $(call obj,tools/view/view_server.c tools/view/view_msg.c) $(BUILD)/obj/gen/view_page.o
 VIEW_LIBS := -lwebsockets
-CLI_SRC   := $(wildcard tools/irdm/*.c)
+CLI_SRC   := $(wildcard apps/irdm/*.c)
 PLUGIN_SRC := $(wildcard tools/dist/plugin/*.c)
-TEST_SRC  := $(wildcard tests/test_*.c)
-TICK_TEST_SRC := $(wildcard tests/test_tick_*.c)
+CORE_TEST_SRC := $(wildcard tests/core/test_*.c)
+FWAPP_TEST_SRC := $(wildcard tests/apps/irdm-fw/test_*.c)
+TEST_SRC  := $(wildcard tests/test_*.c) $(CORE_TEST_SRC) $(FWAPP_TEST_SRC)
 TESTSUP_SRC := $(wildcard tests/support/*.c)
 BENCH_SRC := $(wildcard tests/bench/*.c)
 FUZZ_SRC  := $(wildcard tests/fuzz/fuzz_*.c)
@@ -134,6 +160,7 @@ obj = $(patsubst %.c,$(BUILD)/obj/%.o,$(1))
 MEASURE := tools/scripts/measure.sh
 
 FW_LIB   := $(BUILD)/libirdmfw.a
+POSIX_LIB := $(BUILD)/libirdmposix.a
 HAL_LIB  := $(BUILD)/libirdmhal.a
 SIM_LIB  := $(BUILD)/libirdmsim.a
 TOOL_LIB := $(BUILD)/libirdmtools.a
@@ -141,39 +168,50 @@ IRDM     := $(BUILD)/irdm
 IRDM_FW  := $(BUILD)/irdm-fw
 IRDM_CD  := $(BUILD)/irdm-candrives
 TESTS    := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TEST_SRC))
-TICK_TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(TICK_TEST_SRC))
+CORE_TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(CORE_TEST_SRC))
+FWAPP_TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(FWAPP_TEST_SRC))
 BENCHES  := $(patsubst tests/bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC))
 
-.PHONY: all test test-variants san fuzz bench bench-precompute bench-mpi run render view-shots jitter-view stability report jitter check deps clean docs docs-check cfg-fws sizes hil
+.PHONY: all test test-variants san fuzz bench bench-precompute bench-mpi run render view-shots jitter-view stability report jitter check deps clean docs docs-check cfg-fws sizes hil format format-check
 .SECONDARY:
-all: $(if $(CONFIG),,$(IRDM) $(SLEPC_PLUGIN)) $(FW_LIB) $(HAL_LIB) $(SIM_LIB) $(if $(FWMAIN_SRC),$(IRDM_FW)) \
+all: $(if $(CONFIG),,$(IRDM) $(SLEPC_PLUGIN)) $(FW_LIB) $(POSIX_LIB) $(HAL_LIB) $(SIM_LIB) $(if $(FWMAIN_SRC),$(IRDM_FW)) \
   $(if $(CDMAIN_SRC),$(IRDM_CD))
 
 $(BUILD)/obj/firmware/%.o: LAYER_INC = $(FW_INC)
-# irdm-fw's main() is the composition root: it alone sees every layer below
-# the tools (it registers the HAL back-ends, the simulator's among them).
-$(BUILD)/obj/firmware/main/%.o: LAYER_INC = $(SIM_INC)
+$(BUILD)/obj/platform/posix/%.o: LAYER_INC = $(POSIX_INC)
+# irdm-fw sees the core, the platform and the HAL; its simulated back-ends'
+# files alone also see the simulator's headers (the loop cannot include them)
+$(BUILD)/obj/apps/irdm-fw/%.o: LAYER_INC = $(FWAPP_INC)
+$(addprefix $(BUILD)/obj/apps/irdm-fw/,fw_backend_sim.o fw_backend_canemu.o fw_user.o): \
+  LAYER_INC = $(SIM_INC)
 # its publisher alone also sees the view's server (tools/view/)
-$(BUILD)/obj/firmware/main/fw_view.o: LAYER_INC = $(SIM_INC) -Itools
+$(BUILD)/obj/apps/irdm-fw/fw_view.o: LAYER_INC = $(FWAPP_INC) -Itools
+$(BUILD)/obj/apps/irdm-candrives/%.o: LAYER_INC = $(SIM_INC)
+$(BUILD)/obj/apps/irdm/%.o: LAYER_INC = $(TOOL_INC)
 $(BUILD)/obj/hal/%.o:      LAYER_INC = $(HAL_INC)
 $(BUILD)/obj/sim/%.o:      LAYER_INC = $(SIM_INC)
 $(BUILD)/obj/tools/%.o:    LAYER_INC = $(TOOL_INC)
 $(BUILD)/obj/tests/%.o:    LAYER_INC = $(TEST_INC)
+$(BUILD)/obj/tests/core/%.o: LAYER_INC = $(CORE_TEST_INC)
+$(BUILD)/obj/tests/apps/irdm-fw/%.o: LAYER_INC = $(SIM_INC) -Iapps/irdm-fw
 
 $(BUILD)/obj/%.o: %.c
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(LAYER_INC) -c $< -o $@
 
 # An empty layer still gets its (empty) archive, so links need no special case.
+# A library also depends on its source folders, so that a file removed
+# from one leaves the archive too.
 $(BUILD)/lib%.a:
 	@mkdir -p $(dir $@)
 	rm -f $@
-	$(AR) rcs $@ $^
+	$(AR) rcs $@ $(filter %.o,$^)
 
-$(FW_LIB):   $(call obj,$(FW_SRC))
-$(HAL_LIB):  $(call obj,$(HAL_SRC))
-$(SIM_LIB):  $(call obj,$(SIM_SRC))
-$(TOOL_LIB): $(call obj,$(TOOL_SRC)) $(BUILD)/obj/gen/view_page.o
+$(FW_LIB):   $(call obj,$(FW_SRC)) $(wildcard firmware/*/)
+$(POSIX_LIB): $(call obj,$(POSIX_SRC)) $(wildcard platform/posix/*/)
+$(HAL_LIB):  $(call obj,$(HAL_SRC)) $(wildcard hal/*/)
+$(SIM_LIB):  $(call obj,$(SIM_SRC)) $(wildcard sim/*/)
+$(TOOL_LIB): $(call obj,$(TOOL_SRC)) $(BUILD)/obj/gen/view_page.o $(wildcard tools/*/)
 
 # The page's files as byte arrays (tools/view/embed.sh)
 $(BUILD)/gen/view_page.c: $(VIEW_PAGE) tools/view/embed.sh
@@ -184,7 +222,7 @@ $(BUILD)/obj/gen/view_page.o: $(BUILD)/gen/view_page.c
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) $(TOOL_INC) -c $< -o $@
 
-$(IRDM): $(call obj,$(CLI_SRC)) $(TOOL_LIB) $(FW_LIB) | $(SLEPC_PLUGIN)
+$(IRDM): $(call obj,$(CLI_SRC)) $(TOOL_LIB) $(POSIX_LIB) $(FW_LIB) | $(SLEPC_PLUGIN)
 	$(CC) $(LDFLAGS) $^ -o $@ $(LDLIBS) $(VIEW_LIBS)
 
 # The slepc plugin: position-independent, only its entry point exported.
@@ -195,28 +233,38 @@ $(BUILD)/obj/tools/dist/plugin/%.o: tools/dist/plugin/%.c
 $(BUILD)/irdm-slepc.so: $(call obj,$(PLUGIN_SRC))
 	$(CC) $(LDFLAGS) -shared $^ -o $@ $(PLUGIN_LIBS)
 
-TEST_LIBS := $(TOOL_LIB) $(SIM_LIB) $(HAL_LIB) $(FW_LIB)
+TEST_LIBS := $(TOOL_LIB) $(SIM_LIB) $(HAL_LIB) $(POSIX_LIB) $(FW_LIB)
 
-# BLAS only for the deformation worker
-$(IRDM_FW): $(call obj,$(FWMAIN_SRC)) $(if $(VIEW),$(VIEW_OBJ)) $(SIM_LIB) $(HAL_LIB) $(FW_LIB)
+# BLAS only for the deformation worker; the simulator only with a simulated back-end
+$(IRDM_FW): $(call obj,$(FWMAIN_SRC)) $(if $(VIEW),$(VIEW_OBJ)) $(if $(FW_SIM),$(SIM_LIB)) \
+  $(HAL_LIB) $(POSIX_LIB) $(FW_LIB)
 	$(CC) $(LDFLAGS) $^ -o $@ $(if $(call feature,DEFORM),-lopenblas) $(if $(VIEW),$(VIEW_LIBS)) \
 	  -lpthread -lm
 
 # The drive emulator: the simulator, the HAL's CAN code, the firmware's arm.
-$(IRDM_CD): $(call obj,$(CDMAIN_SRC)) $(SIM_LIB) $(HAL_LIB) $(FW_LIB)
+$(IRDM_CD): $(call obj,$(CDMAIN_SRC)) $(SIM_LIB) $(HAL_LIB) $(POSIX_LIB) $(FW_LIB)
 	$(CC) $(LDFLAGS) $^ -o $@ -lm
 
-# The force tick alone: the firmware library, libm and cmocka, nothing else.
-$(TICK_TESTS): $(BUILD)/tests/test_tick_%: $(BUILD)/obj/tests/test_tick_%.o $(FW_LIB)
+# The tick's core alone: the core library, libm and cmocka, nothing else.
+$(CORE_TESTS): $(BUILD)/tests/core/%: $(BUILD)/obj/tests/core/%.o $(FW_LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) $^ -o $@ -lcmocka -lm
+
+# irdm-fw's parts: every object of the program but the one with its main()
+FWAPP_MAIN := apps/irdm-fw/irdm_fw.c
+$(FWAPP_TESTS): $(BUILD)/tests/apps/irdm-fw/%: $(BUILD)/obj/tests/apps/irdm-fw/%.o \
+  $(call obj,$(filter-out $(FWAPP_MAIN),$(FWMAIN_SRC))) $(if $(VIEW),$(VIEW_OBJ)) \
+  $(SIM_LIB) $(HAL_LIB) $(POSIX_LIB) $(FW_LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(LDFLAGS) $^ -o $@ $(if $(call feature,DEFORM),-lopenblas) $(if $(VIEW),$(VIEW_LIBS)) \
+	  -lpthread -lm -lcmocka
 
 $(BUILD)/tests/%: $(BUILD)/obj/tests/%.o $(call obj,$(TESTSUP_SRC)) $(TEST_LIBS) | $(SLEPC_PLUGIN)
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) $^ -o $@ $(LDLIBS) -lcmocka
 
-# irdm-fw's signal handlers alone, raised in a child process
-$(BUILD)/tests/test_fw_signals: $(call obj,firmware/main/fw_signals.c)
+# the board table's defaults: every caller in the library gets the test's table
+$(BUILD)/tests/test_board_defaults: LDFLAGS += -Wl,--wrap=irdm_board_options
 
 # the view's test drives its server and decodes the browser's screenshots
 $(BUILD)/tests/test_view: LDLIBS += $(VIEW_LIBS) -lpng
@@ -226,7 +274,7 @@ $(BUILD)/bench/%: $(BUILD)/obj/tests/bench/%.o $(call obj,$(TESTSUP_SRC)) $(TEST
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) $^ -o $@ $(LDLIBS) -lcmocka
 
-# The image the tick-only tests run on (they cannot make one: no tools).
+# The image the core tests run on (they cannot make one: no tools).
 TICK_IMAGE := $(BUILD)/data/tick.img
 $(TICK_IMAGE): $(IRDM)
 	@mkdir -p $(dir $@)
@@ -250,20 +298,21 @@ test-variants: $(STAB_TESTS) $(IRDM) $(TICK_IMAGE)
 
 # The firmware built with the shipped trimmed configurations, beside the
 # full one (test_build_config checks what they leave out and refuse).
-CFG_NAMES := default minimal
+CFG_NAMES := default minimal can
 cfg-fws:
 	$(foreach c,$(CFG_NAMES),$(MAKE) --no-print-directory CONFIG=configs/$(c).config \
 	  BUILD=$(BUILD)/cfg-$(c) all;)
 
-# What each configuration costs: irdm-fw's sections and its libraries
-# (docs/measurements/sizes.md).
+# What each configuration costs: irdm-fw's sections and its libraries (the
+# core's and the platform's; docs/measurements/sizes.md).
 sizes: all cfg-fws
 	$(MEASURE) sizes 'make sizes' -- $(MAKE) --no-print-directory sizes-run
 sizes-run:
 	@size $(IRDM_FW) | head -n 1
 	@for b in $(IRDM_FW) $(foreach c,$(CFG_NAMES),$(BUILD)/cfg-$(c)/irdm-fw); do \
 	  size $$b | tail -n 1; \
-	  echo "  firmware library text: $$(size -t $$(dirname $$b)/libirdmfw.a | tail -n 1 | awk '{print $$1}') bytes"; \
+	  echo "  firmware core library text: $$(size -t $$(dirname $$b)/libirdmfw.a | tail -n 1 | awk '{print $$1}') bytes"; \
+	  echo "  platform library text: $$(size -t $$(dirname $$b)/libirdmposix.a | tail -n 1 | awk '{print $$1}') bytes"; \
 	  echo "  needs: $$(readelf -d $$b | sed -n 's/.*Shared library: \[\(.*\)\]/\1/p' | tr '\n' ' ')"; \
 	done
 
@@ -271,9 +320,10 @@ sizes-run:
 # it into the directory $(1).  A new one: add its name and its gen-doc- line.
 # Whole files come from a --help-markdown; a block inside a hand-written
 # page is spliced between its markers (tools/scripts/splice-doc.sh).
-GEN_DOCS := scene-format.md boards.md testing.md
+GEN_DOCS := scene-format.md boards.md hal-options.md testing.md
 gen-doc-scene-format.md = $(IRDM) precompute --help-markdown > $(1)/scene-format.md
-gen-doc-boards.md = $(IRDM_FW) --help-board-markdown | \
+gen-doc-hal-options.md = $(IRDM_FW) --doc hal-options > $(1)/hal-options.md
+gen-doc-boards.md = $(IRDM_FW) --doc boards | \
   tools/scripts/splice-doc.sh docs/boards.md 'board keys' > $(1)/boards.md
 gen-doc-testing.md = tools/scripts/test-index.sh tests | \
   tools/scripts/splice-doc.sh docs/testing.md 'test index' > $(1)/testing.md
@@ -297,6 +347,17 @@ docs-check: $(GEN_DOCS_TOOLS)
 	if [ -n "$$stale" ]; then echo "docs-check: stale:$$stale (run make docs)"; exit 1; fi; \
 	echo "docs-check: $(GEN_DOCS) current"
 
+# The style (.clang-format, clang-format 14: other versions lay some lines
+# out differently).  Every C source and header but the build trees and the
+# generated ones (crc32c.c's tables).
+CLANG_FORMAT ?= $(or $(shell command -v clang-format-14 2>/dev/null),clang-format)
+FORMAT_SRC = $(filter-out %/crc32c.c,$(shell find . \( -type d \( -name 'build*' -o -name out \
+  -o -name .git \) \) -prune -o \( -name '*.c' -o -name '*.h' \) -print | sed 's|^\./||' | sort))
+format-check:
+	$(CLANG_FORMAT) --dry-run -Werror $(FORMAT_SRC)
+format:
+	$(CLANG_FORMAT) -i $(FORMAT_SRC)
+
 san:
 	$(MAKE) BUILD=build-san SAN=1 OPT="-O1 -g" IRDM_SOAK_SECONDS=10 IRDM_TORUS=small test
 
@@ -309,14 +370,14 @@ FUZZ_CFLAGS := -O1 -g -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-
 fuzz:
 	$(MAKE) CC=clang BUILD=$(FUZZ_BUILD) OPT="$(FUZZ_CFLAGS)" \
 	  $(FUZZ_BUILD)/libirdmtools.a $(FUZZ_BUILD)/libirdmsim.a $(FUZZ_BUILD)/libirdmhal.a \
-	  $(FUZZ_BUILD)/libirdmfw.a
+	  $(FUZZ_BUILD)/libirdmposix.a $(FUZZ_BUILD)/libirdmfw.a
 	mkdir -p $(FUZZ_BUILD)/findings
 	for f in $(FUZZ_SRC); do \
 	  n=$$(basename $$f .c); \
-	  clang $(CSTD) $(WARN) -O1 -g $(TOOL_INC) -Ihal/include -Isim/include \
+	  clang $(CSTD) $(WARN) -O1 -g $(TEST_INC) \
 	    -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all $$f \
 	    $(FUZZ_BUILD)/libirdmtools.a $(FUZZ_BUILD)/libirdmsim.a $(FUZZ_BUILD)/libirdmhal.a \
-	    $(FUZZ_BUILD)/libirdmfw.a -o $(FUZZ_BUILD)/$$n $(LDLIBS); \
+	    $(FUZZ_BUILD)/libirdmposix.a $(FUZZ_BUILD)/libirdmfw.a -o $(FUZZ_BUILD)/$$n $(LDLIBS); \
 	  mkdir -p $(FUZZ_BUILD)/corpus/$$n; \
 	  seeds=tests/fuzz/seeds/$$n; [ -d $$seeds ] || seeds=; \
 	  echo "fuzz: $$n for $(FUZZ_SECONDS) s"; \

@@ -1,8 +1,8 @@
 /* SPDX-License-Identifier: MIT */
 /*
  * Build configurations (docs/build-config.md): make test builds irdm-fw
- * with configs/default.config and configs/minimal.config beside the full
- * build.  For each, against what its config file says:
+ * with configs/default.config, configs/minimal.config and configs/can.config
+ * beside the full build.  For each, against what its config file says:
  *  - the features it leaves out are not in the binary (nm: the entry point
  *    of each feature's file), the ones it keeps are;
  *  - it refuses an image or board needing a feature it lacks, at set-up,
@@ -10,7 +10,11 @@
  *    without the deformed surface;
  *  - what it runs, it runs as the full build does: the same press on the
  *    same image and board gives a byte-identical log;
- *  - trimming shrinks it: text full > default > minimal.
+ *  - the HAL back-ends it leaves out are not registered, and without a
+ *    simulated one (sim, canemu) the simulator is not linked at all (nm:
+ *    no irdm_sim_ symbol); a board naming a left-out back-end is refused,
+ *    exit 3, one line naming the board's line and the CONFIG_ switch;
+ *  - trimming shrinks it: text full > default > minimal > can.
  * And irdm image config writes the configuration an image and board need;
  * make refuses a malformed config.
  * Needs IRDM, IRDM_FW and IRDM_BUILD (make test sets them).
@@ -28,14 +32,18 @@
 #include "support/run_prog.h"
 #include "support/test_files.h"
 
-enum { FULL, DEFAULT, MINIMAL, N_BUILDS };
-enum { MODAL, FIR, FLOATING, DEFORM, N_FEATURES };
+enum { FULL, DEFAULT, MINIMAL, CAN, N_BUILDS };
+enum { MODAL, FIR, FLOATING, DEFORM, HAL_SIM, HAL_CANEMU, HAL_SOCKETCAN, N_FEATURES };
 
-static const char *const build_name[N_BUILDS] = { "full", "default", "minimal" };
-static const char *const feature_name[N_FEATURES] = { "MODAL", "FIR", "FLOATING", "DEFORM" };
-/* one function each feature's files define and the tick or set-up calls */
+static const char *const build_name[N_BUILDS] = { "full", "default", "minimal", "can" };
+static const char *const feature_name[N_FEATURES] = {
+	"MODAL", "FIR", "FLOATING", "DEFORM", "HAL_SIM", "HAL_CANEMU", "HAL_SOCKETCAN",
+};
+/* one function each feature's files define and the tick or set-up calls;
+ * a back-end's: its ops table, which only its registration reaches */
 static const char *const feature_symbol[N_FEATURES] = {
 	"irdm_modal_apply", "irdm_fir_apply", "irdm_rigid_step", "irdm_deform_update",
+	"irdm_hal_sim_backend", "irdm_hal_canemu_backend", "irdm_hal_socketcan_backend",
 };
 
 static char dir[256], fw[N_BUILDS][320], out[16384], err[4096];
@@ -71,23 +79,24 @@ static int sh(const char *cmd)
 
 static void test_left_out_features_are_absent(void **state)
 {
-	char cmd[1024];
+	char cmd[2048];
 
 	(void)state;
-	/* in the binary, and in its firmware library (left out of the build,
-	 * not merely unlinked) */
+	/* in the binary, and in its libraries, core and platform (left out of
+	 * the build, not merely unlinked) */
 	for (int b = 0; b < N_BUILDS; b++)
-		for (int f = 0; f < N_FEATURES; f++)
+		for (int f = 0; f < HAL_SIM; f++)
 			for (int lib = 0; lib < 2; lib++) {
 				snprintf(cmd, sizeof(cmd), "nm %s | grep -c ' T %s$' || true", fw[b],
 					 feature_symbol[f]);
 				if (lib)
-					snprintf(cmd, sizeof(cmd), "nm $(dirname %s)/libirdmfw.a | "
-						 "grep -c ' T %s$' || true", fw[b], feature_symbol[f]);
+					snprintf(cmd, sizeof(cmd), "d=$(dirname %s); nm $d/libirdmfw.a "
+						 "$d/libirdmposix.a | grep -c ' T %s$' || true", fw[b],
+						 feature_symbol[f]);
 				assert_int_equal(sh(cmd), 0);
 				if ((atoi(out) == 1) != on[b][f])
 					fail_msg("%s build's %s: %s (%s) is %s", build_name[b],
-						 lib ? "libirdmfw.a" : "irdm-fw", feature_name[f],
+						 lib ? "libirdmfw.a + libirdmposix.a" : "irdm-fw", feature_name[f],
 						 feature_symbol[f], on[b][f] ? "missing" : "still there");
 			}
 	/* BLAS only with the deformed surface */
@@ -96,6 +105,41 @@ static void test_left_out_features_are_absent(void **state)
 		assert_int_equal(sh(cmd), 0);
 		assert_int_equal(atoi(out) > 0, on[b][DEFORM]);
 	}
+}
+
+/* How many symbols of nm's listing of irdm-fw of build b match the regex. */
+static int nm_count(int b, const char *regex)
+{
+	char cmd[2048];
+
+	snprintf(cmd, sizeof(cmd), "nm %s | grep -c '%s' || true", fw[b], regex);
+	assert_int_equal(sh(cmd), 0);
+	return atoi(out);
+}
+
+static void test_left_out_backends_are_absent(void **state)
+{
+	char regex[128];
+
+	(void)state;
+	for (int b = 0; b < N_BUILDS; b++) {
+		bool simulated = on[b][HAL_SIM] || on[b][HAL_CANEMU];
+		int n_sim;
+
+		for (int f = HAL_SIM; f < N_FEATURES; f++) {
+			snprintf(regex, sizeof(regex), " [RrDd] %s$", feature_symbol[f]);
+			if ((nm_count(b, regex) == 1) != on[b][f])
+				fail_msg("%s build: %s (%s) is %s", build_name[b], feature_name[f],
+					 feature_symbol[f], on[b][f] ? "missing" : "still there");
+		}
+		/* the simulator whole: the arm, the user, the drive emulator */
+		n_sim = nm_count(b, " irdm_sim_");
+		print_message("%s build: %d irdm_sim_ symbols\n", build_name[b], n_sim);
+		if ((n_sim > 0) != simulated)
+			fail_msg("%s build: %d irdm_sim_ symbols %s a simulated back-end",
+				 build_name[b], n_sim, simulated ? "with" : "without");
+	}
+	assert_false(on[CAN][HAL_SIM] || on[CAN][HAL_CANEMU]);
 }
 
 static void expect_refusal(int b, const char *board, const char *image, const char *needle)
@@ -118,6 +162,13 @@ static void test_refuses_what_it_lacks(void **state)
 		       "the image holds a floating object; this build has CONFIG_IRDM_FLOATING off");
 	expect_refusal(MINIMAL, "boards/sim-phantom.board", img_modal,
 		       "this build has CONFIG_IRDM_DEFORM off");
+	/* a board on a back-end the build left out, by its line */
+	expect_refusal(CAN, "boards/sim-phantom.board", img_modal,
+		       "boards/sim-phantom.board:15: hal = sim: not built in this irdm-fw "
+		       "(CONFIG_IRDM_HAL_SIM)");
+	expect_refusal(CAN, "boards/canemu-3dof.board", img_modal,
+		       "boards/canemu-3dof.board:20: hal = canemu: not built in this irdm-fw "
+		       "(CONFIG_IRDM_HAL_CANEMU)");
 	/* and runs what it has */
 	assert_int_equal(rp_run(dir, fw[MINIMAL], (const char *const[]){ "--board", board_nodeform,
 			 "--image", img_modal, "--clock", "virtual", "--duration", "0.5", "-q", NULL },
@@ -165,9 +216,9 @@ static void test_trimming_shrinks(void **state)
 	(void)state;
 	for (int b = 0; b < N_BUILDS; b++)
 		t[b] = text_size(fw[b]);
-	print_message("irdm-fw text: full %ld, default %ld, minimal %ld bytes\n", t[FULL],
-		      t[DEFAULT], t[MINIMAL]);
-	assert_true(t[FULL] > t[DEFAULT] && t[DEFAULT] > t[MINIMAL]);
+	print_message("irdm-fw text: full %ld, default %ld, minimal %ld, can %ld bytes\n", t[FULL],
+		      t[DEFAULT], t[MINIMAL], t[CAN]);
+	assert_true(t[FULL] > t[DEFAULT] && t[DEFAULT] > t[MINIMAL] && t[MINIMAL] > t[CAN]);
 }
 
 static void expect_config(const char *image, const char *board, const char *want)
@@ -205,6 +256,11 @@ static void test_image_config_and_bad_configs(void **state)
 			   "CONFIG_IRDM_DEFORM=n\n");
 	assert_int_not_equal(sh(cmd), 0);
 	assert_non_null(strstr(err, "the engine needs one"));
+	/* a back-end's switch may be left unsaid (built), not misspelt */
+	tf_write_text(bad, "CONFIG_IRDM_MODAL=y\nCONFIG_IRDM_FIR=n\nCONFIG_IRDM_FLOATING=n\n"
+			   "CONFIG_IRDM_DEFORM=n\nCONFIG_IRDM_HAL_SIM=no\n");
+	assert_int_not_equal(sh(cmd), 0);
+	assert_non_null(strstr(err, "CONFIG_IRDM_HAL_SIM must be y or n, got 'no'"));
 }
 
 static void precompute(char *path, const char *name, const char *const *args)
@@ -268,6 +324,7 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_left_out_features_are_absent),
+		cmocka_unit_test(test_left_out_backends_are_absent),
 		cmocka_unit_test(test_refuses_what_it_lacks),
 		cmocka_unit_test(test_same_run_as_the_full_build),
 		cmocka_unit_test(test_trimming_shrinks),

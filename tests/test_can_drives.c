@@ -19,8 +19,8 @@
 
 #include <cmocka.h>
 
-#include "irdm/can_drives.h"
-#include "irdm/can_membus.h"
+#include "irdm/sim/can_drives.h"
+#include "irdm/sim/can_membus.h"
 
 #include "support/can_drain.h"
 

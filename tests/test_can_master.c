@@ -23,9 +23,9 @@
 
 #include <cmocka.h>
 
-#include "irdm/can_drives.h"
-#include "irdm/can_master.h"
-#include "irdm/can_membus.h"
+#include "irdm/sim/can_drives.h"
+#include "irdm/hal/can_master.h"
+#include "irdm/sim/can_membus.h"
 #include "irdm/error.h"
 
 #include "support/strict_mode.h"

@@ -15,8 +15,8 @@
 
 #include <cmocka.h>
 
-#include "irdm/canopen.h"
-#include "irdm/cia402.h"
+#include "irdm/hal/canopen.h"
+#include "irdm/hal/cia402.h"
 
 /* The frame, its listed bytes and zeros after them. */
 #define EXPECT(f, id, dlc, ...) \

@@ -28,6 +28,7 @@
 #include "support/image_fixture.h"
 #include "support/model_fixture.h"
 #include "support/test_files.h"
+#include "irdm/posix/image_map.h"
 
 extern char **environ;
 

@@ -23,6 +23,7 @@
 #include "image/image_writer.h"
 #include "irdm/contact.h"
 #include "irdm/image.h"
+#include "irdm/posix/image_map.h"
 #include "irdm/vec3.h"
 #include "precompute/precompute.h"
 #include "support/image_fixture.h"

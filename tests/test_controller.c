@@ -33,8 +33,11 @@
 
 #include "support/tick_image.h"
 
+#include "irdm/board.h"
 #include "irdm/controller.h"
-#include "irdm/sim_device.h"
+#include "irdm/posix/image_map.h"
+#include "irdm/posix/session.h"
+#include "irdm/sim/sim_device.h"
 #include "irdm/vec3.h"
 #include "support/alloc_count.h"
 #include "support/device_ik.h"
@@ -230,6 +233,28 @@ static void press(struct rig *r, unsigned i, double dx, double depth_m, int n)
 
 /* ---- configuration ---- */
 
+/*
+ * The controller's defaults are a default board's: the arm, its force
+ * limit, the tip speed, overrun count, watchdog and period a board file
+ * that leaves those keys out gives irdm-fw.
+ */
+static void test_defaults_are_the_board_defaults(void **state)
+{
+	struct irdm_ctrl_config c;
+	struct irdm_board b;
+	(void)state;
+
+	irdm_board_default(&b);
+	irdm_ctrl_config_default(&c);
+	assert_memory_equal(&c.device[0].dev, &b.device, sizeof(b.device));
+	assert_true(c.limits.max_force_n == b.device.max_force_n);
+	assert_true(c.limits.max_tip_speed_m_per_s == b.max_tip_speed_m_per_s);
+	assert_int_equal(c.limits.overrun_fault_count, b.overrun_fault_count);
+	assert_int_equal(c.limits.watchdog_us, b.watchdog_us);
+	assert_int_equal(c.period_us, b.period_us);
+	assert_true(c.engine.max_force_n == IRDM_CTRL_ENGINE_FORCE_GUARD * b.device.max_force_n);
+}
+
 static void test_config_errors(void **state)
 {
 	struct irdm_ctrl_config c;
@@ -342,6 +367,12 @@ static void test_transitions_through_the_tick(void **state)
 
 /* ---- safety cases: each ends with zero torque within one tick ---- */
 
+/* The tip speed limit, m/s. */
+static void slow_limit(struct irdm_ctrl_config *cfg, double v)
+{
+	cfg->limits.max_tip_speed_m_per_s = v;
+}
+
 /* Enabled, device 0 pressed 1.5 mm into the top face for 100 ticks. */
 static void contact_rig(struct rig *r, void (*tweak)(struct irdm_ctrl_config *, double), double v)
 {
@@ -452,7 +483,8 @@ static void test_enable_inside_fades_in(void **state)
 	double held, f_prev = 0, max_step = 0;
 	(void)state;
 
-	contact_rig(&r, NULL, 0);
+	/* at 1 m/s a period's travel is 1 mm: 1.5 mm deep cannot come from outside */
+	contact_rig(&r, slow_limit, 1.0);
 	for (int k = 0; k < 2000; k++)          /* settle: the held force */
 		assert_int_equal(tick(&r), IRDM_OK);
 	held = irdm_v3_norm(r.out.dev[0].force_obj_n);
@@ -599,11 +631,6 @@ static void test_workspace(void **state)
 	assert_true(k < 400);
 	assert_faulted(&r, IRDM_FAULT_WORKSPACE);
 	rig_close(&r);
-}
-
-static void slow_limit(struct irdm_ctrl_config *cfg, double v)
-{
-	cfg->limits.max_tip_speed_m_per_s = v;
 }
 
 /*
@@ -1385,6 +1412,7 @@ static int remove_images(void **state)
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_defaults_are_the_board_defaults),
 		cmocka_unit_test(test_config_errors),
 		cmocka_unit_test(test_transitions_through_the_tick),
 		cmocka_unit_test(test_signal_mid_contact),

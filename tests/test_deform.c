@@ -32,7 +32,9 @@
 #include <cmocka.h>
 
 #include "image/image_response.h"
-#include "irdm/deform_worker.h"
+#include "irdm/posix/deform_worker.h"
+#include "irdm/posix/image_map.h"
+#include "irdm/posix/session.h"
 #include "irdm/session.h"
 #include "precompute/precompute.h"
 

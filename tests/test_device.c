@@ -418,6 +418,29 @@ static void test_encoder_rejects(void **state)
 
 /* ---- defaults ------------------------------------------------------------- */
 
+/*
+ * The default count range is written as numbers (irdm/device.h); it is the
+ * counts whose cells hold the joint ranges -0.42..0.42, -0.40..0.40 and
+ * -0.35..0.45 rad, derived here as the encoder formula floors an angle.
+ */
+static void test_default_count_range(void **state)
+{
+	static const double lo_rad[3] = { -0.42, -0.40, -0.35 };
+	static const double hi_rad[3] = { 0.42, 0.40, 0.45 };
+	struct irdm_device_config c;
+	(void)state;
+
+	irdm_device_config_default(&c);
+	for (int i = 0; i < 3; i++) {
+		double per = 2 * M_PI / (c.counts_per_rev[i] * c.gear_ratio[i]);
+		double a = floor(c.sign[i] * (lo_rad[i] - c.angle_offset_rad[i]) / per);
+		double b = floor(c.sign[i] * (hi_rad[i] - c.angle_offset_rad[i]) / per);
+
+		assert_int_equal(c.count_min[i], (int32_t)fmin(a, b));
+		assert_int_equal(c.count_max[i], (int32_t)fmax(a, b));
+	}
+}
+
 static void test_defaults_desktop_like(void **state)
 {
 	struct irdm_device_config c;
@@ -503,6 +526,7 @@ int main(void)
 		cmocka_unit_test(test_encoder_values),
 		cmocka_unit_test(test_encoder_round_trips),
 		cmocka_unit_test(test_encoder_rejects),
+		cmocka_unit_test(test_default_count_range),
 		cmocka_unit_test(test_defaults_desktop_like),
 		cmocka_unit_test(test_config_check_rejects),
 	};

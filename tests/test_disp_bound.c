@@ -18,6 +18,7 @@
 #include <cmocka.h>
 
 #include "support/engine_fixture.h"
+#include "irdm/posix/image_map.h"
 
 #define N_TICKS 2000
 #define PUSH_END 700

@@ -25,6 +25,7 @@
 #include "image/image_response.h"
 #include "replay/replay.h"
 #include "support/engine_fixture.h"
+#include "irdm/posix/image_map.h"
 
 static char dir[64];
 /* modal:all f64; modal:40 + static corr, f32, compressed hard enough to

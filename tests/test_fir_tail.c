@@ -27,6 +27,7 @@
 
 #include "image/image_response.h"
 #include "support/engine_fixture.h"
+#include "irdm/posix/image_map.h"
 
 #define T_HEAD 500              /* the paper's T */
 #define L_TAIL 1000             /* fir_tail = window:1000 */

@@ -24,6 +24,7 @@
 
 #include "image/image_response.h"
 #include "support/engine_fixture.h"
+#include "irdm/posix/image_map.h"
 
 static char dir[64];
 static struct irdm_image cube;

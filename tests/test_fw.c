@@ -13,7 +13,7 @@
  *    mid-contact: torque off and state off in the next tick, the reason
  *    logged, exit 6; SIGXFSZ ignored; SIGSEGV, SIGSYS: the emergency path,
  *    exit 8; signals pending at start: the run ends in the set-up, exit 6,
- *    no drive enabled, no escalation (tests/test_fw_signals.c has every
+ *    no drive enabled, no escalation (tests/apps/irdm-fw/test_fw_signals.c has every
  *    signal, and the escalation, in detail);
  *  - the image file truncated or written over under a running loop: the
  *    run goes on to its end on its own copy;
@@ -21,7 +21,7 @@
  *  - --frame-at: the deformed surface in VTK, checked physically (a dent
  *    at the pressed top centre, a still bottom) and byte-identical in
  *    virtual time;
- *  - --help-board-markdown prints the board key table (what make docs
+ *  - --doc boards prints the board key table (what make docs
  *    splices into docs/boards.md), exit 0, and runs nothing.
  * Needs IRDM and IRDM_FW (make test sets them); runs from the repository root.
  */
@@ -46,8 +46,10 @@
 
 #include "irdm/board.h"
 #include "irdm/image.h"
-#include "irdm/options_doc.h"
-#include "irdm/outdir.h"
+#include "irdm/posix/image_map.h"
+#include "irdm/posix/options_doc.h"
+#include "irdm/posix/outdir.h"
+#include "irdm/posix/telemetry_log.h"
 #include "irdm/vec3.h"
 #include "irdm/safety.h"
 #include "irdm/telemetry.h"
@@ -119,10 +121,46 @@ static const char *board_with(const char *name, const char *key, const char *val
 }
 
 /*
- * Each refusal names the thing, the place and the reason: the back-end's
- * reason with the board's name, a value no device has at its line, a
- * --user board whose back-end does not exist, a frame period shorter than
- * the deformation's before the run, and --help hinted once.
+ * docs/hal-options.md is what `irdm-fw --doc hal-options` writes from the
+ * back-ends' option tables, the key table of docs/boards.md what
+ * `--doc boards` writes; --help-board lists the board keys and every
+ * back-end's options with their defaults.
+ */
+static void test_generated_docs_current(void **state)
+{
+	static char doc[16384];
+	static const char begin[] = "<!-- begin board keys -->\n";
+	char *a, *b;
+
+	(void)state;
+	tf_read_text("docs/hal-options.md", doc, sizeof(doc));
+	assert_int_equal(run_fw((const char *const[]){ "--doc", "hal-options", NULL }), 0);
+	if (strcmp(out_text, doc))
+		fail_msg("docs/hal-options.md is not what `irdm-fw --doc hal-options` writes");
+	tf_read_text("docs/boards.md", doc, sizeof(doc));
+	a = strstr(doc, begin);
+	b = a ? strstr(a, "<!-- end board keys -->") : NULL;
+	assert_non_null(b);
+	*b = 0;
+	assert_int_equal(run_fw((const char *const[]){ "--doc", "boards", NULL }), 0);
+	if (strcmp(out_text, a + strlen(begin)))
+		fail_msg("docs/boards.md's key table is not what `irdm-fw --doc boards` writes");
+	assert_int_equal(run_fw((const char *const[]){ "--help-board", NULL }), 0);
+	assert_non_null(strstr(out_text, "  watchdog_us = N           one tick longer than this "
+				   "faults; > period_us\n                            "
+				   "(default 5000); 1 <= watchdog_us <= 1000000 us\n"));
+	assert_non_null(strstr(out_text, "hal_options of hal = sim (key=value words; "
+				   "docs/hal-options.md):\n  write_delay = K"));
+	assert_non_null(strstr(out_text, "hal_options of hal = canemu"));
+	assert_non_null(strstr(out_text, "hal_options of hal = socketcan"));
+}
+
+/*
+ * Each refusal names the thing, the place and the reason: a hal_options
+ * word the back-end's option table refuses, at the board's line, a value
+ * no device has at its line, a --user board whose back-end does not exist
+ * or has no simulated arm, a frame period shorter than the deformation's
+ * before the run, and --help hinted once.
  */
 static void test_clear_messages(void **state)
 {
@@ -132,11 +170,12 @@ static void test_clear_messages(void **state)
 	b = board_with("opts.board", "hal_options", "write_delay=0,frobnicate=3");
 	expect_error(run_fw((const char *const[]){ "--board", b, "--image", image, "--clock",
 						   "virtual", NULL }),
-		     4, "opts.board: hal 'sim': hal_options 'frobnicate=3': unknown");
+		     4, "opts.board:16: hal_options: unknown sim option 'frobnicate' "
+			"(see docs/hal-options.md)\n");
 	b = board_with("delay.board", "hal_options", "write_delay=999");
 	expect_error(run_fw((const char *const[]){ "--board", b, "--image", image, "--clock",
 						   "virtual", NULL }),
-		     4, "delay.board: hal 'sim': hal_options 'write_delay=999': out of range");
+		     4, "delay.board:16: hal_options: write_delay = 999: must be <= 16\n");
 	b = board_with("gear.board", "gear_ratio", "1e-300,1e-300,1e-300");
 	expect_error(run_fw((const char *const[]){ "--board", b, "--image", image, "--clock",
 						   "virtual", NULL }),
@@ -149,6 +188,12 @@ static void test_clear_messages(void **state)
 	expect_error(run_fw((const char *const[]){ "--board", b, "--image", image, "--user",
 						   PRESS, "--clock", "virtual", NULL }),
 		     3, "nohal.board: hal 'teleport': no such back-end in this build");
+	/* a back-end without a simulated arm has nothing for a hand to push */
+	expect_error(run_fw((const char *const[]){ "--board", "boards/can-3dof.board", "--image",
+						   image, "--user", PRESS, "--clock", "virtual",
+						   NULL }),
+		     3, "--user " PRESS ": a virtual user needs a back-end with a simulated arm, "
+			"and boards/can-3dof.board's hal 'socketcan' has none (hal = sim or canemu)");
 	expect_error(run_fw((const char *const[]){ "--board", BOARD, "--image", image, "--clock",
 						   "virtual", "--frames-every", "0.001", "--frames-out",
 						   "/nonexistent/never", NULL }),
@@ -160,24 +205,6 @@ static void test_clear_messages(void **state)
 
 /* The board keys, not irdm-fw's own options, and nothing else: no board or
  * image is needed, none is read. */
-static void test_help_board_markdown(void **state)
-{
-	char *table = NULL;
-	size_t len = 0;
-	FILE *f;
-
-	(void)state;
-	assert_int_equal(run_fw((const char *const[]){ "--help-board-markdown", NULL }), 0);
-	assert_string_equal(err_text, "");
-	f = open_memstream(&table, &len);
-	assert_non_null(f);
-	irdm_opt_print_markdown(f, irdm_board_options());
-	fclose(f);
-	assert_true(len > 1000 && len < sizeof(out_text));
-	assert_string_equal(out_text, table);
-	assert_non_null(strstr(out_text, "| `hal_options` |"));
-	free(table);
-}
 
 static void test_bad_input(void **state)
 {
@@ -1129,7 +1156,6 @@ static int teardown(void **state)
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
-		cmocka_unit_test(test_help_board_markdown),
 		cmocka_unit_test(test_bad_input),
 		cmocka_unit_test(test_virtual_runs_are_identical),
 		cmocka_unit_test(test_release_ringing_is_the_dominant_mode),
@@ -1151,6 +1177,7 @@ int main(void)
 		cmocka_unit_test(test_frame_at_writes_the_deformed_surface),
 		cmocka_unit_test(test_frames_series),
 		cmocka_unit_test(test_log_write_failure),
+		cmocka_unit_test(test_generated_docs_current),
 		cmocka_unit_test(test_clear_messages),
 		cmocka_unit_test(test_memory_bounded),
 		cmocka_unit_test(test_frame_at_in_real_time),

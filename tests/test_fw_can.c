@@ -41,6 +41,7 @@
 
 #include <cmocka.h>
 
+#include "irdm/posix/telemetry_log.h"
 #include "irdm/safety.h"
 #include "irdm/telemetry.h"
 #include "support/run_prog.h"
@@ -185,10 +186,10 @@ static void test_bad_options_one_line(void **state)
 		"--board", board, "--image", image, "--clock", "virtual", "--duration", "0.1",
 		"-q", NULL });
 	assert_int_not_equal(rc, 0);
-	/* one line: the board it is in, the back-end, the option, the reason */
+	/* one line: the board file and line, the option, the reason */
 	assert_true(!strncmp(err_text, "irdm-fw: EINVAL: ", 17));
-	assert_non_null(strstr(err_text, "bad.board: hal 'canemu': hal_options "
-				   "rated_torque_xxx: unknown option for this back-end\n"));
+	assert_non_null(strstr(err_text, "bad.board:22: hal_options: unknown canemu option "
+				   "'rated_torque_xxx' (see docs/hal-options.md)\n"));
 	assert_ptr_equal(strchr(err_text, '\n'), err_text + strlen(err_text) - 1);
 }
 

@@ -45,6 +45,8 @@
 
 #include "irdm/board.h"
 #include "irdm/engine.h"
+#include "irdm/posix/board_file.h"
+#include "irdm/posix/telemetry_log.h"
 #include "irdm/safety.h"
 #include "irdm/telemetry.h"
 #include "support/run_prog.h"

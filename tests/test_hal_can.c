@@ -16,6 +16,7 @@
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <string.h>
 #include <sys/syscall.h>
 #include <sys/wait.h>
@@ -24,12 +25,14 @@
 #include <cmocka.h>
 
 #include "irdm/error.h"
-#include "irdm/hal_can.h"
-#include "irdm/hal_canemu.h"
-#include "irdm/hal_socketcan.h"
+#include "irdm/hal/hal_can.h"
+#include "irdm/sim/hal_canemu.h"
+#include "irdm/sim/hal_sim.h"
+#include "irdm/hal/hal_socketcan.h"
 
 #include "support/alloc_count.h"
 #include "support/strict_mode.h"
+#include "support/test_files.h"
 
 #define OPTS "nodes=1,2,3 rated_torque_mnm=100 heartbeat_ms=10 heartbeat_timeout_ms=50 " \
 	     "tpdo_missing_periods=3 sync_counter=yes"
@@ -70,32 +73,93 @@ static int open_as(const char *backend, const char *options)
 	return rc;
 }
 
+/*
+ * Each back-end's check_options, as irdm-fw calls it before opening: the
+ * message names the board file and line it is given, the key and the
+ * reason, exactly; docs/hal-options.md shows three of them as they are.
+ */
+static void test_check_options_name_the_line(void **state)
+{
+	static const struct {
+		const struct irdm_hal_backend *be;
+		const char *options, *why;
+		bool in_doc;
+	} cases[] = {
+		{ &irdm_hal_sim_backend, "write_delay=999",
+		  "boards/x.board:16: hal_options: write_delay = 999: must be <= 16", true },
+		{ &irdm_hal_sim_backend, "substeps=10,delay=1",
+		  "boards/x.board:16: hal_options: unknown sim option 'delay' "
+		  "(see docs/hal-options.md)", true },
+		{ &irdm_hal_sim_backend, "end_stops",
+		  "boards/x.board:16: hal_options: 'end_stops': expected key=value", false },
+		{ &irdm_hal_canemu_backend, "rated_torque_mnm=100",
+		  "boards/x.board:22: hal_options: nodes: missing (one node id per joint, "
+		  "e.g. nodes=1,2,3)", true },
+		{ &irdm_hal_canemu_backend, "nodes=1,2,3 rated_torque_mnm=100 emcy_at=4:10",
+		  "boards/x.board:22: hal_options: emcy_at = 4:10: expected DRIVE:MS, drive 1..3, "
+		  "0..3600000 ms", false },
+		{ &irdm_hal_socketcan_backend, "iface=can0 nodes=1,2,3 rated_torque_mnm=100 bitrate=5",
+		  "boards/x.board:23: hal_options: bitrate = 5: must be >= 10000 bit/s", false },
+		{ &irdm_hal_socketcan_backend, "iface=can0 nodes=1,2,3 rated_torque_mnm=100 substeps=2",
+		  "boards/x.board:23: hal_options: unknown socketcan option 'substeps' "
+		  "(see docs/hal-options.md)", false },
+		{ &irdm_hal_socketcan_backend, "nodes=1,2,3 rated_torque_mnm=100",
+		  "boards/x.board:23: hal_options: iface: missing (the CAN interface, e.g. "
+		  "iface=can0)", false },
+	};
+	static char doc[16384];
+	char err[256], where[64];
+	(void)state;
+
+	tf_read_text("docs/hal-options.md", doc, sizeof(doc));
+	for (size_t i = 0; i < sizeof(cases) / sizeof(cases[0]); i++) {
+		const struct irdm_hal_backend *be = cases[i].be;
+
+		snprintf(where, sizeof(where), "boards/x.board:%s: hal_options",
+			 be == &irdm_hal_sim_backend ? "16" : be == &irdm_hal_canemu_backend ? "22"
+											   : "23");
+		assert_non_null(be->check_options);
+		assert_int_equal(be->check_options(cases[i].options, where, err, sizeof(err)),
+				 IRDM_EINVAL);
+		assert_string_equal(err, cases[i].why);
+		if (cases[i].in_doc && !strstr(doc, cases[i].why))
+			fail_msg("docs/hal-options.md does not show '%s'", cases[i].why);
+	}
+	/* the shipped boards' options pass */
+	assert_int_equal(irdm_hal_sim_backend.check_options("write_delay=0,read_delay=0,substeps=10",
+							    "s", err, sizeof(err)), IRDM_OK);
+	assert_int_equal(irdm_hal_canemu_backend.check_options(OPTS, "c", err, sizeof(err)),
+			 IRDM_OK);
+}
+
 static void test_options_refused_by_name(void **state)
 {
 	static const struct {
 		const char *options, *why;
 	} cases[] = {
-		{ "nodes=1,2,3", "hal_options rated_torque_mnm: missing (the drives' rated torque)" },
-		{ "rated_torque_mnm=100", "hal_options nodes: missing (one node id per joint, e.g. "
+		{ "nodes=1,2,3", "hal_options: rated_torque_mnm: missing (the drives' rated torque)" },
+		{ "rated_torque_mnm=100", "hal_options: nodes: missing (one node id per joint, e.g. "
 					  "nodes=1,2,3)" },
-		{ "nodes=1,2 rated_torque_mnm=100", "hal_options nodes: 2 node(s) given, the arm has 3 joints" },
-		{ "nodes=1,2,300 rated_torque_mnm=100", "hal_options nodes: expected 1 to 3 node ids "
-							"1..127, e.g. 1,2,3" },
-		{ "nodes=1,2,3, rated_torque_mnm=100", "hal_options nodes: expected 1 to 3 node ids "
-						       "1..127, e.g. 1,2,3" },
-		{ OPTS " bitrate=2000000", "hal_options bitrate: 10000..1000000 bit/s" },
+		{ "nodes=1,2 rated_torque_mnm=100",
+		  "hal_options: nodes: 2 node(s) given, the arm has 3 joints" },
+		{ "nodes=1,2,300 rated_torque_mnm=100",
+		  "hal_options: nodes = 1,2,300: expected 1 to 3 node ids 1..127, e.g. 1,2,3" },
+		{ "nodes=1,2,3, rated_torque_mnm=100",
+		  "hal_options: nodes = 1,2,3,: expected 1 to 3 node ids 1..127, e.g. 1,2,3" },
+		{ OPTS " bitrate=2000000", "hal_options: bitrate = 2000000: must be <= 1000000 bit/s" },
 		{ OPTS " bitrate=500000", "bitrate: one cycle needs 695 bits worst case, 1000 us at "
 					  "500000 bit/s carries 500" },
-		{ OPTS " sync_counter=maybe", "hal_options sync_counter: expected yes or no" },
-		{ OPTS " iface=can0", "hal_options iface: unknown option for this back-end" },
-		{ OPTS " speed", "hal_options speed: expected key=value" },
-		{ OPTS " heartbeat_timeout_ms=5", "hal_options heartbeat_timeout_ms: must exceed "
+		{ OPTS " sync_counter=maybe", "hal_options: sync_counter = maybe: expected yes | no" },
+		{ OPTS " iface=can0",
+		  "hal_options: unknown canemu option 'iface' (see docs/hal-options.md)" },
+		{ OPTS " speed", "hal_options: 'speed': expected key=value" },
+		{ OPTS " heartbeat_timeout_ms=5", "hal_options: heartbeat_timeout_ms: must exceed "
 						  "heartbeat_ms" },
-		{ "nodes=1,3,4 rated_torque_mnm=100", "hal_options nodes: the emulator's nodes are "
+		{ "nodes=1,3,4 rated_torque_mnm=100", "hal_options: nodes: the emulator's nodes are "
 						      "consecutive (e.g. 1,2,3)" },
-		{ OPTS " master_node=2", "hal_options master_node: is a drive's node id" },
-		{ OPTS " master_node=128", "hal_options master_node: 1..127" },
-		{ OPTS " rpdo_timeout_ms=0", "hal_options rpdo_timeout_ms: 1..65535 ms" },
+		{ OPTS " master_node=2", "hal_options: master_node: is a drive's node id" },
+		{ OPTS " master_node=128", "hal_options: master_node = 128: must be <= 127" },
+		{ OPTS " rpdo_timeout_ms=0", "hal_options: rpdo_timeout_ms = 0: must be >= 1 ms" },
 	};
 
 	(void)state;
@@ -104,7 +168,7 @@ static void test_options_refused_by_name(void **state)
 		assert_string_equal(dev.why, cases[i].why);
 	}
 	assert_int_equal(open_as("socketcan", OPTS), IRDM_EINVAL);
-	assert_string_equal(dev.why, "hal_options iface: missing (the CAN interface, e.g. iface=can0)");
+	assert_string_equal(dev.why, "hal_options: iface: missing (the CAN interface, e.g. iface=can0)");
 }
 
 static void test_socketcan_without_interface(void **state)
@@ -488,6 +552,7 @@ static void test_canemu_emergency_off(void **state)
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_check_options_name_the_line),
 		cmocka_unit_test(test_options_refused_by_name),
 		cmocka_unit_test(test_socketcan_without_interface),
 		cmocka_unit_test(test_canemu_emergency_off),

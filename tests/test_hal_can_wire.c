@@ -18,10 +18,10 @@
 
 #include <cmocka.h>
 
-#include "irdm/can_drives.h"
-#include "irdm/can_membus.h"
+#include "irdm/sim/can_drives.h"
+#include "irdm/sim/can_membus.h"
 #include "irdm/error.h"
-#include "irdm/hal_can.h"
+#include "irdm/hal/hal_can.h"
 
 struct wire_data {
 	struct irdm_hal_can can;        /* first: the shared code's view */

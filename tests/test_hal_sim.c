@@ -3,7 +3,9 @@
  * The HAL (irdm/hal.h) with the simulator's back-end, driven through the
  * ops table only, the way the force loop will: registration and look-up by
  * name, the life cycle and every documented error, a force on the tip that
- * moves it the expected way, safe-off, and a fault that every op reports.
+ * moves it the expected way, safe-off, a fault that every op reports, and
+ * the virtual user's hand that an attached script puts on the arm at each
+ * read.
  * The test reaches behind the ops only to inject the fault and to read the
  * torque that reached the simulated motors.
  */
@@ -20,10 +22,14 @@
 
 #include <cmocka.h>
 
+#include "irdm/board.h"
 #include "irdm/device.h"
 #include "irdm/error.h"
-#include "irdm/hal.h"
-#include "irdm/hal_sim.h"
+#include "irdm/hal/hal.h"
+#include "irdm/sim/hal_sim.h"
+#include "irdm/sim/sim_user.h"
+#include "irdm/sim/sim_user_push.h"
+#include "irdm/posix/board_file.h"
 
 #define PERIOD_S 1e-3
 
@@ -72,8 +78,8 @@ static int nop(struct irdm_hal_dev *d)
 static void test_registry(void **state)
 {
 	static const struct irdm_hal_ops half = { .open = nop };
-	static const struct irdm_hal_backend incomplete = { "half", &half, 0 };
-	static const struct irdm_hal_backend impostor = { "sim", NULL, 0 };
+	static const struct irdm_hal_backend incomplete = { .name = "half", .ops = &half };
+	static const struct irdm_hal_backend impostor = { .name = "sim" };
 	struct irdm_hal_backend twin = irdm_hal_sim_backend;
 	(void)state;
 
@@ -285,6 +291,68 @@ static void test_encoder_out_of_range(void **state)
 	irdm_hal_close(&dev);
 }
 
+/* ---- the virtual user ------------------------------------------------------- */
+
+/*
+ * An attached script's hand pushes the arm at the start of each read, at
+ * tick x period: bit for bit the arm a loop gets that pushes before each
+ * read at its clock's time (the loop irdm-fw ran before the push moved
+ * behind the HAL).  Also: the hand moves the arm, and open forgets it.
+ */
+static void test_attached_user_pushes_at_tick_time(void **state)
+{
+	static struct irdm_sim_user user;
+	static struct irdm_board board;
+	struct irdm_device_config arm_cfg;
+	struct irdm_sim_device ref;
+	struct irdm_sim_params p;
+	struct irdm_hal_joint_state st;
+	struct irdm_hal_config bcfg;
+	double tip[3], home[3], q[3], qd[3], q_ref[3], qd_ref[3], q_free[3];
+	char err[256];
+	(void)state;
+
+	assert_int_equal(irdm_board_load(&board, "boards/sim-phantom.board", err, sizeof(err)),
+			 IRDM_OK);
+	irdm_board_device(&board, 0, &arm_cfg);
+	irdm_device_fk(&arm_cfg, board.calibration_pose_rad, tip);
+	irdm_board_device_to_object(&board, tip, home);
+	assert_int_equal(irdm_sim_user_parse(&user, "press", "place 1 at home\n"
+					     "move 1 by 0,0,-0.02 over 0.1\n", err,
+					     sizeof(err)), IRDM_OK);
+	assert_int_equal(irdm_sim_user_start(&user, 0, home, "press", err, sizeof(err)), IRDM_OK);
+	bcfg = (struct irdm_hal_config){ &arm_cfg, NULL, board.period_us * 1e-6 };
+	assert_int_equal(irdm_hal_init(&dev, "sim", &bcfg, mem, sizeof(mem)), IRDM_OK);
+	assert_int_equal(irdm_hal_open(&dev), IRDM_OK);
+	assert_int_equal(irdm_hal_sim_attach_user(&dev, &user, IRDM_SIM_USER_HANDS, &board),
+			 IRDM_EINVAL);
+	assert_int_equal(irdm_hal_sim_attach_user(&dev, &user, 0, &board), IRDM_OK);
+	irdm_sim_params_default(&p);
+	assert_int_equal(irdm_sim_device_init(&ref, &arm_cfg, &p), IRDM_OK);
+	for (uint64_t k = 0; k < 150; k++) {
+		uint32_t period_ns = board.period_us * 1000u;
+
+		irdm_sim_user_push(&user, 0, &board, &ref, (double)k * period_ns * 1e-9);
+		assert_int_equal(irdm_sim_device_step(&ref, bcfg.period_s), IRDM_OK);
+		assert_int_equal(irdm_hal_read(&dev, &st), IRDM_OK);
+	}
+	irdm_sim_device_state(irdm_hal_sim_device(&dev), q, qd);
+	irdm_sim_device_state(&ref, q_ref, qd_ref);
+	assert_memory_equal(q, q_ref, sizeof(q));
+	assert_memory_equal(qd, qd_ref, sizeof(qd));
+	/* reopened, nobody holds it: the same reads leave the arm elsewhere */
+	irdm_hal_close(&dev);
+	assert_int_equal(irdm_hal_open(&dev), IRDM_OK);
+	for (int k = 0; k < 150; k++)
+		assert_int_equal(irdm_hal_read(&dev, &st), IRDM_OK);
+	irdm_sim_device_state(irdm_hal_sim_device(&dev), q_free, qd);
+	print_message("after 0.15 s: joint 2 at %.6f rad held, %.6f rad free\n", q[1], q_free[1]);
+	assert_true(fabs(q[1] - q_free[1]) > 1e-3);
+	irdm_hal_close(&dev);
+	/* only an open sim instance takes a hand */
+	assert_int_equal(irdm_hal_sim_attach_user(&dev, &user, 0, &board), IRDM_EINVAL);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -294,6 +362,7 @@ int main(void)
 		cmocka_unit_test(test_delay_option),
 		cmocka_unit_test(test_injected_fault),
 		cmocka_unit_test(test_encoder_out_of_range),
+		cmocka_unit_test(test_attached_user_pushes_at_tick_time),
 	};
 
 	return cmocka_run_group_tests(tests, setup, NULL);

@@ -19,6 +19,7 @@
 #include <cmocka.h>
 
 #include "irdm/contact.h"
+#include "irdm/posix/image_map.h"
 #include "support/engine_fixture.h"
 
 static void engine_disp(const void *ctx, uint32_t row, double u[3])

@@ -22,6 +22,7 @@
 #include <unistd.h>
 
 #include "irdm/image.h"
+#include "irdm/posix/image_map.h"
 #include "image/elem_store.h"
 #include "image/image_writer.h"
 #include "support/image_fixture.h"

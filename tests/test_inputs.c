@@ -23,8 +23,10 @@
 #include "irdm/board.h"
 #include "irdm/error.h"
 #include "irdm/image.h"
-#include "irdm/sim_user.h"
-#include "irdm/textfile.h"
+#include "irdm/posix/board_file.h"
+#include "irdm/posix/image_map.h"
+#include "irdm/sim/sim_user.h"
+#include "irdm/posix/textfile.h"
 #include "scene/scene.h"
 #include "support/test_files.h"
 

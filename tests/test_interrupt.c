@@ -31,7 +31,7 @@
 
 #include <cmocka.h>
 
-#include "irdm/outdir.h"
+#include "irdm/posix/outdir.h"
 #include "support/run_prog.h"
 #include "support/test_files.h"
 #include "util/interrupt.h"

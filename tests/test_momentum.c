@@ -29,6 +29,7 @@
 
 #include <cmocka.h>
 
+#include "irdm/posix/image_map.h"
 #include "irdm/rigid.h"
 #include "irdm/vec3.h"
 #include "support/engine_fixture.h"

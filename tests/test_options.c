@@ -16,7 +16,7 @@
 
 #include "irdm/error.h"
 #include "irdm/options.h"
-#include "irdm/options_doc.h"
+#include "irdm/posix/options_doc.h"
 #include "scene/scene.h"
 
 struct cfg {

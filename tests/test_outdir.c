@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * Output directories (irdm/outdir.h): each way an output could destroy a
+ * Output directories (irdm/posix/outdir.h): each way an output could destroy a
  * user's files, tried against the module every directory-writing tool uses.
  *  - a missing DIR is created; DIR written by the same tool is replaced and
  *    its old files go;
@@ -31,7 +31,7 @@
 #include <cmocka.h>
 
 #include "irdm/error.h"
-#include "irdm/outdir.h"
+#include "irdm/posix/outdir.h"
 #include "support/test_files.h"
 
 static char dir[256];

@@ -32,6 +32,7 @@
 #include <cmocka.h>
 
 #include "irdm/contact.h"
+#include "irdm/posix/image_map.h"
 #include "irdm/vec3.h"
 #include "support/engine_fixture.h"
 #include "support/test_files.h"

@@ -37,6 +37,7 @@
 #include <cmocka.h>
 
 #include "irdm/image.h"
+#include "irdm/posix/image_map.h"
 #include "irdm/telemetry.h"
 #include "irdm/precision.h"
 #include "support/run_prog.h"

@@ -29,6 +29,7 @@
 #include <cmocka.h>
 
 #include "irdm/image.h"
+#include "irdm/posix/image_map.h"
 #include "irdm/session.h"
 #include "support/engine_fixture.h"
 #include "support/report_fixture.h"

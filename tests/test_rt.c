@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * The real-time set-up (irdm/rt.h) against what the system says on its own:
+ * The real-time set-up (irdm/posix/rt.h) against what the system says on its own:
  * PREEMPT_RT detection on both kinds of strings, timespec arithmetic across
  * second boundaries and below zero, thread attributes read back from the
  * attr, this host's report against /sys/kernel/realtime and uname computed
@@ -26,7 +26,7 @@
 
 #include <cmocka.h>
 
-#include "irdm/rt.h"
+#include "irdm/posix/rt.h"
 
 #define NS 1000000000L
 #define FIFO_PRIO 10

@@ -19,7 +19,7 @@
 
 #include "irdm/device.h"
 #include "irdm/error.h"
-#include "irdm/sim_device.h"
+#include "irdm/sim/sim_device.h"
 
 #define DT 1e-3
 

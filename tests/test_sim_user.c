@@ -24,8 +24,8 @@
 
 #include "irdm/device.h"
 #include "irdm/error.h"
-#include "irdm/sim_device.h"
-#include "irdm/sim_user.h"
+#include "irdm/sim/sim_device.h"
+#include "irdm/sim/sim_user.h"
 
 static struct irdm_sim_user user;      /* big: keep it off the stack */
 static struct irdm_sim_device sim;

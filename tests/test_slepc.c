@@ -33,6 +33,7 @@
 #include "dist/dist.h"
 #include "image/image_response.h"
 #include "irdm/image.h"
+#include "irdm/posix/image_map.h"
 #include "support/run_prog.h"
 #include "support/test_files.h"
 

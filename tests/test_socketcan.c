@@ -27,7 +27,7 @@
 #include <linux/can/error.h>
 
 #include "irdm/error.h"
-#include "irdm/socketcan.h"
+#include "irdm/hal/socketcan.h"
 
 static bool kernel_has_can(void)
 {

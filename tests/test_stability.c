@@ -24,6 +24,7 @@
 
 #include "support/engine_fixture.h"
 #include "support/test_files.h"
+#include "irdm/posix/image_map.h"
 
 static char dir[64];
 

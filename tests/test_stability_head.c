@@ -28,6 +28,7 @@
 #include <cmocka.h>
 
 #include "irdm/image.h"
+#include "irdm/posix/image_map.h"
 #include "modal/modal.h"
 #include "modal/node_tf.h"
 #include "modal/stability.h"

@@ -21,6 +21,7 @@
 #include <cmocka.h>
 
 #include "irdm/image.h"
+#include "irdm/posix/image_map.h"
 #include "modal/modal.h"
 #include "modal/stability.h"
 #include "support/engine_fixture.h"

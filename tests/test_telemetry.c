@@ -34,7 +34,8 @@
 #include <cmocka.h>
 
 #include "irdm/image.h"
-#include "irdm/outdir.h"
+#include "irdm/posix/outdir.h"
+#include "irdm/posix/telemetry_log.h"
 #include "irdm/telemetry.h"
 #include "support/test_files.h"
 
@@ -1085,7 +1086,7 @@ static size_t count_undefined(const char *obj, const char *const *needles)
 	size_t hits = 0;
 	FILE *p;
 
-	snprintf(cmd, sizeof(cmd), "nm -u %s/obj/firmware/telemetry/%s", build_dir(), obj);
+	snprintf(cmd, sizeof(cmd), "nm -u %s/obj/%s", build_dir(), obj);
 	p = popen(cmd, "r");
 	assert_non_null(p);
 	while (fgets(line, sizeof(line), p)) {
@@ -1107,10 +1108,10 @@ static void test_tick_side_objects(void **state)
 		"free", "printf", "fwrite", "fopen", "fputs", "puts", "clock_", "nanosleep", NULL };
 
 	(void)state;
-	assert_int_equal(count_undefined("telemetry_ring.o", forbidden), 0);
-	assert_int_equal(count_undefined("telemetry_hist.o", forbidden), 0);
+	assert_int_equal(count_undefined("firmware/telemetry/telemetry_ring.o", forbidden), 0);
+	assert_int_equal(count_undefined("firmware/telemetry/telemetry_hist.o", forbidden), 0);
 	/* control: the writer does use them, so the check can see them */
-	assert_true(count_undefined("telemetry_writer.o", forbidden) >= 2);
+	assert_true(count_undefined("platform/posix/telemetry/telemetry_writer.o", forbidden) >= 2);
 }
 
 static int setup(void **state)

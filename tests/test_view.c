@@ -46,6 +46,7 @@
 #include <cmocka.h>
 #include <png.h>
 
+#include "irdm/posix/telemetry_log.h"
 #include "irdm/telemetry.h"
 #include "support/cdp.h"
 #include "support/run_prog.h"

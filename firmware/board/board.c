@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * Board files: read the lines (from memory or, with stdio, from a file)
- * through the option table, then check the board as a whole.  Runs once at
+ * Board files: read the lines (from memory here; from a file in
+ * platform/posix/board/board_file.c) through the option table, then check the board as a whole.  Runs once at
  * start, never in the tick.
  */
 #include <stdio.h>
@@ -9,9 +9,19 @@
 
 #include "board_priv.h"
 #include "irdm/error.h"
-#include "irdm/textfile.h"
 
-static void reader_init(struct irdm_opt_file *f, struct irdm_board *b, const char *name)
+void irdm_board_default(struct irdm_board *b)
+{
+	char why[256];
+
+	memset(b, 0, sizeof(*b));
+	/* every default is the table's: a default it refused would be a broken
+	 * table, which tests/test_board.c rules out entry by entry */
+	(void)irdm_opt_set_defaults(irdm_board_options(), b, why, sizeof(why));
+	irdm_board_set_rotation(b);
+}
+
+void irdm_board_read_begin(struct irdm_opt_file *f, struct irdm_board *b, const char *name)
 {
 	irdm_board_default(b);
 	memset(f, 0, sizeof(*f));
@@ -21,9 +31,8 @@ static void reader_init(struct irdm_opt_file *f, struct irdm_board *b, const cha
 	f->reject_duplicates = true;
 }
 
-/* The next line: its first len characters at s (no newline). */
-static int read_line(struct irdm_opt_file *f, const char *s, size_t len, char *err,
-		     size_t errlen)
+int irdm_board_read_line(struct irdm_opt_file *f, const char *s, size_t len, char *err,
+			  size_t errlen)
 {
 	char line[IRDM_BOARD_LINE_MAX];
 
@@ -44,47 +53,15 @@ int irdm_board_parse(struct irdm_board *b, const char *name, const char *text,
 	struct irdm_opt_file f;
 	int ret = IRDM_OK;
 
-	reader_init(&f, b, name);
+	irdm_board_read_begin(&f, b, name);
 	while (*text && !ret) {
 		size_t len = strcspn(text, "\n");
-		ret = read_line(&f, text, len, err, errlen);
+		ret = irdm_board_read_line(&f, text, len, err, errlen);
 		text += len + (text[len] == '\n');
 	}
 	if (!ret)
 		ret = irdm_board_finish(b, &f, err, errlen);
 	return ret;
-}
-
-int irdm_board_load(struct irdm_board *b, const char *path, char *err, size_t errlen)
-{
-	char buf[IRDM_BOARD_LINE_MAX];
-	struct irdm_text_file t;
-	struct irdm_opt_file f;
-	int ret;
-
-	reader_init(&f, b, path);
-	ret = irdm_text_open(&t, path, IRDM_TEXT_MAX_BYTES, err, errlen);
-	if (ret)
-		return ret;
-	while ((ret = irdm_text_line(&t, buf, IRDM_BOARD_LINE_MAX, err, errlen)) > 0) {
-		ret = read_line(&f, buf, strlen(buf), err, errlen);
-		if (ret)
-			break;
-	}
-	irdm_text_close(&t);
-	if (!ret)
-		ret = irdm_board_finish(b, &f, err, errlen);
-	return ret;
-}
-
-int irdm_board_device(const struct irdm_board *b, unsigned i, struct irdm_device_config *cfg)
-{
-	if (i >= b->devices)
-		return IRDM_EINVAL;
-	*cfg = b->device;
-	if (i == 1)
-		memcpy(cfg->base_offset_m, b->device2_base_offset_m, sizeof(cfg->base_offset_m));
-	return IRDM_OK;
 }
 
 void irdm_board_engine_config(const struct irdm_board *b, struct irdm_engine_config *cfg)

@@ -206,7 +206,9 @@ int irdm_board_finish(struct irdm_board *b, const struct irdm_opt_file *f, char 
 
 	for (size_t i = 0; i < sizeof(checks) / sizeof(checks[0]) && !ret; i++)
 		ret = checks[i](&c);
-	if (!ret)
+	if (!ret) {
 		irdm_board_set_rotation(b);
+		b->hal_options_line = line_of(&c, "hal_options");
+	}
 	return ret;
 }

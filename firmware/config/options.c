@@ -283,6 +283,63 @@ int irdm_opt_set(const struct irdm_opt_table *t, void *obj, const char *where, c
 	return set_entry(o, obj, where, value, err, errlen);
 }
 
+int irdm_opt_set_defaults(const struct irdm_opt_table *t, void *obj, char *err, size_t errlen)
+{
+	char why[256];
+	int ret;
+
+	for (size_t i = 0; i < t->n_opts; i++) {
+		const struct irdm_opt *o = &t->opts[i];
+		if (!o->def)
+			continue;
+		ret = irdm_opt_parse_value(o, obj, o->def, why, sizeof(why));
+		if (ret) {
+			snprintf(err, errlen, "default of %s: %s", o->name, why);
+			return ret;
+		}
+	}
+	return IRDM_OK;
+}
+
+/* One "key=value" word of n characters at w. */
+static int set_word(const struct irdm_opt_table *t, void *obj, const char *where, const char *w,
+		    size_t n, char *err, size_t errlen)
+{
+	char word[256], *eq;
+
+	if (n >= sizeof(word)) {
+		snprintf(err, errlen, "%s: '%.40s...': longer than %zu characters", where, w,
+			 sizeof(word) - 1);
+		return IRDM_EINVAL;
+	}
+	memcpy(word, w, n);
+	word[n] = 0;
+	eq = strchr(word, '=');
+	if (!eq) {
+		snprintf(err, errlen, "%s: '%s': expected key=value", where, word);
+		return IRDM_EINVAL;
+	}
+	*eq = 0;
+	return irdm_opt_set(t, obj, where, word, eq + 1, err, errlen);
+}
+
+int irdm_opt_parse_words(const struct irdm_opt_table *t, void *obj, const char *where,
+			 const char *text, const char *seps, char *err, size_t errlen)
+{
+	int ret = IRDM_OK;
+
+	while (text && *text && !ret) {
+		size_t n;
+
+		text += strspn(text, seps);
+		n = strcspn(text, seps);
+		if (n)
+			ret = set_word(t, obj, where, text, n, err, errlen);
+		text += n;
+	}
+	return ret;
+}
+
 char *irdm_opt_trim(char *s)
 {
 	char *e;

@@ -6,7 +6,7 @@
 #include <limits.h>
 #include <stdio.h>
 
-#include "channel_priv.h"
+#include "irdm/deform_channel.h"
 
 struct deform_layout {
 	size_t payload_off, slot_bytes;

@@ -11,10 +11,6 @@
 
 #define TWO_PI 6.283185307179586
 
-/* Joint angle ranges of the default arm: a 15.8 x 11.9 x 12.2 cm box. */
-static const double default_lo_rad[3] = { -0.42, -0.40, -0.35 };
-static const double default_hi_rad[3] = { 0.42, 0.40, 0.45 };
-
 double irdm_device_rad_per_count(const struct irdm_device_config *cfg, unsigned i)
 {
 	return TWO_PI / (cfg->counts_per_rev[i] * cfg->gear_ratio[i]);
@@ -27,40 +23,28 @@ static double count_of(const struct irdm_device_config *cfg, unsigned i, double 
 		     irdm_device_rad_per_count(cfg, i));
 }
 
-static void default_count_range(struct irdm_device_config *cfg, unsigned i)
-{
-	double a = count_of(cfg, i, default_lo_rad[i]);
-	double b = count_of(cfg, i, default_hi_rad[i]);
-
-	cfg->count_min[i] = (int32_t)fmin(a, b);
-	cfg->count_max[i] = (int32_t)fmax(a, b);
-}
-
 void irdm_device_config_default(struct irdm_device_config *cfg)
 {
-	/* 4000 counts per motor turn (1000 lines, quadrature) through 11.6:1:
-	 * 1.35e-4 rad, 18 um at the tip per count. */
 	static const struct irdm_device_config def = {
-		.l1_m = 0.135,
-		.l2_m = 0.135,
-		.base_offset_m = { 0.0, 0.135, -0.135 },        /* home pose tip at 0 */
-		.counts_per_rev = { 4000, 4000, 4000 },
-		.gear_ratio = { 11.6, 11.6, 11.6 },
-		.angle_offset_rad = { 0, 0, 0 },
-		.sign = { 1, 1, -1 },   /* the third motor turns against its joint */
-		/* 7.9 N along any axis at the home pose: 7.9 N * 0.135 m */
-		.torque_limit_nm = { 1.07, 1.07, 1.07 },
-		.mass_kg = { 0.060, 0.045, 0.090 },
-		.com_m = { 0.065, 0.080, -0.030 },
-		.gravity_m_per_s2 = 9.81,
-		.max_force_n = 7.9,
-		.k_max_n_per_m = 1000.0,
-		.b_device_ns_per_m = 5.0,
+		.l1_m = IRDM_DEVICE_DEFAULT_L1_M,
+		.l2_m = IRDM_DEVICE_DEFAULT_L2_M,
+		.base_offset_m = { IRDM_DEVICE_DEFAULT_BASE_OFFSET_M },
+		.counts_per_rev = { IRDM_DEVICE_DEFAULT_COUNTS_PER_REV },
+		.gear_ratio = { IRDM_DEVICE_DEFAULT_GEAR_RATIO },
+		.angle_offset_rad = { IRDM_DEVICE_DEFAULT_ANGLE_OFFSET_RAD },
+		.sign = { IRDM_DEVICE_DEFAULT_SIGN },
+		.count_min = { IRDM_DEVICE_DEFAULT_COUNT_MIN },
+		.count_max = { IRDM_DEVICE_DEFAULT_COUNT_MAX },
+		.torque_limit_nm = { IRDM_DEVICE_DEFAULT_TORQUE_LIMIT_NM },
+		.mass_kg = { IRDM_DEVICE_DEFAULT_MASS_KG },
+		.com_m = { IRDM_DEVICE_DEFAULT_COM_M },
+		.gravity_m_per_s2 = IRDM_DEVICE_DEFAULT_GRAVITY_M_PER_S2,
+		.max_force_n = IRDM_DEVICE_DEFAULT_MAX_FORCE_N,
+		.k_max_n_per_m = IRDM_DEVICE_DEFAULT_K_MAX_N_PER_M,
+		.b_device_ns_per_m = IRDM_DEVICE_DEFAULT_B_DEVICE_NS_PER_M,
 	};
 
 	*cfg = def;
-	for (unsigned i = 0; i < 3; i++)
-		default_count_range(cfg, i);
 }
 
 static int positive(double v)

@@ -60,7 +60,7 @@ void irdm_engine_config_default(struct irdm_engine_config *cfg)
 	memset(cfg, 0, sizeof(*cfg));
 	cfg->max_contacts = 2;
 	cfg->solve = IRDM_SOLVE_COUPLED;
-	cfg->stable_radius = 0.999;
+	cfg->stable_radius = IRDM_ENGINE_STABLE_RADIUS;
 	cfg->engage_fade_s = IRDM_ENGINE_ENGAGE_FADE_S;
 }
 
@@ -100,7 +100,7 @@ static void fir_tail(struct irdm_engine *e, double *w)
 	double rho = irdm_image_max_radius(e->img), r = 1.0, stable = e->cfg.stable_radius;
 
 	if (stable == 0)
-		stable = 0.999;
+		stable = IRDM_ENGINE_STABLE_RADIUS;
 	if (rho >= 1.0)
 		r = stable / rho;
 	w[0] = 1.0;

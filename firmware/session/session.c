@@ -2,18 +2,19 @@
 /*
  * Session set-up: image, engine and deformation channel, each sized,
  * allocated and initialised here, and freed in one place.  No BLAS, no
- * threads: the worker is session_deform.c's.
+ * threads, no file: the platform maps the image and runs the worker
+ * (platform/posix/session/).
  */
 #include <stdio.h>
 #include <stdlib.h>
 
 #include "irdm/build_config.h"
 
-#include "session_priv.h"
+#include "irdm/session.h"
 
 #define SESSION_ALIGN 64u
 
-int session_part_mem(void **mem, size_t n, const char *part, char *err, size_t errlen)
+int irdm_session_part_mem(void **mem, size_t n, const char *part, char *err, size_t errlen)
 {
 	*mem = NULL;
 	if (!n)
@@ -30,7 +31,7 @@ static int open_engine(struct irdm_session *s, const struct irdm_engine_config *
 		       char *err, size_t errlen)
 {
 	size_t n = irdm_engine_mem_size(s->img, cfg);
-	int rc = session_part_mem(&s->eng_mem, n, "engine", err, errlen);
+	int rc = irdm_session_part_mem(&s->eng_mem, n, "engine", err, errlen);
 
 	if (rc)
 		return rc;
@@ -41,7 +42,7 @@ static int open_deform(struct irdm_session *s, char *err, size_t errlen)
 {
 #if IRDM_CONFIG_DEFORM
 	size_t n = irdm_deform_mem_size(s->img);
-	int rc = session_part_mem(&s->deform_mem, n, "deform", err, errlen);
+	int rc = irdm_session_part_mem(&s->deform_mem, n, "deform", err, errlen);
 
 	if (!rc)
 		rc = irdm_deform_init(&s->deform, s->img, s->deform_mem, n, err, errlen);
@@ -101,8 +102,11 @@ int irdm_session_open_image(struct irdm_session **sp, const struct irdm_image *i
 	return open_parts(sp, s, cfg, err, errlen);
 }
 
-int irdm_session_open(struct irdm_session **sp, const char *path,
-		      const struct irdm_session_config *cfg, char *err, size_t errlen)
+int irdm_session_open_with(struct irdm_session **sp, const char *path,
+			   const struct irdm_session_config *cfg,
+			   int (*map)(const char *path, unsigned flags, struct irdm_image *img,
+				      char *err, size_t errlen),
+			   void (*unmap)(struct irdm_image *img), char *err, size_t errlen)
 {
 	struct irdm_session *s;
 	int rc;
@@ -115,12 +119,13 @@ int irdm_session_open(struct irdm_session **sp, const char *path,
 	s = new_session(err, errlen);
 	if (!s)
 		return IRDM_ENOMEM;
-	rc = irdm_image_map(path, cfg->map_flags, &s->mapped, err, errlen);
+	rc = map(path, cfg->map_flags, &s->mapped, err, errlen);
 	if (rc) {
 		free(s);
 		return rc;
 	}
 	s->img = &s->mapped;
+	s->unmap = unmap;
 	return open_parts(sp, s, cfg, err, errlen);
 }
 
@@ -131,7 +136,7 @@ void irdm_session_close(struct irdm_session *s)
 	free(s->worker_mem);
 	free(s->deform_mem);
 	free(s->eng_mem);
-	if (s->img == &s->mapped)
-		irdm_image_unmap(&s->mapped);
+	if (s->img == &s->mapped && s->unmap)
+		s->unmap(&s->mapped);
 	free(s);
 }

@@ -8,7 +8,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "irdm/can_master.h"
+#include "irdm/hal/can_master.h"
 #include "irdm/error.h"
 
 int16_t irdm_can_torque_permille(const struct irdm_can_axis_cfg *a, double tau_joint_nm)

@@ -9,7 +9,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "irdm/can_master.h"
+#include "irdm/hal/can_master.h"
 #include "irdm/error.h"
 
 #define MODE_CST 10

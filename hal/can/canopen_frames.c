@@ -6,7 +6,7 @@
  */
 #include <string.h>
 
-#include "irdm/canopen.h"
+#include "irdm/hal/canopen.h"
 
 static void put16(uint8_t *p, uint16_t v)
 {

@@ -3,7 +3,7 @@
  * The CiA 402 state machine (irdm/cia402.h).  Transition numbers in the
  * comments are the profile's (docs/canopen.md draws the graph).
  */
-#include "irdm/cia402.h"
+#include "irdm/hal/cia402.h"
 
 /* statusword mask -> value of each state */
 static const struct {

@@ -5,7 +5,7 @@
 #include <string.h>
 
 #include "irdm/error.h"
-#include "irdm/hal_can.h"
+#include "irdm/hal/hal_can.h"
 
 static struct irdm_hal_can *can_of(struct irdm_hal_dev *dev)
 {
@@ -34,7 +34,7 @@ static int master_cfg(struct irdm_hal_dev *dev, const struct irdm_hal_can_opts *
 
 	if (o->n_nodes != IRDM_HAL_JOINTS) {
 		snprintf(dev->why, sizeof(dev->why),
-			 "hal_options nodes: %u node(s) given, the arm has %d joints", o->n_nodes,
+			 "hal_options: nodes: %u node(s) given, the arm has %d joints", o->n_nodes,
 			 IRDM_HAL_JOINTS);
 		return IRDM_EINVAL;
 	}
@@ -75,7 +75,8 @@ int irdm_hal_can_open(struct irdm_hal_dev *dev, const struct irdm_hal_can_link *
 		return IRDM_EINVAL;
 	}
 	c->link = link;
-	rc = irdm_hal_can_parse(cfg->options, extra, &c->opts, dev->why, sizeof(dev->why));
+	rc = irdm_hal_can_parse(cfg->options, extra, "hal_options", &c->opts, dev->why,
+				sizeof(dev->why));
 	if (!rc)
 		rc = master_cfg(dev, &c->opts, &mc);
 	if (!rc)

@@ -9,9 +9,9 @@
 #include <time.h>
 
 #include "irdm/error.h"
-#include "irdm/hal_can.h"
-#include "irdm/hal_socketcan.h"
-#include "irdm/socketcan.h"
+#include "irdm/hal/hal_can.h"
+#include "irdm/hal/hal_socketcan.h"
+#include "irdm/hal/socketcan.h"
 
 struct socketcan_data {
 	struct irdm_hal_can can;        /* first: the shared code's view */
@@ -73,8 +73,16 @@ static int socketcan_open(struct irdm_hal_dev *dev)
 
 static const struct irdm_hal_ops socketcan_ops = IRDM_HAL_CAN_OPS(socketcan_open, irdm_hal_can_emergency_off);
 
+static int socketcan_check_options(const char *options, const char *where, char *err,
+				   size_t errlen)
+{
+	return irdm_hal_can_check(options, IRDM_HAL_CAN_IFACE, where, err, errlen);
+}
+
 const struct irdm_hal_backend irdm_hal_socketcan_backend = {
 	.name = "socketcan",
 	.ops = &socketcan_ops,
 	.data_size = sizeof(struct socketcan_data),
+	.options = &irdm_hal_socketcan_options,
+	.check_options = socketcan_check_options,
 };

@@ -7,7 +7,7 @@
 #include <string.h>
 
 #include "irdm/error.h"
-#include "irdm/hal.h"
+#include "irdm/hal/hal.h"
 
 static const struct irdm_hal_backend *table[IRDM_HAL_BACKENDS_MAX];
 
@@ -25,6 +25,11 @@ const struct irdm_hal_backend *irdm_hal_find(const char *name)
 		if (strcmp(table[i]->name, name) == 0)
 			return table[i];
 	return NULL;
+}
+
+const struct irdm_hal_backend *irdm_hal_backend_at(unsigned i)
+{
+	return i < IRDM_HAL_BACKENDS_MAX ? table[i] : NULL;
 }
 
 int irdm_hal_register(const struct irdm_hal_backend *b)

@@ -19,7 +19,7 @@
 #include <linux/can/raw.h>
 
 #include "irdm/error.h"
-#include "irdm/socketcan.h"
+#include "irdm/hal/socketcan.h"
 
 /* The error classes we want delivered: the ones that say the link is
  * unusable (bus-off) or going bad (controller: error passive, overflows). */

@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* One PDO of an emulated drive, its objects as a strict drive keeps them
  * (irdm/can_drive_pdo.h). */
-#include "irdm/can_drive_pdo.h"
+#include "irdm/sim/can_drive_pdo.h"
 
 /* CiA 301 abort codes (names: irdm_co_abort_name()) */
 #define AB_UNSUPPORTED_ACCESS 0x06010000u       /* the mapping of a valid PDO, or sub 0 != 0 */

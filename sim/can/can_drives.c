@@ -3,7 +3,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "irdm/can_drives.h"
+#include "irdm/sim/can_drives.h"
 #include "irdm/error.h"
 
 #define MODE_CST 10

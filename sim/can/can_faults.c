@@ -5,8 +5,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "irdm/can_faults.h"
-#include "irdm/canopen.h"
+#include "irdm/sim/can_faults.h"
+#include "irdm/hal/canopen.h"
 #include "irdm/error.h"
 
 #define FIELDS_MAX 5

@@ -2,7 +2,7 @@
 /* The in-memory CAN bus (irdm/can_membus.h). */
 #include <string.h>
 
-#include "irdm/can_membus.h"
+#include "irdm/sim/can_membus.h"
 #include "irdm/error.h"
 
 static int membus_send(void *ctx, const struct irdm_can_frame *f)

@@ -14,7 +14,7 @@
 #include <string.h>
 
 #include "irdm/error.h"
-#include "irdm/sim_device.h"
+#include "irdm/sim/sim_device.h"
 
 #define RING (IRDM_SIM_DELAY_MAX + 1)
 
@@ -214,8 +214,10 @@ void irdm_sim_params_default(struct irdm_sim_params *p)
 		.viscous_nm_s_per_rad = { 2e-3, 2e-3, 2e-3 },
 		.coulomb_nm = { 5e-3, 5e-3, 5e-3 },
 		.stick_velocity_rad_per_s = 1e-3,
-		.substeps = 10,
-		.end_stops = 1,
+		.substeps = IRDM_SIM_DEFAULT_SUBSTEPS,
+		.write_delay_ticks = IRDM_SIM_DEFAULT_DELAY_TICKS,
+		.read_delay_ticks = IRDM_SIM_DEFAULT_DELAY_TICKS,
+		.end_stops = IRDM_SIM_DEFAULT_END_STOPS,
 		.stop_inset_rad = 0.02,
 		.stop_stiffness_nm_per_rad = 500,
 		.stop_damping_nm_s_per_rad = 0.6,

@@ -3,14 +3,17 @@
 #include <stdio.h>
 
 #include "irdm/error.h"
-#include "irdm/hal_can.h"
-#include "irdm/hal_canemu.h"
+#include "irdm/hal/hal_can.h"
+#include "irdm/sim/hal_canemu.h"
+
+#include "hal_sim_hand.h"
 
 struct canemu_data {
 	struct irdm_hal_can can;        /* first: the shared code's view */
 	struct irdm_can_membus bus;
 	struct irdm_can_drives drives;
 	bool emcy_done;                 /* the injected emcy_at fault happened */
+	struct sim_hand hand;           /* the virtual user's, if one holds the arm */
 };
 
 static struct canemu_data *data_of(struct irdm_hal_dev *dev)
@@ -28,7 +31,7 @@ static int link_open(struct irdm_hal_dev *dev, struct irdm_can_port *port, char 
 
 	for (unsigned k = 1; k < o->n_nodes; k++)
 		if (o->nodes[k] != o->nodes[0] + k) {
-			snprintf(err, errlen, "hal_options nodes: the emulator's nodes are "
+			snprintf(err, errlen, "hal_options: nodes: the emulator's nodes are "
 				 "consecutive (e.g. 1,2,3)");
 			return IRDM_EINVAL;
 		}
@@ -100,15 +103,44 @@ static int canemu_emergency_off(struct irdm_hal_dev *dev)
 static int canemu_open(struct irdm_hal_dev *dev)
 {
 	data_of(dev)->emcy_done = false;
+	data_of(dev)->hand.user = NULL;
 	return irdm_hal_can_open(dev, &canemu_link, IRDM_HAL_CAN_SUBSTEPS | IRDM_HAL_CAN_EMCY_AT);
 }
 
-static const struct irdm_hal_ops canemu_ops = IRDM_HAL_CAN_OPS(canemu_open, canemu_emergency_off);
+/* The hand first: the SYNC this read may send steps the arm under it. */
+static int canemu_read(struct irdm_hal_dev *dev, struct irdm_hal_joint_state *st)
+{
+	struct canemu_data *d = data_of(dev);
+
+	if (d->can.state != HAL_CAN_CLOSED)
+		sim_hand_push(&d->hand, &d->drives.arm);
+	return irdm_hal_can_read(dev, st);
+}
+
+static const struct irdm_hal_ops canemu_ops = {
+	.open = canemu_open,
+	.start = irdm_hal_can_start,
+	.read = canemu_read,
+	.write = irdm_hal_can_write,
+	.safe_off = irdm_hal_can_safe_off,
+	.poll = irdm_hal_can_poll,
+	.close = irdm_hal_can_close,
+	.emergency_off = canemu_emergency_off,
+};
+
+static int canemu_check_options(const char *options, const char *where, char *err,
+				size_t errlen)
+{
+	return irdm_hal_can_check(options, IRDM_HAL_CAN_SUBSTEPS | IRDM_HAL_CAN_EMCY_AT, where, err,
+				  errlen);
+}
 
 const struct irdm_hal_backend irdm_hal_canemu_backend = {
 	.name = "canemu",
 	.ops = &canemu_ops,
 	.data_size = sizeof(struct canemu_data),
+	.options = &irdm_hal_canemu_options,
+	.check_options = canemu_check_options,
 };
 
 static struct canemu_data *open_canemu(struct irdm_hal_dev *dev)
@@ -131,4 +163,11 @@ struct irdm_can_membus *irdm_hal_canemu_bus(struct irdm_hal_dev *dev)
 	struct canemu_data *d = open_canemu(dev);
 
 	return d ? &d->bus : NULL;
+}
+
+struct sim_hand *irdm_hal_canemu_hand(struct irdm_hal_dev *dev)
+{
+	struct canemu_data *d = open_canemu(dev);
+
+	return d ? &d->hand : NULL;
 }

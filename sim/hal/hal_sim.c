@@ -5,8 +5,10 @@
 #include <string.h>
 
 #include "irdm/error.h"
-#include "irdm/hal_canemu.h"
-#include "irdm/hal_sim.h"
+#include "irdm/sim/hal_canemu.h"
+#include "irdm/sim/hal_sim.h"
+
+#include "hal_sim_hand.h"
 
 enum sim_state { SIM_CLOSED = 0, SIM_OPEN, SIM_RUNNING, SIM_OFF };
 
@@ -15,6 +17,7 @@ struct sim_data {
 	enum sim_state state;
 	uint32_t faults;
 	uint64_t seq;
+	struct sim_hand hand;           /* the virtual user's, if one holds the arm */
 };
 
 static struct sim_data *data_of(struct irdm_hal_dev *dev)
@@ -22,74 +25,51 @@ static struct sim_data *data_of(struct irdm_hal_dev *dev)
 	return dev->data;
 }
 
-/* "key=value" with value an unsigned <= max. */
-static int option_uint(const char *tok, size_t len, const char *key, unsigned max,
-		       unsigned *out, int *matched)
-{
-	size_t klen = strlen(key);
-	unsigned long v = 0;
-	size_t i;
+#define SP(member) IRDM_OPT_FIELD(struct irdm_sim_params, member)
+#define UPTO(lo, hi) .range = IRDM_OPT_GE | IRDM_OPT_LE, .min = (lo), .max = (hi)
 
-	if (len <= klen + 1 || strncmp(tok, key, klen) != 0 || tok[klen] != '=')
-		return IRDM_OK;
-	*matched = 1;
-	for (i = klen + 1; i < len; i++) {
-		if (tok[i] < '0' || tok[i] > '9' || v > max)
-			return IRDM_EINVAL;
-		v = v * 10 + (unsigned long)(tok[i] - '0');
-	}
-	if (v > max)
-		return IRDM_EINVAL;
-	*out = (unsigned)v;
-	return IRDM_OK;
+/* Its hal_options (docs/hal-options.md); the rest of the arm's figures are
+ * irdm_sim_params_default()'s. */
+static const struct irdm_opt sim_opts[] = {
+	{ .name = "write_delay", .type = IRDM_OPT_UNSIGNED, SP(write_delay_ticks),
+	  UPTO(0, IRDM_SIM_DELAY_MAX), .metavar = "K",
+	  .help = "ticks a written torque waits on the simulated bus",
+	  IRDM_OPT_DEFAULT(IRDM_SIM_DEFAULT_DELAY_TICKS) },
+	{ .name = "read_delay", .type = IRDM_OPT_UNSIGNED, SP(read_delay_ticks),
+	  UPTO(0, IRDM_SIM_DELAY_MAX), .metavar = "K",
+	  .help = "ticks an encoder sample waits on the simulated bus",
+	  IRDM_OPT_DEFAULT(IRDM_SIM_DEFAULT_DELAY_TICKS) },
+	{ .name = "substeps", .type = IRDM_OPT_UNSIGNED, SP(substeps),
+	  UPTO(1, IRDM_SIM_SUBSTEPS_MAX), .metavar = "N",
+	  .help = "integration (RK4) steps of the arm per tick",
+	  IRDM_OPT_DEFAULT(IRDM_SIM_DEFAULT_SUBSTEPS) },
+	{ .name = "end_stops", .type = IRDM_OPT_INT, SP(end_stops), UPTO(0, 1), .metavar = "0 | 1",
+	  .help = "the arm's mechanical stops just inside count_min..count_max; 0: an arm "
+		  "that can leave its encoders' range (a test of that fault)",
+	  IRDM_OPT_DEFAULT(IRDM_SIM_DEFAULT_END_STOPS) },
+};
+
+static const struct irdm_opt_table sim_table = {
+	.what = "sim option",
+	.see = "docs/hal-options.md",
+	.opts = sim_opts,
+	.n_opts = sizeof(sim_opts) / sizeof(sim_opts[0]),
+};
+
+/* Space, comma or tab separated "key=value" words into p (defaults first). */
+static int parse_options(const char *options, const char *where, struct irdm_sim_params *p,
+			 char *err, size_t errlen)
+{
+	irdm_sim_params_default(p);
+	return irdm_opt_parse_words(&sim_table, p, where, options, " ,\t", err, errlen) ?
+	       IRDM_EINVAL : IRDM_OK;
 }
 
-static int parse_token(const char *tok, size_t len, struct irdm_sim_params *p)
+static int sim_check_options(const char *options, const char *where, char *err, size_t errlen)
 {
-	int matched = 0, rc;
+	struct irdm_sim_params p;
 
-	rc = option_uint(tok, len, "write_delay", IRDM_SIM_DELAY_MAX, &p->write_delay_ticks,
-			 &matched);
-	if (rc == IRDM_OK && !matched)
-		rc = option_uint(tok, len, "read_delay", IRDM_SIM_DELAY_MAX,
-				 &p->read_delay_ticks, &matched);
-	if (rc == IRDM_OK && !matched)
-		rc = option_uint(tok, len, "substeps", IRDM_SIM_SUBSTEPS_MAX, &p->substeps,
-				 &matched);
-	if (rc == IRDM_OK && !matched) {
-		unsigned stops = 1;
-
-		rc = option_uint(tok, len, "end_stops", 1, &stops, &matched);
-		if (matched)
-			p->end_stops = (int)stops;
-	}
-	if (rc == IRDM_OK && !matched)
-		rc = IRDM_EINVAL;               /* unknown option */
-	return rc;
-}
-
-/* Each option, or the first one refused: its token and why, in why. */
-static int parse_options(const char *s, struct irdm_sim_params *p, char *why, size_t len)
-{
-	while (s && *s) {
-		size_t n = strcspn(s, " ,\t"), eq = strcspn(s, "=");
-		int rc = n ? parse_token(s, n, p) : IRDM_OK;
-
-		if (rc != IRDM_OK) {
-			if (eq < n && (!strncmp(s, "write_delay", eq) || !strncmp(s, "read_delay", eq) ||
-				       !strncmp(s, "substeps", eq) || !strncmp(s, "end_stops", eq)))
-				snprintf(why, len, "hal_options '%.*s': out of range (delays 0..%d, "
-					 "substeps 1..%d, end_stops 0|1)", (int)n, s, IRDM_SIM_DELAY_MAX,
-					 IRDM_SIM_SUBSTEPS_MAX);
-			else
-				snprintf(why, len, "hal_options '%.*s': unknown (write_delay, "
-					 "read_delay, substeps, end_stops)", (int)n, s);
-			return rc;
-		}
-		s += n;
-		s += strspn(s, " ,\t");
-	}
-	return IRDM_OK;
+	return parse_options(options, where, &p, err, errlen);
 }
 
 /* Why the simulated arm refuses this device (the board passed its own checks). */
@@ -124,8 +104,7 @@ static int sim_open(struct irdm_hal_dev *dev)
 		return IRDM_EBUSY;
 	if (!cfg->device || !(isfinite(cfg->period_s) && cfg->period_s > 0))
 		return IRDM_EINVAL;
-	irdm_sim_params_default(&p);
-	rc = parse_options(cfg->options, &p, dev->why, sizeof(dev->why));
+	rc = parse_options(cfg->options, "hal_options", &p, dev->why, sizeof(dev->why));
 	if (rc != IRDM_OK)
 		return rc;
 	rc = irdm_sim_device_init(&d->arm, cfg->device, &p);
@@ -135,6 +114,7 @@ static int sim_open(struct irdm_hal_dev *dev)
 	}
 	d->faults = 0;
 	d->seq = 0;
+	d->hand.user = NULL;
 	d->state = SIM_OPEN;
 	return IRDM_OK;
 }
@@ -159,6 +139,7 @@ static int sim_read(struct irdm_hal_dev *dev, struct irdm_hal_joint_state *st)
 
 	if (d->state == SIM_CLOSED)
 		return IRDM_EINVAL;
+	sim_hand_push(&d->hand, &d->arm);
 	if (d->faults)
 		return IRDM_EHW;
 	rc = irdm_sim_device_step(&d->arm, dev->config->period_s);
@@ -232,6 +213,8 @@ const struct irdm_hal_backend irdm_hal_sim_backend = {
 	.name = "sim",
 	.ops = &sim_ops,
 	.data_size = sizeof(struct sim_data),
+	.options = &sim_table,
+	.check_options = sim_check_options,
 };
 
 static int is_open_sim(const struct irdm_hal_dev *dev)
@@ -256,4 +239,15 @@ struct irdm_sim_device *irdm_hal_sim_device(struct irdm_hal_dev *dev)
 	if (emulated)
 		return &emulated->arm;  /* the arm behind the emulated CAN drives */
 	return is_open_sim(dev) ? &data_of(dev)->arm : NULL;
+}
+
+int irdm_hal_sim_attach_user(struct irdm_hal_dev *dev, const struct irdm_sim_user *u,
+			     unsigned hand, const struct irdm_board *b)
+{
+	struct sim_hand *h = is_open_sim(dev) ? &data_of(dev)->hand : irdm_hal_canemu_hand(dev);
+
+	if (!h || !u || !b || hand >= IRDM_SIM_USER_HANDS)
+		return IRDM_EINVAL;
+	sim_hand_attach(h, u, hand, b);
+	return IRDM_OK;
 }

@@ -8,7 +8,7 @@
 #include <string.h>
 
 #include "irdm/error.h"
-#include "irdm/sim_user.h"
+#include "irdm/sim/sim_user.h"
 
 /* Minimum jerk: s(0) = 0, s(1) = 1 exactly; s' = s'' = 0 at both ends. */
 static double min_jerk(double u)

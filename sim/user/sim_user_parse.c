@@ -15,8 +15,8 @@
 #include <string.h>
 
 #include "irdm/error.h"
-#include "irdm/textfile.h"
-#include "irdm/sim_user.h"
+#include "irdm/posix/textfile.h"
+#include "irdm/sim/sim_user.h"
 
 #define TOKENS_MAX 12
 

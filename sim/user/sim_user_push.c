@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* The virtual user's hand on a simulated arm (irdm/sim_user_push.h). */
 #include "irdm/device.h"
-#include "irdm/sim_user_push.h"
+#include "irdm/sim/sim_user_push.h"
 
 int irdm_sim_user_push(const struct irdm_sim_user *u, unsigned hand, const struct irdm_board *b,
 		       struct irdm_sim_device *sim, double t_s)

@@ -10,7 +10,7 @@
 #include <string.h>
 
 #include "irdm/error.h"
-#include "irdm/sim_user.h"
+#include "irdm/sim/sim_user.h"
 
 static int fail(const char *name, unsigned hand, char *err, size_t errlen, const char *fmt, ...)
 {

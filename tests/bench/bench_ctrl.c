@@ -31,7 +31,8 @@
 #include <unistd.h>
 
 #include "irdm/controller.h"
-#include "irdm/rt.h"
+#include "irdm/posix/rt.h"
+#include "irdm/posix/session.h"
 #include "irdm/session.h"
 #include "../support/bench_util.h"
 #include "../support/device_ik.h"

@@ -10,7 +10,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "irdm/deform_worker.h"
+#include "irdm/posix/deform_worker.h"
+#include "irdm/posix/session.h"
 #include "irdm/session.h"
 #include "../support/bench_util.h"
 

@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "irdm/engine.h"
+#include "irdm/posix/session.h"
 #include "irdm/session.h"
 #include "../support/bench_util.h"
 

@@ -28,7 +28,8 @@
 
 #include "irdm/engine.h"
 #include "irdm/image.h"
-#include "irdm/rt.h"
+#include "irdm/posix/image_map.h"
+#include "irdm/posix/rt.h"
 #include "irdm/session.h"
 #include "../support/bench_util.h"
 #include "../support/engine_fixture.h"

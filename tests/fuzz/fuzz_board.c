@@ -15,6 +15,7 @@
 #include "irdm/board.h"
 #include "irdm/device.h"
 #include "irdm/error.h"
+#include "irdm/posix/board_file.h"
 #include "fuzz_memfile.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);

@@ -10,8 +10,8 @@
 #include <stdint.h>
 #include <string.h>
 
-#include "irdm/canopen.h"
-#include "irdm/cia402.h"
+#include "irdm/hal/canopen.h"
+#include "irdm/hal/cia402.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 

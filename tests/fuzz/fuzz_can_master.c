@@ -14,7 +14,7 @@
 #include <stdint.h>
 #include <string.h>
 
-#include "irdm/can_master.h"
+#include "irdm/hal/can_master.h"
 #include "irdm/error.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);

@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "irdm/error.h"
+#include "irdm/posix/telemetry_log.h"
 #include "irdm/telemetry.h"
 #include "fuzz_memfile.h"
 

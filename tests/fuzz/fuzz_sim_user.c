@@ -14,7 +14,7 @@
 #include <unistd.h>
 
 #include "irdm/error.h"
-#include "irdm/sim_user.h"
+#include "irdm/sim/sim_user.h"
 #include "fuzz_memfile.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);

@@ -21,7 +21,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "irdm/rt.h"
+#include "irdm/posix/rt.h"
 
 static atomic_bool alloc_armed;
 static atomic_ulong alloc_n;

@@ -5,7 +5,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
-#include "irdm/rt.h"
+#include "irdm/posix/rt.h"
 
 #include "bench_util.h"
 #include "precompute/precompute.h"

@@ -5,7 +5,7 @@
 
 #include <stdint.h>
 
-#include "irdm/can_port.h"
+#include "irdm/hal/can_port.h"
 
 /* Receive everything waiting on port; how many frames had identifier id. */
 unsigned can_drain_count(const struct irdm_can_port *port, uint32_t id);

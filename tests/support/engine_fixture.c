@@ -11,6 +11,7 @@
 #include <cmocka.h>
 
 #include "engine_fixture.h"
+#include "irdm/posix/image_map.h"
 #include "irdm/precision.h"
 #include "image/image_response.h"
 #include "precompute/precompute.h"

@@ -12,6 +12,7 @@
 
 #include "engine_fixture.h"
 #include "image/image_response.h"
+#include "irdm/posix/image_map.h"
 #include "irdm/rigid.h"
 #include "stab_harness.h"
 #include "test_files.h"

@@ -2,7 +2,7 @@
 /*
  * CONTACT_BVH builder.  Offline, so it may allocate and sort freely; what it
  * writes is what firmware/image/image_bvh.c checks, and the firmware walks
- * it with a fixed stack (firmware/contact/contact.c).
+ * it with a fixed stack (firmware/proxy/contact.c).
  */
 #include <stdbool.h>
 #include <stdio.h>

@@ -23,8 +23,8 @@
 #include <unistd.h>
 
 #include "irdm/image.h"
-#include "irdm/outdir.h"
-#include "irdm/outfile.h"
+#include "irdm/posix/outdir.h"
+#include "irdm/posix/outfile.h"
 #include "image/image_writer.h"
 #include "util/interrupt.h"
 
@@ -293,7 +293,7 @@ int irdm_iw_write(const struct irdm_image_writer *w, const char *path,
 		ret = IRDM_ENOMEM;
 		goto free_layout;
 	}
-	/* the same names and lock as irdm/outfile.h's: a killed writer's debris goes */
+	/* the same names and lock as irdm/posix/outfile.h's: a killed writer's debris goes */
 	irdm_outfile_remove_debris(path, said_removed, NULL);
 	/* from here on every failure is the file system's */
 	ret = IRDM_EIO;

@@ -7,7 +7,8 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "irdm/outfile.h"
+#include "irdm/posix/outfile.h"
+#include "irdm/posix/telemetry_log.h"
 #include "irdm/telemetry.h"
 #include "log/log_csv.h"
 

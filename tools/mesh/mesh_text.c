@@ -13,7 +13,7 @@
 #include <string.h>
 
 #include "irdm/error.h"
-#include "irdm/textfile.h"
+#include "irdm/posix/textfile.h"
 #include "mesh/mesh_priv.h"
 
 /* Long enough for any sane number ("-1.2345678901234567e-308" is 24). */

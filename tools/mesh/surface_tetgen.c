@@ -21,7 +21,7 @@
 #include <unistd.h>
 
 #include "irdm/error.h"
-#include "irdm/outdir.h"
+#include "irdm/posix/outdir.h"
 #include "mesh/mesh_priv.h"
 #include "util/interrupt.h"
 

@@ -7,7 +7,7 @@
 
 #include "image/image_writer.h"
 #include "irdm/image.h"
-#include "irdm/textfile.h"
+#include "irdm/posix/textfile.h"
 #include "precompute/td_part.h"
 
 #define PART_MAGIC "IRDMPART"

@@ -13,7 +13,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "irdm/outdir.h"
+#include "irdm/posix/outdir.h"
 #include "render/render.h"
 #include "util/interrupt.h"
 

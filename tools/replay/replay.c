@@ -9,7 +9,9 @@
 #include "image/image_response.h"
 #include "irdm/board.h"
 #include "irdm/contact.h"
-#include "irdm/deform_worker.h"
+#include "irdm/posix/board_file.h"
+#include "irdm/posix/deform_worker.h"
+#include "irdm/posix/session.h"
 #include "irdm/session.h"
 #include "modal/lapack.h"           /* openblas_set_num_threads */
 #include "replay/replay.h"

@@ -11,7 +11,7 @@
 #include <string.h>
 
 #include "irdm/limits.h"
-#include "irdm/textfile.h"
+#include "irdm/posix/textfile.h"
 #include "replay/replay_priv.h"
 
 /* ---- trajectory CSV ---- */

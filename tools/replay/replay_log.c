@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "irdm/posix/telemetry_log.h"
 #include "irdm/telemetry.h"
 #include "replay/replay_priv.h"
 

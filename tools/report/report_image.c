@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include "irdm/error.h"
+#include "irdm/posix/image_map.h"
 #include "precompute/precompute.h"
 #include "report/report_image.h"
 

@@ -10,7 +10,8 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "irdm/deform_worker.h"
+#include "irdm/posix/deform_worker.h"
+#include "irdm/posix/session.h"
 #include "irdm/session.h"
 #include "modal/lapack.h"
 #include "report/report_run.h"

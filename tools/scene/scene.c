@@ -9,7 +9,7 @@
 
 #include "irdm/error.h"
 #include "irdm/options.h"
-#include "irdm/textfile.h"
+#include "irdm/posix/textfile.h"
 #include "modal/static_clusters.h"
 #include "modal/static_lowrank.h"
 #include "modal/static_sparse.h"

@@ -5,7 +5,7 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "irdm/outdir.h"
+#include "irdm/posix/outdir.h"
 #include "util/interrupt.h"
 
 enum { FREE, FILLING, ACTIVE };

@@ -14,6 +14,8 @@
 
 #include "irdm/board.h"
 #include "irdm/error.h"
+#include "irdm/posix/board_file.h"
+#include "irdm/posix/telemetry_log.h"
 #include "irdm/telemetry.h"
 #include "replay/replay.h"
 #include "view/view_msg.h"

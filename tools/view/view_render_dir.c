@@ -15,7 +15,7 @@
 #include <string.h>
 
 #include "irdm/error.h"
-#include "irdm/textfile.h"
+#include "irdm/posix/textfile.h"
 #include "view/view_msg.h"
 #include "view/view_playback.h"
 

@@ -47,6 +47,8 @@ struct irdm_board {
 	char name[IRDM_BOARD_NAME_MAX];
 	char hal[IRDM_BOARD_HAL_MAX];                   /* back-end name (irdm_hal_find) */
 	char hal_options[IRDM_BOARD_HAL_OPTIONS_MAX];   /* handed to the back-end as is */
+	unsigned hal_options_line;      /* its line in the file (0: not given), for
+					 * the back-end's messages; set by the loader */
 	unsigned devices;                               /* 1 or 2 */
 
 	/*
@@ -86,7 +88,8 @@ struct irdm_board {
 	double calibration_pose_rad[IRDM_DEVICE_JOINTS];        /* encoders zeroed here */
 };
 
-/* The defaults of every key (docs/boards.md); name and hal empty. */
+/* The defaults of every key, the .def of its entry in irdm_board_options()
+ * (docs/boards.md); name, hal and the workspace box empty. */
 void irdm_board_default(struct irdm_board *b);
 
 /* The key table the parser uses, for help and docs/boards.md. */
@@ -105,10 +108,23 @@ int irdm_board_parse(struct irdm_board *b, const char *name, const char *text,
 		     char *err, size_t errlen);
 
 /*
- * The same from a file (messages name it by path).
- * Return: as irdm_board_parse(); IRDM_EIO if the file cannot be read.
+ * The reader irdm_board_parse() runs, for one that gets its lines
+ * elsewhere (a file: irdm/posix/board_file.h): begin (the defaults into
+ * *b), each line (its first len characters at s, no newline; counted for
+ * messages), then irdm_board_finish().  Return: as irdm_board_parse().
  */
-int irdm_board_load(struct irdm_board *b, const char *path, char *err, size_t errlen);
+void irdm_board_read_begin(struct irdm_opt_file *f, struct irdm_board *b, const char *name);
+int irdm_board_read_line(struct irdm_opt_file *f, const char *s, size_t len, char *err,
+			  size_t errlen);
+
+/*
+ * After every line: required keys, the keys checked against each other, and
+ * the derived fields.  f tells which keys were set and on which line.
+ * Return: IRDM_OK; IRDM_EMISSING if a required key is absent; IRDM_EINVAL
+ * if keys disagree (the message names the line of the key at fault).
+ */
+int irdm_board_finish(struct irdm_board *b, const struct irdm_opt_file *f, char *err,
+		      size_t errlen);
 
 /*
  * The configuration of arm i (0-based): .device, with the shoulder at

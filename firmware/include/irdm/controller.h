@@ -12,7 +12,7 @@
  * torques and feeds telemetry.  All its memory is struct irdm_ctrl, owned by
  * the caller; the engine and image are an already-open session's.
  *
- * The tick, in order (one file in firmware/runtime/ each):
+ * The tick, in order (one file in firmware/controller/ each):
  *  1. timing: watchdog and overruns                 controller_limits.c
  *  2. commands that fault: signal, HAL flags         controller.c
  *  3. counts -> angles -> tip -> velocity            controller_input.c
@@ -91,6 +91,25 @@ struct irdm_ctrl_limits {
 	unsigned overrun_fault_count;           /* K >= 1 consecutive overruns fault */
 	uint32_t watchdog_us;                   /* compute time that faults, > 0 */
 };
+
+/*
+ * The limits and period a configuration has when nobody gives them, each
+ * written as a board file writes it: irdm_ctrl_config_default() and the
+ * board key table (its defaults, help and docs/boards.md) both expand
+ * these, so a board that leaves a key out runs as the controller's default.
+ */
+#define IRDM_CTRL_DEFAULT_MAX_TIP_SPEED_M_PER_S 2
+#define IRDM_CTRL_DEFAULT_OVERRUN_FAULT_COUNT 3
+#define IRDM_CTRL_DEFAULT_WATCHDOG_US 5000
+#define IRDM_CTRL_DEFAULT_PERIOD_US 1000
+
+/*
+ * The engine's own force limit, as a multiple of the controller's clamp
+ * (limits.max_force_n).  The controller clamps the rendered force; the
+ * engine's limit only guards against a runaway (it faults), so it sits
+ * well above.
+ */
+#define IRDM_CTRL_ENGINE_FORCE_GUARD 4
 
 struct irdm_ctrl_config {
 	unsigned n_devices;                     /* 1..IRDM_CTRL_MAX_DEVICES; device i uses engine slot i */
@@ -214,9 +233,11 @@ struct irdm_ctrl {
 
 /*
  * Defaults: one default arm (irdm_device_config_default()) calibrated at
- * the home pose, identity placement, 7.9 N, a workspace box of +-8 cm
- * around the home tip, 1 m/s, K = 3, watchdog 2 periods, 1 ms, the engine's
- * haptic default for that arm, the proxy's default, a 32-sample window.
+ * the home pose, identity placement, its 7.9 N, a workspace box of +-8 cm
+ * around the home tip, the IRDM_CTRL_DEFAULT_* tip speed, K, watchdog and
+ * period, the engine's haptic default for that arm at that period (its
+ * force limit IRDM_CTRL_ENGINE_FORCE_GUARD times the clamp), the proxy's
+ * default, a 32-sample window.
  */
 void irdm_ctrl_config_default(struct irdm_ctrl_config *cfg);
 

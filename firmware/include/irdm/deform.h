@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /*
  * The deformation channel: how the force tick hands its history to the
- * deformation context (irdm/deform_worker.h), which computes the displayed
+ * deformation context (irdm/posix/deform_worker.h), which computes the displayed
  * node positions (eq. 9/12) at its own, lower rate.
  *
  * A lock-free triple buffer in caller memory.  Publishing is a bounded copy
@@ -21,6 +21,10 @@
 #include "irdm/error.h"
 #include "irdm/history.h"
 #include "irdm/image.h"
+
+/* The highest rate a board may ask the deformation worker for (its
+ * deform_rate_hz; the worker: irdm/posix/deform_worker.h). */
+#define IRDM_DEFORM_MAX_RATE_HZ 10000.0
 
 struct irdm_deform;   /* opaque, in caller memory */
 

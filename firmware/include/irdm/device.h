@@ -83,10 +83,39 @@ struct irdm_device_config {
 };
 
 /*
+ * The default arm's figures, one macro per field, each written as a board
+ * file writes it: irdm_device_config_default() and the board key table
+ * (its defaults, help and docs/boards.md) both expand them.  Lists give
+ * one value per joint (or per body, for mass and centre of mass).
+ */
+#define IRDM_DEVICE_DEFAULT_L1_M 0.135
+#define IRDM_DEVICE_DEFAULT_L2_M 0.135
+#define IRDM_DEVICE_DEFAULT_BASE_OFFSET_M 0,0.135,-0.135        /* home-pose tip at 0 */
+/* 4000 counts per motor turn (1000 lines, quadrature) through 11.6:1:
+ * 1.35e-4 rad, 18 um at the tip per count. */
+#define IRDM_DEVICE_DEFAULT_COUNTS_PER_REV 4000,4000,4000
+#define IRDM_DEVICE_DEFAULT_GEAR_RATIO 11.6,11.6,11.6
+#define IRDM_DEVICE_DEFAULT_ANGLE_OFFSET_RAD 0,0,0
+#define IRDM_DEVICE_DEFAULT_SIGN 1,1,-1         /* the third motor turns against its joint */
+/* The counts of the joint ranges -0.42..0.42, -0.40..0.40 and -0.35..0.45
+ * rad (tests/test_device.c derives them from those angles). */
+#define IRDM_DEVICE_DEFAULT_COUNT_MIN -3102,-2954,-3324
+#define IRDM_DEVICE_DEFAULT_COUNT_MAX 3101,2953,2584
+/* 7.9 N along any axis at the home pose: 7.9 N * 0.135 m */
+#define IRDM_DEVICE_DEFAULT_TORQUE_LIMIT_NM 1.07,1.07,1.07
+#define IRDM_DEVICE_DEFAULT_MASS_KG 0.06,0.045,0.09
+#define IRDM_DEVICE_DEFAULT_COM_M 0.065,0.08,-0.03
+#define IRDM_DEVICE_DEFAULT_GRAVITY_M_PER_S2 9.81
+#define IRDM_DEVICE_DEFAULT_MAX_FORCE_N 7.9
+#define IRDM_DEVICE_DEFAULT_K_MAX_N_PER_M 1000
+#define IRDM_DEVICE_DEFAULT_B_DEVICE_NS_PER_M 5
+
+/*
  * Defaults: a PHANToM Desktop-like arm (l1 = l2 = 0.135 m, 4000 counts per
- * motor turn through an 11.6:1 capstan, 1000 N/m, 7.9 N, 5 N s/m).  The
- * figures are plausible, not measured on a device; the joint ranges give a
- * workspace of about 16 x 12 x 12 cm (tests/test_device.c measures it).
+ * motor turn through an 11.6:1 capstan, 1000 N/m, 7.9 N, 5 N s/m: the
+ * macros above).  The figures are plausible, not measured on a device; the
+ * joint ranges give a workspace of about 16 x 12 x 12 cm
+ * (tests/test_device.c measures it).
  */
 void irdm_device_config_default(struct irdm_device_config *cfg);
 

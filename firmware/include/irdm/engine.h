@@ -63,7 +63,7 @@ struct irdm_engine_config {
 	 * stable_radius / that radius, so that its radius becomes <=
 	 * stable_radius (<1).  This distorts the response from the first
 	 * sample; an image made with fir_tail = window:L is stable as stored
-	 * and runs undamped.  0 = 0.999.
+	 * and runs undamped.  0 = IRDM_ENGINE_STABLE_RADIUS.
 	 */
 	double stable_radius;
 	double max_force_n;             /* > 0: a larger force faults the engine (torque off) */
@@ -84,6 +84,9 @@ struct irdm_engine_config {
 /* The default re-engagement fade (irdm_engine_config_default()): long
  * against a hand's reaction (~0.1 s), short against a user's patience. */
 #define IRDM_ENGINE_ENGAGE_FADE_S 0.25
+/* The default stable_radius, also what 0 asks for: just inside the unit
+ * circle, so the damping distorts the response as little as it can. */
+#define IRDM_ENGINE_STABLE_RADIUS 0.999
 /* The longest fade a configuration may ask for (seconds). */
 #define IRDM_ENGINE_ENGAGE_FADE_MAX_S 10.0
 
@@ -126,7 +129,7 @@ struct irdm_engine;   /* opaque; lives in the caller's memory */
 /* Bytes irdm_engine_init() needs (0 on invalid configuration). */
 size_t irdm_engine_mem_size(const struct irdm_image *img, const struct irdm_engine_config *cfg);
 
-/* Defaults: 2 contacts, coupled, rigid coupling, no PC, radius 0.999, no
+/* Defaults: 2 contacts, coupled, rigid coupling, no PC, IRDM_ENGINE_STABLE_RADIUS, no
  * force limit, no snapshots, IRDM_ENGINE_ENGAGE_FADE_S. */
 void irdm_engine_config_default(struct irdm_engine_config *cfg);
 

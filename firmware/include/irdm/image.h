@@ -66,23 +66,6 @@ struct irdm_image {
 };
 
 /*
- * Copy the image at path into private memory, read-only, and validate it.
- * A copy, not a mapping of the file: the bytes a running loop reads cannot
- * change or vanish when the file is truncated or replaced.  Populates the
- * copy (no page fault later) and, with IRDM_IMAGE_MAP_LOCK, locks it.  On failure img is zeroed,
- * nothing stays mapped, and err holds "path: reason" on one line.
- *
- * Return: IRDM_OK;
- * IRDM_EINVAL if flags has a bit other than IRDM_IMAGE_MAP_LOCK;
- * IRDM_EIO if the file cannot be opened, stat'ed, read, copied or locked, is
- * not a regular file, is too large to map or grew while it was read;
- * IRDM_ETRUNC if it is shorter than an image header or shrank while read;
- * otherwise any error of irdm_image_parse().
- */
-int irdm_image_map(const char *path, unsigned flags, struct irdm_image *img,
-		   char *err, size_t errlen);
-
-/*
  * Validate an image already in memory (buf must stay valid; it must be
  * 8-byte aligned).  The checks run in the order of docs/image-format.md
  * section 9 and the first failure is returned, with a one-line reason in
@@ -103,10 +86,6 @@ int irdm_image_map(const char *path, unsigned flags, struct irdm_image *img,
  */
 int irdm_image_parse(const void *buf, size_t size, struct irdm_image *img,
 		     char *err, size_t errlen);
-
-/* Unmap an image from irdm_image_map() (no-op for irdm_image_parse's) and
- * zero img.  Cannot fail. */
-void irdm_image_unmap(struct irdm_image *img);
 
 /* STATIC_CORR_CLUSTERS (img->corr_clusters non-NULL): the cluster of
  * column col, and its index among the cluster's members into *local

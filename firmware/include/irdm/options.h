@@ -1,10 +1,11 @@
 /* SPDX-License-Identifier: MIT */
 /*
  * Option tables: one constant table of keys (name, type, range, unit, help,
- * where the value goes) drives the parsing of "key = value" files, of
- * "--key value" arguments, and the help and documentation printed from it
- * (irdm_opt_range_text() gives the range in words).  The scene of the
- * offline tool and the controller's board file use the same machinery.
+ * default, where the value goes) drives the parsing of "key = value" files,
+ * of "--key value" arguments, the defaults (irdm_opt_set_defaults()), and
+ * the help and documentation printed from it (irdm_opt_range_text() gives
+ * the range in words).  The scene of the offline tool, the controller's
+ * board file and the HAL back-ends' options use the same machinery.
  *
  * No allocation, no I/O: values are stored into a caller's struct (offsetof)
  * or handed to a parse callback; messages go to a caller's buffer.
@@ -53,7 +54,14 @@ struct irdm_opt {
 	enum irdm_opt_type type;
 	const char *metavar;    /* the value's syntax for help: "SECONDS", "yes | no" */
 	const char *unit;       /* "s", "Pa" or NULL */
-	const char *help;       /* one line */
+	const char *help;       /* one line, without the default */
+	/*
+	 * The value a key not given takes, written as in a file and parsed by
+	 * the entry itself: help and docs print it as "(default X)" ("" prints
+	 * as "none").  NULL: the table gives no default (a required key, or one
+	 * set otherwise).
+	 */
+	const char *def;
 	size_t offset;          /* where the value goes in the caller's struct */
 	size_t size;            /* of that field (IRDM_OPT_FIELD) */
 	unsigned range;         /* IRDM_OPT_GE | IRDM_OPT_LT ... */
@@ -65,6 +73,14 @@ struct irdm_opt {
 /* .offset and .size of a member, e.g. IRDM_OPT_FIELD(struct irdm_scene, dt_s). */
 #define IRDM_OPT_FIELD(type, member) \
 	.offset = offsetof(type, member), .size = sizeof(((type *)0)->member)
+
+/*
+ * .def from a macro that expands to the value: the C code and the table
+ * share one definition, e.g. IRDM_OPT_DEFAULT(IRDM_DEVICE_DEFAULT_L1_M);
+ * a list macro (0,0.135,-0.135) keeps its commas.
+ */
+#define IRDM_OPT_DEFAULT(...) .def = IRDM_OPT_TEXT_(__VA_ARGS__)
+#define IRDM_OPT_TEXT_(...) #__VA_ARGS__
 
 /*
  * A STRING entry that stores the pointer in a `const char *` member: the
@@ -105,6 +121,25 @@ int irdm_opt_parse_value(const struct irdm_opt *o, void *obj, const char *value,
  */
 int irdm_opt_set(const struct irdm_opt_table *t, void *obj, const char *where, const char *key,
 		 const char *value, char *err, size_t errlen);
+
+/*
+ * Every entry's .def parsed into obj, in table order (entries without one
+ * are left as they are).  Messages: "default of key: reason".
+ * Return: IRDM_OK; what irdm_opt_parse_value() returns for the first
+ * default it refuses (a broken table).
+ */
+int irdm_opt_set_defaults(const struct irdm_opt_table *t, void *obj, char *err, size_t errlen);
+
+/*
+ * "key=value" words, separated by any character of seps (" ,\t": a HAL
+ * back-end's options), each set through t.  Messages: those of
+ * irdm_opt_set() ("WHERE: key = value: reason", "WHERE: unknown <what>
+ * 'key' (see <see>)"), and "WHERE: 'word': expected key=value".
+ * Return: IRDM_OK; IRDM_EINVAL for an unknown key, a word without '=' or
+ * one longer than 255 characters; IRDM_EFORMAT for an invalid value.
+ */
+int irdm_opt_parse_words(const struct irdm_opt_table *t, void *obj, const char *where,
+			 const char *text, const char *seps, char *err, size_t errlen);
 
 /* s without its leading white space; trailing white space is cut in place. */
 char *irdm_opt_trim(char *s);

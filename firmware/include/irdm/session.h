@@ -53,21 +53,9 @@ struct irdm_session {
 
 	/* private */
 	struct irdm_image mapped;
+	void (*unmap)(struct irdm_image *img);      /* of mapped; NULL: borrowed image */
 	void *eng_mem, *deform_mem, *worker_mem;
 };
-
-/*
- * Map and validate the image at path, then set up as
- * irdm_session_open_image() does.  The session unmaps it on close.
- *
- * Return: IRDM_OK;
- * any error of irdm_image_map() (IRDM_EIO, IRDM_ETRUNC, IRDM_EMAGIC,
- * IRDM_EVERSION, IRDM_ECRC, IRDM_ERANGE, IRDM_EMISSING, IRDM_EFORMAT);
- * otherwise as irdm_session_open_image().
- * On error *s is NULL, nothing is left mapped or allocated, and err says why.
- */
-int irdm_session_open(struct irdm_session **s, const char *path,
-		      const struct irdm_session_config *cfg, char *err, size_t errlen);
 
 /*
  * A session on an image the caller has mapped or parsed (borrowed: it must
@@ -85,18 +73,35 @@ int irdm_session_open_image(struct irdm_session **s, const struct irdm_image *im
 			    const struct irdm_session_config *cfg, char *err, size_t errlen);
 
 /*
- * The deformation worker (irdm/deform_worker.h) on the session's channel,
- * in memory the session frees on close.  Its own object file: calling it
- * links BLAS and threads.  A deformation thread started on s->worker must
- * be stopped before irdm_session_close().
+ * As irdm_session_open_image(), on the image that map(path, cfg->map_flags,
+ * ...) fills in the session's own memory; close hands it to unmap.  The
+ * platform supplies the pair (irdm_session_open(), irdm/posix/session.h).
  *
  * Return: IRDM_OK;
- * IRDM_EINVAL if the session has no deformation channel (config.deform was
- * false) or its image is not one the update can read;
- * IRDM_EBUSY if the session already has a worker;
- * IRDM_ENOMEM if the allocation failed.
+ * IRDM_EINVAL if path or cfg is NULL; IRDM_ENOMEM; any error of map;
+ * otherwise as irdm_session_open_image().
+ * On error *s is NULL, nothing is left mapped or allocated, and err says why.
  */
-int irdm_session_deform_open(struct irdm_session *s, char *err, size_t errlen);
+int irdm_session_open_with(struct irdm_session **s, const char *path,
+			   const struct irdm_session_config *cfg,
+			   int (*map)(const char *path, unsigned flags, struct irdm_image *img,
+				      char *err, size_t errlen),
+			   void (*unmap)(struct irdm_image *img), char *err, size_t errlen);
+
+/*
+ * Memory for one part of the session: *mem = n bytes, cache-line aligned
+ * (the engine wants 16; 64 keeps a part's hot data off its neighbour's
+ * lines).  n == 0 means the part's size call refused the image or the
+ * configuration: nothing is allocated and IRDM_OK returned, so that the
+ * part's init, given no memory, says why.
+ *
+ * For the session's parts that live apart (the platform's deformation
+ * worker: irdm/posix/session.h).
+ *
+ * Return: IRDM_OK; IRDM_ENOMEM (err says which part) if allocation failed.
+ */
+int irdm_session_part_mem(void **mem, size_t n, const char *part, char *err, size_t errlen);
+
 
 /* Free everything the session holds, and unmap what it mapped.  NULL is fine. */
 void irdm_session_close(struct irdm_session *s);
