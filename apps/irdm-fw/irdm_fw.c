@@ -13,6 +13,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/prctl.h>
+#include <sys/syscall.h>
+#include <unistd.h>
 
 #include "irdm/error.h"
 #include "irdm/posix/board_file.h"
@@ -22,6 +24,7 @@
 #include "fw.h"
 
 #define FORCE_STACK_BYTES (256u * 1024u)    /* pre-faulted for the loop */
+#define TASKS_MAX 64                        /* threads listed at start */
 
 static volatile sig_atomic_t signalled;
 
@@ -202,6 +205,43 @@ static int setup_realtime(struct fw *fw)
 	return FW_EXIT_OK;
 }
 
+/*
+ * The loop's CPU to the loop alone, once every thread is up (a BLAS pool
+ * started before main has the whole machine in its mask), and every
+ * thread listed as the system schedules it, read back: one that may still
+ * run on the loop's CPU is named, and --require-rt refuses it.
+ */
+static int isolate_loop(struct fw *fw)
+{
+	struct irdm_rt_task tasks[TASKS_MAX];
+	pid_t loop = (pid_t)syscall(SYS_gettid);
+	int cpu = fw->board.cpu, intruders;
+	char line[160];
+	size_t n;
+
+	if (fw->args.clock != IRDM_CLOCK_REAL)
+		return FW_EXIT_OK;
+	if (cpu >= 0)
+		irdm_rt_isolate_cpu(cpu, loop);
+	intruders = irdm_rt_isolation_check(cpu, loop, tasks, TASKS_MAX, &n);
+	for (size_t i = 0; i < n && !fw->args.quiet; i++) {
+		irdm_rt_task_format(&tasks[i], line, sizeof(line));
+		printf("%s\n", line);
+	}
+	if (intruders == 0)
+		return FW_EXIT_OK;
+	if (intruders > 0)
+		snprintf(line, sizeof(line), "%d other thread%s may run on the loop's CPU %d",
+			 intruders, intruders == 1 ? "" : "s", cpu);
+	else
+		snprintf(line, sizeof(line), "the threads on the loop's CPU %d cannot be listed",
+			 cpu);
+	if (fw->args.require_rt)
+		return fail(FW_EXIT_SETUP, IRDM_EPERM, "%s: %s", "--require-rt", line);
+	fprintf(stderr, "irdm-fw: %s\n", line);
+	return FW_EXIT_OK;
+}
+
 static uint64_t run_ticks(const struct fw *fw)
 {
 	double s = fw->args.duration_s;
@@ -256,6 +296,9 @@ static int start(struct fw *fw)
 		rc = fw_view_start(fw);
 	if (rc)
 		return fail(FW_EXIT_SETUP, rc, "%s%s", "", fw->err);
+	rc = isolate_loop(fw);
+	if (rc)
+		return rc;
 	return start_devices(fw);
 }
 
