@@ -7,7 +7,9 @@
  * every other CPU and not on that one, as /proc/PID/task says from
  * outside the process; the loop's thread runs on that CPU alone.  The
  * start-up lines list each of those threads, as seen here, and none as
- * "may run on the loop's CPU".
+ * "may run on the loop's CPU".  While the loop runs, no CPU may enter an
+ * idle state slower than 0 us to leave (/dev/cpu_dma_latency reads 0:
+ * the request irdm-fw holds, as cyclictest does).
  * Needs IRDM_FW and IRDM_TICK_IMAGE (make test sets them) and two CPUs.
  */
 #define _GNU_SOURCE
@@ -124,12 +126,27 @@ static size_t read_tasks(pid_t pid, pid_t *tids, uint64_t *masks)
 	return n;
 }
 
+/* The kernel's idle-latency limit in force, us; -1 if unreadable (not root). */
+static int32_t cpu_latency_us(void)
+{
+	FILE *f = fopen("/dev/cpu_dma_latency", "rb");
+	int32_t us = -1;
+
+	if (!f)
+		return -1;
+	if (fread(&us, sizeof(us), 1, f) != 1)
+		us = -1;
+	fclose(f);
+	return us;
+}
+
 static void test_only_the_loop_runs_on_its_cpu(void **state)
 {
 	const struct timespec settle = { 1, 0 };    /* every thread up, the loop running */
 	pid_t pid, tids[TASKS_MAX];
 	uint64_t masks[TASKS_MAX], loop_bit;
 	char board[320], log[320], line[128];
+	int32_t before = cpu_latency_us(), during;
 	int cpu, rc;
 	size_t n;
 
@@ -146,9 +163,18 @@ static void test_only_the_loop_runs_on_its_cpu(void **state)
 		"--duration", "2", "--log", log, NULL });
 	nanosleep(&settle, NULL);
 	n = read_tasks(pid, tids, masks);
+	during = cpu_latency_us();
 	rc = rp_finish(dir, pid, out_text, sizeof(out_text), err_text, sizeof(err_text));
 	if (rc != 0)
 		fail_msg("irdm-fw exited %d: %s", rc, err_text);
+	print_message("/dev/cpu_dma_latency: %d us before, %d during the run, %d after\n",
+		      (int)before, (int)during, (int)cpu_latency_us());
+	/* readable here (root): irdm-fw could open it too; 0 before is
+	 * another process's request, which would hide irdm-fw's */
+	if (before > 0) {
+		assert_int_equal(during, 0);
+		assert_non_null(strstr(out_text, "idle states: none slower than 0 us to leave"));
+	}
 	/* the loop, the log writer, the deformation worker, the monitor at least */
 	print_message("%zu threads during the run, the loop on CPU %d\n", n, cpu);
 	assert_true(n >= 4);

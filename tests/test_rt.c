@@ -672,6 +672,28 @@ static void test_isolation(void **state)
 	sem_destroy(&go);
 }
 
+/*
+ * The idle-latency request: held, the kernel's answer is the value asked
+ * for; released, it is what it was before.  Needs the device (root): a
+ * refusal is IRDM_EPERM and the rest is skipped.
+ */
+static void test_cpu_latency_hold(void **state)
+{
+	int32_t before = irdm_rt_cpu_latency_us();
+	int hold;
+
+	(void)state;
+	hold = irdm_rt_cpu_latency_hold(0);
+	print_message("  /dev/cpu_dma_latency: %d us before, hold %d\n", (int)before, hold);
+	if (hold == IRDM_EPERM || hold == IRDM_ENOTSUP)
+		skip();
+	assert_true(hold >= 0);
+	assert_int_equal(irdm_rt_cpu_latency_us(), 0);
+	irdm_rt_cpu_latency_release(hold);
+	assert_int_equal(irdm_rt_cpu_latency_us(), before);
+	irdm_rt_cpu_latency_release(-1);        /* nothing held: nothing done */
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -690,6 +712,7 @@ int main(void)
 		cmocka_unit_test(test_cpu_except),
 		cmocka_unit_test(test_refusals),
 		cmocka_unit_test(test_isolation),
+		cmocka_unit_test(test_cpu_latency_hold),
 	};
 
 	return cmocka_run_group_tests(tests, NULL, NULL);

@@ -175,6 +175,28 @@ static int start_devices(struct fw *fw)
 }
 
 /*
+ * Every CPU kept out of idle states that are slow to leave, as cyclictest
+ * does: otherwise the loop's CPU, idle for most of each period, sleeps
+ * deeply (on a virtual machine the host deschedules it) and every wake
+ * pays for leaving that state.  Held until the process exits.
+ */
+static void hold_idle(struct fw *fw)
+{
+	int32_t us;
+
+	fw->idle_hold = irdm_rt_cpu_latency_hold(0);
+	if (fw->args.quiet)
+		return;
+	us = irdm_rt_cpu_latency_us();
+	if (fw->idle_hold >= 0)
+		printf("idle states: none slower than %d us to leave, while the loop runs "
+		       "(/dev/cpu_dma_latency)\n", (int)us);
+	else
+		printf("idle states: not limited (/dev/cpu_dma_latency: %s); the loop's wake-ups "
+		       "pay for leaving them\n", irdm_strerror(fw->idle_hold));
+}
+
+/*
  * Real time as the board asks (real clock only), then report what was
  * granted, read back; --require-rt refuses to run on less (libfranka-style:
  * never claim real time that was not given).
@@ -200,6 +222,7 @@ static int setup_realtime(struct fw *fw)
 	irdm_rt_report_format(&rep, line, sizeof(line));
 	if (!fw->args.quiet)
 		printf("%s\n", line);
+	hold_idle(fw);
 	if (fw->args.require_rt && !irdm_rt_report_realtime(&rep))
 		return fail(FW_EXIT_SETUP, IRDM_EPERM, "%s: %s", "--require-rt", line);
 	return FW_EXIT_OK;
@@ -334,6 +357,7 @@ static int stop(struct fw *fw, int rc)
 	if (fw->ring && fw_log_close(fw) && fail(FW_EXIT_LOG, IRDM_EIO, "%s%s", "", fw->err) &&
 	    rc == FW_EXIT_OK)
 		rc = FW_EXIT_LOG;
+	irdm_rt_cpu_latency_release(fw->idle_hold);
 	fw_user_free(fw);
 	fw_monitor_free(fw);
 	fw_frame_free(fw);
@@ -375,6 +399,7 @@ int main(int argc, char **argv)
 
 	if (!fw)
 		return fail(FW_EXIT_SETUP, IRDM_ENOMEM, "%s%s", "", "out of memory");
+	fw->idle_hold = -1;
 	rc = fw_args_parse(&fw->args, argc - 1, argv + 1, fw->err, sizeof(fw->err));
 	if (rc || fw->args.help || fw->args.help_board || fw->args.doc) {
 		if (fw->args.help || !rc) {

@@ -100,6 +100,34 @@ void irdm_rt_unlock_memory(void);
  */
 int irdm_rt_prefault_stack(size_t depth_bytes);
 
+/* ---- idle states ---- */
+
+/*
+ * Keep every CPU out of idle states that take longer than max_us to leave,
+ * for as long as the returned handle is held (a PM QoS request: writing
+ * the limit to /dev/cpu_dma_latency and keeping the file open, as
+ * cyclictest does by default).  An idle CPU in a deep state, or a virtual
+ * CPU the host descheduled on HLT, answers its timer tens of microseconds
+ * late: a loop that sleeps most of its period pays that on every wake.
+ * The kernel drops the request when the handle is closed or the process
+ * ends, however it ends.  Process-wide, and it costs power: idle CPUs poll.
+ *
+ * Return: the handle (>= 0); IRDM_EPERM if the device cannot be opened
+ * (root only on most systems); IRDM_ENOTSUP if there is no such device;
+ * IRDM_EIO if the kernel refused the value.
+ */
+int irdm_rt_cpu_latency_hold(int32_t max_us);
+
+/* Drop a request irdm_rt_cpu_latency_hold() made (nothing for a handle < 0). */
+void irdm_rt_cpu_latency_release(int hold);
+
+/*
+ * The limit in force now, us, from all requests of every process (the
+ * kernel's answer to a read of /dev/cpu_dma_latency); -1 if it cannot be
+ * read.  2000000000 means none.
+ */
+int32_t irdm_rt_cpu_latency_us(void);
+
 /* ---- scheduling ---- */
 
 /*
