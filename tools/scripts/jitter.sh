@@ -5,6 +5,9 @@
 # 10 x 3 s; the order swaps every round), so that a load that changes
 # during the measurement falls on both tools alike.
 #   tools/scripts/jitter.sh IRDM IRDM_FW IMAGE
+# irdm-fw's wake-ups are counted as cyclictest counts its own: the ticks run
+# late after a stall (catch-up ticks, which did not sleep) are left out and
+# counted apart, as cyclictest skips the periods a late wake-up missed.
 # Prints each round's p50, p99 and max of both, the pooled percentiles, the
 # ratio of the pooled p50 and p99 (irdm-fw / cyclictest) and its spread over
 # the rounds (min..max of the per-round ratio); writes the same, with the
@@ -84,7 +87,7 @@ for r in $(seq 1 "$rounds"); do
 	fi
 done
 load_after=$(cut -d' ' -f1-3 /proc/loadavg)
-grep -E '^(real-time|thread)' "$out/irdm-fw-1.txt" || true
+grep -E '^(real-time|idle states|thread)' "$out/irdm-fw-1.txt" || true
 
 mkdir -p "$(dirname "$doc")"
 {
@@ -99,18 +102,32 @@ mkdir -p "$(dirname "$doc")"
 	host_header "$load_before" "$load_after"
 	echo
 } > "$out/jitter.md"
-/usr/bin/python3 - "$out" "$rounds" "${baseline:+baseline}" >> "$out/jitter.md" <<'PY'
+/usr/bin/python3 - "$out" "$rounds" "$period" "${baseline:+baseline}" >> "$out/jitter.md" <<'PY'
 import csv, math, sys
 
-out, rounds, baseline = sys.argv[1], int(sys.argv[2]), sys.argv[3]
+out, rounds, period_us, baseline = sys.argv[1], int(sys.argv[2]), float(sys.argv[3]), sys.argv[4]
 
 def q(v, p):
     """nearest rank"""
     return v[max(0, math.ceil(p * len(v)) - 1)]
 
 def fw_lat(path):
+    """irdm-fw's wake-ups, counted as cyclictest counts its own: a tick whose
+    period had begun before the previous tick ended did not sleep (the loop
+    runs every period, late), while cyclictest skips to the next period
+    boundary after a late wake; so one stall of D is one sample in
+    cyclictest and D / period samples in irdm-fw's log.  Those catch-up
+    ticks are left out here and counted apart."""
+    slept, catch_up, prev_end = [], 0, 0.0
     with open(path, newline="") as f:
-        return sorted(int(r["wake_latency_ns"]) / 1000.0 for r in csv.DictReader(f))
+        for r in csv.DictReader(f):
+            lat = int(r["wake_latency_ns"]) / 1000.0
+            if prev_end >= period_us:
+                catch_up += 1
+            else:
+                slept.append(lat)
+            prev_end = lat + int(r["compute_ns"]) / 1000.0
+    return sorted(slept), catch_up
 
 def ct_lat(path):
     v, over = [], 0
@@ -124,54 +141,63 @@ def ct_lat(path):
             v.extend([float(us)] * sum(int(c) for c in counts))
     # beyond the histogram's 100 ms: counted at its end
     v.extend([100000.0] * over)
-    return sorted(v)
+    return sorted(v), 0
 
-tools = [("irdm-fw", lambda r: fw_lat(f"{out}/irdm-fw-{r}.csv"))]
-if baseline:
-    tools.append(("baseline", lambda r: fw_lat(f"{out}/baseline-{r}.csv")))
-tools.append(("cyclictest", lambda r: ct_lat(f"{out}/cyclictest-{r}.txt")))
-per = {name: [get(r) for r in range(1, rounds + 1)] for name, get in tools}
-for name, runs in per.items():
-    if any(not v for v in runs):
-        sys.exit(f"jitter: {name}: a round without samples")
+names = ["irdm-fw"] + (["baseline"] if baseline else []) + ["cyclictest"]
+per, skipped = {}, {}
+for n in names:
+    runs = [ct_lat(f"{out}/cyclictest-{r}.txt") if n == "cyclictest"
+            else fw_lat(f"{out}/{n}-{r}.csv") for r in range(1, rounds + 1)]
+    per[n] = [v for v, _ in runs]
+    skipped[n] = [c for _, c in runs]
+    if any(not v for v in per[n]):
+        sys.exit(f"jitter: {n}: a round without samples")
+fws = names[:-1]
 ct = per["cyclictest"]
 
+def ratio(n, i, p):
+    return q(per[n][i], p) / max(q(ct[i], p), 1)
+
 print("## Each round (us)\n")
-head = "| round |" + "".join(f" {n} p50 | {n} p99 | {n} max |" for n, _ in tools)
-head += " p50 ratio | p99 ratio |"
-print(head)
-print("|---" * (1 + 3 * len(tools) + 2) + "|")
-ratios = {n: ([], []) for n, _ in tools if n != "cyclictest"}
+print("| round |" + "".join(f" {n} p50 | {n} p99 | {n} max |" for n in names) +
+      "".join(f" {n} catch-up ticks |" for n in fws) + " p50 ratio | p99 ratio |")
+print("|---" * (1 + 3 * len(names) + len(fws) + 2) + "|")
 for i in range(rounds):
     row = f"| {i + 1} |"
-    for n, _ in tools:
+    for n in names:
         v = per[n][i]
         row += f" {q(v, .5):.1f} | {q(v, .99):.1f} | {v[-1]:.1f} |"
-    for n in ratios:
-        w = per[n][i]
-        ratios[n][0].append(q(w, .5) / max(q(ct[i], .5), 1))
-        ratios[n][1].append(q(w, .99) / max(q(ct[i], .99), 1))
-    print(row + f" {ratios['irdm-fw'][0][i]:.2f} | {ratios['irdm-fw'][1][i]:.2f} |")
+    row += "".join(f" {skipped[n][i]} |" for n in fws)
+    print(row + f" {ratio('irdm-fw', i, .5):.2f} | {ratio('irdm-fw', i, .99):.2f} |")
 
 print("\n## Pooled over the rounds (us)\n")
-print("| | p50 | p99 | p99.9 | max | samples |")
-print("|---|---|---|---|---|---|")
-pooled = {n: sorted(x for v in per[n] for x in v) for n, _ in tools}
-for n, _ in tools:
+print("| | p50 | p99 | p99.9 | max | samples | catch-up ticks left out |")
+print("|---|---|---|---|---|---|---|")
+pooled = {n: sorted(x for v in per[n] for x in v) for n in names}
+for n in names:
     v = pooled[n]
-    print(f"| {n} | {q(v, .5):.1f} | {q(v, .99):.1f} | {q(v, .999):.1f} | {v[-1]:.1f} | {len(v)} |")
+    print(f"| {n} | {q(v, .5):.1f} | {q(v, .99):.1f} | {q(v, .999):.1f} | {v[-1]:.1f} | "
+          f"{len(v)} | {sum(skipped[n])} |")
 
 print("\n## Ratio to cyclictest\n")
 print("| | pooled p50 | pooled p99 | p50 per round, min..max | p99 per round, min..max |")
 print("|---|---|---|---|---|")
 c = pooled["cyclictest"]
-for n, (r50, r99) in ratios.items():
+for n in fws:
     v = pooled[n]
+    r50 = [ratio(n, i, .5) for i in range(rounds)]
+    r99 = [ratio(n, i, .99) for i in range(rounds)]
     print(f"| {n} / cyclictest | {q(v, .5) / max(q(c, .5), 1):.2f} | "
           f"{q(v, .99) / max(q(c, .99), 1):.2f} | {min(r50):.2f}..{max(r50):.2f} | "
           f"{min(r99):.2f}..{max(r99):.2f} |")
-print("\nRatios divide by at least 1 us.  Percentiles are nearest-rank; cyclictest's")
-print("come from its 1 us histogram.")
+print(f"""
+irdm-fw's samples are its wake-ups as cyclictest counts its own: after a
+late tick, cyclictest skips to the next period boundary, while irdm-fw runs
+every period, late (a tick whose period began before the previous tick
+ended, at wake-up latency + compute >= {period_us:.0f} us, did not sleep: a
+catch-up tick, left out and counted).  irdm-fw's own summary counts every
+tick.  Ratios divide by at least 1 us; percentiles are nearest-rank;
+cyclictest's come from its 1 us histogram.""")
 PY
 cat "$out/jitter.md"
 cp "$out/jitter.md" "$doc"
