@@ -178,7 +178,8 @@ static int start_devices(struct fw *fw)
  * Every CPU kept out of idle states that are slow to leave, as cyclictest
  * does: otherwise the loop's CPU, idle for most of each period, sleeps
  * deeply (on a virtual machine the host deschedules it) and every wake
- * pays for leaving that state.  Held until the process exits.
+ * pays for leaving that state.  Held until the run stops (the kernel drops
+ * it too if the process dies).
  */
 static void hold_idle(struct fw *fw)
 {
@@ -251,7 +252,8 @@ static int isolate_loop(struct fw *fw)
 		irdm_rt_task_format(&tasks[i], line, sizeof(line));
 		printf("%s\n", line);
 	}
-	if (intruders == 0)
+	/* without a CPU of its own, the loop has none to keep */
+	if (intruders == 0 || cpu < 0)
 		return FW_EXIT_OK;
 	if (intruders > 0)
 		snprintf(line, sizeof(line), "%d other thread%s may run on the loop's CPU %d",
