@@ -20,7 +20,8 @@
 #                   the exact model (irdm report; REPORT_CONFIGS, <= 10 min)
 #   make run        the main job: the built-in default scene, end to end
 #   make view-shots after make run: its run in the browser view, docs/view/*.png
-#   make jitter     irdm-fw's wake-up latency beside cyclictest's (JITTER_SECONDS)
+#   make jitter     irdm-fw's wake-up latency beside cyclictest's, alternating
+#                   (JITTER_ROUNDS x JITTER_SECONDS; docs/measurements/jitter.md)
 #   make jitter-view the same loop with and without a browser on its live view
 #   make hil        the CAN back-end end to end in a PREEMPT_RT VM (docs/hil.md)
 #   make docs       every generated document (GEN_DOCS: scene-format.md, the
@@ -417,8 +418,8 @@ $(BENCH_NAMES): %: $(BUILD)/bench/% $(IRDM)
 
 bench: $(BENCHES) $(IRDM) bench-precompute
 	for b in $(BENCH_NAMES); do $(MAKE) --no-print-directory $$b; done
-	@echo "== ticks paced at 1 kHz, deformation thread running (make jitter, 10 s)"
-	$(MAKE) --no-print-directory jitter JITTER_SECONDS=10
+	@echo "== ticks paced at 1 kHz, deformation thread running (make jitter, 5 x 2 s)"
+	$(MAKE) --no-print-directory jitter JITTER_ROUNDS=5 JITTER_SECONDS=2
 
 # Accuracy, tick time and image size of every representation against the
 # exact full model (irdm report --help); CSVs in out/report/, the report
@@ -484,14 +485,15 @@ render: deps
 	$(MAKE) $(IRDM)
 	tools/scripts/render-default-scene.sh $(IRDM)
 
-# irdm-fw's wake-up latency beside cyclictest's (JITTER_SECONDS each, default 60)
+# irdm-fw's wake-up latency beside cyclictest's, alternating in JITTER_ROUNDS
+# rounds of JITTER_SECONDS each (default 10 x 3 s); docs/measurements/jitter.md
 JITTER_IMAGE := $(BUILD)/data/jitter.img
 $(JITTER_IMAGE): $(IRDM) scenes/cuboid-top.scene
 	@mkdir -p $(dir $@)
 	$(IRDM) precompute -q --scene scenes/cuboid-top.scene -o $@
+# (jitter.sh writes the file, with the host's conditions, itself)
 jitter: deps $(IRDM) $(IRDM_FW) $(JITTER_IMAGE)
-	$(MEASURE) jitter 'make jitter JITTER_SECONDS=$(or $(JITTER_SECONDS),60)' -- \
-	  env JITTER_SECONDS=$(or $(JITTER_SECONDS),60) tools/scripts/jitter.sh $(IRDM) $(IRDM_FW) $(JITTER_IMAGE)
+	tools/scripts/jitter.sh $(IRDM) $(IRDM_FW) $(JITTER_IMAGE)
 
 # The same loop with and without a browser on its live view, alternating
 # (JITTER_ROUNDS pairs of JITTER_SECONDS, default 3 x 20 s; docs/view.md)

@@ -13,6 +13,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/prctl.h>
+#include <sys/syscall.h>
+#include <unistd.h>
 
 #include "irdm/board.h"
 #include "irdm/error.h"
@@ -23,6 +25,7 @@
 #include "fw.h"
 
 #define FORCE_STACK_BYTES (256u * 1024u)    /* pre-faulted for the loop */
+#define TASKS_MAX 64                        /* threads listed at start */
 
 static volatile sig_atomic_t signalled;
 
@@ -173,6 +176,29 @@ static int start_devices(struct fw *fw)
 }
 
 /*
+ * Every CPU kept out of idle states that are slow to leave, as cyclictest
+ * does: otherwise the loop's CPU, idle for most of each period, sleeps
+ * deeply (on a virtual machine the host deschedules it) and every wake
+ * pays for leaving that state.  Held until the run stops (the kernel drops
+ * it too if the process dies).
+ */
+static void hold_idle(struct fw *fw)
+{
+	int32_t us;
+
+	fw->idle_hold = irdm_rt_cpu_latency_hold(0);
+	if (fw->args.quiet)
+		return;
+	us = irdm_rt_cpu_latency_us();
+	if (fw->idle_hold >= 0)
+		printf("idle states: none slower than %d us to leave, while the loop runs "
+		       "(/dev/cpu_dma_latency)\n", (int)us);
+	else
+		printf("idle states: not limited (/dev/cpu_dma_latency: %s); the loop's wake-ups "
+		       "pay for leaving them\n", irdm_strerror(fw->idle_hold));
+}
+
+/*
  * Real time as the board asks (real clock only), then report what was
  * granted, read back; --require-rt refuses to run on less (libfranka-style:
  * never claim real time that was not given).
@@ -198,8 +224,47 @@ static int setup_realtime(struct fw *fw)
 	irdm_rt_report_format(&rep, line, sizeof(line));
 	if (!fw->args.quiet)
 		printf("%s\n", line);
+	hold_idle(fw);
 	if (fw->args.require_rt && !irdm_rt_report_realtime(&rep))
 		return fail(FW_EXIT_SETUP, IRDM_EPERM, "%s: %s", "--require-rt", line);
+	return FW_EXIT_OK;
+}
+
+/*
+ * The loop's CPU to the loop alone, once every thread is up (a BLAS pool
+ * started before main has the whole machine in its mask), and every
+ * thread listed as the system schedules it, read back: one that may still
+ * run on the loop's CPU is named, and --require-rt refuses it.
+ */
+static int isolate_loop(struct fw *fw)
+{
+	struct irdm_rt_task tasks[TASKS_MAX];
+	pid_t loop = (pid_t)syscall(SYS_gettid);
+	int cpu = fw->board.cpu, intruders;
+	char line[160];
+	size_t n;
+
+	if (fw->args.clock != IRDM_CLOCK_REAL)
+		return FW_EXIT_OK;
+	if (cpu >= 0)
+		irdm_rt_isolate_cpu(cpu, loop);
+	intruders = irdm_rt_isolation_check(cpu, loop, tasks, TASKS_MAX, &n);
+	for (size_t i = 0; i < n && !fw->args.quiet; i++) {
+		irdm_rt_task_format(&tasks[i], line, sizeof(line));
+		printf("%s\n", line);
+	}
+	/* without a CPU of its own, the loop has none to keep */
+	if (intruders == 0 || cpu < 0)
+		return FW_EXIT_OK;
+	if (intruders > 0)
+		snprintf(line, sizeof(line), "%d other thread%s may run on the loop's CPU %d",
+			 intruders, intruders == 1 ? "" : "s", cpu);
+	else
+		snprintf(line, sizeof(line), "the threads on the loop's CPU %d cannot be listed",
+			 cpu);
+	if (fw->args.require_rt)
+		return fail(FW_EXIT_SETUP, IRDM_EPERM, "%s: %s", "--require-rt", line);
+	fprintf(stderr, "irdm-fw: %s\n", line);
 	return FW_EXIT_OK;
 }
 
@@ -257,6 +322,9 @@ static int start(struct fw *fw)
 		rc = fw_view_start(fw);
 	if (rc)
 		return fail(FW_EXIT_SETUP, rc, "%s%s", "", fw->err);
+	rc = isolate_loop(fw);
+	if (rc)
+		return rc;
 	return start_devices(fw);
 }
 
@@ -292,6 +360,7 @@ static int stop(struct fw *fw, int rc)
 	if (fw->ring && fw_log_close(fw) && fail(FW_EXIT_LOG, IRDM_EIO, "%s%s", "", fw->err) &&
 	    rc == FW_EXIT_OK)
 		rc = FW_EXIT_LOG;
+	irdm_rt_cpu_latency_release(fw->idle_hold);
 	fw_user_free(fw);
 	fw_monitor_free(fw);
 	fw_frame_free(fw);
@@ -333,6 +402,7 @@ int main(int argc, char **argv)
 
 	if (!fw)
 		return fail(FW_EXIT_SETUP, IRDM_ENOMEM, "%s%s", "", "out of memory");
+	fw->idle_hold = -1;
 	rc = fw_args_parse(&fw->args, argc - 1, argv + 1, fw->err, sizeof(fw->err));
 	if (rc || fw->args.help || fw->args.help_board || fw->args.doc) {
 		if (fw->args.help || !rc) {
