@@ -299,7 +299,7 @@ static int setup(void **state)
 		   "scenes/cuboid-paper.scene", "--resolution", "2,2,4", "--representation",
 		   "modal:10", NULL });
 	precompute(img_fir, "fir", (const char *const[]){ "--scene", "scenes/cuboid-paper.scene",
-		   "--resolution", "2,2,4", "--representation", "fir:20", "--dt", "0.001", NULL });
+		   "--resolution", "2,2,4", "--representation", "fir:20", "--dt", "0.001", "--uncertified", "yes", NULL });
 	precompute(img_cube, "cube", (const char *const[]){ "--scene",
 		   "scenes/cube-floating.scene", "--resolution", "2,2,2", "--representation",
 		   "modal:10", NULL });

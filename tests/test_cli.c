@@ -206,6 +206,25 @@ static void test_bad_scene_values(void **state)
 	assert_false(exists(img));
 }
 
+/* An image `image verify --require-stable` would reject is not written
+ * unless the scene asks for it by name. */
+static void test_uncertified_refused(void **state)
+{
+	const char *img = path_in_dir("uncert.img");
+
+	(void)state;
+	unlink(img);
+	expect_failure(run("precompute", SMALL, "--representation", "fir:20", "--modes", "all", "--touch", "z>=0.2",
+			   "-o", img, NULL), "scene cuboid: fir:20 is not certified stable: spectral radius 1.");
+	assert_non_null(strstr(err_text, "try fir_tail = window:40"));
+	assert_non_null(strstr(err_text, "uncertified = yes"));
+	assert_int_not_equal(access(img, F_OK), 0);
+	assert_int_equal(run("precompute", SMALL, "--representation", "fir:20", "--modes", "all", "--touch", "z>=0.2",
+			     "--modes", "all", "--uncertified", "yes", "-o", img, NULL), 0);
+	expect_failure(run("image", "verify", "--require-stable", img, NULL),
+		       "columns have an unstable force recursion");
+}
+
 static void test_bad_meshes(void **state)
 {
 	const char *img = path_in_dir("mesh.img");
@@ -468,7 +487,7 @@ static void test_time_domain_split_and_merge(void **state)
 	const char *p1 = path_in_dir("p1.part"), *p2 = path_in_dir("p2.part");
 	char parts[700], both[700], range2[32], whole_csv[65536], merged_csv[65536];
 #define TD SMALL, "--representation", "fir:20", "--method", "time-domain", "--touch", "z>=0.2", \
-	   "--display", "touch", "--substeps", "4", "--dt", "0.002"
+	   "--display", "touch", "--substeps", "4", "--dt", "0.002", "--uncertified", "yes"
 
 	(void)state;
 	assert_int_equal(run("precompute", "-q", TD, "--count-inputs", NULL), 0);
@@ -656,6 +675,7 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_bad_scene_values),
+		cmocka_unit_test(test_uncertified_refused),
 		cmocka_unit_test(test_bad_meshes),
 		cmocka_unit_test(test_read_failure_is_eio),
 		cmocka_unit_test(test_alloc_failure_is_enomem),

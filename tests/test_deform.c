@@ -50,7 +50,8 @@ static const char *const scene_kv[IMG_N][16] = {
 	[IMG_MODAL16] = { "mesh", "box:0.1,0.1,0.2", "resolution", "2,2,4", "representation",
 			  "modal:20", "precision", "f16", NULL },
 	[IMG_FIR] = { "mesh", "box:0.1,0.1,0.2", "resolution", "2,2,4", "representation",
-		      "fir:50", "precision", "f64", "touch", "z>=0.2", "display", "surface", NULL },
+		      "fir:50", "precision", "f64", "touch", "z>=0.2", "display", "surface", "uncertified",
+		      "yes", NULL },
 	[IMG_FLOAT] = { "mesh", "box:0.1,0.1,0.1", "resolution", "2,2,2", "representation",
 			"modal:20", "precision", "f64", "floating", "yes", NULL },
 	/* the clustered correction: 313 touchable columns in 32 clusters of at

@@ -586,6 +586,59 @@ static int hybrid_stable(const struct build *b, char *err, size_t errlen)
 	return IRDM_ENUMERIC;
 }
 
+/* The representation as the scene says it, for messages. */
+static void repr_text(const struct irdm_scene *sc, char *buf, size_t len)
+{
+	if (sc->representation == IRDM_REPR_FIR)
+		snprintf(buf, len, "fir:%u%s", sc->fir_length, sc->fir_tail ? " with fir_tail" : "");
+	else if (!sc->modes)
+		snprintf(buf, len, "modal:all");
+	else
+		snprintf(buf, len, "modal:%u%s%s", sc->modes,
+			 sc->static_correction ? " + static correction" : "",
+			 sc->exact_head ? " + exact head" : "");
+}
+
+/* What may make an uncertified image certified. */
+static void certify_hint(const struct irdm_scene *sc, char *buf, size_t len)
+{
+	if (sc->representation == IRDM_REPR_FIR && !sc->fir_tail)
+		snprintf(buf, len, "try fir_tail = window:%u or longer, or a modal representation",
+			 2 * sc->fir_length);
+	else if (sc->representation == IRDM_REPR_FIR)
+		snprintf(buf, len, "try a longer fir_tail than window:%u, or a modal representation",
+			 sc->fir_tail);
+	else
+		snprintf(buf, len, "try more modes (representation = modal:K), static_correction = yes or precision = f64");
+}
+
+/*
+ * An image that `irdm image verify --require-stable` rejects is not
+ * written unless the scene asks for it by name (uncertified = yes): a
+ * warning after the fact is too easy to miss, and an uncertified FIR runs
+ * on the engine's tail damping, which distorts it from the first sample.
+ */
+static int certified(const struct build *b, char *err, size_t errlen)
+{
+	size_t unstable = 0, worst = 0;
+	char repr[64], hint[128];
+
+	for (size_t c = 0; c < b->m.n_cols; c++)
+		if (!(b->stab[c].flags & IRDM_STAB_STABLE)) {
+			if (!unstable || b->stab[c].spectral_radius > b->stab[worst].spectral_radius)
+				worst = c;
+			unstable++;
+		}
+	if (!unstable || b->sc->uncertified)
+		return IRDM_OK;
+	repr_text(b->sc, repr, sizeof(repr));
+	certify_hint(b->sc, hint, sizeof(hint));
+	snprintf(err, errlen, "precompute: scene %s: %s is not certified stable: spectral radius %.6f at mesh node %u (%zu of %zu columns >= 1); %s (uncertified = yes writes it anyway)",
+		 b->sc->name, repr, (double)b->stab[worst].spectral_radius,
+		 b->m.rows[b->m.cols[worst]], unstable, b->m.n_cols, hint);
+	return IRDM_ENUMERIC;
+}
+
 static int stability(struct build *b, char *err, size_t errlen)
 {
 	size_t n = b->m.n_cols;
@@ -594,7 +647,7 @@ static int stability(struct build *b, char *err, size_t errlen)
 	pthread_t th[64];
 	bool started[64];
 	struct stab_job jobs[64];
-	int blas_threads;
+	int blas_threads, ret;
 
 	b->stab = calloc(n, sizeof(*b->stab));
 	if (!b->stab) {
@@ -626,7 +679,8 @@ static int stability(struct build *b, char *err, size_t errlen)
 		}
 		b->meta.max_spectral_radius = fmax(b->meta.max_spectral_radius, b->stab[c].spectral_radius);
 	}
-	return b->head ? hybrid_stable(b, err, errlen) : IRDM_OK;
+	ret = b->head ? hybrid_stable(b, err, errlen) : IRDM_OK;
+	return ret ? ret : certified(b, err, errlen);
 }
 
 static void fill_meta(struct build *b)

@@ -436,6 +436,11 @@ static const struct irdm_opt scene_opts[] = {
 		  "first H samples between touchable nodes, on top of the kept modes, tapered off "
 		  "over H more with the static compliance kept exactly; needs every mode, a dense "
 		  "eigensolve (default 0: the static correction alone)" },
+	{ .name = "uncertified", .type = IRDM_OPT_BOOL, SC(uncertified),
+	  .help = "write an image although some touchable node's force recursion is not "
+		  "certified stable (spectral radius >= 1; the engine then damps an FIR's tail "
+		  "by r^s); default no: such an image is refused, as `irdm image verify "
+		  "--require-stable` would reject it" },
 	{ .name = "precision", .type = IRDM_OPT_ENUM, SC(precision), .names = precision_names,
 	  .help = "storage of the responses (default f32)" },
 	{ .name = "touch", .type = IRDM_OPT_CUSTOM, .parse = set_region, SC(touch),

@@ -78,6 +78,7 @@ struct irdm_scene {
 	unsigned substeps;
 	enum irdm_eig_method eigensolver;
 	unsigned threads;
+	bool uncertified;        /* write an image whose stability certificate fails */
 };
 
 /* The defaults: the paper's cuboid at its resolution, modal 300 + static
