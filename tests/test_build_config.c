@@ -265,8 +265,8 @@ static void test_image_config_and_bad_configs(void **state)
 
 static void precompute(char *path, const char *name, const char *const *args)
 {
-	const char *argv[24] = { "precompute", "-q" };
-	int n = 2;
+	const char *argv[24] = { "precompute", "-q", "--max_error", "none" };
+	int n = 4;
 
 	snprintf(path, 320, "%s/%s.img", dir, name);
 	for (; *args && n < 20; args++)

@@ -625,8 +625,8 @@ static void test_replay_log_exact(void **state)
 
 static int precompute(enum img k, const char *name, const char *const *args)
 {
-	const char *argv[32] = { "precompute", "-q" };
-	int n = 2;
+	const char *argv[32] = { "precompute", "-q", "--max_error", "none" };
+	int n = 4;
 
 	snprintf(images[k], sizeof(images[k]), "%s/%s.img", dir, name);
 	for (; *args && n < 28; args++)

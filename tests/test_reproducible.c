@@ -69,6 +69,8 @@ static void precompute_twice(const char *name, const char *const *scene)
 		snprintf(path[k], sizeof(path[k]), "%s/%s-%d.img", dir, name, k);
 		n = 0;
 		args[n++] = "precompute";
+		args[n++] = "--max_error";
+		args[n++] = "none";
 		for (const char *const *s = scene; *s; s++)
 			args[n++] = *s;
 		args[n++] = "-o";

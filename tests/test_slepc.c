@@ -133,6 +133,8 @@ static int precompute(int np, const char *out, const char *const *scene)
 	args[n++] = irdm_path();
 	args[n++] = "precompute";
 	args[n++] = "-q";
+	args[n++] = "--max_error";
+	args[n++] = "none";
 	for (; *scene; scene++)
 		args[n++] = *scene;
 	args[n++] = "-o";

@@ -197,10 +197,20 @@ static void print_report(const struct irdm_scene *sc, const struct irdm_precompu
 	    fmax(r->corr_max_dropped_rel, r->corr_far_max[1]) > 1e-3)
 		printf("note          dropped blocks reach %.3g of sqrt(|S_aa| |S_bb|), about the force error at the worst few nearby contacts; static_correction_cluster = 256 with static_correction_tol = 8e-4 keeps every block within the tolerance\n",
 		       fmax(r->corr_max_dropped_rel, r->corr_far_max[1]));
-	printf("time          %.2f s total: mesh %.2f, FEM %.2f, eigen %.2f, responses %.2f, stability %.2f\n",
+	printf("time          %.2f s total: mesh %.2f, FEM %.2f, eigen %.2f, responses %.2f, stability %.2f, error %.2f\n",
 	       r->seconds_total, r->seconds_mesh, r->seconds_fem, r->seconds_eig,
-	       r->seconds_responses, r->seconds_stability);
+	       r->seconds_responses, r->seconds_stability, r->seconds_error);
 	print_peak_memory();
+	if (o->part_out)
+		return;
+	/* last: the figure a user reads first */
+	if (r->error_measured)
+		printf("force error   %.3g against the exact model (relative RMS, worst of a step and a release at %zu touchable nodes over %zu ticks, first ticks included; worst: %s at mesh node %u); max_error %g\n",
+		       r->measured_error, r->error_cols, r->error_ticks, r->error_worst_run,
+		       r->error_worst_node, sc->max_error);
+	else
+		printf("force error   not measured (%s)\n",
+		       sc->max_error > 0 ? "over MPI ranks" : "max_error = none");
 }
 
 static void print_help(void)

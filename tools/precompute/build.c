@@ -14,6 +14,7 @@
 #include "image/image_writer.h"
 #include "irdm/error.h"
 #include "irdm/image.h"
+#include "irdm/posix/image_map.h"
 #include "modal/exact_head.h"
 #include "modal/lapack.h"
 #include "modal/response.h"
@@ -24,6 +25,7 @@
 #include "precompute/fir_tail.h"
 #include "precompute/precompute.h"
 #include "precompute/td_part.h"
+#include "report/report_measure.h"
 #include "timedomain/timedomain.h"
 #include "util/clock.h"
 #include "util/fnv1a.h"
@@ -821,7 +823,7 @@ static int add_sections(struct build *b, struct irdm_image_writer *w, const void
 	return IRDM_OK;
 }
 
-static int write_image(struct build *b, size_t *bytes, char *err, size_t errlen)
+static int write_image(struct build *b, const char *path, size_t *bytes, char *err, size_t errlen)
 {
 	struct irdm_model *m = &b->m;
 	struct irdm_image_writer w;
@@ -836,11 +838,11 @@ static int write_image(struct build *b, size_t *bytes, char *err, size_t errlen)
 		return ret;
 	ret = add_sections(b, &w, bvh, bvh_bytes, err, errlen);
 	if (!ret)
-		ret = irdm_iw_write(&w, b->o->out_path, err, errlen);
+		ret = irdm_iw_write(&w, path, err, errlen);
 	free(bvh);
 	if (ret)
 		return ret;
-	f = fopen(b->o->out_path, "rb");
+	f = fopen(path, "rb");
 	if (f) {
 		fseek(f, 0, SEEK_END);
 		*bytes = (size_t)ftell(f);
@@ -995,6 +997,97 @@ static void report(const struct build *b, struct irdm_precompute_report *rep)
 	rep->corr_cluster_values = b->clusters.n_values;
 }
 
+/* What may bring an image's measured error under max_error. */
+static void error_hint(const struct irdm_scene *sc, char *buf, size_t len)
+{
+	if (sc->precision == IRDM_ELEM_F16)
+		snprintf(buf, len, "precision = f32");
+	else if (sc->representation == IRDM_REPR_FIR && !sc->fir_tail)
+		snprintf(buf, len, "fir_tail = window:%u (no tail damping), a longer FIR, or a modal representation with exact_head",
+			 2 * sc->fir_length);
+	else if (sc->representation == IRDM_REPR_FIR)
+		snprintf(buf, len, "a longer FIR (fir:%u), or a modal representation with exact_head",
+			 2 * sc->fir_length);
+	else if (!sc->modes)
+		snprintf(buf, len, "precision = f64");
+	else if (!sc->static_correction)
+		snprintf(buf, len, "static_correction = yes with exact_head = 128, or more modes");
+	else if (!sc->exact_head)
+		snprintf(buf, len, "a hybrid head (exact_head = 128) on these modes, more modes, or representation = modal:all");
+	else
+		snprintf(buf, len, "a longer head (exact_head = %u) or more modes (modal:%u)",
+			 2 * sc->exact_head, 2 * sc->modes);
+}
+
+/* Refuse an image whose measured error is above the scene's max_error. */
+static int within_target(const struct build *b, const struct irdm_precompute_report *rep,
+			 char *err, size_t errlen)
+{
+	char repr[64], hint[160];
+
+	if (!rep->error_measured || rep->measured_error <= b->sc->max_error)
+		return IRDM_OK;
+	repr_text(b->sc, repr, sizeof(repr));
+	error_hint(b->sc, hint, sizeof(hint));
+	snprintf(err, errlen, "precompute: scene %s: %s is %.3g off the exact model (relative RMS force error, worst: %s at mesh node %u), above max_error = %g; try %s (max_error = none skips the check)",
+		 b->sc->name, repr, rep->measured_error, rep->error_worst_run,
+		 rep->error_worst_node, b->sc->max_error, hint);
+	return IRDM_ENUMERIC;
+}
+
+/*
+ * The image's force error against the exact model (report_measure.h),
+ * measured on the image as it will be written: a scratch copy beside it,
+ * then the figure goes into META.  max_error = none skips it (the exact
+ * model needs every mode); over MPI ranks it is not measured (the
+ * reference's dense eigensolve would run on rank 0 alone).
+ */
+static int measure(struct build *b, struct irdm_precompute_report *rep, char *err, size_t errlen)
+{
+	const char *out = b->o->out_path;
+	size_t n = strlen(out) + 16, bytes;
+	char *tmp = malloc(n), *ref = malloc(n);
+	struct irdm_measure res;
+	struct irdm_image img;
+	int ret = IRDM_ENOMEM;
+
+	if (!(b->sc->max_error > 0) || irdm_dist_size() > 1) {
+		free(tmp);
+		free(ref);
+		return IRDM_OK;
+	}
+	if (!tmp || !ref) {
+		snprintf(err, errlen, "precompute: out of memory");
+		goto out_free;
+	}
+	snprintf(tmp, n, "%s.unmeasured", out);
+	snprintf(ref, n, "%s.exact", out);
+	ret = write_image(b, tmp, &bytes, err, errlen);
+	if (!ret)
+		ret = irdm_image_map(tmp, 0, &img, err, errlen);
+	if (ret)
+		goto out_unlink;
+	ret = irdm_measure_error(b->sc, &img, ref, b->o->progress, b->o->ctx, &res, err, errlen);
+	irdm_image_unmap(&img);
+	if (ret)
+		goto out_unlink;
+	b->meta.measured_error = (float)res.error;
+	b->meta.flags |= IRDM_META_ERROR_MEASURED;
+	rep->error_measured = true;
+	rep->measured_error = res.error;
+	rep->error_worst_node = res.worst_node;
+	rep->error_worst_run = res.worst_run;
+	rep->error_cols = res.n_cols;
+	rep->error_ticks = res.ticks;
+	rep->seconds_error = res.seconds;
+out_unlink:
+	unlink(tmp);
+out_free:
+	free(tmp);
+	free(ref);
+	return ret;
+}
+
 static uint64_t scene_hash(const struct irdm_scene *sc)
 {
 	char text[4096];
@@ -1048,7 +1141,11 @@ int irdm_precompute(const struct irdm_scene *sc, const struct irdm_precompute_op
 	}
 	if (o->progress)
 		o->progress(o->ctx, "contact BVH and image", 0.0);
-	ret = write_image(&b, &rep->image_bytes, err, errlen);
+	ret = measure(&b, rep, err, errlen);
+	if (!ret)
+		ret = within_target(&b, rep, err, errlen);
+	if (!ret)
+		ret = write_image(&b, o->out_path, &rep->image_bytes, err, errlen);
 	if (ret)
 		goto out_free;
 	if (o->progress)

@@ -49,6 +49,7 @@ void irdm_scene_defaults(struct irdm_scene *sc)
 	sc->method = IRDM_METHOD_MODAL;
 	sc->substeps = 8;
 	sc->eigensolver = IRDM_EIG_AUTO;
+	sc->max_error = IRDM_MAX_ERROR_DEFAULT;
 }
 
 /* Strict number parsing: the whole token, finite. */
@@ -330,6 +331,21 @@ static int set_fir_tail(const struct irdm_opt *o, void *obj, const char *v, char
 	return irdm_opt_parse_value(&count, &sc->fir_tail, v + 7, why, len);
 }
 
+/* "none" (0: not measured, not checked) or a relative error in (0, 1]. */
+static int set_max_error(const struct irdm_opt *o, void *obj, const char *v, char *why, size_t len)
+{
+	static const struct irdm_opt err = { .name = "max_error", .type = IRDM_OPT_DOUBLE,
+		.size = sizeof(double), .range = IRDM_OPT_GT | IRDM_OPT_LE, .min = 0, .max = 1 };
+	struct irdm_scene *sc = obj;
+
+	(void)o;
+	if (!strcmp(v, "none")) {
+		sc->max_error = 0;
+		return IRDM_OK;
+	}
+	return irdm_opt_parse_value(&err, &sc->max_error, v, why, len);
+}
+
 /* "all" or "0": every mode; otherwise 1 to 1000000. */
 static int set_modes(const struct irdm_opt *o, void *obj, const char *v, char *why, size_t len)
 {
@@ -436,6 +452,14 @@ static const struct irdm_opt scene_opts[] = {
 		  "first H samples between touchable nodes, on top of the kept modes, tapered off "
 		  "over H more with the static compliance kept exactly; needs every mode, a dense "
 		  "eigensolve (default 0: the static correction alone)" },
+	{ .name = "max_error", .type = IRDM_OPT_CUSTOM, .parse = set_max_error,
+	  .metavar = "E | none",
+	  .help = "largest force error an image may have: after the build, its relative RMS "
+		  "force error against the exact linear model (every mode, in double) is "
+		  "measured for a step and a release at a few touchable nodes, stored in the "
+		  "image and printed; above E the image is refused.  none neither measures "
+		  "nor checks (the measurement needs every mode: a dense eigensolve) "
+		  "(default 1e-3)" },
 	{ .name = "uncertified", .type = IRDM_OPT_BOOL, SC(uncertified),
 	  .help = "write an image although some touchable node's force recursion is not "
 		  "certified stable (spectral radius >= 1; the engine then damps an FIR's tail "

@@ -40,6 +40,9 @@ struct irdm_region {
 	char text[128];         /* as written, for messages and provenance */
 };
 
+/* The force error an image may have by default (scene key max_error). */
+#define IRDM_MAX_ERROR_DEFAULT 1e-3
+
 enum irdm_damping_kind { IRDM_DAMP_RATIOS = 0, IRDM_DAMP_RAYLEIGH = 1 };
 enum irdm_method { IRDM_METHOD_MODAL = 0, IRDM_METHOD_TIME_DOMAIN = 1 };
 
@@ -79,6 +82,7 @@ struct irdm_scene {
 	enum irdm_eig_method eigensolver;
 	unsigned threads;
 	bool uncertified;        /* write an image whose stability certificate fails */
+	double max_error;        /* largest measured force error written (0: none, not measured) */
 };
 
 /* The defaults: the paper's cuboid at its resolution, modal 300 + static
