@@ -12,7 +12,11 @@
  *    convolution, the image under test run by the engine;
  *  - f16 storage shows in the figure (the values as stored are measured);
  *  - an image over max_error is refused, not written, with what would meet
- *    it; max_error = none neither measures nor flags.
+ *    it; max_error = none neither measures nor flags;
+ *  - representation = auto takes every mode of a small model, and on the
+ *    4 x 4 x 8 cuboid (600 modes, 2 ms, top face) the hybrid with the
+ *    shortest head that meets 1e-3, after refusing modal:300 + static
+ *    correction, which is refused there when asked for by name too.
  */
 #include <math.h>
 #include <setjmp.h>
@@ -227,6 +231,65 @@ static void test_over_target_refused(void **state)
 	irdm_image_unmap(&img);
 }
 
+static void test_auto_small_takes_all(void **state)
+{
+	struct irdm_precompute_report rep;
+	char err[512];
+
+	(void)state;
+	assert_int_equal(build("auto-small.img", &rep, err, sizeof(err), (const char *const[]){
+		"representation", "auto", NULL }), 0);
+	print_message("auto on 108 modes: %s, measured %.3g\n", rep.representation,
+		      rep.measured_error);
+	assert_string_equal(rep.representation, "modal:all");
+	assert_int_equal(rep.auto_tries, 1);
+	assert_true(rep.measured_error < 1e-6);       /* f32 storage */
+}
+
+static int cuboid(const char *name, struct irdm_precompute_report *rep, char *err, size_t errlen,
+		  const char *repr, const char *max_error)
+{
+	struct irdm_scene sc;
+	struct irdm_precompute_opts o = { 0 };
+	char path[128];
+
+	irdm_scene_defaults(&sc);
+	assert_int_equal(irdm_scene_set(&sc, "resolution", "4,4,8", "test", err, errlen), 0);
+	assert_int_equal(irdm_scene_set(&sc, "touch", "z>=0.2", "test", err, errlen), 0);
+	assert_int_equal(irdm_scene_set(&sc, "display", "touch", "test", err, errlen), 0);
+	assert_int_equal(irdm_scene_set(&sc, "dt", "0.002", "test", err, errlen), 0);
+	if (repr)
+		assert_int_equal(irdm_scene_set(&sc, "representation", repr, "test", err, errlen), 0);
+	if (max_error)
+		assert_int_equal(irdm_scene_set(&sc, "max_error", max_error, "test", err, errlen), 0);
+	snprintf(path, sizeof(path), "%s/%s", dir, name);
+	o.out_path = path;
+	return irdm_precompute(&sc, &o, rep, err, errlen);
+}
+
+static void test_auto_cuboid_chooses_hybrid(void **state)
+{
+	struct irdm_precompute_report rep;
+	char err[768];
+
+	(void)state;
+	/* the default: auto, 1e-3 */
+	assert_int_equal(cuboid("auto.img", &rep, err, sizeof(err), NULL, NULL), 0);
+	print_message("auto on 600 modes: %s after %zu candidates, measured %.3g\n",
+		      rep.representation, rep.auto_tries, rep.measured_error);
+	assert_string_equal(rep.representation, "modal:300 + static correction + exact_head 32");
+	assert_int_equal(rep.auto_tries, 2);
+	assert_true(rep.measured_error <= 1e-3);
+	/* its first candidate, by name: refused */
+	assert_int_equal(cuboid("m300.img", &rep, err, sizeof(err), "modal:300", NULL), IRDM_ENUMERIC);
+	assert_non_null(strstr(err, "modal:300 + static correction is "));
+	/* no target: today's modal:300 + static correction, 300 modes solved */
+	assert_int_equal(cuboid("none.img", &rep, err, sizeof(err), NULL, "none"), 0);
+	assert_string_equal(rep.representation, "modal:300 + static correction");
+	assert_int_equal(rep.modes, 300);
+	assert_false(rep.error_measured);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -234,6 +297,8 @@ int main(void)
 		cmocka_unit_test(test_figure_recomputed),
 		cmocka_unit_test(test_f16_measured_as_stored),
 		cmocka_unit_test(test_over_target_refused),
+		cmocka_unit_test(test_auto_small_takes_all),
+		cmocka_unit_test(test_auto_cuboid_chooses_hybrid),
 	};
 
 	return cmocka_run_group_tests(tests, setup, teardown);

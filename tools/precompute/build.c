@@ -56,6 +56,8 @@ struct build {
 /* Modes the scene needs solved (0: all). */
 static size_t modes_needed(const struct irdm_scene *sc)
 {
+	if (sc->repr_auto && sc->max_error > 0)
+		return 0;       /* every candidate is measured: the reference needs all */
 	if (sc->representation == IRDM_REPR_MODAL)
 		return sc->exact_head ? 0 : sc->modes;  /* the head needs every mode */
 	if (sc->method == IRDM_METHOD_TIME_DOMAIN)
@@ -596,9 +598,9 @@ static void repr_text(const struct irdm_scene *sc, char *buf, size_t len)
 	else if (!sc->modes)
 		snprintf(buf, len, "modal:all");
 	else
-		snprintf(buf, len, "modal:%u%s%s", sc->modes,
+		snprintf(buf, len, "modal:%u%s%s%.0u", sc->modes,
 			 sc->static_correction ? " + static correction" : "",
-			 sc->exact_head ? " + exact head" : "");
+			 sc->exact_head ? " + exact_head " : "", sc->exact_head);
 }
 
 /* What may make an uncertified image certified. */
@@ -997,6 +999,58 @@ static void report(const struct build *b, struct irdm_precompute_report *rep)
 	rep->corr_cluster_values = b->clusters.n_values;
 }
 
+/* Every elastic mode was solved (some may be dropped from the image). */
+static bool all_modes(const struct build *b)
+{
+	return !modes_needed(b->sc) && b->sc->method == IRDM_METHOD_MODAL &&
+	       b->m.modes.phi && irdm_dist_size() == 1;
+}
+
+/* The exact model's image from this build's own modes: the same mesh,
+ * FEM and eigensolve, its own selection (the sampled nodes), every mode,
+ * no static correction, in double; nothing else shared. */
+static int reference_from_model(void *ctx, const struct irdm_scene *rsc, const char *path,
+				char *err, size_t errlen)
+{
+	struct build *b = ctx;
+	struct irdm_precompute_opts ro = { .out_path = path };
+	struct build r = { .sc = rsc, .o = &ro, .m = b->m };
+	size_t bytes;
+	int ret;
+
+	r.m.modes.n_modes = r.m.modes.n_elastic_total;
+	r.m.rows = r.m.cols = r.m.tris = NULL;
+	r.m.row_dofs = r.m.col_dofs = NULL;
+	r.m.n_rows = r.m.n_cols = r.m.n_tris = 0;
+	ret = irdm_model_select(rsc, &r.m, err, errlen);
+	if (!ret)
+		ret = responses(&r, err, errlen);
+	if (!ret) {
+		fill_meta(&r);
+		ret = stability(&r, err, errlen);
+	}
+	if (!ret)
+		ret = fill_nodes_rigid(&r);
+	if (!ret)
+		ret = provenance(&r);
+	if (!ret)
+		ret = write_image(&r, path, &bytes, err, errlen);
+	/* r's own allocations only: the mesh, FEM and modes are b's */
+	free(r.m.rows);
+	free(r.m.cols);
+	free(r.m.tris);
+	free(r.m.row_dofs);
+	free(r.m.col_dofs);
+	free(r.zoh);
+	free(r.shapes);
+	for (int i = 0; i < 6; i++)
+		free(r.stored[i]);
+	free(r.stab);
+	free(r.nodes);
+	free(r.prov);
+	return ret;
+}
+
 /* What may bring an image's measured error under max_error. */
 static void error_hint(const struct irdm_scene *sc, char *buf, size_t len)
 {
@@ -1067,7 +1121,8 @@ static int measure(struct build *b, struct irdm_precompute_report *rep, char *er
 		ret = irdm_image_map(tmp, 0, &img, err, errlen);
 	if (ret)
 		goto out_unlink;
-	ret = irdm_measure_error(b->sc, &img, ref, b->o->progress, b->o->ctx, &res, err, errlen);
+	ret = irdm_measure_error(b->sc, &img, ref, all_modes(b) ? reference_from_model : NULL, b,
+				 b->o->progress, b->o->ctx, &res, err, errlen);
 	irdm_image_unmap(&img);
 	if (ret)
 		goto out_unlink;
@@ -1097,18 +1152,139 @@ static uint64_t scene_hash(const struct irdm_scene *sc)
 	return irdm_fnv1a(IRDM_FNV1A_INIT, text, strlen(text));
 }
 
+/* Responses, certificate, nodes, provenance, the measured error: all
+ * but the write. */
+static int one_try(struct build *b, struct irdm_precompute_report *rep, char *err, size_t errlen)
+{
+	double t1 = irdm_now_s();
+	int ret = responses(b, err, errlen);
+
+	if (ret || b->o->part_out)
+		return ret;
+	rep->seconds_responses += irdm_now_s() - t1;
+	fill_meta(b);
+	t1 = irdm_now_s();
+	ret = stability(b, err, errlen);
+	if (ret)
+		return ret;
+	rep->seconds_stability += irdm_now_s() - t1;
+	ret = fill_nodes_rigid(b);
+	if (!ret)
+		ret = provenance(b);
+	if (ret) {
+		snprintf(err, errlen, ret == IRDM_ENOMEM ? "precompute: out of memory"
+			 : "precompute: the scene does not fit in the provenance text");
+		return ret;
+	}
+	ret = measure(b, rep, err, errlen);
+	return ret ? ret : within_target(b, rep, err, errlen);
+}
+
+/* Back to the model alone, every mode in it, for another try. */
+static void reset_try(struct build *b, size_t n_all)
+{
+	free(b->zoh);
+	free(b->fir);
+	free(b->shapes);
+	free(b->corr);
+	free(b->head);
+	free(b->stab);
+	free(b->nodes);
+	free(b->prov);
+	b->zoh = NULL;
+	b->fir = b->shapes = b->corr = b->head = NULL;
+	b->stab = NULL;
+	b->nodes = NULL;
+	b->prov = NULL;
+	irdm_corr_sparse_free(&b->sparse);
+	irdm_corr_lowrank_free(&b->far);
+	irdm_corr_clusters_free(&b->clusters);
+	for (int i = 0; i < 6; i++) {
+		free(b->stored[i]);
+		b->stored[i] = NULL;
+	}
+	b->n_modes = 0;
+	memset(&b->meta, 0, sizeof(b->meta));
+	b->m.modes.n_modes = n_all;
+}
+
+/* representation = auto's candidates, in increasing tick cost. */
+struct candidate {
+	unsigned modes;         /* 0: all */
+	bool corr;
+	unsigned head;
+};
+
+static const struct candidate auto_candidates[] = {
+	{ 300, true, 0 }, { 300, true, 32 }, { 300, true, 128 }, { 300, true, 512 }, { 0, false, 0 },
+};
+
+#define AUTO_ALL_MODES 300      /* at most this many modes: modal:all, exact and as cheap */
+
+/*
+ * representation = auto: every mode is solved; the first candidate whose
+ * image is certified and measures within max_error is kept.  A model of
+ * at most AUTO_ALL_MODES modes takes them all.
+ */
+static int choose(struct build *b, struct irdm_precompute_report *rep, char *err, size_t errlen)
+{
+	struct irdm_scene *eff = (struct irdm_scene *)b->sc;
+	size_t n_all = b->m.modes.n_modes, first = n_all <= AUTO_ALL_MODES ? 4 : 0;
+	char last[768] = "";
+	int ret = IRDM_ENUMERIC;
+
+	for (size_t k = first; k < sizeof(auto_candidates) / sizeof(auto_candidates[0]); k++) {
+		const struct candidate *c = &auto_candidates[k];
+
+		reset_try(b, n_all);
+		eff->modes = c->modes;
+		eff->static_correction = c->corr;
+		eff->exact_head = c->head;
+		eff->static_corr_cluster = 0;
+		/* a head splits the modes itself (split_modes); else keep K */
+		if (c->modes && !c->head && c->modes < n_all)
+			b->m.modes.n_modes = c->modes;
+		ret = one_try(b, rep, err, errlen);
+		rep->auto_tries++;
+		if (!ret)
+			return IRDM_OK;
+		if (ret != IRDM_ENUMERIC)
+			return ret;
+		snprintf(last, sizeof(last), "%s", err);
+		if (b->o->progress)
+			b->o->progress(b->o->ctx, "representation = auto: next candidate", -1.0);
+	}
+	snprintf(err, errlen, "precompute: representation = auto: no candidate met max_error = %g (set max_error higher or none); the last: %s",
+		 eff->max_error, last);
+	return ret;
+}
+
 int irdm_precompute(const struct irdm_scene *sc, const struct irdm_precompute_opts *o,
 		    struct irdm_precompute_report *rep, char *err, size_t errlen)
 {
 	struct build b = { .sc = sc, .o = o };
-	double t0 = irdm_now_s(), t1;
+	/* auto resolves to a representation: the image's provenance says which */
+	struct irdm_scene *eff = sc->repr_auto ? malloc(sizeof(*eff)) : NULL;
+	bool auto_choice = sc->repr_auto && sc->max_error > 0 && irdm_dist_size() == 1;
+	double t0 = irdm_now_s();
 	int ret;
 
 	memset(rep, 0, sizeof(*rep));
+	if (sc->repr_auto && !eff) {
+		snprintf(err, errlen, "precompute: out of memory");
+		return IRDM_ENOMEM;
+	}
+	if (eff) {
+		*eff = *sc;
+		eff->repr_auto = false;
+		b.sc = eff;
+	}
 	b.scene_hash = scene_hash(sc);
 	ret = irdm_model_build(sc, modes_needed(sc), o->progress, o->ctx, &b.m, err, errlen);
-	if (ret)
+	if (ret) {
+		free(eff);
 		return ret;
+	}
 	b.scene_hash = irdm_fnv1a(b.scene_hash, &b.m.damping, sizeof(b.m.damping));
 	/* over MPI the ranks other than 0 are done once the eigenvectors are
 	 * gathered (rank 0 alone holds them and makes the image), or once they
@@ -1118,44 +1294,25 @@ int irdm_precompute(const struct irdm_scene *sc, const struct irdm_precompute_op
 			ret = td_distributed(&b, list_inputs(&b.m, NULL, NULL), err, errlen);
 		goto out_worker;
 	}
-	t1 = irdm_now_s();
-	ret = responses(&b, err, errlen);
-	if (ret)
-		goto out_free;
-	rep->seconds_responses = irdm_now_s() - t1;
-	if (o->part_out)
-		goto out_report;
-	fill_meta(&b);
-	t1 = irdm_now_s();
-	ret = stability(&b, err, errlen);
-	if (ret)
-		goto out_free;
-	rep->seconds_stability = irdm_now_s() - t1;
-	ret = fill_nodes_rigid(&b);
-	if (!ret)
-		ret = provenance(&b);
-	if (ret) {
-		snprintf(err, errlen, ret == IRDM_ENOMEM ? "precompute: out of memory"
-			 : "precompute: the scene does not fit in the provenance text");
-		goto out_free;
-	}
+	ret = auto_choice ? choose(&b, rep, err, errlen) : one_try(&b, rep, err, errlen);
+	if (ret || o->part_out)
+		goto out_done;
 	if (o->progress)
 		o->progress(o->ctx, "contact BVH and image", 0.0);
-	ret = measure(&b, rep, err, errlen);
-	if (!ret)
-		ret = within_target(&b, rep, err, errlen);
-	if (!ret)
-		ret = write_image(&b, o->out_path, &rep->image_bytes, err, errlen);
+	ret = write_image(&b, o->out_path, &rep->image_bytes, err, errlen);
 	if (ret)
 		goto out_free;
 	if (o->progress)
 		o->progress(o->ctx, "contact BVH and image", 1.0);
-out_report:
-	report(&b, rep);
+out_done:
+	if (!ret)
+		report(&b, rep);
 out_worker:
 	rep->seconds_total = irdm_now_s() - t0;
 out_free:
+	repr_text(b.sc, rep->representation, sizeof(rep->representation));
 	build_free(&b);
+	free(eff);
 	return ret;
 }
 

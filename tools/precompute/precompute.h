@@ -49,6 +49,10 @@ struct irdm_precompute_report {
 	uint32_t error_worst_node;
 	const char *error_worst_run;
 	size_t error_cols, error_ticks;
+	/* the representation written (representation = auto: the chosen one)
+	 * and how many candidates auto built */
+	char representation[64];
+	size_t auto_tries;
 };
 
 /*

@@ -192,12 +192,21 @@ static int measure_column(const struct irdm_image *img, const struct irdm_image 
 }
 
 /* The exact model of sc, touchable at the sampled nodes only. */
+static int precompute_ref(void *ctx, const struct irdm_scene *ref, const char *path, char *err,
+			  size_t errlen)
+{
+	struct irdm_precompute_opts o = { .out_path = path };
+	struct irdm_precompute_report rep;
+
+	(void)ctx;
+	return irdm_precompute(ref, &o, &rep, err, errlen);
+}
+
 static int build_reference(const struct irdm_scene *sc, const struct irdm_measure *res,
-			   const char *ref_path, char *err, size_t errlen)
+			   const char *ref_path, irdm_measure_ref_fn build_ref, void *ref_ctx,
+			   char *err, size_t errlen)
 {
 	struct irdm_scene *ref = malloc(sizeof(*ref));
-	struct irdm_precompute_opts o = { .out_path = ref_path };
-	struct irdm_precompute_report rep;
 	char nodes[16 * IRDM_MEASURE_MAX_COLS + 8];
 	size_t len = (size_t)snprintf(nodes, sizeof(nodes), "nodes:");
 	int ret;
@@ -227,14 +236,15 @@ static int build_reference(const struct irdm_scene *sc, const struct irdm_measur
 	if (!ret)
 		ret = irdm_scene_set(ref, "display", "touch", "error measurement", err, errlen);
 	if (!ret)
-		ret = irdm_precompute(ref, &o, &rep, err, errlen);
+		ret = (build_ref ? build_ref : precompute_ref)(ref_ctx, ref, ref_path, err, errlen);
 	free(ref);
 	return ret;
 }
 
 int irdm_measure_error(const struct irdm_scene *sc, const struct irdm_image *img,
-		       const char *ref_path, irdm_progress_fn fn, void *ctx,
-		       struct irdm_measure *res, char *err, size_t errlen)
+		       const char *ref_path, irdm_measure_ref_fn build_ref, void *ref_ctx,
+		       irdm_progress_fn fn, void *ctx, struct irdm_measure *res,
+		       char *err, size_t errlen)
 {
 	uint32_t cols[IRDM_MEASURE_MAX_COLS];
 	struct irdm_image ref;
@@ -250,7 +260,7 @@ int irdm_measure_error(const struct irdm_scene *sc, const struct irdm_image *img
 	res->ticks = irdm_measure_ticks(img->meta->dt_s);
 	if (fn)
 		fn(ctx, "error measurement", 0.0);
-	ret = build_reference(sc, res, ref_path, err, errlen);
+	ret = build_reference(sc, res, ref_path, build_ref, ref_ctx, err, errlen);
 	if (ret)
 		goto out_unlink;
 	ret = irdm_image_map(ref_path, 0, &ref, err, errlen);

@@ -49,15 +49,24 @@ struct irdm_measure {
 };
 
 /*
- * Measure img, made from sc.  The reference image is built at ref_path
- * and removed.
+ * Writes the reference image of scene ref_sc (the exact model) at path; a
+ * precompute that already holds every mode can make it from them.
+ * Return: as irdm_precompute().
+ */
+typedef int (*irdm_measure_ref_fn)(void *ctx, const struct irdm_scene *ref_sc, const char *path,
+				   char *err, size_t errlen);
+
+/*
+ * Measure img, made from sc.  The reference image is built at ref_path by
+ * build_ref(ref_ctx, ...) (NULL: irdm_precompute()) and removed.
  * Return: IRDM_OK; IRDM_ENOMEM; IRDM_EINVAL if the reference is not the
  * same mesh; any error of irdm_precompute(), irdm_image_map(), the
  * convolution or the engine's set-up.  A one-line reason goes to err.
  */
 int irdm_measure_error(const struct irdm_scene *sc, const struct irdm_image *img,
-		       const char *ref_path, irdm_progress_fn fn, void *ctx,
-		       struct irdm_measure *res, char *err, size_t errlen);
+		       const char *ref_path, irdm_measure_ref_fn build_ref, void *ref_ctx,
+		       irdm_progress_fn fn, void *ctx, struct irdm_measure *res,
+		       char *err, size_t errlen);
 
 /* The number of ticks each run lasts at dt_s: about a second. */
 size_t irdm_measure_ticks(double dt_s);

@@ -33,6 +33,7 @@ void irdm_scene_defaults(struct irdm_scene *sc)
 	sc->damp_hz[1] = 100;
 	sc->dt_s = 0.001;
 	sc->representation = IRDM_REPR_MODAL;
+	sc->repr_auto = true;
 	sc->modes = 300;
 	sc->static_correction = true;
 	sc->static_corr_tol = IRDM_STATIC_CORR_TOL_DEFAULT;
@@ -195,6 +196,13 @@ static int parse_damping(struct irdm_scene *sc, const char *s)
 
 static int parse_representation(struct irdm_scene *sc, const char *s)
 {
+	sc->repr_auto = !strcmp(s, "auto");
+	if (sc->repr_auto) {
+		/* what it resolves to without max_error: modal:300 + correction */
+		sc->representation = IRDM_REPR_MODAL;
+		sc->modes = 300;
+		return 0;
+	}
 	if (!strcmp(s, "modal:all")) {
 		sc->representation = IRDM_REPR_MODAL;
 		sc->modes = 0;
@@ -426,8 +434,12 @@ static const struct irdm_opt scene_opts[] = {
 	  .range = IRDM_OPT_GE | IRDM_OPT_LE, .min = 1e-6, .max = 1,
 	  .help = "sample period (default 0.001)" },
 	{ .name = "representation", .type = IRDM_OPT_CUSTOM, .parse = set_representation,
-	  .metavar = "modal:K | modal:all | fir:T",
-	  .help = "K modes (1 to 1000000) or all, or an FIR of T samples (1 to 1000000) (default modal:300)" },
+	  .metavar = "auto | modal:K | modal:all | fir:T",
+	  .help = "K modes (1 to 1000000) or all, or an FIR of T samples (1 to 1000000); auto: "
+		  "the cheapest to tick of modal:all (up to 300 modes), modal:300 + static "
+		  "correction + exact_head 32, 128 or 512, modal:all whose measured error meets "
+		  "max_error (every mode solved: a dense eigensolve); with max_error = none, "
+		  "modal:300 + static correction (default auto)" },
 	{ .name = "modes", .type = IRDM_OPT_CUSTOM, .parse = set_modes, .metavar = "K | all",
 	  .help = "modes that synthesise a modal-method FIR, 1 to 1000000 (default 300)" },
 	{ .name = "fir_tail", .type = IRDM_OPT_CUSTOM, .parse = set_fir_tail,
@@ -602,7 +614,9 @@ int irdm_scene_format(const struct irdm_scene *sc, char *buf, size_t len)
 	else
 		snprintf(damp, sizeof(damp), "%.17g@%.17g,%.17g@%.17g", sc->damp_ratio[0],
 			 sc->damp_hz[0], sc->damp_ratio[1], sc->damp_hz[1]);
-	if (sc->representation == IRDM_REPR_FIR)
+	if (sc->repr_auto)
+		snprintf(repr, sizeof(repr), "auto");
+	else if (sc->representation == IRDM_REPR_FIR)
 		snprintf(repr, sizeof(repr), "fir:%u", sc->fir_length);
 	else if (sc->modes)
 		snprintf(repr, sizeof(repr), "modal:%u", sc->modes);

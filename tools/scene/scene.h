@@ -66,6 +66,7 @@ struct irdm_scene {
 	struct irdm_region fixed;
 	double dt_s;
 	uint32_t representation; /* enum irdm_repr */
+	bool repr_auto;          /* chosen by the precompute to meet max_error */
 	unsigned fir_length;
 	unsigned fir_tail;       /* FIR: samples windowed past fir_length (0: none) */
 	unsigned modes;          /* modes kept (0 = all) */
