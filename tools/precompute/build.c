@@ -51,6 +51,7 @@ struct build {
 	struct irdm_node *nodes;
 	char *prov;
 	uint64_t scene_hash;
+	size_t n_solved;                /* modes the eigensolve gave (all: the exact model's) */
 };
 
 /* Modes the scene needs solved (0: all). */
@@ -1002,7 +1003,7 @@ static void report(const struct build *b, struct irdm_precompute_report *rep)
 /* Every elastic mode was solved (some may be dropped from the image). */
 static bool all_modes(const struct build *b)
 {
-	return !modes_needed(b->sc) && b->sc->method == IRDM_METHOD_MODAL &&
+	return b->n_solved == b->m.modes.n_elastic_total && b->sc->method == IRDM_METHOD_MODAL &&
 	       b->m.modes.phi && irdm_dist_size() == 1;
 }
 
@@ -1286,6 +1287,7 @@ int irdm_precompute(const struct irdm_scene *sc, const struct irdm_precompute_op
 		return ret;
 	}
 	b.scene_hash = irdm_fnv1a(b.scene_hash, &b.m.damping, sizeof(b.m.damping));
+	b.n_solved = b.m.modes.n_modes;
 	/* over MPI the ranks other than 0 are done once the eigenvectors are
 	 * gathered (rank 0 alone holds them and makes the image), or once they
 	 * gave rank 0 their share of the time-domain inputs */
