@@ -598,10 +598,12 @@ static void repr_text(const struct irdm_scene *sc, char *buf, size_t len)
 		snprintf(buf, len, "fir:%u%s", sc->fir_length, sc->fir_tail ? " with fir_tail" : "");
 	else if (!sc->modes)
 		snprintf(buf, len, "modal:all");
+	else if (sc->exact_head)
+		snprintf(buf, len, "modal:%u%s + exact_head %u", sc->modes,
+			 sc->static_correction ? " + static correction" : "", sc->exact_head);
 	else
-		snprintf(buf, len, "modal:%u%s%s%.0u", sc->modes,
-			 sc->static_correction ? " + static correction" : "",
-			 sc->exact_head ? " + exact_head " : "", sc->exact_head);
+		snprintf(buf, len, "modal:%u%s", sc->modes,
+			 sc->static_correction ? " + static correction" : "");
 }
 
 /* What may make an uncertified image certified. */
