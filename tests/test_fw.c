@@ -230,7 +230,7 @@ static void test_bad_input(void **state)
 		pid_t p = spawn(env_or("IRDM", "build/irdm"), (const char *const[]){
 			"precompute", "-q", "--mesh", "cuboid", "--resolution", "2,2,4", "--fixed", "z<=0",
 			"--touch", "z>=0.2", "--display", "touch", "--representation", "modal:10",
-			"--dt", "0.002", "-o", img2, NULL });
+			"--dt", "0.002", "--max_error", "none", "-o", img2, NULL });
 		assert_int_equal(finish(p), 0);
 	}
 	expect_error(run_fw((const char *const[]){ "--board", BOARD, "--image", img2, NULL }), 3,
@@ -856,7 +856,7 @@ static void surface_image(char *path, size_t len)
 	pid = spawn(env_or("IRDM", "build/irdm"), (const char *const[]){
 		"precompute", "-q", "--mesh", "cuboid", "--resolution", "4,4,8", "--fixed", "z<=0",
 		"--touch", "z>=0.2", "--display", "surface", "--representation", "modal:40",
-		"--static_correction", "yes", "-o", path, NULL });
+		"--static_correction", "yes", "--max_error", "none", "-o", path, NULL });
 	assert_int_equal(finish(pid), 0);
 }
 
@@ -1143,7 +1143,7 @@ static int setup(void **state)
 	pid = spawn(env_or("IRDM", "build/irdm"), (const char *const[]){
 		"precompute", "-q", "--mesh", "cuboid", "--resolution", "4,4,8", "--fixed", "z<=0",
 		"--touch", "z>=0.2", "--display", "touch", "--representation", "modal:40",
-		"--static_correction", "yes", "-o", image, NULL });
+		"--static_correction", "yes", "--max_error", "none", "-o", image, NULL });
 	return finish(pid) == 0 ? 0 : -1;
 }
 

@@ -54,6 +54,26 @@ static int open_user(struct fw *fw)
 	return FW_EXIT_OK;
 }
 
+/* What the image is and how far it is from the exact model, first: the
+ * figure says what the forces felt are worth. */
+static void print_image(const struct fw *fw)
+{
+	const struct irdm_meta *m = fw->s->img->meta;
+
+	if (fw->args.quiet)
+		return;
+	if (m->representation == IRDM_REPR_FIR)
+		printf("image: %s: FIR of %u samples", fw->args.image, m->fir_length);
+	else
+		printf("image: %s: modal, %u of %u modes%s%s", fw->args.image, m->n_modes,
+		       m->n_modes_total, m->flags & IRDM_META_STATIC_CORR ? " + static correction" : "",
+		       m->flags & IRDM_META_EXACT_HEAD ? " + exact head" : "");
+	if (m->flags & IRDM_META_ERROR_MEASURED)
+		printf("; force error %.3g against the exact model\n", (double)m->measured_error);
+	else
+		printf("; force error not measured\n");
+}
+
 static int open_inputs(struct fw *fw)
 {
 	struct irdm_session_config sc = { .deform = false };
@@ -80,6 +100,7 @@ static int open_inputs(struct fw *fw)
 			 dt_us, fw->board.period_us);
 		return fail(FW_EXIT_INPUT, IRDM_EINVAL, "%s: %s", fw->args.image, fw->err);
 	}
+	print_image(fw);
 	return fw->args.user ? open_user(fw) : FW_EXIT_OK;
 }
 
