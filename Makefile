@@ -7,21 +7,29 @@
 #                   any finding fails the build and keeps the input
 #   make test-variants  the stability suite with OPENBLAS_NUM_THREADS=1, then
 #                   with the portable history sums forced
-#   make check      what CI runs: fuzz, clang + sanitizer tests, the
+#   make check      what CI runs: docs-check, fuzz, clang + sanitizer tests, the
 #                   variants, then the tests
-#   make bench      benchmarks (print figures; never pass/fail on time)
+#   make bench      benchmarks (print figures; never pass/fail on time), each
+#                   into docs/measurements/NAME.md (make bench_tick: one)
 #   make bench-mpi  the precompute of a 100k-node model, serial and over MPI ranks
 #   make stability  the stability suite's long run (10^7-tick soak): a Markdown
 #                   table and a plot of the worst cases in out/stability/
+#   (the measuring targets write docs/measurements/NAME.md: the figures with
+#   the command, date, machine and load; tools/scripts/measure.sh)
 #   make report     docs/report.md and its plots: every representation against
 #                   the exact model (irdm report; REPORT_CONFIGS, <= 10 min)
 #   make run        the main job: the built-in default scene, end to end
 #   make view-shots after make run: its run in the browser view, docs/view/*.png
-#   make jitter     irdm-fw's wake-up latency beside cyclictest's (JITTER_SECONDS)
+#   make jitter     irdm-fw's wake-up latency beside cyclictest's, alternating
+#                   (JITTER_ROUNDS x JITTER_SECONDS; docs/measurements/jitter.md)
 #   make jitter-view the same loop with and without a browser on its live view
 #   make hil        the CAN back-end end to end in a PREEMPT_RT VM (docs/hil.md)
-#   make docs       docs/scene-format.md from the scene key table
+#   make docs       every generated document (GEN_DOCS: scene-format.md, the
+#                   board keys in boards.md, the test index in testing.md);
+#                   make docs-check: fails if one is stale
 #   make sizes      irdm-fw built with each configs/*.config (CONFIG=FILE: one)
+#   make format-check  every C source and header against .clang-format
+#                   (clang-format 14); make format rewrites them
 #
 # CC=clang works too.  The layers point one way and the include paths
 # enforce it (docs/architecture.md, "Layers"); each folder's objects see
@@ -148,6 +156,10 @@ FUZZ_SRC  := $(wildcard tests/fuzz/fuzz_*.c)
 
 obj = $(patsubst %.c,$(BUILD)/obj/%.o,$(1))
 
+# A measurement's figures go to docs/measurements/NAME.md with the command,
+# the date, the machine and its load (tools/scripts/measure.sh).
+MEASURE := tools/scripts/measure.sh
+
 FW_LIB   := $(BUILD)/libirdmfw.a
 POSIX_LIB := $(BUILD)/libirdmposix.a
 HAL_LIB  := $(BUILD)/libirdmhal.a
@@ -161,7 +173,7 @@ CORE_TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(CORE_TEST_SRC))
 FWAPP_TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(FWAPP_TEST_SRC))
 BENCHES  := $(patsubst tests/bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC))
 
-.PHONY: all test test-variants san fuzz bench bench-precompute bench-mpi run render view-shots jitter-view stability report jitter check deps clean docs cfg-fws sizes hil
+.PHONY: all test test-variants san fuzz bench bench-precompute bench-mpi run render view-shots jitter-view stability report jitter check deps clean docs docs-check cfg-fws sizes hil format format-check
 .SECONDARY:
 all: $(if $(CONFIG),,$(IRDM) $(SLEPC_PLUGIN)) $(FW_LIB) $(POSIX_LIB) $(HAL_LIB) $(SIM_LIB) $(if $(FWMAIN_SRC),$(IRDM_FW)) \
   $(if $(CDMAIN_SRC),$(IRDM_CD))
@@ -293,8 +305,11 @@ cfg-fws:
 	  BUILD=$(BUILD)/cfg-$(c) all;)
 
 # What each configuration costs: irdm-fw's sections and its libraries (the
-# core's and the platform's).
+# core's and the platform's; docs/measurements/sizes.md).
 sizes: all cfg-fws
+	$(MEASURE) sizes 'make sizes' -- $(MAKE) --no-print-directory sizes-run
+sizes-run:
+	@size $(IRDM_FW) | head -n 1
 	@for b in $(IRDM_FW) $(foreach c,$(CFG_NAMES),$(BUILD)/cfg-$(c)/irdm-fw); do \
 	  size $$b | tail -n 1; \
 	  echo "  firmware core library text: $$(size -t $$(dirname $$b)/libirdmfw.a | tail -n 1 | awk '{print $$1}') bytes"; \
@@ -302,10 +317,47 @@ sizes: all cfg-fws
 	  echo "  needs: $$(readelf -d $$b | sed -n 's/.*Shared library: \[\(.*\)\]/\1/p' | tr '\n' ' ')"; \
 	done
 
-# Generated from the scene key table (tests/test_cli.c checks it is current).
-docs: $(IRDM)
-	$(IRDM) precompute --help-markdown > docs/scene-format.md.tmp
-	mv docs/scene-format.md.tmp docs/scene-format.md
+# Every generated document, named by its file in docs/; gen-doc-FILE writes
+# it into the directory $(1).  A new one: add its name and its gen-doc- line.
+# Whole files come from a --help-markdown; a block inside a hand-written
+# page is spliced between its markers (tools/scripts/splice-doc.sh).
+GEN_DOCS := scene-format.md boards.md hal-options.md testing.md
+gen-doc-scene-format.md = $(IRDM) precompute --help-markdown > $(1)/scene-format.md
+gen-doc-hal-options.md = $(IRDM_FW) --doc hal-options > $(1)/hal-options.md
+gen-doc-boards.md = $(IRDM_FW) --doc boards | \
+  tools/scripts/splice-doc.sh docs/boards.md 'board keys' > $(1)/boards.md
+gen-doc-testing.md = tools/scripts/test-index.sh tests | \
+  tools/scripts/splice-doc.sh docs/testing.md 'test index' > $(1)/testing.md
+GEN_DOCS_TOOLS := $(IRDM) $(IRDM_FW)
+gen-docs = $(foreach d,$(GEN_DOCS),$(call gen-doc-$(d),$(1));)
+
+# make docs rewrites what changed; make docs-check (in make check) fails
+# naming each stale file.
+docs: $(GEN_DOCS_TOOLS)
+	@tmp=$$(mktemp -d); trap 'rm -rf "$$tmp"' EXIT; \
+	$(call gen-docs,$$tmp) \
+	for d in $(GEN_DOCS); do \
+	  cmp -s "$$tmp/$$d" docs/$$d || { cp "$$tmp/$$d" docs/$$d; echo "docs: docs/$$d rewritten"; }; \
+	done
+docs-check: $(GEN_DOCS_TOOLS)
+	@tmp=$$(mktemp -d); trap 'rm -rf "$$tmp"' EXIT; \
+	$(call gen-docs,$$tmp) \
+	stale=; for d in $(GEN_DOCS); do \
+	  diff -u docs/$$d "$$tmp/$$d" > "$$tmp/$$d.diff" || { head -n 40 "$$tmp/$$d.diff"; stale="$$stale docs/$$d"; }; \
+	done; \
+	if [ -n "$$stale" ]; then echo "docs-check: stale:$$stale (run make docs)"; exit 1; fi; \
+	echo "docs-check: $(GEN_DOCS) current"
+
+# The style (.clang-format, clang-format 14: other versions lay some lines
+# out differently).  Every C source and header but the build trees and the
+# generated ones (crc32c.c's tables).
+CLANG_FORMAT ?= $(or $(shell command -v clang-format-14 2>/dev/null),clang-format)
+FORMAT_SRC = $(filter-out %/crc32c.c,$(shell find . \( -type d \( -name 'build*' -o -name out \
+  -o -name .git \) \) -prune -o \( -name '*.c' -o -name '*.h' \) -print | sed 's|^\./||' | sort))
+format-check:
+	$(CLANG_FORMAT) --dry-run -Werror $(FORMAT_SRC)
+format:
+	$(CLANG_FORMAT) -i $(FORMAT_SRC)
 
 san:
 	$(MAKE) BUILD=build-san SAN=1 OPT="-O1 -g" IRDM_SOAK_SECONDS=10 IRDM_TORUS=small test
@@ -346,6 +398,10 @@ STAB_OUT ?= out/stability
 STAB_SOAK_SECONDS ?= 10000
 stability: $(BUILD)/tests/test_stability_cases $(BUILD)/tests/test_stability_soak \
   $(BUILD)/tests/test_stability_spin
+	$(MEASURE) -f $(STAB_OUT)/table.md stability \
+	  'make stability STAB_SOAK_SECONDS=$(STAB_SOAK_SECONDS)' -- \
+	  $(MAKE) --no-print-directory stability-run
+stability-run:
 	rm -rf $(STAB_OUT)
 	mkdir -p $(STAB_OUT)
 	IRDM_STAB_OUT=$(STAB_OUT) $(BUILD)/tests/test_stability_cases
@@ -353,10 +409,17 @@ stability: $(BUILD)/tests/test_stability_cases $(BUILD)/tests/test_stability_soa
 	IRDM_STAB_OUT=$(STAB_OUT) IRDM_SOAK_SECONDS=$(STAB_SOAK_SECONDS) $(BUILD)/tests/test_stability_soak
 	/usr/bin/python3 tools/scripts/stability-report.py $(STAB_OUT)
 
+# Each benchmark alone: make bench_tick, make bench_ctrl, ... (the names of
+# tests/bench/*.c), each writing docs/measurements/NAME.md.
+BENCH_NAMES := $(patsubst tests/bench/%.c,%,$(BENCH_SRC))
+.PHONY: $(BENCH_NAMES) sizes-run stability-run
+$(BENCH_NAMES): %: $(BUILD)/bench/% $(IRDM)
+	$(MEASURE) $@ 'make $@' -- env IRDM=$(IRDM) $<
+
 bench: $(BENCHES) $(IRDM) bench-precompute
-	for b in $(BENCHES); do echo "== $$b"; IRDM=$(IRDM) $$b; done
-	@echo "== ticks paced at 1 kHz, deformation thread running (make jitter, 10 s)"
-	$(MAKE) --no-print-directory jitter JITTER_SECONDS=10
+	for b in $(BENCH_NAMES); do $(MAKE) --no-print-directory $$b; done
+	@echo "== ticks paced at 1 kHz, deformation thread running (make jitter, 5 x 2 s)"
+	$(MAKE) --no-print-directory jitter JITTER_ROUNDS=5 JITTER_SECONDS=2
 
 # Accuracy, tick time and image size of every representation against the
 # exact full model (irdm report --help); CSVs in out/report/, the report
@@ -377,12 +440,13 @@ report: $(IRDM)
 
 # Paper-scale images (cuboid, bunny): time and size beside the paper's.
 bench-precompute: $(IRDM) $(BUILD)/data/bunny.off
-	tools/scripts/bench-precompute.sh $(IRDM)
+	$(MEASURE) -m bench-precompute 'make bench-precompute' -- tools/scripts/bench-precompute.sh $(IRDM)
 
 # The precompute over MPI ranks: a 100k-node cuboid, serial and slepc on
-# np = 1, 2 (README, "Beyond one machine"); bounded by TIMEOUT per run.
+# np = 1, 2 (docs/mpi.md); bounded by TIMEOUT per run; figures to
+# docs/measurements/bench-mpi.md.
 bench-mpi: $(IRDM) $(SLEPC_PLUGIN)
-	tools/scripts/bench-mpi.sh $(IRDM)
+	$(MEASURE) bench-mpi 'make bench-mpi' -- tools/scripts/bench-mpi.sh $(IRDM)
 
 $(BUILD)/data/bunny.off:
 	@mkdir -p $(dir $@)
@@ -395,6 +459,7 @@ $(BUILD)/data/bunny.off:
 CHECK_FUZZ_SECONDS ?= 15
 CHECK_JOBS ?= $(shell nproc)
 check: deps
+	$(MAKE) docs-check
 	$(MAKE) -j$(CHECK_JOBS) fuzz FUZZ_SECONDS=$(CHECK_FUZZ_SECONDS)
 	$(MAKE) -j$(CHECK_JOBS) CC=clang BUILD=build-clang test
 	$(MAKE) -j$(CHECK_JOBS) san
@@ -420,25 +485,30 @@ render: deps
 	$(MAKE) $(IRDM)
 	tools/scripts/render-default-scene.sh $(IRDM)
 
-# irdm-fw's wake-up latency beside cyclictest's (JITTER_SECONDS each, default 60)
+# irdm-fw's wake-up latency beside cyclictest's, alternating in JITTER_ROUNDS
+# rounds of JITTER_SECONDS each (default 10 x 3 s); docs/measurements/jitter.md
 JITTER_IMAGE := $(BUILD)/data/jitter.img
 $(JITTER_IMAGE): $(IRDM) scenes/cuboid-top.scene
 	@mkdir -p $(dir $@)
 	$(IRDM) precompute -q --scene scenes/cuboid-top.scene -o $@
+# (jitter.sh writes the file, with the host's conditions, itself)
 jitter: deps $(IRDM) $(IRDM_FW) $(JITTER_IMAGE)
 	tools/scripts/jitter.sh $(IRDM) $(IRDM_FW) $(JITTER_IMAGE)
 
 # The same loop with and without a browser on its live view, alternating
 # (JITTER_ROUNDS pairs of JITTER_SECONDS, default 3 x 20 s; docs/view.md)
-jitter-view: deps $(IRDM_FW) $(JITTER_IMAGE)
-	tools/scripts/jitter-view.sh $(IRDM_FW) $(JITTER_IMAGE)
+jitter-view: deps $(IRDM) $(IRDM_FW) $(JITTER_IMAGE)
+	$(MEASURE) jitter-view \
+	  'make jitter-view JITTER_SECONDS=$(or $(JITTER_SECONDS),20) JITTER_ROUNDS=$(or $(JITTER_ROUNDS),3)' -- \
+	  env JITTER_SECONDS=$(or $(JITTER_SECONDS),20) JITTER_ROUNDS=$(or $(JITTER_ROUNDS),3) \
+	  tools/scripts/jitter-view.sh $(IRDM) $(IRDM_FW) $(JITTER_IMAGE)
 
 # Hardware in the loop without the hardware: Debian's PREEMPT_RT kernel
 # under qemu (TCG), vcan0, irdm-candrives and irdm-fw (the minimal build)
 # on it, candump's log checked on the host (tools/scripts/hil/, docs/hil.md)
 hil: deps $(IRDM) $(IRDM_FW) $(BUILD)/tests/test_socketcan
 	$(MAKE) --no-print-directory CONFIG=configs/minimal.config BUILD=$(BUILD)/cfg-minimal all
-	tools/scripts/hil/hil.sh $(BUILD) $(IRDM) $(BUILD)/cfg-minimal/irdm-fw \
+	$(MEASURE) hil 'make hil' -- tools/scripts/hil/hil.sh $(BUILD) $(IRDM) $(BUILD)/cfg-minimal/irdm-fw \
 	  $(BUILD)/cfg-minimal/irdm-candrives $(BUILD)/tests/test_socketcan $(IRDM_FW)
 
 deps:

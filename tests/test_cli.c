@@ -61,6 +61,14 @@ static void exec_child(const char **argv, const char *out_path, const char *err_
 }
 
 /* Run irdm with a NULL-terminated argument list; capture stdout/stderr. */
+static bool has_arg(const char *const *argv, int n, const char *arg)
+{
+	for (int i = 0; i < n; i++)
+		if (!strcmp(argv[i], arg))
+			return true;
+	return false;
+}
+
 static int run(const char *first, ...)
 {
 	const char *argv[64];
@@ -71,9 +79,15 @@ static int run(const char *first, ...)
 
 	argv[n++] = irdm_path();
 	va_start(ap, first);
-	for (const char *a = first; a && n < 63; a = va_arg(ap, const char *))
+	for (const char *a = first; a && n < 61; a = va_arg(ap, const char *))
 		argv[n++] = a;
 	va_end(ap);
+	/* the accuracy measurement (a dense eigensolve per image) only where a
+	 * test asks for it by setting max_error */
+	if (!strcmp(first, "precompute") && !has_arg(argv, n, "--max_error")) {
+		argv[n++] = "--max_error";
+		argv[n++] = "none";
+	}
 	argv[n] = NULL;
 	snprintf(out_path, sizeof(out_path), "%s/stdout", dir);
 	snprintf(err_path, sizeof(err_path), "%s/stderr", dir);
@@ -204,6 +218,25 @@ static void test_bad_scene_values(void **state)
 	expect_failure(run("precompute", SMALL, "--dt", "1e-300", "-o", img, NULL),
 		       "--dt 1e-300: must be >= 1e-06 s");
 	assert_false(exists(img));
+}
+
+/* An image `image verify --require-stable` would reject is not written
+ * unless the scene asks for it by name. */
+static void test_uncertified_refused(void **state)
+{
+	const char *img = path_in_dir("uncert.img");
+
+	(void)state;
+	unlink(img);
+	expect_failure(run("precompute", SMALL, "--representation", "fir:20", "--modes", "all", "--touch", "z>=0.2",
+			   "-o", img, NULL), "scene cuboid: fir:20 is not certified stable: spectral radius 1.");
+	assert_non_null(strstr(err_text, "try fir_tail = window:40"));
+	assert_non_null(strstr(err_text, "uncertified = yes"));
+	assert_int_not_equal(access(img, F_OK), 0);
+	assert_int_equal(run("precompute", SMALL, "--representation", "fir:20", "--modes", "all", "--touch", "z>=0.2",
+			     "--modes", "all", "--uncertified", "yes", "-o", img, NULL), 0);
+	expect_failure(run("image", "verify", "--require-stable", img, NULL),
+		       "columns have an unstable force recursion");
 }
 
 static void test_bad_meshes(void **state)
@@ -468,7 +501,7 @@ static void test_time_domain_split_and_merge(void **state)
 	const char *p1 = path_in_dir("p1.part"), *p2 = path_in_dir("p2.part");
 	char parts[700], both[700], range2[32], whole_csv[65536], merged_csv[65536];
 #define TD SMALL, "--representation", "fir:20", "--method", "time-domain", "--touch", "z>=0.2", \
-	   "--display", "touch", "--substeps", "4", "--dt", "0.002"
+	   "--display", "touch", "--substeps", "4", "--dt", "0.002", "--uncertified", "yes"
 
 	(void)state;
 	assert_int_equal(run("precompute", "-q", TD, "--count-inputs", NULL), 0);
@@ -656,6 +689,7 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_bad_scene_values),
+		cmocka_unit_test(test_uncertified_refused),
 		cmocka_unit_test(test_bad_meshes),
 		cmocka_unit_test(test_read_failure_is_eio),
 		cmocka_unit_test(test_alloc_failure_is_enomem),

@@ -1392,7 +1392,7 @@ static int make_images(void **state)
 	snprintf(float_path, sizeof(float_path), "%s/float.img", rt_dir);
 	efx_image(&img, fir_path, "mesh", "box:0.04,0.04,0.08", "resolution", "2,2,4",
 		  "fixed", "z<=0", "touch", "z>=0.08", "display", "surface",
-		  "representation", "fir:100", NULL);
+		  "representation", "fir:100", "uncertified", "yes", NULL);
 	irdm_image_unmap(&img);
 	efx_image(&img, float_path, "mesh", "cube", "resolution", "3,3,3", "floating", "yes",
 		  "representation", "modal:all", "touch", "surface", "display", "surface", NULL);

@@ -51,7 +51,7 @@ static int setup(void **state)
 	efx_image(&hybrid, p, "resolution", "4,4,8", "representation", "modal:300",
 		  "exact_head", "32", "precision", "f32", "touch", "z>=0.2", NULL);
 	snprintf(p, sizeof(p), "%s/fir.img", dir);
-	efx_image(&fir, p, "resolution", "4,4,8", "representation", "fir:100",
+	efx_image(&fir, p, "resolution", "4,4,8", "representation", "fir:100", "uncertified", "yes",
 		  "touch", "z>=0.2", NULL);
 	return 0;
 }

@@ -223,7 +223,7 @@ static int setup(void **state)
 	snprintf(image, sizeof(image), "%s/cuboid.img", dir);
 	return run(env_or("IRDM", "build/irdm"), (const char *const[]){
 		"precompute", "-q", "--scene", "scenes/cuboid-paper.scene", "--resolution", "4,4,8",
-		"--representation", "modal:40", "-o", image, NULL }) ? -1 : 0;
+		"--representation", "modal:40", "--max_error", "none", "-o", image, NULL }) ? -1 : 0;
 }
 
 static int teardown(void **state)

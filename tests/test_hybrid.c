@@ -26,7 +26,7 @@
 #include <cmocka.h>
 
 #include "image/image_response.h"
-#include "precompute/fir_tail.h"
+#include "modal/window.h"
 #include "precompute/precompute.h"
 #include "scene/scene.h"
 #include "support/engine_fixture.h"
@@ -107,24 +107,24 @@ static uint32_t same_col(const struct irdm_image *img, uint32_t c, const struct 
 /* rx (2H samples of the dropped modes' exact response) into what the head
  * should hold: the second half tapered by the Hann window, plus what the
  * taps then miss of the whole static correction of block (c, r) -- the kept
- * block and the far field there -- along the sine bump (fir_tail.h). */
+ * block and the far field there -- along the sine bump (modal/window.h). */
 static void taper_expected(const struct irdm_image *img, uint32_t c, uint32_t r, double *rx)
 {
 	double bump_sum = 0, whole[9];
 
 	efx_corr_block(img, c, r, whole);       /* kept block + far field */
 	for (size_t i = 0; i < H_EXACT; i++)
-		bump_sum += irdm_fir_tail_bump(i, H_EXACT);
+		bump_sum += irdm_window_bump(i, H_EXACT);
 	for (int e = 0; e < 9; e++) {
 		double sum = 0;
 		for (size_t s = 0; s < 2 * H_EXACT; s++) {
 			if (s >= H_EXACT)
-				rx[9 * s + (size_t)e] *= irdm_fir_tail_taper(s - H_EXACT, H_EXACT);
+				rx[9 * s + (size_t)e] *= irdm_window_taper(s - H_EXACT, H_EXACT);
 			sum += rx[9 * s + (size_t)e];
 		}
 		double miss = whole[e] - sum;
 		for (size_t i = 0; i < H_EXACT; i++)
-			rx[9 * (H_EXACT + i) + (size_t)e] += miss * irdm_fir_tail_bump(i, H_EXACT) / bump_sum;
+			rx[9 * (H_EXACT + i) + (size_t)e] += miss * irdm_window_bump(i, H_EXACT) / bump_sum;
 	}
 }
 

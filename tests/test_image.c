@@ -935,7 +935,7 @@ static void test_bad_magic_and_version(void **state)
 
 	/* A newer minor is compatible, and may use reserved header fields. */
 	h.version_major = IRDM_IMAGE_VERSION_MAJOR;
-	h.version_minor = 3;
+	h.version_minor = IRDM_IMAGE_VERSION_MINOR + 1;
 	h.flags = 0x10;
 	h.reserved[5] = 7;
 	put_header(buf, &h);
@@ -1420,7 +1420,11 @@ FX(m_fir_corr_flag, fx->meta.flags |= IRDM_META_STATIC_CORR)
 FX(m_unknown_flag, fx->meta.flags |= 1u << 9)
 FX(m_fir_exact, fx->meta.fir_exact = 1)
 FX(m_fir_window_flag, fx->meta.flags |= IRDM_META_FIR_TAIL_WINDOW)
-FX(m_reserved, fx->meta.reserved[3] = 1)
+/* format 2.3's measured error: without its flag, or not a number */
+FX(m_error_no_flag, fx->meta.measured_error = 0.5f)
+FX(m_error_nan, (fx->meta.flags |= IRDM_META_ERROR_MEASURED, fx->meta.measured_error = NAN))
+FX(m_error_neg, (fx->meta.flags |= IRDM_META_ERROR_MEASURED, fx->meta.measured_error = -1e-3f))
+FX(m_error_ok, (fx->meta.flags |= IRDM_META_ERROR_MEASURED, fx->meta.measured_error = 2.5e-4f))
 /* the hybrid's head (format 2.1): 2 samples of the modal fixture's 4 blocks */
 FX(m_head2, (fx->meta.flags |= IRDM_META_EXACT_HEAD, fx->meta.head_samples = 2))
 FX(m_head_samples_only, fx->meta.head_samples = 2)
@@ -1659,7 +1663,11 @@ static const struct sem_case sem_cases[] = {
 	{ "meta fir_exact without its flag", FIR, m_fir_exact, NULL, IRDM_EFORMAT, "fir_exact 1" },
 	{ "meta tail window without fir_exact", FIR, m_fir_window_flag, NULL, IRDM_EFORMAT,
 	  "FIR_TAIL_WINDOW set" },
-	{ "meta reserved", FIR, m_reserved, NULL, IRDM_EFORMAT, "reserved" },
+	{ "meta error without its flag", FIR, m_error_no_flag, NULL, IRDM_EFORMAT,
+	  "measured_error is 0.5 without the ERROR_MEASURED flag" },
+	{ "meta error NaN", FIR, m_error_nan, NULL, IRDM_EFORMAT, "measured_error is nan, must be finite" },
+	{ "meta error negative", FIR, m_error_neg, NULL, IRDM_EFORMAT, "measured_error is -0.001" },
+	{ "meta error measured", FIR, m_error_ok, NULL, IRDM_OK, NULL },
 	{ "tool_version", FIR, m_tool_nul, NULL, IRDM_EFORMAT, "NUL-terminated" },
 	{ "mesh_name", FIR, m_name_nul, NULL, IRDM_EFORMAT, "NUL-terminated" },
 	{ "node NaN", FIR, m_node_nan, NULL, IRDM_EFORMAT, "node 3 has a non-finite position" },

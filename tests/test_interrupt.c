@@ -175,7 +175,8 @@ static void test_precompute_interrupted_in_tetgen(void **state)
 {
 	char fake[320], pidfile[320], img[320], pattern[400], text[32] = "", env[400];
 	const char *const args[] = { "precompute", "--mesh", "tests/data/mesh/cube.off",
-				     "--fixed", "z<=0", "--touch", "z>=0.9", "-o", img, NULL };
+				     "--fixed", "z<=0", "--touch", "z>=0.9", "--max_error", "none",
+				     "-o", img, NULL };
 	pid_t irdm, tetgen;
 	glob_t g;
 	int status;
@@ -221,7 +222,8 @@ static void test_image_debris(void **state)
 	char img[320], dead[400], live[400];
 	const char *const args[] = { "precompute", "-q", "--mesh", "box:0.04,0.04,0.08",
 				     "--resolution", "2,2,4", "--fixed", "z<=0", "--touch",
-				     "z>=0.08", "--representation", "modal:all", "-o", img, NULL };
+				     "z>=0.08", "--representation", "modal:all", "--max_error", "none",
+				     "-o", img, NULL };
 	int fd, rc;
 
 	(void)state;

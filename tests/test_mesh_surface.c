@@ -478,6 +478,45 @@ static void test_obj_relative(void **state)
 	irdm_surface_free(&s);
 }
 
+/* The unit cube with its top face written on its own four vertices, moved
+ * by dz from the others (a generator's seam). */
+static void seam_cube(const char *path, double dz)
+{
+	char text[1024];
+
+	snprintf(text, sizeof(text),
+		 "OFF\n12 6 12\n0 0 0\n1 0 0\n0 1 0\n1 1 0\n0 0 1\n1 0 1\n0 1 1\n1 1 1\n"
+		 "0 0 %.17g\n1 0 %.17g\n0 1 %.17g\n1 1 %.17g\n"
+		 "4 0 2 3 1\n4 8 9 11 10\n4 0 1 5 4\n4 2 6 7 3\n4 0 4 6 2\n4 1 3 7 5\n",
+		 1 + dz, 1 - dz, 1 + dz, 1 - dz);
+	tf_write_text(path, text);
+}
+
+/* Seam vertices equal to 3e-10 (the diagonal is 1.73: tolerance 1.7e-9)
+ * are welded and the count said; at 1e-6 they are distinct points, and
+ * the surface is open. */
+static void test_weld_seam(void **state)
+{
+	struct irdm_mesh_sizing sz = { "pq1.414", 0, 0, "" };
+	struct irdm_mesh m;
+	char path[300], err[512];
+
+	(void)state;
+	snprintf(path, sizeof(path), "%s/seam.off", tmpdir);
+	seam_cube(path, 3e-10);
+	if (irdm_mesh_read_sized(path, 0.01, &sz, &m, err, sizeof(err)))
+		fail_msg("%s", err);
+	print_message("%s\n", sz.note);
+	assert_non_null(strstr(sz.note, "welded 4 vertices (within 1.73e-09"));
+	assert_cube_mesh(&m, 0.01);
+	irdm_mesh_free(&m);
+	seam_cube(path, 1e-6);
+	assert_err(irdm_mesh_read_sized(path, 0.01, &sz, &m, err, sizeof(err)), err, path,
+		   "surface is not closed: 8 open (one triangle) edges");
+	remove(path);
+	assert_tmpdir_empty();
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -489,6 +528,7 @@ int main(void)
 		cmocka_unit_test(test_tetgen_failures),
 		cmocka_unit_test(test_surface_errors),
 		cmocka_unit_test(test_obj_relative),
+		cmocka_unit_test(test_weld_seam),
 	};
 
 	return cmocka_run_group_tests(tests, group_setup, group_teardown);

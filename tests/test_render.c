@@ -451,7 +451,8 @@ static int precompute(const char *path, const char *res, const char *display, co
 	return run_irdm((const char *const[]){ "precompute", "-q", "--mesh", "cuboid", "--resolution",
 					       res, "--fixed", "z<=0", "--touch", "z>=0.2",
 					       "--display", display, "--representation", modes,
-					       "--static_correction", "yes", "-o", path, NULL });
+					       "--static_correction", "yes", "--max_error", "none",
+					       "-o", path, NULL });
 }
 
 static int setup(void **state)

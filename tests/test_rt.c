@@ -12,13 +12,16 @@
 #include <alloca.h>
 #include <pthread.h>
 #include <sched.h>
+#include <semaphore.h>
 #include <setjmp.h>
 #include <stdarg.h>
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/resource.h>
+#include <sys/syscall.h>
 #include <sys/utsname.h>
 #include <sys/wait.h>
 #include <time.h>
@@ -569,6 +572,128 @@ static void test_refusals(void **state)
 	assert_int_equal(WEXITSTATUS(status), 0);
 }
 
+/* ---- the loop's CPU to itself ---- */
+
+struct waiter {
+	sem_t *go, up;
+	pid_t tid;
+};
+
+static void *wait_on(void *arg)
+{
+	struct waiter *w = arg;
+
+	w->tid = (pid_t)syscall(SYS_gettid);
+	sem_post(&w->up);
+	sem_wait(w->go);
+	return NULL;
+}
+
+/* Reads this process's threads: counts the intruders; their masks in *masks. */
+static int check_tasks(int cpu, pid_t loop, pid_t a, pid_t b, uint64_t masks[2], bool *loop_seen)
+{
+	struct irdm_rt_task tasks[16];
+	char line[160];
+	size_t n;
+	int rc = irdm_rt_isolation_check(cpu, loop, tasks, 16, &n);
+
+	*loop_seen = false;
+	for (size_t i = 0; i < n; i++) {
+		assert_int_equal(irdm_rt_task_format(&tasks[i], line, sizeof(line)), IRDM_OK);
+		print_message("  %s\n", line);
+		assert_int_equal(tasks[i].intrudes, strstr(line, "may run on the loop's CPU") != NULL);
+		if (tasks[i].tid == a)
+			masks[0] = tasks[i].cpu_mask;
+		if (tasks[i].tid == b)
+			masks[1] = tasks[i].cpu_mask;
+		if (tasks[i].tid == loop) {
+			*loop_seen = tasks[i].loop && strstr(line, "(the loop)");
+			assert_false(tasks[i].intrudes);
+		}
+	}
+	return rc;
+}
+
+/*
+ * Two threads that may run on the loop's CPU (one on every CPU, one pinned
+ * to it alone): the check names both; after irdm_rt_isolate_cpu() neither
+ * may, the first keeps its other CPUs, the second moves to them; the loop's
+ * own thread (this one) is never an intruder nor moved.
+ */
+static void test_isolation(void **state)
+{
+	struct irdm_rt_sched pin;
+	long online = sysconf(_SC_NPROCESSORS_ONLN);
+	uint64_t all = 0, masks[2] = { 0, 0 }, bit, mine;
+	struct irdm_rt_report r;
+	pthread_t ta, tb;
+	pid_t loop = (pid_t)syscall(SYS_gettid), a, b;
+	struct waiter wa, wb;
+	bool loop_seen;
+	sem_t go;
+	int cpu;
+
+	(void)state;
+	if (online < 2 || online > 64)
+		skip();
+	cpu = (int)online - 1;
+	bit = UINT64_C(1) << cpu;
+	for (long c = 0; c < online; c++)
+		all |= UINT64_C(1) << c;
+	pin = (struct irdm_rt_sched){ SCHED_OTHER, 0, cpu };
+	assert_int_equal(irdm_rt_report_get(&r), IRDM_OK);
+	mine = r.cpu_mask;
+	sem_init(&go, 0, 0);
+	wa = (struct waiter){ .go = &go };
+	wb = wa;
+	sem_init(&wa.up, 0, 0);
+	sem_init(&wb.up, 0, 0);
+	assert_int_equal(pthread_create(&ta, NULL, wait_on, &wa), 0);
+	assert_int_equal(irdm_rt_thread_start(&tb, &pin, wait_on, &wb), IRDM_OK);
+	sem_wait(&wa.up);
+	sem_wait(&wb.up);
+	a = wa.tid;
+	b = wb.tid;
+	assert_int_equal(check_tasks(cpu, loop, a, b, masks, &loop_seen), 2);
+	assert_true(loop_seen);
+	assert_true(masks[0] == all && masks[1] == bit);
+	/* without a CPU of its own, the loop has no intruder to name */
+	assert_int_equal(check_tasks(-1, loop, a, b, masks, &loop_seen), 0);
+	assert_int_equal(irdm_rt_isolate_cpu(cpu, loop), IRDM_OK);
+	assert_int_equal(check_tasks(cpu, loop, a, b, masks, &loop_seen), 0);
+	assert_true(masks[0] == (all & ~bit) && masks[1] == (all & ~bit));
+	assert_int_equal(irdm_rt_report_get(&r), IRDM_OK);
+	assert_true(r.cpu_mask == mine);
+	assert_int_equal(irdm_rt_isolate_cpu(-1, loop), IRDM_EINVAL);
+	sem_post(&go);
+	sem_post(&go);
+	pthread_join(ta, NULL);
+	pthread_join(tb, NULL);
+	sem_destroy(&go);
+}
+
+/*
+ * The idle-latency request: held, the kernel's answer is the value asked
+ * for; released, it is what it was before.  Needs the device (root): a
+ * refusal is IRDM_EPERM and the rest is skipped.
+ */
+static void test_cpu_latency_hold(void **state)
+{
+	int32_t before = irdm_rt_cpu_latency_us();
+	int hold;
+
+	(void)state;
+	hold = irdm_rt_cpu_latency_hold(0);
+	print_message("  /dev/cpu_dma_latency: %d us before, hold %d\n", (int)before, hold);
+	if (hold == IRDM_EPERM || hold == IRDM_ENOTSUP)
+		skip();
+	assert_true(hold >= 0);
+	assert_int_equal(irdm_rt_cpu_latency_us(), 0);
+	irdm_rt_cpu_latency_release(hold);
+	assert_int_equal(irdm_rt_cpu_latency_us(), before);
+	irdm_rt_cpu_latency_release(-1);        /* nothing held: nothing done */
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -586,6 +711,8 @@ int main(void)
 		cmocka_unit_test(test_set_self),
 		cmocka_unit_test(test_cpu_except),
 		cmocka_unit_test(test_refusals),
+		cmocka_unit_test(test_isolation),
+		cmocka_unit_test(test_cpu_latency_hold),
 	};
 
 	return cmocka_run_group_tests(tests, NULL, NULL);

@@ -82,7 +82,7 @@ static int ends_with(const char *s, const char *tail)
 	return n >= m && !strcmp(s + n - m, tail);
 }
 
-/* The scripts the issue names are there; every file in scenes/users/ loads. */
+/* The shipped scripts are there by name; every file in scenes/users/ loads. */
 static void test_every_script_parses(void **state)
 {
 	static const char *const named[] = {

@@ -37,7 +37,8 @@ static const char *const soft_2ms[] = { SMALL, "young", "2e3", "poisson", "0.499
 static const char *const stiff_1ms[] = { SMALL, "young", "2e9", "poisson", "0.4999", "dt", "0.001", NULL };
 static const char *const stiff_2ms[] = { SMALL, "young", "2e9", "poisson", "0.4999", "dt", "0.002", NULL };
 static const char *const stiff_nu3[] = { SMALL, "young", "2e9", "poisson", "0.3", "dt", "0.001", NULL };
-#define FIR "resolution", "2,2,4", "modes", "all", "touch", "z>=0.2", "display", "touch", "dt", "0.002"
+#define FIR "resolution", "2,2,4", "modes", "all", "touch", "z>=0.2", "display", "touch", "dt", "0.002", \
+	"uncertified", "yes"
 static const char *const fir50[] = { FIR, "representation", "fir:50", NULL };
 static const char *const fir500[] = { FIR, "representation", "fir:500", NULL };
 

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * Issue 10, the hybrid representation: the modal certificate with an exact
+ * The hybrid representation: the modal certificate with an exact
  * FIR head of H samples (irdm_stability_modal_cert_head) against the dense
  * eigenvalues of the explicit 2K + 3(H-1) closed-loop matrix
  * (irdm_stability_modal_head), with the tolerances of the modal

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * Issue 10: degenerate and sliver elements.  The unit cube as 5 tets
+ * Degenerate and sliver elements.  The unit cube as 5 tets
  * (tests/test_mesh.c), scaled to 10 cm, with its top corner node moved onto
  * the plane of its three neighbours (x + y + z = 2: the corner tet is
  * flat) or just off it (a sliver of relative volume 3e-4).  Flat: the

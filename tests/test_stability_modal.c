@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * Issue 11: the argument-principle modal certificate (stability_modal.c)
+ * The argument-principle modal certificate (stability_modal.c)
  * against the dense eigenvalues of the 2K closed-loop matrix
  * (irdm_stability_modal) on every column of small images: grounded cuboid
  * and floating cube, all modes and truncated, with and without static

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * Issue 10, the soak: a push held on the soft cuboid, and one let go to
+ * The soak: a push held on the soft cuboid, and one let go to
  * ring down to nothing, for IRDM_SOAK_SECONDS of simulated time at 1 ms
  * (default 60 s; `make san` sets 10, `make stability` 10^4 s = 10^7
  * ticks; never less than 60 s).  Held: no drift of the held force and it stays the static force

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * Issue 10: a fast-spinning floating object.  The paper's 12 cm cube,
+ * A fast-spinning floating object.  The paper's 12 cm cube,
  * grabbed at a top corner through the haptic coupling, is spun up about
  * the vertical through its centre of mass (the device swings the corner
  * round at an angular speed growing to OMEGA_RAD_S in SPIN_UP_S), let go,

@@ -176,6 +176,7 @@ struct fw {
 	bool hal_open[IRDM_BOARD_DEVICES_MAX];
 	struct irdm_sim_user *user;     /* NULL without --user */
 	struct irdm_clock clock;
+	int idle_hold;                  /* real time: the CPUs' idle-latency request, or < 0 */
 	struct fw_trace trace;
 	double rendered_peak_n;         /* |force on tip 0| after the clamp and saturation */
 	uint64_t rendered_peak_tick;

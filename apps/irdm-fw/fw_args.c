@@ -60,7 +60,8 @@ static const struct irdm_opt fw_opts[] = {
 	  .metavar = "real | virtual",
 	  .help = "real time paced at the board's period, or virtual time (deterministic, fast)" },
 	{ .name = "require-rt", .type = IRDM_OPT_FLAG, FA(require_rt),
-	  .help = "refuse to run without PREEMPT_RT, SCHED_FIFO and locked memory" },
+	  .help = "refuse to run without PREEMPT_RT, SCHED_FIFO and locked memory, or with "
+		  "another thread allowed on the loop's CPU" },
 	{ .name = "quiet", .short_name = 'q', .type = IRDM_OPT_FLAG, FA(quiet),
 	  .help = "no summary" },
 	{ .name = "help", .short_name = 'h', .type = IRDM_OPT_FLAG, FA(help), .help = "this text" },

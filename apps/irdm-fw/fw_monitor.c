@@ -22,6 +22,7 @@
  */
 #include <stdlib.h>
 #include <string.h>
+#include <sys/prctl.h>
 #include <time.h>
 
 #include "irdm/error.h"
@@ -78,6 +79,8 @@ static void *consumer(void *arg)
 	struct fw *fw = arg;
 	const struct timespec nap = { 0, 1000000 };
 
+	/* its name in /proc: what irdm-fw's start-up lines call it */
+	prctl(PR_SET_NAME, "irdm-monitor", 0UL, 0UL, 0UL);
 	for (;;) {
 		/* read before the drain: what came before the stop is drained */
 		bool stopping = atomic_load_explicit(&fw->monitor.stop, memory_order_acquire);

@@ -19,6 +19,7 @@
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/prctl.h>
 #include <sys/resource.h>
 #include <sys/syscall.h>
 #include <time.h>
@@ -227,6 +228,8 @@ static void *serve(void *arg)
 	struct fw_view *v = arg;
 	pid_t tid = (pid_t)syscall(SYS_gettid);
 
+	/* its name in /proc: what irdm-fw's start-up lines call it */
+	prctl(PR_SET_NAME, "irdm-view", 0UL, 0UL, 0UL);
 	/* below the deformation worker and beside the log writer */
 	(void)setpriority(PRIO_PROCESS, (id_t)tid, VIEW_NICE);
 	view_server_run(v->srv);

@@ -13,7 +13,10 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/prctl.h>
+#include <sys/syscall.h>
+#include <unistd.h>
 
+#include "irdm/board.h"
 #include "irdm/error.h"
 #include "irdm/posix/board_file.h"
 #include "irdm/posix/rt.h"
@@ -22,6 +25,7 @@
 #include "fw.h"
 
 #define FORCE_STACK_BYTES (256u * 1024u)    /* pre-faulted for the loop */
+#define TASKS_MAX 64                        /* threads listed at start */
 
 static volatile sig_atomic_t signalled;
 
@@ -50,6 +54,26 @@ static int open_user(struct fw *fw)
 	return FW_EXIT_OK;
 }
 
+/* What the image is and how far it is from the exact model, first: the
+ * figure says what the forces felt are worth. */
+static void print_image(const struct fw *fw)
+{
+	const struct irdm_meta *m = fw->s->img->meta;
+
+	if (fw->args.quiet)
+		return;
+	if (m->representation == IRDM_REPR_FIR)
+		printf("image: %s: FIR of %u samples", fw->args.image, m->fir_length);
+	else
+		printf("image: %s: modal, %u of %u modes%s%s", fw->args.image, m->n_modes,
+		       m->n_modes_total, m->flags & IRDM_META_STATIC_CORR ? " + static correction" : "",
+		       m->flags & IRDM_META_EXACT_HEAD ? " + exact head" : "");
+	if (m->flags & IRDM_META_ERROR_MEASURED)
+		printf("; force error %.3g against the exact model\n", (double)m->measured_error);
+	else
+		printf("; force error not measured\n");
+}
+
 static int open_inputs(struct fw *fw)
 {
 	struct irdm_session_config sc = { .deform = false };
@@ -76,6 +100,7 @@ static int open_inputs(struct fw *fw)
 			 dt_us, fw->board.period_us);
 		return fail(FW_EXIT_INPUT, IRDM_EINVAL, "%s: %s", fw->args.image, fw->err);
 	}
+	print_image(fw);
 	return fw->args.user ? open_user(fw) : FW_EXIT_OK;
 }
 
@@ -172,6 +197,29 @@ static int start_devices(struct fw *fw)
 }
 
 /*
+ * Every CPU kept out of idle states that are slow to leave, as cyclictest
+ * does: otherwise the loop's CPU, idle for most of each period, sleeps
+ * deeply (on a virtual machine the host deschedules it) and every wake
+ * pays for leaving that state.  Held until the run stops (the kernel drops
+ * it too if the process dies).
+ */
+static void hold_idle(struct fw *fw)
+{
+	int32_t us;
+
+	fw->idle_hold = irdm_rt_cpu_latency_hold(0);
+	if (fw->args.quiet)
+		return;
+	us = irdm_rt_cpu_latency_us();
+	if (fw->idle_hold >= 0)
+		printf("idle states: none slower than %d us to leave, while the loop runs "
+		       "(/dev/cpu_dma_latency)\n", (int)us);
+	else
+		printf("idle states: not limited (/dev/cpu_dma_latency: %s); the loop's wake-ups "
+		       "pay for leaving them\n", irdm_strerror(fw->idle_hold));
+}
+
+/*
  * Real time as the board asks (real clock only), then report what was
  * granted, read back; --require-rt refuses to run on less (libfranka-style:
  * never claim real time that was not given).
@@ -197,8 +245,47 @@ static int setup_realtime(struct fw *fw)
 	irdm_rt_report_format(&rep, line, sizeof(line));
 	if (!fw->args.quiet)
 		printf("%s\n", line);
+	hold_idle(fw);
 	if (fw->args.require_rt && !irdm_rt_report_realtime(&rep))
 		return fail(FW_EXIT_SETUP, IRDM_EPERM, "%s: %s", "--require-rt", line);
+	return FW_EXIT_OK;
+}
+
+/*
+ * The loop's CPU to the loop alone, once every thread is up (a BLAS pool
+ * started before main has the whole machine in its mask), and every
+ * thread listed as the system schedules it, read back: one that may still
+ * run on the loop's CPU is named, and --require-rt refuses it.
+ */
+static int isolate_loop(struct fw *fw)
+{
+	struct irdm_rt_task tasks[TASKS_MAX];
+	pid_t loop = (pid_t)syscall(SYS_gettid);
+	int cpu = fw->board.cpu, intruders;
+	char line[160];
+	size_t n;
+
+	if (fw->args.clock != IRDM_CLOCK_REAL)
+		return FW_EXIT_OK;
+	if (cpu >= 0)
+		irdm_rt_isolate_cpu(cpu, loop);
+	intruders = irdm_rt_isolation_check(cpu, loop, tasks, TASKS_MAX, &n);
+	for (size_t i = 0; i < n && !fw->args.quiet; i++) {
+		irdm_rt_task_format(&tasks[i], line, sizeof(line));
+		printf("%s\n", line);
+	}
+	/* without a CPU of its own, the loop has none to keep */
+	if (intruders == 0 || cpu < 0)
+		return FW_EXIT_OK;
+	if (intruders > 0)
+		snprintf(line, sizeof(line), "%d other thread%s may run on the loop's CPU %d",
+			 intruders, intruders == 1 ? "" : "s", cpu);
+	else
+		snprintf(line, sizeof(line), "the threads on the loop's CPU %d cannot be listed",
+			 cpu);
+	if (fw->args.require_rt)
+		return fail(FW_EXIT_SETUP, IRDM_EPERM, "%s: %s", "--require-rt", line);
+	fprintf(stderr, "irdm-fw: %s\n", line);
 	return FW_EXIT_OK;
 }
 
@@ -256,6 +343,9 @@ static int start(struct fw *fw)
 		rc = fw_view_start(fw);
 	if (rc)
 		return fail(FW_EXIT_SETUP, rc, "%s%s", "", fw->err);
+	rc = isolate_loop(fw);
+	if (rc)
+		return rc;
 	return start_devices(fw);
 }
 
@@ -291,6 +381,7 @@ static int stop(struct fw *fw, int rc)
 	if (fw->ring && fw_log_close(fw) && fail(FW_EXIT_LOG, IRDM_EIO, "%s%s", "", fw->err) &&
 	    rc == FW_EXIT_OK)
 		rc = FW_EXIT_LOG;
+	irdm_rt_cpu_latency_release(fw->idle_hold);
 	fw_user_free(fw);
 	fw_monitor_free(fw);
 	fw_frame_free(fw);
@@ -332,6 +423,7 @@ int main(int argc, char **argv)
 
 	if (!fw)
 		return fail(FW_EXIT_SETUP, IRDM_ENOMEM, "%s%s", "", "out of memory");
+	fw->idle_hold = -1;
 	rc = fw_args_parse(&fw->args, argc - 1, argv + 1, fw->err, sizeof(fw->err));
 	if (rc || fw->args.help || fw->args.help_board || fw->args.doc) {
 		if (fw->args.help || !rc) {

@@ -127,6 +127,11 @@ static int cmd_info(const char *path)
 		unstable += !(img.stability[c].flags & IRDM_STAB_STABLE);
 	printf("stability     max spectral radius %.6f; %zu of %u columns unstable\n",
 	       m->max_spectral_radius, unstable, m->n_cols);
+	if (m->flags & IRDM_META_ERROR_MEASURED)
+		printf("force error   %.3g against the exact model (relative RMS, measured by the precompute)\n",
+		       (double)m->measured_error);
+	else
+		printf("force error   not measured\n");
 	printf("sections\n");
 	const struct irdm_image_section *s = (const void *)(img.base + h->section_table_offset);
 	for (uint32_t i = 0; i < h->section_count; i++)

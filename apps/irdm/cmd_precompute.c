@@ -43,7 +43,14 @@ static const char markdown_intro[] =
 	"`key = value` lines (`#` starts a comment), given to `irdm precompute\n"
 	"--scene FILE`; every key is also an option `--key value`, and options\n"
 	"override the file wherever they appear.  Keys not set keep their defaults:\n"
-	"the paper's cuboid, modal 300 + static correction, 1 ms, float32.\n"
+	"the paper's cuboid, 1 ms, float32, and the representation chosen to be\n"
+	"within max_error = 1e-3 of the exact model (representation = auto).\n"
+	"\n"
+	"Every image is measured: its relative RMS force error against the exact\n"
+	"linear model (every mode, double) for a step and a release at a few\n"
+	"touchable nodes is stored in the image and printed (`irdm image info`,\n"
+	"irdm-fw); above max_error, or not certified stable, it is not written\n"
+	"(docs/image-format.md, \"Measured error\").\n"
 	"\n"
 	"An invalid value names the line and the reason, e.g.\n"
 	"`cube.scene:12: poisson = 0.6: must be < 0.5`.\n"
@@ -66,7 +73,8 @@ static const char markdown_end[] =
 	"T + L samples; the first T are untouched, so the force of the first T\n"
 	"ticks after a contact is the truncated FIR's, and the held force is the\n"
 	"static one.  The result is certified like any FIR; an image still found\n"
-	"unstable falls back to the engine's r^s damping.  L = 2T certified every\n"
+	"unstable is refused (`uncertified = yes` writes it: the engine then damps\n"
+	"its tail by r^s).  L = 2T certified every\n"
 	"column of the paper's cuboid at 4x4x8 cells (T = 500 at 2 ms; L = T did\n"
 	"not: `docs/architecture.md`, \"Numerical hazards\").\n";
 
@@ -164,6 +172,11 @@ static void print_report(const struct irdm_scene *sc, const struct irdm_precompu
 	       r->free_dofs);
 	printf("modes         %zu of %zu elastic, first %.4f Hz\n", r->modes, r->modes_total,
 	       r->first_elastic_hz);
+	if (sc->repr_auto)
+		printf("representation auto: %s%s (%zu candidate%s built)\n", r->representation,
+		       sc->max_error > 0 ? ", the cheapest to tick that meets max_error" :
+		       " (max_error = none: not chosen by accuracy)",
+		       r->auto_tries, r->auto_tries == 1 ? "" : "s");
 	printf("image nodes   %zu rows, %zu touchable columns, %zu triangles\n", r->rows, r->cols,
 	       r->tris);
 	if (o->part_out) {
@@ -197,10 +210,20 @@ static void print_report(const struct irdm_scene *sc, const struct irdm_precompu
 	    fmax(r->corr_max_dropped_rel, r->corr_far_max[1]) > 1e-3)
 		printf("note          dropped blocks reach %.3g of sqrt(|S_aa| |S_bb|), about the force error at the worst few nearby contacts; static_correction_cluster = 256 with static_correction_tol = 8e-4 keeps every block within the tolerance\n",
 		       fmax(r->corr_max_dropped_rel, r->corr_far_max[1]));
-	printf("time          %.2f s total: mesh %.2f, FEM %.2f, eigen %.2f, responses %.2f, stability %.2f\n",
+	printf("time          %.2f s total: mesh %.2f, FEM %.2f, eigen %.2f, responses %.2f, stability %.2f, error %.2f\n",
 	       r->seconds_total, r->seconds_mesh, r->seconds_fem, r->seconds_eig,
-	       r->seconds_responses, r->seconds_stability);
+	       r->seconds_responses, r->seconds_stability, r->seconds_error);
 	print_peak_memory();
+	if (o->part_out)
+		return;
+	/* last: the figure a user reads first */
+	if (r->error_measured)
+		printf("force error   %.3g against the exact model (relative RMS, worst of a step and a release at %zu touchable nodes over %zu ticks, first ticks included; worst: %s at mesh node %u); max_error %g\n",
+		       r->measured_error, r->error_cols, r->error_ticks, r->error_worst_run,
+		       r->error_worst_node, sc->max_error);
+	else
+		printf("force error   not measured (%s)\n",
+		       sc->max_error > 0 ? "over MPI ranks" : "max_error = none");
 }
 
 static void print_help(void)

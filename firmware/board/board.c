@@ -64,16 +64,6 @@ int irdm_board_parse(struct irdm_board *b, const char *name, const char *text,
 	return ret;
 }
 
-int irdm_board_device(const struct irdm_board *b, unsigned i, struct irdm_device_config *cfg)
-{
-	if (i >= b->devices)
-		return IRDM_EINVAL;
-	*cfg = b->device;
-	if (i == 1)
-		memcpy(cfg->base_offset_m, b->device2_base_offset_m, sizeof(cfg->base_offset_m));
-	return IRDM_OK;
-}
-
 void irdm_board_engine_config(const struct irdm_board *b, struct irdm_engine_config *cfg)
 {
 	const struct irdm_device_config *d = &b->device;

@@ -1,15 +1,28 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * The object's placement in the device frame (irdm/board.h states the
+ * Where the arms and the object sit in the device frame: each arm's
+ * shoulder, and the object's placement (irdm/board.h states the
  * convention): p_dev = t + R p_obj with R = Rz Ry Rx.  R is computed once
  * when the board is loaded; the transforms are pure arithmetic and may run
  * in the tick.
  */
 #include <math.h>
+#include <string.h>
 
 #include "board_priv.h"
+#include "irdm/error.h"
 
 #define DEG_TO_RAD (3.141592653589793 / 180.0)
+
+int irdm_board_device(const struct irdm_board *b, unsigned i, struct irdm_device_config *cfg)
+{
+	if (i >= b->devices)
+		return IRDM_EINVAL;
+	*cfg = b->device;
+	if (i == 1)
+		memcpy(cfg->base_offset_m, b->device2_base_offset_m, sizeof(cfg->base_offset_m));
+	return IRDM_OK;
+}
 
 void irdm_board_set_rotation(struct irdm_board *b)
 {

@@ -1,8 +1,8 @@
 /* SPDX-License-Identifier: MIT */
 /*
  * The static correction in block low-rank form, STATIC_CORR_CLUSTERS
- * (image_format.h): its checks and the read of one block's value.  The
- * checks make every read safe and bounded: the member lists a permutation
+ * (image_format.h): its checks (image_read.c reads it).  The checks make
+ * every read safe and bounded: the member lists a permutation
  * with its inverse, each pair's matrix inside the values and the values
  * tiling them, ranks no higher than the tick can afford, self pairs dense
  * (stored as their upper triangle: symmetric, as R[0] must be), every
@@ -205,72 +205,4 @@ int img_check_corr_clusters(struct parse *p)
 	p->img.corr_cl_pairs = pairs;
 	p->img.corr_cl_values = pl + tb + sizeof(struct irdm_corr_pair) * n_pairs(h.n_clusters);
 	return IRDM_OK;
-}
-
-const struct irdm_corr_pair *irdm_image_corr_pair(const struct irdm_image *img, uint32_t a,
-						  uint32_t b)
-{
-	uint64_t nC = img->corr_clusters->n_clusters;
-
-	if (a > b) {
-		uint32_t t = a;
-		a = b;
-		b = t;
-	}
-	/* row a of the upper triangle starts after a nC - a (a - 1) / 2 pairs */
-	return &img->corr_cl_pairs[irdm_upper_index(nC, a, b)];
-}
-
-uint32_t irdm_image_corr_cluster(const struct irdm_image *img, uint32_t col, uint32_t *local)
-{
-	uint32_t pos = img->corr_cl_pos[col], lo = 0, hi = img->corr_clusters->n_clusters;
-
-	/* the cluster a with start[a] <= pos < start[a + 1] */
-	while (hi - lo > 1) {
-		uint32_t mid = lo + (hi - lo) / 2;
-		if (img->corr_cl_start[mid] <= pos)
-			lo = mid;
-		else
-			hi = mid;
-	}
-	*local = pos - img->corr_cl_start[lo];
-	return lo;
-}
-
-/*
- * blk += the pair's value between the two columns.  Entry [x][y] is row
- * 3 i_d + x, col 3 i_f + y of pair (a_d, a_f), or of pair (a_f, a_d)
- * transposed: the same products in the same order either way, so block
- * (f, d) is block (d, f) transposed to the bit.
- */
-void img_corr_clusters_add(const struct irdm_image *img, uint32_t col_force, uint32_t col_disp,
-			   double blk[9])
-{
-	uint32_t ld, lf, ad = irdm_image_corr_cluster(img, col_disp, &ld);
-	uint32_t af = irdm_image_corr_cluster(img, col_force, &lf);
-	const struct irdm_corr_pair *q = irdm_image_corr_pair(img, ad, af);
-	bool swap = ad > af;
-	uint32_t lr = swap ? lf : ld, lc = swap ? ld : lf, ar = swap ? af : ad, ac = swap ? ad : af;
-	size_t nr = 3 * (size_t)(img->corr_cl_start[ar + 1] - img->corr_cl_start[ar]);
-	size_t ncl = 3 * (size_t)(img->corr_cl_start[ac + 1] - img->corr_cl_start[ac]);
-	uint32_t prec = img->meta->precision;
-	const void *v = img->corr_cl_values;
-	size_t o = (size_t)q->offset;
-
-	for (size_t x = 0; x < 3; x++)
-		for (size_t y = 0; y < 3; y++) {
-			size_t r = 3 * (size_t)lr + (swap ? y : x), c = 3 * (size_t)lc + (swap ? x : y);
-			double s = 0;
-			if (ar == ac) {
-				size_t i = r < c ? r : c, j = r < c ? c : r;
-				s = irdm_elem_get(v, prec, o + irdm_upper_index(nr, i, j));
-			} else if (q->rank == IRDM_CORR_PAIR_DENSE) {
-				s = irdm_elem_get(v, prec, o + r * ncl + c);
-			} else {
-				size_t ur = o + r * q->rank, vc = o + nr * q->rank + c * q->rank;
-				for (size_t t = 0; t < q->rank; t++)
-					s += irdm_elem_get(v, prec, ur + t) * irdm_elem_get(v, prec, vc + t);
-			}
-			blk[3 * x + y] += s;
-		}
 }

@@ -2,10 +2,9 @@
 /*
  * The static correction's far field, STATIC_CORR_LOWRANK: a symmetric
  * low-rank term U diag(lambda) U^T over the touchable DoFs (values in the
- * image's precision) that every block adds, and the one function that
- * reads a whole correction block (kept block plus far field).  The checks
- * make the reads safe: a rank the tick can afford, the size exactly that
- * of the rank and n_cols, every value finite.
+ * image's precision) that every block adds (image_read.c reads it).  The
+ * checks make the reads safe: a rank the tick can afford, the size exactly
+ * that of the rank and n_cols, every value finite.
  */
 #include <stdbool.h>
 #include <stdint.h>
@@ -82,47 +81,4 @@ int img_check_corr_lowrank(struct parse *p)
 	p->img.corr_lambda = pl + HDR;
 	p->img.corr_u = pl + HDR + p->es * h.rank;
 	return IRDM_OK;
-}
-
-/* blk += U[col_disp] diag(lambda) U[col_force]^T, entry [i][j] summed as
- * (u_disp,i u_force,j) lambda: block (a, b) is block (b, a) transposed to
- * the bit, so R[0] stays exactly symmetric. */
-static void add_far_field(const struct irdm_image *img, uint32_t col_force, uint32_t col_disp,
-			  double blk[9])
-{
-	size_t r = img->corr_rank, d = 3 * (size_t)col_disp * r, f = 3 * (size_t)col_force * r;
-	uint32_t prec = img->meta->precision;
-	const void *u = img->corr_u;
-	/* the nine sums in registers (blk may alias nothing the loop reads,
-	 * but the compiler cannot know), each in the order of k */
-	double a0 = blk[0], a1 = blk[1], a2 = blk[2], a3 = blk[3], a4 = blk[4];
-	double a5 = blk[5], a6 = blk[6], a7 = blk[7], a8 = blk[8];
-
-	for (size_t k = 0; k < r; k++) {
-		double l = irdm_elem_get(img->corr_lambda, prec, k);
-		double d0 = irdm_elem_get(u, prec, d + k), f0 = irdm_elem_get(u, prec, f + k);
-		double d1 = irdm_elem_get(u, prec, d + r + k), f1 = irdm_elem_get(u, prec, f + r + k);
-		double d2 = irdm_elem_get(u, prec, d + 2 * r + k);
-		double f2 = irdm_elem_get(u, prec, f + 2 * r + k);
-
-		a0 += (d0 * f0) * l, a1 += (d0 * f1) * l, a2 += (d0 * f2) * l;
-		a3 += (d1 * f0) * l, a4 += (d1 * f1) * l, a5 += (d1 * f2) * l;
-		a6 += (d2 * f0) * l, a7 += (d2 * f1) * l, a8 += (d2 * f2) * l;
-	}
-	blk[0] = a0, blk[1] = a1, blk[2] = a2, blk[3] = a3, blk[4] = a4;
-	blk[5] = a5, blk[6] = a6, blk[7] = a7, blk[8] = a8;
-}
-
-void irdm_image_corr_value(const struct irdm_image *img, uint32_t col_force,
-			   uint32_t col_disp, double blk[9])
-{
-	long k = irdm_image_corr_block(img, col_force, col_disp);
-
-	for (size_t i = 0; i < 9; i++)
-		blk[i] = k < 0 ? 0.0 : irdm_elem_get(img->corr_blocks, img->meta->precision,
-						      (size_t)k * 9 + i);
-	if (img->corr_rank)
-		add_far_field(img, col_force, col_disp, blk);
-	if (img->corr_clusters)
-		img_corr_clusters_add(img, col_force, col_disp, blk);
 }

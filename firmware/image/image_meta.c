@@ -13,7 +13,8 @@
 
 #define META_FLAGS_KNOWN (IRDM_META_FLOATING | IRDM_META_STATIC_CORR | \
 			  IRDM_META_CONSISTENT_MASS | IRDM_META_TIME_DOMAIN | \
-			  IRDM_META_FIR_TAIL_WINDOW | IRDM_META_EXACT_HEAD)
+			  IRDM_META_FIR_TAIL_WINDOW | IRDM_META_EXACT_HEAD | \
+			  IRDM_META_ERROR_MEASURED)
 
 static int check_meta_numbers(struct parse *p)
 {
@@ -124,11 +125,17 @@ int img_check_meta(struct parse *p)
 				"meta precision is %u, expected 1 (F16), 2 (F32) or 3 (F64)",
 				m->precision);
 	p->es = irdm_elem_size(m->precision);
-	if (p->strict && ((m->flags & ~META_FLAGS_KNOWN) ||
-			  !all_zero(m->reserved, sizeof(m->reserved))))
+	if (p->strict && (m->flags & ~META_FLAGS_KNOWN))
+		return img_fail(p, IRDM_EFORMAT, "meta has unknown flags (0x%08x)", m->flags);
+	/* a 2.2 image has zero where 2.3 put the measured error */
+	if (p->strict && !(m->flags & IRDM_META_ERROR_MEASURED) && m->measured_error != 0)
 		return img_fail(p, IRDM_EFORMAT,
-				"meta has unknown flags (0x%08x) or non-zero reserved fields",
-				m->flags);
+				"meta measured_error is %g without the ERROR_MEASURED flag",
+				(double)m->measured_error);
+	if ((m->flags & IRDM_META_ERROR_MEASURED) &&
+	    !(f64_finite((double)m->measured_error) && m->measured_error >= 0))
+		return img_fail(p, IRDM_EFORMAT, "meta measured_error is %g, must be finite and >= 0",
+				(double)m->measured_error);
 	if (!memchr(m->tool_version, 0, sizeof(m->tool_version)) ||
 	    !memchr(m->mesh_name, 0, sizeof(m->mesh_name)))
 		return img_fail(p, IRDM_EFORMAT,

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * Validating an image in memory and looking up its sections.  An image
+ * Validating an image in memory (image_read.c reads it after).  An image
  * comes from a file that may be truncated, corrupted or hostile, so nothing
  * in it is trusted until checked: the header and section table are copied
  * out and validated (magic, version, sizes, checksums, offsets, alignment,
@@ -45,21 +45,4 @@ int irdm_image_parse(const void *buf, size_t size, struct irdm_image *img,
 	img->size = size;
 	img->meta = img_payload(&p, IRDM_SEC_META);
 	return IRDM_OK;
-}
-
-const struct irdm_image_section *irdm_image_find(const struct irdm_image *img,
-						 uint32_t kind)
-{
-	const struct irdm_image_section *tab;
-	struct irdm_image_header h;
-
-	if (!img->base)
-		return NULL;
-	memcpy(&h, img->base, sizeof(h));
-	tab = (const struct irdm_image_section *)(img->base +
-						  h.section_table_offset);
-	for (uint32_t i = 0; i < h.section_count; i++)
-		if (tab[i].kind == kind)
-			return &tab[i];
-	return NULL;
 }

@@ -5,19 +5,25 @@
  *
  *   image_header.c     header, section table
  *   image_sections.c   table entries, layout, payload checksums, kinds
- *   image_semantic.c   the order of the section checks below, and their
- *                      shared presence and shape rules
+ *   image_semantic.c   the order of the section checks below
  *   image_meta.c       META, PROVENANCE
  *   image_object.c     NODES, COLUMNS, SURFACE, RIGID
  *   image_responses.c  STABILITY, FIR or MODES / MODE_SHAPES / STATIC_CORR
- *                      (image_static_corr.c, its far field image_corr_lowrank.c)
+ *                      (image_static_corr.c, its clusters and far field
+ *                      image_corr_clusters.c, image_corr_lowrank.c,
+ *                      image_exact_head.c)
  *   image_bvh.c        CONTACT_BVH
  *
- * image_parse.c is the entry point (irdm_image_parse); the platform's
- * image_map_posix.c (platform/posix/image/) is the only loader file that
- * calls the operating system.
- * Every check returns IRDM_OK or an irdm_err and leaves its reason in
- * the parse's err buffer (img_fail).
+ * The calls go one way, down this list: image_parse.c (the entry point,
+ * irdm_image_parse) calls the steps, image_semantic.c the section checks,
+ * and every check the shared rules of image_rules.c and the messages of
+ * image_check.c.  What the tick reads of a parsed image is image_read.c's,
+ * beside the checks.  The platform's image_map_posix.c
+ * (platform/posix/image/) is the only loader file that calls the operating
+ * system.  Every check returns IRDM_OK or an irdm_err and leaves its reason
+ * in the parse's err buffer (img_fail).
+ * tools/scripts/include-cycles.py (run by make test) keeps the calls
+ * between these files free of circles.
  */
 #ifndef IRDM_IMAGE_PRIV_H
 #define IRDM_IMAGE_PRIV_H
@@ -82,12 +88,14 @@ int img_check_table(struct parse *p);
 int img_check_sections(struct parse *p);
 int img_check_contents(struct parse *p);
 
-/* image_semantic.c: the rules the section checks share. */
+/* image_rules.c: the rules the section checks share. */
 const void *img_payload(const struct parse *p, uint32_t kind);
 int img_check_presence(struct parse *p, uint32_t kind, bool wanted,
 		       const char *why);
 int img_check_shape(struct parse *p, uint32_t kind, const uint64_t *f,
 		    unsigned nf, const char *formula);
+/* Every element of kind's array (meta precision) finite. */
+int img_check_finite(struct parse *p, uint32_t kind, uint64_t count);
 
 /* The section checks, run by img_check_contents in this order. */
 int img_check_meta(struct parse *p);
@@ -104,14 +112,11 @@ int img_check_static_corr(struct parse *p);
 /* image_corr_lowrank.c: STATIC_CORR_LOWRANK, if present, after the above. */
 int img_check_corr_lowrank(struct parse *p);
 /* image_corr_clusters.c: STATIC_CORR_CLUSTERS, if present, after
- * STATIC_CORR; and what irdm_image_corr_value() adds from it. */
+ * STATIC_CORR. */
 int img_check_corr_clusters(struct parse *p);
-void img_corr_clusters_add(const struct irdm_image *img, uint32_t col_force, uint32_t col_disp,
-			   double blk[9]);
 /* image_exact_head.c: EXACT_HEAD against the STATIC_CORR index (checked first) */
 int img_check_exact_head(struct parse *p);
-/* image_responses.c: every element of kind's array (meta precision) finite. */
-int img_check_finite(struct parse *p, uint32_t kind, uint64_t count);
+/* image_bvh.c */
 int img_check_contact_bvh(struct parse *p);
 
 static inline bool all_zero(const void *data, size_t len)

@@ -50,52 +50,6 @@ int img_check_stability(struct parse *p)
 	return IRDM_OK;
 }
 
-double irdm_image_max_radius(const struct irdm_image *img)
-{
-	double max = 0;
-
-	for (uint32_t i = 0; img->stability && i < img->meta->n_cols; i++)
-		if (img->stability[i].spectral_radius > max)
-			max = img->stability[i].spectral_radius;
-	return max;
-}
-
-/* Index of the first non-finite element of an array, or count if none. */
-static uint64_t first_non_finite(const void *data, uint32_t elem, uint64_t count)
-{
-	uint64_t i;
-
-	for (i = 0; i < count; i++)
-		if (!f64_finite(irdm_elem_get(data, elem, (size_t)i)))
-			return i;
-	return i;
-}
-
-/* Scan a response array (elements of the meta precision) for NaN/inf. */
-int img_check_finite(struct parse *p, uint32_t kind, uint64_t count)
-{
-	const void *data = img_payload(p, kind);
-	uint64_t bad = first_non_finite(data, p->meta.precision, count);
-
-	if (bad == count)
-		return IRDM_OK;
-	if (kind == IRDM_SEC_FIR) {
-		uint64_t t = p->meta.fir_length;
-		uint64_t blk = bad / 9;
-
-		return img_fail(p, IRDM_EFORMAT,
-				"FIR element %llu (column %llu, row %llu, sample %llu, entry %llu,%llu) is not finite",
-				(unsigned long long)bad,
-				(unsigned long long)(blk / t / p->meta.n_nodes),
-				(unsigned long long)(blk / t % p->meta.n_nodes),
-				(unsigned long long)(blk % t),
-				(unsigned long long)(bad / 3 % 3),
-				(unsigned long long)(bad % 3));
-	}
-	return img_fail(p, IRDM_EFORMAT, "%s element %llu is not finite",
-			img_kind_name(kind), (unsigned long long)bad);
-}
-
 int img_check_fir(struct parse *p)
 {
 	const struct irdm_meta *m = &p->meta;

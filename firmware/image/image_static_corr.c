@@ -90,22 +90,3 @@ int img_check_static_corr(struct parse *p)
 	p->img.corr_blocks = img_payload(p, IRDM_SEC_STATIC_CORR);
 	return IRDM_OK;
 }
-
-long irdm_image_corr_block(const struct irdm_image *img, uint32_t col_force,
-			   uint32_t col_disp)
-{
-	uint32_t lo, hi;
-
-	if (!img->corr_start)
-		return -1;
-	lo = img->corr_start[col_force];
-	hi = img->corr_start[col_force + 1];
-	while (lo < hi) {
-		uint32_t mid = lo + (hi - lo) / 2;
-		if (img->corr_rows[mid] < col_disp)
-			lo = mid + 1;
-		else
-			hi = mid;
-	}
-	return lo < img->corr_start[col_force + 1] && img->corr_rows[lo] == col_disp ? (long)lo : -1;
-}

@@ -7,7 +7,7 @@
  * at 2 ms, modal 300 modes + static correction, modal with every mode) and
  * on the bunny.  The haptic configuration (virtual coupling, passivity
  * control) and grab contacts (never released, so every timed tick solves
- * its contacts).  Prints figures beside the issue's targets and the paper's
+ * its contacts).  Prints figures beside the targets and the paper's
  * Itanium2 times; never fails on time.
  *
  * Run from the repository root: images are reused from out/bench/ and made
@@ -414,7 +414,7 @@ int main(void)
 	else
 		printf("tick  bunny skipped: neither out/bench/bunny.img nor build/data/bunny.off (make bench-precompute)\n");
 
-	printf("tick  -- issue targets (figures include the timer overhead) --\n");
+	printf("tick  -- targets (figures include the timer overhead) --\n");
 	target("FIR T=500, one point (node)", 10, &fir[K_NODE]);
 	target("FIR T=500, one point (triangle)", 10, &fir[K_TRI]);
 	target("FIR T=500, two points", 20, &fir[K_NODES]);

@@ -3,7 +3,7 @@
  * Run a stretch of code where a system call kills it: a forked child
  * enters seccomp strict mode (from prctl() on it may only read, write,
  * _exit and sigreturn; a system call is SIGKILL) and reports a result
- * struct through a pipe.  Used by the real-time proofs (test_engine_rt,
+ * struct through a pipe.  Used by the real-time proofs (test_engine_nosys,
  * test_controller).
  *
  * The child is single-threaded (fork copies the calling thread only) and

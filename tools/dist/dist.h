@@ -18,6 +18,7 @@
 #include <stddef.h>
 
 #include "irdm/error.h"
+#include "modal/modal.h"
 
 /* Whether this build can run the slepc eigensolver. */
 bool irdm_dist_built_in(void);
@@ -63,6 +64,18 @@ void irdm_dist_wait_all(void);
  */
 int irdm_dist_gather(const double *mine, const size_t *counts, double *all,
 		     char *err, size_t errlen);
+
+/* The eigensolve by SLEPc (Krylov-Schur, shift-invert through MUMPS) over the
+ * MPI ranks (started here if the caller did not): every rank gets w2,
+ * rank 0 alone phi (NULL elsewhere): the first n_whole vectors whole, the
+ * others at the DoFs want->keep marks, NaN elsewhere; with sigma = 0 and
+ * want->n_loads, also (K^-1 e_j at the kept DoFs, NaN elsewhere) into
+ * compliance (rank 0's n x n_loads; NULL elsewhere).  Collective: every
+ * rank calls it. */
+int irdm_eig_slepc(const struct irdm_fem *fem, size_t n_lowest, double sigma,
+		   const struct irdm_modes_want *want, size_t n_whole,
+		   irdm_progress_fn progress, void *ctx, double *w2, double *phi,
+		   double *compliance, char *err, size_t errlen);
 
 /*
  * Fault injection for the failure tests, never set otherwise: true if the

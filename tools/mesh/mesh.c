@@ -6,6 +6,7 @@
  * and mesh_base.c, so no reader calls back into this file.
  */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -111,6 +112,16 @@ static int read_gmsh(const char *path, double scale, struct irdm_mesh *m,
 	return ret;
 }
 
+/* The weld goes into the sizing's note, after what the sizing did. */
+static void say_welded(struct irdm_mesh_sizing *sz, size_t welded, double tol)
+{
+	size_t n = strlen(sz->note);
+
+	snprintf(sz->note + n, sizeof(sz->note) - n,
+		 "%swelded %zu vertices (within %.3g, 1e-9 of the bounding box, of another)",
+		 n ? "; " : "mesh: ", welded, tol);
+}
+
 /*
  * Surfaces are tetrahedralised in their own units, so size switches such
  * as "a0.5" mean what the author of the file would expect; the scale is
@@ -121,7 +132,8 @@ static int read_surface(const char *path, double scale, struct irdm_mesh_sizing 
 {
 	struct irdm_surface s = { 0, NULL, 0, NULL };
 	char *txt;
-	size_t len;
+	size_t len, welded = 0;
+	double tol = 0;
 	int ret;
 
 	ret = mesh_read_file(path, &txt, &len, err, errlen);
@@ -134,10 +146,18 @@ static int read_surface(const char *path, double scale, struct irdm_mesh_sizing 
 	else
 		ret = irdm_surface_parse_stl(txt, len, path, &s, err, errlen);
 	free(txt);
-	if (ret)
+	if (!ret)
+		ret = surface_weld(&s, &welded, &tol);
+	if (ret) {
+		if (ret == IRDM_ENOMEM)
+			mesh_err(err, errlen, path, "out of memory");
+		irdm_surface_free(&s);
 		return ret;
+	}
 	ret = irdm_surface_tetrahedralize_sized(&s, sz, path, m, err, errlen);
 	irdm_surface_free(&s);
+	if (!ret && welded)
+		say_welded(sz, welded, tol);
 	if (ret || scale == 1.0)
 		return ret;
 	scale_positions(m->pos_m, 3 * m->n_nodes, scale);

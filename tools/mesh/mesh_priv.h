@@ -113,6 +113,15 @@ int mesh_read_file(const char *path, char **buf, size_t *len,
 int surface_check(const struct irdm_surface *s, const char *what,
 		  char *err, size_t errlen);
 
+/* Vertices closer than this fraction of the bounding box's diagonal are
+ * one vertex (surface_weld.c): 1e-9 is far below any meshable feature and
+ * far above a generator's rounding. */
+#define IRDM_WELD_REL 1e-9
+
+/* Weld s's coincident vertices in place: welded counts the vertices
+ * removed, tol the distance used (file units).  0 or IRDM_ENOMEM. */
+int surface_weld(struct irdm_surface *s, size_t *welded, double *tol);
+
 /* Every edge in exactly two triangles (surface_closed.c); else
  * IRDM_EFORMAT naming the count and the first bad edge. */
 int surface_check_closed(const struct irdm_surface *s, const char *what, char *err,

@@ -13,7 +13,7 @@
 #include <string.h>
 
 #include "modal/exact_head.h"
-#include "precompute/fir_tail.h"
+#include "modal/window.h"
 
 /* P[(3 c + i) Kd + d] = phi of dropped mode k_kept + d at column c, axis i. */
 static double *dropped_shapes(const struct irdm_modes *m, size_t k_kept, const int64_t *col_dofs,
@@ -49,8 +49,8 @@ static void block_head(const double *Pr, const double *Pc, const double *h, size
 }
 
 /*
- * Samples [H, 2H): the dropped response tapered to zero by fir_tail.c's
- * Hann window, and what the taps' sum then misses of the static
+ * Samples [H, 2H): the dropped response tapered to zero by the Hann
+ * window of window.h, and what the taps' sum then misses of the static
  * correction S (the response past 2H and the taper's cut) added along
  * its sine bump: the static compliance is kept exactly, and neither the
  * response nor the correction jumps (a lump at one sample moved a zero of
@@ -61,8 +61,8 @@ static void taper(double *out, size_t H, const double *S)
 	double bump_sum = 0;
 
 	for (size_t i = 0; i < H; i++) {
-		double w = irdm_fir_tail_taper(i, H);
-		bump_sum += irdm_fir_tail_bump(i, H);
+		double w = irdm_window_taper(i, H);
+		bump_sum += irdm_window_bump(i, H);
 		for (int e = 0; e < 9; e++)
 			out[9 * (H + i) + (size_t)e] *= w;
 	}
@@ -71,7 +71,7 @@ static void taper(double *out, size_t H, const double *S)
 		for (size_t s = 0; s < 2 * H; s++)
 			sum += out[9 * s + (size_t)e];
 		for (size_t i = 0; i < H; i++)
-			out[9 * (H + i) + (size_t)e] += (S[e] - sum) * irdm_fir_tail_bump(i, H) / bump_sum;
+			out[9 * (H + i) + (size_t)e] += (S[e] - sum) * irdm_window_bump(i, H) / bump_sum;
 	}
 }
 

@@ -50,6 +50,20 @@ struct irdm_modes_want {
 typedef void (*irdm_progress_fn)(void *ctx, const char *stage, double fraction);
 
 /*
+ * The eigensolver over MPI ranks (IRDM_EIG_SLEPC), handed in by a caller
+ * that can start MPI (tools/dist/): modal itself knows no MPI.  rank: this
+ * process's rank (rank 0 alone keeps the eigenvectors); solve: as
+ * irdm_eig_slepc() (dist/dist.h).
+ */
+struct irdm_eig_dist {
+	int rank;
+	int (*solve)(const struct irdm_fem *fem, size_t n_lowest, double sigma,
+		     const struct irdm_modes_want *want, size_t n_whole,
+		     irdm_progress_fn progress, void *ctx, double *w2, double *phi,
+		     double *compliance, char *err, size_t errlen);
+};
+
+/*
  * Solve for the lowest n_wanted elastic modes (0: all).  floating: expect 6
  * rigid modes (eigenvalues below rigid_tol * w_max^2) and drop them.
  * A grounded model that shows a zero eigenvalue is an error (a mechanism:
@@ -59,7 +73,8 @@ int irdm_modes_solve(const struct irdm_fem *fem, size_t n_wanted, bool floating,
 		     enum irdm_eig_method method, irdm_progress_fn progress, void *ctx,
 		     struct irdm_modes *out, char *err, size_t errlen);
 /*
- * The same; want->keep (n entries, NULL: all) marks the free DoFs whose
+ * The same; dist: the distributed eigensolver (NULL: IRDM_EIG_SLEPC is an
+ * error); want->keep (n entries, NULL: all) marks the free DoFs whose
  * elastic eigenvector entries the caller will read.  Over MPI
  * (IRDM_EIG_SLEPC) only those cross the network to rank 0, whose other
  * entries are NaN so that a stray read shows; rigid modes always come
@@ -67,9 +82,9 @@ int irdm_modes_solve(const struct irdm_fem *fem, size_t n_wanted, bool floating,
  * want->load_dofs with the eigensolve's MUMPS factor (out->compliance).
  */
 int irdm_modes_solve_kept(const struct irdm_fem *fem, size_t n_wanted, bool floating,
-			  enum irdm_eig_method method, const struct irdm_modes_want *want,
-			  irdm_progress_fn progress, void *ctx, struct irdm_modes *out,
-			  char *err, size_t errlen);
+			  enum irdm_eig_method method, const struct irdm_eig_dist *dist,
+			  const struct irdm_modes_want *want, irdm_progress_fn progress,
+			  void *ctx, struct irdm_modes *out, char *err, size_t errlen);
 void irdm_modes_free(struct irdm_modes *m);
 
 /* Internal solvers (exposed for tests: a second method to compare with). */
@@ -78,18 +93,6 @@ int irdm_eig_dense(const struct irdm_fem *fem, size_t n_lowest, double *w2, doub
 int irdm_eig_lanczos(const struct irdm_fem *fem, size_t n_lowest, double sigma,
 		     irdm_progress_fn progress, void *ctx, double *w2, double *phi,
 		     char *err, size_t errlen);
-/* The same by SLEPc (Krylov-Schur, shift-invert through MUMPS) over the
- * MPI ranks (started here if the caller did not): every rank gets w2,
- * rank 0 alone phi (NULL elsewhere): the first n_whole vectors whole, the
- * others at the DoFs want->keep marks, NaN elsewhere; with sigma = 0 and
- * want->n_loads, also (K^-1 e_j at the kept DoFs, NaN elsewhere) into
- * compliance (rank 0's n x n_loads; NULL elsewhere).  Collective: every
- * rank calls it. */
-int irdm_eig_slepc(const struct irdm_fem *fem, size_t n_lowest, double sigma,
-		   const struct irdm_modes_want *want, size_t n_whole,
-		   irdm_progress_fn progress, void *ctx, double *w2, double *phi,
-		   double *compliance, char *err, size_t errlen);
-
 /*
  * Exact zero-order-hold discretisation of q'' + 2 z w q' + w^2 q = g:
  * x[t+1] = A x[t] + b g[t], x = (q, q').  Any z >= 0 (under-, critically,

@@ -5,7 +5,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "dist/dist.h"
 #include "modal/modal.h"
 
 /* Dense is cheaper than Lanczos below this many DoFs, and always used when
@@ -26,7 +25,7 @@
  */
 #define RIGID_GAP 1e3
 /* max(K_ii / M_ii) above this many times the median: a graded mesh (a
- * uniform one is within 10; test_rigidity's is 1.3e5). */
+ * uniform one is within 10; test_mesh_rigidity's is 1.3e5). */
 #define GRADED 1e3
 #define ZERO_TOL 1e-14
 
@@ -126,22 +125,23 @@ int irdm_modes_solve(const struct irdm_fem *fem, size_t n_wanted, bool floating,
 		     enum irdm_eig_method method, irdm_progress_fn progress, void *ctx,
 		     struct irdm_modes *out, char *err, size_t errlen)
 {
-	return irdm_modes_solve_kept(fem, n_wanted, floating, method, NULL, progress, ctx, out,
-				     err, errlen);
+	return irdm_modes_solve_kept(fem, n_wanted, floating, method, NULL, NULL, progress, ctx,
+				     out, err, errlen);
 }
 
 /* Over MPI ranks; a grounded object's static-correction loads solved with
  * the eigensolve's factor of K (sigma = 0) into out->compliance. */
 static int solve_slepc(const struct irdm_fem *fem, size_t n_req, bool floating, double scale,
-		       const struct irdm_modes_want *want, irdm_progress_fn progress, void *ctx,
-		       double *w2, double *phi, struct irdm_modes *out, char *err, size_t errlen)
+		       const struct irdm_eig_dist *dist, const struct irdm_modes_want *want,
+		       irdm_progress_fn progress, void *ctx, double *w2, double *phi,
+		       struct irdm_modes *out, char *err, size_t errlen)
 {
 	size_t n = fem->K.n, n_loads = floating || !want ? 0 : want->n_loads;
 	struct irdm_modes_want w = want ? *want : (struct irdm_modes_want){ NULL, NULL, 0 };
 	int ret;
 
 	w.n_loads = n_loads;
-	if (n_loads && irdm_dist_rank() == 0) {
+	if (n_loads && dist->rank == 0) {
 		out->compliance = malloc(n * n_loads * sizeof(double));
 		if (!out->compliance) {
 			snprintf(err, errlen, "modes: out of memory for %zu static loads", n_loads);
@@ -150,15 +150,15 @@ static int solve_slepc(const struct irdm_fem *fem, size_t n_req, bool floating, 
 		out->n_compliance = n_loads;
 	}
 	/* a negative shift keeps K - sigma M definite for floating bodies */
-	ret = irdm_eig_slepc(fem, n_req, floating ? -1e-6 * scale : 0.0, &w, floating ? 6 : 0,
-			     progress, ctx, w2, phi, out->compliance, err, errlen);
+	ret = dist->solve(fem, n_req, floating ? -1e-6 * scale : 0.0, &w, floating ? 6 : 0,
+			  progress, ctx, w2, phi, out->compliance, err, errlen);
 	return ret;
 }
 
 int irdm_modes_solve_kept(const struct irdm_fem *fem, size_t n_wanted, bool floating,
-			  enum irdm_eig_method method, const struct irdm_modes_want *want,
-			  irdm_progress_fn progress, void *ctx, struct irdm_modes *out,
-			  char *err, size_t errlen)
+			  enum irdm_eig_method method, const struct irdm_eig_dist *dist,
+			  const struct irdm_modes_want *want, irdm_progress_fn progress,
+			  void *ctx, struct irdm_modes *out, char *err, size_t errlen)
 {
 	size_t n = fem->K.n, n_rigid = floating ? 6 : 0, n_req;
 	double max_scale, scale = typical_scale(fem, &max_scale);
@@ -179,7 +179,7 @@ int irdm_modes_solve_kept(const struct irdm_fem *fem, size_t n_wanted, bool floa
 	/*
 	 * A dense solve resolves an eigenvalue to about eps max(K_ii/M_ii):
 	 * on a graded mesh (a tiny element beside large ones) that is far
-	 * from the low modes' (1e-6 relative measured on test_rigidity's),
+	 * from the low modes' (1e-6 relative measured on test_mesh_rigidity's),
 	 * where shift-and-invert Lanczos is exact to rounding.
 	 */
 	if (method == IRDM_EIG_AUTO)
@@ -193,7 +193,11 @@ int irdm_modes_solve_kept(const struct irdm_fem *fem, size_t n_wanted, bool floa
 			 "use eigensolver = dense", n_req, n);
 		return IRDM_EINVAL;
 	}
-	has_phi = method != IRDM_EIG_SLEPC || irdm_dist_rank() == 0;
+	if (method == IRDM_EIG_SLEPC && !dist) {
+		snprintf(err, errlen, "slepc: no distributed eigensolver given");
+		return IRDM_EINVAL;
+	}
+	has_phi = method != IRDM_EIG_SLEPC || dist->rank == 0;
 	w2 = malloc(n_req * sizeof(double));
 	if (has_phi)
 		phi = malloc(n * n_req * sizeof(double));
@@ -208,8 +212,8 @@ int irdm_modes_solve_kept(const struct irdm_fem *fem, size_t n_wanted, bool floa
 	if (method == IRDM_EIG_DENSE)
 		ret = irdm_eig_dense(fem, n_req, w2, phi, err, errlen);
 	else if (method == IRDM_EIG_SLEPC)
-		ret = solve_slepc(fem, n_req, floating, scale, want, progress, ctx, w2, phi, out,
-				  err, errlen);
+		ret = solve_slepc(fem, n_req, floating, scale, dist, want, progress, ctx, w2, phi,
+				  out, err, errlen);
 	else    /* a negative shift keeps K - sigma M definite for floating bodies */
 		ret = irdm_eig_lanczos(fem, n_req, floating ? -1e-6 * scale : 0.0, progress, ctx,
 				       w2, phi, err, errlen);

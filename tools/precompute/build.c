@@ -14,6 +14,7 @@
 #include "image/image_writer.h"
 #include "irdm/error.h"
 #include "irdm/image.h"
+#include "irdm/posix/image_map.h"
 #include "modal/exact_head.h"
 #include "modal/lapack.h"
 #include "modal/response.h"
@@ -24,6 +25,7 @@
 #include "precompute/fir_tail.h"
 #include "precompute/precompute.h"
 #include "precompute/td_part.h"
+#include "report/report_measure.h"
 #include "timedomain/timedomain.h"
 #include "util/clock.h"
 #include "util/fnv1a.h"
@@ -49,11 +51,14 @@ struct build {
 	struct irdm_node *nodes;
 	char *prov;
 	uint64_t scene_hash;
+	size_t n_solved;                /* modes the eigensolve gave (all: the exact model's) */
 };
 
 /* Modes the scene needs solved (0: all). */
 static size_t modes_needed(const struct irdm_scene *sc)
 {
+	if (sc->repr_auto && sc->max_error > 0)
+		return 0;       /* every candidate is measured: the reference needs all */
 	if (sc->representation == IRDM_REPR_MODAL)
 		return sc->exact_head ? 0 : sc->modes;  /* the head needs every mode */
 	if (sc->method == IRDM_METHOD_TIME_DOMAIN)
@@ -586,6 +591,61 @@ static int hybrid_stable(const struct build *b, char *err, size_t errlen)
 	return IRDM_ENUMERIC;
 }
 
+/* The representation as the scene says it, for messages. */
+static void repr_text(const struct irdm_scene *sc, char *buf, size_t len)
+{
+	if (sc->representation == IRDM_REPR_FIR)
+		snprintf(buf, len, "fir:%u%s", sc->fir_length, sc->fir_tail ? " with fir_tail" : "");
+	else if (!sc->modes)
+		snprintf(buf, len, "modal:all");
+	else if (sc->exact_head)
+		snprintf(buf, len, "modal:%u%s + exact_head %u", sc->modes,
+			 sc->static_correction ? " + static correction" : "", sc->exact_head);
+	else
+		snprintf(buf, len, "modal:%u%s", sc->modes,
+			 sc->static_correction ? " + static correction" : "");
+}
+
+/* What may make an uncertified image certified. */
+static void certify_hint(const struct irdm_scene *sc, char *buf, size_t len)
+{
+	if (sc->representation == IRDM_REPR_FIR && !sc->fir_tail)
+		snprintf(buf, len, "try fir_tail = window:%u or longer, or a modal representation",
+			 2 * sc->fir_length);
+	else if (sc->representation == IRDM_REPR_FIR)
+		snprintf(buf, len, "try a longer fir_tail than window:%u, or a modal representation",
+			 sc->fir_tail);
+	else
+		snprintf(buf, len, "try more modes (representation = modal:K), static_correction = yes or precision = f64");
+}
+
+/*
+ * An image that `irdm image verify --require-stable` rejects is not
+ * written unless the scene asks for it by name (uncertified = yes): a
+ * warning after the fact is too easy to miss, and an uncertified FIR runs
+ * on the engine's tail damping, which distorts it from the first sample.
+ */
+static int certified(const struct build *b, char *err, size_t errlen)
+{
+	size_t unstable = 0, worst = 0;
+	char repr[64], hint[128];
+
+	for (size_t c = 0; c < b->m.n_cols; c++)
+		if (!(b->stab[c].flags & IRDM_STAB_STABLE)) {
+			if (!unstable || b->stab[c].spectral_radius > b->stab[worst].spectral_radius)
+				worst = c;
+			unstable++;
+		}
+	if (!unstable || b->sc->uncertified)
+		return IRDM_OK;
+	repr_text(b->sc, repr, sizeof(repr));
+	certify_hint(b->sc, hint, sizeof(hint));
+	snprintf(err, errlen, "precompute: scene %s: %s is not certified stable: spectral radius %.6f at mesh node %u (%zu of %zu columns >= 1); %s (uncertified = yes writes it anyway)",
+		 b->sc->name, repr, (double)b->stab[worst].spectral_radius,
+		 b->m.rows[b->m.cols[worst]], unstable, b->m.n_cols, hint);
+	return IRDM_ENUMERIC;
+}
+
 static int stability(struct build *b, char *err, size_t errlen)
 {
 	size_t n = b->m.n_cols;
@@ -594,7 +654,7 @@ static int stability(struct build *b, char *err, size_t errlen)
 	pthread_t th[64];
 	bool started[64];
 	struct stab_job jobs[64];
-	int blas_threads;
+	int blas_threads, ret;
 
 	b->stab = calloc(n, sizeof(*b->stab));
 	if (!b->stab) {
@@ -626,7 +686,8 @@ static int stability(struct build *b, char *err, size_t errlen)
 		}
 		b->meta.max_spectral_radius = fmax(b->meta.max_spectral_radius, b->stab[c].spectral_radius);
 	}
-	return b->head ? hybrid_stable(b, err, errlen) : IRDM_OK;
+	ret = b->head ? hybrid_stable(b, err, errlen) : IRDM_OK;
+	return ret ? ret : certified(b, err, errlen);
 }
 
 static void fill_meta(struct build *b)
@@ -767,7 +828,7 @@ static int add_sections(struct build *b, struct irdm_image_writer *w, const void
 	return IRDM_OK;
 }
 
-static int write_image(struct build *b, size_t *bytes, char *err, size_t errlen)
+static int write_image(struct build *b, const char *path, size_t *bytes, char *err, size_t errlen)
 {
 	struct irdm_model *m = &b->m;
 	struct irdm_image_writer w;
@@ -782,11 +843,11 @@ static int write_image(struct build *b, size_t *bytes, char *err, size_t errlen)
 		return ret;
 	ret = add_sections(b, &w, bvh, bvh_bytes, err, errlen);
 	if (!ret)
-		ret = irdm_iw_write(&w, b->o->out_path, err, errlen);
+		ret = irdm_iw_write(&w, path, err, errlen);
 	free(bvh);
 	if (ret)
 		return ret;
-	f = fopen(b->o->out_path, "rb");
+	f = fopen(path, "rb");
 	if (f) {
 		fseek(f, 0, SEEK_END);
 		*bytes = (size_t)ftell(f);
@@ -941,6 +1002,150 @@ static void report(const struct build *b, struct irdm_precompute_report *rep)
 	rep->corr_cluster_values = b->clusters.n_values;
 }
 
+/* Every elastic mode was solved (some may be dropped from the image). */
+static bool all_modes(const struct build *b)
+{
+	return b->n_solved == b->m.modes.n_elastic_total && b->sc->method == IRDM_METHOD_MODAL &&
+	       b->m.modes.phi && irdm_dist_size() == 1;
+}
+
+/* The exact model's image from this build's own modes: the same mesh,
+ * FEM and eigensolve, its own selection (the sampled nodes), every mode,
+ * no static correction, in double; nothing else shared. */
+static int reference_from_model(void *ctx, const struct irdm_scene *rsc, const char *path,
+				char *err, size_t errlen)
+{
+	struct build *b = ctx;
+	struct irdm_precompute_opts ro = { .out_path = path };
+	struct build r = { .sc = rsc, .o = &ro, .m = b->m };
+	size_t bytes;
+	int ret;
+
+	r.m.modes.n_modes = r.m.modes.n_elastic_total;
+	r.m.rows = r.m.cols = r.m.tris = NULL;
+	r.m.row_dofs = r.m.col_dofs = NULL;
+	r.m.n_rows = r.m.n_cols = r.m.n_tris = 0;
+	ret = irdm_model_select(rsc, &r.m, err, errlen);
+	if (!ret)
+		ret = responses(&r, err, errlen);
+	if (!ret) {
+		fill_meta(&r);
+		ret = stability(&r, err, errlen);
+	}
+	if (!ret)
+		ret = fill_nodes_rigid(&r);
+	if (!ret)
+		ret = provenance(&r);
+	if (!ret)
+		ret = write_image(&r, path, &bytes, err, errlen);
+	/* r's own allocations only: the mesh, FEM and modes are b's */
+	free(r.m.rows);
+	free(r.m.cols);
+	free(r.m.tris);
+	free(r.m.row_dofs);
+	free(r.m.col_dofs);
+	free(r.zoh);
+	free(r.shapes);
+	for (int i = 0; i < 6; i++)
+		free(r.stored[i]);
+	free(r.stab);
+	free(r.nodes);
+	free(r.prov);
+	return ret;
+}
+
+/* What may bring an image's measured error under max_error. */
+static void error_hint(const struct irdm_scene *sc, char *buf, size_t len)
+{
+	if (sc->precision == IRDM_ELEM_F16)
+		snprintf(buf, len, "precision = f32");
+	else if (sc->representation == IRDM_REPR_FIR && !sc->fir_tail)
+		snprintf(buf, len, "fir_tail = window:%u (no tail damping), a longer FIR, or a modal representation with exact_head",
+			 2 * sc->fir_length);
+	else if (sc->representation == IRDM_REPR_FIR)
+		snprintf(buf, len, "a longer FIR (fir:%u), or a modal representation with exact_head",
+			 2 * sc->fir_length);
+	else if (!sc->modes)
+		snprintf(buf, len, "precision = f64");
+	else if (!sc->static_correction)
+		snprintf(buf, len, "static_correction = yes with exact_head = 128, or more modes");
+	else if (!sc->exact_head)
+		snprintf(buf, len, "a hybrid head (exact_head = 128) on these modes, more modes, or representation = modal:all");
+	else
+		snprintf(buf, len, "a longer head (exact_head = %u) or more modes (modal:%u)",
+			 2 * sc->exact_head, 2 * sc->modes);
+}
+
+/* Refuse an image whose measured error is above the scene's max_error. */
+static int within_target(const struct build *b, const struct irdm_precompute_report *rep,
+			 char *err, size_t errlen)
+{
+	char repr[64], hint[160];
+
+	if (!rep->error_measured || rep->measured_error <= b->sc->max_error)
+		return IRDM_OK;
+	repr_text(b->sc, repr, sizeof(repr));
+	error_hint(b->sc, hint, sizeof(hint));
+	snprintf(err, errlen, "precompute: scene %s: %s is %.3g off the exact model (relative RMS force error, worst: %s at mesh node %u), above max_error = %g; try %s (max_error = none skips the check)",
+		 b->sc->name, repr, rep->measured_error, rep->error_worst_run,
+		 rep->error_worst_node, b->sc->max_error, hint);
+	return IRDM_ENUMERIC;
+}
+
+/*
+ * The image's force error against the exact model (report_measure.h),
+ * measured on the image as it will be written: a scratch copy beside it,
+ * then the figure goes into META.  max_error = none skips it (the exact
+ * model needs every mode); over MPI ranks it is not measured (the
+ * reference's dense eigensolve would run on rank 0 alone).
+ */
+static int measure(struct build *b, struct irdm_precompute_report *rep, char *err, size_t errlen)
+{
+	const char *out = b->o->out_path;
+	size_t n = strlen(out) + 16, bytes;
+	char *tmp = malloc(n), *ref = malloc(n);
+	struct irdm_measure res;
+	struct irdm_image img;
+	int ret = IRDM_ENOMEM;
+
+	if (!(b->sc->max_error > 0) || irdm_dist_size() > 1) {
+		free(tmp);
+		free(ref);
+		return IRDM_OK;
+	}
+	if (!tmp || !ref) {
+		snprintf(err, errlen, "precompute: out of memory");
+		goto out_free;
+	}
+	snprintf(tmp, n, "%s.unmeasured", out);
+	snprintf(ref, n, "%s.exact", out);
+	ret = write_image(b, tmp, &bytes, err, errlen);
+	if (!ret)
+		ret = irdm_image_map(tmp, 0, &img, err, errlen);
+	if (ret)
+		goto out_unlink;
+	ret = irdm_measure_error(b->sc, &img, ref, all_modes(b) ? reference_from_model : NULL, b,
+				 b->o->progress, b->o->ctx, &res, err, errlen);
+	irdm_image_unmap(&img);
+	if (ret)
+		goto out_unlink;
+	b->meta.measured_error = (float)res.error;
+	b->meta.flags |= IRDM_META_ERROR_MEASURED;
+	rep->error_measured = true;
+	rep->measured_error = res.error;
+	rep->error_worst_node = res.worst_node;
+	rep->error_worst_run = res.worst_run;
+	rep->error_cols = res.n_cols;
+	rep->error_ticks = res.ticks;
+	rep->seconds_error = res.seconds;
+out_unlink:
+	unlink(tmp);
+out_free:
+	free(tmp);
+	free(ref);
+	return ret;
+}
+
 static uint64_t scene_hash(const struct irdm_scene *sc)
 {
 	char text[4096];
@@ -950,19 +1155,141 @@ static uint64_t scene_hash(const struct irdm_scene *sc)
 	return irdm_fnv1a(IRDM_FNV1A_INIT, text, strlen(text));
 }
 
+/* Responses, certificate, nodes, provenance, the measured error: all
+ * but the write. */
+static int one_try(struct build *b, struct irdm_precompute_report *rep, char *err, size_t errlen)
+{
+	double t1 = irdm_now_s();
+	int ret = responses(b, err, errlen);
+
+	if (ret || b->o->part_out)
+		return ret;
+	rep->seconds_responses += irdm_now_s() - t1;
+	fill_meta(b);
+	t1 = irdm_now_s();
+	ret = stability(b, err, errlen);
+	if (ret)
+		return ret;
+	rep->seconds_stability += irdm_now_s() - t1;
+	ret = fill_nodes_rigid(b);
+	if (!ret)
+		ret = provenance(b);
+	if (ret) {
+		snprintf(err, errlen, ret == IRDM_ENOMEM ? "precompute: out of memory"
+			 : "precompute: the scene does not fit in the provenance text");
+		return ret;
+	}
+	ret = measure(b, rep, err, errlen);
+	return ret ? ret : within_target(b, rep, err, errlen);
+}
+
+/* Back to the model alone, every mode in it, for another try. */
+static void reset_try(struct build *b, size_t n_all)
+{
+	free(b->zoh);
+	free(b->fir);
+	free(b->shapes);
+	free(b->corr);
+	free(b->head);
+	free(b->stab);
+	free(b->nodes);
+	free(b->prov);
+	b->zoh = NULL;
+	b->fir = b->shapes = b->corr = b->head = NULL;
+	b->stab = NULL;
+	b->nodes = NULL;
+	b->prov = NULL;
+	irdm_corr_sparse_free(&b->sparse);
+	irdm_corr_lowrank_free(&b->far);
+	irdm_corr_clusters_free(&b->clusters);
+	for (int i = 0; i < 6; i++) {
+		free(b->stored[i]);
+		b->stored[i] = NULL;
+	}
+	b->n_modes = 0;
+	memset(&b->meta, 0, sizeof(b->meta));
+	b->m.modes.n_modes = n_all;
+}
+
+/* representation = auto's candidates, in increasing tick cost. */
+struct candidate {
+	unsigned modes;         /* 0: all */
+	bool corr;
+	unsigned head;
+};
+
+static const struct candidate auto_candidates[] = {
+	{ 300, true, 0 }, { 300, true, 32 }, { 300, true, 128 }, { 300, true, 512 }, { 0, false, 0 },
+};
+
+#define AUTO_ALL_MODES 300      /* at most this many modes: modal:all, exact and as cheap */
+
+/*
+ * representation = auto: every mode is solved; the first candidate whose
+ * image is certified and measures within max_error is kept.  A model of
+ * at most AUTO_ALL_MODES modes takes them all.
+ */
+static int choose(struct build *b, struct irdm_precompute_report *rep, char *err, size_t errlen)
+{
+	struct irdm_scene *eff = (struct irdm_scene *)b->sc;
+	size_t n_all = b->m.modes.n_modes, first = n_all <= AUTO_ALL_MODES ? 4 : 0;
+	char last[768] = "";
+	int ret = IRDM_ENUMERIC;
+
+	for (size_t k = first; k < sizeof(auto_candidates) / sizeof(auto_candidates[0]); k++) {
+		const struct candidate *c = &auto_candidates[k];
+
+		reset_try(b, n_all);
+		eff->modes = c->modes;
+		eff->static_correction = c->corr;
+		eff->exact_head = c->head;
+		eff->static_corr_cluster = 0;
+		/* a head splits the modes itself (split_modes); else keep K */
+		if (c->modes && !c->head && c->modes < n_all)
+			b->m.modes.n_modes = c->modes;
+		ret = one_try(b, rep, err, errlen);
+		rep->auto_tries++;
+		if (!ret)
+			return IRDM_OK;
+		if (ret != IRDM_ENUMERIC)
+			return ret;
+		snprintf(last, sizeof(last), "%s", err);
+		if (b->o->progress)
+			b->o->progress(b->o->ctx, "representation = auto: next candidate", -1.0);
+	}
+	snprintf(err, errlen, "precompute: representation = auto: no candidate met max_error = %g (set max_error higher or none); the last: %s",
+		 eff->max_error, last);
+	return ret;
+}
+
 int irdm_precompute(const struct irdm_scene *sc, const struct irdm_precompute_opts *o,
 		    struct irdm_precompute_report *rep, char *err, size_t errlen)
 {
 	struct build b = { .sc = sc, .o = o };
-	double t0 = irdm_now_s(), t1;
+	/* auto resolves to a representation: the image's provenance says which */
+	struct irdm_scene *eff = sc->repr_auto ? malloc(sizeof(*eff)) : NULL;
+	bool auto_choice = sc->repr_auto && sc->max_error > 0 && irdm_dist_size() == 1;
+	double t0 = irdm_now_s();
 	int ret;
 
 	memset(rep, 0, sizeof(*rep));
+	if (sc->repr_auto && !eff) {
+		snprintf(err, errlen, "precompute: out of memory");
+		return IRDM_ENOMEM;
+	}
+	if (eff) {
+		*eff = *sc;
+		eff->repr_auto = false;
+		b.sc = eff;
+	}
 	b.scene_hash = scene_hash(sc);
 	ret = irdm_model_build(sc, modes_needed(sc), o->progress, o->ctx, &b.m, err, errlen);
-	if (ret)
+	if (ret) {
+		free(eff);
 		return ret;
+	}
 	b.scene_hash = irdm_fnv1a(b.scene_hash, &b.m.damping, sizeof(b.m.damping));
+	b.n_solved = b.m.modes.n_modes;
 	/* over MPI the ranks other than 0 are done once the eigenvectors are
 	 * gathered (rank 0 alone holds them and makes the image), or once they
 	 * gave rank 0 their share of the time-domain inputs */
@@ -971,40 +1298,25 @@ int irdm_precompute(const struct irdm_scene *sc, const struct irdm_precompute_op
 			ret = td_distributed(&b, list_inputs(&b.m, NULL, NULL), err, errlen);
 		goto out_worker;
 	}
-	t1 = irdm_now_s();
-	ret = responses(&b, err, errlen);
-	if (ret)
-		goto out_free;
-	rep->seconds_responses = irdm_now_s() - t1;
-	if (o->part_out)
-		goto out_report;
-	fill_meta(&b);
-	t1 = irdm_now_s();
-	ret = stability(&b, err, errlen);
-	if (ret)
-		goto out_free;
-	rep->seconds_stability = irdm_now_s() - t1;
-	ret = fill_nodes_rigid(&b);
-	if (!ret)
-		ret = provenance(&b);
-	if (ret) {
-		snprintf(err, errlen, ret == IRDM_ENOMEM ? "precompute: out of memory"
-			 : "precompute: the scene does not fit in the provenance text");
-		goto out_free;
-	}
+	ret = auto_choice ? choose(&b, rep, err, errlen) : one_try(&b, rep, err, errlen);
+	if (ret || o->part_out)
+		goto out_done;
 	if (o->progress)
 		o->progress(o->ctx, "contact BVH and image", 0.0);
-	ret = write_image(&b, &rep->image_bytes, err, errlen);
+	ret = write_image(&b, o->out_path, &rep->image_bytes, err, errlen);
 	if (ret)
 		goto out_free;
 	if (o->progress)
 		o->progress(o->ctx, "contact BVH and image", 1.0);
-out_report:
-	report(&b, rep);
+out_done:
+	if (!ret)
+		report(&b, rep);
 out_worker:
 	rep->seconds_total = irdm_now_s() - t0;
 out_free:
+	repr_text(b.sc, rep->representation, sizeof(rep->representation));
 	build_free(&b);
+	free(eff);
 	return ret;
 }
 

@@ -6,24 +6,8 @@
 
 #include "irdm/error.h"
 #include "modal/response.h"
+#include "modal/window.h"
 #include "precompute/fir_tail.h"
-
-/* i = 0 is the sample after the head: the taper starts just below 1 and
- * ends just above 0, so neither end of the window jumps. */
-static double window_x(size_t i, size_t L)
-{
-	return (double)(i + 1) / (double)(L + 1);
-}
-
-double irdm_fir_tail_taper(size_t i, size_t L)
-{
-	return 0.5 * (1 + cos(M_PI * window_x(i, L)));
-}
-
-double irdm_fir_tail_bump(size_t i, size_t L)
-{
-	return sin(M_PI * window_x(i, L));
-}
 
 /* X (n x n_in): static compliance columns of the columns' free DoFs;
  * slot[3 c + j]: the X column of DoF j of column c (unused if fixed). */
@@ -64,14 +48,14 @@ static void window_one(double *R, size_t T, size_t L, const double S[9], double 
 	for (int e = 0; e < 9; e++)
 		miss[e] = S[e];
 	for (size_t s = 0; s < T + L; s++) {
-		double w = s < T ? 1.0 : irdm_fir_tail_taper(s - T, L);
+		double w = s < T ? 1.0 : irdm_window_taper(s - T, L);
 		for (int e = 0; e < 9; e++) {
 			R[9 * s + (size_t)e] *= w;
 			miss[e] -= R[9 * s + (size_t)e];
 		}
 	}
 	for (size_t i = 0; i < L; i++) {
-		double a = irdm_fir_tail_bump(i, L) / bump_sum;
+		double a = irdm_window_bump(i, L) / bump_sum;
 		for (int e = 0; e < 9; e++)
 			R[9 * (T + i) + (size_t)e] += a * miss[e];
 	}
@@ -92,7 +76,7 @@ int irdm_fir_tail_window(const struct irdm_model *m, bool floating, size_t T, si
 	if (ret)
 		goto out_free;
 	for (size_t i = 0; i < L; i++)
-		bump_sum += irdm_fir_tail_bump(i, L);
+		bump_sum += irdm_window_bump(i, L);
 	for (size_t c = 0; c < m->n_cols; c++)
 		for (size_t r = 0; r < m->n_rows; r++) {
 			double S[9];

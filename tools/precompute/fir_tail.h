@@ -3,7 +3,7 @@
  * An FIR that is stable and keeps its head: the response computed L
  * samples past T, those samples tapered to zero by a Hann window, and the
  * taps' sum restored to the static compliance by a smooth bump over the
- * same samples.  Samples 0..T-1 are untouched, so the force of the first
+ * same samples (modal/window.h).  Samples 0..T-1 are untouched, so the force of the first
  * T ticks after any contact is the exact one; the held force is the
  * static one.  Stability is not assumed: the precompute certifies the
  * result like any FIR (docs/architecture.md, "Numerical hazards").
@@ -14,10 +14,6 @@
 #include <stddef.h>
 
 #include "precompute/model.h"
-
-/* Taper weight of window sample i (0..L-1) and its DC bump shape. */
-double irdm_fir_tail_taper(size_t i, size_t L);
-double irdm_fir_tail_bump(size_t i, size_t L);
 
 /*
  * fir: [col][row][s][3][3] over T + L samples (build.c's layout), the

@@ -172,6 +172,8 @@ int irdm_model_build(const struct irdm_scene *sc, size_t n_modes_needed,
 {
 	double t0 = irdm_now_s();
 	struct irdm_modes_want want;
+	/* only a slepc run has ranks (irdm_dist_begin started them) */
+	struct irdm_eig_dist dist = { .rank = 0, .solve = irdm_eig_slepc };
 	int ret;
 
 	memset(m, 0, sizeof(*m));
@@ -217,8 +219,10 @@ int irdm_model_build(const struct irdm_scene *sc, size_t n_modes_needed,
 		snprintf(err, errlen, "model: out of memory");
 		goto out_fail;
 	}
-	ret = irdm_modes_solve_kept(&m->fem, n_modes_needed, sc->floating, sc->eigensolver, &want,
-				    progress, ctx, &m->modes, err, errlen);
+	if (sc->eigensolver == IRDM_EIG_SLEPC)
+		dist.rank = irdm_dist_rank();
+	ret = irdm_modes_solve_kept(&m->fem, n_modes_needed, sc->floating, sc->eigensolver, &dist,
+				    &want, progress, ctx, &m->modes, err, errlen);
 	free((void *)want.keep);
 	free((void *)want.load_dofs);
 	if (ret)

@@ -3,6 +3,9 @@
 #ifndef IRDM_TOOLS_PRECOMPUTE_H
 #define IRDM_TOOLS_PRECOMPUTE_H
 
+#include <stdbool.h>
+#include <stdint.h>
+
 #include "irdm/version.h"
 #include "precompute/model.h"
 
@@ -40,6 +43,16 @@ struct irdm_precompute_report {
 	 * largest block error left (units of sqrt(|S_aa| |S_bb|)), values */
 	size_t corr_clusters, corr_cluster_pairs_dense, corr_cluster_max_rank, corr_cluster_values;
 	double corr_cluster_max_err;
+	/* the force error against the exact model (report_measure.h) */
+	bool error_measured;
+	double measured_error, seconds_error;
+	uint32_t error_worst_node;
+	const char *error_worst_run;
+	size_t error_cols, error_ticks;
+	/* the representation written (representation = auto: the chosen one)
+	 * and how many candidates auto built */
+	char representation[64];
+	size_t auto_tries;
 };
 
 /*
@@ -47,7 +60,9 @@ struct irdm_precompute_report {
  * IRDM_ENOMEM; IRDM_EIO if a mesh, part or the image cannot be read or
  * written; IRDM_EFORMAT if an input file is malformed; IRDM_ECHILD if tetgen
  * fails; IRDM_ENUMERIC if a factorisation, eigensolve or stability
- * computation fails.  A one-line reason goes to err.
+ * computation fails, if the image is not certified stable (unless the
+ * scene's uncertified) or if its measured force error is above the
+ * scene's max_error.  A one-line reason goes to err.
  */
 int irdm_precompute(const struct irdm_scene *sc, const struct irdm_precompute_opts *o,
 		    struct irdm_precompute_report *rep, char *err, size_t errlen);

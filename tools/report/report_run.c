@@ -166,7 +166,7 @@ int irdm_report_engine_run(const struct irdm_image *img, const struct irdm_repor
 	int ret;
 
 	memset(out, 0, sizeof(*out));
-	out->n_eval = N / disp_every;
+	out->n_eval = disp_every ? N / disp_every : 0;
 	out->F = malloc(N * 3 * m * sizeof(double));
 	out->disp = calloc((out->n_eval ? out->n_eval : 1) * n_nodes * 3, sizeof(double));
 	out->tick_us = malloc(N * sizeof(double));
@@ -184,7 +184,8 @@ int irdm_report_engine_run(const struct irdm_image *img, const struct irdm_repor
 		snprintf(err, errlen, "engine run: a scenario's contact site is not touchable");
 		goto out_free;
 	}
-	ret = run_deform(img, cmds, sites, m, N, disp_every, out, err, errlen);
+	/* without displayed nodes, the timed run alone */
+	ret = disp_every ? run_deform(img, cmds, sites, m, N, disp_every, out, err, errlen) : 0;
 	if (!ret)
 		ret = run_timed(img, cmds, sites, m, N, out, err, errlen);
 	if (!ret)

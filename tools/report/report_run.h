@@ -20,7 +20,8 @@ struct irdm_report_engine_out {
 /*
  * Two runs on fresh engines (rigid coupling, grab contacts, coupled
  * solve): one publishing to the deformation worker every disp_every ticks
- * (the displayed nodes), one timed without publishing, on the last CPU.
+ * (the displayed nodes; none when disp_every is 0), one timed without
+ * publishing, on the last CPU.
  * Return: IRDM_OK; IRDM_ENOMEM; IRDM_EINVAL or IRDM_ECONTACT from the
  * session or a site.  Free with irdm_report_engine_free().
  */

@@ -33,6 +33,7 @@ void irdm_scene_defaults(struct irdm_scene *sc)
 	sc->damp_hz[1] = 100;
 	sc->dt_s = 0.001;
 	sc->representation = IRDM_REPR_MODAL;
+	sc->repr_auto = true;
 	sc->modes = 300;
 	sc->static_correction = true;
 	sc->static_corr_tol = IRDM_STATIC_CORR_TOL_DEFAULT;
@@ -49,6 +50,7 @@ void irdm_scene_defaults(struct irdm_scene *sc)
 	sc->method = IRDM_METHOD_MODAL;
 	sc->substeps = 8;
 	sc->eigensolver = IRDM_EIG_AUTO;
+	sc->max_error = IRDM_MAX_ERROR_DEFAULT;
 }
 
 /* Strict number parsing: the whole token, finite. */
@@ -194,6 +196,13 @@ static int parse_damping(struct irdm_scene *sc, const char *s)
 
 static int parse_representation(struct irdm_scene *sc, const char *s)
 {
+	sc->repr_auto = !strcmp(s, "auto");
+	if (sc->repr_auto) {
+		/* what it resolves to without max_error: modal:300 + correction */
+		sc->representation = IRDM_REPR_MODAL;
+		sc->modes = 300;
+		return 0;
+	}
 	if (!strcmp(s, "modal:all")) {
 		sc->representation = IRDM_REPR_MODAL;
 		sc->modes = 0;
@@ -330,6 +339,21 @@ static int set_fir_tail(const struct irdm_opt *o, void *obj, const char *v, char
 	return irdm_opt_parse_value(&count, &sc->fir_tail, v + 7, why, len);
 }
 
+/* "none" (0: not measured, not checked) or a relative error in (0, 1]. */
+static int set_max_error(const struct irdm_opt *o, void *obj, const char *v, char *why, size_t len)
+{
+	static const struct irdm_opt err = { .name = "max_error", .type = IRDM_OPT_DOUBLE,
+		.size = sizeof(double), .range = IRDM_OPT_GT | IRDM_OPT_LE, .min = 0, .max = 1 };
+	struct irdm_scene *sc = obj;
+
+	(void)o;
+	if (!strcmp(v, "none")) {
+		sc->max_error = 0;
+		return IRDM_OK;
+	}
+	return irdm_opt_parse_value(&err, &sc->max_error, v, why, len);
+}
+
 /* "all" or "0": every mode; otherwise 1 to 1000000. */
 static int set_modes(const struct irdm_opt *o, void *obj, const char *v, char *why, size_t len)
 {
@@ -410,8 +434,12 @@ static const struct irdm_opt scene_opts[] = {
 	  .range = IRDM_OPT_GE | IRDM_OPT_LE, .min = 1e-6, .max = 1,
 	  .help = "sample period (default 0.001)" },
 	{ .name = "representation", .type = IRDM_OPT_CUSTOM, .parse = set_representation,
-	  .metavar = "modal:K | modal:all | fir:T",
-	  .help = "K modes (1 to 1000000) or all, or an FIR of T samples (1 to 1000000) (default modal:300)" },
+	  .metavar = "auto | modal:K | modal:all | fir:T",
+	  .help = "K modes (1 to 1000000) or all, or an FIR of T samples (1 to 1000000); auto: "
+		  "the cheapest to tick of modal:all (up to 300 modes), modal:300 + static "
+		  "correction + exact_head 32, 128 or 512, modal:all whose measured error meets "
+		  "max_error (every mode solved: a dense eigensolve); with max_error = none, "
+		  "modal:300 + static correction (default auto)" },
 	{ .name = "modes", .type = IRDM_OPT_CUSTOM, .parse = set_modes, .metavar = "K | all",
 	  .help = "modes that synthesise a modal-method FIR, 1 to 1000000 (default 300)" },
 	{ .name = "fir_tail", .type = IRDM_OPT_CUSTOM, .parse = set_fir_tail,
@@ -436,6 +464,19 @@ static const struct irdm_opt scene_opts[] = {
 		  "first H samples between touchable nodes, on top of the kept modes, tapered off "
 		  "over H more with the static compliance kept exactly; needs every mode, a dense "
 		  "eigensolve (default 0: the static correction alone)" },
+	{ .name = "max_error", .type = IRDM_OPT_CUSTOM, .parse = set_max_error,
+	  .metavar = "E | none",
+	  .help = "largest force error an image may have: after the build, its relative RMS "
+		  "force error against the exact linear model (every mode, in double) is "
+		  "measured for a step and a release at a few touchable nodes, stored in the "
+		  "image and printed; above E the image is refused.  none neither measures "
+		  "nor checks (the measurement needs every mode: a dense eigensolve) "
+		  "(default 1e-3)" },
+	{ .name = "uncertified", .type = IRDM_OPT_BOOL, SC(uncertified),
+	  .help = "write an image although some touchable node's force recursion is not "
+		  "certified stable (spectral radius >= 1; the engine then damps an FIR's tail "
+		  "by r^s); default no: such an image is refused, as `irdm image verify "
+		  "--require-stable` would reject it" },
 	{ .name = "precision", .type = IRDM_OPT_ENUM, SC(precision), .names = precision_names,
 	  .help = "storage of the responses (default f32)" },
 	{ .name = "touch", .type = IRDM_OPT_CUSTOM, .parse = set_region, SC(touch),
@@ -450,7 +491,7 @@ static const struct irdm_opt scene_opts[] = {
 	  .help = "time-domain integration steps per sample (default 8)" },
 	{ .name = "eigensolver", .type = IRDM_OPT_ENUM, SC(eigensolver), .names = eig_names,
 	  .help = "eigenvalue solver (default auto: by size); slepc: SLEPc over MPI ranks "
-		  "(run under mpirun -np N; README, \"Beyond one machine\")" },
+		  "(run under mpirun -np N; docs/mpi.md)" },
 	{ .name = "threads", .type = IRDM_OPT_UNSIGNED, SC(threads), .metavar = "N",
 	  .range = IRDM_OPT_LE, .max = 256, .help = "worker threads (0: all cores)" },
 };
@@ -573,7 +614,9 @@ int irdm_scene_format(const struct irdm_scene *sc, char *buf, size_t len)
 	else
 		snprintf(damp, sizeof(damp), "%.17g@%.17g,%.17g@%.17g", sc->damp_ratio[0],
 			 sc->damp_hz[0], sc->damp_ratio[1], sc->damp_hz[1]);
-	if (sc->representation == IRDM_REPR_FIR)
+	if (sc->repr_auto)
+		snprintf(repr, sizeof(repr), "auto");
+	else if (sc->representation == IRDM_REPR_FIR)
 		snprintf(repr, sizeof(repr), "fir:%u", sc->fir_length);
 	else if (sc->modes)
 		snprintf(repr, sizeof(repr), "modal:%u", sc->modes);

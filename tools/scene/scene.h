@@ -40,6 +40,9 @@ struct irdm_region {
 	char text[128];         /* as written, for messages and provenance */
 };
 
+/* The force error an image may have by default (scene key max_error). */
+#define IRDM_MAX_ERROR_DEFAULT 1e-3
+
 enum irdm_damping_kind { IRDM_DAMP_RATIOS = 0, IRDM_DAMP_RAYLEIGH = 1 };
 enum irdm_method { IRDM_METHOD_MODAL = 0, IRDM_METHOD_TIME_DOMAIN = 1 };
 
@@ -63,6 +66,7 @@ struct irdm_scene {
 	struct irdm_region fixed;
 	double dt_s;
 	uint32_t representation; /* enum irdm_repr */
+	bool repr_auto;          /* chosen by the precompute to meet max_error */
 	unsigned fir_length;
 	unsigned fir_tail;       /* FIR: samples windowed past fir_length (0: none) */
 	unsigned modes;          /* modes kept (0 = all) */
@@ -78,6 +82,8 @@ struct irdm_scene {
 	unsigned substeps;
 	enum irdm_eig_method eigensolver;
 	unsigned threads;
+	bool uncertified;        /* write an image whose stability certificate fails */
+	double max_error;        /* largest measured force error written (0: none, not measured) */
 };
 
 /* The defaults: the paper's cuboid at its resolution, modal 300 + static

@@ -17,7 +17,7 @@ out=${OUT:-out/bench-mpi}
 limit=${TIMEOUT:-3600}
 mpirun=(mpirun --allow-run-as-root --oversubscribe)
 scene=(precompute --mesh cuboid --resolution "$res" --fixed 'z<=0' --touch "$touch"
-       --representation modal:300)
+       --representation modal:300 --max_error none)
 mkdir -p "$out"
 run() {  # name command...
 	local name=$1 log=$out/$1.log

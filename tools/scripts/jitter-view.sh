@@ -6,9 +6,9 @@
 # one CPU, overruns counted rather than faulting); then the wake-up latency
 # and compute-time percentiles of every run from its log, the spread of the
 # runs without the browser, and whether the runs with it stay inside.
-#   tools/scripts/jitter-view.sh IRDM_FW IMAGE
+#   tools/scripts/jitter-view.sh IRDM IRDM_FW IMAGE
 set -euo pipefail
-fw=$1; image=$2
+irdm=$1; fw=$2; image=$3
 secs=${JITTER_SECONDS:-20}
 rounds=${JITTER_ROUNDS:-3}
 browser=${IRDM_CHROMIUM:-/usr/bin/chromium}
@@ -53,6 +53,8 @@ run() {   # run NAME [--view 0]
 	fi
 	wait $pid
 	stop_browser
+	# the log's blocks and checksums are read by irdm (docs/log-format.md)
+	"$irdm" log export "$out/$name.log" -o "$out/$name.csv"
 	grep -E '^view: [0-9]' "$out/$name.txt" || true
 }
 
@@ -62,22 +64,16 @@ for r in $(seq "$rounds"); do
 done
 
 /usr/bin/python3 - "$out" "$rounds" <<'PY'
-import math, struct, sys
+import csv, math, sys
 
 out, rounds = sys.argv[1], int(sys.argv[2])
-REC, HEAD = 392, 256          # irdm/telemetry.h: record and header sizes
 
 def load(path):
     lat, comp = [], []
-    with open(path, 'rb') as f:
-        f.seek(HEAD)
-        while True:
-            r = f.read(REC)
-            if len(r) < REC:
-                break
-            _, wake, c = struct.unpack_from('<QiI', r)
-            lat.append(wake / 1000.0)
-            comp.append(c / 1000.0)
+    with open(path, newline='') as f:
+        for r in csv.DictReader(f):
+            lat.append(int(r['wake_latency_ns']) / 1000.0)
+            comp.append(int(r['compute_ns']) / 1000.0)
     return sorted(lat), sorted(comp)
 
 def pct(v):
@@ -87,7 +83,7 @@ def pct(v):
 rows = {}
 for kind in ('plain', 'browser'):
     for r in range(1, rounds + 1):
-        lat, comp = load(f'{out}/{kind}-{r}.log')
+        lat, comp = load(f'{out}/{kind}-{r}.csv')
         rows[(kind, r)] = (pct(lat), pct(comp), sum(1 for x in comp if x > 1000.0), len(lat))
 names = ['p50', 'p99', 'p99.9', 'max']
 print(f"{'run':12s} | wake-up latency (us) {'':8s}| compute (us) {'':16s}| overruns  ticks")

@@ -16,7 +16,7 @@
 
 #define IRDM_IMAGE_MAGIC "IRDMIMG"          /* 7 chars + NUL = 8 bytes */
 #define IRDM_IMAGE_VERSION_MAJOR 2u         /* incompatible layout change */
-#define IRDM_IMAGE_VERSION_MINOR 2u         /* compatible additions: 2.1 STATIC_CORR_LOWRANK, EXACT_HEAD; 2.2 STATIC_CORR_CLUSTERS */
+#define IRDM_IMAGE_VERSION_MINOR 3u         /* compatible additions: 2.1 STATIC_CORR_LOWRANK, EXACT_HEAD; 2.2 STATIC_CORR_CLUSTERS; 2.3 measured_error */
 #define IRDM_IMAGE_ALIGN 64u                /* payload alignment, bytes */
 #define IRDM_IMAGE_MAX_SECTIONS 32u
 
@@ -87,6 +87,8 @@ enum irdm_meta_flags {
 	IRDM_META_FIR_TAIL_WINDOW = 1u << 4,
 	/* modal with STATIC_CORR: EXACT_HEAD present, head_samples samples */
 	IRDM_META_EXACT_HEAD = 1u << 5,
+	/* measured_error holds the precompute's measured force error */
+	IRDM_META_ERROR_MEASURED = 1u << 6,
 };
 
 /* Longest head (samples): the engine keeps a ring of that many ticks. */
@@ -119,7 +121,9 @@ struct irdm_meta {                          /* 256 bytes */
 	char     tool_version[32];          /* NUL-terminated */
 	char     mesh_name[64];             /* NUL-terminated */
 	uint32_t head_samples;              /* EXACT_HEAD: samples stored, 1..IRDM_HEAD_SAMPLES_MAX; else 0 (2.1) */
-	uint8_t  reserved[4];               /* 0 */
+	/* ERROR_MEASURED: relative RMS force error against the exact linear
+	 * model, worst of the sampled columns' step and release (2.3); else 0 */
+	float    measured_error;
 };
 
 struct irdm_node {                          /* 16 bytes */

@@ -8,6 +8,7 @@
 #include <sched.h>
 #include <stdio.h>
 #include <string.h>
+#include <sys/prctl.h>
 #include <sys/resource.h>
 #include <sys/syscall.h>
 #include <time.h>
@@ -46,6 +47,8 @@ static void *deform_thread(void *arg)
 	int policy;
 	struct sched_param sp;
 
+	/* its name in /proc, for a program that lists its threads */
+	prctl(PR_SET_NAME, "irdm-deform", 0UL, 0UL, 0UL);
 	if (!pthread_getschedparam(pthread_self(), &policy, &sp) && policy == SCHED_OTHER)
 		th->prio_errno = lower_nice();
 	/* the stack the update will use, so it never faults in the loop; a

@@ -222,3 +222,21 @@ int irdm_rt_report_format(const struct irdm_rt_report *r, char *buf, size_t len)
 	put_affinity(&l, r->cpu_mask, r->n_cpus);
 	return l.cut ? IRDM_ENOMEM : IRDM_OK;
 }
+
+int irdm_rt_task_format(const struct irdm_rt_task *t, char *buf, size_t len)
+{
+	struct line l = { buf, len, 0, false };
+
+	if (!buf || !len)
+		return IRDM_EINVAL;
+	buf[0] = '\0';
+	put(&l, "thread %d '%s': ", (int)t->tid, t->name);
+	put_policy(&l, t->policy, t->priority);
+	put(&l, ", CPUs ");
+	put_affinity(&l, t->cpu_mask, t->n_cpus);
+	if (t->loop)
+		put(&l, " (the loop)");
+	if (t->intrudes)
+		put(&l, " (may run on the loop's CPU)");
+	return l.cut ? IRDM_ENOMEM : IRDM_OK;
+}

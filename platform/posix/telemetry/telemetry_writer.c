@@ -14,6 +14,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/prctl.h>
 #include <sys/resource.h>
 #include <sys/syscall.h>
 #include <time.h>
@@ -53,6 +54,8 @@ static void *writer_main(void *arg)
 	struct irdm_log_writer *w = arg;
 	const struct timespec idle = { 0, IRDM_LOG_WRITER_IDLE_US * 1000L };
 
+	/* its name in /proc, for a program that lists its threads */
+	prctl(PR_SET_NAME, "irdm-log", 0UL, 0UL, 0UL);
 	/*
 	 * Below a deformation thread that is itself SCHED_OTHER (at nice + 5)
 	 * too: nice is per thread on Linux.  Best effort: raising nice needs

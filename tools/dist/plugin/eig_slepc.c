@@ -31,7 +31,7 @@ struct monitor_ctx {
 };
 
 /* Where the time went, as a line of the progress (rank 0): what a user
- * extrapolates from (README, "Beyond one machine"). */
+ * extrapolates from (docs/mpi.md, "What scales"). */
 static void say_times(const struct monitor_ctx *m, const double t[6])
 {
 	char line[256];

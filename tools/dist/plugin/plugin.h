@@ -13,7 +13,7 @@ int irdm_mpi_rank(void);
 int irdm_mpi_size(void);
 bool irdm_mpi_fault(const char *where);
 
-/* irdm_eig_slepc() of modal.h, here. */
+/* irdm_eig_slepc() of dist.h, here. */
 int irdm_slepc_eig(const struct irdm_fem *fem, size_t n_lowest, double sigma,
 		   const struct irdm_modes_want *want, size_t n_whole,
 		   irdm_progress_fn progress, void *pctx, double *w2, double *phi,

@@ -20,6 +20,7 @@
 #include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <sys/types.h>
 #include <time.h>
 
 #include "irdm/error.h"
@@ -99,6 +100,34 @@ void irdm_rt_unlock_memory(void);
  */
 int irdm_rt_prefault_stack(size_t depth_bytes);
 
+/* ---- idle states ---- */
+
+/*
+ * Keep every CPU out of idle states that take longer than max_us to leave,
+ * for as long as the returned handle is held (a PM QoS request: writing
+ * the limit to /dev/cpu_dma_latency and keeping the file open, as
+ * cyclictest does by default).  An idle CPU in a deep state, or a virtual
+ * CPU the host descheduled on HLT, answers its timer tens of microseconds
+ * late: a loop that sleeps most of its period pays that on every wake.
+ * The kernel drops the request when the handle is closed or the process
+ * ends, however it ends.  Process-wide, and it costs power: idle CPUs poll.
+ *
+ * Return: the handle (>= 0); IRDM_EPERM if the device cannot be opened
+ * (root only on most systems); IRDM_ENOTSUP if there is no such device;
+ * IRDM_EIO if the kernel refused the value.
+ */
+int irdm_rt_cpu_latency_hold(int32_t max_us);
+
+/* Drop a request irdm_rt_cpu_latency_hold() made (nothing for a handle < 0). */
+void irdm_rt_cpu_latency_release(int hold);
+
+/*
+ * The limit in force now, us, from all requests of every process (the
+ * kernel's answer to a read of /dev/cpu_dma_latency); -1 if it cannot be
+ * read.  2000000000 means none.
+ */
+int32_t irdm_rt_cpu_latency_us(void);
+
 /* ---- scheduling ---- */
 
 /*
@@ -177,6 +206,59 @@ bool irdm_rt_report_realtime(const struct irdm_rt_report *r);
  * the line was cut to fit len (buf still holds a terminated prefix).
  */
 int irdm_rt_report_format(const struct irdm_rt_report *r, char *buf, size_t len);
+
+/* ---- the loop's CPU to itself (init-time: reads /proc/self/task) ---- */
+
+/*
+ * A thread of this process as the system schedules it now.  A thread's
+ * name is its comm (pthread_setname_np); one a library started (OpenBLAS's
+ * pool) carries the program's.
+ */
+struct irdm_rt_task {
+	pid_t tid;
+	char name[16];
+	int policy;                 /* -1 if unknown (the thread ended meanwhile) */
+	int priority;
+	uint64_t cpu_mask;          /* CPUs 0..63, as irdm_rt_report */
+	unsigned n_cpus;            /* 0 if unknown */
+	bool loop;                  /* the loop's thread: set by irdm_rt_isolation_check() */
+	bool intrudes;              /* not the loop's and may run on its CPU: likewise */
+};
+
+/*
+ * Take CPU cpu from every thread of the process but keep_tid (the loop's):
+ * a thread's affinity loses that CPU, and one pinned to it alone moves to
+ * every other online CPU.  Threads a library started before main (a BLAS
+ * pool) inherited the whole machine; threads started later inherit their
+ * creator's mask: call once every thread is up, then check.
+ *
+ * Return: IRDM_OK; IRDM_EINVAL if cpu is not below CPU_SETSIZE or is the
+ * only online CPU; IRDM_EIO if /proc/self/task cannot be read; IRDM_EPERM
+ * if a thread's affinity could not be changed (the others still are).
+ */
+int irdm_rt_isolate_cpu(int cpu, pid_t keep_tid);
+
+/*
+ * Every thread of the process, read back: up to max of them into tasks[]
+ * (*n says how many were read), each marked `intrudes` when it is not
+ * loop_tid and may run on cpu.  A thread whose affinity cannot be read
+ * intrudes too: nothing says it stays off the CPU.  With cpu < 0 (a loop
+ * with no CPU of its own) none intrudes: the threads are only read.
+ *
+ * Return: the number of intruders (0: the CPU is the loop's alone), or
+ * IRDM_EIO if /proc/self/task cannot be read, IRDM_ENOMEM if the process
+ * has more than max threads (those read are filled).
+ */
+int irdm_rt_isolation_check(int cpu, pid_t loop_tid, struct irdm_rt_task *tasks, size_t max,
+			    size_t *n);
+
+/*
+ * One line (no newline) for a thread, e.g.
+ *   "thread 4242 'irdm-fw': SCHED_FIFO priority 80, CPUs 1 (the loop)"
+ *   "thread 4243 'irdm-fw': SCHED_OTHER, CPUs 0-1 (may run on the loop's CPU)"
+ * Return: as irdm_rt_report_format().
+ */
+int irdm_rt_task_format(const struct irdm_rt_task *t, char *buf, size_t len);
 
 /* ---- time (safe inside a loop: no allocation, one system call) ---- */
 

@@ -889,7 +889,7 @@ static int setup(void **state)
 	 * column at T = 500, so only four nodes of the top face along y = 5 cm
 	 * (x = 3.3 .. 8.3 cm) are touchable.
 	 */
-	efx_image(&fir_img, p2, "resolution", "6,6,12", "representation", "fir:500",
+	efx_image(&fir_img, p2, "resolution", "6,6,12", "representation", "fir:500", "uncertified", "yes",
 		  "touch", "box:0.03,0.049,0.199,0.09,0.051,0.201", "display", "touch", NULL);
 	/* the hybrid: 300 modes and the other 1464's exact head (32 + 32
 	 * samples: the head's ring and sums), the top face touchable */

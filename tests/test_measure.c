@@ -1,0 +1,307 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * The precompute's measured force error (scene key max_error; META
+ * measured_error), on a 2 x 2 x 4 box (45 nodes, 108 elastic modes):
+ *  - an image of every mode in double measures as exact (below 1e-9):
+ *    the engine's recursion and the reference's convolution agree, and
+ *    the runs are at the same nodes in both;
+ *  - the stored figure is the step or release error at the node it names,
+ *    recomputed here against an exact image built by the test itself
+ *    (every mode, f64, the whole top touchable: another image than the
+ *    precompute's reference, of the same full eigensolve) by direct
+ *    convolution, the image under test run by the engine;
+ *  - f16 storage shows in the figure (the values as stored are measured);
+ *  - an image over max_error is refused, not written, with what would meet
+ *    it; max_error = none neither measures nor flags;
+ *  - representation = auto takes every mode of a small model, and on the
+ *    4 x 4 x 8 cuboid (600 modes, 2 ms, top face) the hybrid with the
+ *    shortest head that meets 1e-3, after refusing modal:300 + static
+ *    correction, which is refused there when asked for by name too.
+ */
+#include <math.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include <cmocka.h>
+
+#include "irdm/error.h"
+#include "irdm/posix/image_map.h"
+#include "precompute/precompute.h"
+#include "report/report_measure.h"
+#include "report/report_reference.h"
+#include "report/report_run.h"
+#include "scene/scene.h"
+#include "support/test_files.h"
+
+static char dir[64];
+
+static const char *const box[] = { "mesh", "box:0.1,0.1,0.2", "resolution", "2,2,4",
+				   "touch", "z>=0.2", "display", "touch", "dt", "0.002", NULL };
+
+/* Precompute box + keys (NULL-ended pairs) into name; the code. */
+static int build(const char *name, struct irdm_precompute_report *rep, char *err, size_t errlen,
+		 const char *const *keys)
+{
+	struct irdm_scene sc;
+	struct irdm_precompute_opts o = { 0 };
+	char path[128];
+
+	irdm_scene_defaults(&sc);
+	for (const char *const *kv = box; *kv; kv += 2)
+		assert_int_equal(irdm_scene_set(&sc, kv[0], kv[1], "test", err, errlen), 0);
+	for (const char *const *kv = keys; *kv; kv += 2)
+		assert_int_equal(irdm_scene_set(&sc, kv[0], kv[1], "test", err, errlen), 0);
+	snprintf(path, sizeof(path), "%s/%s", dir, name);
+	o.out_path = path;
+	err[0] = 0;
+	return irdm_precompute(&sc, &o, rep, err, errlen);
+}
+
+static void map(const char *name, struct irdm_image *img)
+{
+	char path[128], err[256];
+
+	snprintf(path, sizeof(path), "%s/%s", dir, name);
+	if (irdm_image_map(path, 0, img, err, sizeof(err)))
+		fail_msg("%s", err);
+}
+
+/* The commands of report_measure.h's runs, written out again here. */
+static void cmds_of(bool release, uint32_t row, size_t N, struct irdm_report_cmd *c)
+{
+	static const double d[3] = { 0.3, 0.2, -0.9327379 };
+
+	for (size_t t = 0; t < N; t++) {
+		bool held = !release || t < N / 3;
+
+		memset(&c[t], 0, sizeof(c[t]));
+		c[t].on_node = true;
+		c[t].row = row;
+		c[t].active = !release || t < N / 3 || t >= 2 * N / 3;
+		for (int a = 0; a < 3; a++)
+			c[t].target_m[a] = held ? 1e-3 * d[a] : 0;
+	}
+}
+
+static uint32_t row_of(const struct irdm_image *img, uint32_t mesh_node)
+{
+	for (uint32_t r = 0; r < img->meta->n_nodes; r++)
+		if (img->nodes[r].mesh_node == mesh_node)
+			return r;
+	fail_msg("mesh node %u not in the image", mesh_node);
+	return 0;
+}
+
+/* The error of one run at mesh_node: img by the engine, exact by convolution. */
+static double run_error(const struct irdm_image *img, const struct irdm_image *exact,
+			uint32_t mesh_node, bool release, size_t N)
+{
+	struct irdm_report_cmd *cmds = malloc(N * sizeof(*cmds));
+	struct irdm_report_conv c = { .img = exact, .m = 1, .N = N, .n_resp = N, .cmds = cmds };
+	struct irdm_report_conv_out ref;
+	struct irdm_report_engine_out eo;
+	double num = 0, den = 0;
+	char err[256];
+
+	assert_non_null(cmds);
+	cmds_of(release, row_of(exact, mesh_node), N, cmds);
+	assert_int_equal(irdm_report_convolve(&c, &ref, err, sizeof(err)), 0);
+	cmds_of(release, row_of(img, mesh_node), N, cmds);
+	assert_int_equal(irdm_report_engine_run(img, cmds, 1, N, 0, &eo, err, sizeof(err)), 0);
+	assert_false(eo.faulted);
+	for (size_t i = 0; i < 3 * N; i++) {
+		num += (eo.F[i] - ref.F[i]) * (eo.F[i] - ref.F[i]);
+		den += ref.F[i] * ref.F[i];
+	}
+	irdm_report_engine_free(&eo);
+	irdm_report_conv_free(&ref);
+	free(cmds);
+	return sqrt(num / den);
+}
+
+static int setup(void **state)
+{
+	struct irdm_precompute_report rep;
+	char err[512];
+
+	(void)state;
+	if (tf_tmpdir(dir, sizeof(dir), "measure"))
+		return -1;
+	/* the test's own exact model: every mode, f64, not measured */
+	return build("exact.img", &rep, err, sizeof(err), (const char *const[]){
+		"representation", "modal:all", "static_correction", "no", "precision", "f64",
+		"max_error", "none", NULL });
+}
+
+static int teardown(void **state)
+{
+	(void)state;
+	return tf_rmdir(dir);
+}
+
+static void test_exact_measures_exact(void **state)
+{
+	struct irdm_precompute_report rep;
+	struct irdm_image img;
+	char err[512];
+
+	(void)state;
+	assert_int_equal(build("all.img", &rep, err, sizeof(err), (const char *const[]){
+		"representation", "modal:all", "precision", "f64", NULL }), 0);
+	print_message("modal:all f64: measured %.3g over %zu columns x %zu ticks in %.2f s\n",
+		      rep.measured_error, rep.error_cols, rep.error_ticks, rep.seconds_error);
+	assert_true(rep.error_measured);
+	assert_int_equal(rep.error_cols, IRDM_MEASURE_MAX_COLS);
+	assert_int_equal(rep.error_ticks, 500);        /* 1 s at 2 ms */
+	assert_true(rep.measured_error < 1e-9);
+	map("all.img", &img);
+	assert_true(img.meta->flags & IRDM_META_ERROR_MEASURED);
+	assert_true(img.meta->measured_error == (float)rep.measured_error);
+	irdm_image_unmap(&img);
+}
+
+/* The stored figure, recomputed at the node it names against the test's own
+ * exact image; both runs there, the larger is the figure. */
+static void test_figure_recomputed(void **state)
+{
+	struct irdm_precompute_report rep;
+	struct irdm_image img, exact;
+	char err[512];
+	double e[2];
+
+	(void)state;
+	assert_int_equal(build("m40.img", &rep, err, sizeof(err), (const char *const[]){
+		"representation", "modal:40", "max_error", "1", NULL }), 0);
+	map("m40.img", &img);
+	map("exact.img", &exact);
+	for (int release = 0; release < 2; release++)
+		e[release] = run_error(&img, &exact, rep.error_worst_node, release, rep.error_ticks);
+	print_message("modal:40 + static correction: stored %.6g (%s at node %u); here step %.6g, release %.6g\n",
+		      (double)img.meta->measured_error, rep.error_worst_run, rep.error_worst_node,
+		      e[0], e[1]);
+	assert_true(rep.measured_error > 1e-3);        /* the ZOH ringing it lacks */
+	assert_float_equal(rep.measured_error, fmax(e[0], e[1]), 1e-9 * rep.measured_error);
+	assert_string_equal(rep.error_worst_run, e[1] > e[0] ? "release" : "step");
+	assert_float_equal(img.meta->measured_error, rep.measured_error, 1e-7 * rep.measured_error);
+	irdm_image_unmap(&img);
+	irdm_image_unmap(&exact);
+}
+
+/* Stored in f16, every mode: the rounding of the stored values is measured. */
+static void test_f16_measured_as_stored(void **state)
+{
+	struct irdm_precompute_report rep;
+	char err[512];
+
+	(void)state;
+	assert_int_equal(build("f16.img", &rep, err, sizeof(err), (const char *const[]){
+		"representation", "modal:all", "precision", "f16", "max_error", "1", NULL }), 0);
+	print_message("modal:all f16: measured %.3g\n", rep.measured_error);
+	assert_true(rep.measured_error > 1e-6 && rep.measured_error < 1e-2);
+}
+
+static void test_over_target_refused(void **state)
+{
+	struct irdm_precompute_report rep;
+	struct irdm_image img;
+	char err[512], path[128];
+
+	(void)state;
+	snprintf(path, sizeof(path), "%s/m10.img", dir);
+	assert_int_equal(build("m10.img", &rep, err, sizeof(err), (const char *const[]){
+		"representation", "modal:10", NULL }), IRDM_ENUMERIC);
+	print_message("%s\n", err);
+	assert_non_null(strstr(err, "scene cuboid: modal:10 + static correction is "));
+	assert_non_null(strstr(err, "above max_error = 0.001; try a hybrid head (exact_head = 128)"));
+	/* the release's free vibration is what modal:10 misses most here */
+	assert_non_null(strstr(err, "worst: release at mesh node"));
+	assert_int_not_equal(access(path, F_OK), 0);
+	/* nothing left beside it either: the scratch image and the reference */
+	assert_int_not_equal(access(strcat(path, ".unmeasured"), F_OK), 0);
+	/* none: written, neither measured nor flagged */
+	assert_int_equal(build("m10.img", &rep, err, sizeof(err), (const char *const[]){
+		"representation", "modal:10", "max_error", "none", NULL }), 0);
+	assert_false(rep.error_measured);
+	map("m10.img", &img);
+	assert_false(img.meta->flags & IRDM_META_ERROR_MEASURED);
+	assert_true(img.meta->measured_error == 0);
+	irdm_image_unmap(&img);
+}
+
+static void test_auto_small_takes_all(void **state)
+{
+	struct irdm_precompute_report rep;
+	char err[512];
+
+	(void)state;
+	assert_int_equal(build("auto-small.img", &rep, err, sizeof(err), (const char *const[]){
+		"representation", "auto", NULL }), 0);
+	print_message("auto on 108 modes: %s, measured %.3g\n", rep.representation,
+		      rep.measured_error);
+	assert_string_equal(rep.representation, "modal:all");
+	assert_int_equal(rep.auto_tries, 1);
+	assert_true(rep.measured_error < 1e-6);       /* f32 storage */
+}
+
+static int cuboid(const char *name, struct irdm_precompute_report *rep, char *err, size_t errlen,
+		  const char *repr, const char *max_error)
+{
+	struct irdm_scene sc;
+	struct irdm_precompute_opts o = { 0 };
+	char path[128];
+
+	irdm_scene_defaults(&sc);
+	assert_int_equal(irdm_scene_set(&sc, "resolution", "4,4,8", "test", err, errlen), 0);
+	assert_int_equal(irdm_scene_set(&sc, "touch", "z>=0.2", "test", err, errlen), 0);
+	assert_int_equal(irdm_scene_set(&sc, "display", "touch", "test", err, errlen), 0);
+	assert_int_equal(irdm_scene_set(&sc, "dt", "0.002", "test", err, errlen), 0);
+	if (repr)
+		assert_int_equal(irdm_scene_set(&sc, "representation", repr, "test", err, errlen), 0);
+	if (max_error)
+		assert_int_equal(irdm_scene_set(&sc, "max_error", max_error, "test", err, errlen), 0);
+	snprintf(path, sizeof(path), "%s/%s", dir, name);
+	o.out_path = path;
+	return irdm_precompute(&sc, &o, rep, err, errlen);
+}
+
+static void test_auto_cuboid_chooses_hybrid(void **state)
+{
+	struct irdm_precompute_report rep;
+	char err[768];
+
+	(void)state;
+	/* the default: auto, 1e-3 */
+	assert_int_equal(cuboid("auto.img", &rep, err, sizeof(err), NULL, NULL), 0);
+	print_message("auto on 600 modes: %s after %zu candidates, measured %.3g\n",
+		      rep.representation, rep.auto_tries, rep.measured_error);
+	assert_string_equal(rep.representation, "modal:300 + static correction + exact_head 32");
+	assert_int_equal(rep.auto_tries, 2);
+	assert_true(rep.measured_error <= 1e-3);
+	/* its first candidate, by name: refused */
+	assert_int_equal(cuboid("m300.img", &rep, err, sizeof(err), "modal:300", NULL), IRDM_ENUMERIC);
+	assert_non_null(strstr(err, "modal:300 + static correction is "));
+	/* no target: today's modal:300 + static correction, 300 modes solved */
+	assert_int_equal(cuboid("none.img", &rep, err, sizeof(err), NULL, "none"), 0);
+	assert_string_equal(rep.representation, "modal:300 + static correction");
+	assert_int_equal(rep.modes, 300);
+	assert_false(rep.error_measured);
+}
+
+int main(void)
+{
+	const struct CMUnitTest tests[] = {
+		cmocka_unit_test(test_exact_measures_exact),
+		cmocka_unit_test(test_figure_recomputed),
+		cmocka_unit_test(test_f16_measured_as_stored),
+		cmocka_unit_test(test_over_target_refused),
+		cmocka_unit_test(test_auto_small_takes_all),
+		cmocka_unit_test(test_auto_cuboid_chooses_hybrid),
+	};
+
+	return cmocka_run_group_tests(tests, setup, teardown);
+}

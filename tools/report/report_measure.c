@@ -1,0 +1,295 @@
+/* SPDX-License-Identifier: MIT */
+/* An image's force error against the exact model, on a few columns. */
+#include <math.h>
+#include <stdbool.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "image/image_response.h"
+#include "irdm/error.h"
+#include "irdm/posix/image_map.h"
+#include "precompute/precompute.h"
+#include "report/report_measure.h"
+#include "report/report_reference.h"
+#include "report/report_run.h"
+#include "util/clock.h"
+
+/* Oblique, so that every axis of the contact's 3x3 response is excited. */
+static const double push_dir[3] = { 0.3, 0.2, -0.9327379 };
+#define PUSH_M 1e-3     /* the model is linear: the size only sets the units */
+
+size_t irdm_measure_ticks(double dt_s)
+{
+	size_t n = (size_t)llround(1.0 / dt_s);
+
+	return n < 300 ? 300 : (n > 3000 ? 3000 : n);
+}
+
+static double dist2(const float *a, const float *b)
+{
+	double d = 0;
+
+	for (int k = 0; k < 3; k++)
+		d += ((double)a[k] - b[k]) * ((double)a[k] - b[k]);
+	return d;
+}
+
+static bool have(const uint32_t *cols, size_t n, uint32_t c)
+{
+	for (size_t i = 0; i < n; i++)
+		if (cols[i] == c)
+			return true;
+	return false;
+}
+
+/* Farthest-point samples of the columns, then the largest radii. */
+static size_t pick_columns(const struct irdm_image *img, uint32_t *cols)
+{
+	uint32_t nc = img->meta->n_cols;
+	size_t n = 0;
+
+	cols[n++] = 0;
+	while (n < IRDM_MEASURE_SPREAD && n < nc) {
+		double best = -1;
+		uint32_t bc = 0;
+
+		for (uint32_t c = 0; c < nc; c++) {
+			double dmin = INFINITY;
+			for (size_t i = 0; i < n; i++)
+				dmin = fmin(dmin, dist2(img->nodes[img->columns[c]].pos_m,
+							img->nodes[img->columns[cols[i]]].pos_m));
+			if (dmin > best) {
+				best = dmin;
+				bc = c;
+			}
+		}
+		if (have(cols, n, bc))
+			break;
+		cols[n++] = bc;
+	}
+	for (int k = 0; k < IRDM_MEASURE_WORST && n < nc; k++) {
+		float best = -1;
+		uint32_t bc = UINT32_MAX;
+
+		for (uint32_t c = 0; c < nc; c++)
+			if (!have(cols, n, c) && img->stability[c].spectral_radius > best) {
+				best = img->stability[c].spectral_radius;
+				bc = c;
+			}
+		if (bc == UINT32_MAX)
+			break;
+		cols[n++] = bc;
+	}
+	return n;
+}
+
+/* The image row of a mesh node, or -1. */
+static int64_t row_of_mesh_node(const struct irdm_image *img, uint32_t mesh_node)
+{
+	for (uint32_t r = 0; r < img->meta->n_nodes; r++)
+		if (img->nodes[r].mesh_node == mesh_node)
+			return r;
+	return -1;
+}
+
+/* The commands of one run at image row `row`. */
+static void make_cmds(bool release, uint32_t row, size_t N, struct irdm_report_cmd *cmds)
+{
+	for (size_t t = 0; t < N; t++) {
+		struct irdm_report_cmd *c = &cmds[t];
+		bool held = !release || t < N / 3;
+
+		memset(c, 0, sizeof(*c));
+		c->on_node = true;
+		c->row = row;
+		c->active = !release || t < N / 3 || t >= 2 * N / 3;
+		for (int a = 0; a < 3; a++)
+			c->target_m[a] = held ? PUSH_M * push_dir[a] : 0;
+	}
+}
+
+static double rel_rms(const double *F, const double *Fref, size_t n)
+{
+	double num = 0, den = 0;
+
+	for (size_t i = 0; i < n; i++) {
+		num += (F[i] - Fref[i]) * (F[i] - Fref[i]);
+		den += Fref[i] * Fref[i];
+	}
+	return den > 0 ? sqrt(num / den) : (num > 0 ? INFINITY : 0);
+}
+
+/* The exact model's forces for one run. */
+static int reference(const struct irdm_image *ref, const struct irdm_report_cmd *cmds, size_t N,
+		     double **F, char *err, size_t errlen)
+{
+	struct irdm_report_conv c = { .img = ref, .cmds = cmds, .m = 1, .N = N, .n_resp = N };
+	struct irdm_report_conv_out co;
+	struct irdm_report_engine_out eo;
+	int ret;
+
+	if (!ref->rigid) {
+		ret = irdm_report_convolve(&c, &co, err, errlen);
+		if (ret)
+			return ret;
+		*F = co.F;
+		free(co.disp);
+		return IRDM_OK;
+	}
+	ret = irdm_report_engine_run(ref, cmds, 1, N, 0, &eo, err, errlen);
+	if (ret)
+		return ret;
+	if (eo.faulted) {
+		irdm_report_engine_free(&eo);
+		snprintf(err, errlen, "error measurement: the exact model's engine run faulted");
+		return IRDM_ECONTACT;
+	}
+	*F = eo.F;
+	eo.F = NULL;
+	irdm_report_engine_free(&eo);
+	return IRDM_OK;
+}
+
+/* One column, both runs: the larger error into res. */
+static int measure_column(const struct irdm_image *img, const struct irdm_image *ref,
+			  uint32_t col, size_t N, struct irdm_report_cmd *cmds,
+			  struct irdm_measure *res, char *err, size_t errlen)
+{
+	uint32_t mesh_node = img->nodes[img->columns[col]].mesh_node;
+	int64_t ref_row = row_of_mesh_node(ref, mesh_node);
+
+	if (ref_row < 0) {
+		snprintf(err, errlen, "error measurement: mesh node %u is not in the exact model", mesh_node);
+		return IRDM_EINVAL;
+	}
+	for (int release = 0; release < 2; release++) {
+		struct irdm_report_engine_out eo;
+		double *Fref = NULL, e;
+		int ret;
+
+		make_cmds(release, (uint32_t)ref_row, N, cmds);
+		ret = reference(ref, cmds, N, &Fref, err, errlen);
+		if (ret)
+			return ret;
+		make_cmds(release, img->columns[col], N, cmds);
+		ret = irdm_report_engine_run(img, cmds, 1, N, 0, &eo, err, errlen);
+		if (ret) {
+			free(Fref);
+			return ret;
+		}
+		e = eo.faulted ? INFINITY : rel_rms(eo.F, Fref, 3 * N);
+		if (!(e <= res->error)) {
+			res->error = e;
+			res->worst_node = mesh_node;
+			res->worst_run = release ? "release" : "step";
+		}
+		irdm_report_engine_free(&eo);
+		free(Fref);
+	}
+	return IRDM_OK;
+}
+
+/* The exact model of sc, touchable at the sampled nodes only. */
+static int precompute_ref(void *ctx, const struct irdm_scene *ref, const char *path, char *err,
+			  size_t errlen)
+{
+	struct irdm_precompute_opts o = { .out_path = path };
+	struct irdm_precompute_report rep;
+
+	(void)ctx;
+	return irdm_precompute(ref, &o, &rep, err, errlen);
+}
+
+static int build_reference(const struct irdm_scene *sc, const struct irdm_measure *res,
+			   const char *ref_path, irdm_measure_ref_fn build_ref, void *ref_ctx,
+			   char *err, size_t errlen)
+{
+	struct irdm_scene *ref = malloc(sizeof(*ref));
+	char nodes[16 * IRDM_MEASURE_MAX_COLS + 8];
+	size_t len = (size_t)snprintf(nodes, sizeof(nodes), "nodes:");
+	int ret;
+
+	if (!ref) {
+		snprintf(err, errlen, "error measurement: out of memory");
+		return IRDM_ENOMEM;
+	}
+	*ref = *sc;
+	for (size_t i = 0; i < res->n_cols; i++)
+		len += (size_t)snprintf(nodes + len, sizeof(nodes) - len, "%s%u", i ? "," : "",
+					res->nodes[i]);
+	ref->method = IRDM_METHOD_MODAL;
+	ref->fir_tail = 0;
+	ref->exact_head = 0;
+	ref->static_corr_cluster = 0;
+	ref->uncertified = true;
+	ref->max_error = 0;     /* not measured itself */
+	ref->eigensolver = IRDM_EIG_DENSE;
+	ret = irdm_scene_set(ref, "representation", "modal:all", "error measurement", err, errlen);
+	if (!ret)
+		ret = irdm_scene_set(ref, "static_correction", "no", "error measurement", err, errlen);
+	if (!ret)
+		ret = irdm_scene_set(ref, "precision", "f64", "error measurement", err, errlen);
+	if (!ret)
+		ret = irdm_scene_set(ref, "touch", nodes, "error measurement", err, errlen);
+	if (!ret)
+		ret = irdm_scene_set(ref, "display", "touch", "error measurement", err, errlen);
+	if (!ret)
+		ret = (build_ref ? build_ref : precompute_ref)(ref_ctx, ref, ref_path, err, errlen);
+	free(ref);
+	return ret;
+}
+
+int irdm_measure_error(const struct irdm_scene *sc, const struct irdm_image *img,
+		       const char *ref_path, irdm_measure_ref_fn build_ref, void *ref_ctx,
+		       irdm_progress_fn fn, void *ctx, struct irdm_measure *res,
+		       char *err, size_t errlen)
+{
+	uint32_t cols[IRDM_MEASURE_MAX_COLS];
+	struct irdm_image ref;
+	struct irdm_report_cmd *cmds;
+	double t0 = irdm_now_s();
+	int ret;
+
+	memset(res, 0, sizeof(*res));
+	res->error = -1;
+	res->n_cols = pick_columns(img, cols);
+	for (size_t i = 0; i < res->n_cols; i++)
+		res->nodes[i] = img->nodes[img->columns[cols[i]]].mesh_node;
+	res->ticks = irdm_measure_ticks(img->meta->dt_s);
+	if (fn)
+		fn(ctx, "error measurement", 0.0);
+	ret = build_reference(sc, res, ref_path, build_ref, ref_ctx, err, errlen);
+	if (ret)
+		goto out_unlink;
+	ret = irdm_image_map(ref_path, 0, &ref, err, errlen);
+	if (ret)
+		goto out_unlink;
+	ret = IRDM_EINVAL;
+	if (ref.meta->mesh_hash != img->meta->mesh_hash) {
+		snprintf(err, errlen, "error measurement: the exact model's mesh differs from the image's (hash %016llx, %016llx)",
+			 (unsigned long long)ref.meta->mesh_hash,
+			 (unsigned long long)img->meta->mesh_hash);
+		goto out_unmap;
+	}
+	ret = IRDM_ENOMEM;
+	cmds = malloc(res->ticks * sizeof(*cmds));
+	if (!cmds) {
+		snprintf(err, errlen, "error measurement: out of memory");
+		goto out_unmap;
+	}
+	ret = IRDM_OK;
+	for (size_t i = 0; i < res->n_cols && !ret; i++) {
+		ret = measure_column(img, &ref, cols[i], res->ticks, cmds, res, err, errlen);
+		if (fn)
+			fn(ctx, "error measurement", (double)(i + 1) / (double)res->n_cols);
+	}
+	free(cmds);
+out_unmap:
+	irdm_image_unmap(&ref);
+out_unlink:
+	unlink(ref_path);
+	res->seconds = irdm_now_s() - t0;
+	return ret;
+}
