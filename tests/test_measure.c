@@ -32,9 +32,9 @@
 #include "irdm/error.h"
 #include "irdm/posix/image_map.h"
 #include "precompute/precompute.h"
-#include "report/report_measure.h"
-#include "report/report_reference.h"
-#include "report/report_run.h"
+#include "accuracy/measure.h"
+#include "accuracy/reference.h"
+#include "accuracy/run.h"
 #include "scene/scene.h"
 #include "support/test_files.h"
 
@@ -71,7 +71,7 @@ static void map(const char *name, struct irdm_image *img)
 		fail_msg("%s", err);
 }
 
-/* The commands of report_measure.h's runs, written out again here. */
+/* The commands of accuracy/measure.h's runs, written out again here. */
 static void cmds_of(bool release, uint32_t row, size_t N, struct irdm_report_cmd *c)
 {
 	static const double d[3] = { 0.3, 0.2, -0.9327379 };

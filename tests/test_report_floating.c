@@ -31,7 +31,7 @@
 #include "irdm/image.h"
 #include "irdm/posix/image_map.h"
 #include "irdm/session.h"
-#include "report/report_scenario.h"
+#include "accuracy/scenario.h"
 #include "support/engine_fixture.h"
 #include "support/report_fixture.h"
 #include "support/test_files.h"

@@ -144,7 +144,7 @@ static void header(FILE *f, const double load[3], const double load_end[3], doub
 		"correction, double precision (`representation=modal:all precision=f64`), its\n"
 		"responses R[s] read back for every sample of the run (no truncation) and the\n"
 		"contact forces solved tick by tick by direct convolution in double\n"
-		"(`tools/report/report_reference.c`), not by the engine.  It shares the mesh,\n"
+		"(`tools/accuracy/reference.c`), not by the engine.  It shares the mesh,\n"
 		"the material and the eigensolver with the modal and FIR images under test, and\n"
 		"nothing else: their truncation, static correction, storage precision and the\n"
 		"engine's recursions are what is measured.  A floating object's reference is\n"

@@ -25,7 +25,7 @@
 #include "precompute/fir_tail.h"
 #include "precompute/precompute.h"
 #include "precompute/td_part.h"
-#include "report/report_measure.h"
+#include "accuracy/measure.h"
 #include "timedomain/timedomain.h"
 #include "util/clock.h"
 #include "util/fnv1a.h"
@@ -1093,12 +1093,24 @@ static int within_target(const struct build *b, const struct irdm_precompute_rep
 }
 
 /*
- * The image's force error against the exact model (report_measure.h),
+ * The image's force error against the exact model (accuracy/measure.h),
  * measured on the image as it will be written: a scratch copy beside it,
  * then the figure goes into META.  max_error = none skips it (the exact
  * model needs every mode); over MPI ranks it is not measured (the
  * reference's dense eigensolve would run on rank 0 alone).
  */
+/* The exact model as a precompute of its own, when this one did not solve
+ * every mode. */
+static int reference_by_precompute(void *ctx, const struct irdm_scene *rsc, const char *path,
+				   char *err, size_t errlen)
+{
+	struct irdm_precompute_opts o = { .out_path = path };
+	struct irdm_precompute_report rep;
+
+	(void)ctx;
+	return irdm_precompute(rsc, &o, &rep, err, errlen);
+}
+
 static int measure(struct build *b, struct irdm_precompute_report *rep, char *err, size_t errlen)
 {
 	const char *out = b->o->out_path;
@@ -1124,7 +1136,7 @@ static int measure(struct build *b, struct irdm_precompute_report *rep, char *er
 		ret = irdm_image_map(tmp, 0, &img, err, errlen);
 	if (ret)
 		goto out_unlink;
-	ret = irdm_measure_error(b->sc, &img, ref, all_modes(b) ? reference_from_model : NULL, b,
+	ret = irdm_measure_error(b->sc, &img, ref, all_modes(b) ? reference_from_model : reference_by_precompute, b,
 				 b->o->progress, b->o->ctx, &res, err, errlen);
 	irdm_image_unmap(&img);
 	if (ret)

@@ -43,7 +43,7 @@ struct irdm_precompute_report {
 	 * largest block error left (units of sqrt(|S_aa| |S_bb|)), values */
 	size_t corr_clusters, corr_cluster_pairs_dense, corr_cluster_max_rank, corr_cluster_values;
 	double corr_cluster_max_err;
-	/* the force error against the exact model (report_measure.h) */
+	/* the force error against the exact model (accuracy/measure.h) */
 	bool error_measured;
 	double measured_error, seconds_error;
 	uint32_t error_worst_node;

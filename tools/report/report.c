@@ -10,8 +10,8 @@
 #include "report/report.h"
 #include "report/report_check.h"
 #include "report/report_image.h"
-#include "report/report_reference.h"
-#include "report/report_run.h"
+#include "accuracy/reference.h"
+#include "accuracy/run.h"
 
 /* Progress of a nested stage, prefixed with what the report is doing. */
 struct prefixed {

@@ -6,13 +6,13 @@
  * A representation and a model are strings of scene keys ("key=value"
  * separated by spaces: docs/scene-format.md), so a representation added
  * to the precompute library later is one more line of a table.  A
- * scenario is a prescribed contact trajectory (report_scenario.h).
+ * scenario is a prescribed contact trajectory (accuracy/scenario.h).
  *
  * The reference of a model is its exact full model: every elastic mode,
  * no static correction, double precision (representation = modal:all),
  * its responses R[s] read back for every sample of the run (no
  * truncation) and the contact forces solved by direct convolution in
- * double (report_reference.c), not by the engine.  A floating object's
+ * double (accuracy/reference.c), not by the engine.  A floating object's
  * reference is that exact model run by the force engine with its rigid
  * body (the convolution has no rigid motion): report.c, engine_reference().
  * The representation under test runs in the force engine, as the firmware
@@ -26,7 +26,7 @@
 #include <stdio.h>
 
 #include "modal/modal.h"        /* irdm_progress_fn */
-#include "report/report_scenario.h"
+#include "accuracy/scenario.h"
 
 struct irdm_report_repr {
 	const char *name;       /* short label for tables and plots */

@@ -9,7 +9,7 @@
 #include "irdm/error.h"
 #include "report/report_check.h"
 #include "report/report_image.h"
-#include "report/report_reference.h"
+#include "accuracy/reference.h"
 
 static void check_progress(void *ctx, const char *stage, double fraction)
 {

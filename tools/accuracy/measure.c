@@ -10,10 +10,9 @@
 #include "image/image_response.h"
 #include "irdm/error.h"
 #include "irdm/posix/image_map.h"
-#include "precompute/precompute.h"
-#include "report/report_measure.h"
-#include "report/report_reference.h"
-#include "report/report_run.h"
+#include "accuracy/measure.h"
+#include "accuracy/reference.h"
+#include "accuracy/run.h"
 #include "util/clock.h"
 
 /* Oblique, so that every axis of the contact's 3x3 response is excited. */
@@ -191,17 +190,6 @@ static int measure_column(const struct irdm_image *img, const struct irdm_image 
 	return IRDM_OK;
 }
 
-/* The exact model of sc, touchable at the sampled nodes only. */
-static int precompute_ref(void *ctx, const struct irdm_scene *ref, const char *path, char *err,
-			  size_t errlen)
-{
-	struct irdm_precompute_opts o = { .out_path = path };
-	struct irdm_precompute_report rep;
-
-	(void)ctx;
-	return irdm_precompute(ref, &o, &rep, err, errlen);
-}
-
 static int build_reference(const struct irdm_scene *sc, const struct irdm_measure *res,
 			   const char *ref_path, irdm_measure_ref_fn build_ref, void *ref_ctx,
 			   char *err, size_t errlen)
@@ -236,7 +224,7 @@ static int build_reference(const struct irdm_scene *sc, const struct irdm_measur
 	if (!ret)
 		ret = irdm_scene_set(ref, "display", "touch", "error measurement", err, errlen);
 	if (!ret)
-		ret = (build_ref ? build_ref : precompute_ref)(ref_ctx, ref, ref_path, err, errlen);
+		ret = build_ref(ref_ctx, ref, ref_path, err, errlen);
 	free(ref);
 	return ret;
 }

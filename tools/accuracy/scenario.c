@@ -5,7 +5,7 @@
 
 #include "irdm/error.h"
 #include "replay/replay.h"
-#include "report/report_scenario.h"
+#include "accuracy/scenario.h"
 
 /* The paper's Fig. 6a: the top centre pushed 1 cm at once and held. */
 const struct irdm_report_scenario irdm_report_step = {

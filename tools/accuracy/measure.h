@@ -2,7 +2,7 @@
 /*
  * The precompute's own accuracy figure: an image's relative RMS force
  * error against the exact linear model of the same scene, measured with
- * the report's machinery on a few touchable columns.
+ * the machinery irdm report also uses (this folder) on a few touchable columns.
  *
  * The columns: some spread over the touchable surface (farthest-point
  * sampling of their rest positions) and the worst-conditioned ones (the
@@ -19,13 +19,13 @@
  * damping rebuilt with every elastic mode (a dense eigensolve), no static
  * correction, in double, touchable at the sampled nodes only; its
  * responses read back for every sample and the forces solved by direct
- * convolution in double (report_reference.h), not by the engine.  A
+ * convolution in double (accuracy/reference.h), not by the engine.  A
  * floating object's reference is that model run by the engine (the
  * convolution has no rigid motion).  The image under test runs in the
  * force engine as the firmware runs it, on its stored values.
  */
-#ifndef IRDM_TOOLS_REPORT_MEASURE_H
-#define IRDM_TOOLS_REPORT_MEASURE_H
+#ifndef IRDM_TOOLS_ACCURACY_MEASURE_H
+#define IRDM_TOOLS_ACCURACY_MEASURE_H
 
 #include <stddef.h>
 #include <stdint.h>
@@ -58,7 +58,7 @@ typedef int (*irdm_measure_ref_fn)(void *ctx, const struct irdm_scene *ref_sc, c
 
 /*
  * Measure img, made from sc.  The reference image is built at ref_path by
- * build_ref(ref_ctx, ...) (NULL: irdm_precompute()) and removed.
+ * build_ref(ref_ctx, ...) (never NULL) and removed.
  * Return: IRDM_OK; IRDM_ENOMEM; IRDM_EINVAL if the reference is not the
  * same mesh; any error of irdm_precompute(), irdm_image_map(), the
  * convolution or the engine's set-up.  A one-line reason goes to err.

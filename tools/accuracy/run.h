@@ -1,13 +1,13 @@
 /* SPDX-License-Identifier: MIT */
 /* A scenario through the force engine on one image, timed tick by tick. */
-#ifndef IRDM_TOOLS_REPORT_RUN_H
-#define IRDM_TOOLS_REPORT_RUN_H
+#ifndef IRDM_TOOLS_ACCURACY_RUN_H
+#define IRDM_TOOLS_ACCURACY_RUN_H
 
 #include <stdbool.h>
 #include <stddef.h>
 
 #include "irdm/image.h"
-#include "report/report_scenario.h"
+#include "accuracy/scenario.h"
 
 struct irdm_report_engine_out {
 	double *F;              /* N x 3m */

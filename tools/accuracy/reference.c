@@ -8,7 +8,7 @@
 #include "image/image_response.h"
 #include "irdm/error.h"
 #include "modal/lapack.h"
-#include "report/report_reference.h"
+#include "accuracy/reference.h"
 
 /* The nodes of one contact: local column index and weight. */
 struct site_nodes {

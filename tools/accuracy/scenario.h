@@ -6,8 +6,8 @@
  * point's displacement from its rest position, in the world frame (for a
  * floating object the engine's world, docs/architecture.md).
  */
-#ifndef IRDM_TOOLS_REPORT_SCENARIO_H
-#define IRDM_TOOLS_REPORT_SCENARIO_H
+#ifndef IRDM_TOOLS_ACCURACY_SCENARIO_H
+#define IRDM_TOOLS_ACCURACY_SCENARIO_H
 
 #include <stdbool.h>
 #include <stddef.h>

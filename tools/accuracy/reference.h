@@ -9,13 +9,13 @@
  * n_resp = T it is that FIR's recorded recursion without the engine's
  * tail damping.
  */
-#ifndef IRDM_TOOLS_REPORT_REFERENCE_H
-#define IRDM_TOOLS_REPORT_REFERENCE_H
+#ifndef IRDM_TOOLS_ACCURACY_REFERENCE_H
+#define IRDM_TOOLS_ACCURACY_REFERENCE_H
 
 #include <stddef.h>
 
 #include "irdm/image.h"
-#include "report/report_scenario.h"
+#include "accuracy/scenario.h"
 
 struct irdm_report_conv {
 	const struct irdm_image *img;

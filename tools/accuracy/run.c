@@ -14,7 +14,7 @@
 #include "irdm/posix/session.h"
 #include "irdm/session.h"
 #include "modal/lapack.h"
-#include "report/report_run.h"
+#include "accuracy/run.h"
 
 /* The sites of every tick, made before the run so the timed loop holds
  * only what the firmware's tick does (a site moves when it changes). */
