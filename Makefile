@@ -7,7 +7,7 @@
 #                   any finding fails the build and keeps the input
 #   make test-variants  the stability suite with OPENBLAS_NUM_THREADS=1, then
 #                   with the portable history sums forced
-#   make check      what CI runs: docs-check, fuzz, clang + sanitizer tests, the
+#   make check      what CI runs: docs-check, format-check, fuzz, clang + sanitizer tests, the
 #                   variants, then the tests
 #   make bench      benchmarks (print figures; never pass/fail on time), each
 #                   into docs/measurements/NAME.md (make bench_tick: one)
@@ -460,6 +460,7 @@ CHECK_FUZZ_SECONDS ?= 15
 CHECK_JOBS ?= $(shell nproc)
 check: deps
 	$(MAKE) docs-check
+	$(MAKE) format-check
 	$(MAKE) -j$(CHECK_JOBS) fuzz FUZZ_SECONDS=$(CHECK_FUZZ_SECONDS)
 	$(MAKE) -j$(CHECK_JOBS) CC=clang BUILD=build-clang test
 	$(MAKE) -j$(CHECK_JOBS) san

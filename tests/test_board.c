@@ -145,7 +145,7 @@ static void test_documented_defaults(void **state)
 	assert_int_equal(irdm_opt_set_defaults(t, &b, why, sizeof(why)), IRDM_OK);
 	/* the default arm is irdm_device_config_default()'s */
 	struct irdm_device_config dc;
-	memset(&dc, 0, sizeof(dc));     /* padding: compared as bytes */
+	memset(&dc, 0, sizeof(dc)); /* padding: compared as bytes */
 	irdm_device_config_default(&dc);
 	assert_memory_equal(&def.device, &dc, sizeof(dc));
 	assert_string_equal(def.hal_options, "");
@@ -180,7 +180,8 @@ static double solve_ik(const struct irdm_device_config *c, const double p[3], do
 			for (int row = 0; row < 3; row++)
 				m[3 * row + k] = r[row];
 			dq[k] = (m[0] * (m[4] * m[8] - m[5] * m[7]) - m[1] * (m[3] * m[8] - m[5] * m[6]) +
-				 m[2] * (m[3] * m[7] - m[4] * m[6])) / det;
+				 m[2] * (m[3] * m[7] - m[4] * m[6])) /
+				det;
 		}
 		for (int k = 0; k < 3; k++)
 			q[k] += dq[k];
@@ -264,7 +265,8 @@ static void test_shipped_board(void **state)
 
 				for (int i = 0; i < 3; i++)
 					cnt[i] = dc.count_min[i] + (int32_t)((int64_t)(dc.count_max[i] -
-								dc.count_min[i]) * k[i] / 40);
+										       dc.count_min[i]) *
+									     k[i] / 40);
 				assert_int_equal(irdm_device_angles_from_counts(&dc, cnt, q), IRDM_OK);
 				irdm_device_fk(&dc, q, tip);
 				for (int i = 0; i < 3; i++) {
@@ -306,7 +308,7 @@ static void test_shipped_board_complete(void **state)
  * reach of that hand's arm.
  */
 struct hand_point {
-	unsigned arm;           /* 0, 1; LAST_POINT ends a list */
+	unsigned arm; /* 0, 1; LAST_POINT ends a list */
 	double p_obj[3];
 };
 
@@ -318,34 +320,22 @@ static const struct {
 	struct hand_point points[MAX_POINTS];
 } shipped_boards[] = {
 	/* press-hold-release, stroke, tap, pull-and-release on the cuboid scenes */
-	{ "boards/sim-phantom.board", {
-		{ 0, { 0.05, 0.05, 0.21 } }, { 0, { 0.05, 0.05, 0.19 } },
-		{ 0, { 0.02, 0.05, 0.21 } }, { 0, { 0.02, 0.05, 0.195 } },
-		{ 0, { 0.08, 0.05, 0.195 } }, { 0, { 0.05, 0.05, 0.197 } },
-		{ 0, { 0.05, 0.05, 0.205 } }, { LAST_POINT, { 0 } } } },
+	{ "boards/sim-phantom.board", { { 0, { 0.05, 0.05, 0.21 } }, { 0, { 0.05, 0.05, 0.19 } }, { 0, { 0.02, 0.05, 0.21 } }, { 0, { 0.02, 0.05, 0.195 } }, { 0, { 0.08, 0.05, 0.195 } }, { 0, { 0.05, 0.05, 0.197 } }, { 0, { 0.05, 0.05, 0.205 } }, { LAST_POINT, { 0 } } } },
 	/* swing (the -x face, pushed 2 cm) and swirl (two 2 cm circles on top) */
-	{ "boards/sim-phantom-cube.board", {
-		{ 0, { -0.01, 0.06, 0.09 } }, { 0, { 0.02, 0.06, 0.09 } },
-		{ 0, { 0.005, 0.06, 0.09 } }, { 0, { 0.06, 0.06, 0.13 } },
-		{ 0, { 0.08, 0.06, 0.115 } }, { 0, { 0.04, 0.06, 0.115 } },
-		{ 0, { 0.06, 0.08, 0.115 } }, { 0, { 0.06, 0.04, 0.115 } },
-		{ LAST_POINT, { 0 } } } },
+	{ "boards/sim-phantom-cube.board", { { 0, { -0.01, 0.06, 0.09 } }, { 0, { 0.02, 0.06, 0.09 } }, { 0, { 0.005, 0.06, 0.09 } }, { 0, { 0.06, 0.06, 0.13 } }, { 0, { 0.08, 0.06, 0.115 } }, { 0, { 0.04, 0.06, 0.115 } }, { 0, { 0.06, 0.08, 0.115 } }, { 0, { 0.06, 0.04, 0.115 } }, { LAST_POINT, { 0 } } } },
 	/* bunny-press */
-	{ "boards/sim-phantom-bunny.board", {
-		{ 0, { 0.02, -0.02, 0.14 } }, { 0, { 0.02, -0.02, 0.12 } },
-		{ LAST_POINT, { 0 } } } },
+	{ "boards/sim-phantom-bunny.board", { { 0, { 0.02, -0.02, 0.14 } }, { 0, { 0.02, -0.02, 0.12 } }, { LAST_POINT, { 0 } } } },
 	/* pinch: hand 1 on the face x = 0, hand 2 on x = 0.1, each squeezing 5 mm */
-	{ "boards/sim-phantom-pinch.board", {
-		{ 0, { -0.01, 0.05, 0.15 } }, { 0, { 0.005, 0.05, 0.15 } },
-		{ 1, { 0.11, 0.05, 0.15 } }, { 1, { 0.095, 0.05, 0.15 } },
-		{ LAST_POINT, { 0 } } } },
+	{ "boards/sim-phantom-pinch.board", { { 0, { -0.01, 0.05, 0.15 } }, { 0, { 0.005, 0.05, 0.15 } }, { 1, { 0.11, 0.05, 0.15 } }, { 1, { 0.095, 0.05, 0.15 } }, { LAST_POINT, { 0 } } } },
 };
 
 static void check_board_opens(const struct irdm_board *b, const struct irdm_device_config *dc)
 {
 	static _Alignas(max_align_t) unsigned char mem[1 << 16];
 	struct irdm_hal_config cfg = {
-		.device = dc, .options = b->hal_options, .period_s = b->period_us * 1e-6,
+		.device = dc,
+		.options = b->hal_options,
+		.period_s = b->period_us * 1e-6,
 	};
 	struct irdm_hal_dev dev;
 
@@ -378,7 +368,8 @@ static void test_shipped_boards(void **state)
 			for (int i = 0; i < 3; i++)
 				if (!(p[i] > board.workspace_min_m[i] && p[i] < board.workspace_max_m[i]))
 					fail_msg("%s: (%g, %g, %g) is at device (%g, %g, %g), outside "
-						 "the workspace", path, h->p_obj[0], h->p_obj[1],
+						 "the workspace",
+						 path, h->p_obj[0], h->p_obj[1],
 						 h->p_obj[2], p[0], p[1], p[2]);
 			assert_reachable(&arm[h->arm], p, path);
 		}
@@ -503,13 +494,14 @@ static void test_good_values(void **state)
 	expect_ok("coupling = 1000,4.4\n");
 	assert_false(board.coupling_auto);
 	assert_true(board.coupling_k_n_per_m == 1000 && board.coupling_b_ns_per_m == 4.4);
-	expect_ok("coupling = 0,0\n");                /* rigid */
+	expect_ok("coupling = 0,0\n"); /* rigid */
 	assert_true(board.coupling_k_n_per_m == 0 && board.coupling_b_ns_per_m == 0);
 	expect_ok("coupling = auto\n");
 	assert_true(board.coupling_auto);
 	/* no newline at the end, CR LF line ends */
 	assert_int_equal(parse("name = t\r\nhal = sim\r\nworkspace_min_m = -1,-1,-1\r\n"
-			       "workspace_max_m = 1,1,1"), IRDM_OK);
+			       "workspace_max_m = 1,1,1"),
+			 IRDM_OK);
 	assert_true(board.workspace_max_m[2] == 1);
 }
 
@@ -532,15 +524,18 @@ static void test_refused_boards(void **state)
 	assert_int_equal(parse(""), IRDM_EMISSING);
 	assert_string_equal(err, "t.board: missing required key 'name' (see docs/boards.md)");
 	assert_int_equal(parse("name =\nhal = sim\nworkspace_min_m = -1,-1,-1\n"
-			       "workspace_max_m = 1,1,1\n"), IRDM_EINVAL);
+			       "workspace_max_m = 1,1,1\n"),
+			 IRDM_EINVAL);
 	assert_string_equal(err, "t.board:1: name: must not be empty");
 	/* workspace: min == max on one axis is refused as min > max is */
 	assert_int_equal(parse("name = t\nhal = sim\nworkspace_max_m = 0.1,0.05,0.1\n"
-			       "workspace_min_m = -0.1,0.05,-0.1\n"), IRDM_EINVAL);
+			       "workspace_min_m = -0.1,0.05,-0.1\n"),
+			 IRDM_EINVAL);
 	assert_string_equal(err, "t.board:4: workspace_min_m: must be < workspace_max_m (line 3) "
-			    "on every axis; y: 0.05 >= 0.05");
+				 "on every axis; y: 0.05 >= 0.05");
 	assert_int_equal(parse("name = t\nhal = sim\nworkspace_max_m = 0.1,0.1,-0.2\n"
-			       "workspace_min_m = -0.1,-0.1,-0.1\n"), IRDM_EINVAL);
+			       "workspace_min_m = -0.1,-0.1,-0.1\n"),
+			 IRDM_EINVAL);
 	assert_non_null(strstr(err, "; z: -0.1 >= -0.2"));
 	/* devices */
 	expect_refused("devices = 2\n", IRDM_EINVAL,
@@ -588,10 +583,10 @@ static void test_long_line(void **state)
 	FILE *f;
 
 	(void)state;
-	memset(text + at, 'x', IRDM_BOARD_LINE_MAX - 3);        /* 511 characters: fits */
+	memset(text + at, 'x', IRDM_BOARD_LINE_MAX - 3); /* 511 characters: fits */
 	text[at + IRDM_BOARD_LINE_MAX - 3] = '\n';
 	assert_int_equal(parse(text), IRDM_OK);
-	text[at + IRDM_BOARD_LINE_MAX - 3] = 'x';               /* 512: one too many */
+	text[at + IRDM_BOARD_LINE_MAX - 3] = 'x'; /* 512: one too many */
 	assert_int_equal(parse(text), IRDM_EFORMAT);
 	assert_string_equal(err, "t.board:5: line longer than 511 characters");
 
@@ -784,7 +779,8 @@ static void test_docs_current(void **state)
 	fclose(f);
 	if (strcmp(a, table))
 		fail_msg("%s is not what irdm_opt_print_markdown() writes from the board table: "
-			 "regenerate the block between the markers", DOC);
+			 "regenerate the block between the markers",
+			 DOC);
 	free(table);
 }
 
@@ -792,7 +788,10 @@ static void test_docs_current(void **state)
 static void test_doc_examples(void **state)
 {
 	static const char *const lines[] = {
-		"torque_limit_nm = 1.07,0,1.07\n", "name = x\n", "torque_limit = 1\n", NULL,
+		"torque_limit_nm = 1.07,0,1.07\n",
+		"name = x\n",
+		"torque_limit = 1\n",
+		NULL,
 	};
 	static char doc[65536], text[1024], msg[4][160];
 	struct irdm_board b;
@@ -803,10 +802,12 @@ static void test_doc_examples(void **state)
 		/* the bad line at line 12 (the duplicate's first at line 1: "name") */
 		snprintf(text, sizeof(text), "%s%s%s", minimal, "#\n#\n#\n#\n#\n#\n#\n", lines[i]);
 		assert_int_not_equal(irdm_board_parse(&b, "boards/x.board", text, msg[i],
-						      sizeof(msg[i])), IRDM_OK);
+						      sizeof(msg[i])),
+				     IRDM_OK);
 	}
 	assert_int_equal(irdm_board_parse(&b, "boards/x.board", "name = x\n", msg[3],
-					  sizeof(msg[3])), IRDM_EMISSING);
+					  sizeof(msg[3])),
+			 IRDM_EMISSING);
 	for (int i = 0; i < 4; i++)
 		if (!strstr(doc, msg[i]))
 			fail_msg("%s does not show the parser's message '%s'", DOC, msg[i]);

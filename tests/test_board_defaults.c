@@ -100,13 +100,16 @@ static void expect_defaults(const char *watchdog, const char *gear, unsigned wat
 	char want[256], err[256];
 
 	snprintf(want, sizeof(want), "watchdog_us = N one tick longer than this faults; "
-		 "> period_us (default %s); 1 <= watchdog_us <= 1000000 us", watchdog);
+				     "> period_us (default %s); 1 <= watchdog_us <= 1000000 us",
+		 watchdog);
 	expect_in(printed(print_keys), want, "the key help");
 	snprintf(want, sizeof(want), "gear_ratio = J1,J2,J3 motor turns per joint turn "
-		 "(the capstan) (default %s);", gear);
+				     "(the capstan) (default %s);",
+		 gear);
 	expect_in(printed(print_keys), want, "the key help");
 	snprintf(want, sizeof(want), "| `watchdog_us` | `N` | 1 <= watchdog_us <= 1000000 us | "
-		 "one tick longer than this faults; > period_us (default %s) |", watchdog);
+				     "one tick longer than this faults; > period_us (default %s) |",
+		 watchdog);
 	expect_in(printed(print_doc), want, "the Markdown");
 	snprintf(want, sizeof(want), "| motor turns per joint turn (the capstan) (default %s) |",
 		 gear);
@@ -127,7 +130,7 @@ static void test_shipped_defaults(void **state)
 {
 	(void)state;
 	use_changed = false;
-	expect_defaults("5000", "11.6,11.6,11.6", 5000, (const double[3]){ 11.6, 11.6, 11.6 });
+	expect_defaults("5000", "11.6, 11.6, 11.6", 5000, (const double[3]){ 11.6, 11.6, 11.6 });
 }
 
 static void test_changed_defaults(void **state)

@@ -32,18 +32,40 @@
 #include "support/run_prog.h"
 #include "support/test_files.h"
 
-enum { FULL, DEFAULT, MINIMAL, CAN, N_BUILDS };
-enum { MODAL, FIR, FLOATING, DEFORM, HAL_SIM, HAL_CANEMU, HAL_SOCKETCAN, N_FEATURES };
+enum { FULL,
+       DEFAULT,
+       MINIMAL,
+       CAN,
+       N_BUILDS };
+enum { MODAL,
+       FIR,
+       FLOATING,
+       DEFORM,
+       HAL_SIM,
+       HAL_CANEMU,
+       HAL_SOCKETCAN,
+       N_FEATURES };
 
 static const char *const build_name[N_BUILDS] = { "full", "default", "minimal", "can" };
 static const char *const feature_name[N_FEATURES] = {
-	"MODAL", "FIR", "FLOATING", "DEFORM", "HAL_SIM", "HAL_CANEMU", "HAL_SOCKETCAN",
+	"MODAL",
+	"FIR",
+	"FLOATING",
+	"DEFORM",
+	"HAL_SIM",
+	"HAL_CANEMU",
+	"HAL_SOCKETCAN",
 };
 /* one function each feature's files define and the tick or set-up calls;
  * a back-end's: its ops table, which only its registration reaches */
 static const char *const feature_symbol[N_FEATURES] = {
-	"irdm_modal_apply", "irdm_fir_apply", "irdm_rigid_step", "irdm_deform_update",
-	"irdm_hal_sim_backend", "irdm_hal_canemu_backend", "irdm_hal_socketcan_backend",
+	"irdm_modal_apply",
+	"irdm_fir_apply",
+	"irdm_rigid_step",
+	"irdm_deform_update",
+	"irdm_hal_sim_backend",
+	"irdm_hal_canemu_backend",
+	"irdm_hal_socketcan_backend",
 };
 
 static char dir[256], fw[N_BUILDS][320], out[16384], err[4096];
@@ -91,7 +113,8 @@ static void test_left_out_features_are_absent(void **state)
 					 feature_symbol[f]);
 				if (lib)
 					snprintf(cmd, sizeof(cmd), "d=$(dirname %s); nm $d/libirdmfw.a "
-						 "$d/libirdmposix.a | grep -c ' T %s$' || true", fw[b],
+								   "$d/libirdmposix.a | grep -c ' T %s$' || true",
+						 fw[b],
 						 feature_symbol[f]);
 				assert_int_equal(sh(cmd), 0);
 				if ((atoi(out) == 1) != on[b][f])
@@ -144,8 +167,7 @@ static void test_left_out_backends_are_absent(void **state)
 
 static void expect_refusal(int b, const char *board, const char *image, const char *needle)
 {
-	int rc = rp_run(dir, fw[b], (const char *const[]){ "--board", board, "--image", image,
-			"--clock", "virtual", "--duration", "0.1", NULL }, out, sizeof(out), err,
+	int rc = rp_run(dir, fw[b], (const char *const[]){ "--board", board, "--image", image, "--clock", "virtual", "--duration", "0.1", NULL }, out, sizeof(out), err,
 			sizeof(err));
 
 	if (rc != 3 || !strstr(err, needle) || strchr(err, '\n') != err + strlen(err) - 1)
@@ -170,9 +192,9 @@ static void test_refuses_what_it_lacks(void **state)
 		       "boards/canemu-3dof.board:20: hal = canemu: not built in this irdm-fw "
 		       "(CONFIG_IRDM_HAL_CANEMU)");
 	/* and runs what it has */
-	assert_int_equal(rp_run(dir, fw[MINIMAL], (const char *const[]){ "--board", board_nodeform,
-			 "--image", img_modal, "--clock", "virtual", "--duration", "0.5", "-q", NULL },
-			 out, sizeof(out), err, sizeof(err)), 0);
+	assert_int_equal(rp_run(dir, fw[MINIMAL], (const char *const[]){ "--board", board_nodeform, "--image", img_modal, "--clock", "virtual", "--duration", "0.5", "-q", NULL },
+				out, sizeof(out), err, sizeof(err)),
+			 0);
 }
 
 /* The press on the default build and the full one: the same log, byte for byte. */
@@ -185,10 +207,7 @@ static void test_same_run_as_the_full_build(void **state)
 	(void)state;
 	for (int k = 0; k < 2; k++) {
 		snprintf(log[k], sizeof(log[k]), "%s/press%d.log", dir, k);
-		if (rp_run(dir, fw[k == 0 ? FULL : DEFAULT], (const char *const[]){
-			"--board", "boards/sim-phantom.board", "--image", img_modal, "--user",
-			"scenes/users/press-hold-release.user", "--clock", "virtual", "--log", log[k],
-			"-q", NULL }, out, sizeof(out), err, sizeof(err)))
+		if (rp_run(dir, fw[k == 0 ? FULL : DEFAULT], (const char *const[]){ "--board", "boards/sim-phantom.board", "--image", img_modal, "--user", "scenes/users/press-hold-release.user", "--clock", "virtual", "--log", log[k], "-q", NULL }, out, sizeof(out), err, sizeof(err)))
 			fail_msg("%s build: %s", k ? "default" : "full", err);
 		bytes[k] = tf_load(log[k], &len[k]);
 	}
@@ -230,7 +249,8 @@ static void expect_config(const char *image, const char *board, const char *want
 		args[4] = board;
 	}
 	assert_int_equal(rp_run(dir, env_or("IRDM", "build/irdm"), args, out, sizeof(out), err,
-				sizeof(err)), 0);
+				sizeof(err)),
+			 0);
 	if (!strstr(out, want))
 		fail_msg("irdm image config %s: '%s' lacks '%s'", image, out, want);
 }
@@ -295,14 +315,9 @@ static int setup(void **state)
 		read_config(cfg, on[b]);
 	}
 	read_config("configs/full.config", on[FULL]);
-	precompute(img_modal, "modal", (const char *const[]){ "--scene",
-		   "scenes/cuboid-paper.scene", "--resolution", "2,2,4", "--representation",
-		   "modal:10", NULL });
-	precompute(img_fir, "fir", (const char *const[]){ "--scene", "scenes/cuboid-paper.scene",
-		   "--resolution", "2,2,4", "--representation", "fir:20", "--dt", "0.001", "--uncertified", "yes", NULL });
-	precompute(img_cube, "cube", (const char *const[]){ "--scene",
-		   "scenes/cube-floating.scene", "--resolution", "2,2,2", "--representation",
-		   "modal:10", NULL });
+	precompute(img_modal, "modal", (const char *const[]){ "--scene", "scenes/cuboid-paper.scene", "--resolution", "2,2,4", "--representation", "modal:10", NULL });
+	precompute(img_fir, "fir", (const char *const[]){ "--scene", "scenes/cuboid-paper.scene", "--resolution", "2,2,4", "--representation", "fir:20", "--dt", "0.001", "--uncertified", "yes", NULL });
+	precompute(img_cube, "cube", (const char *const[]){ "--scene", "scenes/cube-floating.scene", "--resolution", "2,2,2", "--representation", "modal:10", NULL });
 	/* the shipped board without the deformed surface */
 	tf_read_text("boards/sim-phantom.board", text, sizeof(text));
 	p = strstr(text, "deform_rate_hz");

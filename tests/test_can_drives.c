@@ -168,14 +168,14 @@ static void test_boot_and_sdo(void **state)
 
 	(void)state;
 	bring_up();
-	for (unsigned node = 1; node <= 3; node++) {           /* boot-up heartbeats */
+	for (unsigned node = 1; node <= 3; node++) { /* boot-up heartbeats */
 		f = rx_id(IRDM_CO_HEARTBEAT + node);
 		assert_int_equal(f.dlc, 1);
 		assert_int_equal(f.data[0], 0x00);
 	}
 	assert_int_equal(sdo_write(2, 0x6060, 0, 10, 1, &abort_code), IRDM_OK);
 	assert_int_equal(dr.d[1].mode, 10);
-	assert_int_equal(sdo_write(2, 0x6060, 0, 9, 1, &abort_code), IRDM_EHW);     /* CSV */
+	assert_int_equal(sdo_write(2, 0x6060, 0, 9, 1, &abort_code), IRDM_EHW); /* CSV */
 	assert_int_equal(abort_code, 0x06090030);
 	assert_int_equal(sdo_write(2, 0x2000, 0, 1, 1, &abort_code), IRDM_EHW);
 	assert_int_equal(abort_code, 0x06020000);
@@ -262,15 +262,15 @@ static void test_pdo_mapping_strict(void **state)
 	/* on again: both run */
 	expect_write(1, 0x1400, 1, 0x201, 4, 0);
 	expect_write(1, 0x1800, 1, 0x40000181, 4, 0);
-	expect_write(1, 0x1600, 1, 0x60400010, 4, 0x06010000);          /* valid again */
+	expect_write(1, 0x1600, 1, 0x60400010, 4, 0x06010000); /* valid again */
 	rpdo(1, 0x06, 0);
 	assert_int_equal(dr.d[0].rpdo_cw, 0x06);
 	sync_once();
-	assert_int_equal(count_id(0x181), 0);           /* TPDO1 still event-driven */
+	assert_int_equal(count_id(0x181), 0); /* TPDO1 still event-driven */
 	expect_write(1, 0x1800, 1, 0xC0000181, 4, 0);
-	expect_write(1, 0x1800, 2, 1, 1, 0);            /* the type may change while valid, too */
+	expect_write(1, 0x1800, 2, 1, 1, 0); /* the type may change while valid, too */
 	sync_once();
-	assert_int_equal(count_id(0x181), 0);           /* now synchronous but off */
+	assert_int_equal(count_id(0x181), 0); /* now synchronous but off */
 	expect_write(1, 0x1800, 1, 0x40000181, 4, 0);
 	sync_once();
 	assert_int_equal(count_id(0x181), 1);
@@ -330,7 +330,8 @@ static void test_enable_and_move(void **state)
 		irdm_sim_device_step(&ref, PERIOD_S);
 	}
 	print_message("yaw moved %d counts in 300 periods, count for count with the "
-		      "simulated device\n", pos[0]);
+		      "simulated device\n",
+		      pos[0]);
 	assert_true(pos[0] > 100);
 }
 
@@ -374,7 +375,7 @@ static void test_faults(void **state)
 	bring_up();
 	configure_and_start();
 	enable_all();
-	(void)count_id(0);                                      /* drain */
+	(void)count_id(0); /* drain */
 	/* heartbeats every 100 ms, until stopped (counted as they come: the
 	 * bus keeps 1024 frames) */
 	{
@@ -406,7 +407,7 @@ static void test_faults(void **state)
 	sync_once();
 	tpdo(1, &sw, &pos);
 	assert_int_equal(irdm_cia402_decode(sw), IRDM_CIA402_FAULT);
-	rpdo(1, IRDM_CIA402_CW_ENABLE_OPERATION, 100);          /* ignored in fault */
+	rpdo(1, IRDM_CIA402_CW_ENABLE_OPERATION, 100); /* ignored in fault */
 	sync_once();
 	tpdo(1, &sw, &pos);
 	assert_int_equal(irdm_cia402_decode(sw), IRDM_CIA402_FAULT);
@@ -419,7 +420,6 @@ static void test_faults(void **state)
 	tpdo(1, &sw, &pos);
 	assert_int_equal(irdm_cia402_decode(sw), IRDM_CIA402_SWITCH_ON_DISABLED);
 }
-
 
 /* The value of an upload of index:sub from node, its size; fails on an abort. */
 static uint32_t sdo_read(unsigned node, uint16_t index, uint8_t sub, unsigned *size)
@@ -513,7 +513,7 @@ static void test_sync_format_strict(void **state)
 	expect_write(1, 0x1019, 0, 240, 2, 0x06070010);
 	expect_write(1, 0x1019, 0, 240, 1, 0);
 	expect_write(1, 0x1006, 0, 1000, 4, 0);
-	expect_write(1, 0x1019, 0, 0, 1, 0x08000022);   /* and not back either */
+	expect_write(1, 0x1019, 0, 0, 1, 0x08000022); /* and not back either */
 	{
 		struct irdm_can_frame start;
 
@@ -565,7 +565,7 @@ static void run_with_deadlines(uint32_t consumer, uint16_t rpdo_ms, uint16_t opt
 			       uint64_t wall_us)
 {
 	bring_up();
-	if (wall_us) {                          /* a drive process: the wall clock */
+	if (wall_us) { /* a drive process: the wall clock */
 		dr.wall_heartbeat = true;
 		irdm_can_drives_wall(&dr, wall_us);
 	}
@@ -604,13 +604,13 @@ static void test_consumer_heartbeat_deadline(void **state)
 
 	(void)state;
 	run_with_deadlines(127u << 16 | 20u, 0, 2, 0);
-	for (k = 0; k < 100; k++) {             /* no beat yet: nothing watched */
+	for (k = 0; k < 100; k++) { /* no beat yet: nothing watched */
 		for (unsigned node = 1; node <= 3; node++)
 			rpdo(node, IRDM_CIA402_CW_ENABLE_OPERATION, node == 1 ? 300 : 0);
 		sync_once();
 	}
 	(void)count_id(0);
-	master_beat(126);                       /* another node's: not watched */
+	master_beat(126); /* another node's: not watched */
 	master_beat(127);
 	for (k = 1; k <= 30 && !dr.d[0].lost_code; k++) {
 		for (unsigned node = 1; node <= 3; node++)
@@ -618,16 +618,16 @@ static void test_consumer_heartbeat_deadline(void **state)
 		sync_once();
 	}
 	print_message("consumer heartbeat 20 ms: lost at the SYNC of %d ms after the beat\n", k - 1);
-	assert_int_equal(k - 1, 21);            /* the first instant later than 20 ms */
+	assert_int_equal(k - 1, 21); /* the first instant later than 20 ms */
 	for (unsigned node = 1; node <= 3; node++) {
 		assert_int_equal(emcy_of(node, vendor), 0x8130);
-		assert_int_equal(vendor[0] | vendor[1] << 8, 0);        /* torque from now on */
+		assert_int_equal(vendor[0] | vendor[1] << 8, 0); /* torque from now on */
 	}
 	sync_once();
 	tpdo(1, &sw, &pos);
 	assert_int_equal(irdm_cia402_decode(sw), IRDM_CIA402_SWITCH_ON_DISABLED);
 	assert_true(dr.arm.cmd_nm[0] == 0.0);
-	rpdo(1, IRDM_CIA402_CW_ENABLE_OPERATION, 300);  /* not taken any more */
+	rpdo(1, IRDM_CIA402_CW_ENABLE_OPERATION, 300); /* not taken any more */
 	assert_int_equal(dr.d[0].rpdo_torque_permille, 0);
 }
 
@@ -651,7 +651,7 @@ static void test_rpdo_deadline_on_the_wall_clock(void **state)
 			rpdo(node, IRDM_CIA402_CW_ENABLE_OPERATION, node == 1 ? 300 : 0);
 		sync_once();
 	}
-	last = t;                               /* the master dies here */
+	last = t; /* the master dies here */
 	(void)count_id(0);
 	while (!dr.d[2].lost_code && t < last + 100000) {
 		t += 100;

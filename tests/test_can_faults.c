@@ -115,7 +115,7 @@ static void bring_up(void)
 	assert_int_equal(irdm_can_send(&master, &f), IRDM_OK);
 	irdm_can_drives_poll(&dr);
 	while (irdm_can_recv(&master, &f) == 1)
-		;                                       /* boot-up heartbeats */
+		; /* boot-up heartbeats */
 }
 
 static void schedule(const char *word)
@@ -174,15 +174,15 @@ static void test_delay_on_the_wall_clock(void **state)
 	schedule("delay:1:2:2:500");
 	sync_count(ids, 0x800);
 	assert_int_equal(ids[0x181], 1);
-	sync_count(ids, 0x800);                         /* SYNC 2: held */
+	sync_count(ids, 0x800); /* SYNC 2: held */
 	assert_int_equal(ids[0x181], 0);
 	assert_int_equal(irdm_can_drives_wall(&dr, 1000499), 1000500);
 	assert_int_equal(count_id(0x181), 0);
 	assert_int_equal(irdm_can_drives_wall(&dr, 1000500), UINT64_MAX);
 	assert_int_equal(count_id(0x181), 1);
-	sync_count(ids, 0x800);                         /* SYNC 3: held again */
+	sync_count(ids, 0x800); /* SYNC 3: held again */
 	assert_int_equal(ids[0x181], 0);
-	sync_count(ids, 0x800);                         /* SYNC 4: the held one first, then its own */
+	sync_count(ids, 0x800); /* SYNC 4: the held one first, then its own */
 	assert_int_equal(ids[0x181], 2);
 	assert_int_equal(dr.tpdos_delayed, 2);
 }
@@ -198,17 +198,17 @@ static void test_heartbeat_wall_and_stop(void **state)
 	for (unsigned k = 0; k < 3; k++)
 		dr.d[k].heartbeat_ms = 10;
 	schedule("heartbeat-stop:3:2");
-	for (uint64_t ms = 0; ms <= 100; ms++)          /* no SYNC: the wall clock alone */
+	for (uint64_t ms = 0; ms <= 100; ms++) /* no SYNC: the wall clock alone */
 		irdm_can_drives_wall(&dr, t0 + 1000 * ms);
-	assert_int_equal(count_id(0x703), 11);          /* at 0, 10, ..., 100 ms */
+	assert_int_equal(count_id(0x703), 11); /* at 0, 10, ..., 100 ms */
 	sync_count(ids, 0x800);
-	sync_count(ids, 0x800);                         /* SYNC 2: node 3 goes silent */
+	sync_count(ids, 0x800); /* SYNC 2: node 3 goes silent */
 	for (uint64_t ms = 101; ms <= 200; ms++)
 		irdm_can_drives_wall(&dr, t0 + 1000 * ms);
 	assert_int_equal(count_id(0x703), 0);
 	for (uint64_t ms = 201; ms <= 300; ms++)
 		irdm_can_drives_wall(&dr, t0 + 1000 * ms);
-	assert_int_equal(count_id(0x701), 10);          /* the others beat on */
+	assert_int_equal(count_id(0x701), 10); /* the others beat on */
 }
 
 /* word makes node 2 fault at SYNC 4; the EMCY frames heard. */
@@ -308,13 +308,13 @@ static void test_dock_until_torque(void **state)
 	bring_up();
 	dr.docked = true;
 	for (unsigned k = 0; k < 3; k++)
-		dr.d[k].mode = 10;                      /* cyclic synchronous torque */
+		dr.d[k].mode = 10; /* cyclic synchronous torque */
 	irdm_sim_device_state(&dr.arm, q0, qd);
 	for (int s = 0; s < 50; s++)
 		sync_count(ids, 0x800);
 	irdm_sim_device_state(&dr.arm, q, qd);
 	assert_memory_equal(q, q0, sizeof(q));
-	for (unsigned r = 0; r < 6; r++) {              /* shutdown, switch on, enable, hold */
+	for (unsigned r = 0; r < 6; r++) { /* shutdown, switch on, enable, hold */
 		static const uint16_t cw[6] = { 0x06, 0x07, 0x0F, 0x0F, 0x0F, 0x0F };
 
 		for (unsigned node = 1; node <= 3; node++) {
@@ -336,8 +336,7 @@ static void test_dock_until_torque(void **state)
 
 static void test_schedule_refuses(void **state)
 {
-	struct irdm_can_fault f = { .kind = IRDM_CAN_FAULT_DROP, .node = 4, .at_sync = 1,
-				    .count = 1 };
+	struct irdm_can_fault f = { .kind = IRDM_CAN_FAULT_DROP, .node = 4, .at_sync = 1, .count = 1 };
 
 	(void)state;
 	bring_up();

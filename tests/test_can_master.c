@@ -34,7 +34,7 @@
 
 struct logged {
 	struct irdm_can_frame f;
-	uint64_t period;        /* the master's period when it was sent */
+	uint64_t period; /* the master's period when it was sent */
 };
 
 static struct irdm_can_membus bus;
@@ -43,7 +43,7 @@ static struct irdm_can_master m;
 static struct irdm_can_port master_port, drives_port, rogue;
 static struct irdm_device_config dev;
 static struct irdm_sim_params params;
-static struct logged sent[LOG_MAX];     /* what the master sent */
+static struct logged sent[LOG_MAX]; /* what the master sent */
 static unsigned n_sent;
 static char err[256];
 
@@ -182,37 +182,37 @@ static const struct {
 	uint8_t bytes[8];
 	bool plus_node;
 } setup_sdo[SETUP_SDOS] = {
-	{ { 0x40, 0x00, 0x10, 0x00, 0, 0, 0, 0 }, false },        /* read 0x1000 device type */
-	{ { 0x40, 0x18, 0x10, 0x01, 0, 0, 0, 0 }, false },        /* read 0x1018:01 vendor */
-	{ { 0x40, 0x18, 0x10, 0x02, 0, 0, 0, 0 }, false },        /* :02 product */
-	{ { 0x40, 0x18, 0x10, 0x03, 0, 0, 0, 0 }, false },        /* :03 revision */
-	{ { 0x40, 0x18, 0x10, 0x04, 0, 0, 0, 0 }, false },        /* :04 serial */
-	{ { 0x2F, 0x60, 0x60, 0x00, 0x0A, 0, 0, 0 }, false },     /* 0x6060 = 10 (CST), 1 B */
-	{ { 0x2B, 0x17, 0x10, 0x00, 0x0A, 0, 0, 0 }, false },     /* 0x1017 = 10 ms, 2 B */
-	{ { 0x23, 0x76, 0x60, 0x00, 0xF4, 0x01, 0, 0 }, false },     /* 0x6076 = 500 mN m */
-	{ { 0x23, 0x06, 0x10, 0x00, 0x00, 0x00, 0, 0 }, false },     /* 0x1006 = 0 first */
-	{ { 0x2F, 0x19, 0x10, 0x00, 0x00, 0, 0, 0 }, false },     /* 0x1019 = 0: no counter */
-	{ { 0x23, 0x06, 0x10, 0x00, 0xE8, 0x03, 0, 0 }, false },     /* 0x1006 = 1000 us */
-	{ { 0x23, 0x16, 0x10, 0x01, 0x1E, 0x00, 0x7F, 0x00 }, false },  /* 0x1016:01 node 127, 30 ms */
-	{ { 0x2B, 0x07, 0x60, 0x00, 0x02, 0x00, 0, 0 }, false },     /* 0x6007 = 2 disable voltage */
+	{ { 0x40, 0x00, 0x10, 0x00, 0, 0, 0, 0 }, false },             /* read 0x1000 device type */
+	{ { 0x40, 0x18, 0x10, 0x01, 0, 0, 0, 0 }, false },             /* read 0x1018:01 vendor */
+	{ { 0x40, 0x18, 0x10, 0x02, 0, 0, 0, 0 }, false },             /* :02 product */
+	{ { 0x40, 0x18, 0x10, 0x03, 0, 0, 0, 0 }, false },             /* :03 revision */
+	{ { 0x40, 0x18, 0x10, 0x04, 0, 0, 0, 0 }, false },             /* :04 serial */
+	{ { 0x2F, 0x60, 0x60, 0x00, 0x0A, 0, 0, 0 }, false },          /* 0x6060 = 10 (CST), 1 B */
+	{ { 0x2B, 0x17, 0x10, 0x00, 0x0A, 0, 0, 0 }, false },          /* 0x1017 = 10 ms, 2 B */
+	{ { 0x23, 0x76, 0x60, 0x00, 0xF4, 0x01, 0, 0 }, false },       /* 0x6076 = 500 mN m */
+	{ { 0x23, 0x06, 0x10, 0x00, 0x00, 0x00, 0, 0 }, false },       /* 0x1006 = 0 first */
+	{ { 0x2F, 0x19, 0x10, 0x00, 0x00, 0, 0, 0 }, false },          /* 0x1019 = 0: no counter */
+	{ { 0x23, 0x06, 0x10, 0x00, 0xE8, 0x03, 0, 0 }, false },       /* 0x1006 = 1000 us */
+	{ { 0x23, 0x16, 0x10, 0x01, 0x1E, 0x00, 0x7F, 0x00 }, false }, /* 0x1016:01 node 127, 30 ms */
+	{ { 0x2B, 0x07, 0x60, 0x00, 0x02, 0x00, 0, 0 }, false },       /* 0x6007 = 2 disable voltage */
 	/* RPDO1 */
-	{ { 0x23, 0x00, 0x14, 0x01, 0x00, 0x02, 0x00, 0x80 }, true },      /* 0x1400:01 off */
-	{ { 0x2F, 0x00, 0x16, 0x00, 0x00, 0, 0, 0 }, false },     /* 0x1600:00 = 0 */
-	{ { 0x23, 0x00, 0x16, 0x01, 0x10, 0x00, 0x40, 0x60 }, false },     /* 0x6040, 16 bit */
-	{ { 0x23, 0x00, 0x16, 0x02, 0x10, 0x00, 0x71, 0x60 }, false },     /* 0x6071, 16 bit */
-	{ { 0x2F, 0x00, 0x16, 0x00, 0x02, 0, 0, 0 }, false },     /* two entries */
-	{ { 0x2F, 0x00, 0x14, 0x02, 0x01, 0, 0, 0 }, false },     /* every SYNC */
-	{ { 0x2B, 0x00, 0x14, 0x05, 0x03, 0x00, 0, 0 }, false },     /* deadline 3 ms */
-	{ { 0x23, 0x00, 0x14, 0x01, 0x00, 0x02, 0x00, 0x00 }, true },      /* 0x1400:01 on */
+	{ { 0x23, 0x00, 0x14, 0x01, 0x00, 0x02, 0x00, 0x80 }, true },  /* 0x1400:01 off */
+	{ { 0x2F, 0x00, 0x16, 0x00, 0x00, 0, 0, 0 }, false },          /* 0x1600:00 = 0 */
+	{ { 0x23, 0x00, 0x16, 0x01, 0x10, 0x00, 0x40, 0x60 }, false }, /* 0x6040, 16 bit */
+	{ { 0x23, 0x00, 0x16, 0x02, 0x10, 0x00, 0x71, 0x60 }, false }, /* 0x6071, 16 bit */
+	{ { 0x2F, 0x00, 0x16, 0x00, 0x02, 0, 0, 0 }, false },          /* two entries */
+	{ { 0x2F, 0x00, 0x14, 0x02, 0x01, 0, 0, 0 }, false },          /* every SYNC */
+	{ { 0x2B, 0x00, 0x14, 0x05, 0x03, 0x00, 0, 0 }, false },       /* deadline 3 ms */
+	{ { 0x23, 0x00, 0x14, 0x01, 0x00, 0x02, 0x00, 0x00 }, true },  /* 0x1400:01 on */
 	/* TPDO1 */
-	{ { 0x23, 0x00, 0x18, 0x01, 0x80, 0x01, 0x00, 0xC0 }, true },      /* 0x1800:01 off, no RTR */
-	{ { 0x2F, 0x00, 0x1A, 0x00, 0x00, 0, 0, 0 }, false },     /* 0x1A00:00 = 0 */
-	{ { 0x23, 0x00, 0x1A, 0x01, 0x10, 0x00, 0x41, 0x60 }, false },     /* 0x6041, 16 bit */
-	{ { 0x23, 0x00, 0x1A, 0x02, 0x20, 0x00, 0x64, 0x60 }, false },     /* 0x6064, 32 bit */
-	{ { 0x2F, 0x00, 0x1A, 0x00, 0x02, 0, 0, 0 }, false },     /* two entries */
-	{ { 0x2F, 0x00, 0x18, 0x02, 0x01, 0, 0, 0 }, false },     /* every SYNC */
-	{ { 0x23, 0x00, 0x18, 0x01, 0x80, 0x01, 0x00, 0x40 }, true },      /* 0x1800:01 on, no RTR */
-	{ { 0x40, 0x61, 0x60, 0x00, 0, 0, 0, 0 }, false },        /* read 0x6061 mode display */
+	{ { 0x23, 0x00, 0x18, 0x01, 0x80, 0x01, 0x00, 0xC0 }, true },  /* 0x1800:01 off, no RTR */
+	{ { 0x2F, 0x00, 0x1A, 0x00, 0x00, 0, 0, 0 }, false },          /* 0x1A00:00 = 0 */
+	{ { 0x23, 0x00, 0x1A, 0x01, 0x10, 0x00, 0x41, 0x60 }, false }, /* 0x6041, 16 bit */
+	{ { 0x23, 0x00, 0x1A, 0x02, 0x20, 0x00, 0x64, 0x60 }, false }, /* 0x6064, 32 bit */
+	{ { 0x2F, 0x00, 0x1A, 0x00, 0x02, 0, 0, 0 }, false },          /* two entries */
+	{ { 0x2F, 0x00, 0x18, 0x02, 0x01, 0, 0, 0 }, false },          /* every SYNC */
+	{ { 0x23, 0x00, 0x18, 0x01, 0x80, 0x01, 0x00, 0x40 }, true },  /* 0x1800:01 on, no RTR */
+	{ { 0x40, 0x61, 0x60, 0x00, 0, 0, 0, 0 }, false },             /* read 0x6061 mode display */
 };
 
 static void test_setup_sequence(void **state)
@@ -234,7 +234,7 @@ static void test_setup_sequence(void **state)
 			expect_frame((node - 1) * SETUP_SDOS + i, 0x600 + node, 8, want);
 		}
 	for (unsigned node = 1; node <= 3; node++) {
-		uint8_t nmt[2] = { 0x01, (uint8_t)node };       /* start remote node */
+		uint8_t nmt[2] = { 0x01, (uint8_t)node }; /* start remote node */
 
 		expect_frame(3 * SETUP_SDOS + node - 1, 0x000, 2, nmt);
 	}
@@ -258,7 +258,7 @@ static void test_setup_sequence(void **state)
 	}
 	irdm_can_master_identity_line(&m, 1, line, sizeof(line));
 	assert_string_equal(line, "drive 2 (node 2): CiA 402 device type 0x00020192, vendor "
-			    "0x00000000, product 0x00000402, revision 0x00010000, serial 0x00000002");
+				  "0x00000000, product 0x00000402, revision 0x00010000, serial 0x00000002");
 }
 
 /* With the SYNC counter: 0x1019 = 240 between 0x1006 = 0 and the period,
@@ -289,7 +289,8 @@ static void test_setup_sync_counter(void **state)
 static void upload_answer(const struct irdm_can_frame *f, struct irdm_can_frame *a)
 {
 	uint16_t index = (uint16_t)(f->data[1] | f->data[2] << 8);
-	uint32_t v = index == 0x1000 ? 0x00020192 : index == 0x6061 ? 10 : 0;
+	uint32_t v = index == 0x1000 ? 0x00020192 : index == 0x6061 ? 10 :
+								      0;
 
 	memset(a->data, 0, 8);
 	a->data[0] = 0x43;
@@ -336,17 +337,13 @@ static void test_setup_aborts_named(void **state)
 		int rc;
 		const char *line;
 	} cases[] = {
-		{ { 0x80, 0x60, 0x60, 0x00, 0x00, 0x00, 0x02, 0x06 }, IRDM_EHW,
-		  "drive 1 (node 1): SDO abort 0x06020000 object does not exist in the object "
-		  "dictionary writing 0x6060:00" },
-		{ { 0x80, 0x60, 0x60, 0x00, 0x30, 0x00, 0x09, 0x06 }, IRDM_EHW,
-		  "drive 1 (node 1): SDO abort 0x06090030 invalid value for parameter writing "
-		  "0x6060:00" },
-		{ { 0x80, 0x60, 0x60, 0x00, 0x02, 0x00, 0x01, 0x06 }, IRDM_EHW,
-		  "drive 1 (node 1): SDO abort 0x06010002 attempt to write a read-only object "
-		  "writing 0x6060:00" },
-		{ { 0x80, 0x60, 0x60, 0x00, 0x00, 0x00, 0x04, 0x05 }, IRDM_EHW,
-		  "drive 1 (node 1): SDO abort 0x05040000 SDO protocol timed out writing 0x6060:00" },
+		{ { 0x80, 0x60, 0x60, 0x00, 0x00, 0x00, 0x02, 0x06 }, IRDM_EHW, "drive 1 (node 1): SDO abort 0x06020000 object does not exist in the object "
+										"dictionary writing 0x6060:00" },
+		{ { 0x80, 0x60, 0x60, 0x00, 0x30, 0x00, 0x09, 0x06 }, IRDM_EHW, "drive 1 (node 1): SDO abort 0x06090030 invalid value for parameter writing "
+										"0x6060:00" },
+		{ { 0x80, 0x60, 0x60, 0x00, 0x02, 0x00, 0x01, 0x06 }, IRDM_EHW, "drive 1 (node 1): SDO abort 0x06010002 attempt to write a read-only object "
+										"writing 0x6060:00" },
+		{ { 0x80, 0x60, 0x60, 0x00, 0x00, 0x00, 0x04, 0x05 }, IRDM_EHW, "drive 1 (node 1): SDO abort 0x05040000 SDO protocol timed out writing 0x6060:00" },
 		/* a confirmation about another object; an upload's answer; garbage */
 		{ { 0x60, 0x61, 0x60, 0x00, 0, 0, 0, 0 }, IRDM_EFORMAT, NULL },
 		{ { 0x4F, 0x60, 0x60, 0x00, 0x0A, 0, 0, 0 }, IRDM_EFORMAT, NULL },
@@ -397,10 +394,10 @@ static void picky_turn(void *ctx)
 			continue;
 		}
 		memset(a.data, 0, 8);
-		a.data[0] = 0x60;                       /* download confirmed */
+		a.data[0] = 0x60; /* download confirmed */
 		memcpy(a.data + 1, f.data + 1, 3);
 		if ((f.data[1] | f.data[2] << 8) == picky_index) {
-			a.data[0] = 0x80;               /* abort, the code little endian */
+			a.data[0] = 0x80; /* abort, the code little endian */
 			for (int b = 0; b < 4; b++)
 				a.data[4 + b] = (uint8_t)(picky_abort >> (8 * b));
 		}
@@ -429,11 +426,11 @@ static void test_setup_pdo_refused_named(void **state)
 
 	(void)state;
 	bus_up();
-	dr.d[1].rpdo1.map = other_map;          /* drive 2 maps 0x6071 as 32 bit */
+	dr.d[1].rpdo1.map = other_map; /* drive 2 maps 0x6071 as 32 bit */
 	assert_int_equal(irdm_can_master_init(&m, &wrapped, &c, err, sizeof(err)), IRDM_EHW);
 	assert_string_equal(err, "drive 2 (node 2): SDO abort 0x06040041 object cannot be mapped "
 				 "to the PDO writing 0x1600:02");
-	assert_int_equal(n_sent, SETUP_SDOS + 17);      /* drive 1, then drive 2 up to 0x1600:02 */
+	assert_int_equal(n_sent, SETUP_SDOS + 17); /* drive 1, then drive 2 up to 0x1600:02 */
 	c.n_axes = 1;
 	c.idle = picky_turn;
 	for (size_t i = 0; i < sizeof(cases) / sizeof(cases[0]); i++) {
@@ -467,7 +464,7 @@ static void test_every_axis_enabled(void **state)
 				uint16_t cw = (uint16_t)(sent[i].f.data[0] | sent[i].f.data[1] << 8);
 
 				if (j == 0 && cw == 0)
-					continue;       /* the first period: state still unknown */
+					continue; /* the first period: state still unknown */
 				assert_int_equal(cw, want[j++]);
 			}
 		assert_int_equal(j, 3);
@@ -546,7 +543,7 @@ static void test_fault_emcy(void **state)
 	period(NULL);
 	p0 = m.period;
 	irdm_can_drives_fault(&dr, 1, 0x2310);
-	assert_int_equal(run_until_fault(5), p0 + 1);    /* found in the same period */
+	assert_int_equal(run_until_fault(5), p0 + 1); /* found in the same period */
 	period(NULL);
 	expect_off_within_two(p0);
 	assert_string_equal(m.why, "drive 2 (node 2): EMCY 0x2310 (current), error register 0x01");
@@ -561,7 +558,7 @@ static void test_fault_drive_state(void **state)
 	(void)state;
 	run_up(&c);
 	p0 = m.period;
-	irdm_cia402_drive_fault(&dr.d[2].fsa);  /* no EMCY: the statusword says it */
+	irdm_cia402_drive_fault(&dr.d[2].fsa); /* no EMCY: the statusword says it */
 	run_until_fault(5);
 	period(NULL);
 	expect_off_within_two(p0);
@@ -585,14 +582,13 @@ static void test_fault_drive_state(void **state)
 static void test_preop_beat_crossing_start(void **state)
 {
 	struct irdm_can_master_cfg c = cfg_3axes();
-	struct irdm_can_frame hb = { .id = IRDM_CO_HEARTBEAT + 1, .dlc = 1,
-				     .data = { IRDM_CO_STATE_PRE_OPERATIONAL } };
+	struct irdm_can_frame hb = { .id = IRDM_CO_HEARTBEAT + 1, .dlc = 1, .data = { IRDM_CO_STATE_PRE_OPERATIONAL } };
 
 	(void)state;
 	bus_up();
 	master_up(&c);
 	irdm_can_master_enable(&m, true);
-	dr.d[0].no_heartbeat = true;    /* its own (operational) beats would mask the stale one */
+	dr.d[0].no_heartbeat = true; /* its own (operational) beats would mask the stale one */
 	assert_int_equal(irdm_can_send(&rogue, &hb), IRDM_OK);
 	for (int p = 1; p <= 10 && !irdm_can_master_all_enabled(&m); p++)
 		assert_int_equal(period(NULL), IRDM_OK);
@@ -609,7 +605,7 @@ static void test_fault_heartbeat(void **state)
 
 	(void)state;
 	run_up(&c);
-	for (int p = 0; p < 40; p++)            /* heartbeats come: no fault */
+	for (int p = 0; p < 40; p++) /* heartbeats come: no fault */
 		assert_int_equal(period(NULL), IRDM_OK);
 	p0 = m.ax[0].heartbeat_period;
 	dr.d[0].no_heartbeat = true;
@@ -632,9 +628,9 @@ static void test_fault_tpdos_dropped(void **state)
 	run_up(&c);
 	dr.d[1].drop_tpdos = 100;
 	p0 = m.period;
-	assert_int_equal(period(NULL), IRDM_ETIMEDOUT);        /* missing 1 */
-	assert_int_equal(period(NULL), IRDM_ETIMEDOUT);        /* missing 2 */
-	assert_int_equal(period(NULL), IRDM_EHW);              /* missing 3: lost */
+	assert_int_equal(period(NULL), IRDM_ETIMEDOUT); /* missing 1 */
+	assert_int_equal(period(NULL), IRDM_ETIMEDOUT); /* missing 2 */
+	assert_int_equal(period(NULL), IRDM_EHW);       /* missing 3: lost */
 	period(NULL);
 	expect_off_within_two(p0 + 2);
 	assert_string_equal(m.why, "drive 2 (node 2): no TPDO1 for 3 periods");
@@ -651,7 +647,7 @@ static void test_fault_link_down(void **state)
 	(void)state;
 	run_up(&c);
 	p0 = m.period;
-	rx_down = true;                         /* bus-off seen by the receive side */
+	rx_down = true; /* bus-off seen by the receive side */
 	assert_int_equal(irdm_can_master_receive(&m), IRDM_EHW);
 	irdm_can_drives_poll(&dr);
 	expect_off_within_two(p0);
@@ -688,15 +684,15 @@ static void test_malformed_counted(void **state)
 	/* the drives' TPDOs of this period are read, then the junk */
 	irdm_can_master_send(&m, NULL);
 	irdm_can_drives_poll(&dr);
-	rogue_send(0x181, 5, junk);             /* TPDO1 of node 1, DLC 5: malformed */
-	rogue_send(0x181, 8, junk);             /* DLC 8 */
-	rogue_send(0x701, 2, junk);             /* heartbeat of 2 bytes */
-	rogue_send(0x702, 1, (const uint8_t[]){ 0x33 });        /* no such NMT state */
-	rogue_send(0x081, 3, junk);             /* EMCY of 3 bytes */
-	rogue_send(0x123, 8, junk);             /* nobody's COB-ID */
-	rogue_send(0x089, 8, junk);             /* EMCY from node 9: not ours */
-	rogue_send(0x189, 6, junk);             /* TPDO1 of node 9 */
-	rogue_send(0x582, 8, junk);             /* an SDO answer after set-up */
+	rogue_send(0x181, 5, junk);                      /* TPDO1 of node 1, DLC 5: malformed */
+	rogue_send(0x181, 8, junk);                      /* DLC 8 */
+	rogue_send(0x701, 2, junk);                      /* heartbeat of 2 bytes */
+	rogue_send(0x702, 1, (const uint8_t[]){ 0x33 }); /* no such NMT state */
+	rogue_send(0x081, 3, junk);                      /* EMCY of 3 bytes */
+	rogue_send(0x123, 8, junk);                      /* nobody's COB-ID */
+	rogue_send(0x089, 8, junk);                      /* EMCY from node 9: not ours */
+	rogue_send(0x189, 6, junk);                      /* TPDO1 of node 9 */
+	rogue_send(0x582, 8, junk);                      /* an SDO answer after set-up */
 	assert_int_equal(irdm_can_master_receive(&m), IRDM_OK);
 	assert_int_equal(m.bad_frames, 5);
 	assert_int_equal(m.unknown_frames, 3);
@@ -744,7 +740,7 @@ static void test_drain_hiccups_and_flood(void **state)
 	irdm_can_drives_poll(&dr);
 	for (int k = 0; k < 600; k++)
 		rogue_send(0x123, 8, junk);
-	assert_int_equal(irdm_can_master_receive(&m), IRDM_OK);  /* the TPDOs came first */
+	assert_int_equal(irdm_can_master_receive(&m), IRDM_OK); /* the TPDOs came first */
 	assert_int_equal(m.unknown_frames, IRDM_CAN_RX_MAX - 3);
 	irdm_can_master_receive(&m);
 	assert_int_equal(m.unknown_frames, 2 * IRDM_CAN_RX_MAX - 3);
@@ -767,7 +763,7 @@ static void test_bus_load(void **state)
 	assert_int_equal(irdm_can_master_cycle_bits(&c), 685);
 	irdm_can_master_load_line(&c, line, sizeof(line));
 	assert_string_equal(line, "CAN bus load: SYNC + 3 x RPDO1 (4 B) + 3 x TPDO1 (6 B) = 685 "
-			    "bits worst case in 1000 us at 1000000 bit/s: 68.5 %");
+				  "bits worst case in 1000 us at 1000000 bit/s: 68.5 %");
 	c.sync_counter = true;
 	assert_int_equal(irdm_can_master_cycle_bits(&c), 695);
 	assert_int_equal(irdm_can_master_check(&c, err, sizeof(err)), IRDM_OK);
@@ -775,7 +771,7 @@ static void test_bus_load(void **state)
 	c.bitrate = 500000;
 	assert_int_equal(irdm_can_master_check(&c, err, sizeof(err)), IRDM_EINVAL);
 	assert_string_equal(err, "bitrate: one cycle needs 695 bits worst case, 1000 us at "
-			    "500000 bit/s carries 500");
+				 "500000 bit/s carries 500");
 	/* ... but 2 ms carries 1000 */
 	c.period_us = 2000;
 	assert_int_equal(irdm_can_master_check(&c, err, sizeof(err)), IRDM_OK);
@@ -833,7 +829,7 @@ static void test_one_rpdo_per_sync_and_counter(void **state)
 			memset(rpdos, 0, sizeof(rpdos));
 			if (syncs > 0)
 				assert_int_equal(f->data[0], last == 240 ? 1 : last + 1);
-			else    /* run_up's periods came first */
+			else /* run_up's periods came first */
 				assert_int_equal(f->data[0], m.period - 500 + 1);
 			last = f->data[0];
 			syncs++;
@@ -848,7 +844,7 @@ static void test_one_rpdo_per_sync_and_counter(void **state)
 	}
 	assert_int_equal(syncs, 500);
 	assert_int_equal(beats, 50);
-	assert_int_equal(dr.syncs, m.period);     /* every SYNC reached the drives */
+	assert_int_equal(dr.syncs, m.period); /* every SYNC reached the drives */
 	assert_int_equal(dr.sync_counter, last);
 	assert_int_equal(dr.sync_length_errors, 0);
 	for (unsigned k = 0; k < 3; k++) {
@@ -914,7 +910,8 @@ static void test_master_dies_drives_stop(void **state)
 	/* the RPDO1 deadline first: 3 ms after the last RPDO1 (3 periods) */
 	us = master_dies(3, codes);
 	print_message("master silent: every drive off %.1f ms after its last frame (RPDO1 "
-		      "deadline 3 ms)\n", us / 1000.0);
+		      "deadline 3 ms)\n",
+		      us / 1000.0);
 	for (unsigned k = 0; k < 3; k++)
 		assert_int_equal(codes[k], 0x8250);
 	assert_true(us > 3000 && us <= 3100);
@@ -923,7 +920,8 @@ static void test_master_dies_drives_stop(void **state)
 	 * heartbeat period, 10 ms, before the last frame) */
 	us = master_dies(65535, codes);
 	print_message("master silent: every drive off %.1f ms after its last frame (consumer "
-		      "heartbeat 30 ms)\n", us / 1000.0);
+		      "heartbeat 30 ms)\n",
+		      us / 1000.0);
 	for (unsigned k = 0; k < 3; k++)
 		assert_int_equal(codes[k], 0x8130);
 	assert_true(us > 20000 && us <= 30100);
@@ -942,8 +940,8 @@ static void test_master_dies_drives_stop(void **state)
 struct emergency_result {
 	unsigned magic;
 	int rc;
-	unsigned recvs;         /* recv calls: must stay 0 */
-	int state_changed;      /* the master differs from before */
+	unsigned recvs;    /* recv calls: must stay 0 */
+	int state_changed; /* the master differs from before */
 };
 
 static int frames_fd = -1;
@@ -997,7 +995,7 @@ static void test_emergency_off_frames(void **state)
 	(void)state;
 	c.sync_counter = true;
 	run_up(&c);
-	for (int p = 0; p < 245; p++)   /* past the counter's wrap: 240 -> 1 */
+	for (int p = 0; p < 245; p++) /* past the counter's wrap: 240 -> 1 */
 		assert_int_equal(period(tau), IRDM_OK);
 	assert_int_equal(dr.d[0].rpdo_torque_permille, irdm_can_torque_permille(&c.axis[0], 0.3));
 	assert_int_not_equal(dr.d[0].rpdo_torque_permille, 0);
@@ -1012,7 +1010,8 @@ static void test_emergency_off_frames(void **state)
 	}
 	if (WIFSIGNALED(status))
 		fail_msg("the emergency path died of signal %d (SIGKILL: a system call other "
-			 "than write)", WTERMSIG(status));
+			 "than write)",
+			 WTERMSIG(status));
 	assert_int_equal(WEXITSTATUS(status), 0);
 	assert_int_equal(got, sizeof(res));
 	assert_int_equal(res.magic, EMERGENCY_MAGIC);
@@ -1021,7 +1020,7 @@ static void test_emergency_off_frames(void **state)
 	assert_int_equal(res.state_changed, 0);
 	n = read(fds[0], f, sizeof(f));
 	close(fds[0]);
-	assert_int_equal(n, 4 * (ssize_t)sizeof(f[0]));         /* 3 RPDO1 + SYNC, nothing more */
+	assert_int_equal(n, 4 * (ssize_t)sizeof(f[0])); /* 3 RPDO1 + SYNC, nothing more */
 	n_sent = 0;
 	for (unsigned k = 0; k < 4; k++)
 		sent[n_sent++] = (struct logged){ f[k], m.period };

@@ -82,7 +82,7 @@ static void test_no_can(void **state)
 	(void)state;
 	if (fd >= 0) {
 		close(fd);
-		skip();         /* a kernel with CAN: make hil runs the process */
+		skip(); /* a kernel with CAN: make hil runs the process */
 	}
 	refused((const char *const[]){ "--board", BOARD, "--if", "vcan0", NULL }, 4,
 		"vcan0: this kernel has no CAN sockets");

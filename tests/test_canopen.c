@@ -50,7 +50,7 @@ static void test_frames_sent(void **state)
 	(void)state;
 	assert_int_equal(irdm_co_nmt(&f, IRDM_CO_NMT_START, 3), IRDM_OK);
 	EXPECT(&f, 0x000, 2, 0x01, 0x03);
-	assert_int_equal(irdm_co_nmt(&f, IRDM_CO_NMT_RESET_NODE, 0), IRDM_OK);  /* all nodes */
+	assert_int_equal(irdm_co_nmt(&f, IRDM_CO_NMT_RESET_NODE, 0), IRDM_OK); /* all nodes */
 	EXPECT(&f, 0x000, 2, 0x81, 0x00);
 	assert_int_equal(irdm_co_nmt(&f, IRDM_CO_NMT_STOP, 128), IRDM_EINVAL);
 
@@ -66,9 +66,9 @@ static void test_frames_sent(void **state)
 	assert_int_equal(irdm_co_rpdo_cst(&f, 0, 0, 0), IRDM_EINVAL);
 
 	/* expedited downloads: 0x2F one byte, 0x2B two, 0x23 four */
-	assert_int_equal(irdm_co_sdo_write(&f, 1, 0x6060, 0, 10, 1), IRDM_OK);   /* CST */
+	assert_int_equal(irdm_co_sdo_write(&f, 1, 0x6060, 0, 10, 1), IRDM_OK); /* CST */
 	EXPECT(&f, 0x601, 8, 0x2F, 0x60, 0x60, 0x00, 0x0A);
-	assert_int_equal(irdm_co_sdo_write(&f, 1, 0x1017, 0, 100, 2), IRDM_OK);  /* heartbeat */
+	assert_int_equal(irdm_co_sdo_write(&f, 1, 0x1017, 0, 100, 2), IRDM_OK); /* heartbeat */
 	EXPECT(&f, 0x601, 8, 0x2B, 0x17, 0x10, 0x00, 0x64, 0x00);
 	assert_int_equal(irdm_co_sdo_write(&f, 3, 0x1A00, 1, 0x60410010, 4), IRDM_OK);
 	EXPECT(&f, 0x603, 8, 0x23, 0x00, 0x1A, 0x01, 0x10, 0x00, 0x41, 0x60);
@@ -107,13 +107,13 @@ static void test_frames_received(void **state)
 	f = make(0x705, 1, (const uint8_t[]){ 0x05 });
 	assert_int_equal(irdm_co_heartbeat(&f, 5, &st), IRDM_OK);
 	assert_int_equal(st, IRDM_CO_STATE_OPERATIONAL);
-	f.data[0] = 0x85;                       /* node guarding's toggle bit */
+	f.data[0] = 0x85; /* node guarding's toggle bit */
 	assert_int_equal(irdm_co_heartbeat(&f, 5, &st), IRDM_OK);
 	assert_int_equal(st, IRDM_CO_STATE_OPERATIONAL);
 	f.data[0] = 0x7F;
 	assert_int_equal(irdm_co_heartbeat(&f, 5, &st), IRDM_OK);
 	assert_int_equal(st, IRDM_CO_STATE_PRE_OPERATIONAL);
-	f.data[0] = 0x03;                       /* no such state */
+	f.data[0] = 0x03; /* no such state */
 	assert_int_equal(irdm_co_heartbeat(&f, 5, &st), IRDM_EFORMAT);
 
 	/* EMCY of node 2: 0x2310 (current: continuous over-current), register 0x04 */
@@ -124,7 +124,7 @@ static void test_frames_received(void **state)
 	assert_int_equal(e.vendor[4], 5);
 	assert_string_equal(irdm_co_emcy_class(e.code), "current");
 	assert_int_equal(irdm_co_node_of(&f, IRDM_CO_EMCY), 2);
-	f.id = 0x080;                           /* the SYNC, not an EMCY */
+	f.id = 0x080; /* the SYNC, not an EMCY */
 	assert_int_equal(irdm_co_node_of(&f, IRDM_CO_EMCY), 0);
 	assert_int_equal(irdm_co_emcy(&f, 0, &e), IRDM_EFORMAT);
 
@@ -177,15 +177,24 @@ static void test_statusword_decode(void **state)
 	} cases[] = {
 		/* the profile's patterns, with bits the masks ignore set too
 		 * (4 voltage enabled, 7 warning, 9 remote, 10 target reached) */
-		{ 0x0000, IRDM_CIA402_NOT_READY }, { 0x0610, IRDM_CIA402_NOT_READY },
-		{ 0x0040, SOD }, { 0x0670, SOD },
-		{ 0x0021, RTSO }, { 0x0631, RTSO },
-		{ 0x0023, SO }, { 0x02B3, SO },
-		{ 0x0027, OE }, { 0x0637, OE },
-		{ 0x0007, QSA }, { 0x0617, QSA },
-		{ 0x000F, FRA }, { 0x003F, FRA },
-		{ 0x0008, FLT }, { 0x0638, FLT },
-		{ 0x0001, IRDM_CIA402_UNKNOWN }, { 0x0061, IRDM_CIA402_UNKNOWN },
+		{ 0x0000, IRDM_CIA402_NOT_READY },
+		{ 0x0610, IRDM_CIA402_NOT_READY },
+		{ 0x0040, SOD },
+		{ 0x0670, SOD },
+		{ 0x0021, RTSO },
+		{ 0x0631, RTSO },
+		{ 0x0023, SO },
+		{ 0x02B3, SO },
+		{ 0x0027, OE },
+		{ 0x0637, OE },
+		{ 0x0007, QSA },
+		{ 0x0617, QSA },
+		{ 0x000F, FRA },
+		{ 0x003F, FRA },
+		{ 0x0008, FLT },
+		{ 0x0638, FLT },
+		{ 0x0001, IRDM_CIA402_UNKNOWN },
+		{ 0x0061, IRDM_CIA402_UNKNOWN },
 	};
 
 	(void)state;
@@ -212,21 +221,21 @@ static void test_drive_transitions(void **state)
 		uint16_t cw;
 		enum irdm_cia402_state to;
 	} table[] = {
-		{ SOD, 0x0006, RTSO },  /* 2 */
-		{ RTSO, 0x0007, SO },   /* 3 */
-		{ RTSO, 0x000F, OE },   /* 3 + 4 (switch on + enable operation) */
-		{ SO, 0x000F, OE },     /* 4 */
-		{ OE, 0x0007, SO },     /* 5 (disable operation) */
-		{ SO, 0x0006, RTSO },   /* 6 */
-		{ RTSO, 0x0000, SOD },  /* 7 (disable voltage) */
-		{ RTSO, 0x0002, SOD },  /* 7 (quick stop) */
-		{ OE, 0x0006, RTSO },   /* 8 */
-		{ OE, 0x0000, SOD },    /* 9 */
-		{ SO, 0x0000, SOD },    /* 10 (disable voltage) */
-		{ SO, 0x0002, SOD },    /* 10 (quick stop) */
-		{ OE, 0x0002, QSA },    /* 11 */
-		{ QSA, 0x0000, SOD },   /* 12 */
-		{ QSA, 0x000F, OE },    /* 16 */
+		{ SOD, 0x0006, RTSO }, /* 2 */
+		{ RTSO, 0x0007, SO },  /* 3 */
+		{ RTSO, 0x000F, OE },  /* 3 + 4 (switch on + enable operation) */
+		{ SO, 0x000F, OE },    /* 4 */
+		{ OE, 0x0007, SO },    /* 5 (disable operation) */
+		{ SO, 0x0006, RTSO },  /* 6 */
+		{ RTSO, 0x0000, SOD }, /* 7 (disable voltage) */
+		{ RTSO, 0x0002, SOD }, /* 7 (quick stop) */
+		{ OE, 0x0006, RTSO },  /* 8 */
+		{ OE, 0x0000, SOD },   /* 9 */
+		{ SO, 0x0000, SOD },   /* 10 (disable voltage) */
+		{ SO, 0x0002, SOD },   /* 10 (quick stop) */
+		{ OE, 0x0002, QSA },   /* 11 */
+		{ QSA, 0x0000, SOD },  /* 12 */
+		{ QSA, 0x000F, OE },   /* 16 */
 	};
 	static const enum irdm_cia402_state states[] = { SOD, RTSO, SO, OE, QSA };
 	struct irdm_cia402_drive d;
@@ -251,19 +260,19 @@ static void test_drive_transitions(void **state)
 		d.state = states[a];
 		irdm_cia402_drive_fault(&d);
 		assert_int_equal(d.state, FRA);
-		irdm_cia402_drive_command(&d, 0x000F);          /* no command leaves FRA */
+		irdm_cia402_drive_command(&d, 0x000F); /* no command leaves FRA */
 		assert_int_equal(d.state, FRA);
 		irdm_cia402_drive_settle(&d);
 		assert_int_equal(d.state, FLT);
 	}
 	d.last_cw = 0x0080;
-	irdm_cia402_drive_command(&d, 0x0080);                  /* held high: no edge */
+	irdm_cia402_drive_command(&d, 0x0080); /* held high: no edge */
 	assert_int_equal(d.state, FLT);
 	for (size_t c = 0; c < sizeof(cmds) / sizeof(cmds[0]); c++) {
-		irdm_cia402_drive_command(&d, cmds[c]);         /* commands do not leave FAULT */
+		irdm_cia402_drive_command(&d, cmds[c]); /* commands do not leave FAULT */
 		assert_int_equal(d.state, FLT);
 	}
-	irdm_cia402_drive_command(&d, 0x0080);                  /* the edge: 15 */
+	irdm_cia402_drive_command(&d, 0x0080); /* the edge: 15 */
 	assert_int_equal(d.state, SOD);
 }
 
@@ -281,7 +290,7 @@ static void test_master_enables(void **state)
 		irdm_cia402_drive_command(&d, cw);
 	}
 	assert_int_equal(d.state, OE);
-	assert_int_equal(steps, 3);                             /* 2, 3, 4 */
+	assert_int_equal(steps, 3); /* 2, 3, 4 */
 	/* quick stop, then back */
 	irdm_cia402_drive_command(&d, IRDM_CIA402_CW_QUICK_STOP);
 	assert_int_equal(d.state, QSA);
@@ -304,7 +313,7 @@ static void test_master_enables(void **state)
 		irdm_cia402_drive_command(&d, cw);
 	}
 	assert_int_equal(d.state, OE);
-	assert_int_equal(steps, 4);                             /* 15, 2, 3, 4 */
+	assert_int_equal(steps, 4); /* 15, 2, 3, 4 */
 }
 
 /*

@@ -134,7 +134,7 @@ static void expect_failure(int rc, const char *needle)
 		last--;
 	if (rc == 0 || strncmp(last, "irdm", 4) || !strstr(last, needle))
 		fail_msg("expected a one-line error with '%s' (exit %d): %s", needle, rc, err_text);
-	assert_true(rc > 0 && rc < 128);   /* an error exit, not a crash */
+	assert_true(rc > 0 && rc < 128); /* an error exit, not a crash */
 }
 
 static int setup(void **state)
@@ -183,7 +183,8 @@ static void test_bad_scene_values(void **state)
 	expect_failure(run("precompute", SMALL, "--static_correction_cluster", "3", "-o", img, NULL),
 		       "static_correction_cluster = 3 is below 4 nodes per cluster");
 	expect_failure(run("precompute", SMALL, "--static_correction_cluster", "1025", "-o", img,
-			   NULL), "static_correction_cluster");
+			   NULL),
+		       "static_correction_cluster");
 	expect_failure(run("precompute", SMALL, "--static_correction_cluster", "8", "--exact_head",
 			   "4", "-o", img, NULL),
 		       "exact_head = 4 with static_correction_cluster = 8");
@@ -229,12 +230,14 @@ static void test_uncertified_refused(void **state)
 	(void)state;
 	unlink(img);
 	expect_failure(run("precompute", SMALL, "--representation", "fir:20", "--modes", "all", "--touch", "z>=0.2",
-			   "-o", img, NULL), "scene cuboid: fir:20 is not certified stable: spectral radius 1.");
+			   "-o", img, NULL),
+		       "scene cuboid: fir:20 is not certified stable: spectral radius 1.");
 	assert_non_null(strstr(err_text, "try fir_tail = window:40"));
 	assert_non_null(strstr(err_text, "uncertified = yes"));
 	assert_int_not_equal(access(img, F_OK), 0);
 	assert_int_equal(run("precompute", SMALL, "--representation", "fir:20", "--modes", "all", "--touch", "z>=0.2",
-			     "--modes", "all", "--uncertified", "yes", "-o", img, NULL), 0);
+			     "--modes", "all", "--uncertified", "yes", "-o", img, NULL),
+			 0);
 	expect_failure(run("image", "verify", "--require-stable", img, NULL),
 		       "columns have an unstable force recursion");
 }
@@ -250,7 +253,8 @@ static void test_bad_meshes(void **state)
 	tf_write_text(path_in_dir("inv.node"), nodes);
 	tf_write_text(path_in_dir("inv.ele"), "2 4 0\n1 1 2 3 4\n2 5 2 3 4\n");
 	expect_failure(run("precompute", "--mesh", path_in_dir("inv.node"), "--fixed", "z<=0",
-			   "-o", img, NULL), "element 2");
+			   "-o", img, NULL),
+		       "element 2");
 	/* zero volume: four coplanar nodes */
 	tf_write_text(path_in_dir("flat.node"), "4 3 0 0\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 1 1 0\n");
 	tf_write_text(path_in_dir("flat.ele"), "1 4 0\n1 1 2 3 4\n");
@@ -403,7 +407,8 @@ static void test_export_matches_library(void **state)
 	(void)state;
 	assert_int_equal(run("precompute", "-q", "--mesh", "box:0.1,0.1,0.2", "--resolution", "2,2,4",
 			     "--tets_per_hex", "6", "--representation", "modal:all", "--precision", "f64",
-			     "--dt", "0.002", "-o", img, NULL), 0);
+			     "--dt", "0.002", "-o", img, NULL),
+			 0);
 	fixture_model(&m, 0.1, 0.1, 0.2, 2, 2, 4, 6, 0.49, false, 0, IRDM_EIG_AUTO, 0.002);
 	const double top[3] = { 0.05, 0.05, 0.2 };
 	uint32_t c = fixture_nearest_node(&m.mesh, top);
@@ -546,7 +551,8 @@ static void test_replay(void **state)
 
 	(void)state;
 	assert_int_equal(run("precompute", "-q", SMALL, "--representation", "modal:all", "--precision", "f64",
-			     "--touch", "z>=0.2", "-o", img, NULL), 0);
+			     "--touch", "z>=0.2", "-o", img, NULL),
+			 0);
 	p += sprintf(p, "t,ux,uy,uz\n");
 	for (int t = 0; t < 300; t++) {
 		target[3 * t + 2] = -0.01;
@@ -604,7 +610,8 @@ static void test_replay(void **state)
 	expect_failure(run("replay", "--image", img, "--contact", "1,2", "--displacement", traj, "-o", out, NULL),
 		       "--contact");
 	expect_failure(run("replay", "--image", img, "--contact", "40", "--displacement", path_in_dir("no.csv"),
-			   "-o", out, NULL), "no.csv");
+			   "-o", out, NULL),
+		       "no.csv");
 	expect_failure(run("replay", "--image", img, "--contact", "40", NULL), "needs");
 	/* --sites: each row's site checked, named by file and row */
 	{
@@ -613,33 +620,41 @@ static void test_replay(void **state)
 		tf_write_text(traj, "t,ux,uy,uz\n0,0,0,-0.001\n0.001,nan,nan,nan\n");
 		tf_write_text(sites, "t,tri,b0,b1,b2\n0,99999,0.2,0.3,0.5\n0.001,-1,0,0,0\n");
 		expect_failure(run("replay", "--image", img, "--sites", sites, "--displacement", traj,
-				   "-o", out, NULL), "rps.csv: row 1, contact 1: triangle is not -1");
+				   "-o", out, NULL),
+			       "rps.csv: row 1, contact 1: triangle is not -1");
 		tf_write_text(sites, "t,tri,b0,b1,b2\n0,0,0.2,0.3,0.6\n0.001,-1,0,0,0\n");
 		expect_failure(run("replay", "--image", img, "--sites", sites, "--displacement", traj,
-				   "-o", out, NULL), "row 1, contact 1: barycentrics must sum to 1");
+				   "-o", out, NULL),
+			       "row 1, contact 1: barycentrics must sum to 1");
 		tf_write_text(sites, "t,tri,b0,b1,b2\n0,0,-0.2,0.7,0.5\n0.001,-1,0,0,0\n");
 		expect_failure(run("replay", "--image", img, "--sites", sites, "--displacement", traj,
-				   "-o", out, NULL), "finite and >= 0");
+				   "-o", out, NULL),
+			       "finite and >= 0");
 		tf_write_text(sites, "t,tri,b0,b1,b2\n0,-1,0,0,0\n0.001,-1,0,0,0\n");
 		expect_failure(run("replay", "--image", img, "--sites", sites, "--displacement", traj,
-				   "-o", out, NULL), "row 1: contact 1 has a displacement but no site");
+				   "-o", out, NULL),
+			       "row 1: contact 1 has a displacement but no site");
 		tf_write_text(sites, "t,tri,b0,b1,b2\n0,0,0.2,0.3,0.5\n");
 		expect_failure(run("replay", "--image", img, "--sites", sites, "--displacement", traj,
-				   "-o", out, NULL), "1 rows, but");
+				   "-o", out, NULL),
+			       "1 rows, but");
 		expect_failure(run("replay", "--image", img, "--sites", sites, "--contact", "40",
-				   "--displacement", traj, "-o", out, NULL), "exclude each other");
+				   "--displacement", traj, "-o", out, NULL),
+			       "exclude each other");
 		/* pushed rigidly into a triangle that cannot move: refused,
 		 * saying why (the regularised solve gave 1e7 N for 1 mm before) */
 		snprintf(text, sizeof(text), "t,tri,b0,b1,b2\n0,%ld,0.2,0.3,0.5\n0.001,-1,0,0,0\n",
 			 fixed_tri);
 		tf_write_text(sites, text);
 		expect_failure(run("replay", "--image", img, "--sites", sites, "--displacement", traj,
-				   "-o", out, NULL), "contact targets contradict each other");
+				   "-o", out, NULL),
+			       "contact targets contradict each other");
 		snprintf(text, sizeof(text), "t,tri,b0,b1,b2\n0,%ld,0.2,0.3,0.5\n0.001,-1,0,0,0\n",
 			 top_tri);
 		tf_write_text(sites, text);
 		assert_int_equal(run("replay", "--image", img, "--sites", sites, "--displacement",
-				     traj, "-o", out, NULL), 0);
+				     traj, "-o", out, NULL),
+				 0);
 		remove(out);
 	}
 	assert_false(exists(out));

@@ -111,13 +111,14 @@ static void test_virtual_time_makes_no_system_call(void **state)
 
 static void test_real_time_paces_absolute_periods(void **state)
 {
-	enum { N = 100, PERIOD_US = 1000 };
+	enum { N = 100,
+	       PERIOD_US = 1000 };
 	struct irdm_clock c;
 	int64_t late, worst = 0;
 	double t0, t1;
 
 	(void)state;
-	t0 = now_s();           /* before the start: load only adds to t1 - t0 */
+	t0 = now_s(); /* before the start: load only adds to t1 - t0 */
 	assert_int_equal(irdm_clock_start(&c, IRDM_CLOCK_REAL, PERIOD_US), IRDM_OK);
 	for (int i = 0; i < N; i++) {
 		late = irdm_clock_wait(&c);

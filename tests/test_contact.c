@@ -28,16 +28,19 @@
 #include "precompute/precompute.h"
 #include "support/image_fixture.h"
 
-enum { IMG_ALL, IMG_TOP, IMG_HALF, IMG_COUNT };
+enum { IMG_ALL,
+       IMG_TOP,
+       IMG_HALF,
+       IMG_COUNT };
 
 /* The test box: 10 x 10 x 20 cm, 2 x 2 x 4 hexes, bottom fixed. */
 struct box_image {
 	char path[600];
 	struct irdm_image img;
 	struct irdm_contact_mesh cm;
-	uint32_t *beyond;               /* cm's face-beyond table */
-	uint32_t rim_searched;          /* its build's searches */
-	double lo[3], hi[3];            /* bounds of the rest nodes */
+	uint32_t *beyond;      /* cm's face-beyond table */
+	uint32_t rim_searched; /* its build's searches */
+	double lo[3], hi[3];   /* bounds of the rest nodes */
 };
 
 static char tmpdir[512];
@@ -47,7 +50,7 @@ static struct box_image boxes[IMG_COUNT];
 
 static uint64_t rng_state = 0x9e3779b97f4a7c15u;
 
-static double urand(void)       /* [0, 1), xorshift64* */
+static double urand(void) /* [0, 1), xorshift64* */
 {
 	rng_state ^= rng_state >> 12;
 	rng_state ^= rng_state << 25;
@@ -82,7 +85,7 @@ static int make_box(struct box_image *b, const char *name, const char *touch)
 
 	snprintf(b->path, sizeof(b->path), "%s/%s.img", tmpdir, name);
 	irdm_scene_defaults(&sc);
-	sc.max_error = 0;       /* not what is tested here */
+	sc.max_error = 0; /* not what is tested here */
 	if (irdm_scene_set(&sc, "mesh", "box:0.1,0.1,0.2", "test", err, sizeof(err)) ||
 	    irdm_scene_set(&sc, "resolution", "2,2,4", "test", err, sizeof(err)) ||
 	    irdm_scene_set(&sc, "representation", "modal:10", "test", err, sizeof(err)) ||
@@ -162,7 +165,7 @@ static int brute_closest(const struct irdm_contact_mesh *cm, const struct irdm_c
 		irdm_v3_sub(ac, v[2], v[0]);
 		irdm_v3_cross(n, ab, ac);
 		nn = irdm_v3_norm(n);
-		assert_true(nn > 0);            /* the box has no degenerate triangle */
+		assert_true(nn > 0); /* the box has no degenerate triangle */
 		d2 = irdm_contact_closest_on_tri(v[0], v[1], v[2], p, bary, q);
 		if (d2 < best || (!found && d2 <= best)) {
 			best = d2;
@@ -300,7 +303,7 @@ static void test_adjacency(void **state)
 			}
 		}
 		assert_true(linked > 0);
-		assert_true(boundary > 0);      /* the region is open at the bottom / top rim */
+		assert_true(boundary > 0); /* the region is open at the bottom / top rim */
 	}
 }
 
@@ -369,7 +372,7 @@ static double ref_tri_dist(const double *a, const double *b, const double *c, co
 	nn = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
 	/* collinear vertices give a rounding-noise normal: no interior then */
 	if (nn > 1e-20 * (ab[0] * ab[0] + ab[1] * ab[1] + ab[2] * ab[2]) *
-		  (ac[0] * ac[0] + ac[1] * ac[1] + ac[2] * ac[2])) {
+			 (ac[0] * ac[0] + ac[1] * ac[1] + ac[2] * ac[2])) {
 		/* solve ap = s ab + t ac + h n by Cramer in the 2x2 normal equations */
 		double aa = ab[0] * ab[0] + ab[1] * ab[1] + ab[2] * ab[2];
 		double bb = ac[0] * ac[0] + ac[1] * ac[1] + ac[2] * ac[2];
@@ -409,10 +412,10 @@ static void test_point_triangle(void **state)
 		for (unsigned k = 0; k < 3; k++)
 			for (unsigned a = 0; a < 3; a++)
 				v[k][a] = urange(-1, 1);
-		if (kind == 3)          /* collinear */
+		if (kind == 3) /* collinear */
 			for (unsigned a = 0; a < 3; a++)
 				v[2][a] = v[0][a] + 0.37 * (v[1][a] - v[0][a]);
-		if (kind == 4)          /* two coincident vertices */
+		if (kind == 4) /* two coincident vertices */
 			memcpy(v[2], v[1], sizeof(v[1]));
 		for (unsigned a = 0; a < 3; a++)
 			p[a] = urange(-2, 2);
@@ -574,7 +577,8 @@ static void test_box_normals(void **state)
 		}
 		/* the normal points away from the box centre */
 		assert_true((c[0] - mid[0]) * face[0] + (c[1] - mid[1]) * face[1] +
-			    (c[2] - mid[2]) * face[2] > 0);
+				    (c[2] - mid[2]) * face[2] >
+			    0);
 	}
 }
 
@@ -615,7 +619,7 @@ static void test_proxy_stroke(void **state)
 	memcpy(prev, px.point_m, sizeof(prev));
 	for (int k = 1; k <= 400; k++) {
 		double s = k / 400.0, x = x0 + s * (x1 - x0), y = y0 + s * (y1 - y0);
-		double z = top - 0.003 - 0.002 * sin(0.1 * k);    /* pressing harder and softer */
+		double z = top - 0.003 - 0.002 * sin(0.1 * k); /* pressing harder and softer */
 		double step = hypot(x1 - x0, y1 - y0) / 400;
 		bool new_tri = true;
 
@@ -654,7 +658,7 @@ static void test_proxy_deep(void **state)
 	irdm_proxy_reset(&px);
 	assert_int_equal(upd(&px, b, NULL, xc, yc, top - 0.001), IRDM_PROXY_TOUCH);
 	for (int k = 1; k <= 100; k++) {
-		double z = top - 0.001 - 0.0015 * k;          /* down to 15 cm deep */
+		double z = top - 0.001 - 0.0015 * k; /* down to 15 cm deep */
 
 		assert_int_equal(upd(&px, b, NULL, xc + 0.0001 * k, yc, z), IRDM_PROXY_SLIDE);
 		assert_true(fabs(px.point_m[2] - top) < 1e-12);
@@ -845,9 +849,10 @@ static void test_proxy_shared_edge(void **state)
 		irdm_proxy_reset(&px);
 		assert_int_equal(upd(&px, b, NULL, xe + side * 0.01, y0, top - 0.002),
 				 IRDM_PROXY_TOUCH);
-		for (int k = 1; k <= 20; k++)   /* onto the edge */
+		for (int k = 1; k <= 20; k++) /* onto the edge */
 			assert_int_equal(upd(&px, b, NULL, xe + side * 0.01 * (1 - k / 20.0), y0,
-					     top - 0.002), IRDM_PROXY_SLIDE);
+					     top - 0.002),
+					 IRDM_PROXY_SLIDE);
 		assert_int_equal(px.tri, pair[0]);
 		for (int k = 0; k <= 500; k++) {
 			double y = y0 + (y1 - y0) * k / 500.0;
@@ -900,7 +905,8 @@ static void test_proxy_creases(void **state)
 	assert_int_equal(upd(&px, b, &d, xe - 0.02, yc, top - 0.004), IRDM_PROXY_TOUCH);
 	for (int k = 1; k <= 20; k++)
 		assert_int_equal(upd(&px, b, &d, xe - 0.02 + 0.00095 * k, yc,
-				     top - 0.004 - 0.00055 * k), IRDM_PROXY_SLIDE);
+				     top - 0.004 - 0.00055 * k),
+				 IRDM_PROXY_SLIDE);
 	/* 10 mm under the crease, within 0.1 x 10 mm of it: behind both
 	 * faces, each projection beyond the other face: held on the crease */
 	for (int k = -9; k <= 9; k++) {
@@ -1088,7 +1094,7 @@ static void test_proxy_friction(void **state)
 		assert_true(fabs(px.depth_m + dn) < 1e-12);
 		worst_gain = fmax(worst_gain, spring(p, px.point_m) - e_old);
 		ratio = hypot(p[0] - px.point_m[0], p[1] - px.point_m[1]) / dn;
-		if (dist3(before, px.point_m) == 0) {   /* stuck */
+		if (dist3(before, px.point_m) == 0) { /* stuck */
 			if (back)
 				back_max = back_slips ? back_max : fmax(back_max, ratio);
 			else
@@ -1103,7 +1109,7 @@ static void test_proxy_friction(void **state)
 	print_message("friction: stuck up to F_t / F_n = %.5f (mu_s %.2f), back %.5f; on the rim "
 		      "|ratio - mu_d| <= %.1e; %u + %u slips; largest energy gain %.1e (k = 1)\n",
 		      stuck_max, mu_s, back_max, rim_err, slips, back_slips, worst_gain);
-	assert_true(slips >= 5 && back_slips >= 5);     /* stick-slip: every 0.2 mm */
+	assert_true(slips >= 5 && back_slips >= 5); /* stick-slip: every 0.2 mm */
 	assert_true(fabs(stuck_max - mu_s) <= 0.01 * mu_s);
 	assert_true(fabs(back_max - mu_s) <= 0.01 * mu_s);
 	assert_true(rim_err <= 1e-9);
@@ -1169,7 +1175,7 @@ static void test_proxy_displaced_site(void **state)
 struct bvh_copy {
 	uint8_t *buf;
 	size_t size;
-	uint8_t *payload;               /* BVH payload inside buf */
+	uint8_t *payload; /* BVH payload inside buf */
 	struct irdm_bvh_header h;
 };
 
@@ -1244,17 +1250,17 @@ static void test_loader_rejects(void **state)
 		free(c.buf);
 	}
 
-	copy_image(b, &c);                      /* child out of range */
+	copy_image(b, &c); /* child out of range */
 	i = first_internal(&c);
 	node_at(&c, i)->left_or_first = c.h.n_bvh_nodes;
 	expect_reject(&c, "child");
 
-	copy_image(b, &c);                      /* right child out of range */
+	copy_image(b, &c); /* right child out of range */
 	i = first_internal(&c);
 	node_at(&c, i)->count_or_right = IRDM_BVH_INTERNAL | 0x7fffffffu;
 	expect_reject(&c, "child");
 
-	copy_image(b, &c);                      /* cycle: a child pointing at the root */
+	copy_image(b, &c); /* cycle: a child pointing at the root */
 	i = first_internal(&c);
 	i = node_at(&c, i)->count_or_right & ~IRDM_BVH_INTERNAL;
 	while (!(node_at(&c, i)->count_or_right & IRDM_BVH_INTERNAL))
@@ -1262,25 +1268,25 @@ static void test_loader_rejects(void **state)
 	node_at(&c, i)->left_or_first = 0;
 	expect_reject(&c, "child");
 
-	copy_image(b, &c);                      /* self loop */
+	copy_image(b, &c); /* self loop */
 	i = first_internal(&c);
 	node_at(&c, i)->left_or_first = i;
 	expect_reject(&c, "child");
 
-	copy_image(b, &c);                      /* two parents: shared subtree */
+	copy_image(b, &c); /* two parents: shared subtree */
 	i = first_internal(&c);
 	node_at(&c, i)->count_or_right = IRDM_BVH_INTERNAL | node_at(&c, i)->left_or_first;
 	expect_reject(&c, "more than one parent");
 
-	copy_image(b, &c);                      /* NaN box */
+	copy_image(b, &c); /* NaN box */
 	node_at(&c, c.h.n_bvh_nodes - 1)->lo[1] = NAN;
 	expect_reject(&c, "box");
 
-	copy_image(b, &c);                      /* inverted box */
+	copy_image(b, &c); /* inverted box */
 	node_at(&c, 0)->lo[2] = node_at(&c, 0)->hi[2] + 1;
 	expect_reject(&c, "box");
 
-	copy_image(b, &c);                      /* leaf box misses its triangle */
+	copy_image(b, &c); /* leaf box misses its triangle */
 	i = first_leaf(&c);
 	for (unsigned a = 0; a < 3; a++)
 		if (node_at(&c, i)->lo[a] < node_at(&c, i)->hi[a]) {
@@ -1289,70 +1295,71 @@ static void test_loader_rejects(void **state)
 		}
 	expect_reject(&c, "contain");
 
-	copy_image(b, &c);                      /* bad leaf range: past the list */
+	copy_image(b, &c); /* bad leaf range: past the list */
 	i = first_leaf(&c);
 	node_at(&c, i)->left_or_first = c.h.n_contact_tris - 1;
 	node_at(&c, i)->count_or_right = 2;
 	expect_reject(&c, "leaf");
 
-	copy_image(b, &c);                      /* bad leaf range: too many */
+	copy_image(b, &c); /* bad leaf range: too many */
 	i = first_leaf(&c);
 	node_at(&c, i)->count_or_right = IRDM_BVH_LEAF_MAX + 1;
 	expect_reject(&c, "leaf");
 
-	copy_image(b, &c);                      /* bad leaf range: overlapping leaves */
+	copy_image(b, &c); /* bad leaf range: overlapping leaves */
 	i = first_leaf(&c);
 	node_at(&c, i)->left_or_first = node_at(&c, i)->left_or_first ? 0 : 1;
 	expect_reject(&c, "leaf");
 
-	copy_image(b, &c);                      /* index out of range */
+	copy_image(b, &c); /* index out of range */
 	*u32_at(&c, c.h.index_offset, 3) = b->img.meta->n_tris;
 	expect_reject(&c, "index[3]");
 
-	copy_image(b, &c);                      /* index repeats */
+	copy_image(b, &c); /* index repeats */
 	*u32_at(&c, c.h.index_offset, 3) = *u32_at(&c, c.h.index_offset, 4);
 	expect_reject(&c, "repeats");
 
-	copy_image(b, &c);                      /* index names a non-contactable triangle */
+	copy_image(b, &c); /* index names a non-contactable triangle */
 	for (t = 0; irdm_contact_tri_contactable(&b->cm, t); t++)
 		;
 	*u32_at(&c, c.h.index_offset, 0) = t;
 	expect_reject(&c, "not a column");
 
-	copy_image(b, &c);                      /* asymmetric adjacency */
+	copy_image(b, &c); /* asymmetric adjacency */
 	for (t = 0; *u32_at(&c, c.h.adj_offset, 3 * t) == IRDM_BVH_NONE; t++)
 		;
 	for (i = 0; *u32_at(&c, c.h.index_offset, i) == t ||
-		    *u32_at(&c, c.h.index_offset, i) == *u32_at(&c, c.h.adj_offset, 3 * t); i++)
+		    *u32_at(&c, c.h.index_offset, i) == *u32_at(&c, c.h.adj_offset, 3 * t);
+	     i++)
 		;
 	*u32_at(&c, c.h.adj_offset, 3 * t) = *u32_at(&c, c.h.index_offset, i);
 	expect_reject(&c, "neighbour");
 
-	copy_image(b, &c);                      /* adjacency out of range */
+	copy_image(b, &c); /* adjacency out of range */
 	*u32_at(&c, c.h.adj_offset, 3 * t + 0) = b->img.meta->n_tris + 7;
 	expect_reject(&c, "neighbour");
 
-	copy_image(b, &c);                      /* col_of_row wrong */
+	copy_image(b, &c); /* col_of_row wrong */
 	*u32_at(&c, c.h.col_of_row_offset, b->img.columns[0]) = 1;
 	expect_reject(&c, "col_of_row");
 
-	copy_image(b, &c);                      /* depth lies */
+	copy_image(b, &c); /* depth lies */
 	((struct irdm_bvh_header *)c.payload)->depth = c.h.depth + 1;
 	expect_reject(&c, "levels deep");
 
-	copy_image(b, &c);                      /* depth beyond the limit */
+	copy_image(b, &c); /* depth beyond the limit */
 	((struct irdm_bvh_header *)c.payload)->depth = IRDM_BVH_MAX_DEPTH + 1;
 	expect_reject(&c, "depth");
 
-	copy_image(b, &c);                      /* layout */
+	copy_image(b, &c); /* layout */
 	((struct irdm_bvh_header *)c.payload)->adj_offset += 4;
 	expect_reject(&c, "layout");
 
-	copy_image(b, &c);                      /* counts */
+	copy_image(b, &c); /* counts */
 	((struct irdm_bvh_header *)c.payload)->n_surface_tris += 1;
 	expect_reject(&c, "triangles");
 
-	copy_image(b, &c);                      /* reserved */
+	copy_image(b, &c); /* reserved */
 	((struct irdm_bvh_header *)c.payload)->reserved[5] = 1;
 	expect_reject(&c, "reserved");
 }
@@ -1400,7 +1407,8 @@ static void test_fixture_images(void **state)
 	/* built: a fan on a 4 x 4 grid, all nodes columns (some triangles are
 	 * flat-degenerate: collinear grid points) */
 	assert_int_equal(irdm_bvh_build(fx.nodes, fx.meta.n_nodes, fx.columns, fx.meta.n_cols,
-					fx.tris, fx.meta.n_tris, &bvh, &bvh_size, err, sizeof(err)), 0);
+					fx.tris, fx.meta.n_tris, &bvh, &bvh_size, err, sizeof(err)),
+			 0);
 	irdm_iw_init(&w);
 	img_fixture_add(&fx, &w);
 	assert_int_equal(irdm_iw_add(&w, IRDM_SEC_CONTACT_BVH, IRDM_ELEM_BYTES, bvh, bvh_size), 0);
@@ -1418,7 +1426,8 @@ static void test_fixture_images(void **state)
 	img_fixture_free(&fx);
 	assert_int_equal(img_fixture_fir(&fx, IRDM_ELEM_F32, 6, 2, 2), 0);
 	assert_int_equal(irdm_bvh_build(fx.nodes, fx.meta.n_nodes, fx.columns, fx.meta.n_cols,
-					fx.tris, fx.meta.n_tris, &bvh, &bvh_size, err, sizeof(err)), 0);
+					fx.tris, fx.meta.n_tris, &bvh, &bvh_size, err, sizeof(err)),
+			 0);
 	irdm_iw_init(&w);
 	img_fixture_add(&fx, &w);
 	assert_int_equal(irdm_iw_add(&w, IRDM_SEC_CONTACT_BVH, IRDM_ELEM_BYTES, bvh, bvh_size), 0);
@@ -1433,7 +1442,8 @@ static void test_fixture_images(void **state)
 	/* the builder refuses bad indices */
 	fx.tris[0] = 99;
 	assert_int_equal(irdm_bvh_build(fx.nodes, fx.meta.n_nodes, fx.columns, fx.meta.n_cols,
-					fx.tris, fx.meta.n_tris, &bvh, &bvh_size, err, sizeof(err)), IRDM_EINVAL);
+					fx.tris, fx.meta.n_tris, &bvh, &bvh_size, err, sizeof(err)),
+			 IRDM_EINVAL);
 	assert_non_null(strstr(err, "triangle 0"));
 	img_fixture_free(&fx);
 }

@@ -44,11 +44,11 @@
 #include "support/strict_mode.h"
 #include "support/engine_fixture.h"
 
-#define GAP_M 0.002             /* home tip above the top face */
+#define GAP_M 0.002 /* home tip above the top face */
 #define PERIOD_US 1000
 #define PERIOD_NS (PERIOD_US * 1000ull)
 
-static const double rot[9] = { 1, 0, 0, 0, 0, -1, 0, 1, 0 };   /* device -> object */
+static const double rot[9] = { 1, 0, 0, 0, 0, -1, 0, 1, 0 }; /* device -> object */
 
 struct rig {
 	struct irdm_session *s;
@@ -56,9 +56,9 @@ struct rig {
 	struct irdm_ctrl ctrl;
 	struct irdm_ctrl_input in;
 	struct irdm_ctrl_output out;
-	double top_z, cx, cy;           /* object: top face height, centre of the top */
+	double top_z, cx, cy; /* object: top face height, centre of the top */
 	int rc;
-	const char *path;               /* the image; NULL: IRDM_TICK_IMAGE */
+	const char *path; /* the image; NULL: IRDM_TICK_IMAGE */
 };
 
 /* ---- geometry helpers (the test's own, not the controller's) ---- */
@@ -162,7 +162,8 @@ static void rig_open(struct rig *r)
 	for (unsigned i = 0; i < r->cfg.n_devices; i++)
 		assert_int_equal(irdm_device_counts_from_angles(&r->cfg.device[i].dev,
 								r->cfg.device[i].calib_q_rad,
-								r->in.counts[i]), IRDM_OK);
+								r->in.counts[i]),
+				 IRDM_OK);
 }
 
 static void rig_close(struct rig *r)
@@ -263,15 +264,19 @@ static void test_config_errors(void **state)
 
 	irdm_ctrl_config_default(&c);
 	assert_int_equal(irdm_ctrl_config_check(&c), IRDM_OK);
-#define BAD(stmt) do { irdm_ctrl_config_default(&c); stmt; \
-		assert_int_equal(irdm_ctrl_config_check(&c), IRDM_EINVAL); } while (0)
+#define BAD(stmt) \
+	do { \
+		irdm_ctrl_config_default(&c); \
+		stmt; \
+		assert_int_equal(irdm_ctrl_config_check(&c), IRDM_EINVAL); \
+	} while (0)
 	BAD(c.n_devices = 0);
 	BAD(c.n_devices = 3);
-	BAD(c.obj_rot[8] = -1);                         /* a reflection */
-	BAD(c.obj_rot[1] = 0.1);                        /* not orthonormal */
+	BAD(c.obj_rot[8] = -1);  /* a reflection */
+	BAD(c.obj_rot[1] = 0.1); /* not orthonormal */
 	BAD(c.obj_offset_m[2] = NAN);
 	BAD(c.device[0].mount_offset_m[0] = INFINITY);
-	BAD(c.device[0].calib_q_rad[1] = 10);           /* outside the encoder range */
+	BAD(c.device[0].calib_q_rad[1] = 10); /* outside the encoder range */
 	BAD(c.device[0].dev.l1_m = 0);
 	BAD(c.limits.max_force_n = 0);
 	BAD(c.limits.max_tip_speed_m_per_s = -1);
@@ -485,14 +490,14 @@ static void test_enable_inside_fades_in(void **state)
 
 	/* at 1 m/s a period's travel is 1 mm: 1.5 mm deep cannot come from outside */
 	contact_rig(&r, slow_limit, 1.0);
-	for (int k = 0; k < 2000; k++)          /* settle: the held force */
+	for (int k = 0; k < 2000; k++) /* settle: the held force */
 		assert_int_equal(tick(&r), IRDM_OK);
 	held = irdm_v3_norm(r.out.dev[0].force_obj_n);
 	tick_cmd(&r, IRDM_CTRL_CMD_HAL_FAULT);
 	assert_faulted(&r, IRDM_FAULT_HAL_FAULT);
 	tick_cmd(&r, IRDM_CTRL_CMD_RESET);
 	assert_int_equal(r.out.state, IRDM_SAFETY_READY);
-	for (int k = 0; k < 2000; k++)          /* the object relaxes under the tool */
+	for (int k = 0; k < 2000; k++) /* the object relaxes under the tool */
 		assert_int_equal(tick(&r), IRDM_OK);
 	tick_cmd(&r, IRDM_CTRL_CMD_ENABLE);
 	assert_int_equal(r.out.state, IRDM_SAFETY_ENABLED);
@@ -645,7 +650,7 @@ static double slide(struct rig *r, double *x, double *y, double ux, double uy,
 	const double v_obj[3] = { speed_m_per_s * ux, speed_m_per_s * uy, 0 };
 	double vmax = 0, v_dev[3];
 
-	for (int a = 0; a < 3; a++)            /* R^T v */
+	for (int a = 0; a < 3; a++) /* R^T v */
 		v_dev[a] = rot[a] * v_obj[0] + rot[3 + a] * v_obj[1] + rot[6 + a] * v_obj[2];
 	for (int k = 0; k < n; k++) {
 		double p[3], e[3];
@@ -721,7 +726,7 @@ static void test_clamp(void **state)
 	/* the force clamp */
 	contact_rig(&r, small_force, f_lim);
 	const struct irdm_ctrl_device_output *o = &r.out.dev[0];
-	assert_true(irdm_v3_norm(o->force_obj_n) > 2 * f_lim);  /* it did bind */
+	assert_true(irdm_v3_norm(o->force_obj_n) > 2 * f_lim); /* it did bind */
 	assert_true(r.out.faults & IRDM_FAULT_CLAMP);
 	assert_false(r.out.new_faults & IRDM_FAULT_CLAMP);
 	assert_int_equal(r.ctrl.safety.faults, 0);
@@ -767,8 +772,7 @@ static void no_gravity(struct irdm_ctrl_config *cfg, double unused)
  */
 static void test_force_to_torque_virtual_work(void **state)
 {
-	static const double where[][2] = { { 0, 0 }, { -0.012, 0.008 }, { 0.013, -0.01 },
-					   { 0.006, 0.014 } };
+	static const double where[][2] = { { 0, 0 }, { -0.012, 0.008 }, { 0.013, -0.01 }, { 0.006, 0.014 } };
 	const double h = 1e-6;
 	double worst = 0;
 	(void)state;
@@ -801,7 +805,7 @@ static void test_force_to_torque_virtual_work(void **state)
 				dx[a] = (xp[a] - xm[a]) / (2 * h);
 			ref = irdm_v3_dot(o->force_n, dx);
 			worst = fmax(worst, fabs(o->torque_nm[j] - ref) /
-				     (irdm_v3_norm(o->force_n) * 0.27));
+						    (irdm_v3_norm(o->force_n) * 0.27));
 		}
 		rig_close(&r);
 	}
@@ -826,7 +830,7 @@ static double hold_drift(bool enable)
 	rig_config(&r, 1);
 	memcpy(r.cfg.device[0].calib_q_rad, q0, sizeof(q0));
 	rig_open(&r);
-	r.cfg.obj_offset_m[2] += 1.0;           /* the object a metre away */
+	r.cfg.obj_offset_m[2] += 1.0; /* the object a metre away */
 	assert_int_equal(irdm_ctrl_init(&r.ctrl, &r.cfg, r.s), IRDM_OK);
 	irdm_sim_params_default(&sp);
 	memcpy(sp.q0_rad, q0, sizeof(q0));
@@ -841,14 +845,14 @@ static double hold_drift(bool enable)
 		assert_int_equal(tick(&r), IRDM_OK);
 		assert_int_equal(irdm_sim_device_set_torque(&sim, r.out.dev[0].torque_nm), IRDM_OK);
 		if (k == 0)
-			continue;       /* held in its calibration rest until enabled */
+			continue; /* held in its calibration rest until enabled */
 		assert_int_equal(irdm_sim_device_step(&sim, PERIOD_US * 1e-6), IRDM_OK);
 		irdm_sim_device_state(&sim, q, qd);
 		irdm_device_fk(&r.cfg.device[0].dev, q, tip);
 		irdm_v3_sub(d, tip, tip0);
 		drift = fmax(drift, irdm_v3_norm(d));
 		if (drift > 0.02)
-			break;          /* fallen: before it leaves the encoders' range */
+			break; /* fallen: before it leaves the encoders' range */
 	}
 	assert_int_equal(r.out.state, enable ? IRDM_SAFETY_ENABLED : IRDM_SAFETY_READY);
 	assert_false(r.out.dev[0].contact);
@@ -918,7 +922,7 @@ static void test_proxy_follows_and_releases(void **state)
 	print_message("  touch after %d ticks, %d bounces, settled %d ticks after the touch\n",
 		      touch_at, bounces, settled_at - touch_at);
 	assert_true(settled_at - touch_at <= 60);
-	assert_true(k - settled_at >= 60);               /* then in contact for good */
+	assert_true(k - settled_at >= 60); /* then in contact for good */
 	assert_true(r.out.dev[0].contact);
 	/* pushed: the object is pushed down, the device up (device +y) */
 	assert_true(r.out.dev[0].force_obj_n[2] < 0);
@@ -1052,7 +1056,7 @@ static void test_two_devices_two_contacts(void **state)
 		put(&r, 1, p);
 		assert_int_equal(tick(&r), IRDM_OK);
 	}
-	for (int k = 0; k < 200; k++)           /* settled (the first touch bounces) */
+	for (int k = 0; k < 200; k++) /* settled (the first touch bounces) */
 		assert_int_equal(tick(&r), IRDM_OK);
 	for (unsigned i = 0; i < 2; i++) {
 		const struct irdm_ctrl_device_output *o = &r.out.dev[i];
@@ -1113,7 +1117,7 @@ static void test_rigid_coupling_reproduces_the_engine(void **state)
 	rig_enable(&r);
 	approach(&r, 0, -0.01, 0.003);
 	memset(cmd, 0, sizeof(cmd));
-	for (uint64_t k = 0; k < r.out.tick; k++)      /* the set-up ticks: no contact */
+	for (uint64_t k = 0; k < r.out.tick; k++) /* the set-up ticks: no contact */
 		assert_int_equal(irdm_engine_tick(ref->eng, cmd), IRDM_OK);
 	/* down, across, up, over, down again, up: 1600 ticks */
 	for (int k = 0; k < 1600; k++) {
@@ -1155,7 +1159,7 @@ static void test_rigid_coupling_reproduces_the_engine(void **state)
 		      n, f_peak, touches, worst, worst / f_peak, worst_p);
 	irdm_session_close(ref);
 	rig_close(&r);
-	assert_true(touches >= 2);                       /* two presses (and bounces) */
+	assert_true(touches >= 2); /* two presses (and bounces) */
 	assert_true(n > 500);
 	assert_true(f_peak > 0);
 	assert_true(worst <= 1e-9 * f_peak);
@@ -1168,7 +1172,7 @@ struct rt_result {
 	uint32_t magic;
 	int prctl_errno;
 	unsigned long ticks, bad, touches, slides, site_changes, releases, faults, resets,
-		      holds, nonzero_in_fault, allocs;
+		holds, nonzero_in_fault, allocs;
 	double max_f;
 };
 
@@ -1222,23 +1226,23 @@ static void rt_cycle(struct rig *r, struct rt_result *res)
 	uint32_t tri = UINT32_MAX;
 	double bary[3] = { 0 };
 
-	rt_move(r, res, -0.01, GAP_M, -0.01, GAP_M, 20, &tri, bary);          /* free */
-	rt_move(r, res, -0.01, GAP_M, -0.01, -0.0015, 100, &tri, bary);       /* touch */
-	rt_move(r, res, -0.01, -0.0015, 0.01, -0.0015, 400, &tri, bary);      /* slide */
-	r->in.prev_compute_ns = PERIOD_NS + 1;                               /* overrun */
+	rt_move(r, res, -0.01, GAP_M, -0.01, GAP_M, 20, &tri, bary);     /* free */
+	rt_move(r, res, -0.01, GAP_M, -0.01, -0.0015, 100, &tri, bary);  /* touch */
+	rt_move(r, res, -0.01, -0.0015, 0.01, -0.0015, 400, &tri, bary); /* slide */
+	r->in.prev_compute_ns = PERIOD_NS + 1;                           /* overrun */
 	rt_move(r, res, 0.01, -0.0015, 0.01, -0.0015, 1, &tri, bary);
-	rt_move(r, res, 0.01, -0.0015, 0.01, GAP_M, 200, &tri, bary);         /* release */
+	rt_move(r, res, 0.01, -0.0015, 0.01, GAP_M, 200, &tri, bary); /* release */
 	rt_move(r, res, 0.01, GAP_M, -0.01, GAP_M, 200, &tri, bary);
-	r->in.counts[0][0] = IRDM_CTRL_COUNT_NAN;                            /* fault */
+	r->in.counts[0][0] = IRDM_CTRL_COUNT_NAN; /* fault */
 	rt_tick(r, res, &tri, bary);
 	res->faults += r->out.state == IRDM_SAFETY_FAULT;
 	rt_move(r, res, -0.01, GAP_M, -0.01, GAP_M, 1, &tri, bary);
-	r->in.cmd = IRDM_CTRL_CMD_RESET;                                      /* reset */
+	r->in.cmd = IRDM_CTRL_CMD_RESET; /* reset */
 	rt_tick(r, res, &tri, bary);
 	res->resets += r->out.state == IRDM_SAFETY_READY;
 	r->in.cmd = IRDM_CTRL_CMD_ENABLE;
 	rt_tick(r, res, &tri, bary);
-	r->in.prev_compute_ns = 1000000000ull;                               /* watchdog */
+	r->in.prev_compute_ns = 1000000000ull; /* watchdog */
 	rt_tick(r, res, &tri, bary);
 	res->faults += r->out.state == IRDM_SAFETY_FAULT;
 	r->in.cmd = IRDM_CTRL_CMD_RESET | IRDM_CTRL_CMD_ENABLE;
@@ -1266,7 +1270,7 @@ static void rt_stop(struct rig *r, struct rt_result *res)
 
 struct strict_job {
 	struct rig *r;
-	bool slip;              /* make one system call: the control */
+	bool slip; /* make one system call: the control */
 };
 
 /* Exit status 0, or killed by SIGKILL if it made a system call. */
@@ -1275,7 +1279,7 @@ static void strict_child(void *arg, int fd)
 	const struct strict_job *job = arg;
 	struct rt_result res = { .magic = RT_MAGIC }, warm = { 0 };
 
-	rt_cycle(job->r, &warm);        /* every path once: first touches done */
+	rt_cycle(job->r, &warm); /* every path once: first touches done */
 	res.prctl_errno = strict_enter();
 	if (res.prctl_errno)
 		strict_exit(fd, &res, sizeof(res), STRICT_UNAVAILABLE);
@@ -1293,10 +1297,10 @@ static void strict_child(void *arg, int fd)
 /* An image and an engine configuration the strict-mode run covers. */
 struct rt_variant {
 	const char *name;
-	const char *path;               /* NULL: IRDM_TICK_IMAGE */
+	const char *path; /* NULL: IRDM_TICK_IMAGE */
 	enum irdm_solve_mode solve;
-	bool rigid;                     /* coupling_k = 0 */
-	bool floating;                  /* the object drifts off: fewer touches */
+	bool rigid;    /* coupling_k = 0 */
+	bool floating; /* the object drifts off: fewer touches */
 };
 
 static char rt_dir[64];

@@ -40,7 +40,14 @@
 
 void openblas_set_num_threads(int n);
 
-enum { IMG_MODAL64, IMG_MODAL32, IMG_MODAL16, IMG_FIR, IMG_FLOAT, IMG_CL64, IMG_CL32, IMG_N };
+enum { IMG_MODAL64,
+       IMG_MODAL32,
+       IMG_MODAL16,
+       IMG_FIR,
+       IMG_FLOAT,
+       IMG_CL64,
+       IMG_CL32,
+       IMG_N };
 
 static const char *const scene_kv[IMG_N][16] = {
 	[IMG_MODAL64] = { "mesh", "box:0.1,0.1,0.2", "resolution", "2,2,4", "representation",
@@ -73,11 +80,12 @@ static struct irdm_image images[IMG_N];
 /* ---- fixtures ---------------------------------------------------------- */
 
 /* cmocka 1.1 has no assert_double_equal */
-#define assert_close(a, b, tol) do { \
-	double a_ = (a), b_ = (b); \
-	if (!(fabs(a_ - b_) <= (tol))) \
-		fail_msg("%s = %.17g, expected %.17g (tolerance %g)", #a, a_, b_, (double)(tol)); \
-} while (0)
+#define assert_close(a, b, tol) \
+	do { \
+		double a_ = (a), b_ = (b); \
+		if (!(fabs(a_ - b_) <= (tol))) \
+			fail_msg("%s = %.17g, expected %.17g (tolerance %g)", #a, a_, b_, (double)(tol)); \
+	} while (0)
 
 static int build_image(int which, char *err, size_t errlen)
 {
@@ -87,7 +95,7 @@ static int build_image(int which, char *err, size_t errlen)
 	char path[128];
 
 	irdm_scene_defaults(&sc);
-	sc.max_error = 0;       /* not what is tested here */
+	sc.max_error = 0; /* not what is tested here */
 	for (const char *const *kv = scene_kv[which]; *kv; kv += 2)
 		if (irdm_scene_set(&sc, kv[0], kv[1], "test", err, errlen))
 			return -1;
@@ -137,8 +145,8 @@ static int group_teardown(void **state)
  */
 struct ctx {
 	struct irdm_session *s;
-	struct irdm_deform *d;              /* the session's channel */
-	struct irdm_deform_worker *w;       /* and its worker */
+	struct irdm_deform *d;        /* the session's channel */
+	struct irdm_deform_worker *w; /* and its worker */
 	double *pos;
 	const struct irdm_image *img;
 };
@@ -180,7 +188,7 @@ static double uniform(void)
 
 struct history {
 	uint32_t col[N_FORCE];
-	double f[N_TICKS][N_FORCE][3];      /* N */
+	double f[N_TICKS][N_FORCE][3]; /* N */
 };
 
 static void random_history(const struct irdm_image *img, struct history *h)
@@ -241,7 +249,7 @@ static void reference_disp(const struct irdm_image *img, const struct history *h
 				for (int i = 0; i < 3; i++)
 					for (int j = 0; j < 3; j++)
 						u[3 * r + (uint32_t)i] += R[9 * s + 3 * i + j] *
-							h->f[N_TICKS - 1 - s][e][j];
+									  h->f[N_TICKS - 1 - s][e][j];
 		}
 	free(R);
 }
@@ -277,8 +285,8 @@ static double modal_case(int which)
 	assert_non_null(h);
 	assert_non_null(x);
 	assert_non_null(uref);
-	assert_non_null(img->corr_start);       /* the default scene keeps it, */
-	assert_true(img->corr_rank > 0);        /* and its far field */
+	assert_non_null(img->corr_start); /* the default scene keeps it, */
+	assert_true(img->corr_rank > 0);  /* and its far field */
 	random_history(img, h);
 	modal_states(img, h, x);
 	reference_disp(img, h, uref);
@@ -328,9 +336,9 @@ static void test_fir(void **state)
 	assert_non_null(h);
 	assert_non_null(ticks);
 	assert_non_null(uref);
-	assert_true(T < N_TICKS);                /* the ring wraps: head is not T - 1 */
+	assert_true(T < N_TICKS); /* the ring wraps: head is not T - 1 */
 	random_history(img, h);
-	reference_disp(img, h, uref);            /* zeros past T: the whole history */
+	reference_disp(img, h, uref); /* zeros past T: the whole history */
 	for (int t = 0; t < N_TICKS; t++) {
 		ring.head = (uint32_t)t % T;
 		force_tick(h, t, &ticks[ring.head]);
@@ -723,9 +731,9 @@ static void test_misaligned_memory(void **state)
  * t w with w the displacement of tick 1.  A snapshot mixing two ticks is off
  * by a relative |t1 - t2| / t >> 1e-9.
  */
-#define HAMMER_FRAMES 20000            /* frames the reader checks */
-#define HAMMER_MAX_TICKS 100000000ull   /* writer's bound if the reader stalls */
-#define HAMMER_SECONDS 1.5              /* or this long */
+#define HAMMER_FRAMES 20000           /* frames the reader checks */
+#define HAMMER_MAX_TICKS 100000000ull /* writer's bound if the reader stalls */
+#define HAMMER_SECONDS 1.5            /* or this long */
 
 static double now_s(void)
 {
@@ -738,9 +746,9 @@ static double now_s(void)
 struct hammer {
 	struct irdm_deform *d;
 	uint32_t K, col;
-	atomic_bool enough;                 /* reader -> writer: stop */
-	atomic_bool done;                   /* writer -> reader */
-	atomic_uint_fast64_t last;          /* writer's last tick */
+	atomic_bool enough;        /* reader -> writer: stop */
+	atomic_bool done;          /* writer -> reader */
+	atomic_uint_fast64_t last; /* writer's last tick */
 };
 
 static void hammer_state(uint64_t t, uint32_t K, uint32_t col, double *x,
@@ -825,7 +833,7 @@ static void test_no_torn_snapshot(void **state)
 	while (!atomic_load(&hm.done)) {
 		if (!irdm_deform_update(c.w, c.pos, &tick))
 			continue;
-		assert_true(tick > last);         /* never an old one again */
+		assert_true(tick > last); /* never an old one again */
 		check_linear(img, c.pos, w, wmax, tick);
 		last = tick;
 		if (++frames == HAMMER_FRAMES || now_s() > t_end)

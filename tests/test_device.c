@@ -87,8 +87,7 @@ static void test_fk_hand_poses(void **state)
 	/* yaw 30 deg, upper arm 30 deg up, forearm 60 deg from vertical:
 	 * r = 0.1 cos30 + 0.2 sin60 = 0.15 s3, h = 0.1 sin30 - 0.2 cos60 = -0.05 */
 	irdm_device_fk(&c, (double[3]){ PI / 6, PI / 6, PI / 3 }, tip);
-	assert_vec_near(tip, (double[3]){ 0.01 + 0.15 * s3 * 0.5, 0.02 - 0.05,
-					  0.03 + 0.15 * s3 * s3 / 2 }, 1e-15);
+	assert_vec_near(tip, (double[3]){ 0.01 + 0.15 * s3 * 0.5, 0.02 - 0.05, 0.03 + 0.15 * s3 * s3 / 2 }, 1e-15);
 }
 
 /* ---- Jacobian and J^T ------------------------------------------------------ */
@@ -128,7 +127,7 @@ static void test_jacobian_fd(void **state)
 	/* central differences at h = 1e-5: truncation l h^2 / 6 ~ 5e-12 m/rad,
 	 * round-off 1e-16 * 0.3 m / 1e-5 ~ 3e-12; measured below */
 	printf("jacobian vs central FD (64 poses, h 1e-5): max |error| %.3g m/rad\n", worst);
-	assert_true(worst < 3e-11);        /* 6.5e-12 measured: 5x */
+	assert_true(worst < 3e-11); /* 6.5e-12 measured: 5x */
 }
 
 static void test_transpose_virtual_work(void **state)
@@ -154,14 +153,14 @@ static void test_transpose_virtual_work(void **state)
 		irdm_device_fk(&c, qm, pm);
 		for (int i = 0; i < 3; i++) {
 			w_joint += tau[i] * dq[i];
-			w_tip += f[i] * (pp[i] - pm[i]) / 2;    /* F . dx, centred */
+			w_tip += f[i] * (pp[i] - pm[i]) / 2; /* F . dx, centred */
 			scale += fabs(tau[i] * dq[i]);
 		}
 		worst = fmax(worst, fabs(w_joint - w_tip) / scale);
 	}
 	/* the centred dx is exact to O(dq^3): relative ~ 1e-9 at dq 1e-4 */
 	printf("virtual work tau.dq vs F.dx (64 poses): max relative error %.3g\n", worst);
-	assert_true(worst < 1e-8);         /* 4.5e-9 measured: 2x */
+	assert_true(worst < 1e-8); /* 4.5e-9 measured: 2x */
 }
 
 /* ---- saturation ------------------------------------------------------------ */
@@ -236,7 +235,7 @@ static void test_saturation_keeps_direction(void **state)
 		double f[3], tau[3], out[3], fo[3], s;
 
 		for (int i = 0; i < 3; i++)
-			f[i] = uniform(-12, 12);        /* up to 1.5x the device's force */
+			f[i] = uniform(-12, 12); /* up to 1.5x the device's force */
 		irdm_device_force_to_torque(&c, q, f, tau);
 		assert_int_equal(irdm_device_torque_saturate(&c, tau, out, &s), IRDM_OK);
 		assert_true(fabs(s - bisect_scale(lim, tau)) <= 1e-12);
@@ -252,8 +251,8 @@ static void test_saturation_keeps_direction(void **state)
 	}
 	printf("saturation: %d of 200 saturated, worst force turn %.3g rad\n", saturated,
 	       worst_angle);
-	assert_true(saturated > 20 && saturated < 180);       /* both cases */
-	assert_true(worst_angle < 1e-14);  /* 3e-16 measured: round-off of the test's solve */
+	assert_true(saturated > 20 && saturated < 180); /* both cases */
+	assert_true(worst_angle < 1e-14);               /* 3e-16 measured: round-off of the test's solve */
 }
 
 static void test_saturation_edges(void **state)
@@ -270,7 +269,8 @@ static void test_saturation_edges(void **state)
 	assert_memory_equal(out, inside, sizeof(out));
 	/* one joint at twice its limit: everything halves (clipping would not) */
 	assert_int_equal(irdm_device_torque_saturate(&c, (double[3]){ 0.5, 2 * 1.07, -0.2 }, out,
-						     &s), IRDM_OK);
+						     &s),
+			 IRDM_OK);
 	assert_true(fabs(s - 0.5) < 1e-15);
 	assert_true(fabs(out[0] - 0.25) < 1e-15 && fabs(out[2] + 0.1) < 1e-15);
 	/* non-finite: zero torque and EFAULT */
@@ -288,9 +288,9 @@ static void test_saturation_edges(void **state)
 static double potential(const struct irdm_device_config *c, const double q[3])
 {
 	double elbow_y = c->l1_m * sin(q[1]);
-	double y0 = c->com_m[0] * sin(q[1]);                    /* along the upper arm */
-	double y1 = elbow_y - c->com_m[1] * cos(q[2]);          /* along the forearm */
-	double y2 = -c->com_m[2] * cos(q[2]);                   /* with theta3, from the shoulder */
+	double y0 = c->com_m[0] * sin(q[1]);           /* along the upper arm */
+	double y1 = elbow_y - c->com_m[1] * cos(q[2]); /* along the forearm */
+	double y2 = -c->com_m[2] * cos(q[2]);          /* with theta3, from the shoulder */
 
 	return c->gravity_m_per_s2 * (c->mass_kg[0] * y0 + c->mass_kg[1] * y1 + c->mass_kg[2] * y2);
 }
@@ -320,7 +320,7 @@ static void test_gravity_fd(void **state)
 	printf("gravity torque vs dU/dq (64 poses): max |error| %.3g N m (torques up to %.3g)\n",
 	       worst, biggest);
 	assert_true(biggest > 0.05);
-	assert_true(worst < 1e-11);        /* 1.9e-12 measured: 5x */
+	assert_true(worst < 1e-11); /* 1.9e-12 measured: 5x */
 }
 
 /* ---- encoders -------------------------------------------------------------- */
@@ -398,9 +398,9 @@ static void test_encoder_rejects(void **state)
 		assert_int_equal(irdm_device_counts_from_angles(&c, qb, n), IRDM_EFAULT);
 		qb[i] = -INFINITY;
 		assert_int_equal(irdm_device_counts_from_angles(&c, qb, n), IRDM_EFAULT);
-		qb[i] = 1e300;          /* past any int32 count */
+		qb[i] = 1e300; /* past any int32 count */
 		assert_int_equal(irdm_device_counts_from_angles(&c, qb, n), IRDM_EFAULT);
-		qb[i] = 1.0;            /* past the joint's range */
+		qb[i] = 1.0; /* past the joint's range */
 		assert_int_equal(irdm_device_counts_from_angles(&c, qb, n), IRDM_EFAULT);
 	}
 	/* a failed call leaves its output alone */

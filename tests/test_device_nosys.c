@@ -72,8 +72,7 @@ static int tick(unsigned k)
 static void setup_rig(void)
 {
 	irdm_device_config_default(&device);
-	cfg = (struct irdm_hal_config){ .device = &device, .options = "write_delay=1",
-					.period_s = 1e-3 };
+	cfg = (struct irdm_hal_config){ .device = &device, .options = "write_delay=1", .period_s = 1e-3 };
 	assert_int_equal(irdm_hal_register(&irdm_hal_sim_backend), IRDM_OK);
 	assert_int_equal(irdm_hal_init(&dev, "sim", &cfg, mem, sizeof(mem)), IRDM_OK);
 	assert_int_equal(irdm_hal_open(&dev), IRDM_OK);
@@ -89,7 +88,7 @@ static __attribute__((noreturn)) void strict_child(int slip_syscall)
 {
 	int bad = 0;
 
-	signal(SIGABRT, SIG_DFL);       /* a crash must not look like a kill */
+	signal(SIGABRT, SIG_DFL); /* a crash must not look like a kill */
 	if (prctl(PR_SET_SECCOMP, SECCOMP_MODE_STRICT, 0, 0, 0))
 		_exit(errno == EINVAL ? 2 : 3);
 	for (unsigned k = 0; k < TICKS; k++) {

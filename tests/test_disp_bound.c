@@ -116,7 +116,7 @@ static struct ratio run(const char *name, const struct irdm_image *img)
 	for (unsigned i = 0; i < 2; i++)
 		assert_int_equal(irdm_engine_site_node(e, efx_column_row_near(img, at[i]), &site[i]),
 				 IRDM_OK);
-	assert_true(irdm_engine_disp_bound(e) == 0);    /* at rest */
+	assert_true(irdm_engine_disp_bound(e) == 0); /* at rest */
 	for (size_t t = 0; t < N_TICKS; t++) {
 		double b = irdm_engine_disp_bound(e), mx = brute_max(e, img->meta->n_nodes);
 
@@ -133,7 +133,8 @@ static struct ratio run(const char *name, const struct irdm_image *img)
 		for (unsigned i = 0; i < 2 && t < PUSH_END; i++) {
 			if (irdm_engine_contact(e, i)->mode == IRDM_CONTACT_OFF)
 				assert_int_equal(irdm_engine_contact_begin(e, i, &site[i],
-									   IRDM_CONTACT_GRAB), 0);
+									   IRDM_CONTACT_GRAB),
+						 0);
 			cmd[i].mode = IRDM_CONTACT_GRAB;
 			target(i, t, cmd[i].target_m);
 		}
@@ -144,7 +145,7 @@ static struct ratio run(const char *name, const struct irdm_image *img)
 	}
 	printf("disp bound %-24s peak max|u| %.3e m, bound/max: mean %.2f, worst %.2f, best %.9f (%zu ticks)\n",
 	       name, peak, q.n ? q.sum / (double)q.n : 0, q.worst, q.best, q.n);
-	assert_true(peak > 1e-4);               /* the scenario did move the surface */
+	assert_true(peak > 1e-4); /* the scenario did move the surface */
 	assert_true(q.n > 0 && q.worst < LOOSE_MAX);
 	irdm_session_close(ses);
 	return q;

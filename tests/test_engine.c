@@ -37,7 +37,7 @@ static struct irdm_image hybrid;
 /* modal:40 with the clustered correction (clusters of at most 8 columns,
  * tol 1e-2, the upper half touchable), f32: every block from the clusters, dense and low-rank pairs */
 static struct irdm_image clustered;
-static struct irdm_image fir[3];                /* fir:200 f64, f32, f16 */
+static struct irdm_image fir[3]; /* fir:200 f64, f32, f16 */
 static const char *const fir_prec[3] = { "f64", "f32", "f16" };
 
 #define N_STEP 2000
@@ -83,12 +83,12 @@ static int setup(void **state)
 			n_lowrank += irdm_image_corr_pair(&clustered, a, b)->rank != IRDM_CORR_PAIR_DENSE;
 	print_message("clustered: %u clusters, %u low-rank pairs\n", nC, n_lowrank);
 	if (!n_lowrank)
-		return -1;      /* the tick must read low-rank pairs */
+		return -1; /* the tick must read low-rank pairs */
 	uint32_t nc = trunc32.meta->n_cols;
 	print_message("modal 40: %u of %u static-correction blocks kept, far field rank %u\n",
 		      trunc32.corr_start[nc], nc * nc, trunc32.corr_rank);
 	if (trunc32.corr_start[nc] >= nc * nc || trunc32.corr_rank == 0)
-		return -1;      /* the tick must meet dropped blocks and the far field */
+		return -1; /* the tick must meet dropped blocks and the far field */
 	for (int k = 0; k < 3; k++) {
 		snprintf(p1, sizeof(p1), "%s/fir-%s.img", dir, fir_prec[k]);
 		efx_image(&fir[k], p1, "resolution", "4,4,8", "representation", "fir:200", "uncertified", "yes",
@@ -321,17 +321,19 @@ static void test_two_points(void **state)
 
 	(void)state;
 	for (size_t t = 0; t < N; t++)
-		u[6 * t + 5] = -0.01 * fmin(1.0, (double)t / 1000.0);   /* b ramps to 1 cm */
+		u[6 * t + 5] = -0.01 * fmin(1.0, (double)t / 1000.0); /* b ramps to 1 cm */
 	for (int pass = 0; pass < 4; pass++) {
 		static const char *const what[4] = { "two points, modal f64", "two points, modal 40 f32",
 						     "two points, hybrid 300 + 32 f32",
 						     "two points, modal 40 + clustered f32" };
 		const struct irdm_image *img = pass == 3 ? &clustered : pass == 2 ? &hybrid :
-					       pass ? &trunc32 : &exact;
+								pass              ? &trunc32 :
+										    &exact;
 		node_site(img, a, &s[0]);
 		node_site(img, b, &s[1]);
 		compare(what[pass], img, s, 2, N, u,
-			pass == 2 ? TOL_HYBRID : pass ? TOL_MODAL_F32 : TOL_MODAL_F64);
+			pass == 2 ? TOL_HYBRID : pass ? TOL_MODAL_F32 :
+							TOL_MODAL_F64);
 	}
 	/* the held point's force grows as the other is pushed (the ring-down
 	 * wobbles, so compare averages) */
@@ -374,10 +376,12 @@ static void test_fir(void **state)
 			u[3 * t + (size_t)a] = t < 500 ? (a == 2 ? -0.01 : 0) : NAN;
 	for (size_t t = 0; t < N; t++)
 		for (int a = 0; a < 6; a++)
-			u2[6 * t + (size_t)a] = t < 500 ? (a == 2 ? -0.01 : a == 5 ? -0.006 : 0) : NAN;
+			u2[6 * t + (size_t)a] = t < 500 ? (a == 2 ? -0.01 : a == 5 ? -0.006 :
+										     0) :
+							  NAN;
 	for (int k = 0; k < 3; k++) {
 		assert_int_equal(fir[k].meta->representation, IRDM_REPR_FIR);
-		assert_true(fir_tail_r(&fir[k]) < 1.0);        /* the damped path runs */
+		assert_true(fir_tail_r(&fir[k]) < 1.0); /* the damped path runs */
 		node_site(&fir[k], top, &s);
 		snprintf(what, sizeof(what), "step + release, FIR 200 %s", fir_prec[k]);
 		compare(what, &fir[k], &s, 1, N, u, TOL_FIR);
@@ -385,7 +389,7 @@ static void test_fir(void **state)
 		 * (fir_sum.c: a pass of four, then one of two) */
 		point_site(&fir[k], pa, &tri[0]);
 		point_site(&fir[k], pb, &tri[1]);
-		assert_true(distinct_rows(tri, 2) > 4);         /* more than one pass */
+		assert_true(distinct_rows(tri, 2) > 4); /* more than one pass */
 		snprintf(what, sizeof(what), "two triangle points, FIR 200 %s", fir_prec[k]);
 		compare(what, &fir[k], tri, 2, N, u2, TOL_FIR);
 	}
@@ -427,7 +431,9 @@ static void test_fir_sum_paths(void **state)
 	irdm_session_close(ses);
 	for (size_t t = 0; t < N; t++)
 		for (int a = 0; a < 6; a++)
-			u[6 * t + (size_t)a] = t < 400 ? (a == 2 ? -0.01 : a == 5 ? -0.006 : 0) : NAN;
+			u[6 * t + (size_t)a] = t < 400 ? (a == 2 ? -0.01 : a == 5 ? -0.006 :
+										    0) :
+							 NAN;
 	for (int k = 0; k < 3; k++) {
 		for (int layout = 0; layout < 3; layout++) {
 			int m = layout ? 2 : 1;
@@ -539,8 +545,7 @@ static void test_coupling(void **state)
 	irdm_engine_config_default(&cfg);
 	cfg.coupling_k_n_per_m = 1000;
 	cfg.coupling_b_ns_per_m = 2.25;
-	struct efx_ref_opts o = { .tail_r = 1.0, .k_n_per_m = 1000, .b_ns_per_m = 2.25,
-				  .dt_s = exact.meta->dt_s };
+	struct efx_ref_opts o = { .tail_r = 1.0, .k_n_per_m = 1000, .b_ns_per_m = 2.25, .dt_s = exact.meta->dt_s };
 	double err = compare_mode("step through the coupling", cfg, &s, 1, N, u,
 				  IRDM_CONTACT_GRAB, &o, F, R, NULL);
 	print_message("coupled force after 1.5 s: %.4f N\n", F[3 * (N - 1) + 2]);
@@ -577,8 +582,7 @@ static void test_push_release(void **state)
 	irdm_engine_config_default(&cfg);
 	cfg.coupling_k_n_per_m = 1000;
 	cfg.coupling_b_ns_per_m = 2.25;
-	struct efx_ref_opts o = { .tail_r = 1.0, .push = 1, .normal = s.normal, .k_n_per_m = 1000,
-				  .b_ns_per_m = 2.25, .dt_s = exact.meta->dt_s };
+	struct efx_ref_opts o = { .tail_r = 1.0, .push = 1, .normal = s.normal, .k_n_per_m = 1000, .b_ns_per_m = 2.25, .dt_s = exact.meta->dt_s };
 	double err = compare_mode("push, lifted off", cfg, &s, 1, N, u, IRDM_CONTACT_PUSH, &o, F,
 				  R, &rel);
 	for (size_t t = 0; t < N && ref_rel == N; t++)
@@ -601,7 +605,7 @@ static void test_push_release(void **state)
 /* R[s] of (column, row) pairs, read from the image on first use */
 struct pair_cache {
 	uint32_t n_rows;
-	double **R;             /* n_cols x n_rows table of N_STROKE x 9 */
+	double **R; /* n_cols x n_rows table of N_STROKE x 9 */
 };
 
 static const double *pair(struct pair_cache *pc, const struct irdm_image *img, uint32_t col, uint32_t row)
@@ -625,8 +629,8 @@ static void stroke_reference(const struct irdm_image *img, const struct irdm_con
 {
 	struct pair_cache pc = { img->meta->n_nodes,
 				 calloc((size_t)img->meta->n_cols * img->meta->n_nodes, sizeof(double *)) };
-	uint32_t (*col)[3] = malloc(N_STROKE * sizeof(*col));
-	double (*fv)[3][3] = malloc(N_STROKE * sizeof(*fv));
+	uint32_t(*col)[3] = malloc(N_STROKE * sizeof(*col));
+	double(*fv)[3][3] = malloc(N_STROKE * sizeof(*fv));
 
 	for (size_t t = 0; t < N_STROKE; t++) {
 		const struct irdm_contact_site *st = &sites[t];
@@ -767,7 +771,7 @@ static void test_errors(void **state)
 	ses = efx_session(&exact, &cfg);
 	e = ses->eng;
 	assert_int_equal(irdm_engine_site_node(e, exact.meta->n_nodes, &site), IRDM_ECONTACT);
-	uint32_t row = 0;                       /* a displayed node nobody may touch */
+	uint32_t row = 0; /* a displayed node nobody may touch */
 	while (row < exact.meta->n_nodes && irdm_engine_site_node(e, row, &site) == IRDM_OK)
 		row++;
 	assert_true(row < exact.meta->n_nodes);
@@ -785,7 +789,7 @@ static void test_errors(void **state)
 	cmd[0].target_m[2] = NAN;
 	assert_int_equal(irdm_engine_tick(e, cmd), IRDM_EFAULT);
 	cmd[0].target_m[2] = -0.001;
-	assert_int_equal(irdm_engine_tick(e, cmd), IRDM_EFAULT);    /* held until reset */
+	assert_int_equal(irdm_engine_tick(e, cmd), IRDM_EFAULT); /* held until reset */
 	irdm_engine_reset(e);
 	assert_int_equal(irdm_engine_contact_begin(e, 0, &site, IRDM_CONTACT_GRAB), IRDM_OK);
 	assert_int_equal(irdm_engine_tick(e, cmd), IRDM_OK);

@@ -91,14 +91,41 @@ void openblas_set_num_threads(int n);
 
 /* ---- allocator and mapping interposition ---- */
 
-enum { I_MALLOC, I_CALLOC, I_REALLOC, I_REALLOCARRAY, I_FREE, I_ALIGNED_ALLOC,
-       I_POSIX_MEMALIGN, I_MEMALIGN, I_VALLOC, I_PVALLOC, I_MMAP, I_MMAP64, I_MUNMAP,
-       I_MREMAP, I_BRK, I_SBRK, I_COUNT };
+enum { I_MALLOC,
+       I_CALLOC,
+       I_REALLOC,
+       I_REALLOCARRAY,
+       I_FREE,
+       I_ALIGNED_ALLOC,
+       I_POSIX_MEMALIGN,
+       I_MEMALIGN,
+       I_VALLOC,
+       I_PVALLOC,
+       I_MMAP,
+       I_MMAP64,
+       I_MUNMAP,
+       I_MREMAP,
+       I_BRK,
+       I_SBRK,
+       I_COUNT };
 
 static const char *const fn_name[I_COUNT] = {
-	"malloc", "calloc", "realloc", "reallocarray", "free", "aligned_alloc",
-	"posix_memalign", "memalign", "valloc", "pvalloc", "mmap", "mmap64", "munmap",
-	"mremap", "brk", "sbrk",
+	"malloc",
+	"calloc",
+	"realloc",
+	"reallocarray",
+	"free",
+	"aligned_alloc",
+	"posix_memalign",
+	"memalign",
+	"valloc",
+	"pvalloc",
+	"mmap",
+	"mmap64",
+	"munmap",
+	"mremap",
+	"brk",
+	"sbrk",
 };
 
 static atomic_bool armed;
@@ -348,26 +375,26 @@ static struct irdm_image modal_img, fir_img, hybrid_img, clustered_img;
 
 struct rig {
 	const struct irdm_image *img;
-	struct irdm_session *s;        /* engine, deformation channel and worker */
-	struct irdm_engine *e;         /* the session's */
-	uint32_t push_row[4];          /* the push slides over these */
+	struct irdm_session *s; /* engine, deformation channel and worker */
+	struct irdm_engine *e;  /* the session's */
+	uint32_t push_row[4];   /* the push slides over these */
 	int n_push;
 	struct irdm_contact_site grab;
 	bool grab_on_tri;
-	uint64_t t;                    /* scenario time, ticks */
+	uint64_t t; /* scenario time, ticks */
 	struct irdm_contact_cmd cmd[IRDM_MAX_CONTACTS];
-	double *pos;                   /* the worker's frame, 3 n_nodes */
+	double *pos; /* the worker's frame, 3 n_nodes */
 };
 
 struct run_result {
 	uint32_t magic;
-	int prctl_errno;               /* seccomp child: prctl failed */
+	int prctl_errno; /* seccomp child: prctl failed */
 	unsigned long ticks_ok, ticks_bad, slides, retouches;
 	double max_f;
 	bool all_finite;
-	int nan_rc, nan_rc2;           /* the NaN-target ticks */
+	int nan_rc, nan_rc2; /* the NaN-target ticks */
 	bool nan_zero_force;
-	unsigned long alloc_calls;     /* seccomp child: counted while armed */
+	unsigned long alloc_calls; /* seccomp child: counted while armed */
 };
 
 #define RESULT_MAGIC 0x52545431u
@@ -402,7 +429,8 @@ static int tri_near(const struct irdm_image *img, const double p[3], const uint3
 			continue;
 		for (int a = 0; a < 3; a++) {
 			double c = (img->nodes[v[0]].pos_m[a] + img->nodes[v[1]].pos_m[a] +
-				    img->nodes[v[2]].pos_m[a]) / 3;
+				    img->nodes[v[2]].pos_m[a]) /
+				   3;
 			d += (c - p[a]) * (c - p[a]);
 		}
 		if (d < best) {
@@ -475,7 +503,7 @@ static int scenario_tick(struct rig *r, struct run_result *res)
 	struct irdm_engine *e = r->e;
 	struct irdm_contact_cmd *cmd = r->cmd;
 	const struct irdm_contact_state *c0 = irdm_engine_contact(e, 0);
-	double w = 2 * M_PI * (double)r->t * r->img->meta->dt_s;   /* rad at 1 Hz */
+	double w = 2 * M_PI * (double)r->t * r->img->meta->dt_s; /* rad at 1 Hz */
 	int rc;
 
 	if (r->t % SLIDE_EVERY == 0 || c0->mode == IRDM_CONTACT_OFF) {
@@ -636,7 +664,7 @@ static void check_update(const struct update_result *u, uint64_t ticks)
 	assert_true(u->updated);
 	assert_true(u->pos_finite);
 	assert_int_equal(u->tick % PUBLISH_EVERY, 0);
-	assert_true(u->tick + PUBLISH_EVERY > ticks - 1);   /* the newest, before the reset tick */
+	assert_true(u->tick + PUBLISH_EVERY > ticks - 1); /* the newest, before the reset tick */
 }
 
 static void alloc_and_fault_free(const struct irdm_image *img)
@@ -666,7 +694,7 @@ static void alloc_and_fault_free(const struct irdm_image *img)
 	memset(r.cmd, 0, sizeof(r.cmd));
 	int reset_rc = irdm_engine_tick(r.e, r.cmd);
 	uint64_t ticks = irdm_engine_stats(r.e)->ticks;
-	rig_free(&r);           /* before any assertion: no leak on failure */
+	rig_free(&r); /* before any assertion: no leak on failure */
 
 	check_result("armed", &res, N_TICKS);
 	if (RT_ASAN)
@@ -759,7 +787,8 @@ static void no_system_call(const struct irdm_image *img)
 	assert_int_equal(res.magic, RESULT_MAGIC);
 	check_result("seccomp strict", &res, N_TICKS);
 	print_message("  %d ticks in seccomp strict mode: no system call%s\n", N_TICKS,
-		      RT_ASAN ? "" : res.alloc_calls ? "" : ", no allocator call");
+		      RT_ASAN ? "" : res.alloc_calls ? "" :
+						       ", no allocator call");
 	if (!RT_ASAN)
 		assert_int_equal(res.alloc_calls, 0);
 }

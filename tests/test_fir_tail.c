@@ -29,9 +29,9 @@
 #include "support/engine_fixture.h"
 #include "irdm/posix/image_map.h"
 
-#define T_HEAD 500              /* the paper's T */
-#define L_TAIL 1000             /* fir_tail = window:1000 */
-#define N_HOLD 6000             /* 12 s at 2 ms */
+#define T_HEAD 500  /* the paper's T */
+#define L_TAIL 1000 /* fir_tail = window:1000 */
+#define N_HOLD 6000 /* 12 s at 2 ms */
 
 #define TOP_NODE "box:0.035,0.035,0.199,0.065,0.065,0.201"
 
@@ -123,7 +123,7 @@ static void hold(const struct irdm_image *img, size_t n, double *F)
 static void static_compliance_of(const struct irdm_image *img, uint32_t row, double S[9])
 {
 	const struct irdm_meta *m = img->meta;
-	const double *phi = img->mode_shapes;           /* f64: [row][3][mode] */
+	const double *phi = img->mode_shapes; /* f64: [row][3][mode] */
 
 	assert_int_equal(m->precision, IRDM_ELEM_F64);
 	assert_int_equal(m->n_modes, m->n_modes_total);
@@ -155,7 +155,7 @@ static struct figures measure(const double *F, const double *Fex, double f_stati
 	struct figures g = { 0 };
 
 	g.head = efx_rel_rms(F, Fex, 3 * T_HEAD);
-	g.second = efx_rel_rms(F, Fex, 3 * 500);         /* 1 s at 2 ms */
+	g.second = efx_rel_rms(F, Fex, 3 * 500); /* 1 s at 2 ms */
 	g.all = efx_rel_rms(F, Fex, 3 * N_HOLD);
 	g.held_pct = 100 * (F[3 * N_HOLD - 1] / f_static - 1);
 	for (size_t i = 0; i < 3 * N_HOLD; i++)
@@ -166,7 +166,8 @@ static struct figures measure(const double *F, const double *Fex, double f_stati
 static void print_figures(const char *what, const struct figures *g, double first100)
 {
 	print_message("%-28s first 100 ticks %.2e, first T %.2e, first 1 s %.2e, 12 s %.2e; "
-		      "held %+.3f %% of static; max |F| %.3f N\n", what, first100, g->head,
+		      "held %+.3f %% of static; max |F| %.3f N\n",
+		      what, first100, g->head,
 		      g->second, g->all, g->held_pct, g->max_abs);
 }
 
@@ -183,9 +184,9 @@ static void test_window_hold(void **state)
 	hold(&exact, N_HOLD, Fex);
 	print_message("static force %.6f N; exact force at 12 s %.6f N\n", f_static,
 		      Fex[3 * N_HOLD - 1]);
-	assert_true(fabs(Fex[3 * N_HOLD - 1] / f_static - 1) < 1e-3);   /* rung down */
+	assert_true(fabs(Fex[3 * N_HOLD - 1] / f_static - 1) < 1e-3); /* rung down */
 
-	hold(&bare, N_HOLD, F);         /* radius >= 1: the engine damps by r^s */
+	hold(&bare, N_HOLD, F); /* radius >= 1: the engine damps by r^s */
 	struct figures old = measure(F, Fex, f_static);
 	print_figures("old: tail damped by r^s", &old, efx_rel_rms(F, Fex, 300));
 	hold(&win, N_HOLD, F);

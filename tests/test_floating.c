@@ -42,9 +42,15 @@ static void quat_rotate(const double q[4], const double v[3], double o[3])
 {
 	double w = q[0], x = q[1], y = q[2], z = q[3];
 	double R[9] = {
-		1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y),
-		2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
-		2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y),
+		1 - 2 * (y * y + z * z),
+		2 * (x * y - w * z),
+		2 * (x * z + w * y),
+		2 * (x * y + w * z),
+		1 - 2 * (x * x + z * z),
+		2 * (y * z - w * x),
+		2 * (x * z - w * y),
+		2 * (y * z + w * x),
+		1 - 2 * (x * x + y * y),
 	};
 	for (int r = 0; r < 3; r++)
 		o[r] = R[3 * r] * v[0] + R[3 * r + 1] * v[1] + R[3 * r + 2] * v[2];
@@ -133,9 +139,9 @@ static void world_of(const struct body *b, const double p[3], double o[3])
 
 struct ref {
 	struct body b;
-	const double *R;        /* N x 9 responses of the contact node to itself */
-	double *fb;             /* N x 3 body-frame force history */
-	double rest[3];         /* contact rest point */
+	const double *R; /* N x 9 responses of the contact node to itself */
+	double *fb;      /* N x 3 body-frame force history */
+	double rest[3];  /* contact rest point */
 };
 
 /*
@@ -182,8 +188,7 @@ static void end_position(const struct ref *r, size_t t, const double F[3], doubl
 
 static void solve3(double a[9], double b[3])
 {
-	double d = a[0] * (a[4] * a[8] - a[5] * a[7]) - a[1] * (a[3] * a[8] - a[5] * a[6])
-		   + a[2] * (a[3] * a[7] - a[4] * a[6]);
+	double d = a[0] * (a[4] * a[8] - a[5] * a[7]) - a[1] * (a[3] * a[8] - a[5] * a[6]) + a[2] * (a[3] * a[7] - a[4] * a[6]);
 	double x[3];
 	x[0] = (b[0] * (a[4] * a[8] - a[5] * a[7]) - a[1] * (b[1] * a[8] - a[5] * b[2]) + a[2] * (b[1] * a[7] - a[4] * b[2])) / d;
 	x[1] = (a[0] * (b[1] * a[8] - a[5] * b[2]) - b[0] * (a[3] * a[8] - a[5] * a[6]) + a[2] * (a[3] * b[2] - b[1] * a[6])) / d;
@@ -257,7 +262,7 @@ static void reference(const struct irdm_contact_site *site, const double *target
 
 /* The run; with keep, the session stays open (the caller closes it). */
 static struct irdm_session *engine_run_keep(const struct irdm_contact_site *site,
-					   const double *target, double *F, bool keep)
+					    const double *target, double *F, bool keep)
 {
 	struct irdm_engine_config cfg;
 	struct irdm_contact_cmd cmd[IRDM_MAX_CONTACTS];
@@ -399,8 +404,9 @@ static void test_frames(void **state)
 		}
 	}
 	print_message("frames: points moved up to %.2e m; object->world vs reference %.2e m; "
-		      "round trip %.2e m\n", moved, worst, round);
-	assert_true(moved > 1e-3);      /* the test means something: the cube has moved */
+		      "round trip %.2e m\n",
+		      moved, worst, round);
+	assert_true(moved > 1e-3); /* the test means something: the cube has moved */
 	assert_true(worst <= 1e-6);
 	assert_true(round <= 1e-15);
 	irdm_session_close(ses);

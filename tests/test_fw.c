@@ -147,10 +147,10 @@ static void test_generated_docs_current(void **state)
 		fail_msg("docs/boards.md's key table is not what `irdm-fw --doc boards` writes");
 	assert_int_equal(run_fw((const char *const[]){ "--help-board", NULL }), 0);
 	assert_non_null(strstr(out_text, "  watchdog_us = N           one tick longer than this "
-				   "faults; > period_us\n                            "
-				   "(default 5000); 1 <= watchdog_us <= 1000000 us\n"));
+					 "faults; > period_us\n                            "
+					 "(default 5000); 1 <= watchdog_us <= 1000000 us\n"));
 	assert_non_null(strstr(out_text, "hal_options of hal = sim (key=value words; "
-				   "docs/hal-options.md):\n  write_delay = K"));
+					 "docs/hal-options.md):\n  write_delay = K"));
 	assert_non_null(strstr(out_text, "hal_options of hal = canemu"));
 	assert_non_null(strstr(out_text, "hal_options of hal = socketcan"));
 }
@@ -213,24 +213,28 @@ static void test_bad_input(void **state)
 	(void)state;
 	expect_error(run_fw((const char *const[]){ "--image", image, NULL }), 2, "--board");
 	expect_error(run_fw((const char *const[]){ "--board", BOARD, "--image", image, "--frobnicate",
-						   "1", NULL }), 2, "frobnicate");
+						   "1", NULL }),
+		     2, "frobnicate");
 	expect_error(run_fw((const char *const[]){ "--board", BOARD, "--image", image, "--clock",
-						   "sundial", NULL }), 2, "sundial");
+						   "sundial", NULL }),
+		     2, "sundial");
 	expect_error(run_fw((const char *const[]){ "--board", "/nonexistent.board", "--image", image,
-						   NULL }), 3, "/nonexistent.board");
+						   NULL }),
+		     3, "/nonexistent.board");
 	snprintf(bad_board, sizeof(bad_board), "%s/bad.board", dir);
 	tf_write_text(bad_board, "name = x\nhal = sim\nperiod_us = -5\n");
 	expect_error(run_fw((const char *const[]){ "--board", bad_board, "--image", image, NULL }), 3,
 		     "bad.board:3");
 	expect_error(run_fw((const char *const[]){ "--board", BOARD, "--image", "/nonexistent.img",
-						   NULL }), 3, "EIO");
+						   NULL }),
+		     3, "EIO");
 	/* a 2 ms image on a 1 ms board */
 	snprintf(img2, sizeof(img2), "%s/dt2.img", dir);
 	{
 		pid_t p = spawn(env_or("IRDM", "build/irdm"), (const char *const[]){
-			"precompute", "-q", "--mesh", "cuboid", "--resolution", "2,2,4", "--fixed", "z<=0",
-			"--touch", "z>=0.2", "--display", "touch", "--representation", "modal:10",
-			"--dt", "0.002", "--max_error", "none", "-o", img2, NULL });
+								      "precompute", "-q", "--mesh", "cuboid", "--resolution", "2,2,4", "--fixed", "z<=0",
+								      "--touch", "z>=0.2", "--display", "touch", "--representation", "modal:10",
+								      "--dt", "0.002", "--max_error", "none", "-o", img2, NULL });
 		assert_int_equal(finish(p), 0);
 	}
 	expect_error(run_fw((const char *const[]){ "--board", BOARD, "--image", img2, NULL }), 3,
@@ -257,9 +261,11 @@ static void test_bad_input(void **state)
 			     3, "uses 2 hands, the board has 1 device");
 	}
 	expect_error(run_fw((const char *const[]){ "--board", BOARD, "--image", image, "--clock",
-						   "virtual", "--require-rt", NULL }), 2, "--require-rt");
+						   "virtual", "--require-rt", NULL }),
+		     2, "--require-rt");
 	expect_error(run_fw((const char *const[]){ "--board", BOARD, "--image", image,
-						   "--frame-at", "1", NULL }), 2, "--frame-out");
+						   "--frame-at", "1", NULL }),
+		     2, "--frame-out");
 	expect_error(run_fw((const char *const[]){ "--board", BOARD, "--image", image, "--clock",
 						   "virtual", "--duration", "1", "--frame-at", "2",
 						   "--frame-out", "/nonexistent/f.vtk", NULL }),
@@ -281,7 +287,8 @@ static void test_virtual_runs_are_identical(void **state)
 		snprintf(log[k], sizeof(log[k]), "%s/run%d.log", dir, k);
 		assert_int_equal(run_fw((const char *const[]){ "--board", BOARD, "--image", image,
 							       "--user", PRESS, "--clock", "virtual",
-							       "--log", log[k], "-q", NULL }), 0);
+							       "--log", log[k], "-q", NULL }),
+				 0);
 		bytes[k] = tf_load(log[k], &len[k]);
 	}
 	assert_int_equal(len[0], len[1]);
@@ -341,7 +348,8 @@ static void test_release_ringing_is_the_dominant_mode(void **state)
 
 	(void)state;
 	assert_int_equal(run_fw((const char *const[]){ "--board", BOARD, "--image", image, "--user",
-						       PRESS, "--clock", "virtual", NULL }), 0);
+						       PRESS, "--clock", "virtual", NULL }),
+			 0);
 	p = strstr(out_text, "release ringing: ");
 	assert_non_null(p);
 	assert_int_equal(sscanf(p, "release ringing: %lf Hz", &hz), 1);
@@ -375,11 +383,13 @@ static void test_summary_rendered_force(void **state)
 	snprintf(path, sizeof(path), "%s/weak.board", dir);
 	tf_write_text(path, out);
 	assert_int_equal(run_fw((const char *const[]){ "--board", path, "--image", image, "--user",
-						       PRESS, "--clock", "virtual", NULL }), 0);
+						       PRESS, "--clock", "virtual", NULL }),
+			 0);
 	p = strstr(out_text, "force: peak ");
 	assert_non_null(p);
 	assert_int_equal(sscanf(p, "force: peak %lf N at %lf s on the object, %lf N at %lf s rendered",
-				&obj, &at_obj, &rend, &at_rend), 4);
+				&obj, &at_obj, &rend, &at_rend),
+			 4);
 	print_message("summary: %.4f N on the object, %.4f N rendered (max_force_n 0.2 N)\n", obj,
 		      rend);
 	assert_true(obj > 0.25);
@@ -479,7 +489,7 @@ static void assert_off_with_zero_torque(const struct irdm_tick_record *last)
 static void signal_mid_contact(int sig, const char *name)
 {
 	char log[320], board[320], line[96];
-	struct timespec t = { 1, 700000000 };    /* 1.7 s: pressed and holding */
+	struct timespec t = { 1, 700000000 }; /* 1.7 s: pressed and holding */
 	struct irdm_tick_record last;
 	uint64_t n, contact_ticks;
 	pid_t pid;
@@ -488,8 +498,8 @@ static void signal_mid_contact(int sig, const char *name)
 	snprintf(log, sizeof(log), "%s/sig-%d.log", dir, sig);
 	relaxed_board(board, sizeof(board));
 	pid = spawn(env_or("IRDM_FW", "build/irdm-fw"), (const char *const[]){
-		"--board", board, "--image", image, "--user", PRESS, "--clock", "real",
-		"--log", log, NULL });
+								"--board", board, "--image", image, "--user", PRESS, "--clock", "real",
+								"--log", log, NULL });
 	nanosleep(&t, NULL);
 	kill(pid, sig);
 	rc = finish(pid);
@@ -502,7 +512,7 @@ static void signal_mid_contact(int sig, const char *name)
 	print_message("%s: %llu ticks logged, %llu in contact; last: state %u, faults 0x%x\n", name,
 		      (unsigned long long)n, (unsigned long long)contact_ticks, last.state,
 		      last.fault_flags);
-	assert_true(contact_ticks > 100);       /* the signal came mid-contact */
+	assert_true(contact_ticks > 100); /* the signal came mid-contact */
 	assert_off_with_zero_torque(&last);
 	assert_true(last.fault_flags & IRDM_FAULT_SIGNAL);
 }
@@ -562,8 +572,8 @@ static void test_sigxfsz_is_ignored(void **state)
 	snprintf(log, sizeof(log), "%s/xfsz.log", dir);
 	relaxed_board(board, sizeof(board));
 	pid = spawn(env_or("IRDM_FW", "build/irdm-fw"), (const char *const[]){
-		"--board", board, "--image", image, "--user", PRESS, "--clock", "real",
-		"--duration", "2.5", "--log", log, "-q", NULL });
+								"--board", board, "--image", image, "--user", PRESS, "--clock", "real",
+								"--duration", "2.5", "--log", log, "-q", NULL });
 	nanosleep(&t, NULL);
 	kill(pid, SIGXFSZ);
 	rc = finish(pid);
@@ -587,7 +597,7 @@ static void emergency_signal(int sig, const char *name)
 
 	relaxed_board(board, sizeof(board));
 	pid = spawn(env_or("IRDM_FW", "build/irdm-fw"), (const char *const[]){
-		"--board", board, "--image", image, "--user", PRESS, "--clock", "real", NULL });
+								"--board", board, "--image", image, "--user", PRESS, "--clock", "real", NULL });
 	nanosleep(&t, NULL);
 	kill(pid, sig);
 	rc = finish(pid);
@@ -643,7 +653,7 @@ static void test_signals_during_setup_enable_nothing(void **state)
 		sigaddset(&set, SIGTERM);
 		sigaddset(&set, SIGINT);
 		sigprocmask(SIG_BLOCK, &set, NULL);
-		raise(SIGTERM);         /* pending across exec */
+		raise(SIGTERM); /* pending across exec */
 		raise(SIGINT);
 		execl(prog, prog, "--board", BOARD, "--image", image, "--user", PRESS, "--clock",
 		      "virtual", "--log", log, (char *)NULL);
@@ -694,7 +704,7 @@ static void scribble_over(const char *path)
 static void image_changed_under_run(bool truncate_it)
 {
 	char log[320], board[320], live[320];
-	struct timespec t = { 1, 500000000 };    /* 1.5 s: holding */
+	struct timespec t = { 1, 500000000 }; /* 1.5 s: holding */
 	struct irdm_tick_record last;
 	uint64_t n, contact_after;
 	pid_t pid;
@@ -705,8 +715,8 @@ static void image_changed_under_run(bool truncate_it)
 	copy_file(image, live);
 	relaxed_board(board, sizeof(board));
 	pid = spawn(env_or("IRDM_FW", "build/irdm-fw"), (const char *const[]){
-		"--board", board, "--image", live, "--user", PRESS, "--clock", "real",
-		"--duration", "2.5", "--log", log, NULL });
+								"--board", board, "--image", live, "--user", PRESS, "--clock", "real",
+								"--duration", "2.5", "--log", log, NULL });
 	nanosleep(&t, NULL);
 	if (truncate_it)
 		assert_int_equal(truncate(live, 0), 0);
@@ -721,7 +731,7 @@ static void image_changed_under_run(bool truncate_it)
 		      truncate_it ? "truncated" : "overwritten", (unsigned long long)n,
 		      (unsigned long long)contact_after);
 	assert_true(n == 2500);
-	assert_true(contact_after > 500);       /* still pressing, on the same surface */
+	assert_true(contact_after > 500); /* still pressing, on the same surface */
 	assert_off_with_zero_torque(&last);
 }
 
@@ -759,7 +769,7 @@ static void test_never_enabled_exits_nonzero(void **state)
 	snprintf(board, sizeof(board), "%s/slow.board", dir);
 	tf_write_text(board, out);
 	rc = run_fw((const char *const[]){ "--board", board, "--image", image, "--clock", "virtual",
-					  "--duration", "0.5", "-q", NULL });
+					   "--duration", "0.5", "-q", NULL });
 	expect_error(rc, 7, "the torque was never enabled in 500 ticks: 'workspace' refused");
 }
 
@@ -787,7 +797,7 @@ static void vtk_doubles(const char **p, double *v, size_t n)
 struct frame_vtk {
 	uint32_t n_points, n_polys;
 	double *pos, *u, contact_m[3], time_s;
-	uint32_t *tris;                 /* 3 n_polys */
+	uint32_t *tris; /* 3 n_polys */
 	bool polys_in_range;
 };
 
@@ -854,9 +864,9 @@ static void surface_image(char *path, size_t len)
 
 	snprintf(path, len, "%s/surface.img", dir);
 	pid = spawn(env_or("IRDM", "build/irdm"), (const char *const[]){
-		"precompute", "-q", "--mesh", "cuboid", "--resolution", "4,4,8", "--fixed", "z<=0",
-		"--touch", "z>=0.2", "--display", "surface", "--representation", "modal:40",
-		"--static_correction", "yes", "--max_error", "none", "-o", path, NULL });
+							  "precompute", "-q", "--mesh", "cuboid", "--resolution", "4,4,8", "--fixed", "z<=0",
+							  "--touch", "z>=0.2", "--display", "surface", "--representation", "modal:40",
+							  "--static_correction", "yes", "--max_error", "none", "-o", path, NULL });
 	assert_int_equal(finish(pid), 0);
 }
 
@@ -883,7 +893,8 @@ static void test_frame_at_writes_the_deformed_surface(void **state)
 		assert_int_equal(run_fw((const char *const[]){ "--board", BOARD, "--image", img_path,
 							       "--user", PRESS, "--clock", "virtual",
 							       "--frame-at", "1.5", "--frame-out",
-							       vtk[k], "-q", NULL }), 0);
+							       vtk[k], "-q", NULL }),
+				 0);
 		bytes[k] = tf_load(vtk[k], &len[k]);
 	}
 	assert_int_equal(len[0], len[1]);
@@ -909,7 +920,8 @@ static void test_frame_at_writes_the_deformed_surface(void **state)
 	}
 	row = nearest_row(&img, f.contact_m);
 	print_message("frame at 1.5 s: %u points, %u triangles; node %u nearest the contact "
-		      "moved %.3f mm down\n", f.n_points, f.n_polys, row, -f.u[3 * row + 2] * 1e3);
+		      "moved %.3f mm down\n",
+		      f.n_points, f.n_polys, row, -f.u[3 * row + 2] * 1e3);
 	assert_true(f.u[3 * row + 2] <= -0.002 && f.u[3 * row + 2] >= -0.012);
 	for (uint32_t r = 0; r < f.n_points; r++) {
 		if (img.nodes[r].pos_m[2] != 0.0f)
@@ -966,9 +978,9 @@ static void test_frames_series(void **state)
 		if (run == 1)
 			tf_write_text(stray, "the user's\n");
 	}
-	assert_int_equal(access(stray, F_OK), -1);         /* replaced as a whole */
+	assert_int_equal(access(stray, F_OK), -1); /* replaced as a whole */
 	snprintf(path, sizeof(path), "%s" IRDM_OUTDIR_TMP "*", out);
-	assert_int_equal(glob(path, 0, NULL, &g), GLOB_NOMATCH);   /* nothing left beside */
+	assert_int_equal(glob(path, 0, NULL, &g), GLOB_NOMATCH); /* nothing left beside */
 	snprintf(path, sizeof(path), "%s/frames.vtk.series", out);
 	idx = fopen(path, "r");
 	assert_non_null(idx);
@@ -992,9 +1004,9 @@ static void test_frames_series(void **state)
 		for (uint32_t r = 0; r < f.n_points; r++)
 			du = fmax(du, fabs(f.u[3 * r + 2]));
 		if (t < 1.0)
-			assert_true(du <= 1e-12);               /* not touched yet */
+			assert_true(du <= 1e-12); /* not touched yet */
 		if (t >= 1.5 && t <= 3.0)
-			assert_true(du >= 0.002);               /* the press holds its dent */
+			assert_true(du >= 0.002); /* the press holds its dent */
 		free(f.pos);
 		free(f.u);
 		free(f.tris);
@@ -1048,18 +1060,22 @@ static void test_memory_bounded(void **state)
 	(void)state;
 	assert_int_equal(run_fw((const char *const[]){ "--board", BOARD, "--image", image,
 						       "--user", PRESS, "--clock", "virtual",
-						       "--duration", "3", NULL }), 0);
+						       "--duration", "3", NULL }),
+			 0);
 	short_kb = peak_resident_kb();
 	assert_int_equal(run_fw((const char *const[]){ "--board", BOARD, "--image", image,
 						       "--user", PRESS, "--clock", "virtual",
-						       "--duration", "150", NULL }), 0);
+						       "--duration", "150", NULL }),
+			 0);
 	long_kb = peak_resident_kb();
 	print_message("peak resident: %ld kB for 3 s, %ld kB for 150 s of virtual time\n",
 		      short_kb, long_kb);
 	assert_true(labs(long_kb - short_kb) < 1024);
 	/* the ringing after release is still found in the bounded window */
 	assert_non_null(strstr(out_text, "release ringing: ") &&
-			!strstr(out_text, "release ringing: none") ? out_text : NULL);
+					!strstr(out_text, "release ringing: none") ?
+				out_text :
+				NULL);
 }
 
 /*
@@ -1077,13 +1093,13 @@ static void test_log_write_failure(void **state)
 
 	(void)state;
 	snprintf(log, sizeof(log), "%s/full.log", dir);
-	relaxed_board(board, sizeof(board));        /* a busy host: no overrun fault */
+	relaxed_board(board, sizeof(board)); /* a busy host: no overrun fault */
 	for (int c = 0; c < 2; c++) {
 		int rc = finish(spawn("/bin/sh", (const char *const[]){
-			"-c", "ulimit -f 200 && exec \"$0\" \"$@\"",
-			env_or("IRDM_FW", "build/irdm-fw"), "--board", board, "--image", image,
-			"--user", PRESS, "--clock", clocks[c], "--duration", "1.5", "--log", log,
-			"-q", NULL }));
+							 "-c", "ulimit -f 200 && exec \"$0\" \"$@\"",
+							 env_or("IRDM_FW", "build/irdm-fw"), "--board", board, "--image", image,
+							 "--user", PRESS, "--clock", clocks[c], "--duration", "1.5", "--log", log,
+							 "-q", NULL }));
 
 		expect_error(rc, 9, "full.log: log not written: write failed after");
 		assert_int_equal(access(log, F_OK), -1);
@@ -1108,14 +1124,15 @@ static void test_frame_at_in_real_time(void **state)
 
 	(void)state;
 	snprintf(img_path, sizeof(img_path), "%s/surface.img", dir);
-	if (access(img_path, R_OK))     /* run alone: the previous test made it */
+	if (access(img_path, R_OK)) /* run alone: the previous test made it */
 		surface_image(img_path, sizeof(img_path));
 	snprintf(vtk, sizeof(vtk), "%s/frame-rt.vtk", dir);
 	relaxed_board(board, sizeof(board));
 	assert_int_equal(run_fw((const char *const[]){ "--board", board, "--image", img_path,
 						       "--user", PRESS, "--clock", "real",
 						       "--duration", "1", "--frame-at", "0.5",
-						       "--frame-out", vtk, NULL }), 0);
+						       "--frame-out", vtk, NULL }),
+			 0);
 	p = strstr(out_text, "deformation: ");
 	assert_non_null(p);
 	assert_int_equal(sscanf(p, "deformation: %llu frames", &frames), 1);
@@ -1141,9 +1158,9 @@ static int setup(void **state)
 	snprintf(image, sizeof(image), "%s/cuboid.img", dir);
 	/* the paper's cuboid at 4 x 4 x 8 cells, where the board places it */
 	pid = spawn(env_or("IRDM", "build/irdm"), (const char *const[]){
-		"precompute", "-q", "--mesh", "cuboid", "--resolution", "4,4,8", "--fixed", "z<=0",
-		"--touch", "z>=0.2", "--display", "touch", "--representation", "modal:40",
-		"--static_correction", "yes", "--max_error", "none", "-o", image, NULL });
+							  "precompute", "-q", "--mesh", "cuboid", "--resolution", "4,4,8", "--fixed", "z<=0",
+							  "--touch", "z>=0.2", "--display", "touch", "--representation", "modal:40",
+							  "--static_correction", "yes", "--max_error", "none", "-o", image, NULL });
 	return finish(pid) == 0 ? 0 : -1;
 }
 

@@ -47,7 +47,7 @@
 #include "support/run_prog.h"
 #include "support/test_files.h"
 
-#define TICKS 6200                      /* the script's end + 1 s at 1 kHz */
+#define TICKS 6200 /* the script's end + 1 s at 1 kHz */
 
 static char dir[256], image[320], out_text[8192], err_text[4096];
 
@@ -95,8 +95,8 @@ static void read_trace(const char *log, struct trace *t)
 static void run_board(const char *board, const char *log)
 {
 	if (run(env_or("IRDM_FW", "build/irdm-fw"), (const char *const[]){
-		"--board", board, "--image", image, "--user",
-		"scenes/users/press-hold-release.user", "--clock", "virtual", "--log", log, NULL }))
+							    "--board", board, "--image", image, "--user",
+							    "scenes/users/press-hold-release.user", "--clock", "virtual", "--log", log, NULL }))
 		fail_msg("irdm-fw on %s: %s", board, err_text);
 }
 
@@ -142,8 +142,8 @@ static void test_canemu_matches_delayed_sim(void **state)
 	snprintf(rd_log, sizeof(rd_log), "%s/sim-rd.log", dir);
 	run_board("boards/canemu-3dof.board", can_log);
 	assert_non_null(strstr(out_text, "hal 'canemu': CAN bus load: SYNC + 3 x RPDO1 (4 B) + 3 x "
-				   "TPDO1 (6 B) = 695 bits worst case in 1000 us at 1000000 "
-				   "bit/s: 69.5 %"));
+					 "TPDO1 (6 B) = 695 bits worst case in 1000 us at 1000000 "
+					 "bit/s: 69.5 %"));
 	assert_non_null(strstr(out_text, "state: off"));
 	edited_board("boards/sim-phantom.board", "write_delay=0", "write_delay=1",
 		     "sim-delayed.board", board, sizeof(board));
@@ -183,13 +183,13 @@ static void test_bad_options_one_line(void **state)
 	edited_board("boards/canemu-3dof.board", "rated_torque_mnm=100", "rated_torque_xxx=100",
 		     "bad.board", board, sizeof(board));
 	rc = run(env_or("IRDM_FW", "build/irdm-fw"), (const char *const[]){
-		"--board", board, "--image", image, "--clock", "virtual", "--duration", "0.1",
-		"-q", NULL });
+							     "--board", board, "--image", image, "--clock", "virtual", "--duration", "0.1",
+							     "-q", NULL });
 	assert_int_not_equal(rc, 0);
 	/* one line: the board file and line, the option, the reason */
 	assert_true(!strncmp(err_text, "irdm-fw: EINVAL: ", 17));
 	assert_non_null(strstr(err_text, "bad.board:22: hal_options: unknown canemu option "
-				   "'rated_torque_xxx' (see docs/hal-options.md)\n"));
+					 "'rated_torque_xxx' (see docs/hal-options.md)\n"));
 	assert_ptr_equal(strchr(err_text, '\n'), err_text + strlen(err_text) - 1);
 }
 
@@ -204,15 +204,15 @@ static void test_fault_reason_one_line(void **state)
 	edited_board("boards/canemu-3dof.board", "substeps=10", "substeps=10 emcy_at=2:500",
 		     "emcy.board", board, sizeof(board));
 	rc = run(env_or("IRDM_FW", "build/irdm-fw"), (const char *const[]){
-		"--board", board, "--image", image, "--user", "scenes/users/press-hold-release.user",
-		"--clock", "virtual", NULL });
+							     "--board", board, "--image", image, "--user", "scenes/users/press-hold-release.user",
+							     "--clock", "virtual", NULL });
 	print_message("exit %d; stderr: %s", rc, err_text);
 	assert_int_not_equal(rc, 0);
 	assert_non_null(strstr(err_text, "irdm-fw: EFAULT: fault "));
 	assert_non_null(strstr(err_text, ": torque off: drive 2 (node 2): EMCY 0x2310 (current), "
-				   "error register 0x01\n"));
+					 "error register 0x01\n"));
 	assert_non_null(strstr(out_text, "(torque off): drive 2 (node 2): EMCY 0x2310 (current), "
-				   "error register 0x01\n"));
+					 "error register 0x01\n"));
 }
 
 static int setup(void **state)
@@ -222,8 +222,10 @@ static int setup(void **state)
 		return -1;
 	snprintf(image, sizeof(image), "%s/cuboid.img", dir);
 	return run(env_or("IRDM", "build/irdm"), (const char *const[]){
-		"precompute", "-q", "--scene", "scenes/cuboid-paper.scene", "--resolution", "4,4,8",
-		"--representation", "modal:40", "--max_error", "none", "-o", image, NULL }) ? -1 : 0;
+							 "precompute", "-q", "--scene", "scenes/cuboid-paper.scene", "--resolution", "4,4,8",
+							 "--representation", "modal:40", "--max_error", "none", "-o", image, NULL }) ?
+		       -1 :
+		       0;
 }
 
 static int teardown(void **state)

@@ -142,7 +142,7 @@ static int32_t cpu_latency_us(void)
 
 static void test_only_the_loop_runs_on_its_cpu(void **state)
 {
-	const struct timespec settle = { 1, 0 };    /* every thread up, the loop running */
+	const struct timespec settle = { 1, 0 }; /* every thread up, the loop running */
 	pid_t pid, tids[TASKS_MAX];
 	uint64_t masks[TASKS_MAX], loop_bit;
 	char board[320], log[320], line[128];
@@ -158,9 +158,7 @@ static void test_only_the_loop_runs_on_its_cpu(void **state)
 	pinned_board(board, sizeof(board), cpu);
 	snprintf(log, sizeof(log), "%s/run.log", dir);
 	/* with the log: its writer is one more thread */
-	pid = rp_spawn(dir, env_or("IRDM_FW", "build/irdm-fw"), (const char *const[]){
-		"--board", board, "--image", tick_image_path(), "--user", PRESS, "--clock", "real",
-		"--duration", "2", "--log", log, NULL });
+	pid = rp_spawn(dir, env_or("IRDM_FW", "build/irdm-fw"), (const char *const[]){ "--board", board, "--image", tick_image_path(), "--user", PRESS, "--clock", "real", "--duration", "2", "--log", log, NULL });
 	nanosleep(&settle, NULL);
 	n = read_tasks(pid, tids, masks);
 	during = cpu_latency_us();

@@ -60,21 +60,26 @@
  */
 #define WORK_TOL_J 1e-3
 
-enum img { IMG_CUBOID, IMG_FIR, IMG_CUBE, IMG_TOP, IMG_BUNNY, N_IMG };
+enum img { IMG_CUBOID,
+	   IMG_FIR,
+	   IMG_CUBE,
+	   IMG_TOP,
+	   IMG_BUNNY,
+	   N_IMG };
 
 static char dir[256], images[N_IMG][320], err_text[4096];
 static bool have_bunny;
 
 struct soak_case {
-	const char *script;     /* scenes/users/NAME.user */
+	const char *script; /* scenes/users/NAME.user */
 	enum img img;
-	const char *board;      /* boards/NAME.board */
+	const char *board; /* boards/NAME.board */
 };
 
 struct soak_result {
 	double peak_n, work_j, min_work_j;
 	uint64_t ticks, contact_ticks;
-	bool bad_tick;          /* a tick failed check_tick() (the first one is said) */
+	bool bad_tick; /* a tick failed check_tick() (the first one is said) */
 };
 
 static const char *env_or(const char *name, const char *dflt)
@@ -169,8 +174,8 @@ static int soak_one(const struct soak_case *c, const char *seconds)
 	snprintf(what, sizeof(what), "%s on %s", c->script, images[c->img]);
 	assert_int_equal(irdm_board_load(&b, board_path, err, sizeof(err)), 0);
 	rc = run(env_or("IRDM_FW", "build/irdm-fw"), (const char *const[]){
-		"--board", board_path, "--image", images[c->img], "--user", script, "--clock",
-		"virtual", "--duration", seconds, "--log", log, "-q", NULL });
+							     "--board", board_path, "--image", images[c->img], "--user", script, "--clock",
+							     "virtual", "--duration", seconds, "--log", log, "-q", NULL });
 	if (rc)
 		print_error("%s: irdm-fw exit %d: %s", what, rc, err_text);
 	scan_log(&b, log, what, &res);
@@ -257,9 +262,9 @@ static void test_scripts_bounded_and_passive(void **state)
 #define PULL_TOL_N 1e-3
 
 struct edge_result {
-	uint64_t contact_out;           /* ticks in contact more than SIDE_BULGE_M outside */
-	double max_out_m;               /* farthest outside while in contact */
-	double max_pull_n;              /* largest force on the object pointing out of it,
+	uint64_t contact_out; /* ticks in contact more than SIDE_BULGE_M outside */
+	double max_out_m;     /* farthest outside while in contact */
+	double max_pull_n;    /* largest force on the object pointing out of it,
 					 * beyond SIDE_BULGE_M */
 	uint64_t contact_ticks;
 };
@@ -279,7 +284,8 @@ static void edge_scan(const struct irdm_board *b, const char *log, struct edge_r
 
 		irdm_board_device_to_object(b, rec.dev[0].tip_pos_m, p);
 		for (int a = 0; a < 2; a++)
-			out[a] = p[a] > 0.1 ? p[a] - 0.1 : p[a] < 0 ? p[a] : 0;
+			out[a] = p[a] > 0.1 ? p[a] - 0.1 : p[a] < 0 ? p[a] :
+								      0;
 		d = hypot(out[0], out[1]);
 		res->contact_ticks += contact;
 		if (!contact || d == 0)
@@ -325,12 +331,14 @@ static void test_edges_release(void **state)
 		snprintf(log, sizeof(log), "%s/edge-%s-%d.log", dir, c->script, (int)c->img);
 		assert_int_equal(irdm_board_load(&b, board_path, err, sizeof(err)), 0);
 		assert_int_equal(run(env_or("IRDM_FW", "build/irdm-fw"), (const char *const[]){
-			"--board", board_path, "--image", images[c->img], "--user", script,
-			"--clock", "virtual", "--duration", "4.5", "--log", log, "-q", NULL }), 0);
+										 "--board", board_path, "--image", images[c->img], "--user", script,
+										 "--clock", "virtual", "--duration", "4.5", "--log", log, "-q", NULL }),
+				 0);
 		edge_scan(&b, log, &res);
 		unlink(log);
 		print_message("%-13s %-7s contact %5llu ticks, beyond the sides %.2f mm at most, "
-			      "%llu ticks > %.1f mm; pull %.4f N\n", c->script,
+			      "%llu ticks > %.1f mm; pull %.4f N\n",
+			      c->script,
 			      strrchr(images[c->img], '/') + 1,
 			      (unsigned long long)res.contact_ticks, res.max_out_m * 1e3,
 			      (unsigned long long)res.contact_out, SIDE_BULGE_M * 1e3,
@@ -382,9 +390,10 @@ static void test_pinch_twist(void **state)
 	irdm_engine_coupling_for_device(b.device.k_max_n_per_m, b.device.b_device_ns_per_m,
 					b.period_us * 1e-6, &k, &bd);
 	assert_int_equal(run(env_or("IRDM_FW", "build/irdm-fw"), (const char *const[]){
-		"--board", "boards/sim-phantom-pinch.board", "--image", images[IMG_CUBOID],
-		"--user", "scenes/users/pinch-twist.user", "--clock", "virtual", "--duration",
-		"5.5", "--log", log, "-q", NULL }), 0);
+									 "--board", "boards/sim-phantom-pinch.board", "--image", images[IMG_CUBOID],
+									 "--user", "scenes/users/pinch-twist.user", "--clock", "virtual", "--duration",
+									 "5.5", "--log", log, "-q", NULL }),
+			 0);
 	rec = calloc(cap, sizeof(*rec));
 	assert_non_null(rec);
 	assert_int_equal(irdm_log_open(&r, log, err, sizeof(err)), 0);
@@ -410,12 +419,13 @@ static void test_pinch_twist(void **state)
 		for (int a = 0; a < 3; a++)
 			d2x[a] = d->tip_pos_m[a] - 2 * p->tip_pos_m[a] + pp->tip_pos_m[a];
 		worst = fmax(worst, dist3(d->force_n, p->force_n) -
-				    (k * dist3(d->tip_pos_m, p->tip_pos_m) +
-				     bd / (b.period_us * 1e-6) * dist3(d2x, zero)));
+					    (k * dist3(d->tip_pos_m, p->tip_pos_m) +
+					     bd / (b.period_us * 1e-6) * dist3(d2x, zero)));
 	}
 	free(rec);
 	print_message("pinch-twist: hand 1's last contact tick %zu; hand 2's force steps exceed "
-		      "K |dx| + B |d2x| / dt by %+.4f N at most; largest pull %.2e N\n", end,
+		      "K |dx| + B |d2x| / dt by %+.4f N at most; largest pull %.2e N\n",
+		      end,
 		      worst, pull);
 	assert_true(worst > -INFINITY);
 	assert_true(worst <= OBJECT_STEP_N);
@@ -424,7 +434,7 @@ static void test_pinch_twist(void **state)
 
 /* ---- irdm-fw against irdm replay, rigid coupling ---- */
 
-#define RIGID_TICKS 6200        /* press-hold-release: touch 1.04 s, release 3.2 s */
+#define RIGID_TICKS 6200 /* press-hold-release: touch 1.04 s, release 3.2 s */
 
 /* The shipped board with the coupling made rigid (coupling = 0,0). */
 static void rigid_board(char *path, size_t len)
@@ -444,7 +454,7 @@ static void rigid_board(char *path, size_t len)
 
 struct rigid_run {
 	struct irdm_tick_record rec[RIGID_TICKS];
-	size_t n, touched, sites;       /* records; ticks with a site; distinct sites */
+	size_t n, touched, sites; /* records; ticks with a site; distinct sites */
 };
 
 static void read_log(struct rigid_run *w, const char *log)
@@ -503,7 +513,7 @@ static double compare_forces(const struct rigid_run *w, const char *forces, doub
 	size_t k = 0;
 
 	assert_non_null(f);
-	assert_non_null(fgets(line, sizeof(line), f));         /* header */
+	assert_non_null(fgets(line, sizeof(line), f)); /* header */
 	*peak = 0;
 	while (fgets(line, sizeof(line), f) && k < w->n) {
 		const double *fw = w->rec[k++].dev[0].force_n;
@@ -532,9 +542,9 @@ static void test_rigid_matches_replay(void **state)
 	rigid_board(board_path, sizeof(board_path));
 	snprintf(log, sizeof(log), "%s/rigid.log", dir);
 	if (run(env_or("IRDM_FW", "build/irdm-fw"), (const char *const[]){
-		"--board", board_path, "--image", images[IMG_CUBOID], "--user",
-		"scenes/users/press-hold-release.user", "--clock", "virtual", "--duration", "6.2",
-		"--log", log, "-q", NULL }))
+							    "--board", board_path, "--image", images[IMG_CUBOID], "--user",
+							    "scenes/users/press-hold-release.user", "--clock", "virtual", "--duration", "6.2",
+							    "--log", log, "-q", NULL }))
 		fail_msg("irdm-fw, rigid: %s", err_text);
 	memset(&w, 0, sizeof(w));
 	read_log(&w, log);
@@ -545,12 +555,13 @@ static void test_rigid_matches_replay(void **state)
 	write_inputs(&w, sites, traj);
 	/* the board's engine: pushes only, passivity control on */
 	if (run(env_or("IRDM", "build/irdm"), (const char *const[]){
-		"replay", "--image", images[IMG_CUBOID], "--sites", sites, "--displacement", traj,
-		"--push", "--passivity", "-o", forces, NULL }))
+						      "replay", "--image", images[IMG_CUBOID], "--sites", sites, "--displacement", traj,
+						      "--push", "--passivity", "-o", forces, NULL }))
 		fail_msg("irdm replay: %s", err_text);
 	rel = compare_forces(&w, forces, &peak);
 	print_message("rigid: %zu ticks, %zu in contact over %zu distinct sites (the proxy "
-		      "slides), peak %.4f N: max |F_fw - F_replay| / peak = %.3e\n", w.n, w.touched,
+		      "slides), peak %.4f N: max |F_fw - F_replay| / peak = %.3e\n",
+		      w.n, w.touched,
 		      w.sites, peak, rel);
 	/* the test means something: contact, and the site moved */
 	assert_true(w.touched > 1000 && w.sites > 100);
@@ -605,11 +616,10 @@ static void test_replay_log_exact(void **state)
 		snprintf(log, sizeof(log), "%s/replay-%s-%d.log", dir, c->script, (int)c->img);
 		snprintf(forces, sizeof(forces), "%s/replay-%s-%d.csv", dir, c->script, (int)c->img);
 		assert_int_equal(run(env_or("IRDM_FW", "build/irdm-fw"), (const char *const[]){
-			"--board", board, "--image", images[c->img], "--user", script, "--clock",
-			"virtual", "--duration", "8", "--log", log, "-q", NULL }), 0);
-		if (rp_run(dir, env_or("IRDM", "build/irdm"), (const char *const[]){
-			"replay", "--image", images[c->img], "--log", log, "--board", board, "-o",
-			forces, NULL }, out, sizeof(out), err_text, sizeof(err_text)))
+										 "--board", board, "--image", images[c->img], "--user", script, "--clock",
+										 "virtual", "--duration", "8", "--log", log, "-q", NULL }),
+				 0);
+		if (rp_run(dir, env_or("IRDM", "build/irdm"), (const char *const[]){ "replay", "--image", images[c->img], "--log", log, "--board", board, "-o", forces, NULL }, out, sizeof(out), err_text, sizeof(err_text)))
 			fail_msg("%s: irdm replay --log: %s", c->script, err_text);
 		p = strstr(out, "within ");
 		if (!p || sscanf(p, "within %lf N of the logged ones (peak %lf N)", &diff, &peak) != 2)
@@ -646,22 +656,13 @@ static int setup(void **state)
 	if (tf_tmpdir(dir, sizeof(dir), "fwscenes"))
 		return -1;
 	/* the cuboid scenes small; touch = surface as cuboid-paper, for the pinch */
-	if (precompute(IMG_CUBOID, "cuboid", (const char *const[]){
-		"--scene", "scenes/cuboid-paper.scene", "--resolution", "4,4,8",
-		"--representation", "modal:40", NULL }) ||
-	    precompute(IMG_FIR, "fir", (const char *const[]){
-		"--scene", "scenes/cuboid-paper.scene", "--resolution", "4,4,8",
-		"--representation", "fir:100", "--dt", "0.001", "--uncertified", "yes", NULL }) ||
-	    precompute(IMG_CUBE, "cube", (const char *const[]){
-		"--scene", "scenes/cube-floating.scene", "--resolution", "4,4,4",
-		"--representation", "modal:40", NULL }) ||
-	    precompute(IMG_TOP, "top", (const char *const[]){
-		"--scene", "scenes/cuboid-top.scene", "--resolution", "4,4,8",
-		"--representation", "modal:40", NULL }))
+	if (precompute(IMG_CUBOID, "cuboid", (const char *const[]){ "--scene", "scenes/cuboid-paper.scene", "--resolution", "4,4,8", "--representation", "modal:40", NULL }) ||
+	    precompute(IMG_FIR, "fir", (const char *const[]){ "--scene", "scenes/cuboid-paper.scene", "--resolution", "4,4,8", "--representation", "fir:100", "--dt", "0.001", "--uncertified", "yes", NULL }) ||
+	    precompute(IMG_CUBE, "cube", (const char *const[]){ "--scene", "scenes/cube-floating.scene", "--resolution", "4,4,4", "--representation", "modal:40", NULL }) ||
+	    precompute(IMG_TOP, "top", (const char *const[]){ "--scene", "scenes/cuboid-top.scene", "--resolution", "4,4,8", "--representation", "modal:40", NULL }))
 		return -1;
 	have_bunny = access("build/data/bunny.off", R_OK) == 0;
-	if (have_bunny && precompute(IMG_BUNNY, "bunny", (const char *const[]){
-		"--scene", "scenes/bunny.scene", "--representation", "modal:40", NULL }))
+	if (have_bunny && precompute(IMG_BUNNY, "bunny", (const char *const[]){ "--scene", "scenes/bunny.scene", "--representation", "modal:40", NULL }))
 		return -1;
 	return 0;
 }

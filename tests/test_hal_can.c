@@ -89,23 +89,28 @@ static void test_check_options_name_the_line(void **state)
 		  "boards/x.board:16: hal_options: write_delay = 999: must be <= 16", true },
 		{ &irdm_hal_sim_backend, "substeps=10,delay=1",
 		  "boards/x.board:16: hal_options: unknown sim option 'delay' "
-		  "(see docs/hal-options.md)", true },
+		  "(see docs/hal-options.md)",
+		  true },
 		{ &irdm_hal_sim_backend, "end_stops",
 		  "boards/x.board:16: hal_options: 'end_stops': expected key=value", false },
 		{ &irdm_hal_canemu_backend, "rated_torque_mnm=100",
 		  "boards/x.board:22: hal_options: nodes: missing (one node id per joint, "
-		  "e.g. nodes=1,2,3)", true },
+		  "e.g. nodes=1,2,3)",
+		  true },
 		{ &irdm_hal_canemu_backend, "nodes=1,2,3 rated_torque_mnm=100 emcy_at=4:10",
 		  "boards/x.board:22: hal_options: emcy_at = 4:10: expected DRIVE:MS, drive 1..3, "
-		  "0..3600000 ms", false },
+		  "0..3600000 ms",
+		  false },
 		{ &irdm_hal_socketcan_backend, "iface=can0 nodes=1,2,3 rated_torque_mnm=100 bitrate=5",
 		  "boards/x.board:23: hal_options: bitrate = 5: must be >= 10000 bit/s", false },
 		{ &irdm_hal_socketcan_backend, "iface=can0 nodes=1,2,3 rated_torque_mnm=100 substeps=2",
 		  "boards/x.board:23: hal_options: unknown socketcan option 'substeps' "
-		  "(see docs/hal-options.md)", false },
+		  "(see docs/hal-options.md)",
+		  false },
 		{ &irdm_hal_socketcan_backend, "nodes=1,2,3 rated_torque_mnm=100",
 		  "boards/x.board:23: hal_options: iface: missing (the CAN interface, e.g. "
-		  "iface=can0)", false },
+		  "iface=can0)",
+		  false },
 	};
 	static char doc[16384];
 	char err[256], where[64];
@@ -116,8 +121,8 @@ static void test_check_options_name_the_line(void **state)
 		const struct irdm_hal_backend *be = cases[i].be;
 
 		snprintf(where, sizeof(where), "boards/x.board:%s: hal_options",
-			 be == &irdm_hal_sim_backend ? "16" : be == &irdm_hal_canemu_backend ? "22"
-											   : "23");
+			 be == &irdm_hal_sim_backend ? "16" : be == &irdm_hal_canemu_backend ? "22" :
+											       "23");
 		assert_non_null(be->check_options);
 		assert_int_equal(be->check_options(cases[i].options, where, err, sizeof(err)),
 				 IRDM_EINVAL);
@@ -127,7 +132,8 @@ static void test_check_options_name_the_line(void **state)
 	}
 	/* the shipped boards' options pass */
 	assert_int_equal(irdm_hal_sim_backend.check_options("write_delay=0,read_delay=0,substeps=10",
-							    "s", err, sizeof(err)), IRDM_OK);
+							    "s", err, sizeof(err)),
+			 IRDM_OK);
 	assert_int_equal(irdm_hal_canemu_backend.check_options(OPTS, "c", err, sizeof(err)),
 			 IRDM_OK);
 }
@@ -213,11 +219,12 @@ static void test_socketcan_bus_off_loses_link(void **state)
 	irdm_hal_socketcan_judge(&sock, m);
 	assert_true(m->faulted && m->link_lost);
 	assert_string_equal(m->why, "CAN link: bus-off (the controller left the bus)");
-	assert_int_equal(n_log, 4);     /* off to 0x201..0x203, then the SYNC */
+	assert_int_equal(n_log, 4); /* off to 0x201..0x203, then the SYNC */
 	for (unsigned i = 0; i < 3; i++) {
 		assert_int_equal(bus_log[i].f.id, 0x201 + i);
 		assert_int_equal(bus_log[i].f.data[0] | bus_log[i].f.data[1] | bus_log[i].f.data[2] |
-					 bus_log[i].f.data[3], 0);
+					 bus_log[i].f.data[3],
+				 0);
 	}
 	assert_int_equal(bus_log[3].f.id, 0x080);
 	irdm_hal_close(&dev);
@@ -237,7 +244,7 @@ static void run_ticks(int n, const double tau[3], int *bad)
 
 static void test_canemu_runs_and_faults(void **state)
 {
-	double tau[3] = { 0.0, 0.098, 0.0 };    /* about the shoulder's gravity torque */
+	double tau[3] = { 0.0, 0.098, 0.0 }; /* about the shoulder's gravity torque */
 	struct irdm_hal_joint_state st;
 	uint32_t faults;
 	unsigned mark;
@@ -248,18 +255,18 @@ static void test_canemu_runs_and_faults(void **state)
 	assert_int_equal(open_as("canemu", OPTS), IRDM_OK);
 	/* the bus load, then each drive as its 0x1000 and 0x1018 say */
 	assert_string_equal(dev.info, "CAN bus load: SYNC + 3 x RPDO1 (4 B) + 3 x TPDO1 (6 B) = "
-			    "695 bits worst case in 1000 us at 1000000 bit/s: 69.5 %\n"
-			    "drive 1 (node 1): CiA 402 device type 0x00020192, vendor 0x00000000, "
-			    "product 0x00000402, revision 0x00010000, serial 0x00000001\n"
-			    "drive 2 (node 2): CiA 402 device type 0x00020192, vendor 0x00000000, "
-			    "product 0x00000402, revision 0x00010000, serial 0x00000002\n"
-			    "drive 3 (node 3): CiA 402 device type 0x00020192, vendor 0x00000000, "
-			    "product 0x00000402, revision 0x00010000, serial 0x00000003");
-	assert_int_equal(irdm_hal_write(&dev, tau), IRDM_EINVAL);      /* not started */
+				      "695 bits worst case in 1000 us at 1000000 bit/s: 69.5 %\n"
+				      "drive 1 (node 1): CiA 402 device type 0x00020192, vendor 0x00000000, "
+				      "product 0x00000402, revision 0x00010000, serial 0x00000001\n"
+				      "drive 2 (node 2): CiA 402 device type 0x00020192, vendor 0x00000000, "
+				      "product 0x00000402, revision 0x00010000, serial 0x00000002\n"
+				      "drive 3 (node 3): CiA 402 device type 0x00020192, vendor 0x00000000, "
+				      "product 0x00000402, revision 0x00010000, serial 0x00000003");
+	assert_int_equal(irdm_hal_write(&dev, tau), IRDM_EINVAL); /* not started */
 	assert_int_equal(irdm_hal_start(&dev), IRDM_OK);
 	run_ticks(100, tau, &bad);
 	assert_int_equal(bad, 0);
-	{       /* a torque that is not a number: refused, zero sent instead */
+	{ /* a torque that is not a number: refused, zero sent instead */
 		double nan_tau[3] = { 0.0, 0.0 / 0.0, 0.0 };
 
 		assert_int_equal(irdm_hal_write(&dev, nan_tau), IRDM_EFAULT);
@@ -274,7 +281,7 @@ static void test_canemu_runs_and_faults(void **state)
 	/* drive 2 raises EMCY 0x4210 (temperature) and faults */
 	mark = n_log;
 	irdm_can_drives_fault(irdm_hal_canemu_drives(&dev), 1, 0x4210);
-	assert_int_equal(irdm_hal_write(&dev, tau), IRDM_OK);   /* the EMCY is not read yet */
+	assert_int_equal(irdm_hal_write(&dev, tau), IRDM_OK); /* the EMCY is not read yet */
 	assert_int_equal(irdm_hal_read(&dev, &st), IRDM_EHW);
 	/* in the same tick, before any write: every emulated drive was told off */
 	for (unsigned k = 0; k < 3; k++) {
@@ -298,7 +305,7 @@ static void test_canemu_runs_and_faults(void **state)
 		assert_int_not_equal(irdm_hal_canemu_drives(&dev)->d[k].fsa.state,
 				     IRDM_CIA402_OPERATION_ENABLED);
 	assert_int_equal(irdm_hal_safe_off(&dev), IRDM_OK);
-	assert_int_equal(irdm_hal_start(&dev), IRDM_EHW);       /* latched */
+	assert_int_equal(irdm_hal_start(&dev), IRDM_EHW); /* latched */
 	/* the operator's reset: the drive leaves fault, and enables again */
 	irdm_hal_can_reset_faults(&dev);
 	for (int k = 0; k < 5; k++)
@@ -322,7 +329,7 @@ static void test_one_sync_per_tick(void **state)
 	n_log = 0;
 	for (int k = 0; k < 300; k++) {
 		assert_int_equal(irdm_hal_read(&dev, &st), IRDM_OK);
-		if (k % 3)      /* every third tick writes nothing */
+		if (k % 3) /* every third tick writes nothing */
 			assert_int_equal(irdm_hal_write(&dev, tau), IRDM_OK);
 	}
 	for (unsigned i = 0; i < n_log; i++) {
@@ -337,7 +344,7 @@ static void test_one_sync_per_tick(void **state)
 			if (syncs++)
 				assert_int_equal(f->data[0], last % 240 + 1);
 			last = f->data[0];
-		} else if (f->id != 0x77F) {    /* (the master's heartbeat) */
+		} else if (f->id != 0x77F) { /* (the master's heartbeat) */
 			assert_true(f->id >= 0x201 && f->id <= 0x203);
 			rpdos[f->id - 0x201]++;
 		}
@@ -386,7 +393,7 @@ static void test_canemu_start_times_out(void **state)
 	assert_int_equal(open_as("canemu", OPTS " enable_timeout_ms=2"), IRDM_OK);
 	assert_int_equal(irdm_hal_start(&dev), IRDM_ETIMEDOUT);
 	assert_string_equal(dev.why, "CAN: fewer than 5 SYNCs answered in a row before enabling, "
-			    "within 2 ms");
+				     "within 2 ms");
 	irdm_hal_close(&dev);
 	/* 6 ms: those, then not the enable sequence (3 SYNCs at least) */
 	assert_int_equal(open_as("canemu", OPTS " enable_timeout_ms=6"), IRDM_OK);
@@ -415,7 +422,7 @@ static void strict_child(void *arg, int fd)
 	uint32_t faults;
 	bool slip = arg != NULL;
 
-	run_ticks(10, tau, &res.bad);           /* every path once before the filter */
+	run_ticks(10, tau, &res.bad); /* every path once before the filter */
 	res.prctl_errno = strict_enter();
 	if (res.prctl_errno)
 		strict_exit(fd, &res, sizeof(res), STRICT_UNAVAILABLE);
@@ -467,7 +474,8 @@ static void test_tick_ops_no_system_call_no_allocation(void **state)
 	assert_int_equal(WEXITSTATUS(status), 0);
 	assert_int_equal(res.magic, STRICT_MAGIC);
 	print_message("  %d ticks + 10 with a drive lost: %d failed ops, %d polls with the fault, "
-		      "%lu allocator calls%s\n", STRICT_TICKS, res.bad, res.faults_seen, res.allocs,
+		      "%lu allocator calls%s\n",
+		      STRICT_TICKS, res.bad, res.faults_seen, res.allocs,
 		      alloc_counting() ? "" : " (not counted: ASan owns the allocator)");
 	assert_int_equal(res.bad, 0);
 	/* tick 1 still reads the TPDO of the SYNC before the drop; ticks 2, 3, 4
@@ -491,10 +499,10 @@ static void test_tick_ops_no_system_call_no_allocation(void **state)
 struct emergency_result {
 	uint32_t magic;
 	int rc;
-	unsigned frames;                /* frames on the bus during the call */
+	unsigned frames; /* frames on the bus during the call */
 	uint16_t cw[3];
 	int16_t torque[3];
-	double arm_nm;                  /* sum of |command| and |motor| torques */
+	double arm_nm; /* sum of |command| and |motor| torques */
 };
 
 static void emergency_child(void *arg, int fd)
@@ -530,8 +538,8 @@ static void test_canemu_emergency_off(void **state)
 	run_ticks(50, tau, &bad);
 	assert_int_equal(bad, 0);
 	dr = irdm_hal_canemu_drives(&dev);
-	assert_int_equal(dr->d[1].rpdo_torque_permille, 84);    /* as test_canemu_runs_and_faults */
-	assert_int_equal(dr->d[1].rpdo_cw, 0x0F);               /* enable operation */
+	assert_int_equal(dr->d[1].rpdo_torque_permille, 84); /* as test_canemu_runs_and_faults */
+	assert_int_equal(dr->d[1].rpdo_cw, 0x0F);            /* enable operation */
 	status = strict_run(emergency_child, NULL, &res, sizeof(res), &got);
 	irdm_hal_close(&dev);
 	if (WIFEXITED(status) && WEXITSTATUS(status) == STRICT_UNAVAILABLE)

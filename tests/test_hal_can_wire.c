@@ -24,7 +24,7 @@
 #include "irdm/hal/hal_can.h"
 
 struct wire_data {
-	struct irdm_hal_can can;        /* first: the shared code's view */
+	struct irdm_hal_can can; /* first: the shared code's view */
 	struct irdm_can_membus bus;
 	struct irdm_can_drives drives;
 };
@@ -60,7 +60,7 @@ static void wire_close(struct irdm_hal_dev *dev)
 
 static const struct irdm_hal_can_link wire_link = {
 	.open = wire_open_link,
-	.pump = NULL,           /* a wire: nobody answers within the call */
+	.pump = NULL, /* a wire: nobody answers within the call */
 	.idle = wire_idle,
 	.check = NULL,
 	.close = wire_close,
@@ -87,15 +87,16 @@ static void up(void)
 {
 	irdm_device_config_default(&arm);
 	cfg = (struct irdm_hal_config){ &arm,
-		"nodes=1,2,3 rated_torque_mnm=100 heartbeat_ms=10 heartbeat_timeout_ms=50 "
-		"tpdo_missing_periods=3", 1e-3 };
+					"nodes=1,2,3 rated_torque_mnm=100 heartbeat_ms=10 heartbeat_timeout_ms=50 "
+					"tpdo_missing_periods=3",
+					1e-3 };
 	irdm_hal_register(&wire_backend);
 	assert_int_equal(irdm_hal_init(&dev, "test-wire", &cfg, &data, sizeof(data)), IRDM_OK);
 	if (irdm_hal_open(&dev))
 		fail_msg("open: %s", dev.why);
 	if (irdm_hal_start(&dev))
 		fail_msg("start: %s", dev.why);
-	irdm_can_drives_poll(&data.drives);     /* the answer to start's last SYNC */
+	irdm_can_drives_poll(&data.drives); /* the answer to start's last SYNC */
 }
 
 static void test_unwritten_period(void **state)
@@ -105,9 +106,9 @@ static void test_unwritten_period(void **state)
 
 	(void)state;
 	up();
-	assert_int_equal(irdm_hal_read(&dev, &st), IRDM_OK);    /* tick 0: calibrate, no write */
+	assert_int_equal(irdm_hal_read(&dev, &st), IRDM_OK); /* tick 0: calibrate, no write */
 	irdm_can_drives_poll(&data.drives);
-	if (irdm_hal_read(&dev, &st))                           /* tick 1 closes tick 0's period */
+	if (irdm_hal_read(&dev, &st)) /* tick 1 closes tick 0's period */
 		fail_msg("read after an unwritten period: %s", dev.why);
 	irdm_can_drives_poll(&data.drives);
 	assert_int_equal(irdm_hal_write(&dev, zero), IRDM_OK);
@@ -126,19 +127,19 @@ static void test_late_tpdo_tolerated_then_lost(void **state)
 
 	(void)state;
 	up();
-	for (k = 0; k < 5; k++) {                               /* steady: each answered */
+	for (k = 0; k < 5; k++) { /* steady: each answered */
 		assert_int_equal(irdm_hal_read(&dev, &st), IRDM_OK);
 		assert_int_equal(irdm_hal_write(&dev, zero), IRDM_OK);
 		irdm_can_drives_poll(&data.drives);
 	}
 	assert_int_equal(irdm_hal_read(&dev, &st), IRDM_OK);
-	assert_int_equal(irdm_hal_write(&dev, zero), IRDM_OK);  /* this SYNC is answered late */
+	assert_int_equal(irdm_hal_write(&dev, zero), IRDM_OK); /* this SYNC is answered late */
 	if (irdm_hal_read(&dev, &st))
 		fail_msg("one late TPDO1: %s", dev.why);
 	assert_int_equal(irdm_hal_write(&dev, zero), IRDM_OK);
-	irdm_can_drives_poll(&data.drives);                     /* both answers come */
+	irdm_can_drives_poll(&data.drives); /* both answers come */
 	assert_int_equal(irdm_hal_read(&dev, &st), IRDM_OK);
-	for (k = 0; k < 3; k++) {                               /* now none for 3 periods */
+	for (k = 0; k < 3; k++) { /* now none for 3 periods */
 		assert_int_equal(irdm_hal_write(&dev, zero), IRDM_OK);
 		if (irdm_hal_read(&dev, &st))
 			break;

@@ -86,11 +86,11 @@ static void test_registry(void **state)
 	assert_ptr_equal(irdm_hal_find("sim"), &irdm_hal_sim_backend);
 	assert_null(irdm_hal_find("can"));
 	assert_null(irdm_hal_find(NULL));
-	assert_int_equal(irdm_hal_register(&irdm_hal_sim_backend), IRDM_OK);   /* again */
+	assert_int_equal(irdm_hal_register(&irdm_hal_sim_backend), IRDM_OK); /* again */
 	assert_int_equal(irdm_hal_register(&incomplete), IRDM_EINVAL);
 	assert_int_equal(irdm_hal_register(&impostor), IRDM_EINVAL);
 	assert_int_equal(irdm_hal_register(NULL), IRDM_EINVAL);
-	assert_int_equal(irdm_hal_register(&twin), IRDM_EBUSY);                 /* name taken */
+	assert_int_equal(irdm_hal_register(&twin), IRDM_EBUSY); /* name taken */
 
 	assert_int_equal(irdm_hal_init(&dev, "can", &cfg, mem, sizeof(mem)), IRDM_ENOTSUP);
 	assert_true(irdm_hal_sim_backend.data_size <= sizeof(mem));
@@ -115,7 +115,7 @@ static void test_life_cycle_errors(void **state)
 	assert_int_equal(irdm_hal_read(&dev, &st), IRDM_EINVAL);
 	assert_int_equal(irdm_hal_write(&dev, tau), IRDM_EINVAL);
 	assert_int_equal(irdm_hal_poll(&dev, &faults), IRDM_EINVAL);
-	assert_int_equal(irdm_hal_safe_off(&dev), IRDM_OK);     /* always allowed */
+	assert_int_equal(irdm_hal_safe_off(&dev), IRDM_OK); /* always allowed */
 	/* bad options, bad configuration */
 	cfg.options = "write_delay=2 warp=9";
 	assert_int_equal(irdm_hal_open(&dev), IRDM_EINVAL);
@@ -150,7 +150,7 @@ static void test_life_cycle_errors(void **state)
 	}
 	irdm_hal_close(&dev);
 	assert_int_equal(irdm_hal_read(&dev, &st), IRDM_EINVAL);
-	open_sim(NULL);                 /* may open again */
+	open_sim(NULL); /* may open again */
 	irdm_hal_close(&dev);
 }
 
@@ -160,7 +160,7 @@ static void test_force_moves_tip(void **state)
 {
 	struct irdm_hal_joint_state st;
 	double tip0[3], tip[3], q[3], g[3], tau[3];
-	const double f[3] = { 0.3, 0, 0 };      /* push toward +x */
+	const double f[3] = { 0.3, 0, 0 }; /* push toward +x */
 	(void)state;
 
 	open_sim(NULL);
@@ -192,7 +192,7 @@ static void test_force_moves_tip(void **state)
 	assert_int_equal(irdm_hal_read(&dev, &st), IRDM_OK);
 	motor_torque(tau);
 	assert_true(tau[0] == 0 && tau[1] == 0 && tau[2] == 0);
-	assert_int_equal(irdm_hal_safe_off(&dev), IRDM_OK);     /* twice is fine */
+	assert_int_equal(irdm_hal_safe_off(&dev), IRDM_OK); /* twice is fine */
 	/* only start re-enables */
 	assert_int_equal(irdm_hal_start(&dev), IRDM_OK);
 	assert_int_equal(irdm_hal_write(&dev, (double[3]){ 0.2, 0, 0 }), IRDM_OK);
@@ -239,7 +239,7 @@ static void test_injected_fault(void **state)
 	/* every op reports it, the torque is already off, and it stays latched */
 	st.seq = 42;
 	assert_int_equal(irdm_hal_read(&dev, &st), IRDM_EHW);
-	assert_int_equal(st.seq, 42);           /* untouched */
+	assert_int_equal(st.seq, 42); /* untouched */
 	assert_int_equal(irdm_hal_poll(&dev, &faults), IRDM_EHW);
 	assert_int_equal(faults, IRDM_HAL_FAULT_DRIVE);
 	assert_int_equal(irdm_hal_write(&dev, (double[3]){ 0.3, 0, 0 }), IRDM_EHW);
@@ -318,8 +318,10 @@ static void test_attached_user_pushes_at_tick_time(void **state)
 	irdm_device_fk(&arm_cfg, board.calibration_pose_rad, tip);
 	irdm_board_device_to_object(&board, tip, home);
 	assert_int_equal(irdm_sim_user_parse(&user, "press", "place 1 at home\n"
-					     "move 1 by 0,0,-0.02 over 0.1\n", err,
-					     sizeof(err)), IRDM_OK);
+							     "move 1 by 0,0,-0.02 over 0.1\n",
+					     err,
+					     sizeof(err)),
+			 IRDM_OK);
 	assert_int_equal(irdm_sim_user_start(&user, 0, home, "press", err, sizeof(err)), IRDM_OK);
 	bcfg = (struct irdm_hal_config){ &arm_cfg, NULL, board.period_us * 1e-6 };
 	assert_int_equal(irdm_hal_init(&dev, "sim", &bcfg, mem, sizeof(mem)), IRDM_OK);

@@ -46,7 +46,7 @@ static void test_retouch_sees_the_deformed_surface(void **state)
 	cfg.max_contacts = 1;
 	struct irdm_session *ses = efx_session(&img, &cfg);
 	struct irdm_engine *e = ses->eng;
-	cm = ses->cm;                   /* with the session's face-beyond table */
+	cm = ses->cm; /* with the session's face-beyond table */
 	assert_non_null(cm.beyond);
 	irdm_proxy_config_default(&pcfg);
 	pcfg.max_disp_m = 0.05;

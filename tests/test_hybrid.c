@@ -32,8 +32,8 @@
 #include "support/engine_fixture.h"
 #include "irdm/posix/image_map.h"
 
-#define H_EXACT 32              /* scene key exact_head */
-#define N_TICKS 1500            /* 3 s at 2 ms */
+#define H_EXACT 32   /* scene key exact_head */
+#define N_TICKS 1500 /* 3 s at 2 ms */
 #define N_FIRST 10
 #define RELEASE_TICK 500
 
@@ -112,7 +112,7 @@ static void taper_expected(const struct irdm_image *img, uint32_t c, uint32_t r,
 {
 	double bump_sum = 0, whole[9];
 
-	efx_corr_block(img, c, r, whole);       /* kept block + far field */
+	efx_corr_block(img, c, r, whole); /* kept block + far field */
 	for (size_t i = 0; i < H_EXACT; i++)
 		bump_sum += irdm_window_bump(i, H_EXACT);
 	for (int e = 0; e < 9; e++) {
@@ -151,7 +151,8 @@ static void test_head_responses(void **state)
 			assert_int_equal(irdm_image_response(&hybrid, c, hybrid.columns[r], Hs, rh), 0);
 			assert_int_equal(irdm_image_response(&exact, same_col(&hybrid, c, &exact),
 							     exact.columns[same_col(&hybrid, r, &exact)],
-							     Hs, rx), 0);
+							     Hs, rx),
+					 0);
 			/* the dropped modes' part: the exact model less the 300
 			 * modes' recursion (sc_only's response without its
 			 * static correction); its second half tapered, plus what
@@ -173,7 +174,7 @@ static void test_head_responses(void **state)
 				scale = fmax(scale, fabs(rx[i]));
 			}
 			double blk_norm = 0, diff = 0, whole[9];
-			efx_corr_block(&hybrid, c, r, whole);   /* kept block + far field */
+			efx_corr_block(&hybrid, c, r, whole); /* kept block + far field */
 			for (int e = 0; e < 9; e++) {
 				double sum = 0, sc = whole[e];
 				for (uint32_t s = 0; s < Hs; s++)
@@ -304,7 +305,8 @@ static void test_unstable_refused(void **state)
 	irdm_scene_defaults(&sc);
 	assert_int_equal(irdm_scene_set(&sc, "resolution", "4,4,8", "test", err, sizeof(err)), 0);
 	assert_int_equal(irdm_scene_set(&sc, "touch", "box:0.0499,0.0499,0.1999,0.0751,0.0751,0.2001",
-					"test", err, sizeof(err)), 0);
+					"test", err, sizeof(err)),
+			 0);
 	assert_int_equal(irdm_scene_set(&sc, "representation", "modal:40", "test", err, sizeof(err)), 0);
 	assert_int_equal(irdm_scene_set(&sc, "exact_head", "8", "test", err, sizeof(err)), 0);
 	assert_int_equal(irdm_precompute(&sc, &o, &rep, err, sizeof(err)), IRDM_ENUMERIC);

@@ -28,7 +28,7 @@
 #include "support/image_fixture.h"
 
 static char tmpdir[512];
-static const char *current_case = "";      /* named when a check fails */
+static const char *current_case = ""; /* named when a check fails */
 
 /* ------------------------------------------------------------- helpers */
 
@@ -162,7 +162,8 @@ static void small_modal(struct img_fixture *fx)
 {
 	assert_int_equal(img_fixture_modal(fx, IRDM_ELEM_F64, 5, 2, 3,
 					   IRDM_META_FLOATING |
-					   IRDM_META_STATIC_CORR), 0);
+						   IRDM_META_STATIC_CORR),
+			 0);
 }
 
 static struct irdm_image_section get_entry(const void *buf, unsigned i)
@@ -267,18 +268,15 @@ static void test_f16_known_patterns(void **state)
 		float f;
 		uint16_t h;
 	} t[] = {
-		{ 1.0f, 0x3c00 }, { -2.0f, 0xc000 }, { 65504.0f, 0x7bff },
-		{ 0x1p-24f, 0x0001 }, { 0x1p-14f, 0x0400 }, { 0.1f, 0x2e66 },
-		{ 0.0f, 0x0000 }, { -0.0f, 0x8000 }, { 0.5f, 0x3800 },
-		{ 65520.0f, 0x7c00 }, { 1e6f, 0x7c00 }, { -1e6f, 0xfc00 },
-		{ INFINITY, 0x7c00 }, { -INFINITY, 0xfc00 },
-		{ 0x1p-25f, 0x0000 },           /* tie: to even (0) */
-		{ 0x1.8p-24f, 0x0002 },         /* tie 1.5 units: to even (2) */
-		{ 0x1.0p-26f, 0x0000 }, { 0x1.000002p-25f, 0x0001 },
-		{ 65519.0f, 0x7bff }, { 0x1.ff8p-15f, 0x03ff },
-		{ 0x1.ffcp-15f, 0x0400 },        /* tie: to even (normal) */
-		{ 1.0f + 0x1p-11f, 0x3c00 },    /* tie: to even */
-		{ 1.0f + 0x1.8p-10f, 0x3c02 },  /* tie: to even (up) */
+		{ 1.0f, 0x3c00 }, { -2.0f, 0xc000 }, { 65504.0f, 0x7bff }, { 0x1p-24f, 0x0001 }, { 0x1p-14f, 0x0400 }, { 0.1f, 0x2e66 }, { 0.0f, 0x0000 }, { -0.0f, 0x8000 }, { 0.5f, 0x3800 }, { 65520.0f, 0x7c00 }, { 1e6f, 0x7c00 }, { -1e6f, 0xfc00 }, { INFINITY, 0x7c00 }, { -INFINITY, 0xfc00 }, { 0x1p-25f, 0x0000 }, /* tie: to even (0) */
+		{ 0x1.8p-24f, 0x0002 },                                                                                                                                                                                                                                                                                       /* tie 1.5 units: to even (2) */
+		{ 0x1.0p-26f, 0x0000 },
+		{ 0x1.000002p-25f, 0x0001 },
+		{ 65519.0f, 0x7bff },
+		{ 0x1.ff8p-15f, 0x03ff },
+		{ 0x1.ffcp-15f, 0x0400 },      /* tie: to even (normal) */
+		{ 1.0f + 0x1p-11f, 0x3c00 },   /* tie: to even */
+		{ 1.0f + 0x1.8p-10f, 0x3c02 }, /* tie: to even (up) */
 	};
 
 	(void)state;
@@ -331,7 +329,7 @@ static void test_f16_rounding_all_midpoints(void **state)
 	for (uint16_t h = 0; h < 0x7c00; h++) {
 		float lo = irdm_f16_to_f32(h);
 		float hi = irdm_f16_to_f32((uint16_t)(h + 1));
-		float mid = lo + (hi - lo) / 2;     /* exact in binary32 */
+		float mid = lo + (hi - lo) / 2; /* exact in binary32 */
 		uint16_t even = (h & 1) ? (uint16_t)(h + 1) : h;
 
 		if (h == 0x7bff)
@@ -404,7 +402,7 @@ static void test_writer_layout(void **state)
 		assert_int_equal(s.reserved, 0);
 		end = s.offset + s.size;
 	}
-	assert_int_equal(end, size);            /* no trailing bytes */
+	assert_int_equal(end, size); /* no trailing bytes */
 	free(buf);
 	img_fixture_free(&fx);
 }
@@ -467,7 +465,8 @@ static void check_common_views(const struct irdm_image *img,
 	assert_null(irdm_image_find(img, IRDM_SEC_CONTACT_BVH));
 	assert_null(irdm_image_find(img, 1000));
 	assert_ptr_equal(irdm_image_find(img, IRDM_SEC_META)->offset +
-			 img->base, (const uint8_t *)img->meta);
+				 img->base,
+			 (const uint8_t *)img->meta);
 }
 
 static void check_fir_values(const struct irdm_image *img, uint32_t prec)
@@ -542,11 +541,11 @@ static void test_modal_floating_roundtrip(void **state)
 	assert_null(img.fir);
 	assert_memory_equal(img.modes, fx.modes, 3 * sizeof(*fx.modes));
 	assert_memory_equal(img.rigid, &fx.rigid, sizeof(fx.rigid));
-	n = (uint64_t)5 * 3 * 3;        /* [row][3][mode] */
+	n = (uint64_t)5 * 3 * 3; /* [row][3][mode] */
 	for (uint64_t k = 0; k < n; k++)
 		assert_true(irdm_elem_get(img.mode_shapes, IRDM_ELEM_F64, k) ==
 			    img_fixture_value(IRDM_SEC_MODE_SHAPES, k));
-	n = (uint64_t)2 * 2 * 9;        /* every block kept: [col][col][3][3] */
+	n = (uint64_t)2 * 2 * 9; /* every block kept: [col][col][3][3] */
 	for (uint64_t k = 0; k < n; k++)
 		assert_true(irdm_elem_get(img.corr_blocks, IRDM_ELEM_F64, k) ==
 			    img_fixture_value(IRDM_SEC_STATIC_CORR, k));
@@ -555,7 +554,8 @@ static void test_modal_floating_roundtrip(void **state)
 			assert_int_equal(irdm_image_corr_block(&img, c, r), 2 * c + r);
 	/* The fixture's modes are exact ZOH discretisations: |eig(A)| < 1. */
 	assert_true(img.modes[0].a[0] * img.modes[0].a[3] -
-		    img.modes[0].a[1] * img.modes[0].a[2] < 1);
+			    img.modes[0].a[1] * img.modes[0].a[2] <
+		    1);
 	irdm_image_unmap(&img);
 	img_fixture_free(&fx);
 }
@@ -669,11 +669,11 @@ static void test_modal_clusters_roundtrip(void **state)
 	static const struct {
 		uint32_t prec, n_clusters, rank, far;
 	} runs[] = {
-		{ IRDM_ELEM_F16, 3, 2, 0 },     /* clusters of 2, 2, 3 columns */
-		{ IRDM_ELEM_F32, 3, 6, 2 },     /* full rank of the smaller cluster */
+		{ IRDM_ELEM_F16, 3, 2, 0 }, /* clusters of 2, 2, 3 columns */
+		{ IRDM_ELEM_F32, 3, 6, 2 }, /* full rank of the smaller cluster */
 		{ IRDM_ELEM_F64, 2, IRDM_CORR_PAIR_DENSE, 3 },
-		{ IRDM_ELEM_F64, 7, 0, 0 },     /* one column each, cross pairs zero */
-		{ IRDM_ELEM_F64, 1, 0, 2 },     /* one dense self pair */
+		{ IRDM_ELEM_F64, 7, 0, 0 }, /* one column each, cross pairs zero */
+		{ IRDM_ELEM_F64, 1, 0, 2 }, /* one dense self pair */
 		{ IRDM_ELEM_F64, 4, 3, 1 },
 	};
 	const uint32_t NC = 7;
@@ -685,7 +685,8 @@ static void test_modal_clusters_roundtrip(void **state)
 	(void)state;
 	for (size_t n = 0; n < sizeof(runs) / sizeof(runs[0]); n++) {
 		assert_int_equal(img_fixture_modal(&fx, runs[n].prec, 8, NC, 3,
-						   IRDM_META_STATIC_CORR), 0);
+						   IRDM_META_STATIC_CORR),
+				 0);
 		symmetric_kept(&fx);
 		if (runs[n].far)
 			assert_int_equal(img_fixture_lowrank(&fx, runs[n].far), 0);
@@ -893,7 +894,8 @@ static void test_every_byte_flip_detected(void **state)
 		}
 	}
 	print_message("%zu bytes x 3 flips: trunc %d magic %d version %d crc %d "
-		      "range %d missing %d format %d\n", size, hist[-IRDM_ETRUNC],
+		      "range %d missing %d format %d\n",
+		      size, hist[-IRDM_ETRUNC],
 		      hist[-IRDM_EMAGIC], hist[-IRDM_EVERSION], hist[-IRDM_ECRC],
 		      hist[-IRDM_ERANGE], hist[-IRDM_EMISSING], hist[-IRDM_EFORMAT]);
 	free(buf);
@@ -914,7 +916,7 @@ static void test_bad_magic_and_version(void **state)
 	buf[0] = 'X';
 	expect_parse(buf, size, IRDM_EMAGIC, "not an IRDM image");
 	buf[0] = 'I';
-	buf[7] = ' ';                   /* the NUL is part of the magic */
+	buf[7] = ' '; /* the NUL is part of the magic */
 	expect_parse(buf, size, IRDM_EMAGIC, "magic");
 	buf[7] = 0;
 
@@ -924,7 +926,7 @@ static void test_bad_magic_and_version(void **state)
 	put_header(buf, &h);
 	img_fixture_reseal(buf, size);
 	expect_parse(buf, size, IRDM_EVERSION, "version 3.0");
-	h.version_major = 1;            /* the dense STATIC_CORR of before */
+	h.version_major = 1; /* the dense STATIC_CORR of before */
 	put_header(buf, &h);
 	img_fixture_reseal(buf, size);
 	expect_parse(buf, size, IRDM_EVERSION, "1.x kept the static correction dense; re-run irdm precompute");
@@ -969,11 +971,11 @@ static void test_bad_checksums(void **state)
 	small_fir(&fx);
 	fixture_buffer(&fx, (void **)&buf, &size);
 
-	buf[20] ^= 0x40;                /* file_size, covered by header crc */
+	buf[20] ^= 0x40; /* file_size, covered by header crc */
 	expect_parse(buf, size, IRDM_ECRC, "header checksum mismatch");
 	buf[20] ^= 0x40;
 
-	buf[64 + 3 * 32 + 8] ^= 0x40;   /* an offset in the table */
+	buf[64 + 3 * 32 + 8] ^= 0x40; /* an offset in the table */
 	expect_parse(buf, size, IRDM_ECRC, "section table checksum mismatch");
 	buf[64 + 3 * 32 + 8] ^= 0x40;
 
@@ -983,7 +985,7 @@ static void test_bad_checksums(void **state)
 	expect_parse(buf, size, IRDM_ECRC, "(NODES) checksum mismatch");
 	buf[s.offset + 5] ^= 1;
 
-	s.crc32c ^= 1;                  /* the stored crc is in the table */
+	s.crc32c ^= 1; /* the stored crc is in the table */
 	put_entry(buf, i, &s);
 	expect_parse(buf, size, IRDM_ECRC, "section table checksum");
 	free(buf);
@@ -1092,7 +1094,7 @@ static void e_runs_past(struct irdm_image_section *s, size_t size)
 static void e_wraps(struct irdm_image_section *s, size_t size)
 {
 	(void)size;
-	s->size = UINT64_MAX - s->offset + 2;   /* offset + size wraps to 1 */
+	s->size = UINT64_MAX - s->offset + 2; /* offset + size wraps to 1 */
 }
 
 static void e_misaligned(struct irdm_image_section *s, size_t size)
@@ -1191,12 +1193,12 @@ static void test_padding_must_be_zero(void **state)
 	(void)state;
 	small_fir(&fx);
 	fixture_buffer(&fx, (void **)&buf, &size);
-	buf[64 + 7 * 32 + 1] = 0x5a;    /* after the table of 7 */
+	buf[64 + 7 * 32 + 1] = 0x5a; /* after the table of 7 */
 	expect_parse(buf, size, IRDM_EFORMAT,
 		     "padding byte at offset 289 is 0x5a");
 	buf[64 + 7 * 32 + 1] = 0;
 	s = get_entry(buf, entry_of(buf, IRDM_SEC_PROVENANCE));
-	buf[s.offset + s.size] = 1;     /* after a payload */
+	buf[s.offset + s.size] = 1; /* after a payload */
 	expect_parse(buf, size, IRDM_EFORMAT, "padding");
 	free(buf);
 	img_fixture_free(&fx);
@@ -1243,7 +1245,8 @@ static void test_unknown_kind(void **state)
 	img_fixture_add(&fx, &w);
 	assert_int_equal(irdm_iw_add(&w, 0x1000, IRDM_ELEM_BYTES, blob, 40), 0);
 	assert_int_equal(irdm_iw_add(&w, IRDM_SEC_CONTACT_BVH, IRDM_ELEM_U32,
-				     blob, 40), 0);
+				     blob, 40),
+			 0);
 	assert_int_equal(irdm_iw_to_buffer(&w, (void **)&buf, &size), 0);
 	expect_parse(buf, size, IRDM_OK, NULL);
 
@@ -1275,18 +1278,54 @@ static void w_remove(struct irdm_image_writer *w, uint32_t kind)
 static struct irdm_mode spare_modes[2];
 static uint8_t spare_bytes[256];
 
-static void w_no_meta(struct irdm_image_writer *w) { w_remove(w, IRDM_SEC_META); }
-static void w_no_prov(struct irdm_image_writer *w) { w_remove(w, IRDM_SEC_PROVENANCE); }
-static void w_no_nodes(struct irdm_image_writer *w) { w_remove(w, IRDM_SEC_NODES); }
-static void w_no_cols(struct irdm_image_writer *w) { w_remove(w, IRDM_SEC_COLUMNS); }
-static void w_no_surface(struct irdm_image_writer *w) { w_remove(w, IRDM_SEC_SURFACE); }
-static void w_no_stab(struct irdm_image_writer *w) { w_remove(w, IRDM_SEC_STABILITY); }
-static void w_no_fir(struct irdm_image_writer *w) { w_remove(w, IRDM_SEC_FIR); }
-static void w_no_modes(struct irdm_image_writer *w) { w_remove(w, IRDM_SEC_MODES); }
-static void w_no_shapes(struct irdm_image_writer *w) { w_remove(w, IRDM_SEC_MODE_SHAPES); }
-static void w_no_rigid(struct irdm_image_writer *w) { w_remove(w, IRDM_SEC_RIGID); }
-static void w_no_corr(struct irdm_image_writer *w) { w_remove(w, IRDM_SEC_STATIC_CORR); }
-static void w_no_corr_index(struct irdm_image_writer *w) { w_remove(w, IRDM_SEC_STATIC_CORR_INDEX); }
+static void w_no_meta(struct irdm_image_writer *w)
+{
+	w_remove(w, IRDM_SEC_META);
+}
+static void w_no_prov(struct irdm_image_writer *w)
+{
+	w_remove(w, IRDM_SEC_PROVENANCE);
+}
+static void w_no_nodes(struct irdm_image_writer *w)
+{
+	w_remove(w, IRDM_SEC_NODES);
+}
+static void w_no_cols(struct irdm_image_writer *w)
+{
+	w_remove(w, IRDM_SEC_COLUMNS);
+}
+static void w_no_surface(struct irdm_image_writer *w)
+{
+	w_remove(w, IRDM_SEC_SURFACE);
+}
+static void w_no_stab(struct irdm_image_writer *w)
+{
+	w_remove(w, IRDM_SEC_STABILITY);
+}
+static void w_no_fir(struct irdm_image_writer *w)
+{
+	w_remove(w, IRDM_SEC_FIR);
+}
+static void w_no_modes(struct irdm_image_writer *w)
+{
+	w_remove(w, IRDM_SEC_MODES);
+}
+static void w_no_shapes(struct irdm_image_writer *w)
+{
+	w_remove(w, IRDM_SEC_MODE_SHAPES);
+}
+static void w_no_rigid(struct irdm_image_writer *w)
+{
+	w_remove(w, IRDM_SEC_RIGID);
+}
+static void w_no_corr(struct irdm_image_writer *w)
+{
+	w_remove(w, IRDM_SEC_STATIC_CORR);
+}
+static void w_no_corr_index(struct irdm_image_writer *w)
+{
+	w_remove(w, IRDM_SEC_STATIC_CORR_INDEX);
+}
 
 /* A 2-column correction of one block per column, each the other's: the
  * diagonal of column 0 is missing. */
@@ -1363,7 +1402,7 @@ static void w_add_fir(struct irdm_image_writer *w)
 
 static void w_meta_short(struct irdm_image_writer *w)
 {
-	w->sec[0].size = 248;           /* META is added first */
+	w->sec[0].size = 248; /* META is added first */
 }
 
 static void w_surface_short(struct irdm_image_writer *w)
@@ -1394,7 +1433,10 @@ static void w_fir_elem(struct irdm_image_writer *w)
 }
 
 #define FX(name, stmt) \
-	static void name(struct img_fixture *fx) { stmt; }
+	static void name(struct img_fixture *fx) \
+	{ \
+		stmt; \
+	}
 
 FX(m_dt_zero, fx->meta.dt_s = 0)
 FX(m_dt_big, fx->meta.dt_s = 1.5)
@@ -1513,7 +1555,7 @@ FX(m_lr_rank_big, with_lowrank(fx)->rank = 7)
 FX(m_lr_rank_size, with_lowrank(fx)->rank = 1)
 FX(m_lr_reserved, with_lowrank(fx)->reserved[1] = 1)
 FX(m_lr_lambda_nan, lowrank_values(fx)[1] = NAN)
-FX(m_lr_u_inf, lowrank_values(fx)[2 + 2 * (3 + 2)] = INFINITY)    /* U[5][0] */
+FX(m_lr_u_inf, lowrank_values(fx)[2 + 2 * (3 + 2)] = INFINITY) /* U[5][0] */
 FX(m_lr_short, (with_lowrank(fx), fx->lowrank_bytes = 8))
 FX(m_lr_long, (with_lowrank(fx), fx->lowrank_bytes -= 8))
 /* The modal fixture without its static correction (flag and sections). */
@@ -1529,7 +1571,7 @@ static void drop_corr(struct img_fixture *fx)
 /* the far field without the correction it belongs to */
 FX(m_lr_no_corr, (with_lowrank(fx), drop_corr(fx)))
 
-static const uint8_t lowrank_bytes[16 + 8 * 2 * 7] = { 2 };   /* rank 2, zeros */
+static const uint8_t lowrank_bytes[16 + 8 * 2 * 7] = { 2 }; /* rank 2, zeros */
 
 static void w_add_lowrank(struct irdm_image_writer *w)
 {
@@ -1613,7 +1655,7 @@ FX(m_cl_inf, cl_values(fx)[23] = -INFINITY)
 /* the clusters without the correction they belong to */
 FX(m_cl_no_corr, (clusters(fx), drop_corr(fx)))
 
-static const uint8_t clusters_bytes[32] = { 1 };  /* 1 cluster, tables missing */
+static const uint8_t clusters_bytes[32] = { 1 }; /* 1 cluster, tables missing */
 
 static void w_add_clusters(struct irdm_image_writer *w)
 {
@@ -1626,7 +1668,8 @@ static void w_clusters_f64(struct irdm_image_writer *w)
 	w_set_elem(w, IRDM_SEC_STATIC_CORR_CLUSTERS, IRDM_ELEM_F64);
 }
 
-enum base { FIR, MODAL };
+enum base { FIR,
+	    MODAL };
 
 struct sem_case {
 	const char *name;
@@ -1863,7 +1906,8 @@ static void test_empty_section(void **state)
 	img_fixture_add(&fx, &w);
 	w_remove(&w, IRDM_SEC_SURFACE);
 	assert_int_equal(irdm_iw_add(&w, IRDM_SEC_SURFACE, IRDM_ELEM_U32,
-				     NULL, 0), 0);
+				     NULL, 0),
+			 0);
 	assert_int_equal(irdm_iw_to_buffer(&w, (void **)&buf, &size), 0);
 	assert_int_equal(size % 64, 0);
 	assert_int_equal(get_entry(buf, w.n - 1).offset, size);
@@ -1885,11 +1929,11 @@ static void test_f16_nan_in_fir(void **state)
 	fixture_buffer(&fx, &buf, &size);
 	expect_parse(buf, size, IRDM_EFORMAT, "FIR element 5");
 	free(buf);
-	((uint16_t *)fx.fir)[5] = 0xfc00;       /* -inf */
+	((uint16_t *)fx.fir)[5] = 0xfc00; /* -inf */
 	fixture_buffer(&fx, &buf, &size);
 	expect_parse(buf, size, IRDM_EFORMAT, "FIR element 5");
 	free(buf);
-	((uint16_t *)fx.fir)[5] = 0x7bff;       /* 65504: finite */
+	((uint16_t *)fx.fir)[5] = 0x7bff; /* 65504: finite */
 	fixture_buffer(&fx, &buf, &size);
 	expect_parse(buf, size, IRDM_OK, NULL);
 	free(buf);
@@ -1900,9 +1944,17 @@ static void test_f16_nan_in_fir(void **state)
 static void test_strerror(void **state)
 {
 	static const int codes[] = {
-		IRDM_OK, IRDM_EINVAL, IRDM_ENOMEM, IRDM_EIO, IRDM_ETRUNC,
-		IRDM_EMAGIC, IRDM_EVERSION, IRDM_ECRC, IRDM_ERANGE,
-		IRDM_EMISSING, IRDM_EFORMAT,
+		IRDM_OK,
+		IRDM_EINVAL,
+		IRDM_ENOMEM,
+		IRDM_EIO,
+		IRDM_ETRUNC,
+		IRDM_EMAGIC,
+		IRDM_EVERSION,
+		IRDM_ECRC,
+		IRDM_ERANGE,
+		IRDM_EMISSING,
+		IRDM_EFORMAT,
 	};
 
 	(void)state;
@@ -2014,7 +2066,7 @@ static void test_write_failure_keeps_old_image(void **state)
 	assert_int_equal(getrlimit(RLIMIT_FSIZE, &old), 0);
 	old_handler = signal(SIGXFSZ, SIG_IGN);
 	lim = old;
-	lim.rlim_cur = 64 * 1024;       /* big image is ~1.4 MB */
+	lim.rlim_cur = 64 * 1024; /* big image is ~1.4 MB */
 	assert_int_equal(setrlimit(RLIMIT_FSIZE, &lim), 0);
 	ret = img_fixture_write(&big, path, err, sizeof(err));
 	assert_int_equal(setrlimit(RLIMIT_FSIZE, &old), 0);

@@ -89,9 +89,7 @@ static void plant_module(const char *root, bool back_edge)
 {
 	put(root, "firmware/mod/mod_priv.h", "int a(void);\nint b(void);\n");
 	put(root, "firmware/mod/a.c", "#include \"mod_priv.h\"\nint a(void)\n{\n\treturn b();\n}\n");
-	put(root, "firmware/mod/b.c", back_edge ?
-	    "#include \"mod_priv.h\"\nint b(void)\n{\n\treturn a() + 1;\n}\n" :
-	    "#include \"mod_priv.h\"\nint b(void)\n{\n\treturn 1;\n}\n");
+	put(root, "firmware/mod/b.c", back_edge ? "#include \"mod_priv.h\"\nint b(void)\n{\n\treturn a() + 1;\n}\n" : "#include \"mod_priv.h\"\nint b(void)\n{\n\treturn 1;\n}\n");
 }
 
 static void test_planted_module_circle_is_found(void **state)
@@ -116,10 +114,8 @@ static void plant_tools(const char *root, bool back_edge)
 	put(root, "tools/low/low.h", "int low(void);\n");
 	put(root, "tools/high/high.h", "int high(void);\n");
 	put(root, "tools/high/high.c", "#include \"high/high.h\"\n#include \"low/low.h\"\n"
-	    "int high(void)\n{\n\treturn low();\n}\n");
-	put(root, "tools/low/low.c", back_edge ?
-	    "#include \"high/high.h\"\n#include \"low/low.h\"\nint low(void)\n{\n\treturn 1;\n}\n" :
-	    "#include \"low/low.h\"\nint low(void)\n{\n\treturn 1;\n}\n");
+				       "int high(void)\n{\n\treturn low();\n}\n");
+	put(root, "tools/low/low.c", back_edge ? "#include \"high/high.h\"\n#include \"low/low.h\"\nint low(void)\n{\n\treturn 1;\n}\n" : "#include \"low/low.h\"\nint low(void)\n{\n\treturn 1;\n}\n");
 }
 
 static void test_planted_tools_circle_is_found(void **state)

@@ -30,11 +30,15 @@
 #include "scene/scene.h"
 #include "support/test_files.h"
 
-#define GUARD_S 20      /* far above a reader's real time; a hang dies here */
+#define GUARD_S 20 /* far above a reader's real time; a hang dies here */
 
 static char dir[256], fifo[320], nul[320], longl[320], huge[320], err[1024];
 
-enum reader { BOARD, USER, SCENE, IMAGE, N_READERS };
+enum reader { BOARD,
+	      USER,
+	      SCENE,
+	      IMAGE,
+	      N_READERS };
 static const char *const reader_name[N_READERS] = { "board", "user script", "scene", "image" };
 
 static int read_with(enum reader r, const char *path)

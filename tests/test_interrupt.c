@@ -234,7 +234,7 @@ static void test_image_debris(void **state)
 	tf_write_text(live, "half an image of a running writer");
 	fd = open(live, O_RDONLY);
 	assert_true(fd >= 0);
-	assert_int_equal(flock(fd, LOCK_EX), 0);       /* this process: a live writer */
+	assert_int_equal(flock(fd, LOCK_EX), 0); /* this process: a live writer */
 	rc = rp_run(dir, irdm_path(), args, NULL, 0, err_text, sizeof(err_text));
 	close(fd);
 	if (rc)

@@ -37,31 +37,117 @@ static const char *build_dir(void)
  * clock nor a thread (and glibc's names for ctype and errno). */
 static const char *const allowed[] = {
 	/* string and memory */
-	"memcpy", "memmove", "memset", "memcmp", "memchr", "strlen", "strnlen", "strcmp",
-	"strncmp", "strchr", "strrchr", "strstr", "strcspn", "strspn", "strpbrk", "strcpy",
-	"strncpy", "strcat", "strncat",
+	"memcpy",
+	"memmove",
+	"memset",
+	"memcmp",
+	"memchr",
+	"strlen",
+	"strnlen",
+	"strcmp",
+	"strncmp",
+	"strchr",
+	"strrchr",
+	"strstr",
+	"strcspn",
+	"strspn",
+	"strpbrk",
+	"strcpy",
+	"strncpy",
+	"strcat",
+	"strncat",
 	/* formatting into a buffer */
-	"snprintf", "vsnprintf",
+	"snprintf",
+	"vsnprintf",
 	/* numbers from text */
-	"strtod", "strtof", "strtold", "strtol", "strtoll", "strtoul", "strtoull",
-	"__isoc23_strtol", "__isoc23_strtoll", "__isoc23_strtoul", "__isoc23_strtoull",
+	"strtod",
+	"strtof",
+	"strtold",
+	"strtol",
+	"strtoll",
+	"strtoul",
+	"strtoull",
+	"__isoc23_strtol",
+	"__isoc23_strtoll",
+	"__isoc23_strtoul",
+	"__isoc23_strtoull",
 	/* ctype */
-	"__ctype_b_loc", "__ctype_tolower_loc", "__ctype_toupper_loc", "isalnum", "isalpha",
-	"isdigit", "isspace", "isxdigit", "isupper", "islower", "isprint", "ispunct", "tolower",
+	"__ctype_b_loc",
+	"__ctype_tolower_loc",
+	"__ctype_toupper_loc",
+	"isalnum",
+	"isalpha",
+	"isdigit",
+	"isspace",
+	"isxdigit",
+	"isupper",
+	"islower",
+	"isprint",
+	"ispunct",
+	"tolower",
 	"toupper",
 	/* libm */
-	"sqrt", "sqrtf", "cbrt", "hypot", "pow", "exp", "exp2", "expm1", "log", "log2", "log10",
-	"log1p", "sin", "cos", "tan", "sincos", "sinf", "cosf", "asin", "acos", "atan", "atan2",
-	"sinh", "cosh", "tanh", "fabs", "fabsf", "floor", "ceil", "round", "lround", "llround",
-	"trunc", "rint", "nearbyint", "fmod", "fmin", "fmax", "fma", "copysign", "frexp", "ldexp",
+	"sqrt",
+	"sqrtf",
+	"cbrt",
+	"hypot",
+	"pow",
+	"exp",
+	"exp2",
+	"expm1",
+	"log",
+	"log2",
+	"log10",
+	"log1p",
+	"sin",
+	"cos",
+	"tan",
+	"sincos",
+	"sinf",
+	"cosf",
+	"asin",
+	"acos",
+	"atan",
+	"atan2",
+	"sinh",
+	"cosh",
+	"tanh",
+	"fabs",
+	"fabsf",
+	"floor",
+	"ceil",
+	"round",
+	"lround",
+	"llround",
+	"trunc",
+	"rint",
+	"nearbyint",
+	"fmod",
+	"fmin",
+	"fmax",
+	"fma",
+	"copysign",
+	"frexp",
+	"ldexp",
 	"modf",
 	/* allocation, at initialisation */
-	"calloc", "malloc", "aligned_alloc", "free",
+	"calloc",
+	"malloc",
+	"aligned_alloc",
+	"free",
 	/* errno */
 	"__errno_location",
 	/* the compiler's, not the library's (clang turns memcmp() == 0 into bcmp) */
-	"_GLOBAL_OFFSET_TABLE_", "__stack_chk_fail", "bcmp", "__memcpy_chk", "__memmove_chk",
-	"__memset_chk", "__snprintf_chk", "__vsnprintf_chk", "__strncpy_chk", "__strcpy_chk",
+	"_GLOBAL_OFFSET_TABLE_",
+	"__stack_chk_fail",
+	"bcmp",
+	"__memcpy_chk",
+	"__memmove_chk",
+	"__memset_chk",
+	"__snprintf_chk",
+	"__vsnprintf_chk",
+	"__strncpy_chk",
+	"__strcpy_chk",
 	NULL,
 };
 
@@ -114,9 +200,9 @@ static void objects_of(char *buf, size_t len, const char *dir)
 
 struct layer_scan {
 	const char *dir;
-	size_t bad;             /* symbols outside the allow-list */
+	size_t bad; /* symbols outside the allow-list */
 	int seen_pthread_create, seen_open;
-	int quiet;              /* the control: count, do not report */
+	int quiet; /* the control: count, do not report */
 };
 
 static void name_culprits(const char *sym, const char *dir)
@@ -155,7 +241,8 @@ static void check_symbol(const char *line, void *ctx)
 	s->bad++;
 	if (!s->quiet) {
 		print_error("%s: the core needs '%s', not an ISO C library function it may call "
-			    "(POSIX, threads, BLAS or stdio belong in platform/posix/):\n", s->dir, sym);
+			    "(POSIX, threads, BLAS or stdio belong in platform/posix/):\n",
+			    s->dir, sym);
 		name_culprits(sym, s->dir);
 	}
 }
@@ -244,7 +331,7 @@ static void test_core_tests_link_the_core_alone(void **state)
 		 "for s in tests/core/test_*.c; do readelf -d %s/tests/core/$(basename $s .c) | grep NEEDED; done",
 		 build_dir());
 	needed = each_line(cmd, no_service_library, NULL);
-	assert_true(needed >= n);       /* libc at least: the check saw the lists */
+	assert_true(needed >= n); /* libc at least: the check saw the lists */
 }
 
 static void report_include(const char *line, void *ctx)

@@ -55,11 +55,12 @@ static void check(unsigned nx, unsigned ny, unsigned nz, double a, double b, dou
 	assert_int_equal(irdm_mesh_gen_box(a, b, c, nx, ny, nz, 5, &mesh, err, sizeof(err)), 0);
 	box_reference(a, b, c, &rm, rcom, rin);
 	for (int k = 0; k < 2; k++) {
-		assert_int_equal(irdm_fem_assemble(&mesh, &mat, k ? IRDM_MASS_CONSISTENT
-								  : IRDM_MASS_LUMPED, NULL, &fem[k],
-						   err, sizeof(err)), 0);
+		assert_int_equal(irdm_fem_assemble(&mesh, &mat, k ? IRDM_MASS_CONSISTENT : IRDM_MASS_LUMPED, NULL, &fem[k],
+						   err, sizeof(err)),
+				 0);
 		assert_int_equal(irdm_mass_properties_of_matrix(&mesh, &fem[k], &m[k], com[k],
-								 in[k]), 0);
+								in[k]),
+				 0);
 	}
 	irdm_mass_properties(&mesh, fem[0].lumped_mass_kg, &lm, lcom, lin);
 	double e_cons = rel_err(in[1], rin, 9, rin[8]);
@@ -85,9 +86,9 @@ static void check(unsigned nx, unsigned ny, unsigned nz, double a, double b, dou
 static void test_box_inertia(void **state)
 {
 	(void)state;
-	check(3, 3, 3, 0.12, 0.12, 0.12);       /* the paper's cube */
-	check(6, 6, 1, 0.12, 0.12, 0.02);       /* flat: lumped worst */
-	check(2, 3, 5, 0.05, 0.08, 0.2);        /* no symmetry to hide behind */
+	check(3, 3, 3, 0.12, 0.12, 0.12); /* the paper's cube */
+	check(6, 6, 1, 0.12, 0.12, 0.02); /* flat: lumped worst */
+	check(2, 3, 5, 0.05, 0.08, 0.2);  /* no symmetry to hide behind */
 }
 
 int main(void)

@@ -133,9 +133,7 @@ static int setup(void **state)
 	if (tf_tmpdir(dir, sizeof(dir), "measure"))
 		return -1;
 	/* the test's own exact model: every mode, f64, not measured */
-	return build("exact.img", &rep, err, sizeof(err), (const char *const[]){
-		"representation", "modal:all", "static_correction", "no", "precision", "f64",
-		"max_error", "none", NULL });
+	return build("exact.img", &rep, err, sizeof(err), (const char *const[]){ "representation", "modal:all", "static_correction", "no", "precision", "f64", "max_error", "none", NULL });
 }
 
 static int teardown(void **state)
@@ -151,13 +149,12 @@ static void test_exact_measures_exact(void **state)
 	char err[512];
 
 	(void)state;
-	assert_int_equal(build("all.img", &rep, err, sizeof(err), (const char *const[]){
-		"representation", "modal:all", "precision", "f64", NULL }), 0);
+	assert_int_equal(build("all.img", &rep, err, sizeof(err), (const char *const[]){ "representation", "modal:all", "precision", "f64", NULL }), 0);
 	print_message("modal:all f64: measured %.3g over %zu columns x %zu ticks in %.2f s\n",
 		      rep.measured_error, rep.error_cols, rep.error_ticks, rep.seconds_error);
 	assert_true(rep.error_measured);
 	assert_int_equal(rep.error_cols, IRDM_MEASURE_MAX_COLS);
-	assert_int_equal(rep.error_ticks, 500);        /* 1 s at 2 ms */
+	assert_int_equal(rep.error_ticks, 500); /* 1 s at 2 ms */
 	assert_true(rep.measured_error < 1e-9);
 	map("all.img", &img);
 	assert_true(img.meta->flags & IRDM_META_ERROR_MEASURED);
@@ -175,8 +172,7 @@ static void test_figure_recomputed(void **state)
 	double e[2];
 
 	(void)state;
-	assert_int_equal(build("m40.img", &rep, err, sizeof(err), (const char *const[]){
-		"representation", "modal:40", "max_error", "1", NULL }), 0);
+	assert_int_equal(build("m40.img", &rep, err, sizeof(err), (const char *const[]){ "representation", "modal:40", "max_error", "1", NULL }), 0);
 	map("m40.img", &img);
 	map("exact.img", &exact);
 	for (int release = 0; release < 2; release++)
@@ -184,7 +180,7 @@ static void test_figure_recomputed(void **state)
 	print_message("modal:40 + static correction: stored %.6g (%s at node %u); here step %.6g, release %.6g\n",
 		      (double)img.meta->measured_error, rep.error_worst_run, rep.error_worst_node,
 		      e[0], e[1]);
-	assert_true(rep.measured_error > 1e-3);        /* the ZOH ringing it lacks */
+	assert_true(rep.measured_error > 1e-3); /* the ZOH ringing it lacks */
 	assert_float_equal(rep.measured_error, fmax(e[0], e[1]), 1e-9 * rep.measured_error);
 	assert_string_equal(rep.error_worst_run, e[1] > e[0] ? "release" : "step");
 	assert_float_equal(img.meta->measured_error, rep.measured_error, 1e-7 * rep.measured_error);
@@ -199,8 +195,7 @@ static void test_f16_measured_as_stored(void **state)
 	char err[512];
 
 	(void)state;
-	assert_int_equal(build("f16.img", &rep, err, sizeof(err), (const char *const[]){
-		"representation", "modal:all", "precision", "f16", "max_error", "1", NULL }), 0);
+	assert_int_equal(build("f16.img", &rep, err, sizeof(err), (const char *const[]){ "representation", "modal:all", "precision", "f16", "max_error", "1", NULL }), 0);
 	print_message("modal:all f16: measured %.3g\n", rep.measured_error);
 	assert_true(rep.measured_error > 1e-6 && rep.measured_error < 1e-2);
 }
@@ -213,8 +208,7 @@ static void test_over_target_refused(void **state)
 
 	(void)state;
 	snprintf(path, sizeof(path), "%s/m10.img", dir);
-	assert_int_equal(build("m10.img", &rep, err, sizeof(err), (const char *const[]){
-		"representation", "modal:10", NULL }), IRDM_ENUMERIC);
+	assert_int_equal(build("m10.img", &rep, err, sizeof(err), (const char *const[]){ "representation", "modal:10", NULL }), IRDM_ENUMERIC);
 	print_message("%s\n", err);
 	assert_non_null(strstr(err, "scene cuboid: modal:10 + static correction is "));
 	assert_non_null(strstr(err, "above max_error = 0.001; try a hybrid head (exact_head = 128)"));
@@ -224,8 +218,7 @@ static void test_over_target_refused(void **state)
 	/* nothing left beside it either: the scratch image and the reference */
 	assert_int_not_equal(access(strcat(path, ".unmeasured"), F_OK), 0);
 	/* none: written, neither measured nor flagged */
-	assert_int_equal(build("m10.img", &rep, err, sizeof(err), (const char *const[]){
-		"representation", "modal:10", "max_error", "none", NULL }), 0);
+	assert_int_equal(build("m10.img", &rep, err, sizeof(err), (const char *const[]){ "representation", "modal:10", "max_error", "none", NULL }), 0);
 	assert_false(rep.error_measured);
 	map("m10.img", &img);
 	assert_false(img.meta->flags & IRDM_META_ERROR_MEASURED);
@@ -239,13 +232,12 @@ static void test_auto_small_takes_all(void **state)
 	char err[512];
 
 	(void)state;
-	assert_int_equal(build("auto-small.img", &rep, err, sizeof(err), (const char *const[]){
-		"representation", "auto", NULL }), 0);
+	assert_int_equal(build("auto-small.img", &rep, err, sizeof(err), (const char *const[]){ "representation", "auto", NULL }), 0);
 	print_message("auto on 108 modes: %s, measured %.3g\n", rep.representation,
 		      rep.measured_error);
 	assert_string_equal(rep.representation, "modal:all");
 	assert_int_equal(rep.auto_tries, 1);
-	assert_true(rep.measured_error < 1e-6);       /* f32 storage */
+	assert_true(rep.measured_error < 1e-6); /* f32 storage */
 }
 
 static int cuboid(const char *name, struct irdm_precompute_report *rep, char *err, size_t errlen,

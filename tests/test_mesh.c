@@ -161,7 +161,8 @@ static void assert_closed_outward(const struct irdm_mesh *m, double scale)
 		sum[2] += n[2];
 		vol += (a[0] * (b[1] * c[2] - b[2] * c[1]) +
 			a[1] * (b[2] * c[0] - b[0] * c[2]) +
-			a[2] * (b[0] * c[1] - b[1] * c[0])) / 6.0;
+			a[2] * (b[0] * c[1] - b[1] * c[0])) /
+		       6.0;
 	}
 	assert_true(fabs(sum[0]) < 1e-12 * scale * scale);
 	assert_true(fabs(sum[1]) < 1e-12 * scale * scale);
@@ -211,7 +212,8 @@ static void check_box(double lx, double ly, double lz, unsigned nx, unsigned ny,
 	size_t tris;
 
 	assert_int_equal(irdm_mesh_gen_box(lx, ly, lz, nx, ny, nz, per_hex, &m,
-					   err, sizeof(err)), 0);
+					   err, sizeof(err)),
+			 0);
 	assert_int_equal(m.n_nodes, (size_t)(nx + 1) * (ny + 1) * (nz + 1));
 	assert_int_equal(m.n_tets, (size_t)nx * ny * nz * per_hex);
 	assert_true(fabs(irdm_mesh_volume(&m) - lx * ly * lz) <
@@ -236,7 +238,8 @@ static void test_box_paper_cuboid(void **state)
 
 	(void)state;
 	assert_int_equal(irdm_mesh_gen_box(0.1, 0.1, 0.2, 11, 11, 22, 5, &m, err,
-					   sizeof(err)), 0);
+					   sizeof(err)),
+			 0);
 	assert_int_equal(m.n_nodes, 3312);
 	assert_int_equal(m.n_tets, 13310);
 	assert_true(fabs(irdm_mesh_volume(&m) - 0.002) < 1e-15);
@@ -274,7 +277,8 @@ static void test_box_bad_args(void **state)
 	assert_err(irdm_mesh_gen_box(1, NAN, 1, 1, 1, 1, 5, &m, err, sizeof(err)),
 		   &m, err, "box", "positive");
 	assert_err(irdm_mesh_gen_box(1, 1, 1, 100000, 100000, 100000, 6, &m, err,
-				     sizeof(err)), &m, err, "box", "too many");
+				     sizeof(err)),
+		   &m, err, "box", "too many");
 }
 
 /* FNV-1a 64 reference, written out from its definition. */
@@ -302,7 +306,8 @@ static void test_hash(void **state)
 	memset(&e, 0, sizeof(e));
 	assert_true(irdm_mesh_hash(&e) == 0xcbf29ce484222325ULL);
 	assert_int_equal(irdm_mesh_gen_box(1, 1, 1, 2, 2, 2, 5, &m, err,
-					   sizeof(err)), 0);
+					   sizeof(err)),
+			 0);
 	h = irdm_mesh_hash(&m);
 	assert_true(h == ref_fnv(m.pos_m, 3 * m.n_nodes * sizeof(double), m.tets,
 				 4 * m.n_tets * sizeof(uint32_t)));
@@ -326,7 +331,7 @@ static const char cube_node0[] =
 	"4 0 0 1 9.5\n\n5 1 0 1 9.5\n6 0 1 1 9.5\n7 1 1 1 9.5\n";
 static const char cube_ele0[] =
 	"5 4 1\n0 0 3 6 5 1\n1 1 0 5 3 1\n# comment\n2 2 3 6 0 1\n"
-	"3 4 5 0 6 1\n4 7 6 3 5 1";	/* no final newline */
+	"3 4 5 0 6 1\n4 7 6 3 5 1"; /* no final newline */
 
 static void test_tetgen_cube(void **state)
 {
@@ -335,9 +340,11 @@ static void test_tetgen_cube(void **state)
 
 	(void)state;
 	assert_int_equal(parse_tetgen_str(cube_node1, strlen(cube_node1), cube_ele1,
-					  strlen(cube_ele1), &a, err, sizeof(err)), 0);
+					  strlen(cube_ele1), &a, err, sizeof(err)),
+			 0);
 	assert_int_equal(parse_tetgen_str(cube_node0, strlen(cube_node0), cube_ele0,
-					  strlen(cube_ele0), &b, err, sizeof(err)), 0);
+					  strlen(cube_ele0), &b, err, sizeof(err)),
+			 0);
 	assert_int_equal(a.n_nodes, 8);
 	assert_int_equal(a.n_tets, 5);
 	assert_true(fabs(irdm_mesh_volume(&a) - 1.0) < 1e-15);
@@ -396,7 +403,8 @@ static void test_tetgen_real_output_orientation(void **state)
 
 	(void)state;
 	assert_int_equal(parse_tetgen_str(node, strlen(node), ele, strlen(ele), &m,
-					  err, sizeof(err)), 0);
+					  err, sizeof(err)),
+			 0);
 	assert_true(fabs(irdm_mesh_volume(&m) - 1.0) < 1e-15);
 	irdm_mesh_free(&m);
 }
@@ -484,7 +492,7 @@ static void test_tetgen_errors(void **state)
 	scratch_path(path, sizeof(path), "t.ele");
 	for (i = 0; i < sizeof(cases) / sizeof(cases[0]); i++) {
 		const char *fneedle = cases[i].file_needle ? cases[i].file_needle :
-				      cases[i].needle;
+							     cases[i].needle;
 
 		ret = parse_tetgen_str(cases[i].node, strlen(cases[i].node),
 				       cases[i].ele, strlen(cases[i].ele), &m,
@@ -537,7 +545,8 @@ static void test_tetgen_truncations(void **state)
 static void test_gmsh_files_agree(void **state)
 {
 	static const char *const files[] = {
-		DATA "cube6_v22.msh", DATA "cube6_v41.msh",
+		DATA "cube6_v22.msh",
+		DATA "cube6_v41.msh",
 	};
 	struct irdm_mesh m[2];
 	char err[256];
@@ -614,11 +623,14 @@ static void test_gmsh_errors(void **state)
 		{ "$MeshFormat\n2.2 0 8\n$EndMeshFormat\nhello\n", "found 'hello'", NULL },
 		{ "$MeshFormat\n2.2 0 8\n$Nodes\n", "expected $EndMeshFormat", NULL },
 		{ "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 2 1 2\n0 1 0 3\n1\n2\n"
-		  "0 0 0\n0 0 0\n$EndNodes\n", "node block size 3 is too large", NULL },
+		  "0 0 0\n0 0 0\n$EndNodes\n",
+		  "node block size 3 is too large", NULL },
 		{ "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 2 1 2\n0 1 0 1\n1\n"
-		  "0 0 0\n$EndNodes\n", "declares 2 nodes but its blocks hold 1", NULL },
+		  "0 0 0\n$EndNodes\n",
+		  "declares 2 nodes but its blocks hold 1", NULL },
 		{ "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n0 0 0 0\n$EndNodes\n"
-		  "$Elements\n1 2 1 2\n3 1 4 3\n", "element block size 3 is too large", NULL },
+		  "$Elements\n1 2 1 2\n3 1 4 3\n",
+		  "element block size 3 is too large", NULL },
 		{ "", "missing $MeshFormat", NULL },
 		{ "\xff\xfe\x00garbage", "expected a $Section, found '???garbage'", NULL },
 	};
@@ -630,11 +642,11 @@ static void test_gmsh_errors(void **state)
 	scratch_path(path, sizeof(path), "t.msh");
 	for (i = 0; i < sizeof(cases) / sizeof(cases[0]); i++) {
 		const char *fneedle = cases[i].file_needle ? cases[i].file_needle :
-				      cases[i].needle;
+							     cases[i].needle;
 		size_t len = strlen(cases[i].txt);
 		int ret;
 
-		if (i == 1)	/* embedded NULs */
+		if (i == 1) /* embedded NULs */
 			len = 40;
 		if (i == sizeof(cases) / sizeof(cases[0]) - 1)
 			len = 10;
@@ -674,9 +686,11 @@ static void test_read_tetgen_files(void **state)
 
 	(void)state;
 	assert_int_equal(irdm_mesh_read(DATA "cube5.node", 1.0, NULL, &a, err,
-					sizeof(err)), 0);
+					sizeof(err)),
+			 0);
 	assert_int_equal(irdm_mesh_read(DATA "cube5.ele", 0.001, NULL, &b, err,
-					sizeof(err)), 0);
+					sizeof(err)),
+			 0);
 	assert_string_equal(a.name, "cube5");
 	assert_int_equal(a.n_tets, 5);
 	assert_true(fabs(irdm_mesh_volume(&a) - 1.0) < 1e-15);
@@ -696,21 +710,26 @@ static void test_read_errors(void **state)
 	assert_int_equal(irdm_mesh_read(DATA "missing.node", 1.0, NULL, &m, err, sizeof(err)),
 			 IRDM_EIO);
 	assert_err(irdm_mesh_read(DATA "missing.node", 1.0, NULL, &m, err,
-				  sizeof(err)), &m, err, DATA "missing.node",
+				  sizeof(err)),
+		   &m, err, DATA "missing.node",
 		   "cannot open");
 	assert_int_equal(irdm_mesh_read(DATA "cube5.vtk", 1.0, NULL, &m, err, sizeof(err)),
 			 IRDM_EFORMAT);
 	assert_err(irdm_mesh_read(DATA "cube5.vtk", 1.0, NULL, &m, err,
-				  sizeof(err)), &m, err, DATA "cube5.vtk",
+				  sizeof(err)),
+		   &m, err, DATA "cube5.vtk",
 		   "unknown mesh format");
 	assert_err(irdm_mesh_read(DATA "cube5.ele", 0.0, NULL, &m, err,
-				  sizeof(err)), &m, err, DATA "cube5.ele",
+				  sizeof(err)),
+		   &m, err, DATA "cube5.ele",
 		   "not a positive number");
 	assert_err(irdm_mesh_read(DATA "cube5.ele", NAN, NULL, &m, err,
-				  sizeof(err)), &m, err, DATA "cube5.ele",
+				  sizeof(err)),
+		   &m, err, DATA "cube5.ele",
 		   "not a positive number");
 	assert_err(irdm_mesh_read("tests/data/mesh", 1.0, NULL, &m, err,
-				  sizeof(err)), &m, err, "tests/data/mesh",
+				  sizeof(err)),
+		   &m, err, "tests/data/mesh",
 		   "unknown mesh format");
 }
 
@@ -750,7 +769,8 @@ static void test_finish_large(void **state)
 
 	(void)state;
 	assert_int_equal(irdm_mesh_gen_box(1, 1, 1, 30, 30, 30, 6, &m, err,
-					   sizeof(err)), 0);
+					   sizeof(err)),
+			 0);
 	assert_int_equal(m.n_tets, 162000);
 	assert_int_equal(m.n_tris, 4 * 3 * 900);
 	assert_closed_outward(&m, 1.0);
@@ -785,7 +805,7 @@ static void test_mesh_stats(void **state)
 	assert_true(fabs(st.vol_min_m3 - 0.05 * 0.05 * 0.05 / 6) < 1e-15);
 	assert_int_equal(irdm_mesh_stats_text(&m, &st, lines), 1);
 	for (size_t i = 0; i < 3 * m.n_nodes; i++)
-		m.pos_m[i] *= 1000;                     /* drawn in mm, read as m */
+		m.pos_m[i] *= 1000; /* drawn in mm, read as m */
 	irdm_mesh_stats(&m, &st);
 	assert_int_equal(irdm_mesh_stats_text(&m, &st, lines), 2);
 	assert_non_null(strstr(lines[1], "warning: the object is 200 m across: is mesh_scale right?"));

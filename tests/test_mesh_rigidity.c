@@ -91,7 +91,8 @@ static void solve(struct solved *s, double scale, bool floating, size_t n)
 	if (irdm_mesh_check_rigidity(&s->mesh, s->fixed, floating, err, sizeof(err)))
 		fail_msg("%s", err);
 	assert_int_equal(irdm_fem_assemble(&s->mesh, &steel_like, IRDM_MASS_LUMPED,
-					   floating ? NULL : s->fixed, &s->fem, err, sizeof(err)), 0);
+					   floating ? NULL : s->fixed, &s->fem, err, sizeof(err)),
+			 0);
 	if (irdm_modes_solve(&s->fem, n, floating, EIG, NULL, NULL, &s->modes, err,
 			     sizeof(err)))
 		fail_msg("%s", err);
@@ -121,12 +122,14 @@ static void test_graded_mesh_and_its_scaled_copy(void **state)
 				e[k][i] = a.mesh.pos_m[3 * v[k + 1] + i] - a.mesh.pos_m[3 * v[0] + i];
 		vol = fabs(e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) -
 			   e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
-			   e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0])) / 6;
+			   e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0])) /
+		      6;
 		vmin = fmin(vmin, vol);
 		vmax = fmax(vmax, vol);
 	}
 	print_message("graded mesh: %zu nodes, %zu tets, volumes %.2e..%.2e m^3; softest mode "
-		      "omega^2 %.4g = %.1e of max K_ii/M_ii\n", a.mesh.n_nodes, a.mesh.n_tets, vmin,
+		      "omega^2 %.4g = %.1e of max K_ii/M_ii\n",
+		      a.mesh.n_nodes, a.mesh.n_tets, vmin,
 		      vmax, a.modes.omega2[0], a.modes.omega2[0] / max_k_over_m(&a.fem));
 	/* the case the old rule (rigid below 1e-9 max K_ii/M_ii) got wrong */
 	assert_true(a.modes.omega2[0] < 1e-9 * max_k_over_m(&a.fem));
@@ -135,7 +138,7 @@ static void test_graded_mesh_and_its_scaled_copy(void **state)
 	assert_int_equal(a.modes.n_modes, b.modes.n_modes);
 	for (size_t k = 0; k < a.modes.n_modes; k++)
 		worst = fmax(worst, fabs(b.modes.omega2[k] * 100 - a.modes.omega2[k]) /
-				    a.modes.omega2[k]);
+					    a.modes.omega2[k]);
 	print_message("10x copy: omega^2 x 100 vs the original, worst of %zu modes %.1e\n",
 		      a.modes.n_modes, worst);
 	/* measured 5.8e-15 (rounding); 1.4e-6 with a dense solve */
@@ -155,7 +158,8 @@ static void test_graded_floating_has_six_rigid_modes(void **state)
 	assert_int_equal(s.modes.n_rigid, 6);
 	worst = fixture_rigid_outside(&s.mesh, &s.fem, &s.modes, (const double[3]){ 0.05, 0.05, 0.05 });
 	print_message("floating graded mesh: 6 rigid modes, first elastic %.4f Hz; rigid fields "
-		      "outside their span: %.1e\n", sqrt(s.modes.omega2[0]) / (2 * M_PI), worst);
+		      "outside their span: %.1e\n",
+		      sqrt(s.modes.omega2[0]) / (2 * M_PI), worst);
 	assert_true(worst <= 1e-8);
 	solved_free(&s);
 }
@@ -194,7 +198,27 @@ static void test_loose_parts(void **state)
 	/* tet A (0,1,2,3); B shares A's face (1,2,3) with apex 4; C shares
 	 * only A's edge (0,1) with nodes 5, 6 */
 	static const double pos[] = {
-		0, 0, 0,  1, 0, 0,  0, 1, 0,  0, 0, 1,  1, 1, 1,  0.5, -1, 0.2,  0.6, -0.8, 1,
+		0,
+		0,
+		0,
+		1,
+		0,
+		0,
+		0,
+		1,
+		0,
+		0,
+		0,
+		1,
+		1,
+		1,
+		1,
+		0.5,
+		-1,
+		0.2,
+		0.6,
+		-0.8,
+		1,
 	};
 	static const uint32_t face_pair[] = { 0, 1, 2, 3, 1, 2, 3, 4 };
 	static const uint32_t edge_pair[] = { 0, 1, 2, 3, 0, 1, 5, 6 };
@@ -204,12 +228,12 @@ static void test_loose_parts(void **state)
 
 	(void)state;
 	small_mesh(&m, pos, 7, face_pair, 2);
-	expect(&m, three, false, NULL);                 /* B held by the face */
-	expect(&m, two, false, "can move without straining");   /* turns about 0-1 */
+	expect(&m, three, false, NULL);                       /* B held by the face */
+	expect(&m, two, false, "can move without straining"); /* turns about 0-1 */
 	expect(&m, none, false, "2 tet(s) around node 0");
-	expect(&m, NULL, true, NULL);                   /* one rigid body */
+	expect(&m, NULL, true, NULL); /* one rigid body */
 	small_mesh(&m, pos, 7, edge_pair, 2);
-	expect(&m, three, false, "1 tet(s) around node 0 (0, 0, 0)");   /* C: hinged on 0-1 */
+	expect(&m, three, false, "1 tet(s) around node 0 (0, 0, 0)"); /* C: hinged on 0-1 */
 	expect(&m, NULL, true, "must move as one body");
 
 	/* a box of 2 x 1 x 1 hexes: nodes (0,0,0), (0.5,0,0), (1,0,0) are collinear */
@@ -221,7 +245,7 @@ static void test_loose_parts(void **state)
 			fixed[i] = box.pos_m[3 * i + 1] == 0 && box.pos_m[3 * i + 2] == 0;
 		expect(&box, fixed, false, "can move without straining");
 		for (size_t i = 0; i < box.n_nodes; i++)
-			fixed[i] = box.pos_m[3 * i + 2] == 0;  /* the base: a plane */
+			fixed[i] = box.pos_m[3 * i + 2] == 0; /* the base: a plane */
 		expect(&box, fixed, false, NULL);
 		free(fixed);
 	}

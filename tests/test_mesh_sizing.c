@@ -27,7 +27,7 @@
 #include "support/cad_part.h"
 #include "support/test_files.h"
 
-#define FACTOR 2.0      /* the sizing's promise: target / 2 .. target * 2 */
+#define FACTOR 2.0 /* the sizing's promise: target / 2 .. target * 2 */
 
 static char dir[64], off_path[128], stl_path[128];
 
@@ -35,15 +35,31 @@ static char dir[64], off_path[128], stl_path[128];
 static int write_notched_box(const char *path)
 {
 	static const double v[9][3] = {
-		{ 0, 0, 0 }, { 100, 0, 0 }, { 100, 60, 0 }, { 0, 60, 0 },
-		{ 0, 0, 20 }, { 100, 0, 20 }, { 100, 60, 20 }, { 0, 60, 20 },
+		{ 0, 0, 0 },
+		{ 100, 0, 0 },
+		{ 100, 60, 0 },
+		{ 0, 60, 0 },
+		{ 0, 0, 20 },
+		{ 100, 0, 20 },
+		{ 100, 60, 20 },
+		{ 0, 60, 20 },
 		{ 50, 59.95, 20 },
 	};
 	static const int t[14][3] = {
-		{ 0, 2, 1 }, { 0, 3, 2 },                       /* bottom */
-		{ 4, 5, 8 }, { 5, 6, 8 }, { 6, 7, 8 }, { 7, 4, 8 }, /* top, fan around P */
-		{ 0, 1, 5 }, { 0, 5, 4 }, { 1, 2, 6 }, { 1, 6, 5 },
-		{ 2, 3, 7 }, { 2, 7, 6 }, { 3, 0, 4 }, { 3, 4, 7 },
+		{ 0, 2, 1 },
+		{ 0, 3, 2 }, /* bottom */
+		{ 4, 5, 8 },
+		{ 5, 6, 8 },
+		{ 6, 7, 8 },
+		{ 7, 4, 8 }, /* top, fan around P */
+		{ 0, 1, 5 },
+		{ 0, 5, 4 },
+		{ 1, 2, 6 },
+		{ 1, 6, 5 },
+		{ 2, 3, 7 },
+		{ 2, 7, 6 },
+		{ 3, 0, 4 },
+		{ 3, 4, 7 },
 	};
 	FILE *f = fopen(path, "w");
 
@@ -131,7 +147,7 @@ static void test_max_tet_volume(void **state)
 	irdm_scene_defaults(&sc);
 	set(&sc, "mesh", off_path);
 	set(&sc, "mesh_scale", "0.001");
-	set(&sc, "max_tet_volume", "1e-7");     /* 100 mm^3 in the file's units */
+	set(&sc, "max_tet_volume", "1e-7"); /* 100 mm^3 in the file's units */
 	scene_nodes(&sc, note);
 	assert_non_null(strstr(note, "max_tet_volume"));
 	assert_non_null(strstr(note, "a100,"));
@@ -149,21 +165,26 @@ static void test_tetgen_overrides(void **state)
 	set(&sc, "target_nodes", "5000");
 	set(&sc, "tetgen", "p");
 	size_t n = scene_nodes(&sc, note);
-	assert_true(n == 9);    /* -p adds no point to a box */
+	assert_true(n == 9); /* -p adds no point to a box */
 	assert_non_null(strstr(note, "overrides target_nodes"));
 	irdm_scene_defaults(&sc);
 	set(&sc, "mesh", off_path);
 	set(&sc, "tetgen", "p");
 	scene_nodes(&sc, note);
-	assert_string_equal(note, "");  /* nothing to override: no note */
+	assert_string_equal(note, ""); /* nothing to override: no note */
 }
 
 static void test_bad_values(void **state)
 {
 	static const char *const bad[][2] = {
-		{ "target_nodes", "0" }, { "target_nodes", "99" }, { "target_nodes", "3k" },
-		{ "target_nodes", "-5" }, { "max_tet_volume", "0" }, { "max_tet_volume", "-1e-6" },
-		{ "max_tet_volume", "nan" }, { "max_tet_volume", "big" },
+		{ "target_nodes", "0" },
+		{ "target_nodes", "99" },
+		{ "target_nodes", "3k" },
+		{ "target_nodes", "-5" },
+		{ "max_tet_volume", "0" },
+		{ "max_tet_volume", "-1e-6" },
+		{ "max_tet_volume", "nan" },
+		{ "max_tet_volume", "big" },
 	};
 	struct irdm_scene sc;
 	char err[256];
@@ -173,7 +194,8 @@ static void test_bad_values(void **state)
 	for (size_t i = 0; i < sizeof(bad) / sizeof(bad[0]); i++) {
 		err[0] = '\0';
 		assert_int_not_equal(irdm_scene_set(&sc, bad[i][0], bad[i][1], "s.scene:3", err,
-						    sizeof(err)), 0);
+						    sizeof(err)),
+				     0);
 		print_message("%s = %s: %s\n", bad[i][0], bad[i][1], err);
 		assert_non_null(strstr(err, bad[i][0]));
 		assert_null(strchr(err, '\n'));

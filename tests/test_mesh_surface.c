@@ -53,7 +53,6 @@ static void assert_tmpdir_empty(void)
 	assert_int_equal(n, 0);
 }
 
-
 static void assert_err(int ret, const char *err, const char *what,
 		       const char *needle)
 {
@@ -123,7 +122,8 @@ static void assert_cube_mesh(const struct irdm_mesh *m, double l)
 		assert_int_equal(on, 1);
 		div += (a[0] * (b[1] * c[2] - b[2] * c[1]) +
 			a[1] * (b[2] * c[0] - b[0] * c[2]) +
-			a[2] * (b[0] * c[1] - b[1] * c[0])) / 6.0;
+			a[2] * (b[0] * c[1] - b[1] * c[0])) /
+		       6.0;
 	}
 	for (k = 0; k < 3; k++)
 		assert_true(fabs(sum[k]) < 1e-12 * l * l);
@@ -241,7 +241,8 @@ static void test_stl_binary(void **state)
 	(void)state;
 	txt = tf_load(DATA "cube.obj", &len);
 	assert_int_equal(irdm_surface_parse_obj(txt, len, "cube.obj", &ref, err,
-						sizeof(err)), 0);
+						sizeof(err)),
+			 0);
 	free(txt);
 	bin = binary_stl(&ref, &len);
 	if (irdm_surface_parse_stl(bin, len, "cube.stl", &s, err, sizeof(err)))
@@ -269,7 +270,8 @@ static void test_stl_binary(void **state)
 	irdm_surface_free(&s);
 	memcpy(bin, "BINARY", 6);
 	assert_int_equal(irdm_surface_parse_stl(bin, len + 10, "x.stl", &s, err,
-						sizeof(err)), 0);
+						sizeof(err)),
+			 0);
 	assert_cube_surface(&s);
 	irdm_surface_free(&s);
 	/* a count short of the whole records the file holds: a wrong count,
@@ -280,7 +282,7 @@ static void test_stl_binary(void **state)
 	put_le32(bin + 80, 12);
 	/* a triangle of zero area (its third corner on its first edge) */
 	{
-		unsigned char *r = bin + 84 + 12;       /* triangle 1's corners */
+		unsigned char *r = bin + 84 + 12; /* triangle 1's corners */
 		float a[3], b[3], m[3];
 
 		for (int c = 0; c < 3; c++) {
@@ -307,7 +309,9 @@ static void test_stl_binary(void **state)
 static void test_read_surfaces(void **state)
 {
 	static const char *const files[] = {
-		DATA "cube.obj", DATA "cube.off", DATA "cube_ascii.stl",
+		DATA "cube.obj",
+		DATA "cube.off",
+		DATA "cube_ascii.stl",
 	};
 	struct irdm_mesh m;
 	char err[512];
@@ -321,7 +325,8 @@ static void test_read_surfaces(void **state)
 		irdm_mesh_free(&m);
 	}
 	assert_int_equal(irdm_mesh_read(DATA "cube.obj", 1.0, "pq1.414", &m, err,
-					sizeof(err)), 0);
+					sizeof(err)),
+			 0);
 	assert_string_equal(m.name, "cube");
 	irdm_mesh_free(&m);
 	assert_tmpdir_empty();
@@ -342,9 +347,11 @@ static void test_tetgen_failures(void **state)
 	/* open surface (the box misses its x = 1 face): refused before tetgen,
 	 * with the 4 edges of the hole counted and the first one named */
 	assert_int_equal(irdm_surface_parse_obj(open_box_obj, strlen(open_box_obj),
-						"open.obj", &s, err, sizeof(err)), 0);
+						"open.obj", &s, err, sizeof(err)),
+			 0);
 	assert_err(irdm_surface_tetrahedralize(&s, NULL, "open.obj", &m, err,
-					       sizeof(err)), err, "open.obj",
+					       sizeof(err)),
+		   err, "open.obj",
 		   "surface is not closed: 4 open (one triangle) edges, the first from (1, 0, 0) "
 		   "to (1, 1, 0)");
 	print_message("open surface: %s\n", err);
@@ -358,9 +365,11 @@ static void test_tetgen_failures(void **state)
 			"f 1 3 2\nf 1 2 4\nf 2 3 4\nf 1 4 3\n"
 			"f 1 2 5\nf 1 6 2\nf 2 6 5\nf 1 5 6\n";
 		assert_int_equal(irdm_surface_parse_obj(bowtie, strlen(bowtie), "bowtie.obj", &s,
-							err, sizeof(err)), 0);
+							err, sizeof(err)),
+				 0);
 		assert_err(irdm_surface_tetrahedralize(&s, NULL, "bowtie.obj", &m, err,
-						       sizeof(err)), err, "bowtie.obj",
+						       sizeof(err)),
+			   err, "bowtie.obj",
 			   "1 non-manifold (three or more triangles) edge, the first from (0, 0, 0) "
 			   "to (1, 0, 0)");
 		irdm_surface_free(&s);
@@ -368,18 +377,22 @@ static void test_tetgen_failures(void **state)
 
 	txt = tf_load(DATA "cube.obj", &len);
 	assert_int_equal(irdm_surface_parse_obj(txt, len, "cube.obj", &cube, err,
-						sizeof(err)), 0);
+						sizeof(err)),
+			 0);
 	free(txt);
 	assert_err(irdm_surface_tetrahedralize(&cube, "pq;rm -rf /", "cube.obj",
-					       &m, err, sizeof(err)), err,
+					       &m, err, sizeof(err)),
+		   err,
 		   "cube.obj", "switches may hold only");
 	assert_int_equal(setenv("IRDM_TETGEN", "/nonexistent/tetgen", 1), 0);
 	assert_err(irdm_surface_tetrahedralize(&cube, NULL, "cube.obj", &m, err,
-					       sizeof(err)), err, "cube.obj",
+					       sizeof(err)),
+		   err, "cube.obj",
 		   "cannot run /nonexistent/tetgen");
 	assert_int_equal(setenv("IRDM_TETGEN", "false", 1), 0);
 	assert_err(irdm_surface_tetrahedralize(&cube, NULL, "cube.obj", &m, err,
-					       sizeof(err)), err, "cube.obj",
+					       sizeof(err)),
+		   err, "cube.obj",
 		   "false -pq1.414Q failed (exit status 1");
 	assert_int_equal(unsetenv("IRDM_TETGEN"), 0);
 	irdm_surface_free(&cube);
@@ -389,7 +402,7 @@ static void test_tetgen_failures(void **state)
 static void test_surface_errors(void **state)
 {
 	static const struct {
-		int fmt;	/* 0 obj, 1 off, 2 stl */
+		int fmt; /* 0 obj, 1 off, 2 stl */
 		const char *txt, *needle;
 	} cases[] = {
 		{ 0, "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 5\nf 1 2 3\nf 1 3 4\nf 2 3 4\n",
@@ -416,7 +429,8 @@ static void test_surface_errors(void **state)
 		{ 2, "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n",
 		  "truncated inside a facet" },
 		{ 2, "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n"
-		     "endloop\nendfacet\n", "line 7: unexpected 'endfacet'" },
+		     "endloop\nendfacet\n",
+		  "line 7: unexpected 'endfacet'" },
 		{ 2, "solid x\nvertex 0 0 0\n", "vertex outside a facet" },
 		{ 2, "solid x\nfacet normal 0 0 1\nvertex 0 0 inf\n",
 		  "non-finite coordinate" },
@@ -461,7 +475,8 @@ static void test_obj_relative(void **state)
 
 	(void)state;
 	assert_int_equal(irdm_surface_parse_obj(tet, strlen(tet), "tet.obj", &s,
-						err, sizeof(err)), 0);
+						err, sizeof(err)),
+			 0);
 	assert_int_equal(s.n_verts, 4);
 	assert_int_equal(s.n_tris, 4);
 	assert_int_equal(s.tris[0], 0);

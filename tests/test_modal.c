@@ -52,13 +52,13 @@ static void check_zoh(double w, double z, double dt)
 static void test_zoh_matches_closed_form(void **state)
 {
 	(void)state;
-	check_zoh(10.0, 0.05, 0.002);     /* the cuboid's first mode */
-	check_zoh(628.0, 0.05, 0.001);    /* 100 Hz */
-	check_zoh(3000.0, 0.3, 0.002);    /* w dt = 6: far past Nyquist/2 */
-	check_zoh(50.0, 1.0, 0.001);      /* critically damped */
-	check_zoh(50.0, 4.0, 0.001);      /* overdamped */
-	check_zoh(20.0, 0.0, 0.001);      /* undamped */
-	check_zoh(0.0, 0.0, 0.001);       /* free mass: h[s] = (2s+1) dt^2 / 2 */
+	check_zoh(10.0, 0.05, 0.002);  /* the cuboid's first mode */
+	check_zoh(628.0, 0.05, 0.001); /* 100 Hz */
+	check_zoh(3000.0, 0.3, 0.002); /* w dt = 6: far past Nyquist/2 */
+	check_zoh(50.0, 1.0, 0.001);   /* critically damped */
+	check_zoh(50.0, 4.0, 0.001);   /* overdamped */
+	check_zoh(20.0, 0.0, 0.001);   /* undamped */
+	check_zoh(0.0, 0.0, 0.001);    /* free mass: h[s] = (2s+1) dt^2 / 2 */
 }
 
 /* Eigenpairs satisfy K phi = w^2 M phi and Phi^T M Phi = I. */
@@ -171,7 +171,7 @@ static void test_free_body_has_six_rigid_modes(void **state)
 		fixture_model(&m, 0.12, 0.12, 0.12, 3, 3, 3, 5, 0.49, true, 10,
 			      (enum irdm_eig_method)method, 0.001);
 		assert_int_equal(m.modes.n_rigid, 6);
-		assert_true(m.modes.omega2[0] > 1.0);  /* first elastic mode well clear of 0 */
+		assert_true(m.modes.omega2[0] > 1.0); /* first elastic mode well clear of 0 */
 		/* |P v|_M == |v|_M for the six rigid fields, P onto the rigid modes */
 		assert_true(fixture_rigid_outside(&m.mesh, &m.fem, &m.modes,
 						  (const double[3]){ 0.06, 0.06, 0.06 }) <= 1e-8);
@@ -192,7 +192,8 @@ static void test_grounded_mechanism_is_an_error(void **state)
 	/* nothing fixed, but declared grounded */
 	assert_int_equal(irdm_fem_assemble(&mesh, &mat, IRDM_MASS_LUMPED, NULL, &fem, err, sizeof(err)), 0);
 	assert_int_equal(irdm_modes_solve(&fem, 0, false, IRDM_EIG_DENSE, NULL, NULL, &modes, err,
-					  sizeof(err)), IRDM_EINVAL);
+					  sizeof(err)),
+			 IRDM_EINVAL);
 	assert_non_null(strstr(err, "zero-stiffness"));
 	irdm_fem_free(&fem);
 	irdm_mesh_free(&mesh);

@@ -35,17 +35,17 @@
 #include "support/engine_fixture.h"
 #include "support/test_files.h"
 
-#define PUSH_S 0.15     /* the push, then the contact ends */
-#define FREE_TICKS 20   /* free flight: momentum must stay put */
+#define PUSH_S 0.15   /* the push, then the contact ends */
+#define FREE_TICKS 20 /* free flight: momentum must stay put */
 
 static int push_ticks;
 
 static char dir[64];
 
 struct impulse {
-	double lin[3];          /* sum F dt, N s */
-	double lin_abs;         /* sum |F| dt: the scale of the sums' rounding */
-	double ang[3];          /* sum (x - c) x F dt about the moving COM, N m s */
+	double lin[3];  /* sum F dt, N s */
+	double lin_abs; /* sum |F| dt: the scale of the sums' rounding */
+	double ang[3];  /* sum (x - c) x F dt about the moving COM, N m s */
 };
 
 /* The grab's target: 0.5 mm sideways, a little in, eased in over the push
@@ -72,9 +72,9 @@ static void inverse3(const double a[9], double inv[9])
 }
 
 struct body_ref {
-	double m_kg, inv_inertia[9];    /* the image's own mass and inertia */
-	double com[3], vel[3];          /* the COM, integrated here */
-	double turn[3];                 /* rotation vector so far (rad): w dt summed */
+	double m_kg, inv_inertia[9]; /* the image's own mass and inertia */
+	double com[3], vel[3];       /* the COM, integrated here */
+	double turn[3];              /* rotation vector so far (rad): w dt summed */
 };
 
 /* v rotated by the rotation vector th, or by its inverse (sign -1): Rodrigues. */
@@ -197,7 +197,8 @@ static void run(const char *what, const char *mesh, const char *res, const char 
 		     irdm_v3_norm(imp.lin);
 	*ang_err = rel_err(l, imp.ang);
 	print_message("%-23s |J| %.3e N s, |H| %.3e N m s, turned %.1e rad: linear %.1e, "
-		      "angular %.1e relative (linear limit %.1e)\n", what, irdm_v3_norm(imp.lin),
+		      "angular %.1e relative (linear limit %.1e)\n",
+		      what, irdm_v3_norm(imp.lin),
 		      irdm_v3_norm(imp.ang), irdm_v3_norm(b.turn), *lin_err, *ang_err, *lin_limit);
 	irdm_session_close(ses);
 	irdm_image_unmap(&img);

@@ -34,10 +34,15 @@ struct cfg {
 	unsigned pair[2];
 };
 
-enum { MODE_OFF = 0, MODE_SLOW = 3, MODE_FAST = 7 };
+enum { MODE_OFF = 0,
+       MODE_SLOW = 3,
+       MODE_FAST = 7 };
 
 static const struct irdm_opt_name mode_names[] = {
-	{ "off", MODE_OFF }, { "slow", MODE_SLOW }, { "fast", MODE_FAST }, { NULL, 0 },
+	{ "off", MODE_OFF },
+	{ "slow", MODE_SLOW },
+	{ "fast", MODE_FAST },
+	{ NULL, 0 },
 };
 
 /* "A,B" with A < B */
@@ -49,7 +54,7 @@ static int parse_pair(const struct irdm_opt *o, void *obj, const char *v, char *
 
 	(void)o;
 	if (sscanf(v, "%u,%u%n", &a, &b, &n) != 2 || v[n])
-		return IRDM_EFORMAT;   /* the default reason: "expected A,B" */
+		return IRDM_EFORMAT; /* the default reason: "expected A,B" */
 	if (a >= b) {
 		snprintf(why, len, "A must be < B");
 		return IRDM_EFORMAT;
@@ -62,29 +67,25 @@ static int parse_pair(const struct irdm_opt *o, void *obj, const char *v, char *
 #define CF(member) IRDM_OPT_FIELD(struct cfg, member)
 
 static const struct irdm_opt cfg_opts[] = {
-	{ .name = "gain", .type = IRDM_OPT_DOUBLE, CF(gain), .unit = "N/m", .help = "gain",
-	  .range = IRDM_OPT_GT | IRDM_OPT_LE, .min = 0, .max = 100 },
-	{ .name = "ratio", .type = IRDM_OPT_DOUBLE, CF(ratio), .help = "ratio",
-	  .range = IRDM_OPT_GE | IRDM_OPT_LT, .min = -1, .max = 0.5 },
-	{ .name = "count", .type = IRDM_OPT_UNSIGNED, CF(count), .help = "count",
-	  .range = IRDM_OPT_GE | IRDM_OPT_LE, .min = 1, .max = 1000 },
+	{ .name = "gain", .type = IRDM_OPT_DOUBLE, CF(gain), .unit = "N/m", .help = "gain", .range = IRDM_OPT_GT | IRDM_OPT_LE, .min = 0, .max = 100 },
+	{ .name = "ratio", .type = IRDM_OPT_DOUBLE, CF(ratio), .help = "ratio", .range = IRDM_OPT_GE | IRDM_OPT_LT, .min = -1, .max = 0.5 },
+	{ .name = "count", .type = IRDM_OPT_UNSIGNED, CF(count), .help = "count", .range = IRDM_OPT_GE | IRDM_OPT_LE, .min = 1, .max = 1000 },
 	{ .name = "small", .type = IRDM_OPT_UNSIGNED, CF(small), .help = "one byte" },
-	{ .name = "offset", .type = IRDM_OPT_INT, CF(offset), .unit = "us", .help = "offset",
-	  .range = IRDM_OPT_GE | IRDM_OPT_LE, .min = -500, .max = 500 },
+	{ .name = "offset", .type = IRDM_OPT_INT, CF(offset), .unit = "us", .help = "offset", .range = IRDM_OPT_GE | IRDM_OPT_LE, .min = -500, .max = 500 },
 	{ .name = "trim", .type = IRDM_OPT_INT, CF(trim), .help = "two bytes" },
 	{ .name = "enabled", .type = IRDM_OPT_BOOL, CF(enabled), .help = "on or off" },
 	{ .name = "verbose", .short_name = 'v', .type = IRDM_OPT_FLAG, CF(verbose), .help = "talk" },
 	{ .name = "mode", .type = IRDM_OPT_ENUM, CF(mode), .names = mode_names, .help = "mode" },
 	{ .name = "label", .type = IRDM_OPT_STRING, CF(label), .help = "label" },
-	{ .name = "path", .short_name = 'p', .type = IRDM_OPT_STRING,
-	  IRDM_OPT_TEXT_REF(struct cfg, path), .metavar = "FILE", .help = "a file" },
-	{ .name = "pair", .type = IRDM_OPT_CUSTOM, .parse = parse_pair, .metavar = "A,B",
-	  .help = "two numbers" },
+	{ .name = "path", .short_name = 'p', .type = IRDM_OPT_STRING, IRDM_OPT_TEXT_REF(struct cfg, path), .metavar = "FILE", .help = "a file" },
+	{ .name = "pair", .type = IRDM_OPT_CUSTOM, .parse = parse_pair, .metavar = "A,B", .help = "two numbers" },
 };
 
 static const struct irdm_opt_table cfg_table = {
-	.what = "board key", .see = "the manual",
-	.opts = cfg_opts, .n_opts = sizeof(cfg_opts) / sizeof(cfg_opts[0]),
+	.what = "board key",
+	.see = "the manual",
+	.opts = cfg_opts,
+	.n_opts = sizeof(cfg_opts) / sizeof(cfg_opts[0]),
 };
 
 static struct cfg c;
@@ -124,7 +125,7 @@ static void test_double(void **state)
 	(void)state;
 	expect_ok("gain", "100");
 	assert_true(c.gain == 100);
-	expect_ok("gain", "2.5e-3 ");        /* trailing space, as strtod's leading */
+	expect_ok("gain", "2.5e-3 "); /* trailing space, as strtod's leading */
 	assert_true(c.gain == 2.5e-3);
 	expect_bad("gain", "0", "b.cfg:4: gain = 0: must be > 0 N/m");
 	expect_bad("gain", "100.5", "b.cfg:4: gain = 100.5: must be <= 100 N/m");
@@ -134,7 +135,7 @@ static void test_double(void **state)
 	expect_bad("gain", "nan", "b.cfg:4: gain = nan: not a finite number");
 	expect_bad("gain", "inf", "b.cfg:4: gain = inf: not a finite number");
 	expect_bad("gain", "1e999", "b.cfg:4: gain = 1e999: not a finite number");
-	assert_true(c.gain == 2.5e-3);      /* a refused value leaves the field */
+	assert_true(c.gain == 2.5e-3); /* a refused value leaves the field */
 	expect_ok("ratio", "-1");
 	expect_ok("ratio", "0.4999");
 	expect_bad("ratio", "0.5", "b.cfg:4: ratio = 0.5: must be < 0.5");
@@ -227,8 +228,7 @@ static void test_unknown_key(void **state)
 /* Lines: comments, blanks, spaces, line numbers in messages, duplicates. */
 static void test_lines(void **state)
 {
-	struct irdm_opt_file f = { .table = &cfg_table, .obj = &c, .name = "b.cfg",
-				   .reject_duplicates = true };
+	struct irdm_opt_file f = { .table = &cfg_table, .obj = &c, .name = "b.cfg", .reject_duplicates = true };
 	char lines[][64] = { "# a board", "", "  gain=  4.5   # N/m", "mode = slow",
 			     "gain = 5", "count 3", "colour = red", "ratio = 0.7" };
 

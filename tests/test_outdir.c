@@ -125,12 +125,14 @@ static void test_fresh_then_replaced(void **state)
 	(void)state;
 	at(out, "fresh");
 	assert_int_equal(write_out(out, "tool-a", false, (const char *const[]){ "a", "b", NULL },
-				   &od), 0);
+				   &od),
+			 0);
 	expect_text(at(p, "fresh/a"), "a");
 	assert_true(exists(at(p, "fresh/%s", IRDM_OUTDIR_MARKER)));
 	/* the same tool again: replaced whole, b (not written this time) gone */
 	assert_int_equal(write_out(out, "tool-a", false, (const char *const[]){ "a", "c", NULL },
-				   &od), 0);
+				   &od),
+			 0);
 	expect_text(at(p, "fresh/c"), "c");
 	assert_false(exists(at(p, "fresh/b")));
 	assert_int_equal(beside_dirs(), 0);
@@ -236,7 +238,8 @@ static void test_neighbours_untouched(void **state)
 	put(at(p, "frames.tmp"), "tmp");
 	for (int run = 0; run < 2; run++)
 		assert_int_equal(write_out(out, "tool-a", false,
-					   (const char *const[]){ "a", NULL }, &od), 0);
+					   (const char *const[]){ "a", NULL }, &od),
+				 0);
 	expect_text(at(p, "frames.old/keep"), "old");
 	expect_text(at(p, "frames.tmp"), "tmp");
 }

@@ -37,21 +37,21 @@
 #include "support/engine_fixture.h"
 #include "support/test_files.h"
 
-#define PUSH_TICKS 300          /* pushed 1 cm, then let go */
-#define FREE_TICKS 40           /* ringing, nobody touching */
-#define GRAB_TICKS 600          /* grabbed where the surface is, lifted at 5 mm/s */
+#define PUSH_TICKS 300 /* pushed 1 cm, then let go */
+#define FREE_TICKS 40  /* ringing, nobody touching */
+#define GRAB_TICKS 600 /* grabbed where the surface is, lifted at 5 mm/s */
 
 static char dir[64];
 static struct irdm_image img;
 
 struct port_run {
-	double min_work_j;              /* running work on the object since the grab */
-	double min_observer_j;          /* the engine's port energy, its minimum */
-	double max_observer_gap_j;      /* |observer - this test's sum| with the controller off */
+	double min_work_j;         /* running work on the object since the grab */
+	double min_observer_j;     /* the engine's port energy, its minimum */
+	double max_observer_gap_j; /* |observer - this test's sum| with the controller off */
 	uint64_t activations;
 	unsigned damped_ticks;
-	double worst_law_error;         /* |alpha - (-E_before dt / |du|^2)| / alpha */
-	double worst_energy_after_j;    /* |port energy| on the ticks it acted */
+	double worst_law_error;      /* |alpha - (-E_before dt / |du|^2)| / alpha */
+	double worst_energy_after_j; /* |port energy| on the ticks it acted */
 };
 
 static void tick(struct irdm_engine *e, enum irdm_contact_mode mode, const double u[3])
@@ -235,7 +235,7 @@ static void test_port_ends_while_another_holds(void **state)
 		assert_int_equal(irdm_engine_contact_begin(e, i, &site[i], IRDM_CONTACT_GRAB), 0);
 	for (int t = 0; t < 1500; t++) {
 		memset(cmd, 0, sizeof(cmd));
-		cmd[1].mode = IRDM_CONTACT_GRAB;        /* held at rest */
+		cmd[1].mode = IRDM_CONTACT_GRAB; /* held at rest */
 		if (t < 1000) {
 			cmd[0].mode = IRDM_CONTACT_GRAB;
 			cmd[0].target_m[2] = -0.01 * fmin(1.0, (t + 1) / 300.0);
@@ -247,7 +247,8 @@ static void test_port_ends_while_another_holds(void **state)
 		assert_int_equal(irdm_engine_tick(e, cmd), IRDM_OK);
 	}
 	print_message("port ends while another holds: contact 1's port energy %+.3e J when "
-		      "contact 0 let go; activations before %llu, after %llu\n", e1_at_end,
+		      "contact 0 let go; activations before %llu, after %llu\n",
+		      e1_at_end,
 		      (unsigned long long)act_at_end,
 		      (unsigned long long)(irdm_engine_stats(e)->pc_activations - act_at_end));
 	/* the case is real: the holding port had taken energy out */
@@ -347,7 +348,7 @@ static void test_friction_threshold_with_the_engine(void **state)
 	struct irdm_engine *e = ses->eng;
 	const struct irdm_contact_disp disp = { .fn = engine_disp, .ctx = e };
 
-	cm = ses->cm;                   /* with the session's face-beyond table */
+	cm = ses->cm; /* with the session's face-beyond table */
 	assert_non_null(cm.beyond);
 	irdm_proxy_config_default(&pc);
 	pc.mu_s = mu_s;
@@ -391,7 +392,8 @@ static void test_friction_threshold_with_the_engine(void **state)
 		}
 	}
 	print_message("friction with the engine: first slip after %d ticks, rendered F_t / F_n "
-		      "at the last stuck tick %.5f (mu_s %.2f)\n", slip_at, ratio, mu_s);
+		      "at the last stuck tick %.5f (mu_s %.2f)\n",
+		      slip_at, ratio, mu_s);
 	assert_true(slip_at > 0);
 	assert_true(fabs(ratio - mu_s) <= 0.01 * mu_s);
 	irdm_session_close(ses);

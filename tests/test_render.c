@@ -44,16 +44,16 @@
 #include "support/test_files.h"
 
 #define DT 0.001
-#define PUSH_M 0.005            /* the step: 5 mm along x at the top centre */
+#define PUSH_M 0.005 /* the step: 5 mm along x at the top centre */
 #define RAMP_ROWS 10
-#define RELEASE_ROW 1500        /* held over rows 0..1499, released from 1500 */
+#define RELEASE_ROW 1500 /* held over rows 0..1499, released from 1500 */
 #define RUN_ROWS 6000
-#define EVERY_ROWS 10           /* --every 0.01 */
+#define EVERY_ROWS 10 /* --every 0.01 */
 #define N_FRAMES (RUN_ROWS / EVERY_ROWS)
 
 static char dir[256], image[320], part_image[320], out_text[16384], err_text[8192];
 static struct irdm_image img;
-static uint32_t top_row;        /* the pressed node: image row and mesh node */
+static uint32_t top_row; /* the pressed node: image row and mesh node */
 
 static const char *env_or(const char *name, const char *dflt)
 {
@@ -72,7 +72,7 @@ static int run_irdm(const char *const *args)
 
 struct frame {
 	double t_s;
-	double *pos, *disp;             /* 3 n_nodes */
+	double *pos, *disp; /* 3 n_nodes */
 	double force[3];
 };
 
@@ -104,7 +104,7 @@ static void vtu_numbers(const char *text, const char *from, const char *name, do
 	}
 	while (*p == ' ' || *p == '\n')
 		p++;
-	assert_true(*p == '<');          /* exactly n of them */
+	assert_true(*p == '<'); /* exactly n of them */
 }
 
 /* One .vtu: the grid is the image's, and points = rest + displacement. */
@@ -133,7 +133,7 @@ static void read_vtu(const char *path, struct frame *fr)
 	for (uint32_t t = 0; t < nt; t++) {
 		for (int k = 0; k < 3; k++)
 			assert_true(conn[3 * t + k] == img.tris[3 * t + k]);
-		assert_true(offs[t] == 3.0 * (t + 1) && types[t] == 5);  /* VTK_TRIANGLE */
+		assert_true(offs[t] == 3.0 * (t + 1) && types[t] == 5); /* VTK_TRIANGLE */
 	}
 	for (uint32_t r = 0; r < nn; r++) {
 		assert_true(mesh[r] == img.nodes[r].mesh_node);
@@ -226,7 +226,7 @@ static void modal_coords(const double *u, double *q)
 			for (uint32_t k = 0; k <= j; k++)
 				A[j * K + k] += pj * irdm_elem_get(phi, prec, (size_t)i * K + k);
 		}
-	for (uint32_t j = 0; j < K; j++) {             /* A = L L^T, in place */
+	for (uint32_t j = 0; j < K; j++) { /* A = L L^T, in place */
 		for (uint32_t k = 0; k < j; k++)
 			A[j * K + j] -= A[j * K + k] * A[j * K + k];
 		assert_true(A[j * K + j] > 0);
@@ -237,7 +237,7 @@ static void modal_coords(const double *u, double *q)
 			A[i * K + j] /= A[j * K + j];
 		}
 	}
-	for (uint32_t j = 0; j < K; j++) {             /* L y = b, L^T q = y */
+	for (uint32_t j = 0; j < K; j++) { /* L y = b, L^T q = y */
 		for (uint32_t k = 0; k < j; k++)
 			b[j] -= A[j * K + k] * b[k];
 		b[j] /= A[j * K + j];
@@ -278,7 +278,7 @@ static double decay_rate(const double *t, const double *x, size_t n)
 
 	for (size_t k = 1; k <= n; k++) {
 		if (k == n || (x[k - 1] < 0) != (x[k] < 0)) {
-			if (peak > 0 && k < n) {        /* a whole half cycle */
+			if (peak > 0 && k < n) { /* a whole half cycle */
 				st += tp;
 				sl += log(peak);
 				stt += tp * tp;
@@ -328,7 +328,8 @@ static void check_hold(const struct frame *fr, size_t n)
 	}
 	swing = hi - lo;
 	print_message("held: %zu frames, contact node within %.3e m of the commanded %.0f mm "
-		      "(limit 1e-8); force swings %.3f..%.3f N while held\n", held, worst,
+		      "(limit 1e-8); force swings %.3f..%.3f N while held\n",
+		      held, worst,
 		      PUSH_M * 1e3, lo, hi);
 	assert_true(held >= 140);
 	assert_true(worst < 1e-8);
@@ -383,10 +384,12 @@ static void check_ringing(const struct frame *fr, size_t n)
 
 	print_message("ringing: lowest mode %u, f_d %.4f Hz, zeta omega %.4f /s (MODES); top node "
 		      "%.4f Hz (%d crossings, %+.3f %%); modal coordinate %.5f Hz (%+.4f %%), decay "
-		      "%.5f /s (%+.3f %%)\n", k0, f_d, sigma, f_node, cx, 100 * (f_node / f_d - 1),
+		      "%.5f /s (%+.3f %%)\n",
+		      k0, f_d, sigma, f_node, cx, 100 * (f_node / f_d - 1),
 		      f_modal, 100 * (f_modal / f_d - 1), s_modal, 100 * (s_modal / sigma - 1));
 	print_message("at rest: max |u| %.3e m at the release, %.3e m 4.5 s later: ratio %.4f "
-		      "(the lowest mode alone: %.4f, %+.2f %%)\n", early, late, late / early, expect_ratio,
+		      "(the lowest mode alone: %.4f, %+.2f %%)\n",
+		      early, late, late / early, expect_ratio,
 		      100 * (late / early / expect_ratio - 1));
 	assert_true(cx >= 12 && cq >= 12);
 	/* limits 5x to 10x the measured (gcc, clang, ASan alike): the top
@@ -528,11 +531,9 @@ static void test_pictures(void **state)
 					    "--nodes", "212", NULL }))
 		fail_msg("irdm render: %s", err_text);
 	/* frames at 1..6 s: every other one, 1, 3, 5 s */
-	if (rp_run(dir, "/usr/bin/python3", (const char *const[]){ "tools/scripts/plot-surface.py",
-		   pvd, "--each", pngdir, "--step=2", "render test", NULL }, out_text,
+	if (rp_run(dir, "/usr/bin/python3", (const char *const[]){ "tools/scripts/plot-surface.py", pvd, "--each", pngdir, "--step=2", "render test", NULL }, out_text,
 		   sizeof(out_text), err_text, sizeof(err_text)) ||
-	    rp_run(dir, "/usr/bin/python3", (const char *const[]){ "tools/scripts/plot-forces.py",
-		   forces, fpng, "render test", NULL }, out_text, sizeof(out_text), err_text,
+	    rp_run(dir, "/usr/bin/python3", (const char *const[]){ "tools/scripts/plot-forces.py", forces, fpng, "render test", NULL }, out_text, sizeof(out_text), err_text,
 		   sizeof(err_text)))
 		fail_msg("plot: %s", err_text);
 	for (int k = 0; k < 6; k++) {
@@ -581,10 +582,7 @@ static void test_from_log(void **state)
 	snprintf(log, sizeof(log), "%s/run.log", dir);
 	snprintf(fwdir, sizeof(fwdir), "%s/fwframes", dir);
 	snprintf(outdir, sizeof(outdir), "%s/fromlog", dir);
-	if (rp_run(dir, env_or("IRDM_FW", "build/irdm-fw"), (const char *const[]){
-		   "--board", "boards/sim-phantom.board", "--image", image, "--user",
-		   "scenes/users/press-hold-release.user", "--clock", "virtual", "--log", log,
-		   "--frames-every", "0.5", "--frames-out", fwdir, NULL }, out_text,
+	if (rp_run(dir, env_or("IRDM_FW", "build/irdm-fw"), (const char *const[]){ "--board", "boards/sim-phantom.board", "--image", image, "--user", "scenes/users/press-hold-release.user", "--clock", "virtual", "--log", log, "--frames-every", "0.5", "--frames-out", fwdir, NULL }, out_text,
 		   sizeof(out_text), err_text, sizeof(err_text)))
 		fail_msg("irdm-fw: %s", err_text);
 	if (run_irdm((const char *const[]){ "render", "--image", image, "--log", log, "--board",
@@ -592,7 +590,9 @@ static void test_from_log(void **state)
 					    "0.5", NULL }))
 		fail_msg("irdm render --log: %s", err_text);
 	assert_int_equal(sscanf(strstr(out_text, "forces within"), "forces within %lf N of the "
-				"logged ones (peak %lf N)", &df_n, &fpeak_n), 2);
+								   "logged ones (peak %lf N)",
+				&df_n, &fpeak_n),
+			 2);
 	n = read_pvd(outdir, fr, 16);
 	assert_int_equal(n, 12);
 	for (size_t k = 0; k < n; k++) {
@@ -605,7 +605,8 @@ static void test_from_log(void **state)
 		}
 	}
 	print_message("log: forces within %.3g N of the logged (peak %.4f N); %zu frames, "
-		      "max |u_render - u_irdm-fw| %.3e m of %.3e m\n", df_n, fpeak_n, n, worst,
+		      "max |u_render - u_irdm-fw| %.3e m of %.3e m\n",
+		      df_n, fpeak_n, n, worst,
 		      peak);
 	/* the same engine on the same commands, the same product: equal but
 	 * for the .vtu's %.9g, half a unit of the 9th digit of 8 mm (5e-12) */
@@ -616,8 +617,7 @@ static void test_from_log(void **state)
 	/* one bit flipped in block 3's records: replay and render refuse the
 	 * log naming the block, and write nothing */
 	{
-		const long at = IRDM_LOG_HEADER_SIZE + 3 * (IRDM_LOG_BLOCK_RECORDS *
-			IRDM_TICK_RECORD_SIZE + (long)sizeof(struct irdm_log_block_end)) + 1000;
+		const long at = IRDM_LOG_HEADER_SIZE + 3 * (IRDM_LOG_BLOCK_RECORDS * IRDM_TICK_RECORD_SIZE + (long)sizeof(struct irdm_log_block_end)) + 1000;
 		char forces[320], flipped[320], *bytes;
 		unsigned char byte;
 		size_t len;
@@ -643,14 +643,16 @@ static void test_from_log(void **state)
 		assert_int_equal(run_irdm((const char *const[]){ "replay", "--image", image, "--log",
 								 flipped, "--board",
 								 "boards/sim-phantom.board", "-o",
-								 forces, NULL }), 1);
+								 forces, NULL }),
+				 1);
 		assert_non_null(strstr(err_text, "flipped.log: block 3 (records 768..1023): bad checksum"));
 		assert_int_not_equal(access(forces, F_OK), 0);
 		snprintf(outdir, sizeof(outdir), "%s/fromflipped", dir);
 		assert_int_equal(run_irdm((const char *const[]){ "render", "--image", image, "--log",
 								 flipped, "--board",
 								 "boards/sim-phantom.board", "-o",
-								 outdir, NULL }), 1);
+								 outdir, NULL }),
+				 1);
 		assert_non_null(strstr(err_text, "block 3 (records 768..1023): bad checksum"));
 		assert_int_not_equal(access(outdir, F_OK), 0);
 	}
@@ -725,32 +727,42 @@ static void test_bad_input(void **state)
 	write_step(traj);
 	tf_write_text(bad, "t,ux,uy,uz\n0,0.001,0,0\n0.002,0.001,0,0\n");
 	expect_refusal((const char *const[]){ "render", "--image", image, "--contact", "212",
-					      "--displacement", traj, NULL }, 2, "-o DIR", outdir);
+					      "--displacement", traj, NULL },
+		       2, "-o DIR", outdir);
 	expect_refusal((const char *const[]){ "render", "--image", image, "--contact", "212",
 					      "--displacement", traj, "-o", outdir, "--every", "0",
-					      NULL }, 2, "--every '0'", outdir);
+					      NULL },
+		       2, "--every '0'", outdir);
 	expect_refusal((const char *const[]){ "render", "--image", image, "--contact", "212",
 					      "--displacement", traj, "-o", outdir, "--every", "7",
-					      NULL }, 1, "--every 7", outdir);
+					      NULL },
+		       1, "--every 7", outdir);
 	expect_refusal((const char *const[]){ "render", "--image", image, "--contact", "212",
 					      "--displacement", traj, "-o", outdir, "--every",
-					      "0.0001", NULL }, 1, "--every 0.0001", outdir);
+					      "0.0001", NULL },
+		       1, "--every 0.0001", outdir);
 	expect_refusal((const char *const[]){ "render", "--image", image, "--contact", "212",
-					      "--displacement", bad, "-o", outdir, NULL }, 1,
+					      "--displacement", bad, "-o", outdir, NULL },
+		       1,
 		       "bad.csv:3", outdir);
 	expect_refusal((const char *const[]){ "render", "--image", image, "--contact", "9999",
-					      "--displacement", traj, "-o", outdir, NULL }, 1,
+					      "--displacement", traj, "-o", outdir, NULL },
+		       1,
 		       "--contact 9999", outdir);
 	expect_refusal((const char *const[]){ "render", "--image", image, "--log", log, "-o",
-					      outdir, NULL }, 2, "--board", outdir);
+					      outdir, NULL },
+		       2, "--board", outdir);
 	expect_refusal((const char *const[]){ "render", "--image", image, "--log", log, "--board",
 					      "boards/sim-phantom.board", "--displacement", traj,
-					      "-o", outdir, NULL }, 2, "--displacement", outdir);
+					      "-o", outdir, NULL },
+		       2, "--displacement", outdir);
 	expect_refusal((const char *const[]){ "render", "--image", image, "--log", log, "--board",
 					      "boards/sim-phantom-pinch.board", "-o", outdir,
-					      NULL }, 1, "recorded on board", outdir);
+					      NULL },
+		       1, "recorded on board", outdir);
 	expect_refusal((const char *const[]){ "render", "--image", image, "--log", traj, "--board",
-					      "boards/sim-phantom.board", "-o", outdir, NULL }, 1,
+					      "boards/sim-phantom.board", "-o", outdir, NULL },
+		       1,
 		       "step.csv", outdir);
 	expect_refusal((const char *const[]){ "render", "--image", "/nonexistent.img", "--contact",
 					      "212", "--displacement", traj, "-o", outdir, NULL },

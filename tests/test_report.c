@@ -75,7 +75,7 @@ static void test_rows(void **state)
 	for (int i = 0; i < n_rows; i++) {
 		assert_float_equal(rows[i].dt_ms, 2.0, 0);
 		assert_string_equal(rows[i].scenario, "step");
-		assert_int_equal(rows[i].ticks, 1500);      /* 3 s at 2 ms */
+		assert_int_equal(rows[i].ticks, 1500); /* 3 s at 2 ms */
 		assert_true(rows[i].median_us > 0 && rows[i].p99_us >= rows[i].median_us);
 	}
 }
@@ -92,7 +92,7 @@ static void test_exact_model_is_rounding(void **state)
 	assert_true(r->disp_err < 1e-13);
 	assert_true(r->cert_stable && r->bounded);
 	assert_true(r->radius < 1.0);
-	assert_true(isnan(r->growth));              /* modal: no raw FIR run */
+	assert_true(isnan(r->growth)); /* modal: no raw FIR run */
 }
 
 /* A truncated FIR: unstable by the certificate, and its raw recursion grows

@@ -69,7 +69,7 @@ static void test_rows(void **state)
 	assert_int_equal(n_rows, 8);
 	for (int i = 0; i < n_rows; i++)
 		assert_float_equal(rows[i].dt_ms, 1.0, 0);
-	assert_int_equal(row_of("modal:all/f64", "swing")->ticks, 2000);   /* 2 s at 1 ms */
+	assert_int_equal(row_of("modal:all/f64", "swing")->ticks, 2000); /* 2 s at 1 ms */
 	assert_int_equal(row_of("modal:all/f64", "tap")->ticks, 1000);
 }
 

@@ -54,7 +54,6 @@ static int run_irdm(const char *const *args)
 	return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
 }
 
-
 /* Precompute `scene` (options, NULL-terminated) twice; the files must match
  * byte for byte and verify. */
 static void precompute_twice(const char *name, const char *const *scene)
@@ -90,28 +89,28 @@ static void precompute_twice(const char *name, const char *const *scene)
 }
 
 #define BOX "--mesh", "box:0.04,0.04,0.08", "--resolution", "2,2,4", "--fixed", "z<=0", \
-	"--touch", "z>=0.08", "--display", "surface"
+	    "--touch", "z>=0.08", "--display", "surface"
 
 static void test_modal_dense_f64(void **state)
 {
 	(void)state;
 	precompute_twice("modal-dense", (const char *const[]){
-		BOX, "--representation", "modal:all", "--eigensolver", "dense", NULL });
+						BOX, "--representation", "modal:all", "--eigensolver", "dense", NULL });
 }
 
 static void test_modal_lanczos_static_f32(void **state)
 {
 	(void)state;
 	precompute_twice("modal-lanczos", (const char *const[]){
-		BOX, "--representation", "modal:12", "--eigensolver", "lanczos",
-		"--static_correction", "yes", "--precision", "f32", NULL });
+						  BOX, "--representation", "modal:12", "--eigensolver", "lanczos",
+						  "--static_correction", "yes", "--precision", "f32", NULL });
 }
 
 static void test_fir_modal_f16(void **state)
 {
 	(void)state;
 	precompute_twice("fir-f16", (const char *const[]){
-		BOX, "--representation", "fir:50", "--precision", "f16", "--uncertified", "yes", NULL });
+					    BOX, "--representation", "fir:50", "--precision", "f16", "--uncertified", "yes", NULL });
 }
 
 /* Threads split the inputs of the time-domain method: their order must not
@@ -120,17 +119,17 @@ static void test_fir_time_domain_threads(void **state)
 {
 	(void)state;
 	precompute_twice("fir-td", (const char *const[]){
-		BOX, "--representation", "fir:40", "--method", "time-domain",
-		"--substeps", "4", "--threads", "2", "--uncertified", "yes", NULL });
+					   BOX, "--representation", "fir:40", "--method", "time-domain",
+					   "--substeps", "4", "--threads", "2", "--uncertified", "yes", NULL });
 }
 
 static void test_floating_modal(void **state)
 {
 	(void)state;
 	precompute_twice("floating", (const char *const[]){
-		"--mesh", "cube", "--resolution", "3,3,3", "--floating", "yes",
-		"--touch", "surface", "--display", "surface",
-		"--representation", "modal:20", "--precision", "f32", NULL });
+					     "--mesh", "cube", "--resolution", "3,3,3", "--floating", "yes",
+					     "--touch", "surface", "--display", "surface",
+					     "--representation", "modal:20", "--precision", "f32", NULL });
 }
 
 static int setup(void **state)

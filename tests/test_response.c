@@ -31,7 +31,9 @@ static void pick_columns(const struct irdm_model *m, double lx, double ly, doubl
 			 uint32_t cols[3])
 {
 	const double p[3][3] = {
-		{ lx / 2, ly / 2, lz }, { lx, ly, lz }, { lx, ly / 2, lz / 2 },
+		{ lx / 2, ly / 2, lz },
+		{ lx, ly, lz },
+		{ lx, ly / 2, lz / 2 },
 	};
 
 	for (int c = 0; c < 3; c++)
@@ -68,10 +70,15 @@ static double modal_vs_time_domain(struct irdm_model *m, const uint32_t *cols, s
 		in[c] = 3 * (int64_t)cols[c / 3] + (int64_t)(c % 3);
 	irdm_modes_discretise(&m->modes, &m->damping, dt, zoh);
 	assert_int_equal(irdm_fir_from_modes(&m->modes, zoh, cd, n_cols, rd, nn, T, NULL, fir,
-					     NULL, NULL), 0);
+					     NULL, NULL),
+			 0);
 	struct irdm_td_opts o = {
-		.dt_s = dt, .n_samples = (unsigned)T, .substeps = substeps,
-		.damping = m->damping, .floating = floating, .threads = 2,
+		.dt_s = dt,
+		.n_samples = (unsigned)T,
+		.substeps = substeps,
+		.damping = m->damping,
+		.floating = floating,
+		.threads = 2,
 		.rigid = IRDM_TD_RIGID_KABSCH,
 	};
 	if (irdm_td_responses(&m->mesh, &m->fem, &o, in, 3 * n_cols, rows, nn, td, err, sizeof(err)))
@@ -106,7 +113,7 @@ static void test_modal_equals_time_domain_grounded_cuboid(void **state)
 	pick_columns(&m, 0.1, 0.1, 0.2, cols);
 	double rel = modal_vs_time_domain(&m, cols, 3, false, 0.002, 250, 32);
 	print_message("grounded cuboid: max |R_modal - R_td| / max |R| = %.3g\n", rel);
-	assert_true(rel <= 3e-4);       /* measured 1.03e-4 at 32 sub-steps */
+	assert_true(rel <= 3e-4); /* measured 1.03e-4 at 32 sub-steps */
 	irdm_model_free(&m);
 }
 
@@ -120,7 +127,7 @@ static void test_modal_equals_time_domain_floating_cube(void **state)
 	pick_columns(&m, 0.12, 0.12, 0.12, cols);
 	double rel = modal_vs_time_domain(&m, cols, 3, true, 0.002, 250, 32);
 	print_message("floating cube: max |R_modal - R_td| / max |R| = %.3g\n", rel);
-	assert_true(rel <= 5e-4);       /* measured 1.77e-4 */
+	assert_true(rel <= 5e-4); /* measured 1.77e-4 */
 	irdm_model_free(&m);
 }
 
@@ -146,8 +153,12 @@ static void test_reciprocity_time_domain(void **state)
 		in[c] = 3 * (int64_t)cols[c / 3] + (int64_t)(c % 3);
 	double *td = malloc(9 * T * 9 * sizeof(double));
 	struct irdm_td_opts o = {
-		.dt_s = 0.001, .n_samples = (unsigned)T, .substeps = 8,
-		.damping = m.damping, .floating = false, .threads = 2,
+		.dt_s = 0.001,
+		.n_samples = (unsigned)T,
+		.substeps = 8,
+		.damping = m.damping,
+		.floating = false,
+		.threads = 2,
 		.rigid = IRDM_TD_RIGID_KABSCH,
 	};
 	if (irdm_td_responses(&m.mesh, &m.fem, &o, in, 9, cols, 3, td, err, sizeof(err)))
@@ -168,7 +179,7 @@ static void test_reciprocity_time_domain(void **state)
 					}
 	print_message("time domain reciprocity: max |R(a<-b) - R(b<-a)^T| = %.2e of max |R| (cross terms up to %.2e of it)\n",
 		      asym / scale, cross / scale);
-	assert_true(cross > 1e-3 * scale);      /* the pairs carry real responses */
+	assert_true(cross > 1e-3 * scale); /* the pairs carry real responses */
 	assert_true(asym <= RECIPROCITY_TOL * scale);
 	free(td);
 	irdm_model_free(&m);
@@ -194,8 +205,7 @@ static void test_r0_spd_and_reciprocity(void **state)
 	for (size_t c = 0; c < 3; c++) {
 		const double *r0 = &fir[((c * 3 + c) * T) * 9];
 		double m2 = r0[0] * r0[4] - r0[1] * r0[3];
-		double det = r0[0] * (r0[4] * r0[8] - r0[5] * r0[7]) - r0[1] * (r0[3] * r0[8] - r0[5] * r0[6])
-			     + r0[2] * (r0[3] * r0[7] - r0[4] * r0[6]);
+		double det = r0[0] * (r0[4] * r0[8] - r0[5] * r0[7]) - r0[1] * (r0[3] * r0[8] - r0[5] * r0[6]) + r0[2] * (r0[3] * r0[7] - r0[4] * r0[6]);
 		assert_true(r0[0] > 0 && m2 > 0 && det > 0);
 	}
 	double scale = 0, asym = 0;
@@ -221,7 +231,7 @@ static void test_sum_of_responses_is_static_compliance(void **state)
 	struct irdm_model m;
 	uint32_t cols[3];
 	int64_t cd[9];
-	const size_t T = 20000;   /* 40 s at 2 ms: mode 1 (5 %) decays by e^-27 */
+	const size_t T = 20000; /* 40 s at 2 ms: mode 1 (5 %) decays by e^-27 */
 
 	(void)state;
 	fixture_model(&m, 0.1, 0.1, 0.2, 3, 3, 6, 5, 0.49, false, 0, IRDM_EIG_DENSE, 0.002);
@@ -270,13 +280,15 @@ static void test_static_correction_restores_compliance(void **state)
 		size_t n = m.fem.K.n;
 		double D[3 * 3 * 9], *x = malloc(n * sizeof(double));
 		assert_int_equal(irdm_static_correction(&m.fem, &m.modes, floating, cd, 3, cd, 3, D,
-							err, sizeof(err)), 0);
+							err, sizeof(err)),
+				 0);
 		/* reference: dense compliance (grounded) or dense modal sum over all
 		 * elastic modes (floating: K is singular) */
 		struct irdm_modes all;
 		if (floating)
 			assert_int_equal(irdm_modes_solve(&m.fem, 0, true, IRDM_EIG_DENSE, NULL, NULL, &all,
-							  err, sizeof(err)), 0);
+							  err, sizeof(err)),
+					 0);
 		for (size_t c = 0; c < 3; c++)
 			for (int j = 0; j < 3; j++) {
 				int64_t dj = cd[3 * c + (size_t)j];
@@ -337,7 +349,7 @@ static void test_stability_certificate(void **state)
 		/* a certified upper bound, tight to 1e-4 (near a zero, rounding
 		 * noise in det Q ends the refinement on the certified side) */
 		assert_true(wind >= comp - 1e-9 && wind - comp <= 1e-4);
-		assert_true(comp > 1.0);   /* truncation destabilises */
+		assert_true(comp > 1.0); /* truncation destabilises */
 		free(fir);
 	}
 	double *phi = malloc(3 * K * sizeof(double));

@@ -45,9 +45,15 @@ static void qmat(const double q[4], double r[9])
 {
 	double w = q[0], x = q[1], y = q[2], z = q[3];
 
-	r[0] = 1 - 2 * (y * y + z * z); r[1] = 2 * (x * y - w * z);     r[2] = 2 * (x * z + w * y);
-	r[3] = 2 * (x * y + w * z);     r[4] = 1 - 2 * (x * x + z * z); r[5] = 2 * (y * z - w * x);
-	r[6] = 2 * (x * z - w * y);     r[7] = 2 * (y * z + w * x);     r[8] = 1 - 2 * (x * x + y * y);
+	r[0] = 1 - 2 * (y * y + z * z);
+	r[1] = 2 * (x * y - w * z);
+	r[2] = 2 * (x * z + w * y);
+	r[3] = 2 * (x * y + w * z);
+	r[4] = 1 - 2 * (x * x + z * z);
+	r[5] = 2 * (y * z - w * x);
+	r[6] = 2 * (x * z - w * y);
+	r[7] = 2 * (y * z + w * x);
+	r[8] = 1 - 2 * (x * x + y * y);
 }
 
 /* Angle of the rotation a^-1 b, in [0, pi]. */
@@ -110,7 +116,8 @@ static void test_constant_force_at_com(void **state)
 {
 	struct irdm_rigid_params p = { .mass_kg = 2.5 };
 	struct irdm_rigid_state s0 = {
-		.com_m = { 0.1, 0.2, -0.3 }, .vel_m_s = { 0.3, -0.1, 0.05 },
+		.com_m = { 0.1, 0.2, -0.3 },
+		.vel_m_s = { 0.3, -0.1, 0.05 },
 	};
 	const double f[3] = { 1.5, -0.7, 3.2 }, dt = 1e-3, d[3] = { 0.01, 0.02, 0.025 };
 	struct irdm_rigid_body rb;
@@ -144,7 +151,7 @@ static void test_constant_force_at_com(void **state)
 /* ---- 2. Dzhanibekov flip against RK4 ------------------------------------- */
 
 struct ref_state {
-	double w[3];    /* body angular velocity */
+	double w[3]; /* body angular velocity */
 	double q[4];
 };
 
@@ -234,7 +241,7 @@ static void test_dzhanibekov_vs_rk4(void **state)
 	print_message("Dzhanibekov (I = 1,2,3; w = 10 rad/s, dt = 1 ms, 10 s, %d flips): "
 		      "orientation error <= %.3g rad, |dw|/|w| <= %.3g; Newton <= %u iterations\n",
 		      flips, worst_angle, worst_w, max_it);
-	assert_true(flips >= 3);        /* the test is about the flips */
+	assert_true(flips >= 3); /* the test is about the flips */
 	assert_true(worst_angle < 1e-3);
 
 	/* conservation over 1e5 steps (the 1e4 above included) */
@@ -248,7 +255,8 @@ static void test_dzhanibekov_vs_rk4(void **state)
 		dlv = fmax(dlv, rel_err3(l, l0));
 	}
 	print_message("Dzhanibekov over 1e5 steps: |dE|/E <= %.3g, |d|L||/|L| <= %.3g, "
-		      "|dL|/|L| (vector, world) <= %.3g\n", de, dl, dlv);
+		      "|dL|/|L| (vector, world) <= %.3g\n",
+		      de, dl, dlv);
 	assert_true(de < 1e-9);
 	assert_true(dl < 1e-9);
 	assert_true(dlv < 1e-9);
@@ -290,7 +298,8 @@ static void test_symmetric_top_second_order(void **state)
 
 	(void)state;
 	print_message("symmetric top, 5 s: orientation error %.3g (2 ms), %.3g (1 ms), %.3g (0.5 ms); "
-		      "ratios %.3f, %.3f\n", e2, e1, e05, e2 / e1, e1 / e05);
+		      "ratios %.3f, %.3f\n",
+		      e2, e1, e05, e2 / e1, e1 / e05);
 	assert_true(e1 < 1e-3);
 	assert_true(e2 / e1 > 3.6 && e2 / e1 < 4.4);
 	assert_true(e1 / e05 > 3.6 && e1 / e05 < 4.4);
@@ -367,7 +376,8 @@ static void fast_spin(const char *what, const double w[3])
 	}
 	irdm_rigid_rotate_inverse(&rb, l0, l_b);
 	print_message("fast spin %s, 60 s at 1 ms: max |dE|/E %.3g, E_max/E0 - 1 = %.3g, "
-		      "|dL|/|L| %.3g, Newton <= %u iterations\n", what, de, e_max / e0 - 1, dl, max_it);
+		      "|dL|/|L| %.3g, Newton <= %u iterations\n",
+		      what, de, e_max / e0 - 1, dl, max_it);
 	assert_true(de < 1e-9);
 	assert_true(dl < 1e-9);
 	assert_true(fabs(rb.s.q[0] * rb.s.q[0] + rb.s.q[1] * rb.s.q[1] + rb.s.q[2] * rb.s.q[2] +
@@ -377,8 +387,8 @@ static void fast_spin(const char *what, const double w[3])
 
 static void test_fast_spin(void **state)
 {
-	const double w_major[3] = { 2, -1, 200 };       /* near the stable major axis */
-	const double w_inter[3] = { 0.5, 200, 0.5 };    /* near the unstable intermediate axis */
+	const double w_major[3] = { 2, -1, 200 };    /* near the stable major axis */
+	const double w_inter[3] = { 0.5, 200, 0.5 }; /* near the unstable intermediate axis */
 
 	(void)state;
 	fast_spin("near major axis", w_major);
@@ -465,7 +475,8 @@ static void test_off_centre_force(void **state)
 		l[i] -= l0[i];
 	}
 	print_message("off-centre force while spinning: |dp|/|p| %.3g, |dL|/|L| %.3g "
-		      "(|L0|/|r x f dt| = %.3g)\n", rel_err3(pm, want_p), rel_err3(l, want_l),
+		      "(|L0|/|r x f dt| = %.3g)\n",
+		      rel_err3(pm, want_p), rel_err3(l, want_l),
 		      norm3(l0) / norm3(want_l));
 	assert_true(rel_err3(pm, want_p) < 1e-12);
 	assert_true(rel_err3(l, want_l) < 1e-10);
@@ -475,14 +486,14 @@ static void test_off_centre_force(void **state)
 
 	init_ok(&rb, &p, &s0);
 	irdm_rigid_accumulate(&rb, f, x);
-	irdm_rigid_accumulate(&rb, f2, s0.com_m);       /* cancels the force, keeps r x f */
+	irdm_rigid_accumulate(&rb, f2, s0.com_m); /* cancels the force, keeps r x f */
 	irdm_rigid_accumulate_torque(&rb, tau);
 	for (int i = 0; i < 3; i++)
 		assert_true(fabs(rb.force_n[i]) < 1e-16);
 	assert_true(fabs(rb.torque_n_m[0] - (want_l[0] / dt + tau[0])) < 1e-14 * norm3(want_l) / dt);
 	assert_int_equal(irdm_rigid_step(&rb, dt), 0);
 	for (int i = 0; i < 3; i++) {
-		assert_true(rb.force_n[i] == 0 && rb.torque_n_m[i] == 0);    /* consumed */
+		assert_true(rb.force_n[i] == 0 && rb.torque_n_m[i] == 0); /* consumed */
 		assert_true(fabs(rb.s.vel_m_s[i] - s0.vel_m_s[i]) < 1e-16);
 	}
 }
@@ -557,7 +568,8 @@ static void test_point_compliance(void **state)
 	double e_x = fd_error(&rb, r, r2, dt, 1.0, 1, c2);
 
 	print_message("compliance vs finite differences (w = 0): central %.3g, one-sided %.3g, "
-		      "cross point %.3g (relative)\n", e_c, e_1, e_x);
+		      "cross point %.3g (relative)\n",
+		      e_c, e_1, e_x);
 	assert_true(e_c < 1e-6 && e_1 < 1e-6 && e_x < 1e-6);
 
 	/* symmetric, positive definite, reciprocal */
@@ -613,31 +625,62 @@ static void test_bad_params(void **state)
 	memset(&rb, 0x5a, sizeof(rb));
 	before = rb;
 
-#define REJECT(pp, ss) do { \
+#define REJECT(pp, ss) \
+	do { \
 		assert_int_equal(irdm_rigid_init(&rb, pp, ss), IRDM_EINVAL); \
 		assert_memory_equal(&rb, &before, sizeof(rb)); \
 	} while (0)
 
-	p = good; p.mass_kg = 0; REJECT(&p, &s0);
-	p = good; p.mass_kg = -1; REJECT(&p, &s0);
-	p = good; p.mass_kg = NAN; REJECT(&p, &s0);
-	p = good; p.mass_kg = INFINITY; REJECT(&p, &s0);
-	p = good; p.inertia_body_kg_m2[4] = NAN; REJECT(&p, &s0);
-	p = good; p.inertia_body_kg_m2[1] = INFINITY; REJECT(&p, &s0);
-	p = good; p.inertia_body_kg_m2[1] = 0.1; REJECT(&p, &s0);      /* not symmetric */
-	p = good; p.inertia_body_kg_m2[4] = -2; REJECT(&p, &s0);       /* indefinite */
-	p = good; p.inertia_body_kg_m2[8] = 0; REJECT(&p, &s0);        /* singular */
-	p = good;                                                      /* symmetric, indefinite */
+	p = good;
+	p.mass_kg = 0;
+	REJECT(&p, &s0);
+	p = good;
+	p.mass_kg = -1;
+	REJECT(&p, &s0);
+	p = good;
+	p.mass_kg = NAN;
+	REJECT(&p, &s0);
+	p = good;
+	p.mass_kg = INFINITY;
+	REJECT(&p, &s0);
+	p = good;
+	p.inertia_body_kg_m2[4] = NAN;
+	REJECT(&p, &s0);
+	p = good;
+	p.inertia_body_kg_m2[1] = INFINITY;
+	REJECT(&p, &s0);
+	p = good;
+	p.inertia_body_kg_m2[1] = 0.1;
+	REJECT(&p, &s0); /* not symmetric */
+	p = good;
+	p.inertia_body_kg_m2[4] = -2;
+	REJECT(&p, &s0); /* indefinite */
+	p = good;
+	p.inertia_body_kg_m2[8] = 0;
+	REJECT(&p, &s0); /* singular */
+	p = good;        /* symmetric, indefinite */
 	p.inertia_body_kg_m2[1] = p.inertia_body_kg_m2[3] = 1.5;
 	REJECT(&p, &s0);
 	REJECT(NULL, &s0);
 	REJECT(&good, NULL);
-	s = s0; s.q[0] = 0; REJECT(&good, &s);                         /* zero quaternion */
-	s = s0; s.q[0] = 1e-9; REJECT(&good, &s);
-	s = s0; s.q[2] = NAN; REJECT(&good, &s);
-	s = s0; s.com_m[1] = INFINITY; REJECT(&good, &s);
-	s = s0; s.vel_m_s[2] = NAN; REJECT(&good, &s);
-	s = s0; s.omega_body_rad_s[0] = -INFINITY; REJECT(&good, &s);
+	s = s0;
+	s.q[0] = 0;
+	REJECT(&good, &s); /* zero quaternion */
+	s = s0;
+	s.q[0] = 1e-9;
+	REJECT(&good, &s);
+	s = s0;
+	s.q[2] = NAN;
+	REJECT(&good, &s);
+	s = s0;
+	s.com_m[1] = INFINITY;
+	REJECT(&good, &s);
+	s = s0;
+	s.vel_m_s[2] = NAN;
+	REJECT(&good, &s);
+	s = s0;
+	s.omega_body_rad_s[0] = -INFINITY;
+	REJECT(&good, &s);
 	assert_int_equal(irdm_rigid_init(NULL, &good, &s0), IRDM_EINVAL);
 #undef REJECT
 
@@ -660,14 +703,14 @@ static void test_bad_params(void **state)
 	assert_int_equal(irdm_rigid_step(&rb, NAN), IRDM_EINVAL);
 	assert_int_equal(irdm_rigid_step(&rb, INFINITY), IRDM_EINVAL);
 	irdm_rigid_accumulate(&rb, nan3, at);
-	assert_int_equal(irdm_rigid_step(&rb, 1e-3), IRDM_EFAULT);    /* non-finite force */
+	assert_int_equal(irdm_rigid_step(&rb, 1e-3), IRDM_EFAULT); /* non-finite force */
 	assert_memory_equal(&rb, &before, sizeof(rb));
 	rb.s.vel_m_s[0] = 1e308;
 	before = rb;
 	irdm_rigid_accumulate(&rb, big, at);
-	assert_int_equal(irdm_rigid_step(&rb, 1e3), IRDM_EFAULT);     /* overflows */
+	assert_int_equal(irdm_rigid_step(&rb, 1e3), IRDM_EFAULT); /* overflows */
 	assert_memory_equal(&rb, &before, sizeof(rb));
-	assert_int_equal(irdm_rigid_step(&rb, 1e-3), IRDM_OK);        /* forces were consumed */
+	assert_int_equal(irdm_rigid_step(&rb, 1e-3), IRDM_OK); /* forces were consumed */
 }
 
 /* ---- 7. self-contained state --------------------------------------------- */

@@ -176,9 +176,12 @@ static void test_attr_fifo(void **state)
 
 	/* what no thread can be given */
 	static const struct irdm_rt_sched bad[] = {
-		{ SCHED_FIFO, 0, IRDM_RT_ANY_CPU }, { SCHED_FIFO, 100, IRDM_RT_ANY_CPU },
-		{ SCHED_OTHER, 5, IRDM_RT_ANY_CPU }, { SCHED_RR, 10, IRDM_RT_ANY_CPU },
-		{ 12345, 0, IRDM_RT_ANY_CPU }, { SCHED_FIFO, 10, IRDM_RT_CPU_EXCEPT(CPU_SETSIZE) },
+		{ SCHED_FIFO, 0, IRDM_RT_ANY_CPU },
+		{ SCHED_FIFO, 100, IRDM_RT_ANY_CPU },
+		{ SCHED_OTHER, 5, IRDM_RT_ANY_CPU },
+		{ SCHED_RR, 10, IRDM_RT_ANY_CPU },
+		{ 12345, 0, IRDM_RT_ANY_CPU },
+		{ SCHED_FIFO, 10, IRDM_RT_CPU_EXCEPT(CPU_SETSIZE) },
 		{ SCHED_FIFO, 10, CPU_SETSIZE },
 	};
 	for (size_t i = 0; i < sizeof(bad) / sizeof(bad[0]); i++)
@@ -238,9 +241,15 @@ static void test_report_this_host(void **state)
 static void test_report_format(void **state)
 {
 	struct irdm_rt_report r = {
-		.preempt_rt = true, .policy = SCHED_FIFO, .priority = 80, .cpu = 1,
-		.cpu_mask = 0x4e, .n_cpus = 4, .memory_locked = true,
-		.locked_kb = 2000, .mapped_kb = 2032,
+		.preempt_rt = true,
+		.policy = SCHED_FIFO,
+		.priority = 80,
+		.cpu = 1,
+		.cpu_mask = 0x4e,
+		.n_cpus = 4,
+		.memory_locked = true,
+		.locked_kb = 2000,
+		.mapped_kb = 2032,
 	};
 	char line[256], small[24];
 
@@ -248,7 +257,7 @@ static void test_report_format(void **state)
 	assert_true(irdm_rt_report_realtime(&r));
 	assert_int_equal(irdm_rt_report_format(&r, line, sizeof(line)), IRDM_OK);
 	assert_string_equal(line, "real-time: yes (kernel PREEMPT_RT, SCHED_FIFO priority 80, "
-			    "memory locked); CPU 1, affinity 1-3,6");
+				  "memory locked); CPU 1, affinity 1-3,6");
 	r.n_cpus = 6;
 	assert_int_equal(irdm_rt_report_format(&r, line, sizeof(line)), IRDM_OK);
 	assert_non_null(strstr(line, "affinity 1-3,6,+2 above 63"));
@@ -258,7 +267,7 @@ static void test_report_format(void **state)
 	assert_false(irdm_rt_report_realtime(&r));
 	assert_int_equal(irdm_rt_report_format(&r, line, sizeof(line)), IRDM_OK);
 	assert_string_equal(line, "real-time: NO (kernel PREEMPT_RT, SCHED_FIFO priority 80, "
-			    "memory not locked: 2000 of 2032 kB); CPU 1, affinity 1-3,6");
+				  "memory not locked: 2000 of 2032 kB); CPU 1, affinity 1-3,6");
 	r.memory_locked = true;
 	r.preempt_rt = false;
 	assert_false(irdm_rt_report_realtime(&r));
@@ -268,14 +277,15 @@ static void test_report_format(void **state)
 	assert_false(irdm_rt_report_realtime(&r));
 	assert_int_equal(irdm_rt_report_format(&r, line, sizeof(line)), IRDM_OK);
 	assert_int_equal(strncmp(line, "real-time: NO (kernel PREEMPT_RT, SCHED_OTHER, memory locked)",
-				 61), 0);
+				 61),
+			 0);
 	r.policy = -1;
 	r.cpu = -1;
 	r.n_cpus = 0;
 	assert_false(irdm_rt_report_realtime(&r));
 	assert_int_equal(irdm_rt_report_format(&r, line, sizeof(line)), IRDM_OK);
 	assert_string_equal(line, "real-time: NO (kernel PREEMPT_RT, policy unknown, memory locked); "
-			    "CPU unknown, affinity unknown");
+				  "CPU unknown, affinity unknown");
 	/* cut, not overrun */
 	assert_int_equal(irdm_rt_report_format(&r, small, sizeof(small)), IRDM_ENOMEM);
 	assert_int_equal(strlen(small), sizeof(small) - 1);
@@ -404,7 +414,7 @@ static void test_prefault_stack(void **state)
 /* ---- scheduling ---- */
 
 struct granted {
-	struct irdm_rt_sched set_self;      /* applied inside, if policy >= 0 */
+	struct irdm_rt_sched set_self; /* applied inside, if policy >= 0 */
 	int set_rc;
 	struct irdm_rt_report r;
 	int report_rc;
@@ -476,11 +486,11 @@ static void test_cpu_except(void **state)
 	print_message("  CPU_EXCEPT(0) on %ld CPUs: %s\n", online, g.line);
 	assert_int_equal(g.set_rc, IRDM_OK);
 	assert_true(g.r.cpu_mask == want);
-	assert_int_equal(irdm_rt_pinned_cpu(), -1);             /* the test runs on all */
+	assert_int_equal(irdm_rt_pinned_cpu(), -1); /* the test runs on all */
 	g = (struct granted){ .set_self = { SCHED_OTHER, 0, 0 } };
 	assert_int_equal(irdm_rt_thread_start(&t, &pin_first, pinned_cpu_of, &g), IRDM_OK);
 	assert_int_equal(pthread_join(t, NULL), 0);
-	assert_int_equal(g.set_rc, 0);                          /* pinned to CPU 0: 0 */
+	assert_int_equal(g.set_rc, 0); /* pinned to CPU 0: 0 */
 }
 
 /* A thread that starts SCHED_OTHER and makes itself FIFO on the last CPU. */
@@ -691,7 +701,7 @@ static void test_cpu_latency_hold(void **state)
 	assert_int_equal(irdm_rt_cpu_latency_us(), 0);
 	irdm_rt_cpu_latency_release(hold);
 	assert_int_equal(irdm_rt_cpu_latency_us(), before);
-	irdm_rt_cpu_latency_release(-1);        /* nothing held: nothing done */
+	irdm_rt_cpu_latency_release(-1); /* nothing held: nothing done */
 }
 
 int main(void)

@@ -15,11 +15,22 @@
 
 #include "irdm/safety.h"
 
-enum op { OP_CALIBRATED, OP_ENABLE, OP_DISABLE, OP_FAULT, OP_RESET, OP_RESET_BUSY,
-	  OP_SHUTDOWN, OP_COUNT };
+enum op { OP_CALIBRATED,
+	  OP_ENABLE,
+	  OP_DISABLE,
+	  OP_FAULT,
+	  OP_RESET,
+	  OP_RESET_BUSY,
+	  OP_SHUTDOWN,
+	  OP_COUNT };
 
 static const char *const op_name[OP_COUNT] = {
-	"calibrated", "enable", "disable", "fault(workspace)", "reset", "reset(cause holds)",
+	"calibrated",
+	"enable",
+	"disable",
+	"fault(workspace)",
+	"reset",
+	"reset(cause holds)",
 	"shutdown",
 };
 
@@ -88,10 +99,10 @@ struct expect {
 /* [from][op] */
 static const struct expect table[5][OP_COUNT] = {
 	/*          calibrated  enable     disable    fault      reset      reset busy  shutdown */
-	[I] = { { R, OK },  { I, INV }, { I, INV }, { F, OK }, { I, INV }, { I, INV }, { O, OK } },
-	[R] = { { R, INV }, { E, OK },  { R, OK },  { F, OK }, { R, INV }, { R, INV }, { O, OK } },
-	[E] = { { E, INV }, { E, OK },  { R, OK },  { F, OK }, { E, INV }, { E, INV }, { O, OK } },
-	[F] = { { F, INV }, { F, INV }, { F, INV }, { F, OK }, { R, OK },  { F, FLT }, { O, OK } },
+	[I] = { { R, OK }, { I, INV }, { I, INV }, { F, OK }, { I, INV }, { I, INV }, { O, OK } },
+	[R] = { { R, INV }, { E, OK }, { R, OK }, { F, OK }, { R, INV }, { R, INV }, { O, OK } },
+	[E] = { { E, INV }, { E, OK }, { R, OK }, { F, OK }, { E, INV }, { E, INV }, { O, OK } },
+	[F] = { { F, INV }, { F, INV }, { F, INV }, { F, OK }, { R, OK }, { F, FLT }, { O, OK } },
 	[O] = { { O, INV }, { O, INV }, { O, INV }, { O, OK }, { O, INV }, { O, INV }, { O, OK } },
 };
 
@@ -127,7 +138,7 @@ static void test_fault_never_reenables_by_itself(void **state)
 
 	put_in(&s, IRDM_SAFETY_ENABLED);
 	assert_int_equal(irdm_safety_fault(&s, IRDM_FAULT_OVERRUN | IRDM_FAULT_WATCHDOG), IRDM_OK);
-	assert_int_equal(s.cause, IRDM_FAULT_WATCHDOG);         /* the lowest bit */
+	assert_int_equal(s.cause, IRDM_FAULT_WATCHDOG); /* the lowest bit */
 	assert_int_equal(s.faults, IRDM_FAULT_OVERRUN | IRDM_FAULT_WATCHDOG);
 	for (int k = 0; k < 100; k++) {
 		assert_int_equal(irdm_safety_enable(&s), IRDM_EINVAL);
@@ -193,14 +204,32 @@ static void test_reset_before_calibration_goes_to_init(void **state)
 static void test_names(void **state)
 {
 	static const char *const want[IRDM_FAULT_BITS] = {
-		"clamp", "workspace", "velocity", "watchdog", "overrun", "encoder-nan",
-		"encoder-range", "signal", "hal-read", "hal-write", "hal-fault", "engine",
+		"clamp",
+		"workspace",
+		"velocity",
+		"watchdog",
+		"overrun",
+		"encoder-nan",
+		"encoder-range",
+		"signal",
+		"hal-read",
+		"hal-write",
+		"hal-fault",
+		"engine",
 	};
 	static const uint32_t bit[IRDM_FAULT_BITS] = {
-		IRDM_FAULT_CLAMP, IRDM_FAULT_WORKSPACE, IRDM_FAULT_VELOCITY, IRDM_FAULT_WATCHDOG,
-		IRDM_FAULT_OVERRUN, IRDM_FAULT_ENCODER_NAN, IRDM_FAULT_ENCODER_RANGE,
-		IRDM_FAULT_SIGNAL, IRDM_FAULT_HAL_READ, IRDM_FAULT_HAL_WRITE,
-		IRDM_FAULT_HAL_FAULT, IRDM_FAULT_ENGINE,
+		IRDM_FAULT_CLAMP,
+		IRDM_FAULT_WORKSPACE,
+		IRDM_FAULT_VELOCITY,
+		IRDM_FAULT_WATCHDOG,
+		IRDM_FAULT_OVERRUN,
+		IRDM_FAULT_ENCODER_NAN,
+		IRDM_FAULT_ENCODER_RANGE,
+		IRDM_FAULT_SIGNAL,
+		IRDM_FAULT_HAL_READ,
+		IRDM_FAULT_HAL_WRITE,
+		IRDM_FAULT_HAL_FAULT,
+		IRDM_FAULT_ENGINE,
 	};
 	(void)state;
 

@@ -23,7 +23,7 @@
 
 #define DT 1e-3
 
-static struct irdm_sim_device sim, sim2;       /* big: keep them off the stack */
+static struct irdm_sim_device sim, sim2; /* big: keep them off the stack */
 
 /* The free arm: these tests follow motions longer than the joints' travel,
  * so the end stops are off (test_end_stop checks them). */
@@ -47,13 +47,13 @@ static void body_pos(const struct irdm_device_config *c, int k, const double q[3
 	double elbow_r = c->l1_m * cos(q[1]), elbow_h = c->l1_m * sin(q[1]);
 	double r, h;
 
-	if (k == 0) {                   /* along the upper arm */
+	if (k == 0) { /* along the upper arm */
 		r = c->com_m[0] * cos(q[1]);
 		h = c->com_m[0] * sin(q[1]);
-	} else if (k == 1) {            /* along the forearm from the elbow */
+	} else if (k == 1) { /* along the forearm from the elbow */
 		r = elbow_r + c->com_m[1] * sin(q[2]);
 		h = elbow_h - c->com_m[1] * cos(q[2]);
-	} else {                        /* turns with q3 about the shoulder */
+	} else { /* turns with q3 about the shoulder */
 		r = c->com_m[2] * sin(q[2]);
 		h = -c->com_m[2] * cos(q[2]);
 	}
@@ -104,7 +104,7 @@ static void test_energy_conserved(void **state)
 	for (int k = 0; k < 30; k++)
 		assert_int_equal(irdm_sim_device_step(&sim, DT), IRDM_OK);
 	assert_int_equal(irdm_sim_device_set_torque(&sim, (double[3]){ 0, 0, 0 }), IRDM_OK);
-	assert_int_equal(irdm_sim_device_step(&sim, DT), IRDM_OK);    /* zero reaches motors */
+	assert_int_equal(irdm_sim_device_step(&sim, DT), IRDM_OK); /* zero reaches motors */
 	e0 = energy(&sim, &p);
 	for (int k = 0; k < 2000; k++) {
 		assert_int_equal(irdm_sim_device_step(&sim, DT), IRDM_OK);
@@ -114,9 +114,10 @@ static void test_energy_conserved(void **state)
 			vmax = fmax(vmax, fabs(qd[i]));
 	}
 	printf("frictionless swing, 2 s, RK4 at 0.1 ms: |E - E0| <= %.3g J (E0 %.4g J, joint "
-	       "speeds up to %.3g rad/s)\n", drift, e0, vmax);
-	assert_true(vmax > 1);                  /* it did swing */
-	assert_true(drift < 5e-11);        /* 1.2e-11 measured: 4x */
+	       "speeds up to %.3g rad/s)\n",
+	       drift, e0, vmax);
+	assert_true(vmax > 1);      /* it did swing */
+	assert_true(drift < 5e-11); /* 1.2e-11 measured: 4x */
 }
 
 /* ---- a single viscous joint ------------------------------------------------ */
@@ -125,7 +126,7 @@ static void test_viscous_exponential(void **state)
 {
 	struct irdm_device_config c;
 	struct irdm_sim_params p;
-	const double tau = 0.01, b = 2e-3, in = 2e-4;  /* time constant in / b = 0.1 s */
+	const double tau = 0.01, b = 2e-3, in = 2e-4; /* time constant in / b = 0.1 s */
 	double worst = 0, q[3], qd[3], v1 = 0;
 	(void)state;
 
@@ -153,7 +154,7 @@ static void test_viscous_exponential(void **state)
 	}
 	printf("viscous joint vs analytic exponential: max |error| %.3g rad/s (peak %.3g rad/s)\n",
 	       worst, v1);
-	assert_true(worst < 1e-13);        /* 2.1e-14 measured: 5x */
+	assert_true(worst < 1e-13); /* 2.1e-14 measured: 5x */
 }
 
 /* ---- Coulomb friction ------------------------------------------------------ */
@@ -229,7 +230,7 @@ static void test_quantisation_floor(void **state)
 		assert_int_equal(irdm_sim_device_step(&sim, DT), IRDM_OK);
 		irdm_sim_device_state(&sim, q, qd);
 		if (irdm_sim_device_read_counts(&sim, n) != IRDM_OK)
-			break;          /* left the range: checked below */
+			break; /* left the range: checked below */
 		for (int i = 0; i < 3; i++)
 			assert_int_equal(n[i], floor_count(&c, i, q[i]));
 		checked++;
@@ -257,7 +258,7 @@ static void delayed_pair(unsigned write_k, unsigned read_k)
 	double qd[3];
 
 	irdm_device_config_default(&c);
-	c.gravity_m_per_s2 = 0;         /* at rest until the torque arrives */
+	c.gravity_m_per_s2 = 0; /* at rest until the torque arrives */
 	frictionless(&p);
 	assert_int_equal(irdm_sim_device_init(&sim, &c, &p), IRDM_OK);
 	p.write_delay_ticks = write_k;
@@ -287,7 +288,7 @@ static void delayed_pair(unsigned write_k, unsigned read_k)
 		kw = kr - (int)write_k;
 		assert_memory_equal(nb[k], na[kw > 0 ? kw : 0], sizeof(nb[k]));
 	}
-	assert_true(memcmp(qa[N], qa[0], sizeof(qa[0])) != 0);     /* it moved */
+	assert_true(memcmp(qa[N], qa[0], sizeof(qa[0])) != 0); /* it moved */
 	assert_true(memcmp(na[N], na[0], sizeof(na[0])) != 0);
 }
 
@@ -333,7 +334,7 @@ static void test_hand_force_work(void **state)
 	printf("hand force: kinetic energy vs work F.dx: max |error| %.3g J (KE %.3g J)\n", worst,
 	       ke);
 	assert_true(ke > 1e-3);
-	assert_true(worst < 1e-9 * ke);    /* 2.5e-10 KE measured: 4x */
+	assert_true(worst < 1e-9 * ke); /* 2.5e-10 KE measured: 4x */
 	assert_int_equal(irdm_sim_device_set_hand_force(&sim, (double[3]){ NAN, 0, 0 }),
 			 IRDM_EFAULT);
 	assert_true(sim.hand_n[0] == 0 && sim.hand_n[1] == 0 && sim.hand_n[2] == 0);
@@ -390,8 +391,8 @@ static void test_limits_and_rejects(void **state)
 	REJECT(write_delay_ticks, IRDM_SIM_DELAY_MAX + 1);
 	REJECT(read_delay_ticks, IRDM_SIM_DELAY_MAX + 1);
 	REJECT(q0_rad[1], INFINITY);
-	REJECT(q0_rad[1], 0.39);                /* past the shoulder's stop (0.38) */
-	REJECT(stop_inset_rad, 0.5);            /* no travel left between the stops */
+	REJECT(q0_rad[1], 0.39);     /* past the shoulder's stop (0.38) */
+	REJECT(stop_inset_rad, 0.5); /* no travel left between the stops */
 	REJECT(stop_inset_rad, -0.01);
 	REJECT(stop_stiffness_nm_per_rad, 0);
 	REJECT(stop_damping_nm_s_per_rad, NAN);
@@ -427,7 +428,7 @@ static void test_end_stop(void **state)
 	irdm_device_config_default(&c);
 	irdm_sim_params_default(&p);
 	p.coulomb_nm[0] = p.viscous_nm_s_per_rad[0] = 0;
-	p.coulomb_nm[1] = p.coulomb_nm[2] = 5;          /* N m: >> gravity and inertia */
+	p.coulomb_nm[1] = p.coulomb_nm[2] = 5; /* N m: >> gravity and inertia */
 	assert_int_equal(irdm_sim_device_init(&sim, &c, &p), IRDM_OK);
 	inertia = p.joint_inertia_kg_m2[0] + c.mass_kg[0] * c.com_m[0] * c.com_m[0] +
 		  c.mass_kg[1] * c.l1_m * c.l1_m;
@@ -453,10 +454,11 @@ static void test_end_stop(void **state)
 			t_out = k;
 			v_out = qd[0];
 		}
-		assert_true(qd[1] == 0 && qd[2] == 0);  /* the others stick */
+		assert_true(qd[1] == 0 && qd[2] == 0); /* the others stick */
 	}
 	printf("end stop: in at %.4f rad/s, out at %.4f rad/s: e = %.5f (analytic %.5f), "
-	       "%g s in contact (analytic %g s), %.2e rad deep (bound %.2e)\n", v_in, -v_out,
+	       "%g s in contact (analytic %g s), %.2e rad deep (bound %.2e)\n",
+	       v_in, -v_out,
 	       -v_out / v_in, e, (t_out - t_in) * DT / 10, M_PI / (wn * sqrt(1 - zeta * zeta)),
 	       deepest, v_in / wn);
 	assert_true(v_in > 0.5);

@@ -27,7 +27,7 @@
 #include "irdm/sim/sim_device.h"
 #include "irdm/sim/sim_user.h"
 
-static struct irdm_sim_user user;      /* big: keep it off the stack */
+static struct irdm_sim_user user; /* big: keep it off the stack */
 static struct irdm_sim_device sim;
 static char err[256];
 
@@ -86,8 +86,14 @@ static int ends_with(const char *s, const char *tail)
 static void test_every_script_parses(void **state)
 {
 	static const char *const named[] = {
-		"press-hold-release.user", "release.user", "stroke.user", "tap.user",
-		"pull-and-release.user", "pinch.user", "swing.user", "swirl.user",
+		"press-hold-release.user",
+		"release.user",
+		"stroke.user",
+		"tap.user",
+		"pull-and-release.user",
+		"pinch.user",
+		"swing.user",
+		"swirl.user",
 		"bunny-press.user",
 	};
 	DIR *d = opendir(users_dir());
@@ -117,17 +123,17 @@ static void test_scripts_mean_what_they_say(void **state)
 	load_shipped("press-hold-release.user");
 	assert_int_equal(user.hands, 1);
 	assert_target(0, 0.0, 0.05, 0.05, 0.21, 1);
-	assert_target(0, 0.7, 0.05, 0.05, 0.20, 1);         /* on the top centre */
-	assert_target(0, 1.2, 0.05, 0.05, 0.19, 1);         /* 1 cm in, after 0.2 s */
-	assert_target(0, 3.1999, 0.05, 0.05, 0.19, 1);      /* held 2 s */
-	assert_target(0, 3.2, 0.05, 0.05, 0.19, 0);         /* released */
+	assert_target(0, 0.7, 0.05, 0.05, 0.20, 1);    /* on the top centre */
+	assert_target(0, 1.2, 0.05, 0.05, 0.19, 1);    /* 1 cm in, after 0.2 s */
+	assert_target(0, 3.1999, 0.05, 0.05, 0.19, 1); /* held 2 s */
+	assert_target(0, 3.2, 0.05, 0.05, 0.19, 0);    /* released */
 	assert_true(fabs(user.end_s - 5.2) < 1e-12);
 
 	load_shipped("pinch.user");
 	assert_int_equal(user.hands, 2);
-	assert_target(0, 0.7, 0.0, 0.05, 0.15, 1);          /* face x = 0 */
-	assert_target(1, 0.7, 0.1, 0.05, 0.15, 1);          /* face x = 0.1 */
-	assert_target(0, 2.0, 0.005, 0.05, 0.15, 1);        /* squeezed 5 mm */
+	assert_target(0, 0.7, 0.0, 0.05, 0.15, 1);   /* face x = 0 */
+	assert_target(1, 0.7, 0.1, 0.05, 0.15, 1);   /* face x = 0.1 */
+	assert_target(0, 2.0, 0.005, 0.05, 0.15, 1); /* squeezed 5 mm */
 	assert_target(1, 2.0, 0.1 - 0.005, 0.05, 0.15, 1);
 	assert_target(0, 3.3, 0.005, 0.05, 0.15, 0);
 	assert_target(1, 3.3, 0.1 - 0.005, 0.05, 0.15, 0);
@@ -135,23 +141,26 @@ static void test_scripts_mean_what_they_say(void **state)
 	/* from home: sim-phantom's tip rests 1 cm above the top centre */
 	load_shipped("stroke.user");
 	assert_int_equal(irdm_sim_user_start(&user, 0, (double[3]){ 0.05, 0.05, 0.21 },
-					     "stroke", err, sizeof(err)), IRDM_OK);
-	assert_target(0, 0.0, 0.05, 0.05, 0.21, 1);         /* taken where it rests */
-	assert_target(0, 0.5, 0.02, 0.05, 0.21, 1);         /* carried over */
-	assert_target(0, 1.7, 0.02, 0.05, 0.2 - 0.005, 1);  /* 5 mm in */
-	assert_target(0, 3.2, 0.08, 0.05, 0.195, 1);        /* across the top */
+					     "stroke", err, sizeof(err)),
+			 IRDM_OK);
+	assert_target(0, 0.0, 0.05, 0.05, 0.21, 1);        /* taken where it rests */
+	assert_target(0, 0.5, 0.02, 0.05, 0.21, 1);        /* carried over */
+	assert_target(0, 1.7, 0.02, 0.05, 0.2 - 0.005, 1); /* 5 mm in */
+	assert_target(0, 3.2, 0.08, 0.05, 0.195, 1);       /* across the top */
 
 	/* sim-phantom-cube's tip rests at (0.03, 0.06, 0.13), over the top */
-	load_shipped("swirl.user");                         /* floating cube, top at 0.12 */
+	load_shipped("swirl.user"); /* floating cube, top at 0.12 */
 	assert_int_equal(irdm_sim_user_start(&user, 0, (double[3]){ 0.03, 0.06, 0.13 },
-					     "swirl", err, sizeof(err)), IRDM_OK);
+					     "swirl", err, sizeof(err)),
+			 IRDM_OK);
 	assert_target(0, 1.2, 0.06, 0.06, 0.12, 1);
 	load_shipped("swing.user");
 	assert_int_equal(irdm_sim_user_start(&user, 0, (double[3]){ 0.03, 0.06, 0.13 },
-					     "swing", err, sizeof(err)), IRDM_OK);
-	assert_target(0, 0.5, -0.01, 0.06, 0.13, 1);        /* over the -x edge */
-	assert_target(0, 1.0, -0.01, 0.06, 0.09, 1);        /* beside the face */
-	assert_target(0, 2.5, 0.02, 0.06, 0.09, 1);         /* pushed 2 cm in */
+					     "swing", err, sizeof(err)),
+			 IRDM_OK);
+	assert_target(0, 0.5, -0.01, 0.06, 0.13, 1); /* over the -x edge */
+	assert_target(0, 1.0, -0.01, 0.06, 0.09, 1); /* beside the face */
+	assert_target(0, 2.5, 0.02, 0.06, 0.09, 1);  /* pushed 2 cm in */
 }
 
 /* 'home': unresolved, evaluation refuses; resolved, it is the given point
@@ -169,8 +178,8 @@ static void test_home(void **state)
 	assert_int_equal(irdm_sim_user_start(&user, 0, home, "h", err, sizeof(err)), IRDM_OK);
 	assert_target(0, 0.0, home[0], home[1], home[2], 1);
 	assert_target(0, 1.0, home[0] + 0.01, home[1], home[2] - 0.02, 1);
-	assert_target(0, 2.0, 0.1, 0.1, 0.1, 0);              /* released, then placed... */
-	assert_target(0, 2.5, home[0], home[1], home[2], 1);  /* ...at home again */
+	assert_target(0, 2.0, 0.1, 0.1, 0.1, 0);             /* released, then placed... */
+	assert_target(0, 2.5, home[0], home[1], home[2], 1); /* ...at home again */
 	/* idempotent: nothing left to resolve */
 	assert_int_equal(irdm_sim_user_start(&user, 0, home, "h", err, sizeof(err)), IRDM_OK);
 	assert_target(0, 2.5, home[0], home[1], home[2], 1);
@@ -181,16 +190,18 @@ static void test_home(void **state)
 	assert_int_equal(irdm_sim_user_start(&user, 0, home, "far", err, sizeof(err)), IRDM_EFORMAT);
 	assert_string_equal(err, "far: hand 1: first placed 5.0 cm from where the tip rests at "
 				 "the start (at most 1 cm): 'place 1 at home', then move");
-	parse_ok("at 0.5 place 1 at 0.02,-0.03,0.2405\n");          /* 9.5 mm: taken */
+	parse_ok("at 0.5 place 1 at 0.02,-0.03,0.2405\n"); /* 9.5 mm: taken */
 	assert_int_equal(irdm_sim_user_start(&user, 0, home, "near", err, sizeof(err)), IRDM_OK);
 
 	parse_ok("place 1 at home\nmove 1 by 0.9,0,0 over 1\n");
 	assert_int_equal(irdm_sim_user_start(&user, 0, (double[3]){ 0.2, 0, 0 }, "out", err,
-					     sizeof(err)), IRDM_EFORMAT);
+					     sizeof(err)),
+			 IRDM_EFORMAT);
 	assert_string_equal(err, "out: hand 1: segment 2, from home, lies beyond +-1 m");
 	assert_int_equal(irdm_sim_user_target(&user, 0, 0.5, p, &a), IRDM_EINVAL);
 	assert_int_equal(irdm_sim_user_start(&user, 0, (double[3]){ NAN, 0, 0 }, "nan", err,
-					     sizeof(err)), IRDM_EINVAL);
+					     sizeof(err)),
+			 IRDM_EINVAL);
 }
 
 /* ---- rules ------------------------------------------------------------------ */
@@ -198,7 +209,7 @@ static void test_home(void **state)
 struct bad {
 	const char *text;
 	int code;
-	const char *msg;        /* the whole message, "NAME:LINE: ..." */
+	const char *msg; /* the whole message, "NAME:LINE: ..." */
 };
 
 static const struct bad bad_scripts[] = {
@@ -280,7 +291,7 @@ static void test_each_rule_rejected(void **state)
 			fail_msg("script %zu: got %s '%s', want %s '%s'", i, irdm_errname(ret),
 				 err, irdm_errname(b->code), b->msg);
 		assert_null(strchr(err, '\n'));
-		assert_int_equal(user.hands, 0);        /* a failed parse leaves it empty */
+		assert_int_equal(user.hands, 0); /* a failed parse leaves it empty */
 		assert_int_equal(user.hand[0].n, 0);
 	}
 }
@@ -339,7 +350,8 @@ static void test_file_errors(void **state)
 	f = fdopen(fd, "w");
 	fputs("# press\nat 0 place 1 at 0.05,0.05,0.21\n\n"
 	      "at 0.5 move 1 to 0.05,0.05,0.19 over 0.2\nhold 1 for 2.0\nrelease 1\n"
-	      "move 1 to 0.05,0.05 over 1\n", f);
+	      "move 1 to 0.05,0.05 over 1\n",
+	      f);
 	fclose(f);
 	assert_int_equal(irdm_sim_user_load(&user, path, err, sizeof(err)), IRDM_EFORMAT);
 	snprintf(want, sizeof(want), "%s:7: move: hand 1 is not placed", path);
@@ -398,9 +410,13 @@ static const char *motion =
 /* Keyframes exact; between them the profile of the reference. */
 static void test_target_min_jerk(void **state)
 {
-	static const double key[][4] = {        /* t, x, y, z */
-		{ 0.5, 0.05, 0.05, 0.21 }, { 1.0, 0.05, 0.05, 0.21 }, { 1.2, 0.05, 0.05, 0.19 },
-		{ 1.9, 0.08, 0.03, 0.19 }, { 2.9, 0.08, 0.03, 0.19 },
+	static const double key[][4] = {
+		/* t, x, y, z */
+		{ 0.5, 0.05, 0.05, 0.21 },
+		{ 1.0, 0.05, 0.05, 0.21 },
+		{ 1.2, 0.05, 0.05, 0.19 },
+		{ 1.9, 0.08, 0.03, 0.19 },
+		{ 2.9, 0.08, 0.03, 0.19 },
 	};
 	double p[3], worst = 0;
 	int a;
@@ -409,10 +425,10 @@ static void test_target_min_jerk(void **state)
 	parse_ok(motion);
 	for (size_t i = 0; i < sizeof(key) / sizeof(key[0]); i++)
 		assert_target(0, key[i][0], key[i][1], key[i][2], key[i][3], 1);
-	target_at(0, 3.25, p, &a);                 /* the relative move's end */
+	target_at(0, 3.25, p, &a); /* the relative move's end */
 	assert_true(fabs(p[0] - 0.05) < 1e-15 && fabs(p[1] - 0.05) < 1e-15 &&
 		    fabs(p[2] - 0.21) < 1e-15);
-	assert_target(0, 0.4999, 0, 0, 0, 0);       /* before the place */
+	assert_target(0, 0.4999, 0, 0, 0, 0); /* before the place */
 	assert_true(fabs(user.end_s - 3.25) < 1e-12);
 
 	/* the second move, 0.7 s from (0.05,0.05,0.19) to (0.08,0.03,0.19) */
@@ -537,9 +553,9 @@ static void obj_from_dev_vec(const double d[3], double p[3])
 }
 
 struct loop_result {
-	double err_m;           /* |tip - target| at the end */
-	double speed_m_per_s;   /* tip speed at the end */
-	double lag_m;           /* largest |tip - target| during the run */
+	double err_m;         /* |tip - target| at the end */
+	double speed_m_per_s; /* tip speed at the end */
+	double lag_m;         /* largest |tip - target| during the run */
 };
 
 /* One tick: the hand's force from the arm's true state, gravity compensated or not. */
@@ -590,7 +606,7 @@ static struct loop_result run_loop(const struct irdm_sim_params *p, int compensa
 
 static const char *reach =
 	"at 0 place 1 at 0.05,0.05,0.21\n"
-	"at 0.2 move 1 by 0.02,0.01,-0.03 over 0.6\n"    /* device: 2 cm right, 3 down, 1 in */
+	"at 0.2 move 1 by 0.02,0.01,-0.03 over 0.6\n" /* device: 2 cm right, 3 down, 1 in */
 	"hold 1 for 2.5\n";
 
 /* Solve a x = y for a 3x3 row-major a (Cramer: small, independent of the library). */
@@ -606,7 +622,8 @@ static void solve3(const double a[9], const double y[3], double x[3])
 		for (int r = 0; r < 3; r++)
 			m[3 * r + c] = y[r];
 		x[c] = (m[0] * (m[4] * m[8] - m[5] * m[7]) - m[1] * (m[3] * m[8] - m[5] * m[6]) +
-			m[2] * (m[3] * m[7] - m[4] * m[6])) / det;
+			m[2] * (m[3] * m[7] - m[4] * m[6])) /
+		       det;
 	}
 }
 
@@ -652,7 +669,8 @@ static void test_hand_drives_arm(void **state)
 	irdm_sim_device_state(&sim, q, qd);
 	band = friction_band_m(&p, q, IRDM_SIM_USER_K_DEFAULT_N_PER_M);
 	print_message("hand -> arm: error %.3g m after 2.5 s held (friction band %.3g m), "
-		      "speed %.2g m/s, largest lag %.3g m\n", r.err_m, band, r.speed_m_per_s,
+		      "speed %.2g m/s, largest lag %.3g m\n",
+		      r.err_m, band, r.speed_m_per_s,
 		      r.lag_m);
 	/* measured 1.75e-4 m in a band of 2.34e-4 m: stuck by friction, on target */
 	assert_true(r.err_m <= band);
@@ -667,7 +685,7 @@ static void test_hand_drives_arm(void **state)
 	r = run_loop(&p, 1, 3.3);
 	print_message("hand -> frictionless arm: error %.3g m, speed %.2g m/s\n", r.err_m,
 		      r.speed_m_per_s);
-	assert_true(r.err_m < 1e-12);          /* measured 8.2e-17 m */
+	assert_true(r.err_m < 1e-12); /* measured 8.2e-17 m */
 }
 
 /*
@@ -703,9 +721,10 @@ static void test_hand_holds_gravity(void **state)
 		gmax = fmax(gmax, fabs(g[i]));
 	}
 	print_message("hanging on the hand: sag %.3g m, |J^T f - G| %.2g of %.3g N m, "
-		      "speed %.2g m/s\n", r.err_m, resid, gmax, r.speed_m_per_s);
-	assert_true(gmax > 1e-2);               /* gravity matters here */
-	assert_true(r.err_m > 1e-3);            /* and the hand sags under it */
+		      "speed %.2g m/s\n",
+		      r.err_m, resid, gmax, r.speed_m_per_s);
+	assert_true(gmax > 1e-2);    /* gravity matters here */
+	assert_true(r.err_m > 1e-3); /* and the hand sags under it */
 	/* measured 1.7e-14 relative: settled to rounding */
 	assert_true(resid < 1e-12 * gmax);
 }

@@ -100,16 +100,16 @@ static int teardown(void **state)
 
 /* The scenes: args for irdm precompute, NULL-terminated. */
 #define GROUNDED "--mesh", "box:0.04,0.05,0.08", "--resolution", "3,3,5", "--fixed", "z<=0", \
-	"--touch", "z>=0.08", "--precision", "f64", "--representation", "modal:20"
+		 "--touch", "z>=0.08", "--precision", "f64", "--representation", "modal:20"
 #define FLOATING "--mesh", "box:0.04,0.05,0.07", "--resolution", "3,3,4", "--floating", "yes", \
-	"--fixed", "none", "--touch", "z>=0.07", "--precision", "f64", "--representation", "modal:24"
+		 "--fixed", "none", "--touch", "z>=0.07", "--precision", "f64", "--representation", "modal:24"
 #define FIR "--mesh", "box:0.03,0.04,0.06", "--resolution", "2,3,4", "--fixed", "z<=0", \
-	"--touch", "z>=0.06", "--precision", "f64", "--representation", "fir:48", "--modes", "30", \
-	"--uncertified", "yes"
+	    "--touch", "z>=0.06", "--precision", "f64", "--representation", "fir:48", "--modes", "30", \
+	    "--uncertified", "yes"
 
 #define TIME_DOMAIN "--mesh", "box:0.03,0.04,0.06", "--resolution", "2,3,4", "--fixed", "z<=0", \
-	"--touch", "z>=0.06", "--precision", "f64", "--representation", "fir:32", "--uncertified", "yes", \
-	"--method", "time-domain", "--substeps", "4"
+		    "--touch", "z>=0.06", "--precision", "f64", "--representation", "fir:32", "--uncertified", "yes", \
+		    "--method", "time-domain", "--substeps", "4"
 
 /* irdm precompute ARGS... -o OUT, under mpirun -np np (np 0: no mpirun). */
 static int precompute(int np, const char *out, const char *const *scene)

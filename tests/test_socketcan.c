@@ -62,7 +62,7 @@ static void test_bad_names(void **state)
 	assert_int_equal(irdm_socketcan_open(&s, "a-name-too-long0", &port, err, sizeof(err)),
 			 IRDM_EINVAL);
 	assert_int_equal(s.fd, -1);
-	irdm_socketcan_close(&s);       /* harmless on a closed one */
+	irdm_socketcan_close(&s); /* harmless on a closed one */
 }
 
 static void test_no_can_kernel(void **state)
@@ -100,14 +100,14 @@ static void test_round_trip(void **state)
 
 	(void)state;
 	open_pair(ifname, &a, &pa, &b, &pb);
-	assert_int_equal(irdm_can_recv(&pb, &g), 0);            /* nothing yet, no block */
+	assert_int_equal(irdm_can_recv(&pb, &g), 0); /* nothing yet, no block */
 	assert_int_equal(irdm_can_send(&pa, &f), IRDM_OK);
 	assert_int_equal(irdm_can_recv(&pb, &g), 1);
 	assert_int_equal(g.id, 0x201);
 	assert_int_equal(g.dlc, 4);
 	assert_memory_equal(g.data, f.data, 4);
 	assert_int_equal(g.data[4], 0);
-	assert_int_equal(irdm_can_recv(&pa, &g), 0);            /* not its own */
+	assert_int_equal(irdm_can_recv(&pa, &g), 0); /* not its own */
 	assert_int_equal(irdm_can_send(&pa, &wide), IRDM_EINVAL);
 	irdm_socketcan_close(&a);
 	irdm_socketcan_close(&b);
@@ -180,7 +180,7 @@ static void test_error_frames_latch(void **state)
 	assert_int_equal(irdm_can_recv(&pb, &g), IRDM_EIO);
 	assert_true(b.bus_off);
 	assert_int_equal(b.error_frames, 2);
-	assert_int_equal(irdm_can_send(&pb, &f), IRDM_EIO);     /* latched */
+	assert_int_equal(irdm_can_send(&pb, &f), IRDM_EIO); /* latched */
 	assert_int_equal(irdm_can_recv(&pb, &g), IRDM_EIO);
 	irdm_socketcan_close(&b);
 }
@@ -214,7 +214,7 @@ static void test_interface_down(void **state)
 	open_pair(ifname, &a, &pa, &b, &pb);
 	set_up(ifname, false);
 	assert_int_equal(irdm_can_send(&pa, &f), IRDM_EIO);
-	assert_int_equal(irdm_can_recv(&pb, &g), IRDM_EIO);    /* the socket's ENETDOWN */
+	assert_int_equal(irdm_can_recv(&pb, &g), IRDM_EIO); /* the socket's ENETDOWN */
 	irdm_socketcan_close(&a);
 	assert_int_equal(irdm_socketcan_open(&a, ifname, &pa, err, sizeof(err)), IRDM_EIO);
 	assert_non_null(strstr(err, "is down"));

@@ -52,8 +52,8 @@ static char dir[64];
 
 struct outcome {
 	double max_f, min_work, max_work, rho;
-	double first_osc, last_osc;     /* |F|'s standard deviation in the 2nd and last tenth */
-	double held_f, coupling_b;      /* mean |F| of the last window; the coupling's B */
+	double first_osc, last_osc; /* |F|'s standard deviation in the 2nd and last tenth */
+	double held_f, coupling_b;  /* mean |F| of the last window; the coupling's B */
 	unsigned touches;
 };
 
@@ -78,8 +78,7 @@ static struct outcome hold_step(const struct irdm_image *img, double seconds)
 	struct irdm_engine_config cfg;
 	struct irdm_contact_cmd cmd[IRDM_MAX_CONTACTS];
 	struct irdm_contact_site site;
-	struct outcome o = { .min_work = INFINITY, .max_work = -INFINITY,
-			     .rho = img->meta->max_spectral_radius };
+	struct outcome o = { .min_work = INFINITY, .max_work = -INFINITY, .rho = img->meta->max_spectral_radius };
 	struct welford first = { 0 }, last = { 0 };
 	const double top[3] = { 0.05, 0.05, 0.2 };
 	size_t N = (size_t)(seconds / img->meta->dt_s), tenth = N / 10;

@@ -126,7 +126,7 @@ static void node_cases(const char *what, struct tally *t, const struct irdm_mode
 		stab_dropped_head(zoh, phi, n_all, K, n_all, H, head);
 		check_case(what, t, zoh, K, phi_c, head, H);
 		for (size_t a = 0; H > 1 && a < sizeof(alpha) / sizeof(alpha[0]); a++)
-			for (size_t s = 1; s < H; s += H - 1 > 1 ? H - 2 : 1) {
+			for (size_t s = 1; s<H; s += H - 1> 1 ? H - 2 : 1) {
 				stab_dropped_head(zoh, phi, n_all, K, n_all, H, head);
 				add_scaled_r0(zoh, phi_c, K, head, s, alpha[a]);
 				check_case(what, t, zoh, K, phi_c, head, H);
@@ -173,7 +173,7 @@ static void test_cuboid_short_heads(void **state)
  * 40 samples, 0.5 % at 20).
  */
 #define KEEP_SLOW 250
-#define FULL_TOL 2e-8          /* measured 2.5e-9 over the columns, margin 8 */
+#define FULL_TOL 2e-8 /* measured 2.5e-9 over the columns, margin 8 */
 static void test_cuboid_fast_modes_in_head(void **state)
 {
 	static const size_t lengths[] = { 1, 5, 20, MAX_HEAD };
@@ -225,7 +225,8 @@ static void random_system(uint64_t *seed, size_t n_all, size_t K, struct irdm_mo
 
 static void test_random_heads(void **state)
 {
-	enum { N_SYSTEMS = 12, MAX_ALL = 30 };
+	enum { N_SYSTEMS = 12,
+	       MAX_ALL = 30 };
 	struct irdm_mode zoh[MAX_ALL];
 	double phi[3 * MAX_ALL];
 	struct tally t = { 0 };
@@ -250,7 +251,8 @@ static void test_random_heads(void **state)
  */
 static void test_head_alone_is_an_fir(void **state)
 {
-	enum { N_SYSTEMS = 6, MAX_ALL = 20 };
+	enum { N_SYSTEMS = 6,
+	       MAX_ALL = 20 };
 	struct irdm_mode zoh[MAX_ALL];
 	double phi[3 * MAX_ALL], head[9 * MAX_HEAD];
 	struct tally t = { 0 };
@@ -266,8 +268,7 @@ static void test_head_alone_is_an_fir(void **state)
 			stab_dropped_head(zoh, phi, n_all, 0, n_all, H, head);
 			double fir = irdm_stability_fir_companion(head, H);
 			assert_int_equal(irdm_stability_modal_cert_head(zoh, 0, NULL, head, H, &cert), 0);
-			assert_true(fabs(irdm_stability_modal_head(zoh, 0, NULL, head, H) - fir)
-				    <= STAB_DENSE_TOL * fir);
+			assert_true(fabs(irdm_stability_modal_head(zoh, 0, NULL, head, H) - fir) <= STAB_DENSE_TOL * fir);
 			tally_add("head alone", &t, fir, &cert);
 		}
 	}
@@ -283,7 +284,8 @@ static void test_head_alone_is_an_fir(void **state)
  */
 static void test_head_terms(void **state)
 {
-	enum { K = 5, N_HEAD = 9 };
+	enum { K = 5,
+	       N_HEAD = 9 };
 	struct irdm_mode zoh[K];
 	struct irdm_node_tf plain, hybrid;
 	double phi[3 * K], head[9 * N_HEAD];
@@ -327,7 +329,8 @@ static void test_head_terms(void **state)
  */
 static void test_one_sample_head(void **state)
 {
-	enum { K = 8, N_PAD = 4 };
+	enum { K = 8,
+	       N_PAD = 4 };
 	struct irdm_mode zoh[K];
 	struct irdm_node_tf one, padded;
 	double phi[3 * K], head[9 * N_PAD] = { 0 };

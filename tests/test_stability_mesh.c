@@ -24,14 +24,14 @@
 #include "support/stab_harness.h"
 #include "support/test_files.h"
 
-
 static void write_cube(const char *stem, double corner)
 {
 	char path[256], text[512];
 
 	snprintf(text, sizeof(text),
 		 "8 3 0 0\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 1 1 0\n5 0 0 1\n6 1 0 1\n7 0 1 1\n"
-		 "8 %.17g %.17g %.17g\n", corner, corner, corner);
+		 "8 %.17g %.17g %.17g\n",
+		 corner, corner, corner);
 	snprintf(path, sizeof(path), "%s.node", stem);
 	tf_write_text(path, text);
 	snprintf(path, sizeof(path), "%s.ele", stem);
@@ -60,8 +60,8 @@ static void test_flat_tet_refused(void **state)
 	print_message("flat corner tet: %s\n", err);
 	assert_null(strchr(err, '\n'));
 	assert_non_null(strstr(err, "zero volume"));
-	assert_non_null(strstr(err, "5"));      /* the element */
-	assert_int_not_equal(access(out, F_OK), 0);     /* nothing half-written */
+	assert_non_null(strstr(err, "5"));          /* the element */
+	assert_int_not_equal(access(out, F_OK), 0); /* nothing half-written */
 }
 
 static void test_sliver_stable(void **state)
@@ -75,9 +75,13 @@ static void test_sliver_stable(void **state)
 	const char *const image[] = { "mesh", mesh, "mesh_scale", "0.1", "representation", "modal:all",
 				      "touch", "surface", "display", "surface", NULL };
 	struct stab_case c = {
-		.name = "sliver tet, 1 mm push on its node", .image = image,
-		.at_m = { 0.2 / 3 + 1e-5, 0.2 / 3 + 1e-5, 0.2 / 3 + 1e-5 }, .mode = IRDM_CONTACT_PUSH,
-		.depth_m = { 1e-3 }, .ticks = 5000, .static_rel_tol = 1e-4,
+		.name = "sliver tet, 1 mm push on its node",
+		.image = image,
+		.at_m = { 0.2 / 3 + 1e-5, 0.2 / 3 + 1e-5, 0.2 / 3 + 1e-5 },
+		.mode = IRDM_CONTACT_PUSH,
+		.depth_m = { 1e-3 },
+		.ticks = 5000,
+		.static_rel_tol = 1e-4,
 		/* measured 0.7706 N, + 10 % */
 		.max_f_limit_n = 0.85,
 		.energy_tol_j = 1e-12,

@@ -139,16 +139,14 @@ static void test_mode_the_node_barely_sees(void **state)
 			/* 2 .. 80 Hz, the first mode least damped */
 			irdm_zoh_mode(2 * M_PI * 2.0 * (k + 1), k == 0 ? 0.002 : 0.02, 1e-3, &zoh[k]);
 			for (int i = 0; i < 3; i++)
-				phi[i * K + k] = cos(1.0 + 0.7 * k * (i + 1) + i) / (k + 1)
-						 * (k == 0 ? pow(10, -scale) : 1);
+				phi[i * K + k] = cos(1.0 + 0.7 * k * (i + 1) + i) / (k + 1) * (k == 0 ? pow(10, -scale) : 1);
 		}
 		struct irdm_stab_cert cert;
 		double dense = irdm_stability_modal(zoh, K, phi, NULL);
 		assert_int_equal(irdm_stability_modal_cert(zoh, K, phi, NULL, &cert), 0);
 		print_message("phi scale 1e-%d: dense %.12f, certificate [%.12f, %.12f]\n", scale, dense,
 			      cert.rho_lo, cert.rho);
-		assert_true(cert.rho >= dense * (1 - STAB_DENSE_TOL)
-			    && cert.rho <= dense * (1 + STAB_CERT_WIDTH));
+		assert_true(cert.rho >= dense * (1 - STAB_DENSE_TOL) && cert.rho <= dense * (1 + STAB_CERT_WIDTH));
 	}
 }
 

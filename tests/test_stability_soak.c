@@ -21,13 +21,12 @@
 
 #include "support/stab_harness.h"
 
-
 static const char *const soft[] = { "resolution", "2,2,4", "representation", "modal:all", "touch",
-				     "z>=0.2", "display", "touch", "young", "2e3", "poisson", "0.4999",
-				     NULL };
+				    "z>=0.2", "display", "touch", "young", "2e3", "poisson", "0.4999",
+				    NULL };
 static const char *const medium[] = { "resolution", "2,2,4", "representation", "modal:all", "touch",
-				       "z>=0.2", "display", "touch", "young", "2e7", "poisson", "0.4999",
-				       NULL };
+				      "z>=0.2", "display", "touch", "young", "2e7", "poisson", "0.4999",
+				      NULL };
 
 /* pushed 1 cm (stab_step) for 0.2 s, then let go */
 static void push_release(const struct stab_case *c, unsigned long t, double dt_s,
@@ -49,12 +48,17 @@ static unsigned long soak_ticks(void)
 static void test_held(void **state)
 {
 	struct stab_case c = {
-		.name = "soak: 1 cm held", .image = soft, .at_m = { 0.05, 0.05, 0.2 },
-		.mode = IRDM_CONTACT_PUSH, .depth_m = { 0.01 }, .ticks = soak_ticks(),
+		.name = "soak: 1 cm held",
+		.image = soft,
+		.at_m = { 0.05, 0.05, 0.2 },
+		.mode = IRDM_CONTACT_PUSH,
+		.depth_m = { 0.01 },
+		.ticks = soak_ticks(),
 		/* the coupling's spring at 1 cm and damper at 0.2 m/s (as
 		 * test_stability_cases) */
 		.max_f_limit_n = 1000.0 * 0.01 + 2.25 * 0.2 + 0.01,
-		.static_rel_tol = 1e-4, .energy_tol_j = 1e-12,
+		.static_rel_tol = 1e-4,
+		.energy_tol_j = 1e-12,
 	};
 	struct stab_record r;
 
@@ -75,9 +79,14 @@ static void test_held(void **state)
 static void test_released(void **state)
 {
 	struct stab_case c = {
-		.name = "soak: released, rings down", .image = medium, .at_m = { 0.05, 0.05, 0.2 },
-		.mode = IRDM_CONTACT_PUSH, .depth_m = { 0.01 }, .target = push_release,
-		.ticks = soak_ticks(), .max_f_limit_n = 1000.0 * 0.01 + 2.25 * 0.2 + 0.01,
+		.name = "soak: released, rings down",
+		.image = medium,
+		.at_m = { 0.05, 0.05, 0.2 },
+		.mode = IRDM_CONTACT_PUSH,
+		.depth_m = { 0.01 },
+		.target = push_release,
+		.ticks = soak_ticks(),
+		.max_f_limit_n = 1000.0 * 0.01 + 2.25 * 0.2 + 0.01,
 		.energy_tol_j = 1e-12,
 	};
 	struct stab_record r;

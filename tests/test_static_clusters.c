@@ -85,7 +85,7 @@ static double check_blocks(const struct irdm_corr_clusters *cl, const double *D,
 				for (int j = 0; j < 3; j++) {
 					assert_true(b[3 * i + j] == bt[3 * j + i]);
 					e[3 * i + j] = b[3 * i + j] - 0.5 * (d[3 * i + j] +
-						       D[(r * nc + c) * 9 + 3 * (size_t)j + (size_t)i]);
+									     D[(r * nc + c) * 9 + 3 * (size_t)j + (size_t)i]);
 				}
 			worst = fmax(worst, frob(e) / scale);
 			worst_over = fmax(worst_over, frob(e) / scale / bound);
@@ -114,7 +114,8 @@ static void run(bool floating)
 	for (size_t c = 0; c < nc; c++)
 		memcpy(&pos[3 * c], &m.mesh.pos_m[3 * (size_t)m.rows[m.cols[c]]], 3 * sizeof(double));
 	assert_int_equal(irdm_static_correction(&m.fem, &m.modes, floating, m.col_dofs, nc,
-						m.col_dofs, nc, D, err, sizeof(err)), 0);
+						m.col_dofs, nc, D, err, sizeof(err)),
+			 0);
 	if (irdm_static_correction_clusters(&m.fem, &m.modes, floating, m.col_dofs, pos, nc,
 					    CLUSTER, TOL, NULL, NULL, &kept, &cl, err, sizeof(err)))
 		fail_msg("%s", err);
@@ -179,7 +180,8 @@ static void test_refusals(void **state)
 	memset(&m, 0, sizeof(m));
 	assert_int_equal(irdm_static_correction_clusters(&m.fem, &m.modes, false, NULL, pos, 1, 3,
 							 TOL, NULL, NULL, &kept, &cl, err,
-							 sizeof(err)), IRDM_EINVAL);
+							 sizeof(err)),
+			 IRDM_EINVAL);
 	assert_non_null(strstr(err, "3 nodes per cluster is not in 4..1024"));
 	assert_null(cl.values);
 	assert_null(kept.start);

@@ -251,18 +251,21 @@ static void test_cuboid(void **state)
 	assert_non_null(D);
 	assert_non_null(dn);
 	assert_int_equal(irdm_static_correction(&m.fem, &m.modes, false, m.col_dofs, nc, m.col_dofs,
-						nc, D, err, sizeof(err)), 0);
+						nc, D, err, sizeof(err)),
+			 0);
 	double *S = as_matrix(D, nc);
 	for (size_t c = 0; c < nc; c++) {
 		dn[c] = frob(&D[(c * nc + c) * 9]);
 		scale = fmax(scale, dn[c]);
 	}
 	assert_int_equal(irdm_static_correction_sparse(&m.fem, &m.modes, false, m.col_dofs, nc, TOL,
-						       NULL, NULL, &s, err, sizeof(err)), 0);
+						       NULL, NULL, &s, err, sizeof(err)),
+			 0);
 	assert_int_equal(irdm_static_correction_sparse(&m.fem, &m.modes, false, m.col_dofs, nc, TOL,
-						       NULL, NULL, &s2, err, sizeof(err)), 0);
+						       NULL, NULL, &s2, err, sizeof(err)),
+			 0);
 	print_message("%zu columns, %zu of %zu blocks kept\n", nc, s.n_blocks, nc * nc);
-	assert_true(s.n_blocks < 6 * nc * nc / 10);      /* a good part dropped */
+	assert_true(s.n_blocks < 6 * nc * nc / 10); /* a good part dropped */
 	if (irdm_static_correction_lowrank(&m.fem, &m.modes, false, m.col_dofs, &s, RANK, NULL,
 					   NULL, &lr, err, sizeof(err)))
 		fail_msg("%s", err);

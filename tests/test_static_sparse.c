@@ -128,13 +128,15 @@ static void run_case(const char *what, struct irdm_model *m, bool floating)
 
 	print_message("%s: %zu columns, %zu modes of %zu\n", what, nc, m->modes.n_modes,
 		      m->modes.n_elastic_total);
-	assert_true(nc > 64);   /* more than one batch */
+	assert_true(nc > 64); /* more than one batch */
 	assert_non_null(D);
 	assert_int_equal(irdm_static_correction(&m->fem, &m->modes, floating, m->col_dofs, nc,
-						m->col_dofs, nc, D, err, sizeof(err)), 0);
+						m->col_dofs, nc, D, err, sizeof(err)),
+			 0);
 	/* tol = 0: every block that is not exactly zero */
 	assert_int_equal(irdm_static_correction_sparse(&m->fem, &m->modes, floating, m->col_dofs,
-						       nc, 0.0, NULL, NULL, &s, err, sizeof(err)), 0);
+						       nc, 0.0, NULL, NULL, &s, err, sizeof(err)),
+			 0);
 	check_index(&s);
 	assert_int_equal(compare(&s, D, 0.0), 0);
 	irdm_corr_sparse_free(&s);
@@ -142,7 +144,8 @@ static void run_case(const char *what, struct irdm_model *m, bool floating)
 	for (double tol = 1e-3; tol <= 0.11; tol *= 10) {
 		assert_int_equal(irdm_static_correction_sparse(&m->fem, &m->modes, floating,
 							       m->col_dofs, nc, tol, NULL, NULL, &s,
-							       err, sizeof(err)), 0);
+							       err, sizeof(err)),
+				 0);
 		check_index(&s);
 		size_t dropped = compare(&s, D, tol);
 		if (tol >= 0.1)

@@ -156,14 +156,13 @@ static void precompute(const char *scene, const char *img)
 	 * spins whenever the other core is busy (37.8 s of CPU quiet, 44 to
 	 * 51 s under .ci/run) */
 	assert_int_equal(setenv("OPENBLAS_NUM_THREADS", "1", 1), 0);
-	int rc = rp_run(dir, irdm, (const char *[]){ "precompute", "--scene", scene,
-							   "--max_error", "none", "-o", img, NULL },
+	int rc = rp_run(dir, irdm, (const char *[]){ "precompute", "--scene", scene, "--max_error", "none", "-o", img, NULL },
 			out, sizeof(out), err, sizeof(err));
 	if (rc)
 		fail_msg("irdm precompute failed (%d): %s", rc, err);
 	assert_int_equal(getrusage(RUSAGE_CHILDREN, &ru), 0);
 	peak_line = strstr(out, "memory        peak ");
-	assert_non_null(peak_line);     /* irdm precompute reports it */
+	assert_non_null(peak_line); /* irdm precompute reports it */
 	assert_int_equal(sscanf(peak_line, "memory        peak %lf MiB", &peak_mib), 1);
 	assert_int_equal(stat(img, &st), 0);
 	print_message("%s", out);
@@ -233,7 +232,8 @@ static double step_error(const struct irdm_image *img, struct irdm_model *m, con
 		for (int a = 0; a < 3; a++)
 			cd[3 * s + a] = m->col_dofs[3 * (size_t)col[s] + (size_t)a];
 	assert_int_equal(irdm_static_correction(&m->fem, &m->modes, true, cd, 3, cd, 3, D,
-						err, sizeof(err)), 0);
+						err, sizeof(err)),
+			 0);
 	node_sites(img, col, sites);
 	double *W = efx_contact_responses(img, sites, 3, N_TICKS, 1.0);
 	double *Wd = malloc(N_TICKS * 81 * sizeof(double));
@@ -396,7 +396,7 @@ static void test_torus(void **state)
 		irdm_image_unmap(&img);
 		return;
 	}
-	assert_true(irdm_image_corr_block(&img, col[0], col[1]) >= 0);  /* neighbours kept */
+	assert_true(irdm_image_corr_block(&img, col[0], col[1]) >= 0); /* neighbours kept */
 	double e_far = step_error(&img, &m, col, &rho, &left);
 	print_message("step at A, its neighbour B and the farthest C (columns %u, %u, %u of %u): relative RMS force error %.2e (limit %.0e), largest dropped block %.3g, %.3g left with the far field of rank %u\n",
 		      col[0], col[1], col[2], img.meta->n_cols, e_far, MAX_FORCE_RMS, rho, left,

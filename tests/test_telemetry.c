@@ -92,7 +92,7 @@ static uint64_t xorshift(uint64_t *s)
 /* A finite double of any sign and a wide range of magnitudes. */
 static double any_double(uint64_t *s)
 {
-	double m = (double)(xorshift(s) >> 11) / 9007199254740992.0;   /* [0, 1) */
+	double m = (double)(xorshift(s) >> 11) / 9007199254740992.0; /* [0, 1) */
 	int e = (int)(xorshift(s) % 81) - 40;
 
 	return (xorshift(s) & 1 ? -1 : 1) * ldexp(m, e);
@@ -119,10 +119,8 @@ static void make_record(uint64_t i, struct irdm_tick_record *r)
 			for (int k = 0; k < 3; k++)
 				vec[a][k] = any_double(&s);
 		v->proxy = (uint8_t)((i + (uint64_t)d) % IRDM_TELEM_N_PROXY);
-		v->contact_tri = (i + (uint64_t)d) % 7 == 0 ? IRDM_TELEM_NO_TRI
-							   : (uint32_t)(xorshift(&s) % 100000);
-		v->site_tri = (i + (uint64_t)d) % 5 == 0 ? IRDM_TELEM_NO_TRI
-							: (uint32_t)(xorshift(&s) % 100000);
+		v->contact_tri = (i + (uint64_t)d) % 7 == 0 ? IRDM_TELEM_NO_TRI : (uint32_t)(xorshift(&s) % 100000);
+		v->site_tri = (i + (uint64_t)d) % 5 == 0 ? IRDM_TELEM_NO_TRI : (uint32_t)(xorshift(&s) % 100000);
 		for (int k = 0; k < 3; k++) {
 			v->site_bary[k] = any_double(&s);
 			v->target_m[k] = any_double(&s);
@@ -133,7 +131,7 @@ static void make_record(uint64_t i, struct irdm_tick_record *r)
 		r->dev[0].force_n[0] = -0.0;
 		r->dev[0].force_n[1] = INFINITY;
 		r->dev[1].tip_vel_m_s[2] = -INFINITY;
-		r->dev[1].joint_torque_nm[0] = 4.9406564584124654e-324;  /* smallest subnormal */
+		r->dev[1].joint_torque_nm[0] = 4.9406564584124654e-324; /* smallest subnormal */
 	}
 }
 
@@ -149,8 +147,11 @@ static void *ring_mem(uint32_t capacity, struct irdm_telem_ring **ring)
 }
 
 static const struct irdm_log_info info2 = {
-	.period_us = 1000, .n_devices = 2, .start_time_ns = 1234567890123456789LL,
-	.board = "sim-phantom", .image = "out/cuboid-1khz.img",
+	.period_us = 1000,
+	.n_devices = 2,
+	.start_time_ns = 1234567890123456789LL,
+	.board = "sim-phantom",
+	.image = "out/cuboid-1khz.img",
 };
 
 /* Records 0..n-1 to path through the synchronous writer. */
@@ -198,7 +199,7 @@ static uint64_t read_log_check(const char *path, uint64_t first)
 
 struct spsc {
 	struct irdm_telem_ring *ring;
-	uint64_t full;          /* pushes refused (the producer retried) */
+	uint64_t full; /* pushes refused (the producer retried) */
 };
 
 static void *producer(void *arg)
@@ -223,7 +224,7 @@ static void *producer(void *arg)
 
 static void test_ring_spsc_two_threads(void **state)
 {
-	struct irdm_tick_record out[37];     /* an odd batch: pops cross the wrap at every offset */
+	struct irdm_tick_record out[37]; /* an odd batch: pops cross the wrap at every offset */
 	struct spsc t = { 0 };
 	uint64_t next = 0;
 	pthread_t tid;
@@ -246,8 +247,8 @@ static void test_ring_spsc_two_threads(void **state)
 		}
 	}
 	assert_int_equal(pthread_join(tid, NULL), 0);
-	assert_int_equal(irdm_telem_ring_pop(t.ring, out, 37), 0);     /* nothing more: no duplicate */
-	assert_int_equal(irdm_telem_ring_drops(t.ring), t.full);      /* every refusal counted */
+	assert_int_equal(irdm_telem_ring_pop(t.ring, out, 37), 0); /* nothing more: no duplicate */
+	assert_int_equal(irdm_telem_ring_drops(t.ring), t.full);   /* every refusal counted */
 	print_message("spsc: %u records in order, %llu pushes found the ring full\n", SPSC_N,
 		      (unsigned long long)t.full);
 	free(mem);
@@ -289,7 +290,7 @@ static void test_ring_drops_and_limits(void **state)
 		assert_int_equal(irdm_telem_ring_push(ring, &r), i < 12 ? IRDM_OK : IRDM_EBUSY);
 	}
 	assert_int_equal(irdm_telem_ring_drops(ring), 7);
-	assert_int_equal(irdm_telem_ring_pop(ring, out, 8), 4);        /* the kept ones, in order */
+	assert_int_equal(irdm_telem_ring_pop(ring, out, 8), 4); /* the kept ones, in order */
 	assert_int_equal(out[0].tick, 2);
 	assert_int_equal(out[1].tick, 3);
 	assert_int_equal(out[2].tick, 10);
@@ -342,7 +343,18 @@ static long double check_bound(int64_t exact, int64_t rep, int64_t max, const ch
 }
 
 static const uint32_t quantiles[] = {
-	1, 1000, 100000, 250000, 500000, 750000, 900000, 990000, 999000, 999900, 999999, 1000000,
+	1,
+	1000,
+	100000,
+	250000,
+	500000,
+	750000,
+	900000,
+	990000,
+	999000,
+	999900,
+	999999,
+	1000000,
 };
 
 /* Every quantile of h against the sorted samples v[0..n-1]; returns the worst ratio. */
@@ -357,8 +369,7 @@ static long double check_all_quantiles(const struct irdm_hist *h, int64_t *v, si
 	assert_int_equal(h->min_ns, v[0]);
 	assert_int_equal(h->max_ns, v[n - 1]);
 	for (size_t q = 0; q < sizeof(quantiles) / sizeof(quantiles[0]) + 200; q++) {
-		uint32_t pm = q < sizeof(quantiles) / sizeof(quantiles[0])
-			      ? quantiles[q] : 1 + (uint32_t)(xorshift(seed) % 1000000);
+		uint32_t pm = q < sizeof(quantiles) / sizeof(quantiles[0]) ? quantiles[q] : 1 + (uint32_t)(xorshift(seed) % 1000000);
 		/* nearest rank, independently: k = ceil(p n) */
 		size_t k = (size_t)ceil((double)pm * (double)n / 1e6);
 		int64_t exact = v[(k < 1 ? 1 : k) - 1];
@@ -385,7 +396,7 @@ static void test_hist_edges(void **state)
 		long double lo = 100.0L * powl(10.0L, i / 50.0L);
 		long double hi = 100.0L * powl(10.0L, (i + 1) / 50.0L);
 
-		assert_true(h.edge_ns[i] < h.edge_ns[i + 1]);           /* no empty bin */
+		assert_true(h.edge_ns[i] < h.edge_ns[i + 1]); /* no empty bin */
 		if (!((long double)h.edge_ns[i] >= lo * (1 - 1e-15L) &&
 		      (long double)(h.edge_ns[i + 1] - 1) < hi))
 			fail_msg("bin %d = [%u, %u) is not within [%.3Lf, %.3Lf)", i, h.edge_ns[i],
@@ -517,7 +528,7 @@ static void test_hist_overruns(void **state)
 	struct irdm_hist_summary s;
 
 	(void)state;
-	assert_int_equal(irdm_hist_init(&h, 1000), IRDM_OK);   /* > 1000 ns overruns */
+	assert_int_equal(irdm_hist_init(&h, 1000), IRDM_OK); /* > 1000 ns overruns */
 	for (size_t i = 0; i < sizeof(x) / sizeof(x[0]); i++)
 		assert_int_equal(irdm_hist_add(&h, x[i]), run[i]);
 	irdm_hist_summarize(&h, &s);
@@ -563,8 +574,8 @@ static void test_log_round_trip(void **state)
 	struct stat st;
 	assert_int_equal(stat(path, &st), 0);
 	assert_int_equal(st.st_size, IRDM_LOG_HEADER_SIZE + 1000 * IRDM_TICK_RECORD_SIZE +
-				     4 * sizeof(struct irdm_log_block_end) +
-				     sizeof(struct irdm_log_trailer));
+					     4 * sizeof(struct irdm_log_block_end) +
+					     sizeof(struct irdm_log_trailer));
 	assert_int_equal(st.st_size, irdm_log_size(1000));
 	/* bad arguments leave nothing on disk */
 	struct irdm_log_file *lf;
@@ -676,11 +687,11 @@ static void test_log_crash_leaves_no_final_file(void **state)
 
 		if (irdm_log_file_open(&lf, path, &info2, err, sizeof(err)))
 			_exit(1);
-		for (uint64_t i = 0; i < 100; i++) {      /* 28 kB: part of it reaches the file */
+		for (uint64_t i = 0; i < 100; i++) { /* 28 kB: part of it reaches the file */
 			make_record(i, &r);
 			irdm_log_file_append(lf, &r, 1, err, sizeof(err));
 		}
-		_exit(0);                               /* "crash": no close */
+		_exit(0); /* "crash": no close */
 	}
 	assert_int_equal(waitpid(pid, &status, 0), pid);
 	assert_true(WIFEXITED(status) && WEXITSTATUS(status) == 0);
@@ -807,7 +818,7 @@ static void test_log_reader_refuses_bad_logs(void **state)
 	/* 600 records: blocks 0..255, 256..511 and 512..599 */
 	write_log(good, 600, 0);
 	copy_patched(good, bad, full, 0, NULL, 0);
-	assert_int_equal(read_log_check(bad, 0), 600);       /* the control: a copy reads */
+	assert_int_equal(read_log_check(bad, 0), 600); /* the control: a copy reads */
 
 	/* cut short: where it ends, named by block */
 	copy_patched(good, bad, IRDM_LOG_HEADER_SIZE + block + 100, 0, NULL, 0);
@@ -937,7 +948,7 @@ static void expect_text(char **p, const char *want, uint64_t tick, const char *c
 static void fault_names(uint32_t flags, char *buf, size_t len)
 {
 	static const char *const names[] = { "clamp", "workspace", "velocity", "watchdog", "overrun",
-		"encoder_nan", "encoder_range", "signal", "hal_read", "hal_write", "hal_fault", "engine" };
+					     "encoder_nan", "encoder_range", "signal", "hal_read", "hal_write", "hal_fault", "engine" };
 
 	buf[0] = 0;
 	for (unsigned b = 0; b < 12; b++)
@@ -956,7 +967,7 @@ static void check_csv_row(char *line, uint64_t i)
 	make_record(i, &r);
 	snprintf(want, sizeof(want), "%llu", (unsigned long long)r.tick);
 	expect_text(&p, want, i, "tick");
-	snprintf(want, sizeof(want), "%.3f", (double)r.tick * 1e-3);   /* period 1 ms */
+	snprintf(want, sizeof(want), "%.3f", (double)r.tick * 1e-3); /* period 1 ms */
 	assert_true(fabs(strtod(field(&p), NULL) - strtod(want, NULL)) < 1e-9);
 	snprintf(want, sizeof(want), "%d", r.wake_latency_ns);
 	expect_text(&p, want, i, "wake_latency_ns");
@@ -987,7 +998,7 @@ static void check_csv_row(char *line, uint64_t i)
 		for (int k = 0; k < 3; k++)
 			expect_double(&p, v->target_m[k], i, "target");
 	}
-	assert_int_equal(*p, 0);        /* no column left over */
+	assert_int_equal(*p, 0); /* no column left over */
 }
 
 static void test_cli_export_matches_records(void **state)
@@ -1002,7 +1013,8 @@ static void test_cli_export_matches_records(void **state)
 	(void)state;
 	write_log(log, 120, 0);
 	assert_int_equal(irdm_run((const char *[]){ "log", "export", log, "-o", csv, NULL },
-				  err_text, sizeof(err_text)), 0);
+				  err_text, sizeof(err_text)),
+			 0);
 	assert_int_equal(temporaries("cli.csv", NULL, 0), 0);
 	f = fopen(csv, "r");
 	assert_non_null(f);
@@ -1047,8 +1059,7 @@ static void test_cli_export_refuses_bad_logs(void **state)
 	assert_non_null(f);
 	fputs("earlier export\n", f);
 	fclose(f);
-	copy_patched(good, cut, -1, IRDM_LOG_HEADER_SIZE + 5 * IRDM_TICK_RECORD_SIZE +
-		     offsetof(struct irdm_tick_record, n_devices), &seven, 1);
+	copy_patched(good, cut, -1, IRDM_LOG_HEADER_SIZE + 5 * IRDM_TICK_RECORD_SIZE + offsetof(struct irdm_tick_record, n_devices), &seven, 1);
 	rc = irdm_run((const char *[]){ "log", "export", cut, "-o", csv, NULL }, err_text,
 		      sizeof(err_text));
 	assert_int_equal(rc, 1);
@@ -1061,13 +1072,17 @@ static void test_cli_export_refuses_bad_logs(void **state)
 	assert_string_equal(old, "earlier export\n");
 	/* usage errors and --help */
 	assert_int_equal(irdm_run((const char *[]){ "log", "export", good, NULL }, err_text,
-				  sizeof(err_text)), 2);
+				  sizeof(err_text)),
+			 2);
 	assert_int_equal(irdm_run((const char *[]){ "log", "export", "--help", NULL }, err_text,
-				  sizeof(err_text)), 0);
+				  sizeof(err_text)),
+			 0);
 	assert_int_equal(irdm_run((const char *[]){ "log", "--help", NULL }, err_text,
-				  sizeof(err_text)), 0);
+				  sizeof(err_text)),
+			 0);
 	assert_int_equal(irdm_run((const char *[]){ "log", "frobnicate", NULL }, err_text,
-				  sizeof(err_text)), 2);
+				  sizeof(err_text)),
+			 2);
 }
 
 /* ---- the tick side stays free of stdio, allocation and threads ---- */
@@ -1091,7 +1106,7 @@ static size_t count_undefined(const char *obj, const char *const *needles)
 	assert_non_null(p);
 	while (fgets(line, sizeof(line), p)) {
 		if (strstr(line, "__asan_") || strstr(line, "__ubsan_"))
-			continue;       /* a sanitizer build's own hooks */
+			continue; /* a sanitizer build's own hooks */
 		for (const char *const *n = needles; *n; n++)
 			if (strstr(line, *n)) {
 				print_message("%s needs %s", obj, line);
@@ -1105,7 +1120,7 @@ static size_t count_undefined(const char *obj, const char *const *needles)
 static void test_tick_side_objects(void **state)
 {
 	static const char *const forbidden[] = { "pthread_", "sem_", "cblas_", "malloc", "calloc",
-		"free", "printf", "fwrite", "fopen", "fputs", "puts", "clock_", "nanosleep", NULL };
+						 "free", "printf", "fwrite", "fopen", "fputs", "puts", "clock_", "nanosleep", NULL };
 
 	(void)state;
 	assert_int_equal(count_undefined("firmware/telemetry/telemetry_ring.o", forbidden), 0);

@@ -40,9 +40,7 @@ static double tet_volume6(const struct irdm_mesh *m, const uint32_t *t)
 	for (int i = 0; i < 3; i++)
 		for (int k = 0; k < 3; k++)
 			e[i][k] = m->pos_m[3 * t[i + 1] + k] - a[k];
-	return e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1])
-	     - e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0])
-	     + e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0]);
+	return e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) - e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) + e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0]);
 }
 
 /*
@@ -53,8 +51,7 @@ static double tet_volume6(const struct irdm_mesh *m, const uint32_t *t)
 static void box_mesh(struct irdm_mesh *m, double lx, double ly, double lz, unsigned nx,
 		     unsigned ny, unsigned nz, double grade)
 {
-	static const int perm[6][3] = { { 0, 1, 2 }, { 0, 2, 1 }, { 1, 0, 2 },
-					 { 1, 2, 0 }, { 2, 0, 1 }, { 2, 1, 0 } };
+	static const int perm[6][3] = { { 0, 1, 2 }, { 0, 2, 1 }, { 1, 0, 2 }, { 1, 2, 0 }, { 2, 0, 1 }, { 2, 1, 0 } };
 	unsigned sx = nx + 1, sy = ny + 1, sz = nz + 1;
 	const double len[3] = { lx, ly, lz }, nn[3] = { nx, ny, nz };
 	size_t t = 0;
@@ -206,7 +203,7 @@ static void jacobi_eig(size_t n, double *a, double *v)
 /* K phi = w^2 M phi, phi M-orthonormal (columns of phi, row-major n x n). */
 struct modes {
 	size_t n;
-	double *w;      /* rad/s */
+	double *w; /* rad/s */
 	double *phi;
 };
 
@@ -225,7 +222,7 @@ static void modes_compute(const struct irdm_fem *fem, struct modes *md)
 	dense_cholesky(n, m, l);
 	/* a = L^-1 K L^-T, built column by column (K symmetric) */
 	for (size_t j = 0; j < n; j++)
-		lower_solve(n, l, &k[j * n]);	/* rows of k now hold L^-1 K columns */
+		lower_solve(n, l, &k[j * n]); /* rows of k now hold L^-1 K columns */
 	for (size_t j = 0; j < n; j++) {
 		for (size_t i = 0; i < n; i++)
 			col[i] = k[i * n + j];
@@ -293,8 +290,7 @@ static void modal_reference(const struct irdm_fem *fem, const struct modes *md,
 
 					for (size_t k = 0; fo >= 0 && k < n; k++) {
 						double z = irdm_rayleigh_ratio(ray, md->w[k]);
-						double r = step_response(md->w[k], z, (s + 1) * dt)
-							 - step_response(md->w[k], z, s * dt);
+						double r = step_response(md->w[k], z, (s + 1) * dt) - step_response(md->w[k], z, s * dt);
 
 						acc += md->phi[(size_t)fo * n + k] * md->phi[fi * n + k] * r;
 					}
@@ -348,8 +344,7 @@ static void convergence(const struct irdm_mesh *mesh, const struct irdm_fem *fem
 	modes_compute(fem, &md);
 	modal_reference(fem, &md, ray, dt, T, in, n_in, out, n_out, ref);
 	for (int l = 0; l < levels; l++) {
-		struct irdm_td_opts o = { .dt_s = dt, .n_samples = T, .substeps = m0 << l,
-					  .damping = *ray, .threads = 1 };
+		struct irdm_td_opts o = { .dt_s = dt, .n_samples = T, .substeps = m0 << l, .damping = *ray, .threads = 1 };
 
 		td_run(mesh, fem, &o, in, n_in, out, n_out, R);
 		errs[l] = rel_err(R, ref, len);
@@ -418,7 +413,7 @@ static void test_box_consistent_modal(void **state)
 	box_mesh(&mesh, 0.05, 0.05, 0.1, 1, 1, 2, 1.0);
 	box_fem(&mesh, IRDM_MASS_CONSISTENT, true, &fem);
 	for (uint32_t i = 0; i < mesh.n_nodes; i++)
-		out[i] = i;	/* includes the fixed nodes: must read 0 */
+		out[i] = i; /* includes the fixed nodes: must read 0 */
 	in[0] = 3 * 11 + 0;
 	in[1] = 3 * 11 + 2;
 	in[2] = 3 * 6 + 1;
@@ -454,8 +449,7 @@ static void test_reciprocity(void **state)
 		in[i] = 3 * (int64_t)recip_nodes[i] + (int64_t)(i % 3);
 	R = malloc(n * T * 3 * n * sizeof(double));
 	assert_non_null(R);
-	struct irdm_td_opts o = { .dt_s = 2e-3, .n_samples = T, .substeps = 4,
-				  .damping = { 1.0, 1e-3 }, .threads = 2 };
+	struct irdm_td_opts o = { .dt_s = 2e-3, .n_samples = T, .substeps = 4, .damping = { 1.0, 1e-3 }, .threads = 2 };
 
 	td_run(&mesh, &fem, &o, in, n, recip_nodes, n, R);
 	double scale = max_abs(R, n * T * 3 * n);
@@ -473,7 +467,7 @@ static void test_reciprocity(void **state)
 			}
 	print_message("  reciprocity: max |R_ij - R_ji| / max|R| = %.3e\n", worst);
 	assert_true(worst <= 1e-10);
-	dense_cholesky(n, r0, l0);	/* asserts R[0] is positive definite */
+	dense_cholesky(n, r0, l0); /* asserts R[0] is positive definite */
 	free(R);
 	irdm_fem_free(&fem);
 	mesh_release(&mesh);
@@ -506,14 +500,14 @@ static void test_static_limit(void **state)
 	modes_free(&md);
 	/* critical damping at w1 and 10 w1: everything settles by 30 / w1 */
 	assert_int_equal(irdm_rayleigh_from_ratios(1.0, w1, 1.0, 10 * w1, &ray, err,
-						   sizeof(err)), 0);
+						   sizeof(err)),
+			 0);
 	double *R = malloc(2 * T * 3 * no * sizeof(double));
 	double *k = irdm_csc_to_dense(&fem.K), *l = malloc(n * n * sizeof(double));
 	double *x = malloc(n * sizeof(double));
 
 	assert_true(R && k && l && x);
-	struct irdm_td_opts o = { .dt_s = 30.0 / w1 / T, .n_samples = T, .substeps = 2,
-				  .damping = ray };
+	struct irdm_td_opts o = { .dt_s = 30.0 / w1 / T, .n_samples = T, .substeps = 2, .damping = ray };
 
 	td_run(&mesh, &fem, &o, in, 2, out, no, R);
 	dense_cholesky(n, k, l);
@@ -552,9 +546,15 @@ static void rotation_axis_angle(const double axis[3], double ang, double r[9])
 	double x = axis[0] / n, y = axis[1] / n, z = axis[2] / n;
 	double c = cos(ang), s = sin(ang), t = 1 - c;
 
-	r[0] = t * x * x + c;     r[1] = t * x * y - s * z; r[2] = t * x * z + s * y;
-	r[3] = t * x * y + s * z; r[4] = t * y * y + c;     r[5] = t * y * z - s * x;
-	r[6] = t * x * z - s * y; r[7] = t * y * z + s * x; r[8] = t * z * z + c;
+	r[0] = t * x * x + c;
+	r[1] = t * x * y - s * z;
+	r[2] = t * x * z + s * y;
+	r[3] = t * x * y + s * z;
+	r[4] = t * y * y + c;
+	r[5] = t * y * z - s * x;
+	r[6] = t * x * z - s * y;
+	r[7] = t * y * z + s * x;
+	r[8] = t * z * z + c;
 }
 
 /* Weighted centroid, and the 6 rigid modes M-orthonormalised (Gram-Schmidt). */
@@ -579,7 +579,7 @@ static void rigid_modes(size_t nn, const double *p, const double *w, double *phi
 			e[m % 3] = 1;
 			if (m < 3) {
 				memcpy(&v[3 * i], e, sizeof(e));
-			} else {	/* e x r */
+			} else { /* e x r */
 				v[3 * i] = e[1] * r[2] - e[2] * r[1];
 				v[3 * i + 1] = e[2] * r[0] - e[0] * r[2];
 				v[3 * i + 2] = e[0] * r[1] - e[1] * r[0];
@@ -664,8 +664,7 @@ static void test_rigid_fit(void **state)
 		for (int k = 0; k < 3; k++)
 			b[k] = p[3 * i + k] - c[k] + d[3 * i + k];
 		for (int a = 0; a < 3; a++)
-			q[3 * i + a] = r0[3 * a] * b[0] + r0[3 * a + 1] * b[1]
-				     + r0[3 * a + 2] * b[2] + c[a] + t0[a];
+			q[3 * i + a] = r0[3 * a] * b[0] + r0[3 * a + 1] * b[1] + r0[3 * a + 2] * b[2] + c[a] + t0[a];
 	}
 
 	/* mass-weighted Kabsch recovers rotation and deformation */
@@ -729,9 +728,7 @@ static void test_rigid_fit(void **state)
 		q[i] = i % 3 == 0 ? -p[i] : p[i];
 	assert_int_equal(irdm_rigid_fit_kabsch(nn, p, q, w, &fit), 0);
 	double *R9 = fit.rot;
-	double det = R9[0] * (R9[4] * R9[8] - R9[5] * R9[7])
-		   - R9[1] * (R9[3] * R9[8] - R9[5] * R9[6])
-		   + R9[2] * (R9[3] * R9[7] - R9[4] * R9[6]);
+	double det = R9[0] * (R9[4] * R9[8] - R9[5] * R9[7]) - R9[1] * (R9[3] * R9[8] - R9[5] * R9[6]) + R9[2] * (R9[3] * R9[7] - R9[4] * R9[6]);
 
 	assert_true(fabs(det - 1) <= 1e-12);
 	/* collinear points: rotation undetermined */
@@ -752,7 +749,7 @@ static void test_svd3(void **state)
 	(void)state;
 	const double a[3][9] = {
 		{ 1, 2, 3, 4, 5, 6, 7, 8, 10 },
-		{ 1, 2, 3, 2, 4, 6, 1, 0, 1 },	/* rank 2 */
+		{ 1, 2, 3, 2, 4, 6, 1, 0, 1 }, /* rank 2 */
 		{ 0, 0, 0, 0, 0, 0, 0, 0, 0 },
 	};
 
@@ -832,15 +829,15 @@ static void test_floating(void **state)
 	double *R = malloc(len * sizeof(double)), *RL = malloc(len * sizeof(double));
 
 	assert_true(R && RL);
-	struct irdm_td_opts o = { .dt_s = 2e-3, .n_samples = T, .substeps = 4,
-				  .damping = { 0.0, 2e-3 }, .floating = true };
+	struct irdm_td_opts o = { .dt_s = 2e-3, .n_samples = T, .substeps = 4, .damping = { 0.0, 2e-3 }, .floating = true };
 
 	double wt, wr, wtk, wrk;
 
-	td_run(&mesh, &fem, &o, in, 3, out, no, RL);	/* default: linear */
+	td_run(&mesh, &fem, &o, in, 3, out, no, RL); /* default: linear */
 	momentum_residue(&mesh, w, c, RL, 3 * T, &wt, &wr);
 	print_message("  floating (linear): |sum m u| / sum m|u| = %.3e,"
-		      " |sum m r x u| / sum m|r||u| = %.3e\n", wt, wr);
+		      " |sum m r x u| / sum m|r||u| = %.3e\n",
+		      wt, wr);
 	assert_true(wt <= 1e-12);
 	assert_true(wr <= 1e-12);
 
@@ -904,8 +901,7 @@ static void test_threads_bitwise(void **state)
 	double *r3 = malloc(len * sizeof(double));
 
 	assert_true(r1 && r2 && r3);
-	struct irdm_td_opts o = { .dt_s = 1e-3, .n_samples = T, .substeps = 3,
-				  .damping = { 1.0, 1e-3 }, .threads = 1 };
+	struct irdm_td_opts o = { .dt_s = 1e-3, .n_samples = T, .substeps = 3, .damping = { 1.0, 1e-3 }, .threads = 1 };
 
 	td_run(&mesh, &fem, &o, in, 10, out, 5, r1);
 	o.threads = 2;
@@ -942,7 +938,8 @@ static void expect_error(const struct irdm_mesh *mesh, const struct irdm_fem *fe
 	double R[3 * 4];
 
 	assert_int_equal(irdm_td_responses(mesh, fem, o, &in, 1, &out, 1, R, err,
-					   sizeof(err)), IRDM_EINVAL);
+					   sizeof(err)),
+			 IRDM_EINVAL);
 	print_message("  rejected: %s\n", err);
 	assert_non_null(strstr(err, needle));
 }
@@ -984,7 +981,8 @@ static void test_bad_input(void **state)
 	char err[64];
 
 	assert_int_equal(irdm_td_responses(&mesh, &fem, &good, NULL, 0, NULL, 0, NULL, err,
-					   sizeof(err)), 0);
+					   sizeof(err)),
+			 0);
 	irdm_fem_free(&fem);
 	mesh_release(&mesh);
 }

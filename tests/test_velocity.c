@@ -17,8 +17,8 @@
 #include "irdm/error.h"
 
 #define PI 3.14159265358979323846
-#define T_S 1e-3                /* 1 kHz */
-#define STEP 1.0                /* one encoder count (positions in counts) */
+#define T_S 1e-3 /* 1 kHz */
+#define STEP 1.0 /* one encoder count (positions in counts) */
 #define WINDOW 32
 
 struct signal {
@@ -50,8 +50,8 @@ static double ramp_vel(double t, const double *p)
 
 struct errors {
 	double rms_adaptive, rms_fd, rms_true;
-	double lag_ticks;       /* delay that best matches the estimate */
-	double rms_lagged;      /* RMS error against the true velocity so delayed */
+	double lag_ticks;  /* delay that best matches the estimate */
+	double rms_lagged; /* RMS error against the true velocity so delayed */
 };
 
 /* Run n samples; RMS errors after the first window of samples; the lag is
@@ -96,7 +96,8 @@ static void run(const struct signal *s, unsigned n, double band, struct errors *
 static void report(const char *name, double band, const struct errors *e)
 {
 	printf("%-34s band %.2f: RMS error adaptive %8.2f, finite difference %8.2f counts/s "
-	       "(ratio %.1f; true RMS %.1f; best lag %.1f ticks, RMS error at that lag %.2f)\n", name,
+	       "(ratio %.1f; true RMS %.1f; best lag %.1f ticks, RMS error at that lag %.2f)\n",
+	       name,
 	       band, e->rms_adaptive, e->rms_fd, e->rms_fd / e->rms_adaptive, e->rms_true,
 	       e->lag_ticks, e->rms_lagged);
 }
@@ -203,7 +204,8 @@ static void compare_with_paper(const char *name, const struct signal *s, unsigne
 		se_ref += pow(ref - truth, 2);
 	}
 	printf("%-16s: same estimate as the paper's search on %5.1f %% of samples; RMS error "
-	       "%.2f vs the paper's %.2f counts/s\n", name, 100.0 * same / n, sqrt(se_mod / n),
+	       "%.2f vs the paper's %.2f counts/s\n",
+	       name, 100.0 * same / n, sqrt(se_mod / n),
 	       sqrt(se_ref / n));
 	/* never meaningfully worse than the paper's search: measured equal on
 	 * slow signals, up to 2.0 % worse (a longer window, more lag) on the
@@ -238,10 +240,10 @@ static void test_rejects(void **state)
 	assert_int_equal(irdm_velocity_init(&v, T_S, 1, IRDM_VELOCITY_WINDOW_MAX + 1), IRDM_EINVAL);
 	assert_int_equal(irdm_velocity_init(&v, T_S, 1, IRDM_VELOCITY_WINDOW_MAX), IRDM_OK);
 	assert_int_equal(irdm_velocity_update(&v, 5, &vel), IRDM_OK);
-	assert_true(vel == 0);                  /* one sample: no velocity yet */
+	assert_true(vel == 0); /* one sample: no velocity yet */
 	assert_int_equal(irdm_velocity_update(&v, NAN, &vel), IRDM_EFAULT);
 	assert_int_equal(irdm_velocity_update(&v, 7, &vel), IRDM_OK);
-	assert_true(fabs(vel - 2 / T_S) < 1e-9);   /* the NaN was dropped */
+	assert_true(fabs(vel - 2 / T_S) < 1e-9); /* the NaN was dropped */
 }
 
 /* Exact on a straight line, at any window, and the window fills. */

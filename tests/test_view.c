@@ -53,7 +53,7 @@
 #include "support/test_files.h"
 
 #define BOARD "boards/sim-phantom.board"
-#define VIEW_CLIENTS 8          /* the server's limit (tools/view/view_server.h) */
+#define VIEW_CLIENTS 8 /* the server's limit (tools/view/view_server.h) */
 #define W 1000
 #define H 600
 
@@ -89,9 +89,7 @@ static unsigned start_fw_at(pid_t *pid, const char *duration, const char *log, c
 	unsigned port = 0;
 	double t0 = now_s();
 
-	*pid = rp_spawn(dir, env_or("IRDM_FW", "build/irdm-fw"), (const char *const[]){
-		"--board", board, "--image", image, "--user", user, "--duration", duration,
-		"--view", view, log ? "--log" : NULL, log, NULL });
+	*pid = rp_spawn(dir, env_or("IRDM_FW", "build/irdm-fw"), (const char *const[]){ "--board", board, "--image", image, "--user", user, "--duration", duration, "--view", view, log ? "--log" : NULL, log, NULL });
 	snprintf(path, sizeof(path), "%s/stdout", dir);
 	while (now_s() - t0 < 20) {
 		FILE *f = fopen(path, "r");
@@ -262,7 +260,9 @@ static void rect(struct cdp *c, const char *id, int box[4])
 /* Around the top centre the hand presses: 1.2 cm from it on the top face,
  * beside the tool, its proxy and the force arrow (drawn up from the proxy). */
 static const double ring[3][3] = {
-	{ 0.062, 0.05, 0.2 }, { 0.038, 0.05, 0.2 }, { 0.05, 0.038, 0.2 },
+	{ 0.062, 0.05, 0.2 },
+	{ 0.038, 0.05, 0.2 },
+	{ 0.05, 0.038, 0.2 },
 };
 
 /* Red minus blue: the colour scale runs from blue (0) to red (its top). */
@@ -306,7 +306,8 @@ static void test_live_view_in_chromium(void **state)
 	report(c, &r0);
 	if (r0.t > 3.5)
 		fail_msg("the browser came too late: the page first showed t = %.1f s, the hand "
-			 "comes down at 4 s", r0.t);
+			 "comes down at 4 s",
+			 r0.t);
 	screenshot(c, &before, "before");
 	project(c, 0.05, 0.05, 0.1, centre);
 	for (int i = 0; i < 3; i++)
@@ -439,8 +440,8 @@ static int ws_open(unsigned port, const char *origin, int rcvbuf)
 	size_t n = 0;
 
 	snprintf(req, sizeof(req), "GET / HTTP/1.1\r\nHost: 127.0.0.1:%u\r\nUpgrade: websocket\r\n"
-		 "Connection: Upgrade\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n"
-		 "Sec-WebSocket-Version: 13\r\nSec-WebSocket-Protocol: irdm-view\r\n%s%s%s\r\n",
+				   "Connection: Upgrade\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n"
+				   "Sec-WebSocket-Version: 13\r\nSec-WebSocket-Protocol: irdm-view\r\n%s%s%s\r\n",
 		 port, origin ? "Origin: " : "", origin ? origin : "", origin ? "\r\n" : "");
 	send_all(fd, req, strlen(req));
 	/* byte by byte to the blank line: what follows is the first frame */
@@ -585,7 +586,7 @@ static void test_bad_requests_leave_the_controller_alone(void **state)
 	good.fd = ws_open(port, NULL, 0);
 	assert_true(good.fd >= 0);
 	assert_int_equal(ws_frame(good.fd, head), 2);
-	assert_true(head[0] == 0x56445249u && head[1] == 1);    /* the hello first */
+	assert_true(head[0] == 0x56445249u && head[1] == 1); /* the hello first */
 	assert_int_equal(pthread_create(&good.tid, NULL, read_frames, &good), 0);
 	/* unknown paths, other methods, garbage: refused, never served */
 	assert_int_equal(http_get(port, "/nope"), 404);
@@ -617,7 +618,7 @@ static void test_bad_requests_leave_the_controller_alone(void **state)
 	assert_true(hung_up(fd));
 	close(fd);
 	fd = ws_open(port, NULL, 0);
-	ws_send(fd, 0x81, "enable");   /* the page only watches */
+	ws_send(fd, 0x81, "enable"); /* the page only watches */
 	assert_true(hung_up(fd));
 	close(fd);
 	/* another site's page: no socket */
@@ -643,13 +644,13 @@ static void test_bad_requests_leave_the_controller_alone(void **state)
 	assert_int_equal(http_get(port, "/"), 200);
 	assert_false(atomic_load(&good.lost));
 	atomic_store(&good.stop, true);
-	pthread_join(good.tid, NULL);   /* its next frame, or the run's end, wakes it */
+	pthread_join(good.tid, NULL); /* its next frame, or the run's end, wakes it */
 	close(good.fd);
 	close(mute);
 	/* the controller ran on until told to stop, every tick logged */
 	print_message("bad requests: %.1f s\n", now_s() - t0);
 	kill(pid, SIGTERM);
-	assert_int_equal(finish_fw(pid), 6);   /* a signal's documented exit (irdm-fw --help) */
+	assert_int_equal(finish_fw(pid), 6); /* a signal's documented exit (irdm-fw --help) */
 	assert_non_null(strstr(err_text, "(signal 15)"));
 	assert_non_null(strstr(err_text, "torque off, state off"));
 	p = strstr(out_text, "ticks: ");
@@ -673,8 +674,7 @@ static void expect_error(int rc, int code, const char *needle)
 
 static int run_fw(const char *view)
 {
-	return finish_fw(rp_spawn(dir, env_or("IRDM_FW", "build/irdm-fw"), (const char *const[]){
-		"--board", board, "--image", image, "--duration", "0.2", "--view", view, NULL }));
+	return finish_fw(rp_spawn(dir, env_or("IRDM_FW", "build/irdm-fw"), (const char *const[]){ "--board", board, "--image", image, "--duration", "0.2", "--view", view, NULL }));
 }
 
 static void test_view_arguments(void **state)
@@ -713,10 +713,10 @@ static unsigned start_playback(pid_t *pid, char *log, size_t loglen)
 
 	snprintf(log, loglen, "%s/play.log", dir);
 	assert_int_equal(finish_fw(rp_spawn(dir, env_or("IRDM_FW", "build/irdm-fw"),
-		(const char *const[]){ "--board", board, "--image", image, "--user", user,
-				       "--clock", "virtual", "--log", log, "-q", NULL })), 0);
-	*pid = rp_spawn(dir, env_or("IRDM", "build/irdm"), (const char *const[]){
-		"view", log, "--board", board, "--image", image, "--listen", "0", NULL });
+					    (const char *const[]){ "--board", board, "--image", image, "--user", user,
+								   "--clock", "virtual", "--log", log, "-q", NULL })),
+			 0);
+	*pid = rp_spawn(dir, env_or("IRDM", "build/irdm"), (const char *const[]){ "view", log, "--board", board, "--image", image, "--listen", "0", NULL });
 	snprintf(path, sizeof(path), "%s/stdout", dir);
 	while (now_s() - t0 < 60) {
 		FILE *f = fopen(path, "r");
@@ -806,8 +806,7 @@ static void test_playback(void **state)
  * stopped and fails the test). */
 static int view_refuses(const char *bad_dir)
 {
-	pid_t pid = rp_spawn(dir, env_or("IRDM", "build/irdm"), (const char *const[]){
-		"view", bad_dir, "--listen", "0", NULL });
+	pid_t pid = rp_spawn(dir, env_or("IRDM", "build/irdm"), (const char *const[]){ "view", bad_dir, "--listen", "0", NULL });
 	double t0 = now_s();
 
 	while (now_s() - t0 < 30) {
@@ -843,13 +842,11 @@ static void test_render_directory(void **state)
 	snprintf(log, sizeof(log), "%s/play.log", dir);
 	snprintf(rdir, sizeof(rdir), "%s/render", dir);
 	assert_int_equal(finish_fw(rp_spawn(dir, env_or("IRDM_FW", "build/irdm-fw"),
-		(const char *const[]){ "--board", board, "--image", image, "--user", user,
-				       "--clock", "virtual", "--log", log, "-q", NULL })), 0);
-	assert_int_equal(finish_fw(rp_spawn(dir, env_or("IRDM", "build/irdm"), (const char *const[]){
-		"render", "--image", image, "--log", log, "--board", board, "-o", rdir, "--every",
-		"0.1", NULL })), 0);
-	pid = rp_spawn(dir, env_or("IRDM", "build/irdm"), (const char *const[]){
-		"view", rdir, "--listen", "0", NULL });
+					    (const char *const[]){ "--board", board, "--image", image, "--user", user,
+								   "--clock", "virtual", "--log", log, "-q", NULL })),
+			 0);
+	assert_int_equal(finish_fw(rp_spawn(dir, env_or("IRDM", "build/irdm"), (const char *const[]){ "render", "--image", image, "--log", log, "--board", board, "-o", rdir, "--every", "0.1", NULL })), 0);
+	pid = rp_spawn(dir, env_or("IRDM", "build/irdm"), (const char *const[]){ "view", rdir, "--listen", "0", NULL });
 	snprintf(path, sizeof(path), "%s/stdout", dir);
 	while (!port && now_s() - t0 < 30) {
 		char text[1024] = "";
@@ -937,10 +934,7 @@ static int setup(void **state)
 	}
 	tf_write_text(board, out);
 	/* the paper's cuboid at 4 x 4 x 8 cells, its whole surface displayed */
-	pid = rp_spawn(dir, env_or("IRDM", "build/irdm"), (const char *const[]){
-		"precompute", "-q", "--mesh", "cuboid", "--resolution", "4,4,8", "--fixed", "z<=0",
-		"--touch", "z>=0.2", "--display", "surface", "--representation", "modal:40",
-		"--static_correction", "yes", "--max_error", "none", "-o", image, NULL });
+	pid = rp_spawn(dir, env_or("IRDM", "build/irdm"), (const char *const[]){ "precompute", "-q", "--mesh", "cuboid", "--resolution", "4,4,8", "--fixed", "z<=0", "--touch", "z>=0.2", "--display", "surface", "--representation", "modal:40", "--static_correction", "yes", "--max_error", "none", "-o", image, NULL });
 	return finish_fw(pid) == 0 ? 0 : -1;
 }
 

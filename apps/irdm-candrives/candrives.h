@@ -14,18 +14,18 @@
 #include "irdm/sim/can_faults.h"
 
 enum {
-	CD_EXIT_OK = 0,         /* stopped by --syncs, --seconds or a signal */
-	CD_EXIT_USAGE = 2,      /* bad arguments */
-	CD_EXIT_INPUT = 3,      /* board or user script refused */
-	CD_EXIT_SETUP = 4,      /* the CAN interface could not be opened */
-	CD_EXIT_LINK = 5,       /* the link went down during the run */
+	CD_EXIT_OK = 0,    /* stopped by --syncs, --seconds or a signal */
+	CD_EXIT_USAGE = 2, /* bad arguments */
+	CD_EXIT_INPUT = 3, /* board or user script refused */
+	CD_EXIT_SETUP = 4, /* the CAN interface could not be opened */
+	CD_EXIT_LINK = 5,  /* the link went down during the run */
 };
 
 struct cd_args {
 	const char *board, *user, *ifname;
 	unsigned nodes, first_node;
-	uint64_t syncs;                 /* stop after this many SYNCs (0: never) */
-	double seconds;                 /* stop after this long (0: never) */
+	uint64_t syncs; /* stop after this many SYNCs (0: never) */
+	double seconds; /* stop after this long (0: never) */
 	bool quiet, help;
 	struct irdm_can_fault fault[IRDM_CAN_FAULTS_MAX];
 	unsigned n_faults;

@@ -26,7 +26,7 @@
 
 #include "candrives.h"
 
-#define POLL_MAX_MS 100         /* re-check --seconds and signals at least this often */
+#define POLL_MAX_MS 100 /* re-check --seconds and signals at least this often */
 
 static volatile sig_atomic_t stop_signal;
 
@@ -38,7 +38,7 @@ static void on_signal(int sig)
 struct cd {
 	struct cd_args args;
 	struct irdm_board board;
-	struct irdm_sim_user *user;     /* NULL: no hand */
+	struct irdm_sim_user *user; /* NULL: no hand */
 	struct irdm_socketcan sock;
 	struct irdm_can_drives dr;
 	enum irdm_co_nmt_state nmt_seen[IRDM_CAN_DRIVES_MAX];
@@ -141,7 +141,7 @@ static int set_up(struct cd *cd)
 		cd->dr.hook_ctx = cd;
 	}
 	for (unsigned k = 0; k < cd->args.n_faults; k++)
-		irdm_can_drives_schedule(&cd->dr, &cd->args.fault[k]);  /* checked above */
+		irdm_can_drives_schedule(&cd->dr, &cd->args.fault[k]); /* checked above */
 	return -1;
 }
 
@@ -222,7 +222,7 @@ int main(int argc, char **argv)
 	rc = set_up(&cd);
 	if (rc < 0) {
 		memset(&sa, 0, sizeof(sa));
-		sa.sa_handler = on_signal;      /* no SA_RESTART: poll returns EINTR */
+		sa.sa_handler = on_signal; /* no SA_RESTART: poll returns EINTR */
 		sigaction(SIGINT, &sa, NULL);
 		sigaction(SIGTERM, &sa, NULL);
 		setvbuf(stdout, NULL, _IOLBF, 0);

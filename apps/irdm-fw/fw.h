@@ -30,19 +30,19 @@
 #include "irdm/session.h"
 #include "irdm/telemetry.h"
 
-struct irdm_sim_user;   /* the virtual user's script: fw_user.c alone reads it */
+struct irdm_sim_user; /* the virtual user's script: fw_user.c alone reads it */
 
 /* Exit codes (irdm-fw --help lists them). */
 enum fw_exit {
-	FW_EXIT_OK = 0,         /* ran to the end, no fault */
-	FW_EXIT_USAGE = 2,      /* bad arguments */
-	FW_EXIT_INPUT = 3,      /* board, image or user script refused */
-	FW_EXIT_SETUP = 4,      /* HAL, real time (--require-rt) or memory refused */
-	FW_EXIT_FAULT = 5,      /* the controller faulted: torque off, reason printed */
-	FW_EXIT_SIGNAL = 6,     /* stopped by a signal: torque off, state off, logged */
-	FW_EXIT_NEVER_ENABLED = 7,      /* ran, but a limit kept the torque off throughout */
-	FW_EXIT_EMERGENCY = 8,  /* a fatal (or second) signal: emergency torque off */
-	FW_EXIT_LOG = 9,        /* ran, but its --log could not be written (none left) */
+	FW_EXIT_OK = 0,            /* ran to the end, no fault */
+	FW_EXIT_USAGE = 2,         /* bad arguments */
+	FW_EXIT_INPUT = 3,         /* board, image or user script refused */
+	FW_EXIT_SETUP = 4,         /* HAL, real time (--require-rt) or memory refused */
+	FW_EXIT_FAULT = 5,         /* the controller faulted: torque off, reason printed */
+	FW_EXIT_SIGNAL = 6,        /* stopped by a signal: torque off, state off, logged */
+	FW_EXIT_NEVER_ENABLED = 7, /* ran, but a limit kept the torque off throughout */
+	FW_EXIT_EMERGENCY = 8,     /* a fatal (or second) signal: emergency torque off */
+	FW_EXIT_LOG = 9,           /* ran, but its --log could not be written (none left) */
 };
 
 struct fw_args {
@@ -50,25 +50,25 @@ struct fw_args {
 	const char *image;
 	const char *user;
 	const char *log;
-	const char *frame_out;          /* --frame-out: the VTK --frame-at writes */
-	const char *frames_out;         /* --frames-out: the directory of the series */
-	const char *view;               /* --view [ADDR:]PORT: the live view (fw_view.c) */
-	double duration_s;              /* 0: the user script's end + 1 s, else 5 s */
-	double frame_at_s;              /* --frame-at: 0 none */
-	double frames_every_s;          /* --frames-every: 0 none */
-	int clock;                      /* enum irdm_clock_mode */
+	const char *frame_out;  /* --frame-out: the VTK --frame-at writes */
+	const char *frames_out; /* --frames-out: the directory of the series */
+	const char *view;       /* --view [ADDR:]PORT: the live view (fw_view.c) */
+	double duration_s;      /* 0: the user script's end + 1 s, else 5 s */
+	double frame_at_s;      /* --frame-at: 0 none */
+	double frames_every_s;  /* --frames-every: 0 none */
+	int clock;              /* enum irdm_clock_mode */
 	bool require_rt;
-	bool force;                     /* --force: replace a --frames-out DIR we did not write */
+	bool force; /* --force: replace a --frames-out DIR we did not write */
 	bool quiet;
 	bool help;
-	bool help_board;                /* --help-board: the board keys, hal_options */
-	int doc;                        /* --doc: enum fw_doc, 0 none */
+	bool help_board; /* --help-board: the board keys, hal_options */
+	int doc;         /* --doc: enum fw_doc, 0 none */
 };
 
 /* The documents irdm-fw writes from its option tables (fw_docs.c). */
 enum fw_doc {
-	FW_DOC_BOARDS = 1,      /* the key table of docs/boards.md */
-	FW_DOC_HAL_OPTIONS,     /* docs/hal-options.md */
+	FW_DOC_BOARDS = 1,  /* the key table of docs/boards.md */
+	FW_DOC_HAL_OPTIONS, /* docs/hal-options.md */
 };
 
 /*
@@ -78,15 +78,15 @@ enum fw_doc {
  * ringing window after the latest release (one window's samples).
  */
 struct fw_trace {
-	uint64_t n, cap;                /* ticks traced; ticks the run has */
-	double peak_n, final_n;         /* |force on the object|, device 0 */
+	uint64_t n, cap;        /* ticks traced; ticks the run has */
+	double peak_n, final_n; /* |force on the object|, device 0 */
 	uint64_t peak_at;
-	bool contact;                   /* device 0 in contact at the last tick */
-	bool released;                  /* a contact has ended */
-	uint64_t release_at;            /* the tick after the latest contact ended */
-	double *ring_u_m;               /* the watched node's displacement along its
+	bool contact;              /* device 0 in contact at the last tick */
+	bool released;             /* a contact has ended */
+	uint64_t release_at;       /* the tick after the latest contact ended */
+	double *ring_u_m;          /* the watched node's displacement along its
 					 * normal from release_at on */
-	uint64_t ring_n, ring_max;      /* samples held; the window's length */
+	uint64_t ring_n, ring_max; /* samples held; the window's length */
 };
 
 /*
@@ -96,13 +96,13 @@ struct fw_trace {
  */
 struct fw_frame_slot {
 	uint64_t target_tick, held_tick;
-	double *pos_m;                  /* 3 rows, allocated at open */
+	double *pos_m; /* 3 rows, allocated at open */
 	bool held;
 	bool contact_seen, contact_on;
 	double contact_m[3], force_obj_n[3];
 };
 
-#define FW_FRAMES_MAX 1000              /* --frames-every's series, at most */
+#define FW_FRAMES_MAX 1000 /* --frames-every's series, at most */
 
 /*
  * The deformation worker's side of the run (fw_frame.c).  Real time: its
@@ -114,21 +114,21 @@ struct fw_frame_slot {
  * --frame-at's slot among them at single_slot.
  */
 struct fw_frame {
-	struct irdm_deform_thread *th;  /* real time only */
-	struct fw_view *view;           /* --view: offered every frame (fw_view_offer) */
-	unsigned every_ticks;           /* engine ticks between snapshots (publish_every) */
-	uint64_t last_update_tick;      /* virtual time: the last engine tick updated at */
+	struct irdm_deform_thread *th; /* real time only */
+	struct fw_view *view;          /* --view: offered every frame (fw_view_offer) */
+	unsigned every_ticks;          /* engine ticks between snapshots (publish_every) */
+	uint64_t last_update_tick;     /* virtual time: the last engine tick updated at */
 	uint32_t rows;
 	struct fw_frame_slot *slot;
-	unsigned n_slots, single_slot;  /* single_slot: n_slots if no --frame-at */
-	unsigned contact_next;          /* the monitor's: the next slot to take a contact */
+	unsigned n_slots, single_slot; /* single_slot: n_slots if no --frame-at */
+	unsigned contact_next;         /* the monitor's: the next slot to take a contact */
 	/* --frame-at's frame for the summary, copied at stop (the slots are
 	 * freed before the summary prints) */
 	bool single_held;
 	uint64_t single_held_tick;
-	double *scratch_m;              /* 3 rows: virtual time's update target */
+	double *scratch_m; /* 3 rows: virtual time's update target */
 	/* ---- written by the worker's thread (real) or the monitor (virtual) */
-	unsigned next;                  /* the first slot still looking for its frame */
+	unsigned next; /* the first slot still looking for its frame */
 	uint64_t frames;
 	double cpu_sum_ns, cpu_max_ns;
 	uint64_t cpu_n;
@@ -138,13 +138,13 @@ struct fw_frame {
 
 /* One tick as the run's monitor sees it (fw_monitor.c): device 0. */
 struct fw_sample {
-	uint64_t eng_tick;              /* the engine's ticks after this one (the frames' clock) */
-	int state;                      /* enum irdm_safety_state after the tick */
+	uint64_t eng_tick; /* the engine's ticks after this one (the frames' clock) */
+	int state;         /* enum irdm_safety_state after the tick */
 	bool contact;
 	double force_obj_n[3];
-	double scale;                   /* force clamp x torque saturation */
+	double scale; /* force clamp x torque saturation */
 	double proxy_m[3];
-	double node_u_m;                /* the watched node along its contact's normal */
+	double node_u_m; /* the watched node along its contact's normal */
 };
 
 /*
@@ -152,15 +152,15 @@ struct fw_sample {
  * and in real time the samples' ring to the consumer thread.
  */
 struct fw_monitor {
-	uint32_t watch_row;             /* the image node whose ringing is measured */
+	uint32_t watch_row; /* the image node whose ringing is measured */
 	bool watching;
 	double watch_normal[3];
-	struct fw_sample *ring;         /* real time only */
-	_Atomic uint64_t head, tail;    /* written by the loop; by the consumer */
+	struct fw_sample *ring;      /* real time only */
+	_Atomic uint64_t head, tail; /* written by the loop; by the consumer */
 	atomic_bool stop;
 	pthread_t tid;
 	bool running;
-	uint64_t lost;                  /* samples a full ring lost */
+	uint64_t lost; /* samples a full ring lost */
 };
 
 struct fw {
@@ -174,28 +174,28 @@ struct fw {
 	struct irdm_hal_dev hal[IRDM_BOARD_DEVICES_MAX];
 	void *hal_mem[IRDM_BOARD_DEVICES_MAX];
 	bool hal_open[IRDM_BOARD_DEVICES_MAX];
-	struct irdm_sim_user *user;     /* NULL without --user */
+	struct irdm_sim_user *user; /* NULL without --user */
 	struct irdm_clock clock;
-	int idle_hold;                  /* real time: the CPUs' idle-latency request, or < 0 */
+	int idle_hold; /* real time: the CPUs' idle-latency request, or < 0 */
 	struct fw_trace trace;
-	double rendered_peak_n;         /* |force on tip 0| after the clamp and saturation */
+	double rendered_peak_n; /* |force on tip 0| after the clamp and saturation */
 	uint64_t rendered_peak_tick;
 	struct fw_frame frame;
-	struct irdm_outdir frames_dir;  /* --frames-out's, claimed before the run */
+	struct irdm_outdir frames_dir; /* --frames-out's, claimed before the run */
 	/* telemetry: per-tick records through a ring to the log (--log) */
 	struct irdm_telem_ring *ring;
 	void *ring_mem;
-	struct irdm_log_writer *writer;         /* real time: a thread drains the ring */
-	struct irdm_log_file *logf;             /* virtual time: the loop drains it */
-	struct fw_view *view;                   /* --view */
-	struct irdm_telem_ring *view_ring;      /* --view: the same records, for the view */
-	struct irdm_hist latency;               /* ns, real time only (0 in virtual time) */
-	struct irdm_hist compute_measured;      /* ns, measured in both clocks; limit: the period */
+	struct irdm_log_writer *writer;    /* real time: a thread drains the ring */
+	struct irdm_log_file *logf;        /* virtual time: the loop drains it */
+	struct fw_view *view;              /* --view */
+	struct irdm_telem_ring *view_ring; /* --view: the same records, for the view */
+	struct irdm_hist latency;          /* ns, real time only (0 in virtual time) */
+	struct irdm_hist compute_measured; /* ns, measured in both clocks; limit: the period */
 	struct fw_monitor monitor;
-	uint64_t run_ticks;             /* the run's length, ticks */
+	uint64_t run_ticks; /* the run's length, ticks */
 	uint64_t ticks;
-	bool enabled_once;              /* the state was ENABLED in some tick */
-	uint32_t enable_blocked;        /* the conditions that refused the last enable */
+	bool enabled_once;       /* the state was ENABLED in some tick */
+	uint32_t enable_blocked; /* the conditions that refused the last enable */
 	uint32_t last_cause;
 	int last_state;
 	char err[512];
@@ -228,7 +228,7 @@ const char *fw_ctrl_init_why(struct fw *fw);
  */
 struct fw_backend {
 	const struct irdm_hal_backend *hal;
-	bool simulated_arm;             /* a virtual user (--user) can push its arm */
+	bool simulated_arm; /* a virtual user (--user) can push its arm */
 };
 
 void fw_backends_register(void);

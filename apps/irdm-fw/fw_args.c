@@ -27,51 +27,30 @@ static const struct irdm_opt_name doc_names[] = {
 };
 
 static const struct irdm_opt fw_opts[] = {
-	{ .name = "board", .short_name = 'b', .type = IRDM_OPT_STRING, FA_REF(board),
-	  .metavar = "BOARD", .help = "the board file (docs/boards.md); required" },
-	{ .name = "image", .short_name = 'i', .type = IRDM_OPT_STRING, FA_REF(image),
-	  .metavar = "IMAGE", .help = "the object's image (irdm precompute); required" },
-	{ .name = "user", .type = IRDM_OPT_STRING, FA_REF(user), .metavar = "SCRIPT",
-	  .help = "virtual user script (sim boards; scenes/users/)" },
-	{ .name = "duration", .type = IRDM_OPT_DOUBLE, FA(duration_s), .metavar = "S",
-	  .unit = "s", .range = IRDM_OPT_GT | IRDM_OPT_LE, .min = 0, .max = 86400,
-	  .help = "run time (default: the user script's end + 1 s, else 5 s)" },
-	{ .name = "log", .type = IRDM_OPT_STRING, FA_REF(log), .metavar = "FILE",
-	  .help = "binary per-tick log (irdm log export FILE -o CSV)" },
-	{ .name = "frame-at", .type = IRDM_OPT_DOUBLE, FA(frame_at_s), .metavar = "S",
-	  .unit = "s", .range = IRDM_OPT_GT | IRDM_OPT_LE, .min = 0, .max = 86400,
-	  .help = "write the deformed surface at time S to --frame-out (VTK; needs a "
-		  "board with deform_rate_hz > 0)" },
-	{ .name = "frame-out", .type = IRDM_OPT_STRING, FA_REF(frame_out), .metavar = "FILE",
-	  .help = "where --frame-at writes (legacy VTK POLYDATA, ASCII)" },
-	{ .name = "frames-every", .type = IRDM_OPT_DOUBLE, FA(frames_every_s), .metavar = "S",
-	  .unit = "s", .range = IRDM_OPT_GT | IRDM_OPT_LE, .min = 0, .max = 86400,
-	  .help = "a deformed-surface frame every S seconds of the run into --frames-out "
-		  "(at most 1000 frames)" },
-	{ .name = "frames-out", .type = IRDM_OPT_STRING, FA_REF(frames_out), .metavar = "DIR",
-	  .help = "where --frames-every writes: frame_NNNNN.vtk and frames.vtk.series (ParaView "
-		  "opens the series with time); replaced as a whole, and only if irdm-fw wrote it" },
-	{ .name = "force", .type = IRDM_OPT_FLAG, FA(force),
-	  .help = "replace --frames-out DIR even if irdm-fw did not write it (a directory of "
-		  "files only)" },
-	{ .name = "view", .type = IRDM_OPT_STRING, FA_REF(view), .metavar = "[ADDR:]PORT",
-	  .help = "serve the live view (docs/view.md) on ADDR (default 127.0.0.1), PORT (0: any)" },
-	{ .name = "clock", .type = IRDM_OPT_ENUM, FA(clock), .names = clock_names,
-	  .metavar = "real | virtual",
-	  .help = "real time paced at the board's period, or virtual time (deterministic, fast)" },
-	{ .name = "require-rt", .type = IRDM_OPT_FLAG, FA(require_rt),
-	  .help = "refuse to run without PREEMPT_RT, SCHED_FIFO and locked memory, or with "
-		  "another thread allowed on the loop's CPU" },
-	{ .name = "quiet", .short_name = 'q', .type = IRDM_OPT_FLAG, FA(quiet),
-	  .help = "no summary" },
+	{ .name = "board", .short_name = 'b', .type = IRDM_OPT_STRING, FA_REF(board), .metavar = "BOARD", .help = "the board file (docs/boards.md); required" },
+	{ .name = "image", .short_name = 'i', .type = IRDM_OPT_STRING, FA_REF(image), .metavar = "IMAGE", .help = "the object's image (irdm precompute); required" },
+	{ .name = "user", .type = IRDM_OPT_STRING, FA_REF(user), .metavar = "SCRIPT", .help = "virtual user script (sim boards; scenes/users/)" },
+	{ .name = "duration", .type = IRDM_OPT_DOUBLE, FA(duration_s), .metavar = "S", .unit = "s", .range = IRDM_OPT_GT | IRDM_OPT_LE, .min = 0, .max = 86400, .help = "run time (default: the user script's end + 1 s, else 5 s)" },
+	{ .name = "log", .type = IRDM_OPT_STRING, FA_REF(log), .metavar = "FILE", .help = "binary per-tick log (irdm log export FILE -o CSV)" },
+	{ .name = "frame-at", .type = IRDM_OPT_DOUBLE, FA(frame_at_s), .metavar = "S", .unit = "s", .range = IRDM_OPT_GT | IRDM_OPT_LE, .min = 0, .max = 86400, .help = "write the deformed surface at time S to --frame-out (VTK; needs a "
+																					"board with deform_rate_hz > 0)" },
+	{ .name = "frame-out", .type = IRDM_OPT_STRING, FA_REF(frame_out), .metavar = "FILE", .help = "where --frame-at writes (legacy VTK POLYDATA, ASCII)" },
+	{ .name = "frames-every", .type = IRDM_OPT_DOUBLE, FA(frames_every_s), .metavar = "S", .unit = "s", .range = IRDM_OPT_GT | IRDM_OPT_LE, .min = 0, .max = 86400, .help = "a deformed-surface frame every S seconds of the run into --frames-out "
+																						"(at most 1000 frames)" },
+	{ .name = "frames-out", .type = IRDM_OPT_STRING, FA_REF(frames_out), .metavar = "DIR", .help = "where --frames-every writes: frame_NNNNN.vtk and frames.vtk.series (ParaView "
+												       "opens the series with time); replaced as a whole, and only if irdm-fw wrote it" },
+	{ .name = "force", .type = IRDM_OPT_FLAG, FA(force), .help = "replace --frames-out DIR even if irdm-fw did not write it (a directory of "
+								     "files only)" },
+	{ .name = "view", .type = IRDM_OPT_STRING, FA_REF(view), .metavar = "[ADDR:]PORT", .help = "serve the live view (docs/view.md) on ADDR (default 127.0.0.1), PORT (0: any)" },
+	{ .name = "clock", .type = IRDM_OPT_ENUM, FA(clock), .names = clock_names, .metavar = "real | virtual", .help = "real time paced at the board's period, or virtual time (deterministic, fast)" },
+	{ .name = "require-rt", .type = IRDM_OPT_FLAG, FA(require_rt), .help = "refuse to run without PREEMPT_RT, SCHED_FIFO and locked memory, or with "
+									       "another thread allowed on the loop's CPU" },
+	{ .name = "quiet", .short_name = 'q', .type = IRDM_OPT_FLAG, FA(quiet), .help = "no summary" },
 	{ .name = "help", .short_name = 'h', .type = IRDM_OPT_FLAG, FA(help), .help = "this text" },
-	{ .name = "help-board", .type = IRDM_OPT_FLAG, FA(help_board),
-	  .help = "the board file's keys and each HAL back-end's hal_options, with their "
-		  "defaults" },
-	{ .name = "doc", .type = IRDM_OPT_ENUM, FA(doc), .names = doc_names,
-	  .metavar = "boards | hal-options",
-	  .help = "write a generated document to stdout: the key table of docs/boards.md, "
-		  "or docs/hal-options.md" },
+	{ .name = "help-board", .type = IRDM_OPT_FLAG, FA(help_board), .help = "the board file's keys and each HAL back-end's hal_options, with their "
+									       "defaults" },
+	{ .name = "doc", .type = IRDM_OPT_ENUM, FA(doc), .names = doc_names, .metavar = "boards | hal-options", .help = "write a generated document to stdout: the key table of docs/boards.md, "
+															"or docs/hal-options.md" },
 };
 
 static const struct irdm_opt_table fw_table = {
@@ -92,7 +71,8 @@ void fw_args_usage(FILE *f)
 	      "proxy on the deformed surface, force engine, J^T and limits, HAL write,\n"
 	      "every period; torque off on any fault and on every signal.  The torque is\n"
 	      "asked for from the second tick on and the request stands until the limits\n"
-	      "(workspace, speed, encoders) allow it; once on, a fault ends the run.\n\n", f);
+	      "(workspace, speed, encoders) allow it; once on, a fault ends the run.\n\n",
+	      f);
 	irdm_opt_print_help(f, &fw_table, IRDM_OPT_STYLE_ARG);
 	fputs("\nexit codes: 0 ran to the end with the torque enabled; 2 bad arguments;\n"
 	      "3 board, image or user script refused; 4 HAL, real time (--require-rt) or\n"
@@ -105,7 +85,8 @@ void fw_args_usage(FILE *f)
 	      "SIGTRAP, SIGSYS or a second signal while the loop runs: torque off at\n"
 	      "once by the emergency path, the log cut short; 9 the run ended but its\n"
 	      "--log could not be written (no log is left under its name; SIGXFSZ is\n"
-	      "ignored, so a log past the file-size limit ends here)\n", f);
+	      "ignored, so a log past the file-size limit ends here)\n",
+	      f);
 }
 
 int fw_args_parse(struct fw_args *a, int argc, char **argv, char *err, size_t errlen)
@@ -123,13 +104,11 @@ int fw_args_parse(struct fw_args *a, int argc, char **argv, char *err, size_t er
 		return IRDM_EINVAL;
 	}
 	if ((a->frame_at_s > 0) != (a->frame_out != NULL)) {
-		snprintf(err, errlen, "%s", a->frame_out ? "--frame-out needs --frame-at S"
-							 : "--frame-at needs --frame-out FILE");
+		snprintf(err, errlen, "%s", a->frame_out ? "--frame-out needs --frame-at S" : "--frame-at needs --frame-out FILE");
 		return IRDM_EINVAL;
 	}
 	if ((a->frames_every_s > 0) != (a->frames_out != NULL)) {
-		snprintf(err, errlen, "%s", a->frames_out ? "--frames-out needs --frames-every S"
-							  : "--frames-every needs --frames-out DIR");
+		snprintf(err, errlen, "%s", a->frames_out ? "--frames-out needs --frames-every S" : "--frames-every needs --frames-out DIR");
 		return IRDM_EINVAL;
 	}
 	return IRDM_OK;

@@ -111,10 +111,11 @@ const char *fw_user_hal_why(struct fw *fw)
 {
 	if (known_index(fw->board.hal) < 0)
 		snprintf(fw->err, sizeof(fw->err), "%s: hal '%s': no such back-end in this build "
-			 "(sim, canemu, socketcan)", fw->args.board, fw->board.hal);
+						   "(sim, canemu, socketcan)",
+			 fw->args.board, fw->board.hal);
 	else
 		snprintf(fw->err, sizeof(fw->err), "a virtual user needs a back-end with a "
-			 "simulated arm, and %s's hal '%s' has none (hal = sim or canemu)",
+						   "simulated arm, and %s's hal '%s' has none (hal = sim or canemu)",
 			 fw->args.board, fw->board.hal);
 	return fw->err;
 }

@@ -43,8 +43,7 @@ int fw_config_from_board(struct irdm_ctrl_config *c, const struct irdm_board *b)
 	c->proxy.mu_s = b->friction_mu[0];
 	c->proxy.mu_d = b->friction_mu[1];
 	irdm_board_engine_config(b, &c->engine);
-	c->engine.max_contacts = b->devices > c->engine.max_contacts ? b->devices
-								     : c->engine.max_contacts;
+	c->engine.max_contacts = b->devices > c->engine.max_contacts ? b->devices : c->engine.max_contacts;
 	c->engine.max_force_n = IRDM_CTRL_ENGINE_FORCE_GUARD * lim->max_force_n;
 	return irdm_ctrl_config_check(c);
 }
@@ -61,7 +60,8 @@ const char *fw_ctrl_init_why(struct fw *fw)
 
 	if (irdm_contact_mesh_init(&cm, fw->s->img)) {
 		snprintf(fw->err, sizeof(fw->err), "%s: no contact structure (CONTACT_BVH): "
-			 "precompute with --touch and --display covering it", fw->args.image);
+						   "precompute with --touch and --display covering it",
+			 fw->args.image);
 		return fw->err;
 	}
 	for (unsigned j = 0; j < 3; j++)
@@ -69,12 +69,14 @@ const char *fw_ctrl_init_why(struct fw *fw)
 				       irdm_device_rad_per_count(&fw->board.device, j),
 				       fw->ccfg.velocity_window)) {
 			snprintf(fw->err, sizeof(fw->err), "%s: joint %u: counts_per_rev x "
-				 "gear_ratio gives %g rad a count, which the velocity filter "
-				 "cannot use", fw->args.board, j + 1,
+							   "gear_ratio gives %g rad a count, which the velocity filter "
+							   "cannot use",
+				 fw->args.board, j + 1,
 				 irdm_device_rad_per_count(&fw->board.device, j));
 			return fw->err;
 		}
 	snprintf(fw->err, sizeof(fw->err), "%s: the controller refuses this board's arm, "
-		 "limits or placement (irdm_ctrl_config_check)", fw->args.board);
+					   "limits or placement (irdm_ctrl_config_check)",
+		 fw->args.board);
 	return fw->err;
 }

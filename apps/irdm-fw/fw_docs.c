@@ -51,7 +51,8 @@ static void hal_options_doc(FILE *f)
 	      "    boards/x.board:22: hal_options: nodes: missing (one node id per joint, "
 	      "e.g. nodes=1,2,3)\n"
 	      "\n"
-	      "`irdm-fw --help-board` prints the same keys as text.\n", f);
+	      "`irdm-fw --help-board` prints the same keys as text.\n",
+	      f);
 	fw_backends_register();
 	for (unsigned i = 0; (be = irdm_hal_backend_at(i)); i++) {
 		if (!be->options)

@@ -97,7 +97,7 @@ int fw_frame_check_args(struct fw *fw, uint64_t run_ticks)
 		/* two frames in one deformation period would be the same snapshot */
 		if (fw->args.frames_every_s < period_s * (1 - 1e-9)) {
 			snprintf(fw->err, sizeof(fw->err), "--frames-every %g: shorter than the "
-				 "deformation period, %g s (the board's deform_rate_hz)",
+							   "deformation period, %g s (the board's deform_rate_hz)",
 				 fw->args.frames_every_s, period_s);
 			return IRDM_EINVAL;
 		}
@@ -150,7 +150,7 @@ int fw_frame_open(struct fw *fw)
 		return rc;
 	fr->rows = irdm_deform_rows(fw->s->worker);
 #else
-	(void)rc;       /* the session refused the board before (session.c) */
+	(void)rc; /* the session refused the board before (session.c) */
 	return IRDM_ENOTSUP;
 #endif
 	bytes = 3 * (size_t)fr->rows * sizeof(double);
@@ -190,7 +190,7 @@ static void frame_offer(struct fw_frame *fr, const double *pos_m, uint64_t tick)
 		struct fw_frame_slot *sl = &fr->slot[fr->next];
 
 		if (!sl->held || tick_gap(tick, sl->target_tick) < tick_gap(sl->held_tick,
-									     sl->target_tick)) {
+									    sl->target_tick)) {
 			memcpy(sl->pos_m, pos_m, 3 * (size_t)fr->rows * sizeof(double));
 			sl->held_tick = tick;
 			sl->held = true;

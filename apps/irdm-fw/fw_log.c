@@ -18,7 +18,7 @@
 
 #include "fw.h"
 
-#define RING_RECORDS 4096u      /* 4 s at 1 kHz: the writer may stall that long */
+#define RING_RECORDS 4096u /* 4 s at 1 kHz: the writer may stall that long */
 
 static void fill_dev(struct irdm_tick_dev *r, const struct irdm_ctrl_device_output *d)
 {
@@ -41,7 +41,8 @@ static void fill_dev(struct irdm_tick_dev *r, const struct irdm_ctrl_device_outp
 
 static int64_t clamp_i32(int64_t v)
 {
-	return v > INT32_MAX ? INT32_MAX : v < INT32_MIN ? INT32_MIN : v;
+	return v > INT32_MAX ? INT32_MAX : v < INT32_MIN ? INT32_MIN :
+							   v;
 }
 
 static void drain(struct fw *fw, size_t below)

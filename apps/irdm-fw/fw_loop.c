@@ -93,7 +93,7 @@ static void watch_enable(struct fw *fw, const struct irdm_ctrl_input *in,
 	else if ((in->cmd & IRDM_CTRL_CMD_ENABLE) && out->state == IRDM_SAFETY_READY)
 		fw->enable_blocked = fw->ctrl.active & IRDM_FAULT_FATAL;
 	else if ((in->cmd & IRDM_CTRL_CMD_ENABLE) && out->state == IRDM_SAFETY_INIT)
-		fw->enable_blocked = 0;         /* not calibrated: main says so */
+		fw->enable_blocked = 0; /* not calibrated: main says so */
 }
 
 /* The run's exit code from its last tick. */

@@ -31,7 +31,7 @@
 
 #include "fw.h"
 
-#define RING_SAMPLES 4096u      /* 4 s at 1 kHz: the consumer may stall that long */
+#define RING_SAMPLES 4096u /* 4 s at 1 kHz: the consumer may stall that long */
 
 /* The node whose motion after release is the "ringing": the vertex of the
  * contact triangle that carries most of the contact. */
@@ -167,7 +167,7 @@ void fw_monitor_stop(struct fw *fw)
 		m->running = false;
 	}
 	if (m->ring)
-		drain(fw);      /* a thread that never started: the loop's samples */
+		drain(fw); /* a thread that never started: the loop's samples */
 }
 
 void fw_monitor_free(struct fw *fw)

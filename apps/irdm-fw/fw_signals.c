@@ -45,8 +45,17 @@
 #define ALT_STACK_BYTES (64u * 1024u)
 
 static const int soft_signals[] = {
-	SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGPIPE, SIGXCPU, SIGUSR1, SIGUSR2, SIGALRM,
-	SIGVTALRM, SIGPROF,
+	SIGINT,
+	SIGTERM,
+	SIGHUP,
+	SIGQUIT,
+	SIGPIPE,
+	SIGXCPU,
+	SIGUSR1,
+	SIGUSR2,
+	SIGALRM,
+	SIGVTALRM,
+	SIGPROF,
 #ifdef SIGPWR
 	SIGPWR,
 #endif
@@ -56,26 +65,38 @@ static const int soft_signals[] = {
 };
 static const int fatal_signals[] = { SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT, SIGTRAP, SIGSYS };
 
-#define RT_NAME_BYTES 24u               /* "SIGRTMIN+NN", room for any int */
+#define RT_NAME_BYTES 24u /* "SIGRTMIN+NN", room for any int */
 #define RT_SIGNALS_MAX 64u
 
-static struct fw *armed;                /* the devices the emergency path turns off */
+static struct fw *armed; /* the devices the emergency path turns off */
 static volatile sig_atomic_t *loop_flag;
-static volatile sig_atomic_t escalate;  /* set while the loop runs */
+static volatile sig_atomic_t escalate; /* set while the loop runs */
 static char alt_stack[ALT_STACK_BYTES];
-static char rt_names[RT_SIGNALS_MAX][RT_NAME_BYTES];    /* built before arming */
-static int rt_min = 1, rt_max = 0;      /* SIGRTMIN, SIGRTMAX read once, before arming */
+static char rt_names[RT_SIGNALS_MAX][RT_NAME_BYTES]; /* built before arming */
+static int rt_min = 1, rt_max = 0;                   /* SIGRTMIN, SIGRTMAX read once, before arming */
 
 static const struct {
 	int sig;
 	const char *name;
 } names[] = {
-	{ SIGINT, "SIGINT" }, { SIGTERM, "SIGTERM" }, { SIGHUP, "SIGHUP" },
-	{ SIGQUIT, "SIGQUIT" }, { SIGPIPE, "SIGPIPE" }, { SIGXCPU, "SIGXCPU" },
-	{ SIGSEGV, "SIGSEGV" }, { SIGBUS, "SIGBUS" }, { SIGFPE, "SIGFPE" },
-	{ SIGILL, "SIGILL" }, { SIGABRT, "SIGABRT" }, { SIGTRAP, "SIGTRAP" },
-	{ SIGSYS, "SIGSYS" }, { SIGUSR1, "SIGUSR1" }, { SIGUSR2, "SIGUSR2" },
-	{ SIGALRM, "SIGALRM" }, { SIGVTALRM, "SIGVTALRM" }, { SIGPROF, "SIGPROF" },
+	{ SIGINT, "SIGINT" },
+	{ SIGTERM, "SIGTERM" },
+	{ SIGHUP, "SIGHUP" },
+	{ SIGQUIT, "SIGQUIT" },
+	{ SIGPIPE, "SIGPIPE" },
+	{ SIGXCPU, "SIGXCPU" },
+	{ SIGSEGV, "SIGSEGV" },
+	{ SIGBUS, "SIGBUS" },
+	{ SIGFPE, "SIGFPE" },
+	{ SIGILL, "SIGILL" },
+	{ SIGABRT, "SIGABRT" },
+	{ SIGTRAP, "SIGTRAP" },
+	{ SIGSYS, "SIGSYS" },
+	{ SIGUSR1, "SIGUSR1" },
+	{ SIGUSR2, "SIGUSR2" },
+	{ SIGALRM, "SIGALRM" },
+	{ SIGVTALRM, "SIGVTALRM" },
+	{ SIGPROF, "SIGPROF" },
 #ifdef SIGPWR
 	{ SIGPWR, "SIGPWR" },
 #endif
@@ -170,7 +191,7 @@ static int install_one(int sig, void (*fn)(int), int flags, sigset_t *handled)
 	memset(&sa, 0, sizeof(sa));
 	sa.sa_handler = fn;
 	sa.sa_flags = flags;
-	sigfillset(&sa.sa_mask);        /* nothing interrupts the handler */
+	sigfillset(&sa.sa_mask); /* nothing interrupts the handler */
 	sigaddset(handled, sig);
 	return sigaction(sig, &sa, NULL) ? IRDM_EIO : IRDM_OK;
 }
@@ -210,7 +231,8 @@ int fw_signals_arm(struct fw *fw, volatile sig_atomic_t *flag)
 	sigemptyset(&handled);
 	escalate = 0;
 	if (install(soft_signals, sizeof(soft_signals) / sizeof(soft_signals[0]), on_soft, 0,
-		    &handled) || install_rt(&handled))
+		    &handled) ||
+	    install_rt(&handled))
 		return IRDM_EIO;
 	if (install(fatal_signals, sizeof(fatal_signals) / sizeof(fatal_signals[0]), on_fatal,
 		    SA_ONSTACK, &handled))

@@ -125,7 +125,8 @@ void fw_summary_print(const struct fw *fw)
 	       fw->board.period_us, (double)t->n * dt_s,
 	       fw->args.clock == IRDM_CLOCK_VIRTUAL ? "virtual" : "real");
 	printf("force: peak %.4f N at %.3f s on the object, %.4f N at %.3f s rendered (clamped, "
-	       "saturated), final %.4f N\n", t->peak_n, (double)t->peak_at * dt_s,
+	       "saturated), final %.4f N\n",
+	       t->peak_n, (double)t->peak_at * dt_s,
 	       fw->rendered_peak_n, (double)fw->rendered_peak_tick * dt_s, t->final_n);
 	if (t->released && t->release_at + 100 <= t->n)
 		printf("release ringing: %.2f Hz\n", dominant_hz(t->ring_u_m, t->ring_n, dt_s));
@@ -133,7 +134,8 @@ void fw_summary_print(const struct fw *fw)
 		printf("release ringing: none (no release followed by 0.1 s of motion)\n");
 	memory_kb(&locked, &peak);
 	printf("memory: locked %ld kB, peak resident %ld kB (the summary's trace: %llu kB, "
-	       "whatever the run's length)\n", locked, peak,
+	       "whatever the run's length)\n",
+	       locked, peak,
 	       (unsigned long long)((t->ring_max * sizeof(double) + 1023) / 1024));
 	if (fw->args.clock == IRDM_CLOCK_REAL)
 		print_hist("tick wake-up latency", &fw->latency);
@@ -146,7 +148,8 @@ void fw_summary_print(const struct fw *fw)
 	fw_frame_summary(fw);
 	if (fw->monitor.lost)
 		printf("monitor: %llu ticks lost to this summary and the frames (its thread fell "
-		       "4 s behind)\n", (unsigned long long)fw->monitor.lost);
+		       "4 s behind)\n",
+		       (unsigned long long)fw->monitor.lost);
 	if (fw->last_state == IRDM_SAFETY_FAULT)
 		printf("state: fault: %s (torque off)%s%s\n", irdm_safety_fault_name(fw->last_cause),
 		       fw_hal_why(fw)[0] ? ": " : "", fw_hal_why(fw));

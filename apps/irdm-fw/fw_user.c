@@ -24,7 +24,8 @@ static int meet_board(struct fw *fw)
 {
 	if (fw->user->hands > fw->board.devices) {
 		snprintf(fw->err, sizeof(fw->err), "--user %s: the script uses %u hands, the board "
-			 "has %u device%s", fw->args.user, fw->user->hands, fw->board.devices,
+						   "has %u device%s",
+			 fw->args.user, fw->user->hands, fw->board.devices,
 			 fw->board.devices == 1 ? "" : "s");
 		return IRDM_EINVAL;
 	}

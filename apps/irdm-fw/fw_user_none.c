@@ -13,7 +13,8 @@
 int fw_user_open(struct fw *fw)
 {
 	snprintf(fw->err, sizeof(fw->err), "--user %s: this irdm-fw has no simulated back-end "
-		 "(CONFIG_IRDM_HAL_SIM, CONFIG_IRDM_HAL_CANEMU)", fw->args.user);
+					   "(CONFIG_IRDM_HAL_SIM, CONFIG_IRDM_HAL_CANEMU)",
+		 fw->args.user);
 	return IRDM_ENOTSUP;
 }
 

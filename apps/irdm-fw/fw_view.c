@@ -33,10 +33,10 @@
 #include "fw.h"
 
 #define VIEW_RATE_HZ 50.0
-#define VIEW_RING_RECORDS 1024u         /* 1 s at 1 kHz: the publisher may stall that long */
-#define VIEW_SAMPLES_MAX 1024u          /* chart samples in one frame */
+#define VIEW_RING_RECORDS 1024u /* 1 s at 1 kHz: the publisher may stall that long */
+#define VIEW_SAMPLES_MAX 1024u  /* chart samples in one frame */
 #define VIEW_NICE 10
-#define FRESH 4u                        /* in mid: the middle buffer holds a new frame */
+#define FRESH 4u /* in mid: the middle buffer holds a new frame */
 
 struct fw_view {
 	struct fw *fw;
@@ -139,9 +139,7 @@ static void publish(void *ctx, struct view_server *srv)
 
 static int send_hello(struct fw_view *v)
 {
-	struct view_hello h = { .mode = VIEW_MODE_LIVE, .n_dev = v->fw->board.devices,
-				.period_s = (float)(v->fw->board.period_us * 1e-6),
-				.name = v->fw->board.name };
+	struct view_hello h = { .mode = VIEW_MODE_LIVE, .n_dev = v->fw->board.devices, .period_s = (float)(v->fw->board.period_us * 1e-6), .name = v->fw->board.name };
 	unsigned char *buf;
 	size_t len = view_hello_image(&buf, v->fw->s->img, &h);
 	int rc = len ? view_server_set_hello(v->srv, buf, len) : IRDM_ENOMEM;
@@ -213,7 +211,8 @@ int fw_view_open(struct fw *fw)
 		return rc;
 	if (strcmp(addr, VIEW_DEFAULT_ADDR))
 		fprintf(stderr, "irdm-fw: warning: the view listens on %s:%u: whoever reaches it "
-			"can watch the run (it cannot command the device)\n", addr,
+				"can watch the run (it cannot command the device)\n",
+			addr,
 			view_server_port(v->srv));
 	printf("view: http://%s:%u/\n", addr, view_server_port(v->srv));
 	fflush(stdout);

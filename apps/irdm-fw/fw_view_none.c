@@ -14,7 +14,7 @@ int fw_view_open(struct fw *fw)
 	if (!fw->args.view)
 		return IRDM_OK;
 	snprintf(fw->err, sizeof(fw->err), "--view: this build has no view (the trimmed "
-		 "configurations leave it out: build without CONFIG=)");
+					   "configurations leave it out: build without CONFIG=)");
 	return IRDM_ENOTSUP;
 }
 

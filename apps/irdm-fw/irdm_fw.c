@@ -24,8 +24,8 @@
 
 #include "fw.h"
 
-#define FORCE_STACK_BYTES (256u * 1024u)    /* pre-faulted for the loop */
-#define TASKS_MAX 64                        /* threads listed at start */
+#define FORCE_STACK_BYTES (256u * 1024u) /* pre-faulted for the loop */
+#define TASKS_MAX 64                     /* threads listed at start */
 
 static volatile sig_atomic_t signalled;
 
@@ -126,7 +126,7 @@ static int check_hal_options(struct fw *fw, const struct irdm_hal_backend *be)
 	if (fw->board.hal_options_line)
 		snprintf(where, sizeof(where), "%s:%u: hal_options", fw->args.board,
 			 fw->board.hal_options_line);
-	else    /* not in the file: a back-end that needs options names them */
+	else /* not in the file: a back-end that needs options names them */
 		snprintf(where, sizeof(where), "%s: hal_options", fw->args.board);
 	rc = be->check_options(fw->board.hal_options, where, fw->err, sizeof(fw->err));
 	if (rc)
@@ -153,7 +153,7 @@ static int open_devices(struct fw *fw)
 							fw->board.period_us * 1e-6 };
 		fw->hal_mem[i] = aligned_alloc(alignof(max_align_t),
 					       (be->data_size + alignof(max_align_t) - 1) /
-					       alignof(max_align_t) * alignof(max_align_t));
+						       alignof(max_align_t) * alignof(max_align_t));
 		if (!fw->hal_mem[i])
 			return fail(FW_EXIT_SETUP, IRDM_ENOMEM, "hal '%s': %s", fw->board.hal,
 				    "out of memory");
@@ -213,10 +213,12 @@ static void hold_idle(struct fw *fw)
 	us = irdm_rt_cpu_latency_us();
 	if (fw->idle_hold >= 0)
 		printf("idle states: none slower than %d us to leave, while the loop runs "
-		       "(/dev/cpu_dma_latency)\n", (int)us);
+		       "(/dev/cpu_dma_latency)\n",
+		       (int)us);
 	else
 		printf("idle states: not limited (/dev/cpu_dma_latency: %s); the loop's wake-ups "
-		       "pay for leaving them\n", irdm_strerror(fw->idle_hold));
+		       "pay for leaving them\n",
+		       irdm_strerror(fw->idle_hold));
 }
 
 /*
@@ -405,11 +407,13 @@ static void say_end(struct fw *fw, int rc)
 	case FW_EXIT_NEVER_ENABLED:
 		if (fw->enable_blocked)
 			fprintf(stderr, "irdm-fw: EPERM: the torque was never enabled in %llu ticks: "
-				"'%s' refused every request\n", (unsigned long long)fw->ticks,
+					"'%s' refused every request\n",
+				(unsigned long long)fw->ticks,
 				irdm_safety_fault_name(fw->enable_blocked));
 		else
 			fprintf(stderr, "irdm-fw: EPERM: the torque was never enabled in %llu ticks: "
-				"the device was never calibrated\n", (unsigned long long)fw->ticks);
+					"the device was never calibrated\n",
+				(unsigned long long)fw->ticks);
 		break;
 	default:
 		break;
@@ -449,13 +453,14 @@ int main(int argc, char **argv)
 		fw_signals_loop(false);
 		say_end(fw, rc);
 	} else if (rc == FW_EXIT_SIGNAL) {
-		say_end(fw, rc);        /* during the set-up, no drive enabled */
+		say_end(fw, rc); /* during the set-up, no drive enabled */
 	}
 	rc = stop(fw, rc);
 	/* a run stopped by a signal ended cleanly too: what it did is worth
 	 * the same summary */
 	if ((rc == FW_EXIT_OK || rc == FW_EXIT_FAULT || rc == FW_EXIT_NEVER_ENABLED ||
-	     rc == FW_EXIT_SIGNAL || rc == FW_EXIT_LOG) && !fw->args.quiet)
+	     rc == FW_EXIT_SIGNAL || rc == FW_EXIT_LOG) &&
+	    !fw->args.quiet)
 		fw_summary_print(fw);
 	fw_trace_free(&fw->trace);
 	free(fw);

@@ -35,9 +35,9 @@ static const char *elem_name(uint32_t e)
 static const char *kind_name(uint32_t k)
 {
 	static const char *const names[] = { "?", "META", "PROVENANCE", "NODES", "COLUMNS",
-		"SURFACE", "FIR", "MODES", "MODE_SHAPES", "STATIC_CORR", "RIGID", "STABILITY",
-		"CONTACT_BVH", "STATIC_CORR_INDEX", "STATIC_CORR_LOWRANK", "EXACT_HEAD",
-		"STATIC_CORR_CLUSTERS" };
+					     "SURFACE", "FIR", "MODES", "MODE_SHAPES", "STATIC_CORR", "RIGID", "STABILITY",
+					     "CONTACT_BVH", "STATIC_CORR_INDEX", "STATIC_CORR_LOWRANK", "EXACT_HEAD",
+					     "STATIC_CORR_CLUSTERS" };
 
 	return k < sizeof(names) / sizeof(names[0]) ? names[k] : "unknown";
 }
@@ -69,7 +69,8 @@ static void print_clusters(const struct irdm_image *img)
 				top = rank;
 		}
 	printf("clusters      %u over %u columns, pairs %llu dense, %llu low-rank (largest rank %u), "
-	       "%llu bytes\n", n, img->meta->n_cols, dense, low, top,
+	       "%llu bytes\n",
+	       n, img->meta->n_cols, dense, low, top,
 	       (unsigned long long)irdm_image_find(img, IRDM_SEC_STATIC_CORR_CLUSTERS)->size);
 }
 
@@ -91,7 +92,8 @@ static int cmd_info(const char *path)
 		       m->flags & IRDM_META_TIME_DOMAIN ? ", time-domain" : ", from modes");
 	if (m->flags & IRDM_META_FIR_TAIL_WINDOW)
 		printf("tail          samples 0..%u exact, %u past them windowed (fir_tail = window:%u), "
-		       "sum = static compliance\n", m->fir_exact - 1, m->fir_length - m->fir_exact,
+		       "sum = static compliance\n",
+		       m->fir_exact - 1, m->fir_length - m->fir_exact,
 		       m->fir_length - m->fir_exact);
 	if (m->representation != IRDM_REPR_FIR)
 		printf("responses     modal, %u of %u modes%s, %s\n", m->n_modes, m->n_modes_total,
@@ -157,7 +159,8 @@ static int cmd_info(const char *path)
 /* Tolerance for comparing stored values, by precision. */
 static double prec_tol(uint32_t p)
 {
-	return p == IRDM_ELEM_F64 ? 1e-9 : p == IRDM_ELEM_F32 ? 1e-5 : 5e-3;
+	return p == IRDM_ELEM_F64 ? 1e-9 : p == IRDM_ELEM_F32 ? 1e-5 :
+								5e-3;
 }
 
 static int check_r0(const struct irdm_image *img, uint32_t c, const double *r0)
@@ -177,8 +180,7 @@ static int check_r0(const struct irdm_image *img, uint32_t c, const double *r0)
 	/* positive definite: leading minors of the symmetric part */
 	double a = r0[0], b = 0.5 * (r0[1] + r0[3]), d = r0[4];
 	double m2 = a * d - b * b;
-	double det = r0[0] * (r0[4] * r0[8] - r0[5] * r0[7]) - r0[1] * (r0[3] * r0[8] - r0[5] * r0[6])
-		     + r0[2] * (r0[3] * r0[7] - r0[4] * r0[6]);
+	double det = r0[0] * (r0[4] * r0[8] - r0[5] * r0[7]) - r0[1] * (r0[3] * r0[8] - r0[5] * r0[6]) + r0[2] * (r0[3] * r0[7] - r0[4] * r0[6]);
 	if (!(a > 0 && m2 > 0 && det > 0)) {
 		fprintf(stderr, "irdm image verify: column %u: R[0] is not positive definite\n", c);
 		return -1;
@@ -329,24 +331,18 @@ struct export_args {
 	const char *path;
 	const char *out;
 	const char *rows;
-	uint64_t column;        /* UINT64_MAX: not given */
-	uint32_t samples;       /* 0: the FIR length, or one second */
+	uint64_t column;  /* UINT64_MAX: not given */
+	uint32_t samples; /* 0: the FIR length, or one second */
 };
 
 #define EA(member) IRDM_OPT_FIELD(struct export_args, member)
 #define EA_REF(member) IRDM_OPT_TEXT_REF(struct export_args, member)
 
 static const struct irdm_opt export_opts[] = {
-	{ .name = "column", .type = IRDM_OPT_UNSIGNED, EA(column), .metavar = "NODE",
-	  .range = IRDM_OPT_LE, .max = UINT32_MAX,
-	  .help = "the touchable mesh node whose responses are written (required)" },
-	{ .name = "rows", .type = IRDM_OPT_STRING, EA_REF(rows), .metavar = "NODE,...",
-	  .help = "the mesh nodes whose displacement is written (default: NODE)" },
-	{ .name = "samples", .type = IRDM_OPT_UNSIGNED, EA(samples), .metavar = "N",
-	  .range = IRDM_OPT_GE | IRDM_OPT_LE, .min = 1, .max = 10000000,
-	  .help = "samples written (default: the FIR length, or one second)" },
-	{ .name = "output", .short_name = 'o', .type = IRDM_OPT_STRING, EA_REF(out),
-	  .metavar = "FILE.csv", .help = "write here, atomically (default: standard output)" },
+	{ .name = "column", .type = IRDM_OPT_UNSIGNED, EA(column), .metavar = "NODE", .range = IRDM_OPT_LE, .max = UINT32_MAX, .help = "the touchable mesh node whose responses are written (required)" },
+	{ .name = "rows", .type = IRDM_OPT_STRING, EA_REF(rows), .metavar = "NODE,...", .help = "the mesh nodes whose displacement is written (default: NODE)" },
+	{ .name = "samples", .type = IRDM_OPT_UNSIGNED, EA(samples), .metavar = "N", .range = IRDM_OPT_GE | IRDM_OPT_LE, .min = 1, .max = 10000000, .help = "samples written (default: the FIR length, or one second)" },
+	{ .name = "output", .short_name = 'o', .type = IRDM_OPT_STRING, EA_REF(out), .metavar = "FILE.csv", .help = "write here, atomically (default: standard output)" },
 };
 
 static const struct irdm_opt_table export_options = {
@@ -425,8 +421,7 @@ static int cmd_export(int argc, char **argv)
 		rows[n_rows++] = (uint32_t)cr;
 	}
 	if (!n_samples)
-		n_samples = img.meta->representation == IRDM_REPR_FIR ? img.meta->fir_length
-			    : (uint32_t)ceil(1.0 / img.meta->dt_s);
+		n_samples = img.meta->representation == IRDM_REPR_FIR ? img.meta->fir_length : (uint32_t)ceil(1.0 / img.meta->dt_s);
 	FILE *f = stdout;
 	char tmp[4096];
 	if (out) {

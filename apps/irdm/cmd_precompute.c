@@ -80,7 +80,7 @@ static const char markdown_end[] =
 
 /* What the command line asks for, apart from the scene. */
 struct precompute_args {
-	const char *scene;      /* loaded before the other options */
+	const char *scene; /* loaded before the other options */
 	const char *out;
 	const char *merge;
 	size_t part_begin, part_end;
@@ -132,21 +132,14 @@ out_bad:
 #define PA_REF(member) IRDM_OPT_TEXT_REF(struct precompute_args, member)
 
 static const struct irdm_opt precompute_opts[] = {
-	{ .name = "scene", .type = IRDM_OPT_STRING, PA_REF(scene), .metavar = "FILE",
-	  .help = "read scene keys from FILE first; options override them wherever they are" },
-	{ .name = "output", .short_name = 'o', .type = IRDM_OPT_STRING,
-	  PA_REF(out), .metavar = "IMAGE", .help = "the image (or part) to write" },
-	{ .name = "part", .type = IRDM_OPT_CUSTOM, .parse = parse_part, .metavar = "BEGIN:END",
-	  .help = "time-domain inputs BEGIN to END-1 only, written as a part file" },
-	{ .name = "merge", .type = IRDM_OPT_STRING, PA_REF(merge),
-	  .metavar = "PART[,PART]...", .help = "assemble time-domain parts into the image" },
-	{ .name = "count-inputs", .type = IRDM_OPT_FLAG, PA(count_only),
-	  .help = "print the number of time-domain inputs (for --part) and stop" },
-	{ .name = "quiet", .short_name = 'q', .type = IRDM_OPT_FLAG, PA(quiet),
-	  .help = "no progress and no report" },
+	{ .name = "scene", .type = IRDM_OPT_STRING, PA_REF(scene), .metavar = "FILE", .help = "read scene keys from FILE first; options override them wherever they are" },
+	{ .name = "output", .short_name = 'o', .type = IRDM_OPT_STRING, PA_REF(out), .metavar = "IMAGE", .help = "the image (or part) to write" },
+	{ .name = "part", .type = IRDM_OPT_CUSTOM, .parse = parse_part, .metavar = "BEGIN:END", .help = "time-domain inputs BEGIN to END-1 only, written as a part file" },
+	{ .name = "merge", .type = IRDM_OPT_STRING, PA_REF(merge), .metavar = "PART[,PART]...", .help = "assemble time-domain parts into the image" },
+	{ .name = "count-inputs", .type = IRDM_OPT_FLAG, PA(count_only), .help = "print the number of time-domain inputs (for --part) and stop" },
+	{ .name = "quiet", .short_name = 'q', .type = IRDM_OPT_FLAG, PA(quiet), .help = "no progress and no report" },
 	{ .name = "help", .short_name = 'h', .type = IRDM_OPT_FLAG, PA(help), .help = "this text" },
-	{ .name = "help-markdown", .type = IRDM_OPT_FLAG, PA(help_markdown),
-	  .help = "the scene keys as Markdown (docs/scene-format.md)" },
+	{ .name = "help-markdown", .type = IRDM_OPT_FLAG, PA(help_markdown), .help = "the scene keys as Markdown (docs/scene-format.md)" },
 };
 
 static const struct irdm_opt_table irdm_precompute_options = {
@@ -175,7 +168,7 @@ static void print_report(const struct irdm_scene *sc, const struct irdm_precompu
 	if (sc->repr_auto)
 		printf("representation auto: %s%s (%zu candidate%s built)\n", r->representation,
 		       sc->max_error > 0 ? ", the cheapest to tick that meets max_error" :
-		       " (max_error = none: not chosen by accuracy)",
+					   " (max_error = none: not chosen by accuracy)",
 		       r->auto_tries, r->auto_tries == 1 ? "" : "s");
 	printf("image nodes   %zu rows, %zu touchable columns, %zu triangles\n", r->rows, r->cols,
 	       r->tris);
@@ -350,7 +343,7 @@ static int say_rank_memory(const struct irdm_cli_progress *prog)
 		goto out_free;
 	}
 	getrusage(RUSAGE_SELF, &ru);
-	mine = (double)ru.ru_maxrss / 1024.0;   /* KiB on Linux */
+	mine = (double)ru.ru_maxrss / 1024.0; /* KiB on Linux */
 	for (int r = 0; r < n; r++)
 		counts[r] = 1;
 	rc = irdm_dist_gather(&mine, counts, all, err, sizeof(err));
@@ -437,6 +430,5 @@ int irdm_cmd_precompute(int argc, char **argv)
 		return rc;
 	o.progress = irdm_cli_progress;
 	o.ctx = &prog;
-	return sc.eigensolver == IRDM_EIG_SLEPC ? run_distributed(&sc, &o, &prog)
-					       : run(&sc, &o, &prog);
+	return sc.eigensolver == IRDM_EIG_SLEPC ? run_distributed(&sc, &o, &prog) : run(&sc, &o, &prog);
 }

@@ -108,8 +108,8 @@ static void surface_note(const struct irdm_render_opts *o, const struct irdm_ren
 	if (!s->open_edges)
 		return;
 	fprintf(stderr, "irdm render: note: %s displays part of the object only (display = %s): "
-		"its %u triangles leave %u edges open; the frames show that part (precompute with "
-		"--display surface for the whole surface)\n",
+			"its %u triangles leave %u edges open; the frames show that part (precompute with "
+			"--display surface for the whole surface)\n",
 		o->in.image, s->display[0] ? s->display : "?", s->tris, s->open_edges);
 }
 
@@ -134,11 +134,13 @@ int irdm_cmd_render(int argc, char **argv)
 		fprintf(stderr, "irdm render: note: %s: removed %u director%s left by interrupted runs\n",
 			o.out_dir, sum.debris_removed, sum.debris_removed == 1 ? "y" : "ies");
 	printf("render: %zu frames every %zu samples of %zu -> %s/frames.pvd (%u nodes, %u triangles); "
-	       "largest displacement %.4g mm at t = %.3f s\n", sum.frames, sum.every_rows,
+	       "largest displacement %.4g mm at t = %.3f s\n",
+	       sum.frames, sum.every_rows,
 	       sum.replay.rows, o.out_dir, sum.surface.nodes, sum.surface.tris,
 	       sum.max_disp_m * 1e3, sum.max_disp_t_s);
 	if (o.in.log)
 		printf("render: %s replayed: the engine's forces within %.3g N of the logged ones "
-		       "(peak %.4g N)\n", o.in.log, sum.replay.log_max_diff_n, sum.replay.log_peak_n);
+		       "(peak %.4g N)\n",
+		       o.in.log, sum.replay.log_max_diff_n, sum.replay.log_peak_n);
 	return 0;
 }

@@ -105,11 +105,12 @@ static int parse_coupling(struct irdm_replay_opts *o, const char *v, const char 
 /* Options with a value; *v is it. */
 static int replay_value(struct irdm_replay_opts *o, const char *a, const char *v, const char *cmd)
 {
-	const char **dst = !strcmp(a, "--image") ? &o->image :
-			   !strcmp(a, "--sites") ? &o->sites :
+	const char **dst = !strcmp(a, "--image")        ? &o->image :
+			   !strcmp(a, "--sites")        ? &o->sites :
 			   !strcmp(a, "--displacement") ? &o->trajectory :
-			   !strcmp(a, "--log") ? &o->log :
-			   !strcmp(a, "--board") ? &o->board : NULL;
+			   !strcmp(a, "--log")          ? &o->log :
+			   !strcmp(a, "--board")        ? &o->board :
+							  NULL;
 
 	if (dst) {
 		*dst = v;

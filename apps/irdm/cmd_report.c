@@ -52,7 +52,7 @@ struct report_args {
 	const char *dir, *md, *plots, *repr, *tmp;
 	int keep, quiet;
 	bool force;
-	struct irdm_outdir od;          /* the CSVs go to od.tmp, put in dir's place at the end */
+	struct irdm_outdir od; /* the CSVs go to od.tmp, put in dir's place at the end */
 };
 
 static int parse(struct report_args *a, int argc, char **argv)
@@ -187,9 +187,7 @@ static int run_config(const struct report_args *a, const struct irdm_report_conf
 		      struct irdm_cli_progress *prog, struct irdm_report_result *res)
 {
 	char path[IRDM_OUTDIR_PATH_MAX + 128], err[1024];
-	struct irdm_report_opts o = { .cfg = cfg, .tmp_dir = a->tmp, .only_repr = a->repr,
-				      .keep_images = a->keep, .progress = irdm_cli_progress,
-				      .ctx = prog, .row_done = csv_row };
+	struct irdm_report_opts o = { .cfg = cfg, .tmp_dir = a->tmp, .only_repr = a->repr, .keep_images = a->keep, .progress = irdm_cli_progress, .ctx = prog, .row_done = csv_row };
 	FILE *csv;
 	int rc;
 

@@ -106,14 +106,15 @@ static int parse(struct args *a, int argc, char **argv)
 	if (a->pb.log && is_dir(a->pb.log)) {
 		if (a->pb.board || a->pb.image) {
 			fprintf(stderr, "irdm view: %s is a render directory: it needs no --board "
-				"or --image\n", a->pb.log);
+					"or --image\n",
+				a->pb.log);
 			return 2;
 		}
 		return 0;
 	}
 	if (!a->pb.log || !a->pb.board || !a->pb.image) {
 		fprintf(stderr, "irdm view: needs RUN.log, --board BOARD and --image IMAGE, or a "
-			"render directory (see --help)\n");
+				"render directory (see --help)\n");
 		return 2;
 	}
 	return 0;
@@ -125,7 +126,8 @@ static int serve(struct view_server *s, const char *addr)
 
 	if (strcmp(addr, VIEW_DEFAULT_ADDR))
 		fprintf(stderr, "irdm view: warning: listening on %s:%u: whoever reaches it can "
-			"watch the run\n", addr, view_server_port(s));
+				"watch the run\n",
+			addr, view_server_port(s));
 	printf("view: http://%s:%u/ (Ctrl-C to stop)\n", addr, view_server_port(s));
 	fflush(stdout);
 	memset(&sa, 0, sizeof(sa));
@@ -170,7 +172,8 @@ int irdm_cmd_view(int argc, char **argv)
 		printf("view: %s: %zu frames to %.3f s\n", a.pb.log, sum.frames, sum.duration_s);
 	else
 		printf("view: %s: %zu ticks (%.3f s), %zu frames; replayed forces within %.3g N of "
-		       "the log's (peak %.3g N)\n", a.pb.log, sum.records, sum.duration_s, sum.frames,
+		       "the log's (peak %.3g N)\n",
+		       a.pb.log, sum.records, sum.duration_s, sum.frames,
 		       sum.log_max_diff_n, sum.log_peak_n);
 	rc = serve(s, addr);
 	view_server_close(s);

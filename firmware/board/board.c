@@ -32,7 +32,7 @@ void irdm_board_read_begin(struct irdm_opt_file *f, struct irdm_board *b, const 
 }
 
 int irdm_board_read_line(struct irdm_opt_file *f, const char *s, size_t len, char *err,
-			  size_t errlen)
+			 size_t errlen)
 {
 	char line[IRDM_BOARD_LINE_MAX];
 

@@ -163,7 +163,8 @@ static int check_coupling(const struct check *c)
 	if (!(need < d->b_device_ns_per_m))
 		return fail(c, IRDM_EINVAL, "coupling",
 			    " = %.15g,%.15g: not passive: K period/2 + B = %.15g N s/m, must be < "
-			    "device_damping_ns_per_m = %.15g", b->coupling_k_n_per_m,
+			    "device_damping_ns_per_m = %.15g",
+			    b->coupling_k_n_per_m,
 			    b->coupling_b_ns_per_m, need, d->b_device_ns_per_m);
 	return IRDM_OK;
 }
@@ -198,8 +199,13 @@ int irdm_board_finish(struct irdm_board *b, const struct irdm_opt_file *f, char 
 {
 	/* in this order: the later checks rely on what the earlier ones proved */
 	static int (*const checks[])(const struct check *c) = {
-		check_required, check_workspace, check_devices, check_arm, check_loop,
-		check_coupling, check_calibration,
+		check_required,
+		check_workspace,
+		check_devices,
+		check_arm,
+		check_loop,
+		check_coupling,
+		check_calibration,
 	};
 	const struct check c = { .b = b, .f = f, .err = err, .errlen = errlen };
 	int ret = IRDM_OK;

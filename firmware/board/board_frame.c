@@ -35,16 +35,22 @@ void irdm_board_set_rotation(struct irdm_board *b)
 	double *r = b->object_rotation;
 
 	/* Rz(z) Ry(y) Rx(x), multiplied out */
-	r[0] = cz * cy;  r[1] = cz * sy * sx - sz * cx;  r[2] = cz * sy * cx + sz * sx;
-	r[3] = sz * cy;  r[4] = sz * sy * sx + cz * cx;  r[5] = sz * sy * cx - cz * sx;
-	r[6] = -sy;      r[7] = cy * sx;                 r[8] = cy * cx;
+	r[0] = cz * cy;
+	r[1] = cz * sy * sx - sz * cx;
+	r[2] = cz * sy * cx + sz * sx;
+	r[3] = sz * cy;
+	r[4] = sz * sy * sx + cz * cx;
+	r[5] = sz * sy * cx - cz * sx;
+	r[6] = -sy;
+	r[7] = cy * sx;
+	r[8] = cy * cx;
 }
 
 void irdm_board_vector_to_device(const struct irdm_board *b, const double v_obj[3],
 				 double v_dev[3])
 {
 	const double *r = b->object_rotation;
-	double v[3] = { v_obj[0], v_obj[1], v_obj[2] };     /* v_dev may alias v_obj */
+	double v[3] = { v_obj[0], v_obj[1], v_obj[2] }; /* v_dev may alias v_obj */
 
 	for (int i = 0; i < 3; i++)
 		v_dev[i] = r[3 * i] * v[0] + r[3 * i + 1] * v[1] + r[3 * i + 2] * v[2];

@@ -104,7 +104,9 @@ static void store_bits(void *field, size_t size, unsigned long long v)
 	uint64_t u64 = v;
 
 	memcpy(field, size == 1 ? (void *)&u8 : size == 2 ? (void *)&u16 :
-		      size == 4 ? (void *)&u32 : (void *)&u64, size);
+					size == 4         ? (void *)&u32 :
+							    (void *)&u64,
+	       size);
 }
 
 /* Digits only: no sign, no space, no "0x". */
@@ -468,8 +470,10 @@ int irdm_opt_parse_args(const struct irdm_opt_set *sets, size_t n_sets, int argc
 
 void irdm_opt_range_text(const struct irdm_opt *o, const char *name, char *buf, size_t len)
 {
-	const char *lo = (o->range & IRDM_OPT_GE) ? " <=" : (o->range & IRDM_OPT_GT) ? " <" : NULL;
-	const char *hi = (o->range & IRDM_OPT_LE) ? " <=" : (o->range & IRDM_OPT_LT) ? " <" : NULL;
+	const char *lo = (o->range & IRDM_OPT_GE) ? " <=" : (o->range & IRDM_OPT_GT) ? " <" :
+										       NULL;
+	const char *hi = (o->range & IRDM_OPT_LE) ? " <=" : (o->range & IRDM_OPT_LT) ? " <" :
+										       NULL;
 	const char *unit = o->unit ? o->unit : "";
 	const char *sep = o->unit ? " " : "";
 	size_t at = 0;
@@ -494,9 +498,10 @@ void irdm_opt_range_text(const struct irdm_opt *o, const char *name, char *buf, 
 static int check_entry(const struct irdm_opt *o, char *err, size_t errlen)
 {
 	static const size_t any = 0;
-	size_t want = o->type == IRDM_OPT_DOUBLE ? sizeof(double) :
+	size_t want = o->type == IRDM_OPT_DOUBLE                           ? sizeof(double) :
 		      o->type == IRDM_OPT_BOOL || o->type == IRDM_OPT_FLAG ? sizeof(bool) :
-		      o->type == IRDM_OPT_ENUM ? sizeof(int) : any;
+		      o->type == IRDM_OPT_ENUM                             ? sizeof(int) :
+									     any;
 	unsigned long long max;
 
 	if (!o->name || !o->name[0] || !o->help)

@@ -105,7 +105,7 @@ int irdm_ctrl_init(struct irdm_ctrl *c, const struct irdm_ctrl_config *cfg,
 	c->s = s;
 	if (!s->cm.hdr)
 		return IRDM_EINVAL;
-	c->cm = s->cm;          /* with the session's face-beyond table */
+	c->cm = s->cm; /* with the session's face-beyond table */
 	for (unsigned i = 0; i < cfg->n_devices; i++)
 		for (unsigned j = 0; j < 3; j++)
 			if (irdm_velocity_init(&c->dev[i].vel[j], period_s,
@@ -194,7 +194,7 @@ static void calibrate(struct irdm_ctrl *c, const struct irdm_ctrl_input *in,
 		return;
 	for (unsigned i = 0; i < c->cfg.n_devices; i++)
 		if (ctrl_calibrate(c, i, in->counts[i]))
-			return;         /* a NaN sample: already raised */
+			return; /* a NaN sample: already raised */
 	/* this tick's pose, read again with the new offsets */
 	f = devices_in(c, in, out);
 	c->active = (c->active & ~POSE_FAULTS) | f;

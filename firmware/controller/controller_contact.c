@@ -97,7 +97,7 @@ static int touch(struct irdm_ctrl *c, unsigned i, const struct irdm_proxy_config
 		return IRDM_EFAULT;
 	o->proxy_event = ev;
 	if (ev != IRDM_PROXY_TOUCH && ev != IRDM_PROXY_SLIDE)
-		return IRDM_OK;         /* FREE, or RELEASE: the command stays OFF */
+		return IRDM_OK; /* FREE, or RELEASE: the command stays OFF */
 	proxy_out(c, &d->px, o);
 	fresh = irdm_engine_contact(c->s->eng, i)->mode == IRDM_CONTACT_OFF;
 	if (irdm_proxy_site(&d->px, &c->cm, &site) ||
@@ -142,7 +142,7 @@ int ctrl_contacts(struct irdm_ctrl *c, struct irdm_ctrl_output *out, bool on)
 	struct irdm_proxy_config pc;
 
 	memset(cmd, 0, sizeof(cmd));
-	c->disp.stamp++;        /* the engine ticked since: every memo is stale */
+	c->disp.stamp++; /* the engine ticked since: every memo is stale */
 	proxy_cfg(c, &pc);
 	for (unsigned i = 0; i < c->cfg.n_devices; i++) {
 		struct irdm_ctrl_device_output *o = &out->dev[i];

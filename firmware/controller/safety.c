@@ -81,8 +81,18 @@ bool irdm_safety_torque_allowed(const struct irdm_safety *s)
 }
 
 static const char *const fault_names[IRDM_FAULT_BITS] = {
-	"clamp", "workspace", "velocity", "watchdog", "overrun", "encoder-nan",
-	"encoder-range", "signal", "hal-read", "hal-write", "hal-fault", "engine",
+	"clamp",
+	"workspace",
+	"velocity",
+	"watchdog",
+	"overrun",
+	"encoder-nan",
+	"encoder-range",
+	"signal",
+	"hal-read",
+	"hal-write",
+	"hal-fault",
+	"engine",
 };
 
 const char *irdm_safety_fault_name(uint32_t faults)

@@ -48,7 +48,7 @@ size_t irdm_deform_mem_size(const struct irdm_image *img)
 	if (!image_usable(img))
 		return 0;
 	deform_layout(img, &l);
-	return l.total + DEFORM_ALIGN;          /* room to align the caller's memory */
+	return l.total + DEFORM_ALIGN; /* room to align the caller's memory */
 }
 
 int irdm_deform_init(struct irdm_deform **dp, const struct irdm_image *img, void *mem,

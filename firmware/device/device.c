@@ -89,12 +89,18 @@ void irdm_device_fk(const struct irdm_device_config *cfg, const double q[3], dou
 void irdm_device_jacobian(const struct irdm_device_config *cfg, const double q[3], double j[9])
 {
 	double s1 = sin(q[0]), c1 = cos(q[0]);
-	double dr2 = -cfg->l1_m * sin(q[1]), dr3 = cfg->l2_m * cos(q[2]);     /* dr/dq2, dr/dq3 */
+	double dr2 = -cfg->l1_m * sin(q[1]), dr3 = cfg->l2_m * cos(q[2]); /* dr/dq2, dr/dq3 */
 	double r = cfg->l1_m * cos(q[1]) + cfg->l2_m * sin(q[2]);
 
-	j[0] = r * c1;  j[1] = dr2 * s1;                j[2] = dr3 * s1;
-	j[3] = 0;       j[4] = cfg->l1_m * cos(q[1]);   j[5] = cfg->l2_m * sin(q[2]);
-	j[6] = -r * s1; j[7] = dr2 * c1;                j[8] = dr3 * c1;
+	j[0] = r * c1;
+	j[1] = dr2 * s1;
+	j[2] = dr3 * s1;
+	j[3] = 0;
+	j[4] = cfg->l1_m * cos(q[1]);
+	j[5] = cfg->l2_m * sin(q[2]);
+	j[6] = -r * s1;
+	j[7] = dr2 * c1;
+	j[8] = dr3 * c1;
 }
 
 void irdm_device_force_to_torque(const struct irdm_device_config *cfg, const double q[3],

@@ -86,7 +86,8 @@ static double adaptive_slope(struct irdm_velocity *v)
 		v->last_window = v->count;
 		return 0;
 	}
-	n = n < 2 ? 2 : n > v->count ? v->count : n;
+	n = n < 2 ? 2 : n > v->count ? v->count :
+				       n;
 	if (fit(v, n, &slope) || n == 2) {
 		while (n < v->count && fit(v, n + 1, &longer)) {
 			n++;

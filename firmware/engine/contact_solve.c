@@ -15,7 +15,7 @@
 static double coupling_kappa(const struct irdm_engine *e)
 {
 	if (e->cfg.coupling_k_n_per_m == 0)
-		return INFINITY;            /* rigid: the target is the displacement */
+		return INFINITY; /* rigid: the target is the displacement */
 	return e->cfg.coupling_k_n_per_m + e->cfg.coupling_b_ns_per_m / e->dt_s;
 }
 
@@ -34,8 +34,7 @@ static void solve_coupled(struct irdm_engine *e, struct system *s,
 		for (int r = 0; r < 3; r++) {
 			if (!isinf(kappa))
 				a[(3 * i + r) * n + 3 * i + r] += 1.0 / kappa;
-			s->f[3 * i + r] = p[r] - s->u_free[i][r]
-					  - bterm * (c->target_prev_m[r] - c->disp_prev_m[r]);
+			s->f[3 * i + r] = p[r] - s->u_free[i][r] - bterm * (c->target_prev_m[r] - c->disp_prev_m[r]);
 		}
 	}
 	int rc = irdm_solve_spd(a, s->f, n);
@@ -89,7 +88,7 @@ void tick_solve(struct irdm_engine *e, struct system *s, const struct irdm_conta
 
 /* Push contacts whose force would pull the tool are released; re-solve. */
 void tick_release_pulling(struct irdm_engine *e, struct system *s,
-			    const struct irdm_contact_cmd *cmd)
+			  const struct irdm_contact_cmd *cmd)
 {
 	for (int pass = 0; pass < IRDM_MAX_CONTACTS && s->m > 0; pass++) {
 		int keep = 0, dropped = 0;

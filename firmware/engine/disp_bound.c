@@ -102,9 +102,10 @@ static double fir_bound(const struct irdm_engine *e)
 
 double irdm_engine_disp_bound(const struct irdm_engine *e)
 {
-	double b = e->K ? modal_bound(e) : e->T ? fir_bound(e) : 0;
+	double b = e->K ? modal_bound(e) : e->T ? fir_bound(e) :
+						  0;
 
-	if (e->H)       /* a hybrid image's head over the last H - 1 ticks' forces */
+	if (e->H) /* a hybrid image's head over the last H - 1 ticks' forces */
 		b += irdm_head_bound(e, e->head_bound_w);
 
 	return b * BOUND_ROUND;

@@ -41,7 +41,7 @@ const struct irdm_contact_cmd *tick_engage(struct irdm_engine *e, const struct s
 			irdm_v3_sub(c->engage_offset_m, p, s->u_free[i]);
 		irdm_v3_axpy(p, -fade_weight(c->engage_done, c->engage_ticks), c->engage_offset_m);
 		if (++c->engage_done > c->engage_ticks)
-			c->engage_ticks = 0;    /* done: the full coupling from now on */
+			c->engage_ticks = 0; /* done: the full coupling from now on */
 	}
 	return copied ? eff : cmd;
 }

@@ -44,7 +44,7 @@ static int plan(const struct irdm_image *img, const struct irdm_engine_config *c
 	l->tail = l->ring + up((T + H) * sizeof(struct irdm_force_tick));
 	l->bound = l->tail + up(T * sizeof(double));
 	l->head_bound = l->bound + up((K + T) * sizeof(double));
-	l->total = l->head_bound + up(2 * H * sizeof(double));  /* bound weights, slot norms */
+	l->total = l->head_bound + up(2 * H * sizeof(double)); /* bound weights, slot norms */
 	return 0;
 }
 
@@ -68,7 +68,7 @@ void irdm_engine_coupling_for_device(double k_max, double b_device, double dt,
 				     double *k, double *b)
 {
 	/* b_device > K dt / 2 + |B|: spend half the margin on K, half on B */
-	double k_pass = b_device / dt;      /* K dt / 2 = b_device / 2 */
+	double k_pass = b_device / dt; /* K dt / 2 = b_device / 2 */
 
 	*k = fmin(k_max, k_pass);
 	*b = fmax(0.0, 0.5 * (b_device - *k * dt / 2));
@@ -139,7 +139,7 @@ static int start_rigid(struct irdm_engine *e)
 static int start_rigid(struct irdm_engine *e)
 {
 	(void)e;
-	return IRDM_ENOTSUP;        /* refused before, by unsupported() */
+	return IRDM_ENOTSUP; /* refused before, by unsupported() */
 }
 #endif
 
@@ -160,7 +160,8 @@ static int unsupported(const struct irdm_image *img, char *err, size_t errlen)
 	if (!need)
 		return 0;
 	snprintf(err, errlen, "engine: the image holds %s; this build has %s off "
-		 "(docs/build-config.md)", need, config);
+			      "(docs/build-config.md)",
+		 need, config);
 	return IRDM_ENOTSUP;
 }
 
@@ -185,7 +186,7 @@ int irdm_engine_init(struct irdm_engine **out, const struct irdm_image *img,
 			 l.total, mem_size);
 		return IRDM_ENOMEM;
 	}
-	memset(mem, 0, l.total);            /* also pre-faults every page */
+	memset(mem, 0, l.total); /* also pre-faults every page */
 	e->img = img;
 	e->cfg = *cfg;
 	e->dt_s = img->meta->dt_s;
@@ -208,7 +209,7 @@ int irdm_engine_init(struct irdm_engine **out, const struct irdm_image *img,
 	if (e->K)
 		convert_shapes(e, (double *)(base + l.phi));
 	e->phi = (const double *)(base + l.phi);
-	e->ring.T = e->T + e->H;           /* one of the two is 0 */
+	e->ring.T = e->T + e->H; /* one of the two is 0 */
 	e->ring.tick = (struct irdm_force_tick *)(base + l.ring);
 	if (e->T)
 		fir_tail(e, (double *)(base + l.tail));
@@ -326,7 +327,7 @@ int irdm_engine_site_point(const struct irdm_engine *e, uint32_t tri, const doub
 	irdm_v3_cross(n, u, w);
 	double len = irdm_v3_norm(n);
 	if (!(len > 0))
-		return IRDM_ECONTACT;   /* degenerate triangle */
+		return IRDM_ECONTACT; /* degenerate triangle */
 	for (int a = 0; a < 3; a++)
 		s->normal[a] = n[a] / len;
 	return IRDM_OK;
@@ -384,7 +385,8 @@ const char *irdm_engine_fir_sum_name(const struct irdm_engine *e)
 {
 	bool wide = e->T ? e->fir_wide : e->head_wide;
 
-	return !e->T && !e->H ? "none" : wide ? "avx2" : "portable";
+	return !e->T && !e->H ? "none" : wide ? "avx2" :
+						"portable";
 }
 
 const struct irdm_engine_stats *irdm_engine_stats(const struct irdm_engine *e)

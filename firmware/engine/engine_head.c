@@ -27,7 +27,7 @@ bool irdm_head_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_
 	long k = irdm_image_corr_block(e->img, col_force, col_disp);
 
 	if (k < 0)
-		return false;   /* dropped: the far field alone, instantly */
+		return false; /* dropped: the far field alone, instantly */
 	head_block(e, k, 0, blk);
 	return true;
 }
@@ -38,34 +38,34 @@ bool irdm_head_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_
  * loads and multiply-adds only (nine independent sums): a long head is
  * hundreds of samples at every contact node every tick.
  */
-#define HEAD_SUM(NAME, TYPE, LOAD)                                                       \
-static void NAME(const struct irdm_engine *e, uint32_t col, double acc[9])               \
-{                                                                                        \
-	const TYPE *D = e->img->exact_head;                                              \
-	const struct irdm_fir_ring *r = &e->ring;                                        \
-	struct irdm_head_cache cache = { .n = 0 };                                       \
-	double a0 = 0, a1 = 0, a2 = 0, a3 = 0, a4 = 0, a5 = 0, a6 = 0, a7 = 0, a8 = 0;   \
-	uint32_t slot = r->head;        /* age 1; older ticks one slot down each */      \
-                                                                                         \
-	for (uint32_t s = 1; s < e->H; s++) {                                            \
-		const struct irdm_force_tick *t = &r->tick[slot];                        \
-		slot = slot ? slot - 1 : e->H - 1;                                       \
-		for (uint32_t n = 0; n < t->n; n++) {                                    \
-			long k = irdm_head_cached_block(e, &cache, t->col[n], col);      \
-			if (k < 0)                                                       \
-				continue;       /* a dropped block: no head either */    \
-			const TYPE *d = &D[((size_t)k * e->H + s) * 9];                  \
-			double f0 = t->f_n[n][0], f1 = t->f_n[n][1], f2 = t->f_n[n][2];  \
-			a0 += LOAD(d[0]) * f0, a1 += LOAD(d[1]) * f1;                    \
-			a2 += LOAD(d[2]) * f2, a3 += LOAD(d[3]) * f0;                    \
-			a4 += LOAD(d[4]) * f1, a5 += LOAD(d[5]) * f2;                    \
-			a6 += LOAD(d[6]) * f0, a7 += LOAD(d[7]) * f1;                    \
-			a8 += LOAD(d[8]) * f2;                                           \
-		}                                                                        \
-	}                                                                                \
-	acc[0] = a0, acc[1] = a1, acc[2] = a2, acc[3] = a3, acc[4] = a4;                 \
-	acc[5] = a5, acc[6] = a6, acc[7] = a7, acc[8] = a8;                              \
-}
+#define HEAD_SUM(NAME, TYPE, LOAD) \
+	static void NAME(const struct irdm_engine *e, uint32_t col, double acc[9]) \
+	{ \
+		const TYPE *D = e->img->exact_head; \
+		const struct irdm_fir_ring *r = &e->ring; \
+		struct irdm_head_cache cache = { .n = 0 }; \
+		double a0 = 0, a1 = 0, a2 = 0, a3 = 0, a4 = 0, a5 = 0, a6 = 0, a7 = 0, a8 = 0; \
+		uint32_t slot = r->head; /* age 1; older ticks one slot down each */ \
+\
+		for (uint32_t s = 1; s < e->H; s++) { \
+			const struct irdm_force_tick *t = &r->tick[slot]; \
+			slot = slot ? slot - 1 : e->H - 1; \
+			for (uint32_t n = 0; n < t->n; n++) { \
+				long k = irdm_head_cached_block(e, &cache, t->col[n], col); \
+				if (k < 0) \
+					continue; /* a dropped block: no head either */ \
+				const TYPE *d = &D[((size_t)k * e->H + s) * 9]; \
+				double f0 = t->f_n[n][0], f1 = t->f_n[n][1], f2 = t->f_n[n][2]; \
+				a0 += LOAD(d[0]) * f0, a1 += LOAD(d[1]) * f1; \
+				a2 += LOAD(d[2]) * f2, a3 += LOAD(d[3]) * f0; \
+				a4 += LOAD(d[4]) * f1, a5 += LOAD(d[5]) * f2; \
+				a6 += LOAD(d[6]) * f0, a7 += LOAD(d[7]) * f1; \
+				a8 += LOAD(d[8]) * f2; \
+			} \
+		} \
+		acc[0] = a0, acc[1] = a1, acc[2] = a2, acc[3] = a3, acc[4] = a4; \
+		acc[5] = a5, acc[6] = a6, acc[7] = a7, acc[8] = a8; \
+	}
 
 #define LOAD_F(x) ((double)(x))
 #define LOAD_H(x) ((double)irdm_f16_to_f32(x))
@@ -132,7 +132,7 @@ void irdm_head_bound_init(const struct irdm_engine *e, double *w)
 
 double irdm_head_bound(const struct irdm_engine *e, const double *w)
 {
-	uint32_t slot = e->ring.head;   /* age 1; older ticks one slot down each */
+	uint32_t slot = e->ring.head; /* age 1; older ticks one slot down each */
 	double b = 0;
 
 	for (uint32_t s = 1; s < e->H; s++) {

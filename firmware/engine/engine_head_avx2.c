@@ -25,7 +25,7 @@ static WIDE_INLINE void tick_acc(const struct irdm_engine *e, uint32_t prec, con
 		__m256d p0, p1;
 		double p2;
 		if (k < 0)
-			continue;       /* a dropped block: no head either */
+			continue; /* a dropped block: no head either */
 		force_pattern(t->f_n[n], 1.0, &p0, &p1, &p2);
 		block_acc(D, prec, ((size_t)k * e->H + s) * 9, p0, p1, p2, acc);
 	}
@@ -40,7 +40,7 @@ static WIDE_INLINE void head_wide(const struct irdm_engine *e, uint32_t prec, ui
 	/* two named sets (an indexed pair lives in memory, and every fused
 	 * multiply-add then waits on a store) */
 	struct row_acc a, b;
-	uint32_t slot = r->head, s = 1;  /* age 1; older ticks one slot down each */
+	uint32_t slot = r->head, s = 1; /* age 1; older ticks one slot down each */
 
 	a.a0 = a.a1 = b.a0 = b.a1 = _mm256_setzero_pd();
 	a.a2 = b.a2 = 0;
@@ -85,7 +85,7 @@ void irdm_head_sum_wide(const struct irdm_engine *e, uint32_t col, double u[3])
 	case IRDM_ELEM_F32:
 		head_f32(e, col, u);
 		break;
-	default:                    /* the image checks admit f64, f32, f16 */
+	default: /* the image checks admit f64, f32, f16 */
 		head_f16(e, col, u);
 		break;
 	}

@@ -112,8 +112,7 @@ void irdm_modal_apply(struct irdm_engine *e, const struct irdm_force_tick *f)
 	for (uint32_t k = 0; k < K; k++) {
 		double g = 0;
 		for (uint32_t n = 0; n < nf; n++)
-			g += p[n][k] * f->f_n[n][0] + p[n][K + k] * f->f_n[n][1]
-			     + p[n][2 * (size_t)K + k] * f->f_n[n][2];
+			g += p[n][k] * f->f_n[n][0] + p[n][K + k] * f->f_n[n][1] + p[n][2 * (size_t)K + k] * f->f_n[n][2];
 		e->x[2 * k] = flush_tiny(e->y[2 * k] + m[k].b[0] * g);
 		e->x[2 * k + 1] = flush_tiny(e->y[2 * k + 1] + m[k].b[1] * g);
 		evolve(e, m, k);

@@ -24,39 +24,39 @@ struct r0_table {
 	double blk[IRDM_MAX_FORCE_NODES][IRDM_MAX_FORCE_NODES][9];
 };
 
-#define FREE_MEMO 16                /* entries, direct-mapped by column */
+#define FREE_MEMO 16 /* entries, direct-mapped by column */
 
 struct irdm_engine {
 	const struct irdm_image *img;
 	struct irdm_engine_config cfg;
 	double dt_s;
-	uint32_t engage_ticks;              /* cfg.engage_fade_s in ticks */
+	uint32_t engage_ticks; /* cfg.engage_fade_s in ticks */
 	uint32_t repr, n_nodes, n_cols, K, T;
-	uint32_t H;                         /* modal: exact head samples (0: none; engine_head.c) */
-	const uint32_t *col_of_row;         /* n_nodes, NO_COL if not touchable */
+	uint32_t H;                 /* modal: exact head samples (0: none; engine_head.c) */
+	const uint32_t *col_of_row; /* n_nodes, NO_COL if not touchable */
 	/* modal */
-	const double *phi;                  /* [col][3][K], converted at init */
-	double *x;                          /* 2K: (q, q') per mode, x[t] */
-	double *y;                          /* 2K: A x[t], the free evolution: kept
+	const double *phi; /* [col][3][K], converted at init */
+	double *x;         /* 2K: (q, q') per mode, x[t] */
+	double *y;         /* 2K: A x[t], the free evolution: kept
 					     * with x (irdm_modal_apply()), so it is
 					     * current between ticks too */
 	/* FIR, and a modal image's exact head (ring of H ticks) */
 	struct irdm_fir_ring ring;
-	const double *tail_w;               /* T: r^s tail damping (1 when stable) */
-	bool fir_wide;                      /* history sum by fir_sum_avx2.c */
+	const double *tail_w; /* T: r^s tail damping (1 when stable) */
+	bool fir_wide;        /* history sum by fir_sum_avx2.c */
 	/* disp_bound.c: K (modal) max |phi_k| at a column, or T (FIR) max
 	 * ||R[s]||_F over force columns and touchable rows; set at init */
 	const double *bound_w;
-	const double *head_bound_w;         /* H: max ||D_s||_F over kept blocks */
-	double *head_norm;                  /* H: sum of |f| of each ring slot (0 if empty) */
-	bool head_wide;                     /* head sum by engine_head_avx2.c */
+	const double *head_bound_w; /* H: max ||D_s||_F over kept blocks */
+	double *head_norm;          /* H: sum of |f| of each ring slot (0 if empty) */
+	bool head_wide;             /* head sum by engine_head_avx2.c */
 	/* contacts and solve */
 	struct irdm_contact_state c[IRDM_MAX_CONTACTS];
 	/* passivity observer (passivity.c): the work done on the object
 	 * through ports that ended while others go on (zero once none is) */
 	double port_energy_left_j;
 	struct r0_table r0, r0_next;
-	struct irdm_force_tick last;        /* forces applied this tick */
+	struct irdm_force_tick last; /* forces applied this tick */
 	struct irdm_engine_stats stats;
 	uint64_t tick;
 	/* modal: free displacements of columns computed since the state last
@@ -68,12 +68,12 @@ struct irdm_engine {
 		double u[3];
 	} free_memo[FREE_MEMO];
 	bool faulted;
-	const char *fault_why;              /* the fault's reason, a constant string */
+	const char *fault_why; /* the fault's reason, a constant string */
 	struct irdm_deform *deform;
 	/* floating objects: the rigid motion, integrated with the contact forces */
 	bool floating;
 	struct irdm_rigid_body rb;
-	double com_rest_m[3];               /* body origin in the object frame */
+	double com_rest_m[3]; /* body origin in the object frame */
 };
 
 /* engine_modal.c / engine_fir.c: the history term and the R[0] blocks. */

@@ -163,16 +163,16 @@ static ALWAYS_INLINE void sum_pass(const struct irdm_engine *e, uint32_t prec, b
 	}
 }
 
-#define SUM_PASSES(name, prec)                                                              \
+#define SUM_PASSES(name, prec) \
 	static void name(const struct irdm_engine *e, uint32_t n_pairs, const uint32_t *rows, \
-			 double (*u)[3])                                                       \
-	{                                                                                      \
-		for (uint32_t p = 0; p < n_pairs; p += 2) {                                    \
-			if (n_pairs - p >= 2)                                                  \
-				sum_pass(e, prec, true, rows + 2 * p, u + 2 * p);              \
-			else                                                                   \
-				sum_pass(e, prec, false, rows + 2 * p, u + 2 * p);             \
-		}                                                                              \
+			 double(*u)[3]) \
+	{ \
+		for (uint32_t p = 0; p < n_pairs; p += 2) { \
+			if (n_pairs - p >= 2) \
+				sum_pass(e, prec, true, rows + 2 * p, u + 2 * p); \
+			else \
+				sum_pass(e, prec, false, rows + 2 * p, u + 2 * p); \
+		} \
 	}
 
 SUM_PASSES(sum_f64, IRDM_ELEM_F64)
@@ -202,7 +202,7 @@ void irdm_fir_free_disps(const struct irdm_engine *e, uint32_t n, const uint32_t
 	case IRDM_ELEM_F32:
 		sum_f32(e, n_pairs, rows, acc);
 		break;
-	default:                    /* the image checks admit f64, f32, f16 */
+	default: /* the image checks admit f64, f32, f16 */
 		sum_f16(e, n_pairs, rows, acc);
 		break;
 	}

@@ -29,7 +29,6 @@
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 #include "wide_block.h"
 
-
 /*
  * One pass over the ring for n_rows (1..3, a constant at each call site,
  * as prec is) rows.  Ages run newest first: age s is the slot s - 1
@@ -118,7 +117,7 @@ void irdm_fir_sum_wide(const struct irdm_engine *e, uint32_t n, const uint32_t *
 	case IRDM_ELEM_F32:
 		wide_f32(e, n, rows, u);
 		break;
-	default:                    /* the image checks admit f64, f32, f16 */
+	default: /* the image checks admit f64, f32, f16 */
 		wide_f16(e, n, rows, u);
 		break;
 	}

@@ -141,7 +141,7 @@ static void trial_positions(const struct irdm_engine *e, const struct system *s,
 }
 
 void tick_newton_floating(struct irdm_engine *e, struct system *s,
-			    const struct irdm_contact_cmd *cmd)
+			  const struct irdm_contact_cmd *cmd)
 {
 	int n = 3 * s->m;
 

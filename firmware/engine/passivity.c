@@ -3,7 +3,6 @@
  * The Hannaford-Ryu passivity observer and controller at the contact ports.
  */
 
-
 #include <math.h>
 #include <string.h>
 
@@ -90,7 +89,7 @@ void tick_passivity(struct irdm_engine *e, struct system *s)
 	}
 	if (!e->cfg.passivity_control || total >= 0 || v2_sum == 0)
 		return;
-	alpha = -total * e->dt_s / v2_sum;       /* N s/m, with v = du / dt */
+	alpha = -total * e->dt_s / v2_sum; /* N s/m, with v = du / dt */
 	if (e->cfg.passivity_max_damping_ns_per_m > 0)
 		alpha = fmin(alpha, e->cfg.passivity_max_damping_ns_per_m);
 	for (int i = 0; i < s->m; i++) {

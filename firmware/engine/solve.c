@@ -89,7 +89,7 @@ int irdm_solve_spd(double *a, double *rhs, int n)
 		scale = fmax(scale, fabs(a[i * n + i]));
 	if (scale == 0)
 		scale = 1;
-	for (double eps = 0; ; eps = eps ? eps * 100 : PIVOT_REL * scale) {
+	for (double eps = 0;; eps = eps ? eps * 100 : PIVOT_REL * scale) {
 		for (int i = 0; i < n * n; i++)
 			a[i] = keep[i];
 		for (int i = 0; i < n; i++)
@@ -97,7 +97,7 @@ int irdm_solve_spd(double *a, double *rhs, int n)
 		if (!cholesky(a, n, PIVOT_REL * scale * 1e-3))
 			break;
 		regularised = 1;
-		if (eps > scale) {   /* hopeless (non-finite input): no force */
+		if (eps > scale) { /* hopeless (non-finite input): no force */
 			for (int i = 0; i < n; i++)
 				rhs[i] = 0;
 			return 1;

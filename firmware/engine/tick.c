@@ -30,7 +30,7 @@ static void gather_forces(struct irdm_engine *e, const struct system *s, struct 
 		for (uint32_t v = 0; v < st->n_nodes; v++) {
 			uint32_t col = st->col[v], n0 = t->n, k;
 			if (col == NO_COL || st->weight[v] == 0)
-				continue;           /* a fixed node takes its share to ground */
+				continue; /* a fixed node takes its share to ground */
 			k = tick_col_slot(t->col, &t->n, col);
 			if (t->n != n0)
 				memset(t->f_n[k], 0, sizeof(t->f_n[k]));
@@ -154,7 +154,7 @@ int irdm_engine_tick(struct irdm_engine *e, const struct irdm_contact_cmd *cmd_i
 		if (!isfinite(s.f[i]) ||
 		    (e->cfg.max_force_n > 0 && fabs(s.f[i]) > e->cfg.max_force_n))
 			return fault(e, isfinite(s.f[i]) ? "a contact force is over max_force_n" :
-				     "a contact force is not finite");
+							   "a contact force is not finite");
 	body_forces(e, &s);
 	if (FLOATING(e) && tick_move_rigid(e, &s))
 		return fault(e, "the floating object's rigid step failed");

@@ -12,18 +12,18 @@
 #include "engine_priv.h"
 
 struct system {
-	int m;                              /* active contacts */
-	unsigned idx[IRDM_MAX_CONTACTS];    /* their slots */
-	double u_body[IRDM_MAX_CONTACTS][3];    /* history term, object (body) frame */
-	double w_body[MAX_SOLVE * MAX_SOLVE];   /* W in the object frame */
+	int m;                                /* active contacts */
+	unsigned idx[IRDM_MAX_CONTACTS];      /* their slots */
+	double u_body[IRDM_MAX_CONTACTS][3];  /* history term, object (body) frame */
+	double w_body[MAX_SOLVE * MAX_SOLVE]; /* W in the object frame */
 	/* in the solve frame: the object frame, or the world for a floating object */
 	double u_free[IRDM_MAX_CONTACTS][3];
 	double normal[IRDM_MAX_CONTACTS][3];
-	double w[MAX_SOLVE * MAX_SOLVE];    /* row-major 3m x 3m */
+	double w[MAX_SOLVE * MAX_SOLVE]; /* row-major 3m x 3m */
 	double f[MAX_SOLVE];
 	double f_body[MAX_SOLVE];
 	bool contradictory;                 /* the targets cannot all be met (solve.c) */
-	double x_now[IRDM_MAX_CONTACTS][3];     /* floating: world position of each point */
+	double x_now[IRDM_MAX_CONTACTS][3]; /* floating: world position of each point */
 	/* The free displacement of each distinct site node this tick, summed
 	 * once (the history does not change within a tick; a node two
 	 * contacts share is summed once) and read by the history terms and

@@ -54,8 +54,8 @@ static WIDE_INLINE double load1(const void *fir, uint32_t prec, size_t i)
 }
 
 struct row_acc {
-	__m256d a0, a1;     /* elements 0..3, 4..7 */
-	double a2;          /* element 8 */
+	__m256d a0, a1; /* elements 0..3, 4..7 */
+	double a2;      /* element 8 */
 };
 
 /* acc += R (9 elements at i) times the weighted force pattern p0 p1 p2 */

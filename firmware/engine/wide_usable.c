@@ -26,12 +26,14 @@ bool irdm_wide_usable(void)
 	     f16c = c & (1u << 29);
 	if (!(fma && osxsave && avx && f16c))
 		return false;
-	__asm__ volatile("xgetbv" : "=a"(xcr0_lo), "=d"(xcr0_hi) : "c"(0));
+	__asm__ volatile("xgetbv"
+			 : "=a"(xcr0_lo), "=d"(xcr0_hi)
+			 : "c"(0));
 	if ((xcr0_lo & 6) != 6)
 		return false;
 	if (!__get_cpuid_count(7, 0, &a, &b, &c, &d))
 		return false;
-	return b & (1u << 5);                   /* AVX2 */
+	return b & (1u << 5); /* AVX2 */
 }
 
 #else

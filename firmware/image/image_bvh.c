@@ -13,10 +13,10 @@
 
 /* Scratch of the BVH check (init time: allocating is fine here). */
 struct bvh_scratch {
-	uint8_t *tri_seen;              /* per surface triangle: listed in index[] */
-	uint8_t *slot_seen;             /* per index[] entry: covered by a leaf */
-	uint8_t *parents;               /* per node: references from a parent */
-	uint8_t *level;                 /* per node: depth, root = 1 */
+	uint8_t *tri_seen;  /* per surface triangle: listed in index[] */
+	uint8_t *slot_seen; /* per index[] entry: covered by a leaf */
+	uint8_t *parents;   /* per node: references from a parent */
+	uint8_t *level;     /* per node: depth, root = 1 */
 };
 
 static bool bvh_contactable(const uint32_t *col_of_row, const uint32_t *v)
@@ -137,8 +137,8 @@ static int bvh_check_leaf(struct parse *p, const struct irdm_bvh_header *h,
 	if (count < 1 || count > h->leaf_max || first + count > h->n_contact_tris)
 		return img_fail(p, IRDM_EFORMAT,
 				"CONTACT_BVH leaf %u has triangles [%llu, %llu) of %u (at most %u per leaf)",
-			    i, (unsigned long long)first, (unsigned long long)(first + count),
-			    h->n_contact_tris, h->leaf_max);
+				i, (unsigned long long)first, (unsigned long long)(first + count),
+				h->n_contact_tris, h->leaf_max);
 	for (uint64_t k = first; k < first + count; k++) {
 		const uint32_t *v = &p->img.tris[3 * (uint64_t)index[k]];
 

@@ -32,7 +32,8 @@ int img_check_header(struct parse *p)
 				h->version_major, h->version_minor,
 				IRDM_IMAGE_VERSION_MAJOR,
 				h->version_major == 1 ?
-				" (1.x kept the static correction dense; re-run irdm precompute)" : "");
+					" (1.x kept the static correction dense; re-run irdm precompute)" :
+					"");
 	if (h->header_size != HEADER_SIZE)
 		return img_fail(p, IRDM_ERANGE,
 				"header_size is %u, version 1 headers are %zu bytes",
@@ -82,9 +83,9 @@ int img_check_table(struct parse *p)
 	if (off > p->size || len > p->size - off)
 		return img_fail(p, IRDM_ERANGE,
 				"section table [%llu, %llu) lies outside the %llu-byte file",
-			    (unsigned long long)off,
-			    (unsigned long long)(off + len),
-			    (unsigned long long)p->size);
+				(unsigned long long)off,
+				(unsigned long long)(off + len),
+				(unsigned long long)p->size);
 	memcpy(p->tab, p->base + off, (size_t)len);
 	if (!img_crc_matches(p->tab, len, h->table_crc32c, &crc))
 		return img_fail(p, IRDM_ECRC,

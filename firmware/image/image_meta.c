@@ -194,7 +194,7 @@ static int check_provenance_copies(struct parse *p, const char *text, size_t len
 	const struct irdm_meta *m = &p->meta;
 	const struct {
 		const char *key;
-		double v, rel;          /* the text's precision: %.17g exact, %.9g */
+		double v, rel; /* the text's precision: %.17g exact, %.9g */
 	} d[] = {
 		{ "rayleigh_a_per_s", m->rayleigh_a_per_s, 0 },
 		{ "rayleigh_b_s", m->rayleigh_b_s, 0 },

@@ -21,8 +21,7 @@
 int irdm_image_parse(const void *buf, size_t size, struct irdm_image *img,
 		     char *err, size_t errlen)
 {
-	struct parse p = { .base = buf, .size = size, .err = err,
-			   .errlen = errlen };
+	struct parse p = { .base = buf, .size = size, .err = err, .errlen = errlen };
 	int ret;
 
 	memset(img, 0, sizeof(*img));

@@ -55,13 +55,13 @@
 struct parse {
 	const uint8_t *base;
 	uint64_t size;
-	struct irdm_image_header hdr;   /* copies: the mapping may change */
+	struct irdm_image_header hdr; /* copies: the mapping may change */
 	struct irdm_image_section tab[IRDM_IMAGE_MAX_SECTIONS];
 	unsigned n;
-	bool strict;                    /* our minor: reserved must be 0 */
+	bool strict; /* our minor: reserved must be 0 */
 	const struct irdm_image_section *by_kind[KIND_MAX + 1];
 	struct irdm_meta meta;
-	size_t es;                      /* bytes per element of precision */
+	size_t es; /* bytes per element of precision */
 	struct irdm_image img;
 	char *err;
 	size_t errlen;
@@ -69,7 +69,7 @@ struct parse {
 
 /* image_check.c: kind and element names for messages, the reason. */
 const char *img_kind_name(uint32_t kind);
-uint32_t img_kind_elem(uint32_t kind);     /* kind <= KIND_MAX */
+uint32_t img_kind_elem(uint32_t kind); /* kind <= KIND_MAX */
 const char *img_elem_name(uint32_t elem);
 /* Write a one-line reason into buf (if any) and return code. */
 int img_report(char *buf, size_t len, int code, const char *fmt, ...)

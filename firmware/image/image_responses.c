@@ -136,7 +136,7 @@ int img_check_modal(struct parse *p)
 				      "n_nodes x 3 x n_modes");
 	if (!ret)
 		ret = img_check_finite(p, IRDM_SEC_MODE_SHAPES,
-				   p->by_kind[IRDM_SEC_MODE_SHAPES]->size / p->es);
+				       p->by_kind[IRDM_SEC_MODE_SHAPES]->size / p->es);
 	if (!ret && !corr && p->by_kind[IRDM_SEC_STATIC_CORR_LOWRANK])
 		ret = img_check_presence(p, IRDM_SEC_STATIC_CORR_LOWRANK, false,
 					 "its far field needs STATIC_CORR");

@@ -67,8 +67,7 @@ int img_check_shape(struct parse *p, uint32_t kind, const uint64_t *f,
 		return img_fail(p, IRDM_EFORMAT,
 				"section %s has element type %s, expected %s",
 				img_kind_name(kind), img_elem_name(s->elem), img_elem_name(elem));
-	if (!mul_ok(&want, f, nf) || !mul_ok(&want, (uint64_t[]){ want,
-			irdm_elem_size(elem) }, 2))
+	if (!mul_ok(&want, f, nf) || !mul_ok(&want, (uint64_t[]){ want, irdm_elem_size(elem) }, 2))
 		return img_fail(p, IRDM_EFORMAT,
 				"section %s: expected size %s x %zu overflows",
 				img_kind_name(kind), formula, irdm_elem_size(elem));

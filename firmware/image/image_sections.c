@@ -14,7 +14,7 @@
 struct region {
 	uint64_t off;
 	uint64_t end;
-	int sec;                        /* section index, or REGION_* */
+	int sec; /* section index, or REGION_* */
 };
 
 #define REGION_HEADER (-1)
@@ -95,7 +95,8 @@ static unsigned collect_regions(const struct parse *p, struct region *r)
 	r[n++] = (struct region){ 0, HEADER_SIZE, REGION_HEADER };
 	r[n++] = (struct region){ p->hdr.section_table_offset,
 				  p->hdr.section_table_offset +
-				  (uint64_t)p->n * TABLE_ENTRY, REGION_TABLE };
+					  (uint64_t)p->n * TABLE_ENTRY,
+				  REGION_TABLE };
 	for (unsigned i = 0; i < p->n; i++)
 		r[n++] = (struct region){ p->tab[i].offset,
 					  p->tab[i].offset + p->tab[i].size,
@@ -114,8 +115,8 @@ static int check_layout(struct parse *p)
 {
 	struct region r[IRDM_IMAGE_MAX_SECTIONS + 2];
 	unsigned n = collect_regions(p, r);
-	uint64_t covered = 0;           /* end of the furthest region so far */
-	unsigned last = 0;              /* region that reaches it */
+	uint64_t covered = 0; /* end of the furthest region so far */
+	unsigned last = 0;    /* region that reaches it */
 	char a[96], b[96];
 
 	for (unsigned i = 0; i < n; i++) {

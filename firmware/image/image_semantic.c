@@ -11,9 +11,12 @@
 int img_check_contents(struct parse *p)
 {
 	int (*const step[])(struct parse *) = {
-		img_check_meta, img_check_provenance,
-		img_check_nodes, img_check_columns,
-		img_check_surface, img_check_stability,
+		img_check_meta,
+		img_check_provenance,
+		img_check_nodes,
+		img_check_columns,
+		img_check_surface,
+		img_check_stability,
 		img_check_rigid,
 	};
 	int ret;

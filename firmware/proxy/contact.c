@@ -176,7 +176,8 @@ static double seg_param(const double *a, const double *b, const double *p)
 	if (!(l2 > 0))
 		return 0;
 	t = irdm_v3_dot(ap, ab) / l2;
-	return t < 0 ? 0 : t > 1 ? 1 : t;
+	return t < 0 ? 0 : t > 1 ? 1 :
+				   t;
 }
 
 static double finish(const double *a, const double *b, const double *c, const double *p,
@@ -266,24 +267,24 @@ double irdm_contact_closest_on_tri(const double a[3], const double b[3], const d
 	if (!(irdm_v3_dot(n, n) > DEGENERATE_SIN2 * irdm_v3_dot(ab, ab) * irdm_v3_dot(ac, ac)))
 		return closest_on_edges(a, b, c, p, bary, q);
 	vertex_dots(ab, ac, p, a, &d1, &d2);
-	if (d1 <= 0 && d2 <= 0)                 /* vertex region a */
+	if (d1 <= 0 && d2 <= 0) /* vertex region a */
 		return answer(&tq, 1, 0, 0);
 	vertex_dots(ab, ac, p, b, &d3, &d4);
-	if (d3 >= 0 && d4 <= d3)                /* vertex region b */
+	if (d3 >= 0 && d4 <= d3) /* vertex region b */
 		return answer(&tq, 0, 1, 0);
 	vc = d1 * d4 - d3 * d2;
-	if (vc <= 0 && d1 >= 0 && d3 <= 0)      /* edge ab; d1 - d3 = |ab|^2 */
+	if (vc <= 0 && d1 >= 0 && d3 <= 0) /* edge ab; d1 - d3 = |ab|^2 */
 		return answer_edge(&tq, 0, 1, d1, d1 - d3);
 	vertex_dots(ab, ac, p, c, &d5, &d6);
-	if (d6 >= 0 && d5 <= d6)                /* vertex region c */
+	if (d6 >= 0 && d5 <= d6) /* vertex region c */
 		return answer(&tq, 0, 0, 1);
 	vb = d5 * d2 - d1 * d6;
-	if (vb <= 0 && d2 >= 0 && d6 <= 0)      /* edge ac; d2 - d6 = |ac|^2 */
+	if (vb <= 0 && d2 >= 0 && d6 <= 0) /* edge ac; d2 - d6 = |ac|^2 */
 		return answer_edge(&tq, 0, 2, d2, d2 - d6);
 	va = d3 * d6 - d5 * d4;
-	if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0)    /* edge bc */
+	if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0) /* edge bc */
 		return answer_edge(&tq, 1, 2, d4 - d3, (d4 - d3) + (d5 - d6));
-	den = va + vb + vc;                     /* = |ab x ac|^2 */
+	den = va + vb + vc; /* = |ab x ac|^2 */
 	if (!(den > 0) || !isfinite(den))
 		return closest_on_edges(a, b, c, p, bary, q);
 	vb /= den;
@@ -312,9 +313,9 @@ struct query {
 	const struct irdm_contact_mesh *cm;
 	const struct irdm_contact_disp *d;
 	const double *p;
-	double grow_m;                  /* max_disp_m: |u| of every node is below it */
-	double best;                    /* squared distance bound / best so far */
-	double best_cos;                /* |cos| between p - q and the normal */
+	double grow_m;   /* max_disp_m: |u| of every node is below it */
+	double best;     /* squared distance bound / best so far */
+	double best_cos; /* |cos| between p - q and the normal */
 	bool found;
 	struct irdm_contact_hit *hit;
 };
@@ -353,7 +354,7 @@ static void query_tri(struct query *qr, uint32_t t)
 	c = d2 > 0 ? fabs(s) / sqrt(d2) : 1;
 	if (!qr->found || d2 < qr->best * (1 - TIE_REL) - TIE_ABS)
 		better = d2 <= qr->best;
-	else    /* a tie: the face that sees p best gives the sign */
+	else /* a tie: the face that sees p best gives the sign */
 		better = c > qr->best_cos || (c == qr->best_cos && d2 < qr->best);
 	if (!better)
 		return;
@@ -393,7 +394,7 @@ int irdm_contact_closest(const struct irdm_contact_mesh *cm, const struct irdm_c
 				query_tri(&qr, cm->index[nd->left_or_first + k]);
 			continue;
 		}
-		if (sp + 2 > IRDM_CONTACT_STACK)        /* never: depth <= 48 */
+		if (sp + 2 > IRDM_CONTACT_STACK) /* never: depth <= 48 */
 			return IRDM_EINVAL;
 		l = nd->left_or_first;
 		r = nd->count_or_right & ~IRDM_BVH_INTERNAL;
@@ -461,7 +462,7 @@ static uint32_t next_tri(const struct irdm_contact_mesh *cm, uint32_t t, const d
 {
 	unsigned order[3] = { 0, 1, 2 };
 
-	for (unsigned i = 0; i < 2; i++)        /* sort vertices by lam, ascending */
+	for (unsigned i = 0; i < 2; i++) /* sort vertices by lam, ascending */
 		for (unsigned j = 0; j + 1 < 3 - i; j++)
 			if (lam[order[j + 1]] < lam[order[j]]) {
 				unsigned x = order[j];
@@ -509,7 +510,7 @@ static bool normal_beyond(const struct irdm_contact_mesh *cm, const struct irdm_
 		return tri_normal(w, nu);
 	}
 	irdm_v3_sub(ed, v[(e + 1) % 3], v[e]);
-	irdm_v3_cross(nu, ed, n);       /* counter-clockwise: points away from t */
+	irdm_v3_cross(nu, ed, n); /* counter-clockwise: points away from t */
 	len = sqrt(irdm_v3_dot(nu, nu));
 	if (!(len > 0))
 		return false;
@@ -645,7 +646,7 @@ static int proxy_touch(struct irdm_proxy *px, const struct irdm_contact_mesh *cm
 		proxy_set(px, t, v, lam, p, 0);
 		return IRDM_PROXY_TOUCH;
 	}
-	px->tri = t;    /* as the query found it */
+	px->tri = t; /* as the query found it */
 	memcpy(px->bary, hit.bary, sizeof(px->bary));
 	memcpy(px->point_m, hit.point_m, sizeof(px->point_m));
 	memcpy(px->normal, hit.normal, sizeof(px->normal));
@@ -727,9 +728,10 @@ static int friction(struct irdm_proxy *px, const struct irdm_contact_mesh *cm,
 		irdm_v3_scale(ft, fn, px->normal);
 		irdm_v3_add(ft, ft, px->force_n);
 		ftl = sqrt(irdm_v3_dot(ft, ft));
-		dn = !(fn > 0) ? 0 : ftl > 0 ? fn * tl / ftl : INFINITY;
+		dn = !(fn > 0) ? 0 : ftl > 0 ? fn * tl / ftl :
+					       INFINITY;
 	}
-	if (tl <= cfg->mu_s * dn) {             /* stick */
+	if (tl <= cfg->mu_s * dn) { /* stick */
 		px->tri = anchor_tri;
 		memcpy(px->bary, anchor_bary, sizeof(px->bary));
 		memcpy(px->point_m, a, sizeof(a));
@@ -781,7 +783,7 @@ int irdm_proxy_update(struct irdm_proxy *px, const struct irdm_contact_mesh *cm,
 		return proxy_release(px, IRDM_EINVAL);
 	max_walk = cfg->max_walk < IRDM_CONTACT_MAX_WALK ? cfg->max_walk : IRDM_CONTACT_MAX_WALK;
 	in = walk(cm, d, max_walk, p, &t, v, lam, q, &steps);
-	if (in < 0)                     /* crushed flat: detect afresh */
+	if (in < 0) /* crushed flat: detect afresh */
 		return proxy_release(px, IRDM_PROXY_RELEASE);
 	tri_normal(v, n);
 	outside = outside_beyond(cm, d, t, v, n, lam, p);

@@ -45,10 +45,10 @@
 #include "irdm/rigid.h"
 #include "irdm/vec3.h"
 
-#define SYM_TOL 1e-12           /* inertia asymmetry allowed, relative to its largest entry */
-#define PIVOT_TOL 1e-12         /* smallest Cholesky pivot, relative to the trace */
-#define Q_MIN_NORM 1e-6         /* a quaternion shorter than this is "zero" */
-#define NEWTON_TOL 1e-13        /* relative Newton step at which w has converged */
+#define SYM_TOL 1e-12    /* inertia asymmetry allowed, relative to its largest entry */
+#define PIVOT_TOL 1e-12  /* smallest Cholesky pivot, relative to the trace */
+#define Q_MIN_NORM 1e-6  /* a quaternion shorter than this is "zero" */
+#define NEWTON_TOL 1e-13 /* relative Newton step at which w has converged */
 
 /* ---- small matrix algebra (vectors: irdm/vec3.h) ------------------------ */
 
@@ -68,9 +68,15 @@ static void mat_mul(const double a[9], const double b[9], double c[9])
 
 static void skew(const double v[3], double s[9])
 {
-	s[0] = 0;     s[1] = -v[2]; s[2] = v[1];
-	s[3] = v[2];  s[4] = 0;     s[5] = -v[0];
-	s[6] = -v[1]; s[7] = v[0];  s[8] = 0;
+	s[0] = 0;
+	s[1] = -v[2];
+	s[2] = v[1];
+	s[3] = v[2];
+	s[4] = 0;
+	s[5] = -v[0];
+	s[6] = -v[1];
+	s[7] = v[0];
+	s[8] = 0;
 }
 
 static int finite_n(const double *v, int n)
@@ -186,7 +192,7 @@ static void left_jacobian(const double phi[3], double j[9])
 static void quat_exp(const double phi[3], double q[4])
 {
 	double h = 0.5 * irdm_v3_norm(phi);
-	double s = 0.5 * sinc(h);   /* sin(h) / |phi| */
+	double s = 0.5 * sinc(h); /* sin(h) / |phi| */
 
 	q[0] = cos(h);
 	q[1] = s * phi[0];
@@ -223,7 +229,7 @@ static void quat_rotate(const double q[4], int inverse, const double v[3], doubl
 	double t[3], ut[3];
 
 	if (inverse)
-		w = -w;     /* conj(q) and -conj(q) are the same rotation */
+		w = -w; /* conj(q) and -conj(q) are the same rotation */
 	irdm_v3_cross(t, u, v);
 	irdm_v3_scale(t, 2, t);
 	irdm_v3_cross(ut, u, t);
@@ -279,7 +285,7 @@ static int inertia_inverse(const double a_in[9], double a[9], double inv[9])
 	for (int c = 0; c < 3; c++) {
 		double y[3];
 
-		for (int i = 0; i < 3; i++) {   /* L y = e_c, then D, then L^T */
+		for (int i = 0; i < 3; i++) { /* L y = e_c, then D, then L^T */
 			y[i] = i == c;
 			for (int k = 0; k < i; k++)
 				y[i] -= l[3 * i + k] * y[k];
@@ -359,7 +365,7 @@ static unsigned drift(const struct irdm_rigid_body *rb, double q[4], double l[3]
 	double w[3], phi[3], lp[3], g[3], jl[9], sk[9], jac[9], d[3], qi[4];
 	unsigned it = 0;
 
-	mat_vec(rb->inv_inertia_body_per_kg_m2, l, w);  /* explicit guess, O(dt) off */
+	mat_vec(rb->inv_inertia_body_per_kg_m2, l, w); /* explicit guess, O(dt) off */
 	while (it < IRDM_RIGID_MAX_NEWTON) {
 		it++;
 		irdm_v3_scale(phi, -dt, w);

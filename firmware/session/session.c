@@ -52,7 +52,7 @@ static int open_deform(struct irdm_session *s, char *err, size_t errlen)
 #else
 	(void)s;
 	snprintf(err, errlen, "session: the deformed surface is asked for (a board's "
-		 "deform_rate_hz > 0); this build has CONFIG_IRDM_DEFORM off (docs/build-config.md)");
+			      "deform_rate_hz > 0); this build has CONFIG_IRDM_DEFORM off (docs/build-config.md)");
 	return IRDM_ENOTSUP;
 #endif
 }
@@ -66,7 +66,7 @@ static int open_contact(struct irdm_session *s, char *err, size_t errlen)
 	int rc;
 
 	if (irdm_contact_mesh_init(&s->cm, s->img))
-		return IRDM_OK;         /* no CONTACT_BVH: the engine alone */
+		return IRDM_OK; /* no CONTACT_BVH: the engine alone */
 	rc = irdm_session_part_mem(&s->contact_mem, irdm_contact_beyond_size(&s->cm), "contact",
 				   err, errlen);
 	if (rc)

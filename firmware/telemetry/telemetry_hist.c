@@ -34,7 +34,7 @@ int irdm_hist_init(struct irdm_hist *h, int64_t limit_ns)
 /* Index into count[]: 0 below 100 ns, 1 + i for [edge i, edge i+1), LAST_BIN at or above 100 ms. */
 static unsigned bin_of(const struct irdm_hist *h, int64_t v)
 {
-	unsigned lo = 0, hi = IRDM_HIST_LOG_BINS;     /* edge_ns[lo] <= v < edge_ns[hi] */
+	unsigned lo = 0, hi = IRDM_HIST_LOG_BINS; /* edge_ns[lo] <= v < edge_ns[hi] */
 
 	if (v < IRDM_HIST_MIN_NS)
 		return 0;

@@ -5,7 +5,11 @@
 const char *irdm_telem_state_name(unsigned state)
 {
 	static const char *const names[IRDM_TELEM_N_STATES] = {
-		"init", "ready", "enabled", "fault", "off",
+		"init",
+		"ready",
+		"enabled",
+		"fault",
+		"off",
 	};
 
 	return state < IRDM_TELEM_N_STATES ? names[state] : "?";
@@ -21,8 +25,18 @@ const char *irdm_telem_proxy_name(unsigned proxy)
 const char *irdm_telem_fault_name(unsigned bit)
 {
 	static const char *const names[IRDM_TELEM_N_FAULTS] = {
-		"clamp", "workspace", "velocity", "watchdog", "overrun", "encoder_nan",
-		"encoder_range", "signal", "hal_read", "hal_write", "hal_fault", "engine",
+		"clamp",
+		"workspace",
+		"velocity",
+		"watchdog",
+		"overrun",
+		"encoder_nan",
+		"encoder_range",
+		"signal",
+		"hal_read",
+		"hal_write",
+		"hal_fault",
+		"engine",
 	};
 
 	return bit < IRDM_TELEM_N_FAULTS ? names[bit] : "?";

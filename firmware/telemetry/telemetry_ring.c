@@ -26,10 +26,10 @@ _Static_assert(ATOMIC_LLONG_LOCK_FREE == 2, "the drop counter needs lock-free 64
 #define CACHE_LINE 64
 
 struct irdm_telem_ring {
-	alignas(CACHE_LINE) atomic_uint head;   /* written by the producer */
-	atomic_ullong drops;                    /* written by the producer */
-	alignas(CACHE_LINE) atomic_uint tail;   /* written by the consumer */
-	alignas(CACHE_LINE) uint32_t capacity;  /* read-only after init */
+	alignas(CACHE_LINE) atomic_uint head;  /* written by the producer */
+	atomic_ullong drops;                   /* written by the producer */
+	alignas(CACHE_LINE) atomic_uint tail;  /* written by the consumer */
+	alignas(CACHE_LINE) uint32_t capacity; /* read-only after init */
 	uint32_t mask;
 	struct irdm_tick_record *slot;
 };

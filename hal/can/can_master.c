@@ -107,7 +107,7 @@ void irdm_can_master_lose(struct irdm_can_master *m, int axis, const char *reaso
 	/* torque off first, then say why */
 	m->faulted = true;
 	m->enable = false;
-	(void)send_off(m);      /* the link may be the fault: nothing more to do */
+	(void)send_off(m); /* the link may be the fault: nothing more to do */
 	if (!first)
 		return;
 	if (axis < 0)
@@ -138,7 +138,7 @@ static int take_emcy(struct irdm_can_master *m, int k, const struct irdm_can_fra
 	}
 	m->emcy_frames++;
 	if (e.code == 0)
-		return IRDM_OK;         /* "error reset or no error": nothing to lose */
+		return IRDM_OK; /* "error reset or no error": nothing to lose */
 	snprintf(reason, sizeof(reason), "EMCY 0x%04X (%s), error register 0x%02X", e.code,
 		 irdm_co_emcy_class(e.code), e.reg);
 	irdm_can_master_lose(m, k, reason);
@@ -155,7 +155,7 @@ static int take_tpdo(struct irdm_can_master *m, int k, const struct irdm_can_fra
 		m->bad_frames++;
 		return IRDM_EFORMAT;
 	}
-	a->sw = sw;             /* latest wins: an older one is simply replaced */
+	a->sw = sw; /* latest wins: an older one is simply replaced */
 	a->counts = counts;
 	a->fresh = true;
 	a->seen = true;
@@ -192,7 +192,7 @@ int irdm_can_master_take(struct irdm_can_master *m, const struct irdm_can_frame 
 	if ((k = axis_of(m, irdm_co_node_of(f, IRDM_CO_EMCY))) >= 0)
 		return take_emcy(m, k, f);
 	if (axis_of(m, irdm_co_node_of(f, IRDM_CO_SDO_TX)) >= 0)
-		m->sdo_stragglers++;    /* a late answer: set-up is over, never trusted */
+		m->sdo_stragglers++; /* a late answer: set-up is over, never trusted */
 	else
 		m->unknown_frames++;
 	return IRDM_ENOTSUP;
@@ -298,7 +298,7 @@ int irdm_can_master_receive(struct irdm_can_master *m)
 	if (m->faulted)
 		return IRDM_EHW;
 	if (first_fault(m) < 0)
-		m->reset_request = false;       /* every fault reset: asked once, done */
+		m->reset_request = false; /* every fault reset: asked once, done */
 	return stale ? IRDM_ETIMEDOUT : IRDM_OK;
 }
 

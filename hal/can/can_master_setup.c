@@ -23,12 +23,12 @@
 #define PDO_ENTRIES 2
 static const uint32_t rpdo1_map[PDO_ENTRIES] = { 0x60400010, 0x60710010 };
 static const uint32_t tpdo1_map[PDO_ENTRIES] = { 0x60410010, 0x60640020 };
-#define PDO_NOT_VALID 0x80000000u       /* COB-ID bit 31 */
-#define PDO_NO_RTR 0x40000000u          /* COB-ID bit 30: no remote request (RTR) */
-#define CIA402_PROFILE 0x0192u          /* 0x1000's low 16 bits for a drive */
-#define ABORT_FAULT 1                   /* 0x6007 values (CiA 402) */
+#define PDO_NOT_VALID 0x80000000u /* COB-ID bit 31 */
+#define PDO_NO_RTR 0x40000000u    /* COB-ID bit 30: no remote request (RTR) */
+#define CIA402_PROFILE 0x0192u    /* 0x1000's low 16 bits for a drive */
+#define ABORT_FAULT 1             /* 0x6007 values (CiA 402) */
 #define ABORT_DISABLE_VOLTAGE 2
-#define PDO_SYNC_EVERY 1                /* transmission type: synchronous, every SYNC */
+#define PDO_SYNC_EVERY 1 /* transmission type: synchronous, every SYNC */
 
 unsigned irdm_can_master_cycle_bits(const struct irdm_can_master_cfg *cfg)
 {
@@ -114,19 +114,23 @@ int irdm_can_master_check(const struct irdm_can_master_cfg *cfg, char *err, size
 }
 
 /* One object to read or write during set-up. */
-enum sdo_dir { SDO_WRITE, SDO_READ };
+enum sdo_dir { SDO_WRITE,
+	       SDO_READ };
 
 struct sdo_item {
 	uint16_t index;
 	uint8_t sub;
-	uint8_t size;                   /* bytes written; a read takes what comes */
-	uint32_t value;                 /* written; a read's answer */
+	uint8_t size;   /* bytes written; a read takes what comes */
+	uint32_t value; /* written; a read's answer */
 	enum sdo_dir dir;
-	uint32_t skip_abort;            /* this abort means "no such object here": go on */
+	uint32_t skip_abort; /* this abort means "no such object here": go on */
 };
 
 /* A write of size bytes of v to index:sub. */
-#define WR(i, s, z, v) { .index = (i), .sub = (s), .size = (z), .value = (v), .dir = SDO_WRITE }
+#define WR(i, s, z, v) \
+	{ \
+		.index = (i), .sub = (s), .size = (z), .value = (v), .dir = SDO_WRITE \
+	}
 
 static void say_drive(const struct irdm_can_master *m, unsigned k, const struct sdo_item *it,
 		      char *err, size_t errlen, const char *what)
@@ -267,7 +271,8 @@ static int identify(struct irdm_can_master *m, unsigned k, char *err, size_t err
 		m->ax[k].identity[i] = items[1 + i].value;
 	if ((items[0].value & 0xFFFFu) != CIA402_PROFILE) {
 		snprintf(err, errlen, "drive %u (node %u): device type 0x%08X (0x1000) is not a "
-			 "CiA 402 drive (profile 0x%04X, not 0x%04X)", k + 1, m->cfg.axis[k].node,
+				      "CiA 402 drive (profile 0x%04X, not 0x%04X)",
+			 k + 1, m->cfg.axis[k].node,
 			 (unsigned)items[0].value, (unsigned)(items[0].value & 0xFFFFu),
 			 CIA402_PROFILE);
 		return IRDM_ENOTSUP;
@@ -354,7 +359,8 @@ static int configure_drive(struct irdm_can_master *m, unsigned k, char *err, siz
 	/* the mode the drive runs, read back: a drive may keep another */
 	if ((uint8_t)items[n - 1].value != MODE_CST) {
 		snprintf(err, errlen, "drive %u (node %u): mode of operation display 0x6061 is %d, "
-			 "not 10 (cyclic synchronous torque)", k + 1, node,
+				      "not 10 (cyclic synchronous torque)",
+			 k + 1, node,
 			 (int8_t)items[n - 1].value);
 		return IRDM_ENOTSUP;
 	}
@@ -367,7 +373,8 @@ void irdm_can_master_identity_line(const struct irdm_can_master *m, unsigned k, 
 	const struct irdm_can_master_axis *a = &m->ax[k];
 
 	snprintf(line, len, "drive %u (node %u): CiA 402 device type 0x%08X, vendor 0x%08X, "
-		 "product 0x%08X, revision 0x%08X, serial 0x%08X", k + 1, m->cfg.axis[k].node,
+			    "product 0x%08X, revision 0x%08X, serial 0x%08X",
+		 k + 1, m->cfg.axis[k].node,
 		 (unsigned)a->device_type, (unsigned)a->identity[0], (unsigned)a->identity[1],
 		 (unsigned)a->identity[2], (unsigned)a->identity[3]);
 }

@@ -79,7 +79,7 @@ int irdm_co_sdo_write(struct irdm_can_frame *f, unsigned node, uint16_t index, u
 	if (!node_ok(node) || size < 1 || size > 4)
 		return IRDM_EINVAL;
 	frame(f, IRDM_CO_SDO_RX + node, 8);
-	f->data[0] = expedited(0x20, size);             /* initiate download */
+	f->data[0] = expedited(0x20, size); /* initiate download */
 	put16(f->data + 1, index);
 	f->data[3] = sub;
 	for (unsigned k = 0; k < size; k++)
@@ -92,7 +92,7 @@ int irdm_co_sdo_read(struct irdm_can_frame *f, unsigned node, uint16_t index, ui
 	if (!node_ok(node))
 		return IRDM_EINVAL;
 	frame(f, IRDM_CO_SDO_RX + node, 8);
-	f->data[0] = 0x40;                              /* initiate upload */
+	f->data[0] = 0x40; /* initiate upload */
 	put16(f->data + 1, index);
 	f->data[3] = sub;
 	return IRDM_OK;
@@ -128,7 +128,7 @@ int irdm_co_heartbeat(const struct irdm_can_frame *f, unsigned node,
 
 	if (!from(f, IRDM_CO_HEARTBEAT, node, 1))
 		return IRDM_EFORMAT;
-	s = f->data[0] & 0x7F;                          /* bit 7: the toggle of node guarding */
+	s = f->data[0] & 0x7F; /* bit 7: the toggle of node guarding */
 	if (s != IRDM_CO_STATE_BOOTUP && s != IRDM_CO_STATE_STOPPED &&
 	    s != IRDM_CO_STATE_OPERATIONAL && s != IRDM_CO_STATE_PRE_OPERATIONAL)
 		return IRDM_EFORMAT;
@@ -155,13 +155,13 @@ int irdm_co_sdo_answer(const struct irdm_can_frame *f, unsigned node, uint16_t i
 		return IRDM_EFORMAT;
 	*value = 0;
 	*size = 0;
-	if (cmd == 0x80) {                              /* abort */
+	if (cmd == 0x80) { /* abort */
 		*abort_code = get32(f->data + 4);
 		return IRDM_EHW;
 	}
-	if (cmd == 0x60)                                /* download confirmed */
+	if (cmd == 0x60) /* download confirmed */
 		return IRDM_OK;
-	if ((cmd & 0xF3) != 0x43)                       /* expedited upload, size given */
+	if ((cmd & 0xF3) != 0x43) /* expedited upload, size given */
 		return IRDM_EFORMAT;
 	*size = 4 - ((cmd >> 2) & 3);
 	for (unsigned k = 0; k < *size; k++)
@@ -213,10 +213,22 @@ const char *irdm_co_abort_name(uint32_t code)
 const char *irdm_co_emcy_class(uint16_t code)
 {
 	static const char *const cls[16] = {
-		"no error (reset)", "generic", "current", "voltage", "temperature",
-		"device hardware", "device software", "additional modules", "monitoring",
-		"external", "unknown class", "unknown class", "unknown class", "unknown class",
-		"unknown class", "device specific",
+		"no error (reset)",
+		"generic",
+		"current",
+		"voltage",
+		"temperature",
+		"device hardware",
+		"device software",
+		"additional modules",
+		"monitoring",
+		"external",
+		"unknown class",
+		"unknown class",
+		"unknown class",
+		"unknown class",
+		"unknown class",
+		"device specific",
 	};
 
 	return cls[code >> 12];

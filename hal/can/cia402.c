@@ -31,9 +31,15 @@ enum irdm_cia402_state irdm_cia402_decode(uint16_t sw)
 const char *irdm_cia402_name(enum irdm_cia402_state s)
 {
 	static const char *const names[] = {
-		"not ready to switch on", "switch on disabled", "ready to switch on",
-		"switched on", "operation enabled", "quick stop active",
-		"fault reaction active", "fault", "unknown",
+		"not ready to switch on",
+		"switch on disabled",
+		"ready to switch on",
+		"switched on",
+		"operation enabled",
+		"quick stop active",
+		"fault reaction active",
+		"fault",
+		"unknown",
 	};
 
 	return s <= IRDM_CIA402_UNKNOWN ? names[s] : "unknown";
@@ -43,18 +49,18 @@ uint16_t irdm_cia402_next(enum irdm_cia402_state s, bool reset_fault, uint16_t p
 {
 	switch (s) {
 	case IRDM_CIA402_SWITCH_ON_DISABLED:
-		return IRDM_CIA402_CW_SHUTDOWN;                 /* 2 */
+		return IRDM_CIA402_CW_SHUTDOWN; /* 2 */
 	case IRDM_CIA402_READY_TO_SWITCH_ON:
-		return IRDM_CIA402_CW_SWITCH_ON;                /* 3 */
+		return IRDM_CIA402_CW_SWITCH_ON; /* 3 */
 	case IRDM_CIA402_SWITCHED_ON:
 	case IRDM_CIA402_OPERATION_ENABLED:
-		return IRDM_CIA402_CW_ENABLE_OPERATION;         /* 4, then hold */
+		return IRDM_CIA402_CW_ENABLE_OPERATION; /* 4, then hold */
 	case IRDM_CIA402_FAULT:
 		/* 15 on a rising edge of bit 7: 0x80 only after a 0x00 */
 		if (reset_fault && !(prev_cw & IRDM_CIA402_CW_FAULT_RESET))
 			return IRDM_CIA402_CW_FAULT_RESET;
 		return IRDM_CIA402_CW_DISABLE_VOLTAGE;
-	case IRDM_CIA402_QUICK_STOP_ACTIVE:                     /* 12, then up again */
+	case IRDM_CIA402_QUICK_STOP_ACTIVE: /* 12, then up again */
 	case IRDM_CIA402_NOT_READY:
 	case IRDM_CIA402_FAULT_REACTION_ACTIVE:
 	case IRDM_CIA402_UNKNOWN:
@@ -65,12 +71,16 @@ uint16_t irdm_cia402_next(enum irdm_cia402_state s, bool reset_fault, uint16_t p
 
 void irdm_cia402_drive_init(struct irdm_cia402_drive *d)
 {
-	d->state = IRDM_CIA402_SWITCH_ON_DISABLED;      /* 0 then 1: self-test passed */
+	d->state = IRDM_CIA402_SWITCH_ON_DISABLED; /* 0 then 1: self-test passed */
 	d->last_cw = 0;
 }
 
 /* The command a controlword gives (bit 7 clear), as the profile decodes it. */
-enum command { CMD_NONE, CMD_DISABLE_VOLTAGE, CMD_QUICK_STOP, CMD_SHUTDOWN, CMD_SWITCH_ON,
+enum command { CMD_NONE,
+	       CMD_DISABLE_VOLTAGE,
+	       CMD_QUICK_STOP,
+	       CMD_SHUTDOWN,
+	       CMD_SWITCH_ON,
 	       CMD_ENABLE_OPERATION };
 
 static enum command command_of(uint16_t cw)
@@ -78,52 +88,52 @@ static enum command command_of(uint16_t cw)
 	if (cw & 0x80)
 		return CMD_NONE;
 	if ((cw & 0x02) == 0x00)
-		return CMD_DISABLE_VOLTAGE;                     /* 0xxx xx0x */
+		return CMD_DISABLE_VOLTAGE; /* 0xxx xx0x */
 	if ((cw & 0x06) == 0x02)
-		return CMD_QUICK_STOP;                          /* 0xxx x01x */
+		return CMD_QUICK_STOP; /* 0xxx x01x */
 	if ((cw & 0x07) == 0x06)
-		return CMD_SHUTDOWN;                            /* 0xxx x110 */
+		return CMD_SHUTDOWN; /* 0xxx x110 */
 	if ((cw & 0x0F) == 0x07)
-		return CMD_SWITCH_ON;                           /* 0xxx 0111 */
-	return CMD_ENABLE_OPERATION;                            /* 0xxx 1111 */
+		return CMD_SWITCH_ON; /* 0xxx 0111 */
+	return CMD_ENABLE_OPERATION;  /* 0xxx 1111 */
 }
 
 static enum irdm_cia402_state after(enum irdm_cia402_state s, enum command c)
 {
 	switch (s) {
 	case IRDM_CIA402_SWITCH_ON_DISABLED:
-		return c == CMD_SHUTDOWN ? IRDM_CIA402_READY_TO_SWITCH_ON : s;          /* 2 */
+		return c == CMD_SHUTDOWN ? IRDM_CIA402_READY_TO_SWITCH_ON : s; /* 2 */
 	case IRDM_CIA402_READY_TO_SWITCH_ON:
 		if (c == CMD_SWITCH_ON)
-			return IRDM_CIA402_SWITCHED_ON;                                  /* 3 */
+			return IRDM_CIA402_SWITCHED_ON; /* 3 */
 		if (c == CMD_ENABLE_OPERATION)
-			return IRDM_CIA402_OPERATION_ENABLED;                            /* 3 + 4 */
+			return IRDM_CIA402_OPERATION_ENABLED; /* 3 + 4 */
 		if (c == CMD_DISABLE_VOLTAGE || c == CMD_QUICK_STOP)
-			return IRDM_CIA402_SWITCH_ON_DISABLED;                           /* 7 */
+			return IRDM_CIA402_SWITCH_ON_DISABLED; /* 7 */
 		return s;
 	case IRDM_CIA402_SWITCHED_ON:
 		if (c == CMD_ENABLE_OPERATION)
-			return IRDM_CIA402_OPERATION_ENABLED;                            /* 4 */
+			return IRDM_CIA402_OPERATION_ENABLED; /* 4 */
 		if (c == CMD_SHUTDOWN)
-			return IRDM_CIA402_READY_TO_SWITCH_ON;                           /* 6 */
+			return IRDM_CIA402_READY_TO_SWITCH_ON; /* 6 */
 		if (c == CMD_DISABLE_VOLTAGE || c == CMD_QUICK_STOP)
-			return IRDM_CIA402_SWITCH_ON_DISABLED;                           /* 10 */
+			return IRDM_CIA402_SWITCH_ON_DISABLED; /* 10 */
 		return s;
 	case IRDM_CIA402_OPERATION_ENABLED:
 		if (c == CMD_SWITCH_ON)
-			return IRDM_CIA402_SWITCHED_ON;                                  /* 5 */
+			return IRDM_CIA402_SWITCHED_ON; /* 5 */
 		if (c == CMD_SHUTDOWN)
-			return IRDM_CIA402_READY_TO_SWITCH_ON;                           /* 8 */
+			return IRDM_CIA402_READY_TO_SWITCH_ON; /* 8 */
 		if (c == CMD_DISABLE_VOLTAGE)
-			return IRDM_CIA402_SWITCH_ON_DISABLED;                           /* 9 */
+			return IRDM_CIA402_SWITCH_ON_DISABLED; /* 9 */
 		if (c == CMD_QUICK_STOP)
-			return IRDM_CIA402_QUICK_STOP_ACTIVE;                            /* 11 */
+			return IRDM_CIA402_QUICK_STOP_ACTIVE; /* 11 */
 		return s;
 	case IRDM_CIA402_QUICK_STOP_ACTIVE:
 		if (c == CMD_DISABLE_VOLTAGE)
-			return IRDM_CIA402_SWITCH_ON_DISABLED;                           /* 12 */
+			return IRDM_CIA402_SWITCH_ON_DISABLED; /* 12 */
 		if (c == CMD_ENABLE_OPERATION)
-			return IRDM_CIA402_OPERATION_ENABLED;                            /* 16 */
+			return IRDM_CIA402_OPERATION_ENABLED; /* 16 */
 		return s;
 	default:
 		return s;
@@ -136,7 +146,7 @@ void irdm_cia402_drive_command(struct irdm_cia402_drive *d, uint16_t cw)
 
 	if (d->state == IRDM_CIA402_FAULT) {
 		if (edge)
-			d->state = IRDM_CIA402_SWITCH_ON_DISABLED;                       /* 15 */
+			d->state = IRDM_CIA402_SWITCH_ON_DISABLED; /* 15 */
 	} else {
 		d->state = after(d->state, command_of(cw));
 	}
@@ -146,13 +156,13 @@ void irdm_cia402_drive_command(struct irdm_cia402_drive *d, uint16_t cw)
 void irdm_cia402_drive_fault(struct irdm_cia402_drive *d)
 {
 	if (d->state != IRDM_CIA402_FAULT)
-		d->state = IRDM_CIA402_FAULT_REACTION_ACTIVE;                            /* 13 */
+		d->state = IRDM_CIA402_FAULT_REACTION_ACTIVE; /* 13 */
 }
 
 void irdm_cia402_drive_settle(struct irdm_cia402_drive *d)
 {
 	if (d->state == IRDM_CIA402_FAULT_REACTION_ACTIVE)
-		d->state = IRDM_CIA402_FAULT;                                            /* 14 */
+		d->state = IRDM_CIA402_FAULT; /* 14 */
 }
 
 uint16_t irdm_cia402_statusword(enum irdm_cia402_state s)

@@ -51,8 +51,7 @@ static int master_cfg(struct irdm_hal_dev *dev, const struct irdm_hal_can_opts *
 	mc->tpdo_missing_periods = o->tpdo_missing_periods;
 	mc->master_node = o->master_node;
 	/* the drive's deadline: the option, else three periods in whole ms */
-	mc->rpdo_timeout_ms = (uint16_t)(o->rpdo_timeout_ms ? o->rpdo_timeout_ms
-							    : (3u * period_us + 999u) / 1000u);
+	mc->rpdo_timeout_ms = (uint16_t)(o->rpdo_timeout_ms ? o->rpdo_timeout_ms : (3u * period_us + 999u) / 1000u);
 	mc->sdo_timeout_polls = (unsigned)((o->sdo_timeout_ms * 1000ull + period_us - 1) / period_us);
 	mc->idle = can_of(dev)->link->idle;
 	mc->idle_ctx = dev;
@@ -120,7 +119,7 @@ static int receive(struct irdm_hal_dev *dev)
 
 	if (c->link->check)
 		c->link->check(dev, &c->m);
-	pump(dev);              /* a fault just found sent the torque off: heard now */
+	pump(dev); /* a fault just found sent the torque off: heard now */
 	return c->m.faulted ? faulted(dev) : rc;
 }
 
@@ -175,11 +174,13 @@ int irdm_hal_can_start(struct irdm_hal_dev *dev)
 		k = irdm_can_master_first_stale(&c->m);
 		if (k >= 0)
 			snprintf(dev->why, sizeof(dev->why), "drive %d (node %u): no TPDO1 to the "
-				 "disabled SYNCs before enabling (%u ms)", k + 1,
+							     "disabled SYNCs before enabling (%u ms)",
+				 k + 1,
 				 c->m.cfg.axis[k].node, (unsigned)c->opts.enable_timeout_ms);
 		else
 			snprintf(dev->why, sizeof(dev->why), "CAN: fewer than %d SYNCs answered in "
-				 "a row before enabling, within %u ms", IRDM_HAL_CAN_STEADY_PERIODS,
+							     "a row before enabling, within %u ms",
+				 IRDM_HAL_CAN_STEADY_PERIODS,
 				 (unsigned)c->opts.enable_timeout_ms);
 		irdm_can_master_safe_off(&c->m);
 		pump(dev);
@@ -202,7 +203,7 @@ int irdm_hal_can_start(struct irdm_hal_dev *dev)
 			 irdm_cia402_name(c->m.ax[k].state));
 		return IRDM_ETIMEDOUT;
 	}
-	send_hold(dev);         /* the first read's TPDO is on its way */
+	send_hold(dev); /* the first read's TPDO is on its way */
 	c->written = true;
 	c->state = HAL_CAN_RUNNING;
 	return IRDM_OK;
@@ -229,7 +230,7 @@ int irdm_hal_can_read(struct irdm_hal_dev *dev, struct irdm_hal_joint_state *st)
 		rc = IRDM_OK;
 	if (rc)
 		return rc;
-	dev->why[0] = '\0';    /* a late TPDO's line is not the reason of a later fault */
+	dev->why[0] = '\0'; /* a late TPDO's line is not the reason of a later fault */
 	for (unsigned a = 0; a < IRDM_HAL_JOINTS; a++)
 		st->counts[a] = c->m.ax[a].counts;
 	st->seq = ++c->seq;
@@ -245,7 +246,7 @@ int irdm_hal_can_write(struct irdm_hal_dev *dev, const double tau_nm[IRDM_HAL_JO
 	if (c->state != HAL_CAN_RUNNING)
 		return IRDM_EINVAL;
 	if (c->m.faulted) {
-		(void)irdm_can_master_send(&c->m, NULL);        /* off again, with the SYNC */
+		(void)irdm_can_master_send(&c->m, NULL); /* off again, with the SYNC */
 		pump(dev);
 		c->written = true;
 		return faulted(dev);
@@ -268,7 +269,7 @@ int irdm_hal_can_safe_off(struct irdm_hal_dev *dev)
 	int rc;
 
 	if (c->state == HAL_CAN_CLOSED)
-		return IRDM_OK;         /* nothing open: nothing can apply torque */
+		return IRDM_OK; /* nothing open: nothing can apply torque */
 	rc = irdm_can_master_safe_off(&c->m);
 	pump(dev);
 	c->written = true;

@@ -16,8 +16,7 @@
 /* A comma list of 1..IRDM_CAN_AXES_MAX numbers in [lo, hi]; *n of them. */
 static int list(const char *v, unsigned lo, unsigned hi, uint32_t out[], unsigned *n)
 {
-	struct irdm_opt e = { .name = "item", .type = IRDM_OPT_UNSIGNED, .size = sizeof(uint32_t),
-			      UPTO(lo, hi) };
+	struct irdm_opt e = { .name = "item", .type = IRDM_OPT_UNSIGNED, .size = sizeof(uint32_t), UPTO(lo, hi) };
 	char buf[64], why[64], *tok = buf;
 
 	if (strlen(v) >= sizeof(buf))
@@ -77,10 +76,8 @@ static int parse_emcy_at(const struct irdm_opt *o, void *obj, const char *v, cha
 			 size_t len)
 {
 	struct irdm_hal_can_opts *c = obj;
-	struct irdm_opt drive = { .name = "drive", .type = IRDM_OPT_UNSIGNED, CO(emcy_drive),
-				  UPTO(1, IRDM_CAN_AXES_MAX) };
-	struct irdm_opt at = { .name = "at", .type = IRDM_OPT_UNSIGNED, CO(emcy_at_ms),
-			       UPTO(0, 3600000) };
+	struct irdm_opt drive = { .name = "drive", .type = IRDM_OPT_UNSIGNED, CO(emcy_drive), UPTO(1, IRDM_CAN_AXES_MAX) };
+	struct irdm_opt at = { .name = "at", .type = IRDM_OPT_UNSIGNED, CO(emcy_at_ms), UPTO(0, 3600000) };
 	struct irdm_hal_can_opts tmp = *c;
 	char buf[32], *colon, w[64];
 
@@ -102,59 +99,47 @@ bad:
 }
 
 /* The keys every CAN back-end takes. */
-#define CAN_COMMON                                                                              \
-	{ .name = "nodes", .type = IRDM_OPT_CUSTOM, .parse = parse_nodes, .metavar = "N1,N2,N3", \
-	  .help = "the node id (1..127) of the drive of joint 1, 2, 3; canemu: "   \
-		  "consecutive (required)" },                            \
-	{ .name = "rated_torque_mnm", .type = IRDM_OPT_CUSTOM, .parse = parse_torque,          \
-	  .metavar = "T | T1,T2,T3",                                                            \
-	  .help = "each drive's rated motor torque, 1..1000000 mN m, once or per "  \
-		  "axis, written to 0x6076; the target torque is sent in per mille of it "      \
-		  "(required)" },                                                               \
-	{ .name = "bitrate", .type = IRDM_OPT_UNSIGNED, CO(bitrate), UPTO(10000, 1000000),      \
-	  .unit = "bit/s", .help = "only for the bus-load check (the interface's own rate is set "    \
-		  "outside, ip link)", .def = "1000000" },                    \
-	{ .name = "heartbeat_ms", .type = IRDM_OPT_UNSIGNED, CO(heartbeat_ms), UPTO(1, 65535),  \
-	  .unit = "ms", .help = "the drives' heartbeat producer time, written to 0x1017", .def = "10" },        \
-	{ .name = "heartbeat_timeout_ms", .type = IRDM_OPT_UNSIGNED, CO(heartbeat_timeout_ms),  \
-	  UPTO(2, 600000), .unit = "ms",                                                        \
-	  .help = "a drive silent longer is lost; must exceed heartbeat_ms; also "   \
-		  "each drive's tolerance for the master's heartbeat (0x1016:01, at most 65535)", .def = "50" },        \
-	{ .name = "tpdo_missing_periods", .type = IRDM_OPT_UNSIGNED, CO(tpdo_missing_periods),  \
-	  UPTO(1, 1000), .help = "this many periods in a row without a TPDO1 lose the drive",             \
-	  .def = "3" },                                                                         \
-	{ .name = "sync_counter", .type = IRDM_OPT_BOOL, CO(sync_counter),                     \
-	  .help = "a counter byte (1..240) in the SYNC; 0x1019 = 240 (else 0) on each "  \
-		  "drive", .def = "no" },                 \
-	{ .name = "sdo_timeout_ms", .type = IRDM_OPT_UNSIGNED, CO(sdo_timeout_ms),              \
-	  UPTO(1, 60000), .unit = "ms", .help = "the wait for each SDO answer at set-up",          \
-	  .def = "100" },                                                                       \
-	{ .name = "enable_timeout_ms", .type = IRDM_OPT_UNSIGNED, CO(enable_timeout_ms),        \
-	  UPTO(1, 60000), .unit = "ms", .help = "start's wait for the disabled exchange and every drive to be "  \
-		  "operation enabled",      \
-	  .def = "100" },                                                                       \
-	{ .name = "master_node", .type = IRDM_OPT_UNSIGNED, CO(master_node), UPTO(1, 127),     \
-	  .help = "the master's own node id, not a drive's: its heartbeat 0x700 + N, "  \
-		  "each drive's 0x1016:01", .def = "127" },       \
-	{ .name = "rpdo_timeout_ms", .type = IRDM_OPT_UNSIGNED, CO(rpdo_timeout_ms),            \
-	  UPTO(1, 65535), .unit = "ms",                                                         \
-	  .help = "each drive's RPDO1 deadline, 0x1400:05; not given: 3 periods, "  \
-		  "rounded up to ms" }
+#define CAN_COMMON \
+	{ .name = "nodes", .type = IRDM_OPT_CUSTOM, .parse = parse_nodes, .metavar = "N1,N2,N3", .help = "the node id (1..127) of the drive of joint 1, 2, 3; canemu: " \
+													 "consecutive (required)" }, \
+		{ .name = "rated_torque_mnm", .type = IRDM_OPT_CUSTOM, .parse = parse_torque, .metavar = "T | T1,T2,T3", .help = "each drive's rated motor torque, 1..1000000 mN m, once or per " \
+																 "axis, written to 0x6076; the target torque is sent in per mille of it " \
+																 "(required)" }, \
+		{ .name = "bitrate", .type = IRDM_OPT_UNSIGNED, CO(bitrate), UPTO(10000, 1000000), .unit = "bit/s", .help = "only for the bus-load check (the interface's own rate is set " \
+															    "outside, ip link)", \
+		  .def = "1000000" }, \
+		{ .name = "heartbeat_ms", .type = IRDM_OPT_UNSIGNED, CO(heartbeat_ms), UPTO(1, 65535), .unit = "ms", .help = "the drives' heartbeat producer time, written to 0x1017", .def = "10" }, \
+		{ .name = "heartbeat_timeout_ms", .type = IRDM_OPT_UNSIGNED, CO(heartbeat_timeout_ms), UPTO(2, 600000), .unit = "ms", .help = "a drive silent longer is lost; must exceed heartbeat_ms; also " \
+																	      "each drive's tolerance for the master's heartbeat (0x1016:01, at most 65535)", \
+		  .def = "50" }, \
+		{ .name = "tpdo_missing_periods", .type = IRDM_OPT_UNSIGNED, CO(tpdo_missing_periods), UPTO(1, 1000), .help = "this many periods in a row without a TPDO1 lose the drive", .def = "3" }, \
+		{ .name = "sync_counter", .type = IRDM_OPT_BOOL, CO(sync_counter), .help = "a counter byte (1..240) in the SYNC; 0x1019 = 240 (else 0) on each " \
+											   "drive", \
+		  .def = "no" }, \
+		{ .name = "sdo_timeout_ms", .type = IRDM_OPT_UNSIGNED, CO(sdo_timeout_ms), UPTO(1, 60000), .unit = "ms", .help = "the wait for each SDO answer at set-up", .def = "100" }, \
+		{ .name = "enable_timeout_ms", .type = IRDM_OPT_UNSIGNED, CO(enable_timeout_ms), UPTO(1, 60000), .unit = "ms", .help = "start's wait for the disabled exchange and every drive to be " \
+																       "operation enabled", \
+		  .def = "100" }, \
+		{ .name = "master_node", .type = IRDM_OPT_UNSIGNED, CO(master_node), UPTO(1, 127), .help = "the master's own node id, not a drive's: its heartbeat 0x700 + N, " \
+													   "each drive's 0x1016:01", \
+		  .def = "127" }, \
+	{ \
+		.name = "rpdo_timeout_ms", .type = IRDM_OPT_UNSIGNED, CO(rpdo_timeout_ms), \
+		UPTO(1, 65535), .unit = "ms", \
+		.help = "each drive's RPDO1 deadline, 0x1400:05; not given: 3 periods, " \
+			"rounded up to ms" \
+	}
 
 static const struct irdm_opt socketcan_opts[] = {
-	{ .name = "iface", .type = IRDM_OPT_STRING, CO(iface), .metavar = "NAME",
-	  .help = "the SocketCAN interface, e.g. can0 (required)" },
+	{ .name = "iface", .type = IRDM_OPT_STRING, CO(iface), .metavar = "NAME", .help = "the SocketCAN interface, e.g. can0 (required)" },
 	CAN_COMMON,
 };
 
 static const struct irdm_opt canemu_opts[] = {
 	CAN_COMMON,
-	{ .name = "substeps", .type = IRDM_OPT_UNSIGNED, CO(substeps), UPTO(1, 100),
-	  .help = "the emulated arm's integration steps a period", .def = "10" },
-	{ .name = "emcy_at", .type = IRDM_OPT_CUSTOM, .parse = parse_emcy_at,
-	  .metavar = "D:MS",
-	  .help = "an injected fault: drive D (1..3) raises EMCY 0x2310 (current) and faults at "
-		  "MS ms (0..3600000) of emulated time; not given: none" },
+	{ .name = "substeps", .type = IRDM_OPT_UNSIGNED, CO(substeps), UPTO(1, 100), .help = "the emulated arm's integration steps a period", .def = "10" },
+	{ .name = "emcy_at", .type = IRDM_OPT_CUSTOM, .parse = parse_emcy_at, .metavar = "D:MS", .help = "an injected fault: drive D (1..3) raises EMCY 0x2310 (current) and faults at "
+													 "MS ms (0..3600000) of emulated time; not given: none" },
 };
 
 const struct irdm_opt_table irdm_hal_socketcan_options = {
@@ -203,8 +188,7 @@ static int check(const struct irdm_hal_can_opts *o, unsigned extra, const char *
 int irdm_hal_can_parse(const char *options, unsigned extra, const char *where,
 		       struct irdm_hal_can_opts *o, char *err, size_t errlen)
 {
-	const struct irdm_opt_table *t = (extra & IRDM_HAL_CAN_IFACE) ? &irdm_hal_socketcan_options
-								      : &irdm_hal_canemu_options;
+	const struct irdm_opt_table *t = (extra & IRDM_HAL_CAN_IFACE) ? &irdm_hal_socketcan_options : &irdm_hal_canemu_options;
 
 	memset(o, 0, sizeof(*o));
 	if (irdm_opt_set_defaults(t, o, err, errlen) ||

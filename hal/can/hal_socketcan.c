@@ -14,7 +14,7 @@
 #include "irdm/hal/socketcan.h"
 
 struct socketcan_data {
-	struct irdm_hal_can can;        /* first: the shared code's view */
+	struct irdm_hal_can can; /* first: the shared code's view */
 	struct irdm_socketcan sock;
 };
 
@@ -59,7 +59,7 @@ static void link_close(struct irdm_hal_dev *dev)
 
 static const struct irdm_hal_can_link socketcan_link = {
 	.open = link_open,
-	.pump = NULL,           /* a wire: the drives answer on their own */
+	.pump = NULL, /* a wire: the drives answer on their own */
 	.idle = link_idle,
 	.check = link_check,
 	.close = link_close,

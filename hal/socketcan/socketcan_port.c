@@ -46,7 +46,7 @@ static void error_frame(struct irdm_socketcan *s, const struct can_frame *cf)
 	    (cf->data[1] & (CAN_ERR_CRTL_RX_PASSIVE | CAN_ERR_CRTL_TX_PASSIVE)))
 		s->error_passive = true;
 	if (cf->can_id & CAN_ERR_RESTARTED)
-		s->error_passive = false;       /* the controller came back error active */
+		s->error_passive = false; /* the controller came back error active */
 }
 
 static int sc_send(void *ctx, const struct irdm_can_frame *f)
@@ -58,7 +58,7 @@ static int sc_send(void *ctx, const struct irdm_can_frame *f)
 	if (s->fd < 0 || s->bus_off)
 		return IRDM_EIO;
 	if (f->id > CAN_SFF_MASK || f->dlc > CAN_MAX_DLEN)
-		return IRDM_EINVAL;             /* ours to check: the kernel would take an EFF id */
+		return IRDM_EINVAL; /* ours to check: the kernel would take an EFF id */
 	memset(&cf, 0, sizeof(cf));
 	cf.can_id = f->id;
 	cf.len = f->dlc;
@@ -70,7 +70,7 @@ static int sc_send(void *ctx, const struct irdm_can_frame *f)
 		s->tx_dropped++;
 		return IRDM_EBUSY;
 	}
-	return IRDM_EIO;                        /* link gone, or a short write: never normal */
+	return IRDM_EIO; /* link gone, or a short write: never normal */
 }
 
 static int sc_recv(void *ctx, struct irdm_can_frame *f)
@@ -83,7 +83,7 @@ static int sc_recv(void *ctx, struct irdm_can_frame *f)
 		return IRDM_EIO;
 	n = read(s->fd, &cf, sizeof(cf));
 	if (n < 0)
-		return link_gone(errno) ? IRDM_EIO : 0;         /* EAGAIN: nothing waiting */
+		return link_gone(errno) ? IRDM_EIO : 0; /* EAGAIN: nothing waiting */
 	if (n == (ssize_t)sizeof(cf) && (cf.can_id & CAN_ERR_FLAG)) {
 		error_frame(s, &cf);
 		return s->bus_off ? IRDM_EIO : 0;
@@ -153,8 +153,7 @@ int irdm_socketcan_open(struct irdm_socketcan *s, const char *ifname, struct ird
 		int e = errno;
 
 		say(err, errlen, "socketcan: %s: this kernel has no CAN sockets: %s", s->ifname, e);
-		return e == EAFNOSUPPORT || e == EPROTONOSUPPORT || e == EINVAL ? IRDM_ENOTSUP
-										: IRDM_EIO;
+		return e == EAFNOSUPPORT || e == EPROTONOSUPPORT || e == EINVAL ? IRDM_ENOTSUP : IRDM_EIO;
 	}
 	rc = setup(s, err, errlen);
 	if (rc != IRDM_OK) {

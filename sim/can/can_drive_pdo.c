@@ -4,7 +4,7 @@
 #include "irdm/sim/can_drive_pdo.h"
 
 /* CiA 301 abort codes (names: irdm_co_abort_name()) */
-#define AB_UNSUPPORTED_ACCESS 0x06010000u       /* the mapping of a valid PDO, or sub 0 != 0 */
+#define AB_UNSUPPORTED_ACCESS 0x06010000u /* the mapping of a valid PDO, or sub 0 != 0 */
 #define AB_READ_ONLY 0x06010002u
 #define AB_NOT_MAPPABLE 0x06040041u
 #define AB_LENGTH 0x06070010u
@@ -31,7 +31,7 @@ uint32_t irdm_can_pdo_write_comm(struct irdm_can_pdo *p, uint8_t sub, uint32_t v
 {
 	switch (sub) {
 	case 0:
-		return AB_READ_ONLY;                    /* the highest sub-index */
+		return AB_READ_ONLY; /* the highest sub-index */
 	case 1:
 		if (size != 4)
 			return AB_LENGTH;
@@ -71,11 +71,11 @@ uint32_t irdm_can_pdo_write_map(struct irdm_can_pdo *p, uint8_t sub, uint32_t v,
 		return AB_UNSUPPORTED_ACCESS;
 	if (sub == 0) {
 		if (v != 0 && v != IRDM_CAN_PDO_ENTRIES)
-			return AB_INVALID_VALUE;        /* the emulator runs the whole mapping only */
+			return AB_INVALID_VALUE; /* the emulator runs the whole mapping only */
 		p->n_mapped = (uint8_t)v;
 		return 0;
 	}
 	if (p->n_mapped != 0)
-		return AB_UNSUPPORTED_ACCESS;           /* entries change only with the mapping off */
+		return AB_UNSUPPORTED_ACCESS; /* entries change only with the mapping off */
 	return v == p->map[sub - 1] ? 0 : AB_NOT_MAPPABLE;
 }

@@ -7,23 +7,23 @@
 #include "irdm/error.h"
 
 #define MODE_CST 10
-#define DEVICE_TYPE 0x00020192u         /* 0x1000: CiA 402 (0x0192), servo drive */
-#define VENDOR_ID 0x00000000u           /* 0x1018:01: none registered (an emulator) */
+#define DEVICE_TYPE 0x00020192u /* 0x1000: CiA 402 (0x0192), servo drive */
+#define VENDOR_ID 0x00000000u   /* 0x1018:01: none registered (an emulator) */
 #define PRODUCT_CODE 0x00000402u
 #define REVISION 0x00010000u
-#define ABORT_FAULT 1                   /* 0x6007 (CiA 402): its default */
+#define ABORT_FAULT 1 /* 0x6007 (CiA 402): its default */
 #define ABORT_DISABLE_VOLTAGE 2
 #define ABORT_QUICK_STOP 3
-#define EMCY_SYNC_LENGTH 0x8240u        /* unexpected SYNC data length */
-#define EMCY_HEARTBEAT 0x8130u          /* heartbeat (life guard) lost */
-#define EMCY_RPDO_TIMEOUT 0x8250u       /* RPDO time-out */
+#define EMCY_SYNC_LENGTH 0x8240u  /* unexpected SYNC data length */
+#define EMCY_HEARTBEAT 0x8130u    /* heartbeat (life guard) lost */
+#define EMCY_RPDO_TIMEOUT 0x8250u /* RPDO time-out */
 /* the CST mapping the master writes: RPDO1 0x6040 + 0x6071, TPDO1 0x6041 + 0x6064 */
 static const uint32_t rpdo_map[IRDM_CAN_PDO_ENTRIES] = { 0x60400010, 0x60710010 };
 static const uint32_t tpdo_map[IRDM_CAN_PDO_ENTRIES] = { 0x60410010, 0x60640020 };
 
 static void send(struct irdm_can_drives *dr, const struct irdm_can_frame *f)
 {
-	(void)irdm_can_send(&dr->port, f);     /* a full queue drops it, as a wire would */
+	(void)irdm_can_send(&dr->port, f); /* a full queue drops it, as a wire would */
 }
 
 static void heartbeat(struct irdm_can_drives *dr, struct irdm_can_drive *d)
@@ -90,7 +90,7 @@ static void connection_lost(struct irdm_can_drives *dr, struct irdm_can_drive *d
 		irdm_cia402_drive_command(&d->fsa, cw);
 		break;
 	default:
-		break;                          /* 0: no reaction, the torque stays */
+		break; /* 0: no reaction, the torque stays */
 	}
 	if (d->abort_option != 0) {
 		d->rpdo_cw = cw;
@@ -98,7 +98,7 @@ static void connection_lost(struct irdm_can_drives *dr, struct irdm_can_drive *d
 	}
 	f.data[0] = (uint8_t)code;
 	f.data[1] = (uint8_t)(code >> 8);
-	f.data[2] = 0x11;                       /* error register: generic + communication */
+	f.data[2] = 0x11; /* error register: generic + communication */
 	f.data[3] = (uint8_t)(uint16_t)d->rpdo_torque_permille;
 	f.data[4] = (uint8_t)((uint16_t)d->rpdo_torque_permille >> 8);
 	send(dr, &f);
@@ -192,9 +192,9 @@ static void sdo_reply(struct irdm_can_drives *dr, const struct irdm_can_drive *d
 	struct irdm_can_frame f = { .id = IRDM_CO_SDO_TX + d->node, .dlc = 8 };
 
 	f.data[0] = cmd;
-	memcpy(f.data + 1, req->data + 1, 3);           /* index, sub-index */
+	memcpy(f.data + 1, req->data + 1, 3); /* index, sub-index */
 	if (d->sdo_wrong)
-		f.data[1] ^= 0x01;                      /* about another object */
+		f.data[1] ^= 0x01; /* about another object */
 	for (int k = 0; k < 4; k++)
 		f.data[4 + k] = (uint8_t)(data >> (8 * k));
 	send(dr, &f);
@@ -286,7 +286,7 @@ static uint32_t write_consumer(struct irdm_can_drive *d, uint8_t sub, uint32_t v
 	if (v & 0xFF000000u || ((v >> 16) & 0xFF) > IRDM_CO_NODE_MAX)
 		return 0x06090030;
 	d->hb_consumer = v;
-	d->master_beat_seen = false;    /* runs from the next heartbeat heard */
+	d->master_beat_seen = false; /* runs from the next heartbeat heard */
 	return 0;
 }
 
@@ -310,9 +310,9 @@ static uint32_t object_write(struct irdm_can_drive *d, uint16_t index, uint8_t s
 		return 0x06010002;
 	if (sub != 0)
 		return index == 0x6060 || index == 0x1017 || index == 0x6076 || index == 0x1006 ||
-			       index == 0x1019 || index == 0x6007
-			       ? 0x06090011
-			       : 0x06020000;
+				       index == 0x1019 || index == 0x6007 ?
+			       0x06090011 :
+			       0x06020000;
 	switch (index) {
 	case 0x1006:
 		if (size != 4)
@@ -333,7 +333,7 @@ static uint32_t object_write(struct irdm_can_drive *d, uint16_t index, uint8_t s
 		if (size != 2)
 			return 0x06070010;
 		if ((int16_t)v < 0 || (int16_t)v > ABORT_QUICK_STOP)
-			return 0x06090030;      /* no vendor reactions here */
+			return 0x06090030; /* no vendor reactions here */
 		d->abort_option = (int16_t)v;
 		return 0;
 	case 0x6060:
@@ -373,7 +373,7 @@ static void sdo(struct irdm_can_drives *dr, struct irdm_can_drive *d, const stru
 		dr->bad_frames++;
 		return;
 	}
-	if (cmd == 0x40) {                                      /* upload */
+	if (cmd == 0x40) { /* upload */
 		abort_code = object_read(dr, d, index, sub, &v, &size);
 		if (abort_code)
 			sdo_reply(dr, d, f, 0x80, abort_code);
@@ -381,7 +381,7 @@ static void sdo(struct irdm_can_drives *dr, struct irdm_can_drive *d, const stru
 			sdo_reply(dr, d, f, (uint8_t)(0x43 | ((4 - size) << 2)), v);
 		return;
 	}
-	if ((cmd & 0xE3) != 0x23) {                             /* only expedited downloads */
+	if ((cmd & 0xE3) != 0x23) { /* only expedited downloads */
 		sdo_reply(dr, d, f, 0x80, 0x05040001);
 		return;
 	}
@@ -458,7 +458,7 @@ static void tpdo_out(struct irdm_can_drives *dr, struct irdm_can_drive *d,
 		dr->tpdos_dropped++;
 		return;
 	}
-	if (d->held) {                                  /* the older one first: order kept */
+	if (d->held) { /* the older one first: order kept */
 		send(dr, &d->held_frame);
 		d->held = false;
 	}
@@ -490,7 +490,7 @@ static bool sync_accepted(struct irdm_can_drives *dr, struct irdm_can_drive *d, 
 	dr->sync_length_errors++;
 	f.data[0] = (uint8_t)EMCY_SYNC_LENGTH;
 	f.data[1] = (uint8_t)(EMCY_SYNC_LENGTH >> 8);
-	f.data[2] = 0x11;                       /* error register: generic + communication */
+	f.data[2] = 0x11; /* error register: generic + communication */
 	f.data[3] = dlc;
 	send(dr, &f);
 	d->nmt = IRDM_CO_STATE_PRE_OPERATIONAL;
@@ -579,10 +579,10 @@ static void frame_in(struct irdm_can_drives *dr, const struct irdm_can_frame *f)
 			d->rpdo_us = deadline_now(dr);
 		}
 	} else if (irdm_co_node_of(f, IRDM_CO_HEARTBEAT)) {
-		master_beat(dr, f);     /* (our own drives' beats are not ours to watch) */
+		master_beat(dr, f); /* (our own drives' beats are not ours to watch) */
 	} else if (!irdm_co_node_of(f, IRDM_CO_TPDO1) && !irdm_co_node_of(f, IRDM_CO_SDO_TX) &&
 		   !irdm_co_node_of(f, IRDM_CO_EMCY)) {
-		dr->bad_frames++;                               /* nothing of ours */
+		dr->bad_frames++; /* nothing of ours */
 	}
 }
 
@@ -646,7 +646,7 @@ void irdm_can_drives_fault(struct irdm_can_drives *dr, unsigned k, uint16_t code
 
 	f.data[0] = (uint8_t)code;
 	f.data[1] = (uint8_t)(code >> 8);
-	f.data[2] = 0x01;                                       /* error register: generic */
+	f.data[2] = 0x01; /* error register: generic */
 	send(dr, &f);
 	irdm_cia402_drive_fault(&dr->d[k].fsa);
 }

@@ -14,7 +14,7 @@
 static const struct {
 	const char *name;
 	enum irdm_can_fault_kind kind;
-	unsigned fields;                /* numbers after the name */
+	unsigned fields; /* numbers after the name */
 	const char *usage;
 } kinds[] = {
 	{ "drop", IRDM_CAN_FAULT_DROP, 3, "drop:NODE:SYNC:K" },
@@ -108,5 +108,6 @@ int irdm_can_fault_parse(const char *word, struct irdm_can_fault *f, char *err, 
 		return IRDM_OK;
 	}
 	return bad(err, errlen, word, "unknown kind, expected one of drop, delay, heartbeat-stop, "
-		   "emcy, fault, sdo-wrong, flood", NULL);
+				      "emcy, fault, sdo-wrong, flood",
+		   NULL);
 }

@@ -12,7 +12,7 @@ static int membus_send(void *ctx, const struct irdm_can_frame *f)
 	unsigned slot = (unsigned)(bus->sent % IRDM_CAN_MEMBUS_FRAMES);
 
 	if (f->dlc > 8 || f->id > 0x7FF)
-		return IRDM_EIO;                /* a controller would not send it */
+		return IRDM_EIO; /* a controller would not send it */
 	bus->ring[slot] = *f;
 	bus->from[slot] = ep->index;
 	bus->sent++;
@@ -34,7 +34,7 @@ static int membus_recv(void *ctx, struct irdm_can_frame *f)
 		unsigned slot = (unsigned)(ep->next++ % IRDM_CAN_MEMBUS_FRAMES);
 
 		if (bus->from[slot] == ep->index)
-			continue;               /* a node does not hear itself */
+			continue; /* a node does not hear itself */
 		*f = bus->ring[slot];
 		return 1;
 	}

@@ -40,9 +40,15 @@ static void point_kin(const struct body *bd, const double q[3], const double qd[
 	double rdd = -bd->a * c2 * qd[1] * qd[1] - bd->b * s3 * qd[2] * qd[2];
 	double hdd = -bd->a * s2 * qd[1] * qd[1] + bd->b * c3 * qd[2] * qd[2];
 
-	j[0] = r * c1;  j[1] = -bd->a * s2 * s1; j[2] = bd->b * c3 * s1;
-	j[3] = 0;       j[4] = bd->a * c2;       j[5] = bd->b * s3;
-	j[6] = -r * s1; j[7] = -bd->a * s2 * c1; j[8] = bd->b * c3 * c1;
+	j[0] = r * c1;
+	j[1] = -bd->a * s2 * s1;
+	j[2] = bd->b * c3 * s1;
+	j[3] = 0;
+	j[4] = bd->a * c2;
+	j[5] = bd->b * s3;
+	j[6] = -r * s1;
+	j[7] = -bd->a * s2 * c1;
+	j[8] = bd->b * c3 * c1;
 	acc[0] = rdd * s1 + 2 * rd * c1 * qd[0] - r * s1 * qd[0] * qd[0];
 	acc[1] = hdd;
 	acc[2] = rdd * c1 - 2 * rd * s1 * qd[0] - r * c1 * qd[0] * qd[0];
@@ -161,7 +167,7 @@ static unsigned classify(struct irdm_sim_device *s, double fric[3])
 	applied(s, s->q_rad, s->qd_rad_per_s, tau);
 	for (int i = 0; i < 3; i++) {
 		double c = s->p.coulomb_nm[i], v = s->qd_rad_per_s[i];
-		double hold = tau[i] - grav[i];         /* what friction must resist */
+		double hold = tau[i] - grav[i]; /* what friction must resist */
 
 		fric[i] = 0;
 		if (c <= 0)
@@ -172,7 +178,7 @@ static unsigned classify(struct irdm_sim_device *s, double fric[3])
 			stuck |= 1u << i;
 			s->qd_rad_per_s[i] = 0;
 		} else {
-			fric[i] = -copysign(c, hold);   /* breaking away */
+			fric[i] = -copysign(c, hold); /* breaking away */
 		}
 	}
 	return stuck;

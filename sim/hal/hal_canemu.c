@@ -9,11 +9,11 @@
 #include "hal_sim_hand.h"
 
 struct canemu_data {
-	struct irdm_hal_can can;        /* first: the shared code's view */
+	struct irdm_hal_can can; /* first: the shared code's view */
 	struct irdm_can_membus bus;
 	struct irdm_can_drives drives;
-	bool emcy_done;                 /* the injected emcy_at fault happened */
-	struct sim_hand hand;           /* the virtual user's, if one holds the arm */
+	bool emcy_done;       /* the injected emcy_at fault happened */
+	struct sim_hand hand; /* the virtual user's, if one holds the arm */
 };
 
 static struct canemu_data *data_of(struct irdm_hal_dev *dev)
@@ -32,7 +32,7 @@ static int link_open(struct irdm_hal_dev *dev, struct irdm_can_port *port, char 
 	for (unsigned k = 1; k < o->n_nodes; k++)
 		if (o->nodes[k] != o->nodes[0] + k) {
 			snprintf(err, errlen, "hal_options: nodes: the emulator's nodes are "
-				 "consecutive (e.g. 1,2,3)");
+					      "consecutive (e.g. 1,2,3)");
 			return IRDM_EINVAL;
 		}
 	irdm_can_membus_init(&d->bus);
@@ -72,7 +72,7 @@ static void link_idle(void *ctx)
 
 static void link_close(struct irdm_hal_dev *dev)
 {
-	(void)dev;              /* memory only: nothing to release */
+	(void)dev; /* memory only: nothing to release */
 }
 
 static const struct irdm_hal_can_link canemu_link = {
@@ -146,9 +146,9 @@ const struct irdm_hal_backend irdm_hal_canemu_backend = {
 static struct canemu_data *open_canemu(struct irdm_hal_dev *dev)
 {
 	return dev && dev->backend == &irdm_hal_canemu_backend &&
-			       data_of(dev)->can.state != HAL_CAN_CLOSED
-		       ? data_of(dev)
-		       : NULL;
+			       data_of(dev)->can.state != HAL_CAN_CLOSED ?
+		       data_of(dev) :
+		       NULL;
 }
 
 struct irdm_can_drives *irdm_hal_canemu_drives(struct irdm_hal_dev *dev)

@@ -10,14 +10,17 @@
 
 #include "hal_sim_hand.h"
 
-enum sim_state { SIM_CLOSED = 0, SIM_OPEN, SIM_RUNNING, SIM_OFF };
+enum sim_state { SIM_CLOSED = 0,
+		 SIM_OPEN,
+		 SIM_RUNNING,
+		 SIM_OFF };
 
 struct sim_data {
 	struct irdm_sim_device arm;
 	enum sim_state state;
 	uint32_t faults;
 	uint64_t seq;
-	struct sim_hand hand;           /* the virtual user's, if one holds the arm */
+	struct sim_hand hand; /* the virtual user's, if one holds the arm */
 };
 
 static struct sim_data *data_of(struct irdm_hal_dev *dev)
@@ -31,21 +34,11 @@ static struct sim_data *data_of(struct irdm_hal_dev *dev)
 /* Its hal_options (docs/hal-options.md); the rest of the arm's figures are
  * irdm_sim_params_default()'s. */
 static const struct irdm_opt sim_opts[] = {
-	{ .name = "write_delay", .type = IRDM_OPT_UNSIGNED, SP(write_delay_ticks),
-	  UPTO(0, IRDM_SIM_DELAY_MAX), .metavar = "K",
-	  .help = "ticks a written torque waits on the simulated bus",
-	  IRDM_OPT_DEFAULT(IRDM_SIM_DEFAULT_DELAY_TICKS) },
-	{ .name = "read_delay", .type = IRDM_OPT_UNSIGNED, SP(read_delay_ticks),
-	  UPTO(0, IRDM_SIM_DELAY_MAX), .metavar = "K",
-	  .help = "ticks an encoder sample waits on the simulated bus",
-	  IRDM_OPT_DEFAULT(IRDM_SIM_DEFAULT_DELAY_TICKS) },
-	{ .name = "substeps", .type = IRDM_OPT_UNSIGNED, SP(substeps),
-	  UPTO(1, IRDM_SIM_SUBSTEPS_MAX), .metavar = "N",
-	  .help = "integration (RK4) steps of the arm per tick",
-	  IRDM_OPT_DEFAULT(IRDM_SIM_DEFAULT_SUBSTEPS) },
-	{ .name = "end_stops", .type = IRDM_OPT_INT, SP(end_stops), UPTO(0, 1), .metavar = "0 | 1",
-	  .help = "the arm's mechanical stops just inside count_min..count_max; 0: an arm "
-		  "that can leave its encoders' range (a test of that fault)",
+	{ .name = "write_delay", .type = IRDM_OPT_UNSIGNED, SP(write_delay_ticks), UPTO(0, IRDM_SIM_DELAY_MAX), .metavar = "K", .help = "ticks a written torque waits on the simulated bus", IRDM_OPT_DEFAULT(IRDM_SIM_DEFAULT_DELAY_TICKS) },
+	{ .name = "read_delay", .type = IRDM_OPT_UNSIGNED, SP(read_delay_ticks), UPTO(0, IRDM_SIM_DELAY_MAX), .metavar = "K", .help = "ticks an encoder sample waits on the simulated bus", IRDM_OPT_DEFAULT(IRDM_SIM_DEFAULT_DELAY_TICKS) },
+	{ .name = "substeps", .type = IRDM_OPT_UNSIGNED, SP(substeps), UPTO(1, IRDM_SIM_SUBSTEPS_MAX), .metavar = "N", .help = "integration (RK4) steps of the arm per tick", IRDM_OPT_DEFAULT(IRDM_SIM_DEFAULT_SUBSTEPS) },
+	{ .name = "end_stops", .type = IRDM_OPT_INT, SP(end_stops), UPTO(0, 1), .metavar = "0 | 1", .help = "the arm's mechanical stops just inside count_min..count_max; 0: an arm "
+													    "that can leave its encoders' range (a test of that fault)",
 	  IRDM_OPT_DEFAULT(IRDM_SIM_DEFAULT_END_STOPS) },
 };
 
@@ -62,7 +55,8 @@ static int parse_options(const char *options, const char *where, struct irdm_sim
 {
 	irdm_sim_params_default(p);
 	return irdm_opt_parse_words(&sim_table, p, where, options, " ,\t", err, errlen) ?
-	       IRDM_EINVAL : IRDM_OK;
+		       IRDM_EINVAL :
+		       IRDM_OK;
 }
 
 static int sim_check_options(const char *options, const char *where, char *err, size_t errlen)
@@ -86,7 +80,8 @@ static void arm_why(const struct irdm_device_config *dev, const struct irdm_sim_
 
 		if (p->end_stops && !(span > 2 * p->stop_inset_rad)) {
 			snprintf(why, len, "joint %u: count_min..count_max spans %.3g rad, end stops "
-				 "need > %.3g (end_stops=0)", i + 1, span, 2 * p->stop_inset_rad);
+					   "need > %.3g (end_stops=0)",
+				 i + 1, span, 2 * p->stop_inset_rad);
 			return;
 		}
 	}
@@ -237,7 +232,7 @@ struct irdm_sim_device *irdm_hal_sim_device(struct irdm_hal_dev *dev)
 	struct irdm_can_drives *emulated = irdm_hal_canemu_drives(dev);
 
 	if (emulated)
-		return &emulated->arm;  /* the arm behind the emulated CAN drives */
+		return &emulated->arm; /* the arm behind the emulated CAN drives */
 	return is_open_sim(dev) ? &data_of(dev)->arm : NULL;
 }
 

@@ -20,10 +20,10 @@
 #include "irdm/sim/sim_user.h"
 
 struct sim_hand {
-	const struct irdm_sim_user *user;       /* NULL: nobody holds the arm */
-	const struct irdm_board *board;         /* its frames and period */
-	unsigned hand;                          /* the script's hand, 0-based */
-	uint64_t reads;                         /* reads since the hand took the arm */
+	const struct irdm_sim_user *user; /* NULL: nobody holds the arm */
+	const struct irdm_board *board;   /* its frames and period */
+	unsigned hand;                    /* the script's hand, 0-based */
+	uint64_t reads;                   /* reads since the hand took the arm */
 };
 
 void sim_hand_attach(struct sim_hand *h, const struct irdm_sim_user *u, unsigned hand,

@@ -24,7 +24,7 @@ static double min_jerk(double u)
 static const struct irdm_sim_user_seg *segment_at(const struct irdm_sim_user_hand *h,
 						  double t_s)
 {
-	unsigned lo = 0, hi = h->n;        /* first index with t0 > t lies in [lo, hi] */
+	unsigned lo = 0, hi = h->n; /* first index with t0 > t lies in [lo, hi] */
 
 	while (lo < hi) {
 		unsigned mid = lo + (hi - lo) / 2;

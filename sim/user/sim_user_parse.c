@@ -21,11 +21,11 @@
 #define TOKENS_MAX 12
 
 struct hand_state {
-	double clock_s;                 /* when the hand's last command ends */
+	double clock_s; /* when the hand's last command ends */
 	double target_m[3];
 	double k_n_per_m, b_ns_per_m;
 	int active;
-	int target_home;                /* target_m is an offset from home */
+	int target_home; /* target_m is an offset from home */
 };
 
 struct parser {
@@ -42,9 +42,9 @@ struct parser {
 /* One command being read: its tokens, the hand it names and when it starts. */
 struct cmd {
 	char *tok[TOKENS_MAX];
-	unsigned ntok, i;               /* i: the next token to read */
-	const char *what;               /* the command word, for messages */
-	unsigned hand;                  /* 0-based */
+	unsigned ntok, i; /* i: the next token to read */
+	const char *what; /* the command word, for messages */
+	unsigned hand;    /* 0-based */
 	double start_s;
 };
 
@@ -100,7 +100,7 @@ static int number(struct parser *p, const struct cmd *c, const char *tok, const 
 	*v = strtod(tok, &end);
 	if (end == tok || *end)
 		return fail(p, IRDM_EFORMAT, c->what, "expected %s, got '%s'", name, tok);
-	if (!isfinite(*v))              /* "inf", "nan", or overflowed to inf */
+	if (!isfinite(*v)) /* "inf", "nan", or overflowed to inf */
 		return fail(p, IRDM_EFORMAT, c->what, "%s '%s' is not finite", name, tok);
 	return IRDM_OK;
 }
@@ -205,8 +205,7 @@ static int advance(struct parser *p, const struct cmd *c, double dur_s)
 static int need_active(struct parser *p, const struct cmd *c, int want)
 {
 	if (p->h[c->hand].active != want)
-		return fail(p, IRDM_EFORMAT, c->what, want ? "hand %u is not placed" :
-			    "hand %u already holds (release it first)", c->hand + 1);
+		return fail(p, IRDM_EFORMAT, c->what, want ? "hand %u is not placed" : "hand %u already holds (release it first)", c->hand + 1);
 	return IRDM_OK;
 }
 
@@ -417,7 +416,7 @@ static int parse_line(struct parser *p, char *s)
 /* ---- whole scripts --------------------------------------------------------- */
 
 static void parse_begin(struct parser *p, struct irdm_sim_user *u, const char *name, char *err,
-		  size_t errlen)
+			size_t errlen)
 {
 	unsigned i;
 

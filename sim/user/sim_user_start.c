@@ -68,7 +68,8 @@ int irdm_sim_user_start(struct irdm_sim_user *u, unsigned hand, const double hom
 	if (sqrt(d2) > IRDM_SIM_USER_GRASP_MAX_M)
 		return fail(name, hand, err, errlen,
 			    "first placed %.1f cm from where the tip rests at the start (at most "
-			    "%.0f cm): 'place %u at home', then move", 100 * sqrt(d2),
+			    "%.0f cm): 'place %u at home', then move",
+			    100 * sqrt(d2),
 			    100 * IRDM_SIM_USER_GRASP_MAX_M, hand + 1);
 	for (unsigned k = 0; k < h->n; k++) {
 		struct irdm_sim_user_seg *s = &h->seg[k];
@@ -77,7 +78,8 @@ int irdm_sim_user_start(struct irdm_sim_user *u, unsigned hand, const double hom
 		if (resolve(s->from_m, s->from_home, home_m, from) ||
 		    resolve(s->to_m, s->to_home, home_m, to))
 			return fail(name, hand, err, errlen, "segment %u, from home, lies beyond "
-				    "+-%g m", k + 1, IRDM_SIM_USER_COORD_MAX_M);
+							     "+-%g m",
+				    k + 1, IRDM_SIM_USER_COORD_MAX_M);
 	}
 	/* all in range: now write them (a refused hand is left as it was) */
 	for (unsigned k = 0; k < h->n; k++) {

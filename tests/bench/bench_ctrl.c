@@ -47,11 +47,11 @@
 #define N_TICKS 20000
 #define FIFO_PRIO 80
 #define BENCH_CPU 1
-#define GAP_M 0.002             /* home tip above the top face */
+#define GAP_M 0.002 /* home tip above the top face */
 #define SLIDE_M_PER_TICK 50e-6
-#define SLIDE_HALF_M 0.025      /* back and forth +-2.5 cm about the centre */
+#define SLIDE_HALF_M 0.025 /* back and forth +-2.5 cm about the centre */
 
-static const double rot[9] = { 1, 0, 0, 0, 0, -1, 0, 1, 0 };   /* device -> object */
+static const double rot[9] = { 1, 0, 0, 0, 0, -1, 0, 1, 0 }; /* device -> object */
 
 struct bench {
 	struct irdm_session *s;
@@ -60,17 +60,21 @@ struct bench {
 	struct irdm_ctrl_input in;
 	struct irdm_ctrl_output out;
 	double cx, cy, top_z;
-	double edge_y;          /* y of the top face's grid row nearest cy */
+	double edge_y; /* y of the top face's grid row nearest cy */
 };
 
-enum kase { C_HOVER, C_SLIDE1, C_SLIDE10, C_EDGE, C_COUNT };
+enum kase { C_HOVER,
+	    C_SLIDE1,
+	    C_SLIDE10,
+	    C_EDGE,
+	    C_COUNT };
 
 static const char *const kase_name[C_COUNT] = { "hover   ", "slide/1 ", "slide/10",
 						"edge    " };
 static long n_ticks;
 
 static double *samples, *spins;
-static long spin_n;             /* spin() iterations for SPIN_US */
+static long spin_n; /* spin() iterations for SPIN_US */
 #define SPIN_US 6.0
 
 static volatile double spin_sink;
@@ -98,7 +102,7 @@ static void calibrate_spin(void)
 		clock_gettime(CLOCK_MONOTONIC, &t1);
 		t[k] = bench_elapsed_ns(&t0, &t1) * 1e-3;
 	}
-	for (int i = 1; i < 201; i++)            /* insertion sort: small */
+	for (int i = 1; i < 201; i++) /* insertion sort: small */
 		for (int j = i; j > 0 && t[j - 1] > t[j]; j--) {
 			double x = t[j];
 			t[j] = t[j - 1];
@@ -169,8 +173,8 @@ static int open_bench(struct bench *b, const char *path)
 	memset(b, 0, sizeof(*b));
 	irdm_ctrl_config_default(&b->cfg);
 	memcpy(b->cfg.obj_rot, rot, sizeof(rot));
-	b->cfg.limits.max_tip_speed_m_per_s = 10;       /* the steps of slide/10 */
-	b->cfg.limits.watchdog_us = 1000000;            /* a preempted tick is a figure here */
+	b->cfg.limits.max_tip_speed_m_per_s = 10; /* the steps of slide/10 */
+	b->cfg.limits.watchdog_us = 1000000;      /* a preempted tick is a figure here */
 	sc.engine = b->cfg.engine;
 	if (irdm_session_open(&b->s, path, &sc, err, sizeof(err))) {
 		printf("ctrl  %s: %s\n", path, err);
@@ -253,11 +257,13 @@ static int run_case(const char *path_img, enum kase k)
 	bench_count_end(kase_name[k]);
 	bench_stats(samples, n_ticks, &st);
 	printf("ctrl  %s median %7.2f us  p99 %7.2f us  p99.9 %7.2f us  max %8.2f us  (in contact "
-	       "%5.1f%%, triangle changes %ld)\n", kase_name[k], st.median, st.p99, st.p999, st.max,
+	       "%5.1f%%, triangle changes %ld)\n",
+	       kase_name[k], st.median, st.p99, st.p999, st.max,
 	       100.0 * (double)contact / n_ticks, tri_changes);
 	bench_stats(spins, n_ticks, &st);
 	printf("ctrl    spin   median %7.2f us  p99 %7.2f us  p99.9 %7.2f us  max %8.2f us  "
-	       "(beside each tick: the host's share)\n", st.median, st.p99, st.p999, st.max);
+	       "(beside each tick: the host's share)\n",
+	       st.median, st.p99, st.p999, st.max);
 	irdm_session_close(b.s);
 	return 0;
 fault:
@@ -274,7 +280,7 @@ static void realtime(void)
 	int cpu = sysconf(_SC_NPROCESSORS_ONLN) > BENCH_CPU ? BENCH_CPU : 0, rc;
 
 	rc = bench_counting() ? IRDM_EINVAL :
-	     irdm_rt_set_self(&(struct irdm_rt_sched){ SCHED_FIFO, FIFO_PRIO, cpu });
+				irdm_rt_set_self(&(struct irdm_rt_sched){ SCHED_FIFO, FIFO_PRIO, cpu });
 	if (rc)
 		printf("ctrl  scheduling: SCHED_FIFO %d on CPU %d refused: %s\n", FIFO_PRIO, cpu,
 		       irdm_strerror(rc));

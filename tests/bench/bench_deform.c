@@ -109,7 +109,8 @@ static int bench_scene(const char *name, const char *scene, const char *const *k
 		goto out;
 	}
 	printf("deform  %s  %s: %u modes, %s, %u columns", name, path, m->n_modes,
-	       m->precision == IRDM_ELEM_F64 ? "f64" : m->precision == IRDM_ELEM_F32 ? "f32" : "f16",
+	       m->precision == IRDM_ELEM_F64 ? "f64" : m->precision == IRDM_ELEM_F32 ? "f32" :
+										       "f16",
 	       m->n_cols);
 	if (ses->img->corr_clusters)
 		printf(", correction in %u clusters (max rank %u)", ses->img->corr_clusters->n_clusters,

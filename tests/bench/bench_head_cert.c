@@ -22,7 +22,7 @@
 #define K_DROPPED 100
 #define K_ALL (K_KEPT + K_DROPPED)
 #define MAX_HEAD 300
-#define REPEAT 20        /* the fastest run counts: a shared machine */
+#define REPEAT 20 /* the fastest run counts: a shared machine */
 
 /* deterministic, spread shapes and modes; the dropped ones fast and damped */
 static void node_modes(struct irdm_mode *zoh, double *phi)

@@ -39,7 +39,7 @@
 
 #define N_TICKS 20000
 #define N_WARMUP 2000
-#define PAUSE_EVERY 100            /* ticks; then sleep PAUSE_NS (untimed) */
+#define PAUSE_EVERY 100 /* ticks; then sleep PAUSE_NS (untimed) */
 #define PAUSE_NS 200000L
 #define FIFO_PRIO 80
 
@@ -52,7 +52,11 @@ static bool portable_sum;
 #define DEVICE_K 1000.0
 #define DEVICE_B 5.0
 
-enum kase { K_FREE, K_NODE, K_NODES, K_TRI, K_COUNT };
+enum kase { K_FREE,
+	    K_NODE,
+	    K_NODES,
+	    K_TRI,
+	    K_COUNT };
 
 static const char *const kase_name[K_COUNT] = { "free   ", "1 node ", "2 nodes", "1 tri  " };
 
@@ -125,7 +129,8 @@ static void pick_sites(const struct irdm_image *img, struct sites *s)
 			continue;
 		for (int a = 0; a < 3; a++) {
 			double cen = ((double)img->nodes[v[0]].pos_m[a] + img->nodes[v[1]].pos_m[a] +
-				      img->nodes[v[2]].pos_m[a]) / 3;
+				      img->nodes[v[2]].pos_m[a]) /
+				     3;
 			d += (cen - p0[a]) * (cen - p0[a]);
 		}
 		if (d < best) {
@@ -151,7 +156,8 @@ static struct figures bench_case(const char *scene, const char *repr, const stru
 	struct irdm_session *ses;
 	struct irdm_engine *e;
 	struct bench_stats bs;
-	unsigned n_contacts = k == K_FREE ? 0 : k == K_NODES ? 2 : 1;
+	unsigned n_contacts = k == K_FREE ? 0 : k == K_NODES ? 2 :
+							       1;
 	char err[512];
 	int rc = 0;
 
@@ -234,7 +240,7 @@ static struct figures bench_case(const char *scene, const char *repr, const stru
 	return fig;
 }
 
-static uint32_t all_modes;       /* of the all-modes image */
+static uint32_t all_modes; /* of the all-modes image */
 
 static void bench_image(const char *scene, const char *repr, const char *path,
 			struct figures fig[K_COUNT])
@@ -287,7 +293,7 @@ static void header(void)
 	       ncpu, model);
 
 	rc = bench_counting() ? IRDM_EINVAL :
-	     irdm_rt_set_self(&(struct irdm_rt_sched){ SCHED_FIFO, FIFO_PRIO, cpu });
+				irdm_rt_set_self(&(struct irdm_rt_sched){ SCHED_FIFO, FIFO_PRIO, cpu });
 	if (rc)
 		printf("tick  scheduling: SCHED_FIFO %d on CPU %d refused: %s\n", FIFO_PRIO, cpu,
 		       irdm_strerror(rc));
@@ -333,26 +339,56 @@ static void target(const char *what, double limit_us, const struct figures *f)
 	printf("tick  target %-46s <= %4.0f us: median %6.2f, p99 %6.2f, max %7.2f us -> %s\n", what,
 	       limit_us, f->median, f->p99, f->max,
 	       f->max <= limit_us ? "met (max)" : f->p99 <= limit_us ? "met at p99, not at max" :
-	       "NOT met");
+								       "NOT met");
 }
 
 int main(void)
 {
 	static const char *const fir_kv[] = {
-		"name", "cuboid-fir500-patch", "resolution", "11,11,22", "dt", "0.002",
-		"representation", "fir:500", "touch", "box:0.035,0.035,0.199,0.065,0.065,0.201",
-		"display", "touch", NULL,
+		"name",
+		"cuboid-fir500-patch",
+		"resolution",
+		"11,11,22",
+		"dt",
+		"0.002",
+		"representation",
+		"fir:500",
+		"touch",
+		"box:0.035,0.035,0.199,0.065,0.065,0.201",
+		"display",
+		"touch",
+		NULL,
 	};
 	/* the hybrid: 300 modes and the other 9204's exact head of
 	 * 128 samples (+ 128 tapered) at the same patch as the FIR, 1 ms */
 	static const char *const hybrid_kv[] = {
-		"name", "cuboid-hybrid128-patch", "resolution", "11,11,22", "representation", "modal:300",
-		"exact_head", "128", "touch", "box:0.035,0.035,0.199,0.065,0.065,0.201",
-		"display", "touch", NULL,
+		"name",
+		"cuboid-hybrid128-patch",
+		"resolution",
+		"11,11,22",
+		"representation",
+		"modal:300",
+		"exact_head",
+		"128",
+		"touch",
+		"box:0.035,0.035,0.199,0.065,0.065,0.201",
+		"display",
+		"touch",
+		NULL,
 	};
 	static const char *const all_kv[] = {
-		"name", "cuboid-6x6x12-all", "resolution", "6,6,12", "representation", "modal:all",
-		"modes", "all", "touch", "box:0.03,0.03,0.199,0.07,0.07,0.201", "display", "touch",
+		"name",
+		"cuboid-6x6x12-all",
+		"resolution",
+		"6,6,12",
+		"representation",
+		"modal:all",
+		"modes",
+		"all",
+		"touch",
+		"box:0.03,0.03,0.199,0.07,0.07,0.201",
+		"display",
+		"touch",
 		NULL,
 	};
 	struct figures fir[K_COUNT] = { 0 }, fir_portable[K_COUNT] = { 0 }, m300[K_COUNT] = { 0 }, mall[K_COUNT] = { 0 };

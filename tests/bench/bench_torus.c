@@ -39,7 +39,7 @@ static int write_scene(void)
 	if (!f)
 		return -1;
 	fprintf(f, "name = torus\nmesh = %s\nmesh_scale = %g\nfloating = yes\ntarget_nodes = %d\n"
-		"static_correction_cluster = %s\nstatic_correction_tol = %s\n",
+		   "static_correction_cluster = %s\nstatic_correction_tol = %s\n",
 		OFF, TORUS_SCALE, TORUS_NODES, TORUS_CLUSTER, TORUS_CLUSTER_TOL);
 	return fclose(f) ? -1 : 0;
 }

@@ -197,7 +197,7 @@ static void test_step_at_a_node(void **state)
 	assert_int_equal(irdm_engine_stats(s->eng)->ticks, N_TICKS);
 	unmaps = 0;
 	irdm_session_close(s);
-	assert_int_equal(unmaps, 1);    /* the session gave its image back */
+	assert_int_equal(unmaps, 1); /* the session gave its image back */
 }
 
 static void test_open_errors(void **state)
@@ -210,14 +210,16 @@ static void test_open_errors(void **state)
 	irdm_engine_config_default(&sc.engine);
 	/* no such file: the loader's error, nothing left behind */
 	assert_int_equal(irdm_session_open_with(&s, "/nonexistent/irdm-tick.img", &sc, test_map,
-						test_unmap, err, sizeof(err)), IRDM_EIO);
+						test_unmap, err, sizeof(err)),
+			 IRDM_EIO);
 	assert_null(s);
 	assert_true(err[0] != '\0');
 	/* a configuration the engine refuses: the image goes back too */
 	sc.engine.max_contacts = IRDM_MAX_CONTACTS + 1;
 	unmaps = 0;
 	assert_int_equal(irdm_session_open_with(&s, tick_image_path(), &sc, test_map, test_unmap,
-						err, sizeof(err)), IRDM_EINVAL);
+						err, sizeof(err)),
+			 IRDM_EINVAL);
 	assert_null(s);
 	assert_int_equal(unmaps, 1);
 	irdm_session_close(NULL);

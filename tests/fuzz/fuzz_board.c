@@ -26,7 +26,7 @@ static void use(const struct irdm_board *b)
 
 	for (unsigned i = 0; i < b->devices; i++)
 		if (irdm_board_device(b, i, &d) || irdm_device_config_check(&d))
-			abort();        /* accepted, yet not an arm */
+			abort(); /* accepted, yet not an arm */
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)

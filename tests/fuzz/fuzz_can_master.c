@@ -27,14 +27,14 @@ static const struct irdm_can_master *watched;
 static int fake_send(void *ctx, const struct irdm_can_frame *f)
 {
 	(void)ctx;
-	if (f->id >= 0x601 && f->id <= 0x67F) {         /* confirm every download */
+	if (f->id >= 0x601 && f->id <= 0x67F) { /* confirm every download */
 		uint16_t index = (uint16_t)(f->data[1] | f->data[2] << 8);
 
 		sdo_answer = *f;
 		sdo_answer.id = f->id - 0x80;
 		sdo_answer.data[0] = 0x60;
 		memset(sdo_answer.data + 4, 0, 4);
-		if (f->data[0] == 0x40) {               /* an upload: as a CiA 402 drive */
+		if (f->data[0] == 0x40) { /* an upload: as a CiA 402 drive */
 			sdo_answer.data[0] = 0x43;
 			if (index == 0x1000)
 				sdo_answer.data[4] = 0x92, sdo_answer.data[5] = 0x01;
@@ -47,9 +47,9 @@ static int fake_send(void *ctx, const struct irdm_can_frame *f)
 		int torque = f->data[2] | f->data[3];
 
 		if (watched->faulted && (f->data[0] | f->data[1] | torque))
-			__builtin_trap();       /* faulted yet not off */
+			__builtin_trap(); /* faulted yet not off */
 		if (torque && irdm_can_master_first_not_enabled(watched) >= 0)
-			__builtin_trap();       /* torque to a drive not enabled */
+			__builtin_trap(); /* torque to a drive not enabled */
 	}
 	return IRDM_OK;
 }
@@ -81,9 +81,17 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 	static struct irdm_can_master m;
 	struct irdm_can_port port = { &fake_ops, NULL };
 	struct irdm_can_master_cfg cfg = {
-		.n_axes = 3, .period_us = 1000, .bitrate = 1000000, .sync_counter = true,
-		.heartbeat_ms = 10, .heartbeat_timeout_ms = 50, .tpdo_missing_periods = 3,
-		.master_node = 127, .rpdo_timeout_ms = 3, .sdo_timeout_polls = 2, .idle = idle,
+		.n_axes = 3,
+		.period_us = 1000,
+		.bitrate = 1000000,
+		.sync_counter = true,
+		.heartbeat_ms = 10,
+		.heartbeat_timeout_ms = 50,
+		.tpdo_missing_periods = 3,
+		.master_node = 127,
+		.rpdo_timeout_ms = 3,
+		.sdo_timeout_polls = 2,
+		.idle = idle,
 	};
 	const double tau[3] = { 0.5, -0.5, 0.25 };
 	char err[160];
@@ -94,7 +102,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 	n_pending = next_pending = 0;
 	have_answer = 0;
 	if (irdm_can_master_init(&m, &port, &cfg, err, sizeof(err)) != IRDM_OK)
-		__builtin_trap();               /* every SDO was confirmed */
+		__builtin_trap(); /* every SDO was confirmed */
 	irdm_can_master_enable(&m, 1);
 	watched = &m;
 	for (; size >= 12; data += 12, size -= 12) {

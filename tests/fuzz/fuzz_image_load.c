@@ -136,7 +136,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
 	struct irdm_image img;
 	char err[256];
-	void *buf = malloc(size ? size : 1);    /* malloc: 16-aligned */
+	void *buf = malloc(size ? size : 1); /* malloc: 16-aligned */
 
 	if (!buf)
 		return 0;
@@ -144,7 +144,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 	if (irdm_image_parse(buf, size, &img, err, sizeof(err)) == IRDM_OK)
 		walk_views(&img);
 	else if (!err[0] || img.base)
-		abort();        /* every rejection has a reason and no views */
+		abort(); /* every rejection has a reason and no views */
 	free(buf);
 	return 0;
 }

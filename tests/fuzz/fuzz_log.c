@@ -33,7 +33,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 			n++;
 		if (got == 0 && (n != irdm_log_header(r)->record_count ||
 				 irdm_log_size(n) != size))
-			abort();        /* accepted whole, yet not what it says */
+			abort(); /* accepted whole, yet not what it says */
 		irdm_log_close(r);
 	}
 	close(fd);

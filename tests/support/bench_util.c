@@ -70,7 +70,7 @@ int bench_ensure_image(const char *tag, const char *path, const char *scene_file
 		return -1;
 	}
 	irdm_scene_defaults(&sc);
-	sc.max_error = 0;       /* benchmarks time the tick, not the accuracy */
+	sc.max_error = 0; /* benchmarks time the tick, not the accuracy */
 	if (scene_file && irdm_scene_load(&sc, scene_file, err, sizeof(err)))
 		goto fail;
 	for (; kv && kv[0]; kv += 2)

@@ -8,8 +8,8 @@
 
 #include "cad_part.h"
 
-#define FIL_N 3                 /* segments across a fillet */
-#define FLAT_N 3                /* and across a flat */
+#define FIL_N 3  /* segments across a fillet */
+#define FLAT_N 3 /* and across a flat */
 #define AXIS_N (2 * FIL_N + FLAT_N)
 
 const double cad_part_half_mm[3] = { 30, 20, 8 };
@@ -37,7 +37,8 @@ static void round_point(const double q[3], float out[3])
 
 	for (int a = 0; a < 3; a++) {
 		double lim = cad_part_half_mm[a] - fillet_mm;
-		in[a] = q[a] < -lim ? -lim : q[a] > lim ? lim : q[a];
+		in[a] = q[a] < -lim ? -lim : q[a] > lim ? lim :
+							  q[a];
 		d[a] = q[a] - in[a];
 		len += d[a] * d[a];
 	}
@@ -54,7 +55,7 @@ static void put_tri(FILE *f, float v[4][3], int i, int j, int k)
 	memcpy(&rec[3], v[i], sizeof(v[i]));
 	memcpy(&rec[6], v[j], sizeof(v[j]));
 	memcpy(&rec[9], v[k], sizeof(v[k]));
-	fwrite(rec, sizeof(rec), 1, f);         /* little-endian host, as STL */
+	fwrite(rec, sizeof(rec), 1, f); /* little-endian host, as STL */
 	fwrite(&attr, sizeof(attr), 1, f);
 }
 

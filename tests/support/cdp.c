@@ -24,10 +24,10 @@ extern char **environ;
 
 struct cdp {
 	pid_t pid;
-	int to, from;                   /* our ends: commands, replies */
+	int to, from; /* our ends: commands, replies */
 	int next_id;
 	char session[128];
-	char *buf;                      /* bytes read, not yet a whole message */
+	char *buf; /* bytes read, not yet a whole message */
 	size_t len, cap;
 };
 
@@ -151,7 +151,7 @@ struct cdp *cdp_open(const char *dir, const char *url, int w, int h)
 	snprintf(prof, sizeof(prof), "--user-data-dir=%s/chromium-profile", dir);
 	argv[n++] = cdp_browser();
 	argv[n++] = "--headless";
-	argv[n++] = "--no-sandbox";     /* tests run as root in CI */
+	argv[n++] = "--no-sandbox"; /* tests run as root in CI */
 	argv[n++] = "--remote-debugging-pipe";
 	argv[n++] = "--force-device-scale-factor=1";
 	argv[n++] = "--hide-scrollbars";
@@ -215,7 +215,8 @@ static int b64(int ch)
 		return ch - 'a' + 26;
 	if (ch >= '0' && ch <= '9')
 		return ch - '0' + 52;
-	return ch == '+' ? 62 : ch == '/' ? 63 : -1;
+	return ch == '+' ? 62 : ch == '/' ? 63 :
+					    -1;
 }
 
 unsigned char *cdp_screenshot(struct cdp *c, size_t *len)
@@ -235,7 +236,7 @@ unsigned char *cdp_screenshot(struct cdp *c, size_t *len)
 	for (; *p && *p != '"'; p++) {
 		int v = b64(*p);
 		if (v < 0)
-			continue;       /* '=' padding */
+			continue; /* '=' padding */
 		acc = acc << 6 | (uint32_t)v;
 		bits += 6;
 		if (bits >= 8) {

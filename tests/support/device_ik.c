@@ -15,7 +15,8 @@ static void solve3(const double a[9], const double b[3], double x[3])
 		for (int r = 0; r < 3; r++)
 			m[3 * r + c] = b[r];
 		x[c] = (m[0] * (m[4] * m[8] - m[5] * m[7]) - m[1] * (m[3] * m[8] - m[5] * m[6]) +
-			m[2] * (m[3] * m[7] - m[4] * m[6])) / d;
+			m[2] * (m[3] * m[7] - m[4] * m[6])) /
+		       d;
 	}
 }
 

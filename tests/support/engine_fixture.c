@@ -67,8 +67,8 @@ const double *efx_column_modal(const struct irdm_image *img, size_t c, double *p
 		phi[i] = irdm_elem_get(img->mode_shapes, img->meta->precision, row * 3 * K + i);
 	if (!img->corr_start)
 		return NULL;
-	assert_true(k >= 0);    /* the diagonal is always kept */
-	efx_corr_block(img, (uint32_t)c, (uint32_t)c, D);      /* + the far field */
+	assert_true(k >= 0);                              /* the diagonal is always kept */
+	efx_corr_block(img, (uint32_t)c, (uint32_t)c, D); /* + the far field */
 	return D;
 }
 
@@ -91,7 +91,7 @@ uint32_t efx_column_row_near(const struct irdm_image *img, const double p[3])
 }
 
 double *efx_contact_responses(const struct irdm_image *img, const struct irdm_contact_site *st,
-				 int m, size_t N, double tail_r)
+			      int m, size_t N, double tail_r)
 {
 	int n = 3 * m;
 	double *W = calloc(N * (size_t)n * n, sizeof(double));
@@ -226,7 +226,7 @@ void efx_reference_w(const double *W, int m, size_t N, const double *target,
 		     const struct efx_ref_opts *o, double *F)
 {
 	int n = 3 * m;
-	double prev[24];                /* per unknown: the target and displacement of t-1 */
+	double prev[24]; /* per unknown: the target and displacement of t-1 */
 	bool on[4] = { false }, released[4] = { false };
 
 	assert_true(m <= 4);
@@ -238,7 +238,7 @@ void efx_reference_w(const double *W, int m, size_t N, const double *target,
 			F[t * n + k] = 0;
 		for (int i = 0; i < m; i++) {
 			bool want = !isnan(target[t * n + 3 * i]) && !released[i];
-			if (want && !on[i])             /* fresh: no coupling damping yet */
+			if (want && !on[i]) /* fresh: no coupling damping yet */
 				for (int r = 0; r < 3; r++) {
 					int k = 3 * i + r;
 					double u = 0;

@@ -63,10 +63,10 @@ static void fill_meta(struct img_fixture *fx, uint32_t repr, uint32_t precision,
 	snprintf(m->tool_version, sizeof(m->tool_version), "irdm-test 0.1");
 	snprintf(m->mesh_name, sizeof(m->mesh_name), "fixture-grid-%u", n_nodes);
 	fx->provenance_len = (size_t)snprintf(fx->provenance,
-		sizeof(fx->provenance),
-		"mesh=fixture-grid-%u\nmaterial=E2000 nu0.49 rho110\n"
-		"damping=5%% at 4.2 Hz and 100 Hz\ndt=0.001\ntool=irdm-test 0.1\n",
-		n_nodes);
+					      sizeof(fx->provenance),
+					      "mesh=fixture-grid-%u\nmaterial=E2000 nu0.49 rho110\n"
+					      "damping=5%% at 4.2 Hz and 100 Hz\ndt=0.001\ntool=irdm-test 0.1\n",
+					      n_nodes);
 }
 
 /* Nodes on a 4 x 4 x k grid (1 cm), columns the last nodes in reverse order,
@@ -302,7 +302,7 @@ static void cl_put_pair(const struct cl_layout *l, uint32_t prec, uint32_t a, ui
 	uint64_t ra = 3 * (uint64_t)(l->start[a + 1] - l->start[a]);
 	uint64_t rb = 3 * (uint64_t)(l->start[b + 1] - l->start[b]);
 
-	if (a == b) {           /* the upper triangle, row by row */
+	if (a == b) { /* the upper triangle, row by row */
 		for (uint64_t i = 0, k = 0; i < ra; i++)
 			for (uint64_t j = i; j < rb; j++)
 				irdm_elem_put(values, prec, o + k++,
@@ -342,7 +342,8 @@ static uint64_t cl_fill_pairs(const struct cl_layout *l, uint32_t prec,
 				pairs[k].rank = dense ? IRDM_CORR_PAIR_DENSE : l->rank;
 				cl_put_pair(l, prec, a, b, dense, values, next);
 			}
-			next += a == b ? ra * (ra + 1) / 2 : dense ? ra * rb : l->rank * (ra + rb);
+			next += a == b ? ra * (ra + 1) / 2 : dense ? ra * rb :
+								     l->rank * (ra + rb);
 		}
 	return next;
 }
@@ -373,7 +374,7 @@ int img_fixture_clusters(struct img_fixture *fx, uint32_t n_clusters, uint32_t r
 	memcpy(p, &h, sizeof(h));
 	memcpy(p + sizeof(h), start, 4 * ((size_t)n_clusters + 1));
 	memcpy(p + sizeof(h) + 4 * ((size_t)n_clusters + 1), members, 4 * (size_t)nc);
-	for (uint32_t i = 0; i < nc; i++)       /* col_pos: reverse order is its own inverse */
+	for (uint32_t i = 0; i < nc; i++) /* col_pos: reverse order is its own inverse */
 		memcpy(p + sizeof(h) + 4 * ((size_t)n_clusters + 1 + nc + members[i]), &i, 4);
 	cl_fill_pairs(&l, prec, (struct irdm_corr_pair *)(p + tb),
 		      p + tb + sizeof(struct irdm_corr_pair) * np);
@@ -493,7 +494,7 @@ void img_fixture_reseal(void *buf, size_t size)
 
 void *img_fixture_copy(const void *buf, size_t len)
 {
-	void *p = malloc(len ? len : 1);    /* malloc is aligned for double */
+	void *p = malloc(len ? len : 1); /* malloc is aligned for double */
 
 	if (p && len)
 		memcpy(p, buf, len);

@@ -26,13 +26,13 @@ struct img_fixture {
 	struct irdm_meta meta;
 	char provenance[256];
 	size_t provenance_len;
-	struct irdm_node *nodes;            /* n_nodes */
-	uint32_t *columns;                  /* n_cols */
-	uint32_t *tris;                     /* 3 * n_tris */
-	void *fir;                          /* FIR: fir_bytes */
-	struct irdm_mode *modes;            /* modal: n_modes */
-	void *mode_shapes;                  /* modal: shapes_bytes */
-	void *static_corr;                  /* modal + STATIC_CORR: corr_bytes */
+	struct irdm_node *nodes; /* n_nodes */
+	uint32_t *columns;       /* n_cols */
+	uint32_t *tris;          /* 3 * n_tris */
+	void *fir;               /* FIR: fir_bytes */
+	struct irdm_mode *modes; /* modal: n_modes */
+	void *mode_shapes;       /* modal: shapes_bytes */
+	void *static_corr;       /* modal + STATIC_CORR: corr_bytes */
 	/* its STATIC_CORR_INDEX: every block kept (the layout of tol = 0):
 	 * starts c n_cols, then rows 0..n_cols-1 for every column */
 	uint32_t *corr_index;
@@ -42,8 +42,8 @@ struct img_fixture {
 	/* optional STATIC_CORR_CLUSTERS (img_fixture_clusters): the payload
 	 * as image_format.h lays it out */
 	void *corr_clusters;
-	struct irdm_rigid rigid;            /* written iff FLOATING */
-	struct irdm_stability *stability;   /* n_cols */
+	struct irdm_rigid rigid;          /* written iff FLOATING */
+	struct irdm_stability *stability; /* n_cols */
 	/* Sizes of the arrays as built: what img_fixture_add() writes, so
 	 * tampering with meta counts never makes it read past an array. */
 	uint64_t nodes_bytes, columns_bytes, tris_bytes, stability_bytes;

@@ -99,7 +99,7 @@ double fixture_rigid_outside(const struct irdm_mesh *mesh, const struct irdm_fem
 			if (f < 3) {
 				u[f] = 1;
 			} else {
-				int a = f - 3;          /* e_a x r */
+				int a = f - 3; /* e_a x r */
 				u[(a + 1) % 3] = -r[(a + 2) % 3];
 				u[(a + 2) % 3] = r[(a + 1) % 3];
 			}

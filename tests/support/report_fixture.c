@@ -68,7 +68,8 @@ int rfx_read_csv(const char *dir, const char *config, struct rfx_row *rows, int 
 					cfg, r->repr, &r->dt_ms, r->scenario, &r->force_err, &r->first10,
 					&r->after100, &r->disp_err, &r->median_us, &r->p99_us, &r->bytes,
 					&r->radius, &r->cert_stable, &r->bounded, &r->growth, &r->ticks,
-					&r->paper), 17);
+					&r->paper),
+				 17);
 		assert_string_equal(cfg, config);
 		n++;
 	}

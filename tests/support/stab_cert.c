@@ -20,15 +20,14 @@ double stab_cert_check(const char *what, size_t c, double dense, const struct ir
 		fail_msg("%s case %zu: dense %.12f, certificate %.12f: verdicts differ", what, c, dense,
 			 cert->rho);
 	assert_true(cert->lo_certified || cert->lo_newton);
-	if (cert->rho == IRDM_STAB_RHO_MIN) {   /* every pole inside the lower bound */
+	if (cert->rho == IRDM_STAB_RHO_MIN) { /* every pole inside the lower bound */
 		if (!(dense == IRDM_STAB_RHO_MIN && cert->rho_lo == 0))
 			fail_msg("%s case %zu: dense %.15f, certificate below %g", what, c, dense,
 				 IRDM_STAB_RHO_MIN);
 		return dense;
 	}
 	double lo_tol = cert->lo_certified ? STAB_DENSE_TOL : STAB_NEWTON_LO_TOL;
-	if (!(cert->rho >= dense * (1 - STAB_DENSE_TOL) && cert->rho_lo <= dense * (1 + lo_tol)
-	      && cert->rho <= cert->rho_lo * (1 + STAB_CERT_WIDTH)))
+	if (!(cert->rho >= dense * (1 - STAB_DENSE_TOL) && cert->rho_lo <= dense * (1 + lo_tol) && cert->rho <= cert->rho_lo * (1 + STAB_CERT_WIDTH)))
 		fail_msg("%s case %zu: dense %.15f outside [%.15f, %.15f]", what, c, dense, cert->rho_lo,
 			 cert->rho);
 	return dense;

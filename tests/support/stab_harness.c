@@ -271,7 +271,9 @@ static FILE *trace_open(const char *name)
 		return NULL;
 	for (i = 0; name[i] && i < sizeof(slug) - 1; i++)
 		slug[i] = (char)((name[i] >= 'a' && name[i] <= 'z') || (name[i] >= '0' && name[i] <= '9') ||
-				 (name[i] >= 'A' && name[i] <= 'Z') ? name[i] : '_');
+						 (name[i] >= 'A' && name[i] <= 'Z') ?
+					 name[i] :
+					 '_');
 	slug[i] = 0;
 	snprintf(path, sizeof(path), "%s/trace-%s.tsv", out, slug);
 	FILE *f = fopen(path, "w");

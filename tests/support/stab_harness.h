@@ -28,14 +28,14 @@
 #define STAB_DEVICE_B 5.0
 
 enum stab_coupling {
-	STAB_HAPTIC = 0,        /* irdm_engine_config_haptic(): coupling + passivity controller */
-	STAB_RIGID = 1,         /* k = 0: the target is the displacement (eq. 8) */
+	STAB_HAPTIC = 0, /* irdm_engine_config_haptic(): coupling + passivity controller */
+	STAB_RIGID = 1,  /* k = 0: the target is the displacement (eq. 8) */
 };
 
 enum stab_sites {
-	STAB_ONE = 0,           /* one contact at the node nearest `at` */
-	STAB_SAME_NODE = 1,     /* two contacts on that same node */
-	STAB_NEIGHBOURS = 2,    /* two contacts: that node and its nearest column */
+	STAB_ONE = 0,        /* one contact at the node nearest `at` */
+	STAB_SAME_NODE = 1,  /* two contacts on that same node */
+	STAB_NEIGHBOURS = 2, /* two contacts: that node and its nearest column */
 };
 
 struct stab_case;
@@ -46,43 +46,43 @@ typedef void (*stab_target_fn)(const struct stab_case *c, unsigned long t, doubl
 
 struct stab_case {
 	const char *name;
-	const char *const *image;       /* scene "key", "value", ..., NULL */
+	const char *const *image; /* scene "key", "value", ..., NULL */
 	enum stab_coupling coupling;
-	double max_force_n;             /* engine force limit (0: none) */
+	double max_force_n; /* engine force limit (0: none) */
 	enum stab_sites sites;
 	enum irdm_contact_mode mode;
-	double at_m[3];                 /* where the contacts go (object frame) */
+	double at_m[3];                    /* where the contacts go (object frame) */
 	double depth_m[STAB_MAX_CONTACTS]; /* target along -z per contact (held) */
-	stab_target_fn target;          /* NULL: stab_step (ramp in 50 ms, hold) */
+	stab_target_fn target;             /* NULL: stab_step (ramp in 50 ms, hold) */
 	unsigned long ticks;
-	unsigned long poison_tick;      /* stab_poison: from this tick on ... */
-	double poison_m;                /* ... target z is this (NaN, Inf, huge) */
-	int reset_after_fault;          /* reset once after a refusal and go on */
+	unsigned long poison_tick; /* stab_poison: from this tick on ... */
+	double poison_m;           /* ... target z is this (NaN, Inf, huge) */
+	int reset_after_fault;     /* reset once after a refusal and go on */
 	/* limits the test asserts (the table shows them beside the figures) */
 	double max_f_limit_n;
-	double static_rel_tol;          /* |held - static| / static; 0: not checked */
-	double energy_tol_j;            /* -min W allowed */
-	int expect_rc;                  /* what the first refusal must be (0: none) */
-	bool no_releases;               /* no push may be released (re-engagement) */
-	double reset_max_f_limit_n;     /* max sum |F| after the reset (reset_after_fault) */
+	double static_rel_tol;      /* |held - static| / static; 0: not checked */
+	double energy_tol_j;        /* -min W allowed */
+	int expect_rc;              /* what the first refusal must be (0: none) */
+	bool no_releases;           /* no push may be released (re-engagement) */
+	double reset_max_f_limit_n; /* max sum |F| after the reset (reset_after_fault) */
 };
 
 struct stab_record {
-	unsigned long ticks;            /* run */
-	double max_f_n;                 /* largest sum over contacts of |F| */
-	double final_f_n;               /* mean sum |F| over the last 1 % of ticks */
-	double static_f_n;              /* predicted static sum |F| (NAN: none) */
-	double work_max_j, work_min_j;  /* W(t) = sum F . du, on the object */
-	double final_spread_n;          /* max - min of sum |F| over the last 1 % */
-	double first_f_n;               /* sum |F| at the end of the first 10 % (drift) */
-	double kinetic_j, spin_rad_s;   /* floating: the rigid body at the end */
-	unsigned long nonfinite;        /* NaN/Inf forces or displacements seen */
-	unsigned long subnormal;        /* subnormal forces, contact or free node
+	unsigned long ticks;           /* run */
+	double max_f_n;                /* largest sum over contacts of |F| */
+	double final_f_n;              /* mean sum |F| over the last 1 % of ticks */
+	double static_f_n;             /* predicted static sum |F| (NAN: none) */
+	double work_max_j, work_min_j; /* W(t) = sum F . du, on the object */
+	double final_spread_n;         /* max - min of sum |F| over the last 1 % */
+	double first_f_n;              /* sum |F| at the end of the first 10 % (drift) */
+	double kinetic_j, spin_rad_s;  /* floating: the rigid body at the end */
+	unsigned long nonfinite;       /* NaN/Inf forces or displacements seen */
+	unsigned long subnormal;       /* subnormal forces, contact or free node
 					 * displacements seen (denormal hazard) */
-	int rc;                         /* first non-zero tick return (0: none) */
+	int rc;                        /* first non-zero tick return (0: none) */
 	unsigned long rc_tick;
-	char refusal[96];               /* irdm_strerror(rc) */
-	unsigned long singular;         /* regularised coupled solves */
+	char refusal[96];       /* irdm_strerror(rc) */
+	unsigned long singular; /* regularised coupled solves */
 	unsigned long releases;
 	double ns_per_tick_first, ns_per_tick_last; /* first and last 10 % */
 	/* after a reset (reset_after_fault): the largest sum |F| and the work

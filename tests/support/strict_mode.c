@@ -29,7 +29,7 @@ int strict_run(void (*child)(void *arg, int fd), void *arg, void *res, size_t le
 	if (pid == 0) {
 		close(fd[0]);
 		child(arg, fd[1]);
-		syscall(SYS_exit, 5);           /* a child that returned */
+		syscall(SYS_exit, 5); /* a child that returned */
 	}
 	close(fd[1]);
 	fd[1] = -1;

@@ -17,7 +17,7 @@
 #include <stddef.h>
 
 /* Child exit codes besides 0 (and SIGKILL for a system call). */
-#define STRICT_UNAVAILABLE 2    /* prctl() refused strict mode: the result says why */
+#define STRICT_UNAVAILABLE 2 /* prctl() refused strict mode: the result says why */
 #define STRICT_WRITE_FAILED 4
 
 /*

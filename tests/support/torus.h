@@ -8,12 +8,12 @@
 #ifndef IRDM_TESTS_TORUS_H
 #define IRDM_TESTS_TORUS_H
 
-#define TORUS_NU 36                     /* vertices around the ring */
-#define TORUS_NV 18                     /* and around the tube */
-#define TORUS_SCALE 0.05                /* mesh_scale: tube 2 cm, ring 5 cm */
-#define TORUS_NODES 3250                /* target_nodes: about 2,500 touchable */
-#define TORUS_CLUSTER "256"             /* static_correction_cluster */
-#define TORUS_CLUSTER_TOL "8e-4"        /* its static_correction_tol */
+#define TORUS_NU 36              /* vertices around the ring */
+#define TORUS_NV 18              /* and around the tube */
+#define TORUS_SCALE 0.05         /* mesh_scale: tube 2 cm, ring 5 cm */
+#define TORUS_NODES 3250         /* target_nodes: about 2,500 touchable */
+#define TORUS_CLUSTER "256"      /* static_correction_cluster */
+#define TORUS_CLUSTER_TOL "8e-4" /* its static_correction_tol */
 
 /* Ring radius 1 and tube radius 0.4: nu x nv vertices, two triangles per
  * quad, outward (counter-clockwise seen from outside).

@@ -17,7 +17,7 @@
 
 /* Oblique, so that every axis of the contact's 3x3 response is excited. */
 static const double push_dir[3] = { 0.3, 0.2, -0.9327379 };
-#define PUSH_M 1e-3     /* the model is linear: the size only sets the units */
+#define PUSH_M 1e-3 /* the model is linear: the size only sets the units */
 
 size_t irdm_measure_ticks(double dt_s)
 {
@@ -212,7 +212,7 @@ static int build_reference(const struct irdm_scene *sc, const struct irdm_measur
 	ref->exact_head = 0;
 	ref->static_corr_cluster = 0;
 	ref->uncertified = true;
-	ref->max_error = 0;     /* not measured itself */
+	ref->max_error = 0; /* not measured itself */
 	ref->eigensolver = IRDM_EIG_DENSE;
 	ret = irdm_scene_set(ref, "representation", "modal:all", "error measurement", err, errlen);
 	if (!ret)

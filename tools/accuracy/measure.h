@@ -34,18 +34,18 @@
 #include "modal/modal.h"
 #include "scene/scene.h"
 
-#define IRDM_MEASURE_SPREAD 4   /* columns spread over the surface */
-#define IRDM_MEASURE_WORST 2    /* and the largest spectral radii */
+#define IRDM_MEASURE_SPREAD 4 /* columns spread over the surface */
+#define IRDM_MEASURE_WORST 2  /* and the largest spectral radii */
 #define IRDM_MEASURE_MAX_COLS (IRDM_MEASURE_SPREAD + IRDM_MEASURE_WORST)
 
 struct irdm_measure {
-	double error;                   /* the worst relative RMS force error */
-	uint32_t worst_node;            /* its column (mesh node) */
-	const char *worst_run;          /* "step" or "release" */
-	size_t n_cols;                  /* columns measured */
-	uint32_t nodes[IRDM_MEASURE_MAX_COLS];  /* their mesh nodes */
-	size_t ticks;                   /* of each run */
-	double seconds;                 /* the whole measurement */
+	double error;                          /* the worst relative RMS force error */
+	uint32_t worst_node;                   /* its column (mesh node) */
+	const char *worst_run;                 /* "step" or "release" */
+	size_t n_cols;                         /* columns measured */
+	uint32_t nodes[IRDM_MEASURE_MAX_COLS]; /* their mesh nodes */
+	size_t ticks;                          /* of each run */
+	double seconds;                        /* the whole measurement */
 };
 
 /*

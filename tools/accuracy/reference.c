@@ -19,12 +19,12 @@ struct site_nodes {
 
 struct conv_ws {
 	const struct irdm_report_conv *c;
-	size_t L;                       /* columns used */
+	size_t L; /* columns used */
 	uint32_t col[IRDM_REPORT_MAX_COLS];
-	size_t nr;                      /* rows of R */
-	size_t rloc[IRDM_REPORT_MAX_COLS];  /* R row of column l */
-	double *R;                      /* [nr][L][n_resp][9] */
-	double *f;                      /* [N][L][3] node forces */
+	size_t nr;                         /* rows of R */
+	size_t rloc[IRDM_REPORT_MAX_COLS]; /* R row of column l */
+	double *R;                         /* [nr][L][n_resp][9] */
+	double *f;                         /* [N][L][3] node forces */
 };
 
 static const double *resp(const struct conv_ws *w, size_t r, size_t l, size_t s)
@@ -85,7 +85,7 @@ static int collect(struct conv_ws *w, char *err, size_t errlen)
 		if (ret) {
 			snprintf(err, errlen, "reference: tick %zu: %s", i / c->m,
 				 ret == IRDM_EINVAL ? "the scenario touches too many columns" :
-				 "a contact node is not touchable in the image");
+						      "a contact node is not touchable in the image");
 			return ret;
 		}
 	}

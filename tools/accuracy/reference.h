@@ -19,17 +19,17 @@
 
 struct irdm_report_conv {
 	const struct irdm_image *img;
-	const struct irdm_report_cmd *cmds;  /* N x m, tick-major */
-	unsigned m;                          /* contacts */
-	size_t N;                            /* ticks */
-	size_t n_resp;                       /* samples of R used (past it: 0) */
-	unsigned disp_every;                 /* 0: no displayed-node output */
+	const struct irdm_report_cmd *cmds; /* N x m, tick-major */
+	unsigned m;                         /* contacts */
+	size_t N;                           /* ticks */
+	size_t n_resp;                      /* samples of R used (past it: 0) */
+	unsigned disp_every;                /* 0: no displayed-node output */
 };
 
 struct irdm_report_conv_out {
-	double *F;              /* N x 3m: each contact's force on the object */
-	double *disp;           /* n_eval x n_nodes x 3: u of every image node */
-	size_t n_eval;          /* ticks disp_every - 1, 2 disp_every - 1, ... */
+	double *F;     /* N x 3m: each contact's force on the object */
+	double *disp;  /* n_eval x n_nodes x 3: u of every image node */
+	size_t n_eval; /* ticks disp_every - 1, 2 disp_every - 1, ... */
 };
 
 /*

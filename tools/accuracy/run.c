@@ -29,7 +29,7 @@ static int make_sites(const struct irdm_engine *eng, const struct irdm_report_cm
 		if (!c->active)
 			continue;
 		ret = c->on_node ? irdm_engine_site_node(eng, c->row, &sites[i]) :
-			irdm_engine_site_point(eng, c->tri, c->bary, &sites[i]);
+				   irdm_engine_site_point(eng, c->tri, c->bary, &sites[i]);
 		if (ret)
 			return ret;
 	}

@@ -10,10 +10,10 @@
 #include "accuracy/scenario.h"
 
 struct irdm_report_engine_out {
-	double *F;              /* N x 3m */
-	double *disp;           /* n_eval x n_nodes x 3 (deformation worker) */
+	double *F;    /* N x 3m */
+	double *disp; /* n_eval x n_nodes x 3 (deformation worker) */
 	size_t n_eval;
-	double *tick_us;        /* N: irdm_engine_tick() and any site move */
+	double *tick_us; /* N: irdm_engine_tick() and any site move */
 	bool faulted;
 };
 

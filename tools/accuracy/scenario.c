@@ -9,15 +9,19 @@
 
 /* The paper's Fig. 6a: the top centre pushed 1 cm at once and held. */
 const struct irdm_report_scenario irdm_report_step = {
-	.name = "step", .what = "top centre node pushed 1 cm at once, held 3 s",
-	.duration_s = 3.0, .n_contacts = 1,
+	.name = "step",
+	.what = "top centre node pushed 1 cm at once, held 3 s",
+	.duration_s = 3.0,
+	.n_contacts = 1,
 	.path = { { .on_node = true, .on_s = 0, .off_s = 1e9, .depth_m = 0.01 } },
 };
 
 /* Free vibration after a let-go: the same push for 1 s, then 2 s free. */
 const struct irdm_report_scenario irdm_report_release = {
-	.name = "release", .what = "top centre node pushed 1 cm at once, let go after 1 s, 2 s free",
-	.duration_s = 3.0, .n_contacts = 1,
+	.name = "release",
+	.what = "top centre node pushed 1 cm at once, let go after 1 s, 2 s free",
+	.duration_s = 3.0,
+	.n_contacts = 1,
 	.path = { { .on_node = true, .on_s = 0, .off_s = 1.0, .depth_m = 0.01 } },
 };
 
@@ -25,20 +29,19 @@ const struct irdm_report_scenario irdm_report_release = {
 const struct irdm_report_scenario irdm_report_two_points = {
 	.name = "two-points",
 	.what = "top centre node held 5 mm down; the node one cell away diagonally (2.5 cm on the 4x4x8 mesh) pushed to 1 cm over 0.5 s from 0.2 s, both held to 2 s",
-	.duration_s = 2.0, .n_contacts = 2,
+	.duration_s = 2.0,
+	.n_contacts = 2,
 	.path = { { .on_node = true, .on_s = 0, .off_s = 1e9, .depth_m = 0.005 },
-		  { .on_node = true, .from_m = { 0.025, 0.025 }, .on_s = 0.2, .off_s = 1e9,
-		    .depth_m = 0.01, .ramp_s = 0.5 } },
+		  { .on_node = true, .from_m = { 0.025, 0.025 }, .on_s = 0.2, .off_s = 1e9, .depth_m = 0.01, .ramp_s = 0.5 } },
 };
 
 /* Fig. 6c: a point pressed and stroked across the top's triangles. */
 const struct irdm_report_scenario irdm_report_stroke = {
 	.name = "stroke",
 	.what = "a point pressed 5 mm over 0.1 s, stroked 2.1 cm across the top's triangles (beside the centre) in 1 s, held to 2 s",
-	.duration_s = 2.0, .n_contacts = 1,
-	.path = { { .on_node = false, .from_m = { 0.002, 0.011 }, .to_m = { 0.023, 0.014 },
-		    .slide_begin_s = 0.2, .slide_end_s = 1.2, .on_s = 0, .off_s = 1e9,
-		    .depth_m = 0.005, .ramp_s = 0.1 } },
+	.duration_s = 2.0,
+	.n_contacts = 1,
+	.path = { { .on_node = false, .from_m = { 0.002, 0.011 }, .to_m = { 0.023, 0.014 }, .slide_begin_s = 0.2, .slide_end_s = 1.2, .on_s = 0, .off_s = 1e9, .depth_m = 0.005, .ramp_s = 0.1 } },
 };
 
 /*
@@ -50,9 +53,9 @@ const struct irdm_report_scenario irdm_report_stroke = {
 const struct irdm_report_scenario irdm_report_swing = {
 	.name = "swing",
 	.what = "floating cube grabbed at the top centre node, the grab point moved +-3 cm sideways (x) at 1 Hz, 2 periods",
-	.duration_s = 2.0, .n_contacts = 1,
-	.path = { { .on_node = true, .on_s = 0, .off_s = 1e9, .depth_m = 0.03,
-		    .dir = { 1, 0, 0 }, .shape = IRDM_REPORT_SINE, .wave_hz = 1.0 } },
+	.duration_s = 2.0,
+	.n_contacts = 1,
+	.path = { { .on_node = true, .on_s = 0, .off_s = 1e9, .depth_m = 0.03, .dir = { 1, 0, 0 }, .shape = IRDM_REPORT_SINE, .wave_hz = 1.0 } },
 };
 
 /*
@@ -64,10 +67,9 @@ const struct irdm_report_scenario irdm_report_swing = {
 const struct irdm_report_scenario irdm_report_tap = {
 	.name = "tap",
 	.what = "floating cube: the centre node of its +x face pushed 2 mm in (-x) over 10 ms, back over 10 ms, let go, 1 s of free flight",
-	.duration_s = 1.0, .n_contacts = 1,
-	.path = { { .on_node = true, .from_m = { 0.06, 0, -0.06 }, .on_s = 0, .off_s = 0.02,
-		    .depth_m = 0.002, .ramp_s = 0.01, .dir = { -1, 0, 0 },
-		    .shape = IRDM_REPORT_TAP } },
+	.duration_s = 1.0,
+	.n_contacts = 1,
+	.path = { { .on_node = true, .from_m = { 0.06, 0, -0.06 }, .on_s = 0, .off_s = 0.02, .depth_m = 0.002, .ramp_s = 0.01, .dir = { -1, 0, 0 }, .shape = IRDM_REPORT_TAP } },
 };
 
 size_t irdm_report_scenario_ticks(const struct irdm_report_scenario *sc, double dt_s)
@@ -144,7 +146,8 @@ int irdm_report_scenario_cmds(const struct irdm_report_scenario *sc,
 	for (unsigned i = 0; i < sc->n_contacts; i++) {
 		const struct irdm_report_path *p = &sc->path[i];
 		double s = p->slide_end_s > p->slide_begin_s ?
-			clamp01((time_s - p->slide_begin_s) / (p->slide_end_s - p->slide_begin_s)) : 0;
+				   clamp01((time_s - p->slide_begin_s) / (p->slide_end_s - p->slide_begin_s)) :
+				   0;
 		double depth = p->depth_m * depth_fraction(p, time_s);
 		bool down = !p->dir[0] && !p->dir[1] && !p->dir[2];
 		double at[3] = { c[0] + p->from_m[0] + s * (p->to_m[0] - p->from_m[0]),

@@ -18,9 +18,9 @@
 
 /* How a path's depth goes over time from on_s. */
 enum irdm_report_shape {
-	IRDM_REPORT_HOLD = 0,   /* reached over ramp_s (0: a step), held */
-	IRDM_REPORT_TAP,        /* in over ramp_s, back out over ramp_s */
-	IRDM_REPORT_SINE,       /* depth sin(2 pi wave_hz t): there and back */
+	IRDM_REPORT_HOLD = 0, /* reached over ramp_s (0: a step), held */
+	IRDM_REPORT_TAP,      /* in over ramp_s, back out over ramp_s */
+	IRDM_REPORT_SINE,     /* depth sin(2 pi wave_hz t): there and back */
 };
 
 /* One contact: a node (the column nearest to from_m) or a point on the top
@@ -40,7 +40,7 @@ struct irdm_report_path {
 
 struct irdm_report_scenario {
 	const char *name;
-	const char *what;               /* one line for the report */
+	const char *what; /* one line for the report */
 	double duration_s;
 	unsigned n_contacts;
 	struct irdm_report_path path[2];
@@ -50,8 +50,8 @@ struct irdm_report_scenario {
 struct irdm_report_cmd {
 	bool active;
 	bool on_node;
-	uint32_t row;                   /* on_node: the image node */
-	uint32_t tri;                   /* else: the surface triangle */
+	uint32_t row; /* on_node: the image node */
+	uint32_t tri; /* else: the surface triangle */
 	double bary[3];
 	double target_m[3];
 };

@@ -146,6 +146,5 @@ int irdm_eig_slepc(const struct irdm_fem *fem, size_t n_lowest, double sigma,
 {
 	int ret = irdm_dist_begin(err, errlen);
 
-	return ret ? ret : ops->eig(fem, n_lowest, sigma, want, n_whole, progress, ctx, w2, phi,
-				    compliance, err, errlen);
+	return ret ? ret : ops->eig(fem, n_lowest, sigma, want, n_whole, progress, ctx, w2, phi, compliance, err, errlen);
 }

@@ -21,7 +21,7 @@
 #define IRDM_DIST_OPS_VERSION 3
 
 struct irdm_dist_ops {
-	int version;                    /* IRDM_DIST_OPS_VERSION */
+	int version; /* IRDM_DIST_OPS_VERSION */
 	int (*begin)(char *err, size_t errlen);
 	void (*end)(void);
 	int (*rank)(void);

@@ -93,10 +93,8 @@ static double tet_gradients(const double *p[4], double grad[4][3])
 
 	for (int i = 0; i < 3; i++)
 		for (int k = 0; k < 3; k++)
-			e[i][k] = p[i + 1][k] - p[0][k];   /* rows: edge vectors */
-	double det = e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1])
-		   - e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0])
-		   + e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0]);
+			e[i][k] = p[i + 1][k] - p[0][k]; /* rows: edge vectors */
+	double det = e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) - e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) + e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0]);
 	/* inv = E^{-1}; dN_{i+1}/dx = column i of E^{-1}... E maps grad to edge
 	 * differences: e_i . grad N = delta, so grad N_{i+1} = row i of E^{-T}. */
 	inv[0][0] = (e[1][1] * e[2][2] - e[1][2] * e[2][1]) / det;
@@ -128,9 +126,12 @@ static double tet_stiffness(const double *p[4], const double d[6][6], double ke[
 		b[0][c] = x;
 		b[1][c + 1] = y;
 		b[2][c + 2] = z;
-		b[3][c] = y; b[3][c + 1] = x;
-		b[4][c + 1] = z; b[4][c + 2] = y;
-		b[5][c] = z; b[5][c + 2] = x;
+		b[3][c] = y;
+		b[3][c + 1] = x;
+		b[4][c + 1] = z;
+		b[4][c + 2] = y;
+		b[5][c] = z;
+		b[5][c + 2] = x;
 	}
 	for (int i = 0; i < 6; i++)
 		for (int j = 0; j < 12; j++) {
@@ -212,8 +213,7 @@ int irdm_fem_assemble(const struct irdm_mesh *mesh, const struct irdm_material *
 		return ret;
 	elasticity(mat, d);
 	tk = malloc(mesh->n_tets * 144 * sizeof(*tk));
-	tm = malloc((mass == IRDM_MASS_CONSISTENT ? mesh->n_tets * 48 : 0) * sizeof(*tm)
-		    + fem->map.n_free * sizeof(*tm));
+	tm = malloc((mass == IRDM_MASS_CONSISTENT ? mesh->n_tets * 48 : 0) * sizeof(*tm) + fem->map.n_free * sizeof(*tm));
 	fem->lumped_mass_kg = calloc(mesh->n_nodes, sizeof(double));
 	if (!tk || !tm || !fem->lumped_mass_kg)
 		goto out_nomem;
@@ -345,7 +345,7 @@ int irdm_mass_properties_of_matrix(const struct irdm_mesh *mesh, const struct ir
 			for (int a = 0; a < 3; a++)
 				for (int b = 0; b < 3; b++)
 					inertia_kg_m2[3 * a + b] += M->val[p] *
-						((a == b ? dot : 0) - 0.5 * (ri[a] * rj[b] + rj[a] * ri[b]));
+								    ((a == b ? dot : 0) - 0.5 * (ri[a] * rj[b] + rj[a] * ri[b]));
 		}
 	}
 	*mass_kg = m;

@@ -92,7 +92,7 @@ int irdm_fem_factor_diag(const struct irdm_fem *fem, double ck, double cm, const
 	 * and keep the sparser.  On 3D
 	 * meshes METIS typically wins by ~40 %.  Both are deterministic.
 	 */
-	cc->nmethods = 3;	/* given ordering (none: skipped), AMD, METIS */
+	cc->nmethods = 3; /* given ordering (none: skipped), AMD, METIS */
 	*L = cholmod_l_analyze(s, cc);
 	if (!*L) {
 		snprintf(err, errlen, "%s: CHOLMOD analysis failed (status %d)", what,

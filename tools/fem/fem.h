@@ -26,21 +26,22 @@ struct irdm_material {
 /* Symmetric sparse matrix, compressed sparse column, BOTH triangles stored,
  * row indices sorted within each column. */
 struct irdm_csc {
-	size_t   n;
-	size_t   nnz;
-	int64_t *colptr;   /* n + 1 */
-	int64_t *rowind;   /* nnz */
-	double  *val;      /* nnz */
+	size_t n;
+	size_t nnz;
+	int64_t *colptr; /* n + 1 */
+	int64_t *rowind; /* nnz */
+	double *val;     /* nnz */
 };
 
 struct irdm_dofmap {
-	size_t   n_dof;        /* 3 * mesh nodes */
-	size_t   n_free;       /* free DoFs */
-	int64_t *free_of;      /* n_dof: free index or -1 if fixed */
-	int64_t *global_of;    /* n_free: global DoF */
+	size_t n_dof;       /* 3 * mesh nodes */
+	size_t n_free;      /* free DoFs */
+	int64_t *free_of;   /* n_dof: free index or -1 if fixed */
+	int64_t *global_of; /* n_free: global DoF */
 };
 
-enum irdm_mass_kind { IRDM_MASS_LUMPED = 0, IRDM_MASS_CONSISTENT = 1 };
+enum irdm_mass_kind { IRDM_MASS_LUMPED = 0,
+		      IRDM_MASS_CONSISTENT = 1 };
 
 struct irdm_fem {
 	struct irdm_dofmap map;

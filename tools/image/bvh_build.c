@@ -17,17 +17,17 @@ struct sort_key {
 };
 
 struct edge {
-	uint32_t a, b;          /* vertex rows, a < b */
+	uint32_t a, b; /* vertex rows, a < b */
 	uint32_t tri;
-	uint32_t e;             /* edge (v[e], v[(e + 1) % 3]) */
+	uint32_t e; /* edge (v[e], v[(e + 1) % 3]) */
 };
 
 struct bld {
 	const struct irdm_node *nodes;
 	const uint32_t *tris;
-	uint32_t *index;        /* contactable triangles, permuted in place */
-	double *cent;           /* 3 per surface triangle */
-	struct sort_key *keys;  /* scratch, one per contactable triangle */
+	uint32_t *index;       /* contactable triangles, permuted in place */
+	double *cent;          /* 3 per surface triangle */
+	struct sort_key *keys; /* scratch, one per contactable triangle */
 	struct irdm_bvh_node *out;
 	uint32_t n_out;
 	uint32_t depth;
@@ -228,7 +228,8 @@ int irdm_bvh_build(const struct irdm_node *nodes, uint32_t n_nodes,
 
 		for (unsigned a = 0; a < 3; a++)
 			b.cent[3 * (size_t)t + a] = ((double)nodes[v[0]].pos_m[a] +
-						     nodes[v[1]].pos_m[a] + nodes[v[2]].pos_m[a]) / 3;
+						     nodes[v[1]].pos_m[a] + nodes[v[2]].pos_m[a]) /
+						    3;
 		if (contactable(col_of_row, v))
 			b.index[n_contact++] = t;
 	}
@@ -252,7 +253,8 @@ int irdm_bvh_build(const struct irdm_node *nodes, uint32_t n_nodes,
 	h.col_of_row_offset = h.adj_offset + n_tris * 12u;
 	bytes = (size_t)h.col_of_row_offset + (size_t)n_nodes * 4;
 	if ((uint64_t)sizeof(h) + (uint64_t)b.n_out * sizeof(*b.out) + n_contact * 4ull +
-	    n_tris * 12ull + n_nodes * 4ull != bytes) {
+		    n_tris * 12ull + n_nodes * 4ull !=
+	    bytes) {
 		snprintf(err, errlen, "bvh: %u triangles and %u rows do not fit a 4 GiB section",
 			 n_tris, n_nodes);
 		goto out_free;

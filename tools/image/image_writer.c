@@ -35,7 +35,7 @@
 
 #define ALIGN IRDM_IMAGE_ALIGN
 #define HEADER_SIZE sizeof(struct irdm_image_header)
-#define TABLE_OFFSET ALIGN      /* the header fills exactly one 64-byte line */
+#define TABLE_OFFSET ALIGN /* the header fills exactly one 64-byte line */
 #define HEAD_MAX (TABLE_OFFSET + \
 		  IRDM_IMAGE_MAX_SECTIONS * sizeof(struct irdm_image_section))
 
@@ -43,13 +43,13 @@
 struct layout {
 	uint64_t offset[IRDM_IMAGE_MAX_SECTIONS];
 	uint64_t file_size;
-	uint8_t head[HEAD_MAX];         /* header + table */
+	uint8_t head[HEAD_MAX]; /* header + table */
 	size_t head_len;
 };
 
 /* Destination of the bytes: a file descriptor or a memory buffer. */
 struct sink {
-	int fd;                         /* -1: write into mem */
+	int fd; /* -1: write into mem */
 	uint8_t *mem;
 	uint64_t pos;
 };
@@ -146,7 +146,7 @@ static int sink_put(struct sink *s, const void *data, uint64_t len)
 {
 	const uint8_t *p = data;
 
-	if (!len)               /* empty payloads may have no buffer at all */
+	if (!len) /* empty payloads may have no buffer at all */
 		return 0;
 	if (s->fd < 0) {
 		memcpy(s->mem + s->pos, p, (size_t)len);
@@ -209,7 +209,7 @@ int irdm_iw_to_buffer(const struct irdm_image_writer *w, void **buf,
 	s.mem = malloc((size_t)lo->file_size);
 	if (!s.mem)
 		goto free_layout;
-	emit(w, lo, &s);        /* into memory: cannot fail */
+	emit(w, lo, &s); /* into memory: cannot fail */
 	*buf = s.mem;
 	*size = (size_t)lo->file_size;
 	ret = IRDM_OK;

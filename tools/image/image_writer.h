@@ -19,7 +19,7 @@ struct irdm_image_writer {
 	struct {
 		uint32_t kind;
 		uint32_t elem;
-		const void *data;    /* borrowed until irdm_iw_write() returns */
+		const void *data; /* borrowed until irdm_iw_write() returns */
 		uint64_t size;
 	} sec[IRDM_IMAGE_MAX_SECTIONS];
 };

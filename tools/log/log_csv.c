@@ -52,7 +52,8 @@ static void write_header_row(FILE *f, unsigned n_devices)
 			for (int k = 0; k < 3; k++)
 				fprintf(f, ",d%u_%s", d, vec_cols[v][k]);
 		fprintf(f, ",d%u_proxy,d%u_tri,d%u_site_tri,d%u_b0,d%u_b1,d%u_b2,d%u_tx_m,d%u_ty_m,"
-			"d%u_tz_m", d, d, d, d, d, d, d, d, d);
+			   "d%u_tz_m",
+			d, d, d, d, d, d, d, d, d);
 	}
 	fputc('\n', f);
 }

@@ -19,21 +19,21 @@
 #include "irdm/error.h"
 
 struct irdm_mesh {
-	size_t    n_nodes;
-	double   *pos_m;      /* 3 * n_nodes, metres */
-	size_t    n_tets;
-	uint32_t *tets;       /* 4 * n_tets, 0-based, positive volume */
-	size_t    n_tris;
-	uint32_t *tris;       /* 3 * n_tris boundary faces, CCW seen from outside */
-	char      name[64];   /* short name for provenance (file stem or generator) */
+	size_t n_nodes;
+	double *pos_m; /* 3 * n_nodes, metres */
+	size_t n_tets;
+	uint32_t *tets; /* 4 * n_tets, 0-based, positive volume */
+	size_t n_tris;
+	uint32_t *tris; /* 3 * n_tris boundary faces, CCW seen from outside */
+	char name[64];  /* short name for provenance (file stem or generator) */
 };
 
 /* A triangle surface before tetrahedralisation. */
 struct irdm_surface {
-	size_t    n_verts;
-	double   *pos_m;      /* 3 * n_verts */
-	size_t    n_tris;
-	uint32_t *tris;       /* 3 * n_tris, 0-based */
+	size_t n_verts;
+	double *pos_m; /* 3 * n_verts */
+	size_t n_tris;
+	uint32_t *tris; /* 3 * n_tris, 0-based */
 };
 
 void irdm_mesh_free(struct irdm_mesh *m);
@@ -138,13 +138,13 @@ int irdm_mesh_finish(struct irdm_mesh *m, const char *what, char *err, size_t er
 /* What a mesh is made of (mesh_stats.c). */
 struct irdm_mesh_stats {
 	size_t n_nodes, n_tets, worst_tet;
-	double size_m;                          /* the largest bounding-box side */
+	double size_m; /* the largest bounding-box side */
 	double vol_min_m3, vol_max_m3;
-	double quality_min, quality_max;        /* 1: regular tet, 0: flat */
+	double quality_min, quality_max; /* 1: regular tet, 0: flat */
 };
-#define IRDM_MESH_VOL_SPAN_WARN 1e6     /* tet volumes spanning more: graded */
-#define IRDM_MESH_SIZE_WARN_M 5.0       /* a desktop object larger: units? */
-#define IRDM_MESH_SIZE_SMALL_M 1e-3     /* or smaller */
+#define IRDM_MESH_VOL_SPAN_WARN 1e6 /* tet volumes spanning more: graded */
+#define IRDM_MESH_SIZE_WARN_M 5.0   /* a desktop object larger: units? */
+#define IRDM_MESH_SIZE_SMALL_M 1e-3 /* or smaller */
 
 void irdm_mesh_stats(const struct irdm_mesh *m, struct irdm_mesh_stats *st);
 

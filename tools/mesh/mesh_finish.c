@@ -25,14 +25,17 @@
  * row k is the face opposite node k.
  */
 static const unsigned char outward[4][3] = {
-	{ 1, 2, 3 }, { 0, 3, 2 }, { 0, 1, 3 }, { 0, 2, 1 },
+	{ 1, 2, 3 },
+	{ 0, 3, 2 },
+	{ 0, 1, 3 },
+	{ 0, 2, 1 },
 };
 
 struct face {
-	uint32_t v[3];		/* sorted node indices */
+	uint32_t v[3]; /* sorted node indices */
 	uint32_t tet;
-	unsigned char local;	/* row of outward[] */
-	unsigned char odd;	/* sorting took an odd permutation */
+	unsigned char local; /* row of outward[] */
+	unsigned char odd;   /* sorting took an odd permutation */
 };
 
 uint64_t mesh_node_label(const struct mesh_labels *lab, size_t i)

@@ -19,14 +19,21 @@
 #include "mesh/mesh_priv.h"
 
 static const unsigned char kuhn[6][4] = {
-	{ 0, 1, 3, 7 }, { 0, 1, 5, 7 }, { 0, 2, 3, 7 },
-	{ 0, 2, 6, 7 }, { 0, 4, 5, 7 }, { 0, 4, 6, 7 },
+	{ 0, 1, 3, 7 },
+	{ 0, 1, 5, 7 },
+	{ 0, 2, 3, 7 },
+	{ 0, 2, 6, 7 },
+	{ 0, 4, 5, 7 },
+	{ 0, 4, 6, 7 },
 };
 
 /* For even hexes; odd hexes use corner ^ 1 (mirror in x). */
 static const unsigned char five[5][4] = {
-	{ 0, 3, 5, 6 },		/* central: the even corners */
-	{ 1, 0, 3, 5 }, { 2, 3, 0, 6 }, { 4, 5, 6, 0 }, { 7, 6, 5, 3 },
+	{ 0, 3, 5, 6 }, /* central: the even corners */
+	{ 1, 0, 3, 5 },
+	{ 2, 3, 0, 6 },
+	{ 4, 5, 6, 0 },
+	{ 7, 6, 5, 3 },
 };
 
 /*
@@ -47,8 +54,11 @@ static int corner_orientation(const unsigned char c[4])
 		w[k] = p[3][k] - p[0][k];
 	}
 	return (u[1] * v[2] - u[2] * v[1]) * w[0] +
-	       (u[2] * v[0] - u[0] * v[2]) * w[1] +
-	       (u[0] * v[1] - u[1] * v[0]) * w[2] > 0 ? 1 : -1;
+				       (u[2] * v[0] - u[0] * v[2]) * w[1] +
+				       (u[0] * v[1] - u[1] * v[0]) * w[2] >
+			       0 ?
+		       1 :
+		       -1;
 }
 
 /* Local tets for a hex of the given parity, each positively oriented. */
@@ -60,7 +70,7 @@ static void build_pattern(unsigned tets_per_hex, unsigned odd,
 	for (t = 0; t < tets_per_hex; t++) {
 		for (i = 0; i < 4; i++)
 			pat[t][i] = tets_per_hex == 6 ? kuhn[t][i] :
-				    (unsigned char)(five[t][i] ^ odd);
+							(unsigned char)(five[t][i] ^ odd);
 		if (corner_orientation(pat[t]) < 0) {
 			unsigned char c = pat[t][2];
 

@@ -24,16 +24,16 @@
 struct gmsh {
 	const char *what;
 	struct mtext t;
-	int major;		/* 2 or 4; 0 before $MeshFormat */
+	int major; /* 2 or 4; 0 before $MeshFormat */
 	bool have_nodes;
 	bool have_elements;
 
 	size_t n_nodes;
-	double *pos;		/* 3 per node */
+	double *pos; /* 3 per node */
 	uint64_t *node_tag;
 
 	size_t n_tets, cap_tets, cap_tet_tags;
-	uint64_t *tet_nodes;	/* 4 node tags per tet, mapped at the end */
+	uint64_t *tet_nodes; /* 4 node tags per tet, mapped at the end */
 	uint64_t *tet_tag;
 
 	/* The helpers below return 0 or -1 with the reason in err; oom says
@@ -407,7 +407,7 @@ static int parse_section(struct gmsh *g, struct mline *l)
 		if (nodes && (g->major == 2 ? parse_nodes_v2(g) : parse_nodes_v4(g)))
 			return -1;
 		if (!nodes && (g->major == 2 ? parse_elements_v2(g) :
-			       parse_elements_v4(g)))
+					       parse_elements_v4(g)))
 			return -1;
 		return expect_end(g, nodes ? "$EndNodes" : "$EndElements");
 	}
@@ -536,8 +536,8 @@ static int parse_all(struct gmsh *g, struct irdm_mesh *m, struct mesh_labels *la
 			return -1;
 	if (!g->major || !g->have_nodes || !g->have_elements) {
 		mesh_err(g->err, g->errlen, g->what,
-			 "missing %s section", !g->major ? "$MeshFormat" :
-			 !g->have_nodes ? "$Nodes" : "$Elements");
+			 "missing %s section", !g->major ? "$MeshFormat" : !g->have_nodes ? "$Nodes" :
+											    "$Elements");
 		return -1;
 	}
 	if (!g->n_tets) {

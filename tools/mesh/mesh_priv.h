@@ -48,7 +48,7 @@ struct mtext {
 	size_t len;
 	size_t pos;
 	size_t lineno;
-	bool has_comment;	/* cut each line at `comment` */
+	bool has_comment; /* cut each line at `comment` */
 	char comment;
 };
 
@@ -57,7 +57,7 @@ struct mline {
 	const char *p;
 	size_t len;
 	size_t pos;
-	size_t lineno;		/* 1-based line number in the text */
+	size_t lineno; /* 1-based line number in the text */
 };
 
 void mtext_init(struct mtext *t, const char *p, size_t len, int comment);
@@ -81,8 +81,8 @@ int mesh_tok_ll(const char *tok, size_t n, long long *v);
 struct mesh_labels {
 	const char *node_what;
 	const char *tet_what;
-	uint64_t *node_tag;	/* n_nodes entries or NULL */
-	uint64_t *tet_tag;	/* n_tets entries or NULL */
+	uint64_t *node_tag; /* n_nodes entries or NULL */
+	uint64_t *tet_tag;  /* n_tets entries or NULL */
 };
 
 void mesh_labels_free(struct mesh_labels *lab);

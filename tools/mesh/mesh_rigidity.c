@@ -51,9 +51,21 @@ static void sort3(uint32_t v[3])
 {
 	uint32_t t;
 
-	if (v[0] > v[1]) { t = v[0]; v[0] = v[1]; v[1] = t; }
-	if (v[1] > v[2]) { t = v[1]; v[1] = v[2]; v[2] = t; }
-	if (v[0] > v[1]) { t = v[0]; v[0] = v[1]; v[1] = t; }
+	if (v[0] > v[1]) {
+		t = v[0];
+		v[0] = v[1];
+		v[1] = t;
+	}
+	if (v[1] > v[2]) {
+		t = v[1];
+		v[1] = v[2];
+		v[2] = t;
+	}
+	if (v[0] > v[1]) {
+		t = v[0];
+		v[0] = v[1];
+		v[1] = t;
+	}
 }
 
 /* cluster[t]: a representative tet of tet t's face-connected cluster. */
@@ -244,8 +256,8 @@ int irdm_mesh_check_rigidity(const struct irdm_mesh *m, const bool *fixed, bool 
 	v = m->tets[4 * (size_t)loose];
 	snprintf(err, errlen,
 		 floating ? "model: a floating object must move as one body: %u tet(s) around node %u "
-			    "(%.4g, %.4g, %.4g) hang on fewer than 3 non-collinear nodes of the rest"
-			  : "model: %u tet(s) around node %u (%.4g, %.4g, %.4g) can move without "
+			    "(%.4g, %.4g, %.4g) hang on fewer than 3 non-collinear nodes of the rest" :
+			    "model: %u tet(s) around node %u (%.4g, %.4g, %.4g) can move without "
 			    "straining (fewer than 3 non-collinear fixed or held nodes): fix more "
 			    "nodes or declare it floating",
 		 n_loose, v, m->pos_m[3 * (size_t)v], m->pos_m[3 * (size_t)v + 1],

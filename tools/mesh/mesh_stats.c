@@ -35,7 +35,8 @@ static double volume(const double *p[4])
 			e[k][i] = p[k + 1][i] - p[0][i];
 	return (e[0][0] * (e[1][1] * e[2][2] - e[1][2] * e[2][1]) -
 		e[0][1] * (e[1][0] * e[2][2] - e[1][2] * e[2][0]) +
-		e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0])) / 6;
+		e[0][2] * (e[1][0] * e[2][1] - e[1][1] * e[2][0])) /
+	       6;
 }
 
 void irdm_mesh_stats(const struct irdm_mesh *m, struct irdm_mesh_stats *st)
@@ -80,18 +81,21 @@ int irdm_mesh_stats_text(const struct irdm_mesh *m, const struct irdm_mesh_stats
 	snprintf(lines[n++], 256,
 		 "mesh stats: %zu nodes, %zu tets, %.3g m across; tet volumes %.3g..%.3g m^3 "
 		 "(ratio %.2g); shape quality %.3f..%.3f (1: regular), worst tet %zu at "
-		 "(%.4g, %.4g, %.4g)", st->n_nodes, st->n_tets, st->size_m, st->vol_min_m3,
+		 "(%.4g, %.4g, %.4g)",
+		 st->n_nodes, st->n_tets, st->size_m, st->vol_min_m3,
 		 st->vol_max_m3, span, st->quality_min, st->quality_max, st->worst_tet, w[0], w[1],
 		 w[2]);
 	if (span > IRDM_MESH_VOL_SPAN_WARN)
 		snprintf(lines[n++], 256,
 			 "warning: tet volumes span a factor %.2g (more than %.0e): a tiny feature "
 			 "grades the mesh, and the eigensolve pays for its smallest elements "
-			 "(tetgen switches with -a, or a simpler surface)", span,
+			 "(tetgen switches with -a, or a simpler surface)",
+			 span,
 			 IRDM_MESH_VOL_SPAN_WARN);
 	if (st->size_m > IRDM_MESH_SIZE_WARN_M || st->size_m < IRDM_MESH_SIZE_SMALL_M)
 		snprintf(lines[n++], 256,
 			 "warning: the object is %.3g m across: is mesh_scale right? (a part "
-			 "drawn in millimetres needs mesh_scale = 0.001)", st->size_m);
+			 "drawn in millimetres needs mesh_scale = 0.001)",
+			 st->size_m);
 	return n;
 }

@@ -20,9 +20,9 @@
 
 /* Shortest possible records, "1 0 0 0" and "1 1 2 3 4": bounds headers. */
 #define NODE_MIN_BYTES 7
-#define ELE_MIN_BYTES  9
+#define ELE_MIN_BYTES 9
 
-#define ATTRS_MAX 1000      /* attributes a record may declare: far above tetgen's use */
+#define ATTRS_MAX 1000 /* attributes a record may declare: far above tetgen's use */
 
 /*
  * Reads "<count> <second> [<attributes> [<marker>]]" from the first line;

@@ -12,7 +12,7 @@
 #include "mesh/mesh_priv.h"
 
 struct edge {
-	uint32_t a, b;          /* a < b */
+	uint32_t a, b; /* a < b */
 };
 
 static int edge_cmp(const void *x, const void *y)

@@ -21,10 +21,10 @@
 #include "irdm/error.h"
 #include "mesh/mesh_priv.h"
 
-#define SIZING_RUNS 6           /* tetgen runs at most */
-#define SIZING_FACTOR 2.0       /* accepted: target / 2 .. target * 2 nodes */
-#define NODES_PER_TET 0.25      /* about, for quality meshes of a few 1000 nodes */
-#define RHO_START 1.414         /* the unsized default's radius-edge bound */
+#define SIZING_RUNS 6      /* tetgen runs at most */
+#define SIZING_FACTOR 2.0  /* accepted: target / 2 .. target * 2 nodes */
+#define NODES_PER_TET 0.25 /* about, for quality meshes of a few 1000 nodes */
+#define RHO_START 1.414    /* the unsized default's radius-edge bound */
 #define RHO_MAX 16.0
 
 /* Enclosed volume (file units^3) by the divergence theorem; outward or
@@ -44,7 +44,7 @@ double irdm_surface_volume(const struct irdm_surface *s)
 }
 
 struct sizing_try {
-	double rho, vol;        /* -q rho -a vol */
+	double rho, vol; /* -q rho -a vol */
 	char sw[64];
 };
 

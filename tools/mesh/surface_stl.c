@@ -22,7 +22,7 @@
 
 struct corner {
 	double x[3];
-	uint32_t i;		/* position in the unmerged corner list */
+	uint32_t i; /* position in the unmerged corner list */
 };
 
 static int corner_cmp(const void *pa, const void *pb)
@@ -135,7 +135,7 @@ out_free:
 struct stl_ascii {
 	struct corner *c;
 	size_t n, cap;
-	size_t in_facet;	/* corners seen in the open facet, or 0 */
+	size_t in_facet; /* corners seen in the open facet, or 0 */
 	bool open;
 };
 
@@ -271,7 +271,8 @@ int irdm_surface_parse_stl(const void *buf, size_t len, const char *what,
 	if (fits && !exact && !looks_ascii(buf, len) && (len - STL_HEADER) % STL_RECORD == 0) {
 		mesh_err(err, errlen, what,
 			 "binary STL declares %zu triangles at byte 80 but holds %zu whole "
-			 "triangle records: the count is wrong", n,
+			 "triangle records: the count is wrong",
+			 n,
 			 (len - STL_HEADER) / STL_RECORD);
 		ret = IRDM_EFORMAT;
 	} else if (exact || (fits && !looks_ascii(buf, len))) {

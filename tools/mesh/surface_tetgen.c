@@ -32,13 +32,13 @@ extern char **environ;
 #define PATH_BYTES 4096
 
 struct tg_run {
-	char dir[PATH_BYTES - 32];	/* room left for "/surf.1.node" */
+	char dir[PATH_BYTES - 32]; /* room left for "/surf.1.node" */
 	char smesh[PATH_BYTES];
 	char node[PATH_BYTES];
 	char ele[PATH_BYTES];
 	char log[PATH_BYTES];
 	char sw[128];
-	char out_what[256];	/* "<what> (tetgen output)" */
+	char out_what[256]; /* "<what> (tetgen output)" */
 };
 
 /* "-" + switches (+ 'p' so the .smesh facets are read) + 'Q' (quiet). */

@@ -108,7 +108,7 @@ int surface_weld(struct irdm_surface *s, size_t *welded, double *tol_out)
 				kept++;
 			}
 		for (size_t t = 0; t < 3 * s->n_tris; t++)
-			if (s->tris[t] < n)     /* out of range: surface_check says so */
+			if (s->tris[t] < n) /* out of range: surface_check says so */
 				s->tris[t] = idx[rep[s->tris[t]]];
 		s->n_verts = kept;
 	}

@@ -95,8 +95,7 @@ static double step_limit(double r, const struct irdm_tf_point *a)
 static bool arc_ok(double r, double step, const struct irdm_tf_point *a,
 		   const struct irdm_tf_point *b)
 {
-	return fabs(carg(b->det / a->det)) < MAX_TURN && step <= step_limit(r, a)
-	       && step <= step_limit(r, b);
+	return fabs(carg(b->det / a->det)) < MAX_TURN && step <= step_limit(r, a) && step <= step_limit(r, b);
 }
 
 /* Winding number of det H on |z| = r, or INT_MIN if unresolved. */

@@ -13,8 +13,8 @@
 
 struct irdm_tf_point {
 	double complex det;
-	double complex ld;   /* (det H)' / det H = tr(H^-1 H') */
-	double pole_dist;    /* to the nearest pole of H */
+	double complex ld; /* (det H)' / det H = tr(H^-1 H') */
+	double pole_dist;  /* to the nearest pole of H */
 };
 
 /* det H, (log det H)' and the pole distance at z; -1 if det H is 0 or not
@@ -33,10 +33,11 @@ int irdm_tf_point_at(const struct irdm_node_tf *tf, double complex z, struct ird
 
 struct irdm_peaks {
 	double complex z[IRDM_N_PEAKS];
-	double v[IRDM_N_PEAKS];      /* -INFINITY: none */
+	double v[IRDM_N_PEAKS]; /* -INFINITY: none */
 };
 
-enum { IRDM_SIDE_HI, IRDM_SIDE_LO };   /* peaks (all poles inside), dips */
+enum { IRDM_SIDE_HI,
+       IRDM_SIDE_LO }; /* peaks (all poles inside), dips */
 
 struct irdm_walk {
 	struct irdm_peaks side[2];

@@ -59,9 +59,9 @@ static int run_arpack(struct op_ctx *o, const struct irdm_fem *fem, int nev, dou
 		ret = IRDM_ENOMEM;
 		goto out_free;
 	}
-	iparam[0] = 1;          /* exact shifts */
-	iparam[2] = 10000;      /* max restarts */
-	iparam[6] = 3;          /* shift-invert, generalised */
+	iparam[0] = 1;     /* exact shifts */
+	iparam[2] = 10000; /* max restarts */
+	iparam[6] = 3;     /* shift-invert, generalised */
 	size_t ops = 0;
 	for (;;) {
 		dsaupd_c(&ido, "G", n, "LM", nev, tol, resid, ncv, v, n, iparam, ipntr,

@@ -26,8 +26,7 @@ static double *dropped_shapes(const struct irdm_modes *m, size_t k_kept, const i
 		return NULL;
 	for (size_t r = 0; r < 3 * n_cols; r++)
 		for (size_t d = 0; d < Kd; d++)
-			P[r * Kd + d] = col_dofs[r] < 0 ? 0.0
-				      : m->phi[(k_kept + d) * m->n + (size_t)col_dofs[r]];
+			P[r * Kd + d] = col_dofs[r] < 0 ? 0.0 : m->phi[(k_kept + d) * m->n + (size_t)col_dofs[r]];
 	return P;
 }
 
@@ -86,7 +85,7 @@ int irdm_exact_head(const struct irdm_modes *modes, const struct irdm_mode *zoh_
 	if (!Kd || H < 1)
 		return IRDM_EINVAL;
 	P = dropped_shapes(modes, k_kept, col_dofs, n_cols);
-	h = malloc(2 * H * Kd * sizeof(double));        /* [s][d]: the inner loop runs over d */
+	h = malloc(2 * H * Kd * sizeof(double)); /* [s][d]: the inner loop runs over d */
 	hd = malloc(2 * H * sizeof(double));
 	w = malloc(Kd * sizeof(double));
 	if (!P || !h || !hd || !w)

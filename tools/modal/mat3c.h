@@ -7,8 +7,7 @@
 
 static inline double complex irdm_det3c(const double complex a[9])
 {
-	return a[0] * (a[4] * a[8] - a[5] * a[7]) - a[1] * (a[3] * a[8] - a[5] * a[6])
-	       + a[2] * (a[3] * a[7] - a[4] * a[6]);
+	return a[0] * (a[4] * a[8] - a[5] * a[7]) - a[1] * (a[3] * a[8] - a[5] * a[6]) + a[2] * (a[3] * a[7] - a[4] * a[6]);
 }
 
 /* adj(a): a adj(a) = det(a) I */

@@ -16,17 +16,17 @@
 #include "irdm/image_format.h"
 
 enum irdm_eig_method {
-	IRDM_EIG_AUTO = 0,      /* dense when small or all modes wanted, else Lanczos */
+	IRDM_EIG_AUTO = 0, /* dense when small or all modes wanted, else Lanczos */
 	IRDM_EIG_DENSE = 1,
 	IRDM_EIG_LANCZOS = 2,
-	IRDM_EIG_SLEPC = 3,     /* SLEPc over MPI ranks (tools/dist/), if built in */
+	IRDM_EIG_SLEPC = 3, /* SLEPc over MPI ranks (tools/dist/), if built in */
 };
 
 struct irdm_modes {
-	size_t  n;              /* vector length (free DoFs) */
-	size_t  n_modes;        /* elastic modes stored, ascending */
-	size_t  n_rigid;        /* rigid modes found and excluded */
-	size_t  n_elastic_total;/* elastic modes of the model: n - n_rigid */
+	size_t n;               /* vector length (free DoFs) */
+	size_t n_modes;         /* elastic modes stored, ascending */
+	size_t n_rigid;         /* rigid modes found and excluded */
+	size_t n_elastic_total; /* elastic modes of the model: n - n_rigid */
 	double *omega2;         /* n_modes eigenvalues w^2 (rad^2/s^2) */
 	double *phi;            /* n x n_modes, column-major, Phi^T M Phi = I
 				 * (NULL on an MPI rank other than 0) */
@@ -40,8 +40,8 @@ struct irdm_modes {
 
 /* What the caller will read of the modes (irdm_modes_solve_kept). */
 struct irdm_modes_want {
-	const bool *keep;          /* free DoFs read of elastic modes (NULL: all) */
-	const int64_t *load_dofs;  /* free DoFs of the static correction's unit loads */
+	const bool *keep;         /* free DoFs read of elastic modes (NULL: all) */
+	const int64_t *load_dofs; /* free DoFs of the static correction's unit loads */
 	size_t n_loads;
 };
 

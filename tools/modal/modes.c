@@ -85,7 +85,8 @@ static int split_rigid(struct irdm_modes *out, size_t n_req, const double *w2,
 	if (!floating && !(w2[0] > ZERO_TOL * scale)) {
 		snprintf(err, errlen,
 			 "model: a zero-stiffness mode in a grounded object (lowest eigenvalue %g, "
-			 "typical K/M %g): fix more nodes or declare it floating", w2[0], scale);
+			 "typical K/M %g): fix more nodes or declare it floating",
+			 w2[0], scale);
 		return IRDM_EINVAL;
 	}
 	if (floating) {
@@ -96,7 +97,8 @@ static int split_rigid(struct irdm_modes *out, size_t n_req, const double *w2,
 		if (!(w2[6] > RIGID_GAP * rigid)) {
 			snprintf(err, errlen,
 				 "model: a floating object's 6 rigid modes do not stand apart (6th "
-				 "eigenvalue %g, 7th %g): a part nearly free to move?", w2[5], w2[6]);
+				 "eigenvalue %g, 7th %g): a part nearly free to move?",
+				 w2[5], w2[6]);
 			return IRDM_EINVAL;
 		}
 	}
@@ -108,7 +110,7 @@ static int split_rigid(struct irdm_modes *out, size_t n_req, const double *w2,
 		return IRDM_ENOMEM;
 	}
 	memcpy(out->omega2, w2 + r, out->n_modes * sizeof(double));
-	if (!phi)       /* an MPI rank other than 0: eigenvalues only */
+	if (!phi) /* an MPI rank other than 0: eigenvalues only */
 		return 0;
 	out->phi = malloc(n * out->n_modes * sizeof(double));
 	out->rigid_phi = malloc(n * (r ? r : 1) * sizeof(double));
@@ -183,14 +185,14 @@ int irdm_modes_solve_kept(const struct irdm_fem *fem, size_t n_wanted, bool floa
 	 * where shift-and-invert Lanczos is exact to rounding.
 	 */
 	if (method == IRDM_EIG_AUTO)
-		method = (n <= DENSE_MAX_DOF || n_req * 3 > n) && max_scale <= GRADED * scale
-				 ? IRDM_EIG_DENSE : IRDM_EIG_LANCZOS;
+		method = (n <= DENSE_MAX_DOF || n_req * 3 > n) && max_scale <= GRADED * scale ? IRDM_EIG_DENSE : IRDM_EIG_LANCZOS;
 	if (method == IRDM_EIG_LANCZOS && n_req * 2 + 20 > n)
 		method = IRDM_EIG_DENSE;
 	if (method == IRDM_EIG_SLEPC && n_req * 2 + 20 > n) {
 		/* every rank would hold the whole Krylov basis: no gain */
 		snprintf(err, errlen, "slepc: %zu modes of %zu DoFs are too many for a Krylov solver: "
-			 "use eigensolver = dense", n_req, n);
+				      "use eigensolver = dense",
+			 n_req, n);
 		return IRDM_EINVAL;
 	}
 	if (method == IRDM_EIG_SLEPC && !dist) {
@@ -207,14 +209,15 @@ int irdm_modes_solve_kept(const struct irdm_fem *fem, size_t n_wanted, bool floa
 		goto out_free;
 	}
 	if (progress)
-		progress(ctx, method == IRDM_EIG_DENSE ? "dense eigensolve"
-			 : method == IRDM_EIG_SLEPC ? "SLEPc eigensolve" : "Lanczos eigensolve", 0.0);
+		progress(ctx, method == IRDM_EIG_DENSE ? "dense eigensolve" : method == IRDM_EIG_SLEPC ? "SLEPc eigensolve" :
+													 "Lanczos eigensolve",
+			 0.0);
 	if (method == IRDM_EIG_DENSE)
 		ret = irdm_eig_dense(fem, n_req, w2, phi, err, errlen);
 	else if (method == IRDM_EIG_SLEPC)
 		ret = solve_slepc(fem, n_req, floating, scale, dist, want, progress, ctx, w2, phi,
 				  out, err, errlen);
-	else    /* a negative shift keeps K - sigma M definite for floating bodies */
+	else /* a negative shift keeps K - sigma M definite for floating bodies */
 		ret = irdm_eig_lanczos(fem, n_req, floating ? -1e-6 * scale : 0.0, progress, ctx,
 				       w2, phi, err, errlen);
 	if (ret)

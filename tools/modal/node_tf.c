@@ -13,7 +13,7 @@ static void mode_poles(double t, double d, double complex l[2])
 	double disc = t * t - 4 * d;
 
 	if (disc < 0) {
-		l[0] = t / 2 + I * (sqrt(-disc) / 2);   /* finite: I * x is exact */
+		l[0] = t / 2 + I * (sqrt(-disc) / 2); /* finite: I * x is exact */
 		l[1] = conj(l[0]);
 		return;
 	}
@@ -141,7 +141,7 @@ static void add_head(const struct irdm_node_tf *tf, double complex z, double com
 	       di[9] = { 0 };
 
 	for (size_t s = tf->n_head; s-- > 0;) {
-		const double *c = s ? &tf->head[9 * s] : NULL;   /* D_0 is in R0 */
+		const double *c = s ? &tf->head[9 * s] : NULL; /* D_0 is in R0 */
 		for (int e = 0; e < 9; e++) {
 			double t = dr[e] * wr - di[e] * wi + pr[e];
 			di[e] = dr[e] * wi + di[e] * wr + pi[e];

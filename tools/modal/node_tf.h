@@ -31,15 +31,15 @@
 
 struct irdm_node_tf {
 	size_t K;
-	size_t n_pad;                /* length of the mode arrays: even, > K */
-	double r0[9];                /* R[0], row-major */
-	double *t, *d;               /* den_k(z) = z^2 - t z + d */
+	size_t n_pad;  /* length of the mode arrays: even, > K */
+	double r0[9];  /* R[0], row-major */
+	double *t, *d; /* den_k(z) = z^2 - t z + d */
 	double *beta1, *beta0;
-	double *p;                   /* phi phi^T: xx, xy, xz, yy, yz, zz arrays */
-	double complex *pole;        /* 2 per mode */
-	double *pole_xy;             /* the poles of H: re, im of the first, of the second */
-	const double *head;          /* borrowed: n_head blocks D_s of 9, row-major */
-	size_t n_head;               /* > 1: head terms in H, and a pole of H at 0 */
+	double *p;            /* phi phi^T: xx, xy, xz, yy, yz, zz arrays */
+	double complex *pole; /* 2 per mode */
+	double *pole_xy;      /* the poles of H: re, im of the first, of the second */
+	const double *head;   /* borrowed: n_head blocks D_s of 9, row-major */
+	size_t n_head;        /* > 1: head terms in H, and a pole of H at 0 */
 };
 
 /* phi_c: 3 x K row-major; D: 3x3 or NULL.  0, or -1 out of memory. */

@@ -100,7 +100,7 @@ double irdm_stability_fir(const double *R, size_t T)
 	if (!buf)
 		return -1;
 	int c_lo = zeros_inside(R, T, r_lo, buf, &n_fft);
-	if (c_lo != 0) {    /* unresolved or zeros already beyond rho max */
+	if (c_lo != 0) { /* unresolved or zeros already beyond rho max */
 		rho = IRDM_STAB_RHO_MAX;
 		goto out_free;
 	}
@@ -116,9 +116,9 @@ double irdm_stability_fir(const double *R, size_t T)
 		n_fft = n0;
 		int c = zeros_inside(R, T, r, buf, &n_fft);
 		if (c == 0)
-			r_lo = r;   /* certified: no zero inside r */
+			r_lo = r; /* certified: no zero inside r */
 		else
-			r_hi = r;   /* zeros inside, or too close to one to tell:
+			r_hi = r; /* zeros inside, or too close to one to tell:
 				     * either way only below r can be certified */
 	}
 	rho = 1.0 / r_lo;
@@ -156,8 +156,7 @@ out_free:
 /* inv of a 3x3 row-major; returns 0 when singular */
 static int inv3(const double a[9], double b[9])
 {
-	double det = a[0] * (a[4] * a[8] - a[5] * a[7]) - a[1] * (a[3] * a[8] - a[5] * a[6])
-		     + a[2] * (a[3] * a[7] - a[4] * a[6]);
+	double det = a[0] * (a[4] * a[8] - a[5] * a[7]) - a[1] * (a[3] * a[8] - a[5] * a[6]) + a[2] * (a[3] * a[7] - a[4] * a[6]);
 
 	if (!(fabs(det) > 0) || !isfinite(det))
 		return -1;
@@ -196,7 +195,7 @@ double irdm_stability_fir_companion(const double *R, size_t T)
 				a[(size_t)(3 * (s - 1) + (size_t)j) * n + (size_t)i] = v;
 			}
 	for (int i = 3; i < n; i++)
-		a[(size_t)(i - 3) * n + (size_t)i] = 1.0;   /* shift register */
+		a[(size_t)(i - 3) * n + (size_t)i] = 1.0; /* shift register */
 	rho = max_abs_eig(a, n);
 	free(a);
 	return rho;
@@ -212,8 +211,7 @@ static int modal_r0_inv(const struct irdm_mode *zoh, size_t K, const double *phi
 	for (size_t k = 0; k < K; k++)
 		for (int i = 0; i < 3; i++)
 			for (int j = 0; j < 3; j++)
-				r0[3 * i + j] += phi_c[(size_t)i * K + k] * phi_c[(size_t)j * K + k]
-						 * zoh[k].b[0];
+				r0[3 * i + j] += phi_c[(size_t)i * K + k] * phi_c[(size_t)j * K + k] * zoh[k].b[0];
 	if (D0)
 		for (int e = 0; e < 9; e++)
 			r0[e] += D0[e];

@@ -66,10 +66,10 @@ double irdm_stability_modal_head(const struct irdm_mode *zoh, size_t K, const do
  */
 struct irdm_stab_cert {
 	double rho, rho_lo;
-	int lo_certified;           /* rho_lo by a winding number */
-	int lo_newton;              /* rho_lo = |a closed-loop pole| found by Newton */
-	unsigned circles, newton;   /* circles walked, Newton roots found */
-	size_t points;              /* transfer-function evaluations on circles */
+	int lo_certified;         /* rho_lo by a winding number */
+	int lo_newton;            /* rho_lo = |a closed-loop pole| found by Newton */
+	unsigned circles, newton; /* circles walked, Newton roots found */
+	size_t points;            /* transfer-function evaluations on circles */
 };
 
 int irdm_stability_modal_cert(const struct irdm_mode *zoh, size_t K, const double *phi_c,

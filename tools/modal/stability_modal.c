@@ -39,7 +39,7 @@
 #define TRACE(...) ((void)0)
 #endif
 
-#define REL_TOL 1e-8            /* bracket width rho / rho_lo - 1 */
+#define REL_TOL 1e-8 /* bracket width rho / rho_lo - 1 */
 
 /*
  * Newton on F = det H den_m (den_m the denominator of mode m, or 1 when
@@ -58,7 +58,7 @@ static int newton(const struct irdm_node_tf *tf, double complex z, size_t m, dou
 	for (int it = 0; it < 50; it++) {
 		struct irdm_tf_point p;
 		if (irdm_tf_point_at(tf, z, &p)) {
-			*root = z;      /* det H exactly 0 (or not finite: checked below) */
+			*root = z; /* det H exactly 0 (or not finite: checked below) */
 			return isfinite(cabs(z)) ? 0 : -1;
 		}
 		double complex ld = p.ld;
@@ -69,7 +69,7 @@ static int newton(const struct irdm_node_tf *tf, double complex z, size_t m, dou
 			return -1;
 		z -= step;
 		if (!(cabs(z) < 2 * IRDM_STAB_RHO_MAX))
-			return -1;      /* diverging: no root of interest there */
+			return -1; /* diverging: no root of interest there */
 		if (cabs(step) <= NEWTON_TOL * cabs(z)) {
 			*root = z;
 			return 0;
@@ -83,7 +83,7 @@ static int newton(const struct irdm_node_tf *tf, double complex z, size_t m, dou
 
 struct search {
 	const struct irdm_node_tf *tf;
-	long n_all;                /* 2K + 3(n_head - 1) closed-loop poles */
+	long n_all; /* 2K + 3(n_head - 1) closed-loop poles */
 	double lo, hi;
 	bool lo_certified, lo_newton;
 	/* the last hi circle's peaks, the last lo circle's dips; fresh until tried */
@@ -213,13 +213,12 @@ int irdm_stability_modal_cert_head(const struct irdm_mode *zoh, size_t K, const 
 	for (int e = 0; e < 9; e++)
 		r0[e] = tf.r0[e];
 	double det_r0 = creal(irdm_det3c(r0));
-	if (!(fabs(det_r0) > 0) || !isfinite(det_r0)) {   /* as irdm_stability_modal */
+	if (!(fabs(det_r0) > 0) || !isfinite(det_r0)) { /* as irdm_stability_modal */
 		irdm_node_tf_free(&tf);
 		return -1;
 	}
 	/* open bracket just outside the bounds so the bounds themselves are probed */
-	struct search s = { .tf = &tf, .n_all = (long)irdm_node_tf_order(&tf),
-			    .lo = IRDM_STAB_RHO_MIN / 2, .hi = IRDM_STAB_RHO_MAX * 2, .out = out };
+	struct search s = { .tf = &tf, .n_all = (long)irdm_node_tf_order(&tf), .lo = IRDM_STAB_RHO_MIN / 2, .hi = IRDM_STAB_RHO_MAX * 2, .out = out };
 	probe(&s, IRDM_STAB_RHO_MAX);
 	if (s.hi == IRDM_STAB_RHO_MAX) {
 		probe(&s, IRDM_STAB_RHO_MIN);

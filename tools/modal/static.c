@@ -86,7 +86,7 @@ struct irdm_compliance {
 	const struct irdm_fem *fem;
 	const struct irdm_modes *m;
 	bool floating;
-	int steps;                      /* solves per batch */
+	int steps; /* solves per batch */
 	double eps;
 	cholmod_common cc;
 	cholmod_factor *f;
@@ -368,8 +368,7 @@ int irdm_static_correction(const struct irdm_fem *fem, const struct irdm_modes *
 					if (ri >= 0 && cj >= 0) {
 						v = Xr[slot[3 * c + j] * n + (size_t)ri];
 						for (size_t k = 0; k < m->n_modes; k++)
-							v -= m->phi[k * n + (size_t)ri] * m->phi[k * n + (size_t)cj]
-							     / m->omega2[k];
+							v -= m->phi[k * n + (size_t)ri] * m->phi[k * n + (size_t)cj] / m->omega2[k];
 					}
 					out[((c * n_rows + r) * 3 + i) * 3 + j] = v;
 				}

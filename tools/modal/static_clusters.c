@@ -32,7 +32,7 @@
 #include "modal/response.h"
 #include "modal/static_clusters.h"
 
-#define SHARE_POWER 2           /* shares(): the tolerance's power of the condition */
+#define SHARE_POWER 2 /* shares(): the tolerance's power of the condition */
 
 /* What the sweep over the column clusters shares. */
 struct sweep {
@@ -40,11 +40,11 @@ struct sweep {
 	const int64_t *col_dofs;
 	struct irdm_corr_clusters *cl;
 	double tol;
-	size_t nd;                      /* 3 n_cols */
-	double *P, *Ps;                 /* nd x K */
-	double *strip;                  /* nd x 3|b|: S(:, b) */
-	double *sd;                     /* n_cols: sqrt(|S_cc|), 1 where 0 */
-	double **pair;                  /* n_pairs: each pair's values until packed */
+	size_t nd;      /* 3 n_cols */
+	double *P, *Ps; /* nd x K */
+	double *strip;  /* nd x 3|b|: S(:, b) */
+	double *sd;     /* n_cols: sqrt(|S_cc|), 1 where 0 */
+	double **pair;  /* n_pairs: each pair's values until packed */
 };
 
 /* ---- clustering: recursive bisection at the median of the longest side */
@@ -58,7 +58,9 @@ static int by_key(const void *a, const void *b)
 {
 	const struct keyed *x = a, *y = b;
 
-	return x->key < y->key ? -1 : x->key > y->key ? 1 : x->col < y->col ? -1 : x->col > y->col;
+	return x->key < y->key ? -1 : x->key > y->key ? 1 :
+			      x->col < y->col         ? -1 :
+							x->col > y->col;
 }
 
 static void bisect(const double *pos, uint32_t *cols, size_t n, size_t max, struct keyed *tmp,
@@ -159,7 +161,7 @@ static int solve_strip(struct sweep *s, struct irdm_compliance *comp, const doub
 	for (size_t d = 0; d < s->nd; d++)
 		for (size_t j = 0; j < nb; j++)
 			s->strip[d * nb + j] = s->col_dofs[d] < 0 || slot[j] == SIZE_MAX ? 0.0 :
-					       X[slot[j] * n + (size_t)s->col_dofs[d]];
+											   X[slot[j] * n + (size_t)s->col_dofs[d]];
 	if (!K)
 		return IRDM_OK;
 	Psb = malloc(nb * K * sizeof(double));
@@ -213,7 +215,7 @@ static double block_norms(const double *E, size_t m, size_t n, const double *w, 
 struct svd {
 	size_t m, n, r;
 	double *As, *s, *u, *vt, *E, *Us;
-	double *w;                      /* (m/3) x (n/3) */
+	double *w; /* (m/3) x (n/3) */
 };
 
 static int svd_of(struct svd *v)
@@ -410,8 +412,9 @@ static int pack(struct sweep *s)
 		for (size_t b = a; b < cl->n_clusters; b++, q++) {
 			size_t m = 3 * cl_size(cl, a), n = 3 * cl_size(cl, b);
 			cl->offset[q] = at;
-			at += a == b ? m * (m + 1) / 2 :
-			      cl->rank[q] == IRDM_CORR_PAIR_DENSE ? m * n : cl->rank[q] * (m + n);
+			at += a == b                              ? m * (m + 1) / 2 :
+			      cl->rank[q] == IRDM_CORR_PAIR_DENSE ? m * n :
+								    cl->rank[q] * (m + n);
 		}
 	cl->n_values = at;
 	cl->values = malloc((at ? at : 1) * sizeof(double));
@@ -469,8 +472,7 @@ static int sweep_all(struct sweep *s, const struct irdm_fem *fem, bool floating,
 		load_of[d] = s->col_dofs[d] >= 0 ? n_loads++ : SIZE_MAX;
 	/* the slepc path solved every column's loads with its factor */
 	given = m->compliance && m->n_compliance == n_loads ? m->compliance : NULL;
-	ret = given ? IRDM_OK : irdm_compliance_open(fem, m, floating, IRDM_COMPLIANCE_PINNED,
-						     &comp, err, errlen);
+	ret = given ? IRDM_OK : irdm_compliance_open(fem, m, floating, IRDM_COMPLIANCE_PINNED, &comp, err, errlen);
 	for (size_t b = 0; b < cl->n_clusters && !ret; b++) {
 		ret = solve_strip(s, comp, given, load_of, b, X, in, slot, err, errlen);
 		if (!ret)

@@ -22,12 +22,12 @@
 
 struct irdm_corr_clusters {
 	size_t n_cols, n_clusters, n_pairs;
-	uint32_t *start;                /* n_clusters + 1 */
-	uint32_t *members;              /* n_cols, cluster by cluster */
-	uint32_t *col_pos;              /* n_cols: column c is members[col_pos[c]] */
-	uint32_t *rank;                 /* n_pairs: IRDM_CORR_PAIR_DENSE or the rank */
-	uint64_t *offset;               /* n_pairs: into values */
-	double *values;                 /* n_values, the pairs in table order */
+	uint32_t *start;   /* n_clusters + 1 */
+	uint32_t *members; /* n_cols, cluster by cluster */
+	uint32_t *col_pos; /* n_cols: column c is members[col_pos[c]] */
+	uint32_t *rank;    /* n_pairs: IRDM_CORR_PAIR_DENSE or the rank */
+	uint64_t *offset;  /* n_pairs: into values */
+	double *values;    /* n_values, the pairs in table order */
 	size_t n_values, max_rank, n_dense;
 	/* the largest 3x3 block error the compression left, in units of
 	 * sqrt(|S_aa| |S_bb|), measured on every pair (at most tol) */

@@ -32,9 +32,9 @@
 #include "modal/response.h"
 #include "modal/static_lowrank.h"
 
-#define OVERSAMPLE 8            /* sketch columns beyond the rank */
-#define EIG_FLOOR 1e-3          /* eigenvalues below this of the largest: dropped */
-#define N_CHECK 8               /* columns solved for the a-posteriori error */
+#define OVERSAMPLE 8   /* sketch columns beyond the rank */
+#define EIG_FLOOR 1e-3 /* eigenvalues below this of the largest: dropped */
+#define N_CHECK 8      /* columns solved for the a-posteriori error */
 #define SEED 0x5eed1a7e11ull
 
 /* What F V needs. */
@@ -44,9 +44,9 @@ struct far {
 	const struct irdm_corr_sparse *s;
 	struct irdm_compliance *comp;
 	size_t n, nd, K;
-	double *P, *Ps;                 /* nd x K: phi at the columns, and / omega^2 */
-	double *load, *X;               /* n x width, one column after the other */
-	double *T;                      /* K x width */
+	double *P, *Ps;   /* nd x K: phi at the columns, and / omega^2 */
+	double *load, *X; /* n x width, one column after the other */
+	double *T;        /* K x width */
 };
 
 /* splitmix64, then Box-Muller: a seeded Gaussian stream. */
@@ -132,7 +132,8 @@ static int orth(double *Y, size_t nd, size_t w, double *tmp)
 			Y[d * w + j] = tmp[j * nd + d];
 	free(tau);
 	free(work);
-	return !work ? IRDM_ENOMEM : info ? IRDM_ENUMERIC : IRDM_OK;
+	return !work ? IRDM_ENOMEM : info ? IRDM_ENUMERIC :
+					    IRDM_OK;
 }
 
 /* Indices 0..w-1 by |mu| decreasing (w is small: insertion sort). */

@@ -19,14 +19,14 @@
 #define IRDM_STATIC_CORR_POWER_ITERS 2
 
 struct irdm_corr_lowrank {
-	size_t n_dofs;                  /* 3 n_cols */
+	size_t n_dofs; /* 3 n_cols */
 	size_t rank;
-	double *lambda;                 /* rank, |lambda| decreasing */
-	double *u;                      /* n_dofs x rank, row-major, orthonormal columns */
+	double *lambda; /* rank, |lambda| decreasing */
+	double *u;      /* n_dofs x rank, row-major, orthonormal columns */
 	/* a-posteriori, over the dropped blocks of the checked columns, in
 	 * units of sqrt(|S_aa| |S_bb|): the largest and the RMS dropped
 	 * block without the far field and what is left with it */
-	size_t n_checked;               /* columns checked */
+	size_t n_checked; /* columns checked */
 	double max_before, max_after, rms_before, rms_after;
 };
 

@@ -34,10 +34,10 @@ struct batch {
 	const struct irdm_modes *m;
 	const int64_t *col_dofs;
 	size_t c0, c1;
-	const double *X;        /* n x n_in compliance columns */
-	const size_t *slot;     /* 3 (c - c0) + j -> column of X, or SIZE_MAX */
-	const double *mod;      /* 3 c1 x 3 (c1 - c0): modal compliance */
-	double *diag_norm;      /* n_cols: |S_cc|, filled batch by batch */
+	const double *X;    /* n x n_in compliance columns */
+	const size_t *slot; /* 3 (c - c0) + j -> column of X, or SIZE_MAX */
+	const double *mod;  /* 3 c1 x 3 (c1 - c0): modal compliance */
+	double *diag_norm;  /* n_cols: |S_cc|, filled batch by batch */
 };
 
 static int lower_push(struct lower *l, size_t c, size_t r, const double b[9])
@@ -99,8 +99,8 @@ static void block(const struct batch *bt, size_t c, size_t r, double out[9])
 			int64_t ri = bt->col_dofs[3 * r + i];
 			size_t s = bt->slot[3 * (c - bt->c0) + j];
 			out[3 * i + j] = ri < 0 || s == SIZE_MAX ? 0.0 :
-				bt->X[s * n + (size_t)ri] -
-				bt->mod[(3 * r + i) * nb + 3 * (c - bt->c0) + j];
+								   bt->X[s * n + (size_t)ri] -
+									   bt->mod[(3 * r + i) * nb + 3 * (c - bt->c0) + j];
 		}
 }
 
@@ -183,12 +183,12 @@ static int mirror(const struct lower *l, struct irdm_corr_sparse *s)
 	for (size_t c = 0; c < nc; c++)
 		s->start[c + 1] += s->start[c];
 	s->rows = s->start + nc + 1;
-	for (size_t k = 0; k < l->n; k++) {         /* own blocks, in order */
+	for (size_t k = 0; k < l->n; k++) { /* own blocks, in order */
 		size_t c = l->col[k], at = s->start[c] + fill[c]++;
 		s->rows[at] = l->row[k];
 		memcpy(&s->blocks[9 * at], &l->blk[9 * k], 9 * sizeof(double));
 	}
-	for (size_t k = 0; k < l->n; k++) {         /* mirrors: c' increasing */
+	for (size_t k = 0; k < l->n; k++) { /* mirrors: c' increasing */
 		size_t r = l->row[k], at;
 		if (r == l->col[k])
 			continue;
@@ -228,8 +228,7 @@ int irdm_static_correction_sparse(const struct irdm_fem *fem, const struct irdm_
 	for (size_t c = 0; c < 3 * n_cols; c++)
 		n_loads += col_dofs[c] >= 0;
 	given = m->compliance && m->n_compliance == n_loads ? m->compliance : NULL;
-	ret = given ? IRDM_OK : irdm_compliance_open(fem, m, floating, IRDM_COMPLIANCE_PINNED,
-						     &comp, err, errlen);
+	ret = given ? IRDM_OK : irdm_compliance_open(fem, m, floating, IRDM_COMPLIANCE_PINNED, &comp, err, errlen);
 	if (ret)
 		goto out_free;
 	for (size_t c0 = 0; c0 < n_cols; c0 += B) {

@@ -23,10 +23,10 @@
 struct irdm_corr_sparse {
 	size_t n_cols;
 	size_t n_blocks;
-	uint32_t *start;                /* n_cols + 1, then rows: the image's index */
-	uint32_t *rows;                 /* n_blocks, = start + n_cols + 1 */
-	double *blocks;                 /* n_blocks x 9 */
-	double max_dropped_rel;         /* largest |S_rc| / sqrt(|S_cc| |S_rr|) dropped */
+	uint32_t *start;        /* n_cols + 1, then rows: the image's index */
+	uint32_t *rows;         /* n_blocks, = start + n_cols + 1 */
+	double *blocks;         /* n_blocks x 9 */
+	double max_dropped_rel; /* largest |S_rc| / sqrt(|S_cc| |S_rr|) dropped */
 };
 
 /*

@@ -19,8 +19,7 @@ static void mat3_mul(const double a[9], const double b[9], double c[9])
 
 	for (int i = 0; i < 3; i++)
 		for (int j = 0; j < 3; j++)
-			t[3 * i + j] = a[3 * i] * b[j] + a[3 * i + 1] * b[3 + j]
-				     + a[3 * i + 2] * b[6 + j];
+			t[3 * i + j] = a[3 * i] * b[j] + a[3 * i + 1] * b[3 + j] + a[3 * i + 2] * b[6 + j];
 	memcpy(c, t, sizeof(t));
 }
 
@@ -57,9 +56,15 @@ static void expm3(const double m[9], double e[9])
 void irdm_zoh_mode(double w, double z, double dt, struct irdm_mode *out)
 {
 	double m[9] = {
-		0, dt, 0,
-		-w * w * dt, -2 * z * w * dt, dt,
-		0, 0, 0,
+		0,
+		dt,
+		0,
+		-w * w * dt,
+		-2 * z * w * dt,
+		dt,
+		0,
+		0,
+		0,
 	};
 	double e[9];
 

@@ -34,16 +34,16 @@ struct build {
 	const struct irdm_scene *sc;
 	const struct irdm_precompute_opts *o;
 	struct irdm_model m;
-	struct irdm_mode *zoh;          /* modal */
-	size_t n_modes;                 /* modes in the image (modal) */
-	double *fir;                    /* FIR, double, section layout */
-	double *shapes;                 /* modal: [row][3][mode] */
-	double *corr;                   /* FIR: static correction [c][r][3][3] or NULL */
-	struct irdm_corr_sparse sparse; /* modal: the kept blocks (start NULL if none) */
-	double *head;                   /* modal exact_head: [k][s][3][3] (exact_head.h) */
-	struct irdm_corr_lowrank far;   /* modal: their far field (rank 0 if none) */
+	struct irdm_mode *zoh;              /* modal */
+	size_t n_modes;                     /* modes in the image (modal) */
+	double *fir;                        /* FIR, double, section layout */
+	double *shapes;                     /* modal: [row][3][mode] */
+	double *corr;                       /* FIR: static correction [c][r][3][3] or NULL */
+	struct irdm_corr_sparse sparse;     /* modal: the kept blocks (start NULL if none) */
+	double *head;                       /* modal exact_head: [k][s][3][3] (exact_head.h) */
+	struct irdm_corr_lowrank far;       /* modal: their far field (rank 0 if none) */
 	struct irdm_corr_clusters clusters; /* modal: every block, clustered (0 clusters if not) */
-	void *stored[6];                /* converted to the scene's precision */
+	void *stored[6];                    /* converted to the scene's precision */
 	size_t stored_bytes[6];
 	struct irdm_stability *stab;
 	struct irdm_meta meta;
@@ -51,19 +51,19 @@ struct build {
 	struct irdm_node *nodes;
 	char *prov;
 	uint64_t scene_hash;
-	size_t n_solved;                /* modes the eigensolve gave (all: the exact model's) */
+	size_t n_solved; /* modes the eigensolve gave (all: the exact model's) */
 };
 
 /* Modes the scene needs solved (0: all). */
 static size_t modes_needed(const struct irdm_scene *sc)
 {
 	if (sc->repr_auto && sc->max_error > 0)
-		return 0;       /* every candidate is measured: the reference needs all */
+		return 0; /* every candidate is measured: the reference needs all */
 	if (sc->representation == IRDM_REPR_MODAL)
-		return sc->exact_head ? 0 : sc->modes;  /* the head needs every mode */
+		return sc->exact_head ? 0 : sc->modes; /* the head needs every mode */
 	if (sc->method == IRDM_METHOD_TIME_DOMAIN)
-		return 1;       /* only the first mode, for the default damping */
-	return sc->modes;       /* FIR synthesised from modes */
+		return 1; /* only the first mode, for the default damping */
+	return sc->modes; /* FIR synthesised from modes */
 }
 
 /* FIR samples the image holds: T, plus a windowed tail (fir_tail.h). */
@@ -137,10 +137,9 @@ static int split_modes(struct build *b, struct irdm_mode **zoh_all, size_t *n_al
 		return IRDM_ENOMEM;
 	}
 	irdm_modes_discretise(md, &b->m.damping, b->sc->dt_s, *zoh_all);
-	md->n_modes = b->sc->modes;     /* phi is column-major: the first K columns */
+	md->n_modes = b->sc->modes; /* phi is column-major: the first K columns */
 	return IRDM_OK;
 }
-
 
 /* The static correction clustered: the columns' rest positions set the
  * clusters. */
@@ -210,7 +209,8 @@ static int modal_data(struct build *b, char *err, size_t errlen)
 			ret = irdm_static_correction_lowrank(&m->fem, &m->modes, b->sc->floating,
 							     m->col_dofs, &b->sparse,
 							     b->sc->static_corr_rank < 3 * m->n_cols ?
-							     b->sc->static_corr_rank : 3 * m->n_cols,
+								     b->sc->static_corr_rank :
+								     3 * m->n_cols,
 							     b->o->progress, b->o->ctx, &b->far, err,
 							     errlen);
 		/* the hybrid's head, after the far field: it sums to the whole
@@ -296,11 +296,15 @@ static int td_run(struct build *b, size_t begin, size_t end, double *R, char *er
 	int64_t *global = malloc(n_in * sizeof(int64_t));
 	struct td_progress tp = { b->o->progress, b->o->ctx };
 	struct irdm_td_opts o = {
-		.dt_s = b->sc->dt_s, .n_samples = fir_taps(b), .substeps = b->sc->substeps,
-		.damping = m->damping, .floating = b->sc->floating,
+		.dt_s = b->sc->dt_s,
+		.n_samples = fir_taps(b),
+		.substeps = b->sc->substeps,
+		.damping = m->damping,
+		.floating = b->sc->floating,
 		/* over MPI, the cores of a machine shared by its ranks */
 		.threads = b->sc->threads ? b->sc->threads : irdm_dist_threads(),
-		.progress = td_progress, .progress_ctx = &tp,
+		.progress = td_progress,
+		.progress_ctx = &tp,
 		/* rigid motion removed by a mass-weighted best fit (Kabsch):
 		 * docs/architecture.md, "Frames and signs" */
 		.rigid = IRDM_TD_RIGID_KABSCH,
@@ -720,8 +724,7 @@ static void fill_meta(struct build *b)
 	if (sc->damping == IRDM_DAMP_RATIOS) {
 		mt->damping_ratio[0] = sc->damp_ratio[0];
 		mt->damping_ratio[1] = sc->damp_ratio[1];
-		mt->damping_freq_hz[0] = sc->damp_hz[0] > 0 ? sc->damp_hz[0]
-				       : sqrt(m->modes.omega2[0]) / (2 * M_PI);
+		mt->damping_freq_hz[0] = sc->damp_hz[0] > 0 ? sc->damp_hz[0] : sqrt(m->modes.omega2[0]) / (2 * M_PI);
 		mt->damping_freq_hz[1] = sc->damp_hz[1];
 	}
 	mt->first_elastic_hz = sqrt(m->modes.omega2[0]) / (2 * M_PI);
@@ -1187,8 +1190,7 @@ static int one_try(struct build *b, struct irdm_precompute_report *rep, char *er
 	if (!ret)
 		ret = provenance(b);
 	if (ret) {
-		snprintf(err, errlen, ret == IRDM_ENOMEM ? "precompute: out of memory"
-			 : "precompute: the scene does not fit in the provenance text");
+		snprintf(err, errlen, ret == IRDM_ENOMEM ? "precompute: out of memory" : "precompute: the scene does not fit in the provenance text");
 		return ret;
 	}
 	ret = measure(b, rep, err, errlen);
@@ -1225,16 +1227,20 @@ static void reset_try(struct build *b, size_t n_all)
 
 /* representation = auto's candidates, in increasing tick cost. */
 struct candidate {
-	unsigned modes;         /* 0: all */
+	unsigned modes; /* 0: all */
 	bool corr;
 	unsigned head;
 };
 
 static const struct candidate auto_candidates[] = {
-	{ 300, true, 0 }, { 300, true, 32 }, { 300, true, 128 }, { 300, true, 512 }, { 0, false, 0 },
+	{ 300, true, 0 },
+	{ 300, true, 32 },
+	{ 300, true, 128 },
+	{ 300, true, 512 },
+	{ 0, false, 0 },
 };
 
-#define AUTO_ALL_MODES 300      /* at most this many modes: modal:all, exact and as cheap */
+#define AUTO_ALL_MODES 300 /* at most this many modes: modal:all, exact and as cheap */
 
 /*
  * representation = auto: every mode is solved; the first candidate whose

@@ -29,8 +29,7 @@ static int compliance(const struct irdm_model *m, bool floating, double **X, siz
 	*X = malloc(n * (n_in ? n_in : 1) * sizeof(double));
 	if (!*X)
 		goto out_nomem;
-	ret = n_in ? irdm_compliance_solve(&m->fem, &m->modes, floating, in, n_in, *X, err, errlen)
-		   : IRDM_OK;
+	ret = n_in ? irdm_compliance_solve(&m->fem, &m->modes, floating, in, n_in, *X, err, errlen) : IRDM_OK;
 	free(in);
 	return ret;
 out_nomem:
@@ -84,8 +83,7 @@ int irdm_fir_tail_window(const struct irdm_model *m, bool floating, size_t T, si
 				for (int j = 0; j < 3; j++) {
 					int64_t ri = m->row_dofs[3 * r + (size_t)i];
 					int64_t cj = m->col_dofs[3 * c + (size_t)j];
-					S[3 * i + j] = ri >= 0 && cj >= 0
-						     ? X[slot[3 * c + (size_t)j] * n + (size_t)ri] : 0.0;
+					S[3 * i + j] = ri >= 0 && cj >= 0 ? X[slot[3 * c + (size_t)j] * n + (size_t)ri] : 0.0;
 				}
 			window_one(&fir[(c * m->n_rows + r) * (T + L) * 9], T, L, S, bump_sum);
 		}

@@ -30,7 +30,8 @@ static int read_file_mesh(const struct irdm_scene *sc, struct irdm_mesh *mesh, c
 	if (!ret && sc->tetgen_given && sized)
 		snprintf(sz.note, sizeof(sz.note),
 			 "mesh sizing: note: tetgen = %s given, it overrides target_nodes and "
-			 "max_tet_volume", sc->tetgen);
+			 "max_tet_volume",
+			 sc->tetgen);
 	memcpy(note, sz.note, sizeof(sz.note));
 	return ret;
 }
@@ -43,7 +44,7 @@ int irdm_model_mesh(const struct irdm_scene *sc, struct irdm_mesh *mesh, char no
 	int ret;
 
 	note[0] = '\0';
-	if (irdm_dist_fault("mesh")) {  /* the failure tests: one rank cannot read it */
+	if (irdm_dist_fault("mesh")) { /* the failure tests: one rank cannot read it */
 		snprintf(err, errlen, "%s: cannot read the mesh (IRDM_TEST_FAULT)", sc->mesh);
 		return IRDM_EIO;
 	}
@@ -54,7 +55,7 @@ int irdm_model_mesh(const struct irdm_scene *sc, struct irdm_mesh *mesh, char no
 		if (!r[0])
 			r[0] = 11, r[1] = 11, r[2] = 22;
 	} else if (!strcmp(sc->mesh, "cube")) {
-		l[0] = l[1] = l[2] = 0.12;   /* the paper's 12 cm cube */
+		l[0] = l[1] = l[2] = 0.12; /* the paper's 12 cm cube */
 		if (!r[0])
 			r[0] = r[1] = r[2] = 10;
 	} else if (!strncmp(sc->mesh, "box:", 4)) {
@@ -193,8 +194,7 @@ int irdm_model_build(const struct irdm_scene *sc, size_t n_modes_needed,
 	ret = mark_nodes(sc, m, err, errlen);
 	if (ret)
 		goto out_fail;
-	ret = irdm_mesh_check_rigidity(&m->mesh, m->fixed, sc->floating, err, errlen) ? IRDM_EINVAL
-										       : IRDM_OK;
+	ret = irdm_mesh_check_rigidity(&m->mesh, m->fixed, sc->floating, err, errlen) ? IRDM_EINVAL : IRDM_OK;
 	if (ret)
 		goto out_fail;
 	say_stats(&m->mesh, progress, ctx);

@@ -13,20 +13,20 @@
 
 struct irdm_model {
 	struct irdm_mesh mesh;
-	bool *fixed;              /* per mesh node */
-	bool *on_surface;         /* per mesh node */
+	bool *fixed;      /* per mesh node */
+	bool *on_surface; /* per mesh node */
 	struct irdm_fem fem;
 	struct irdm_modes modes;
 	struct irdm_rayleigh damping;
 	/* selection */
 	size_t n_rows;
-	uint32_t *rows;           /* mesh node of each image node, ascending */
+	uint32_t *rows; /* mesh node of each image node, ascending */
 	size_t n_cols;
-	uint32_t *cols;           /* image node index of each column */
-	int64_t *row_dofs;        /* 3 * n_rows free DoF or -1 */
-	int64_t *col_dofs;        /* 3 * n_cols */
+	uint32_t *cols;    /* image node index of each column */
+	int64_t *row_dofs; /* 3 * n_rows free DoF or -1 */
+	int64_t *col_dofs; /* 3 * n_cols */
 	size_t n_tris;
-	uint32_t *tris;           /* 3 * n_tris, image node indices */
+	uint32_t *tris; /* 3 * n_tris, image node indices */
 	double seconds_mesh, seconds_fem, seconds_eig;
 };
 

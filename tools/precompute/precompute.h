@@ -12,7 +12,7 @@
 #define IRDM_TOOL_VERSION "irdm " IRDM_VERSION
 
 struct irdm_precompute_opts {
-	const char *out_path;        /* image to write (NULL with part_out) */
+	const char *out_path; /* image to write (NULL with part_out) */
 	/* time-domain split: compute input DoFs [part_begin, part_end) of the
 	 * scene's column DoFs into part_out instead of an image */
 	const char *part_out;

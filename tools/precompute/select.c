@@ -43,7 +43,7 @@ int irdm_model_select(const struct irdm_scene *sc, struct irdm_model *m, char *e
 		touch[i] = m->on_surface[i] && !m->fixed[i] &&
 			   irdm_region_contains(&sc->touch, (uint32_t)i, p, true);
 		row[i] = touch[i] || (m->on_surface[i] &&
-			  irdm_region_contains(&sc->display, (uint32_t)i, p, true));
+				      irdm_region_contains(&sc->display, (uint32_t)i, p, true));
 	}
 	/* vertices of triangles that have a touchable vertex */
 	for (size_t t = 0; t < m->mesh.n_tris; t++) {

@@ -24,9 +24,7 @@ struct part_header {
  * never sees half a part. */
 int irdm_td_part_write(const char *path, const struct irdm_td_part *p, char *err, size_t errlen)
 {
-	struct part_header h = { .version = 1, .scene_hash = p->scene_hash,
-				 .n_inputs = p->n_inputs, .begin = p->begin, .end = p->end,
-				 .T = p->T, .n_out = p->n_out };
+	struct part_header h = { .version = 1, .scene_hash = p->scene_hash, .n_inputs = p->n_inputs, .begin = p->begin, .end = p->end, .T = p->T, .n_out = p->n_out };
 	size_t n = (size_t)((p->end - p->begin) * p->T * p->n_out);
 	char tmp[4096];
 	FILE *f;

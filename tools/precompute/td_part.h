@@ -15,10 +15,10 @@
 
 struct irdm_td_part {
 	uint64_t scene_hash;
-	uint64_t n_inputs;       /* of the whole scene */
+	uint64_t n_inputs; /* of the whole scene */
 	uint64_t begin, end;
-	uint64_t T, n_out;       /* samples, output DoFs (3 * rows) */
-	double *data;            /* (end - begin) * T * n_out */
+	uint64_t T, n_out; /* samples, output DoFs (3 * rows) */
+	double *data;      /* (end - begin) * T * n_out */
 };
 
 /* Return: IRDM_OK; IRDM_EINVAL if the path is too long; IRDM_EIO. */

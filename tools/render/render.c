@@ -20,9 +20,9 @@
 struct render {
 	const struct irdm_render_opts *o;
 	struct irdm_render_summary *sum;
-	struct irdm_outdir od;          /* the files go to od.tmp, put in DIR's place at the end */
-	char path[4400];                /* scratch: the file being opened */
-	char forces[4400];              /* the replay's output, DIR.tmp/forces.csv */
+	struct irdm_outdir od; /* the files go to od.tmp, put in DIR's place at the end */
+	char path[4400];       /* scratch: the file being opened */
+	char forces[4400];     /* the replay's output, DIR.tmp/forces.csv */
 	FILE *pvd, *csv;
 	bool started;
 };

@@ -19,25 +19,25 @@
 #define IRDM_RENDER_MAX_FRAMES 5000
 
 struct irdm_render_opts {
-	struct irdm_replay_opts in;     /* the inputs as irdm replay's (its out unused) */
+	struct irdm_replay_opts in; /* the inputs as irdm replay's (its out unused) */
 	const char *out_dir;
-	bool force;                     /* replace out_dir even if irdm render did not write it */
-	double every_s;                 /* a frame every every_s, rounded to samples (> 0) */
+	bool force;     /* replace out_dir even if irdm render did not write it */
+	double every_s; /* a frame every every_s, rounded to samples (> 0) */
 };
 
 /* The displayed surface (render_surface.c): what the frames can show. */
 struct irdm_render_surface {
 	uint32_t nodes, tris;
-	uint32_t open_edges;            /* edges of one triangle: 0 for a closed surface */
-	char display[64];               /* the scene's display key (provenance), "" if unknown */
+	uint32_t open_edges; /* edges of one triangle: 0 for a closed surface */
+	char display[64];    /* the scene's display key (provenance), "" if unknown */
 };
 
 struct irdm_render_summary {
 	struct irdm_replay_summary replay;
 	struct irdm_render_surface surface;
 	size_t frames, every_rows;
-	double max_disp_m, max_disp_t_s;        /* over the frames' nodes */
-	unsigned debris_removed;        /* interrupted runs' directories beside DIR, removed */
+	double max_disp_m, max_disp_t_s; /* over the frames' nodes */
+	unsigned debris_removed;         /* interrupted runs' directories beside DIR, removed */
 };
 
 int irdm_render_run(const struct irdm_render_opts *o, struct irdm_render_summary *sum,

@@ -26,7 +26,7 @@ static uint32_t open_edges(const struct irdm_image *img)
 	uint32_t open = 0;
 
 	if (!e)
-		return UINT32_MAX;      /* unknown: said as "not closed" */
+		return UINT32_MAX; /* unknown: said as "not closed" */
 	for (size_t t = 0; t < img->meta->n_tris; t++)
 		for (int j = 0; j < 3; j++) {
 			uint64_t a = img->tris[3 * t + j], b = img->tris[3 * t + (j + 1) % 3];

@@ -13,7 +13,7 @@
 #include "irdm/posix/deform_worker.h"
 #include "irdm/posix/session.h"
 #include "irdm/session.h"
-#include "modal/lapack.h"           /* openblas_set_num_threads */
+#include "modal/lapack.h" /* openblas_set_num_threads */
 #include "replay/replay.h"
 #include "replay/replay_priv.h"
 
@@ -44,20 +44,20 @@ int irdm_replay_locate(const struct irdm_image *img, const double p[3], uint32_t
 
 struct irdm_replay {
 	const struct irdm_replay_opts *o;
-	struct irdm_session *s;         /* image, engine, deformation channel */
-	const struct irdm_image *img;   /* the session's */
-	struct irdm_engine *eng;        /* the session's */
+	struct irdm_session *s;       /* image, engine, deformation channel */
+	const struct irdm_image *img; /* the session's */
+	struct irdm_engine *eng;      /* the session's */
 	struct trajectory tr;
-	struct trajectory sites;        /* --sites or --log: per-sample sites, else none */
-	struct trajectory logged;       /* --log: the controller's forces, else none */
-	struct trajectory softened;     /* --log: the contacts that began softly */
+	struct trajectory sites;    /* --sites or --log: per-sample sites, else none */
+	struct trajectory logged;   /* --log: the controller's forces, else none */
+	struct trajectory softened; /* --log: the contacts that began softly */
 	unsigned n_contacts;
 	enum irdm_contact_mode mode;
-	double *pos;                    /* every image node's position */
-	size_t pos_row;                 /* the sample pos holds, SIZE_MAX: none */
+	double *pos;    /* every image node's position */
+	size_t pos_row; /* the sample pos holds, SIZE_MAX: none */
 	struct irdm_contact_site site[IRDM_MAX_CONTACTS];
-	struct irdm_contact_mesh cm;    /* for the sites' normals; hdr NULL: none */
-	uint32_t *rows, *mesh;          /* --nodes: image rows and their mesh nodes */
+	struct irdm_contact_mesh cm; /* for the sites' normals; hdr NULL: none */
+	uint32_t *rows, *mesh;       /* --nodes: image rows and their mesh nodes */
 	size_t n_nodes, row;
 	struct irdm_replay_summary *sum;
 	FILE *out;
@@ -108,8 +108,7 @@ static int make_sites(struct irdm_replay *r, char *err, size_t errlen)
 		int rc;
 		if (c->is_node) {
 			int64_t row = irdm_image_node_of(r->img, c->mesh_node);
-			rc = row < 0 ? IRDM_ECONTACT
-				     : irdm_engine_site_node(r->eng, (uint32_t)row, &r->site[i]);
+			rc = row < 0 ? IRDM_ECONTACT : irdm_engine_site_node(r->eng, (uint32_t)row, &r->site[i]);
 			if (rc) {
 				snprintf(err, errlen, "--contact %u: mesh node %u is not a touchable node of %s",
 					 c->mesh_node, c->mesh_node, o->image);
@@ -258,7 +257,7 @@ static int start(struct irdm_replay *r, char *err, size_t errlen)
 	r->img = r->s->img;
 	r->eng = r->s->eng;
 	if (irdm_contact_mesh_init(&r->cm, r->img))
-		memset(&r->cm, 0, sizeof(r->cm));       /* no BVH: sites keep the rest normal */
+		memset(&r->cm, 0, sizeof(r->cm)); /* no BVH: sites keep the rest normal */
 	ret = o->log ? start_log(r, board_name, err, errlen) : start_inputs(r, err, errlen);
 	if (ret || !deform)
 		return ret;
@@ -313,7 +312,7 @@ static int commands(struct irdm_replay *r, const double *v, struct irdm_contact_
 	for (unsigned i = 0; i < r->n_contacts; i++) {
 		const double *u = &v[1 + 3 * i];
 		if (isnan(u[0]) || isnan(u[1]) || isnan(u[2]))
-			continue;   /* released this sample */
+			continue; /* released this sample */
 		if (r->sites.v) {
 			/* the site of this sample, handed over every sample as the
 			 * controller does (a slide keeps the contact's past) */
@@ -321,7 +320,8 @@ static int commands(struct irdm_replay *r, const double *v, struct irdm_contact_
 			if (st[0] < 0 || irdm_engine_site_point(r->eng, (uint32_t)st[0], st + 1,
 								&r->site[i])) {
 				snprintf(err, errlen, "%s: row %zu: contact %u has a displacement but "
-					 "no site", r->o->log ? r->o->log : r->o->sites, r->row + 1, i + 1);
+						      "no site",
+					 r->o->log ? r->o->log : r->o->sites, r->row + 1, i + 1);
 				return IRDM_EINVAL;
 			}
 			deformed_normal(r, (uint32_t)st[0], &r->site[i]);
@@ -330,7 +330,8 @@ static int commands(struct irdm_replay *r, const double *v, struct irdm_contact_
 			    r->softened.v[r->row * r->softened.n_cols + 1 + i] != 0 &&
 			    irdm_engine_contact_soften(r->eng, i)) {
 				snprintf(err, errlen, "%s: row %zu: contact %u began softly but is not "
-					 "new", r->o->log, r->row + 1, i + 1);
+						      "new",
+					 r->o->log, r->row + 1, i + 1);
 				return IRDM_EINVAL;
 			}
 		} else if (irdm_engine_contact(r->eng, i)->mode == IRDM_CONTACT_OFF) {
@@ -434,7 +435,7 @@ static int run_rows(struct irdm_replay *r, char *err, size_t errlen)
 		snprintf(err, errlen, "%s: cannot rename into place: %s", o->out, strerror(errno));
 		return IRDM_EIO;
 	}
-	r->tmp[0] = '\0';       /* in place: nothing to remove */
+	r->tmp[0] = '\0'; /* in place: nothing to remove */
 	return IRDM_OK;
 }
 

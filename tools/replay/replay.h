@@ -17,11 +17,11 @@ struct irdm_replay_contact {
 	double point_m[3];
 };
 
-struct irdm_replay;             /* a run in progress (the on_tick hook's handle) */
+struct irdm_replay; /* a run in progress (the on_tick hook's handle) */
 
 struct irdm_replay_opts {
 	const char *image, *trajectory, *out, *nodes;
-	const char *sites;              /* per-sample sites (irdm replay --sites), or NULL */
+	const char *sites; /* per-sample sites (irdm replay --sites), or NULL */
 	/* an irdm-fw log and the board it ran on, instead of trajectory and
 	 * sites: the engine as the controller configured it (push contacts,
 	 * the board's coupling and passivity control), one row per record */
@@ -31,7 +31,7 @@ struct irdm_replay_opts {
 	enum irdm_contact_mode mode;
 	enum irdm_solve_mode solve;
 	double coupling_k, coupling_b;
-	bool passivity;                 /* the engine's passivity control (a haptic board's) */
+	bool passivity; /* the engine's passivity control (a haptic board's) */
 	/*
 	 * Called after every sample's tick, once its forces are written; a
 	 * non-zero return stops the run with that error (irdm render: the

@@ -27,12 +27,12 @@ static int parse_line(char *line, double *v, size_t want, size_t *got)
 		if (k == want)
 			return -1;
 		if (*p == ',' || *p == '\n' || *p == '\r' || *p == 0) {
-			v[k++] = NAN;   /* empty: released */
+			v[k++] = NAN; /* empty: released */
 		} else {
 			char *end;
 			v[k++] = strtod(p, &end);
 			if (end == p)
-				return -2;   /* not a number */
+				return -2; /* not a number */
 			p = end;
 			while (*p == ' ' || *p == '\t')
 				p++;
@@ -68,7 +68,7 @@ static int read_table(const char *path, size_t n_cols, double dt, struct traject
 		lineno++;
 		int rc = parse_line(line, v, n_cols, &got);
 		if (rc == -2 && lineno == 1 && tr->n_rows == 0)
-			continue;   /* header */
+			continue; /* header */
 		if (rc || got != n_cols) {
 			snprintf(err, errlen, "%s:%zu: expected %zu numeric columns", path, lineno,
 				 n_cols);
@@ -111,7 +111,6 @@ out_fail:
 	return ret;
 }
 
-
 void irdm_trajectory_free(struct trajectory *tr)
 {
 	free(tr->v);
@@ -128,7 +127,8 @@ int read_trajectory(const char *path, size_t n_contacts, double dt, struct traje
 			double v = tr->v[r * tr->n_cols + k];
 			if (isinf(v) || fabs(v) > 10.0) {
 				snprintf(err, errlen, "%s: row %zu: displacement %g m is out of range "
-					 "(|u| <= 10 m)", path, r + 1, v);
+						      "(|u| <= 10 m)",
+					 path, r + 1, v);
 				ret = IRDM_EFORMAT;
 				break;
 			}
@@ -194,7 +194,7 @@ int sites_contacts(const char *path, unsigned *n, char *err, size_t errlen)
 		double v[1 + 4 * IRDM_MAX_CONTACTS];
 		if (parse_line(line, v, 1 + 4 * IRDM_MAX_CONTACTS, &cols) == 0)
 			break;
-		cols = 0;       /* the header: the next line says */
+		cols = 0; /* the header: the next line says */
 	}
 	fclose(f);
 	if (cols < 5 || (cols - 1) % 4) {

@@ -65,7 +65,8 @@ static int check_header(const char *path, const struct irdm_log_header *h, doubl
 	}
 	if (h->dropped) {
 		snprintf(err, errlen, "%s: %llu records were dropped while logging: the run "
-			 "cannot be replayed", path, (unsigned long long)h->dropped);
+				      "cannot be replayed",
+			 path, (unsigned long long)h->dropped);
 		return IRDM_EFORMAT;
 	}
 	if (!h->n_devices || !h->record_count) {

@@ -11,7 +11,7 @@
 
 struct trajectory {
 	size_t n_rows, n_cols;
-	double *v;          /* n_rows x n_cols */
+	double *v; /* n_rows x n_cols */
 };
 
 /* t, then ux, uy, uz per contact (nan or empty: released); |u| <= 10 m. */
@@ -35,7 +35,7 @@ void irdm_trajectory_free(struct trajectory *tr);
  */
 struct replay_log {
 	struct trajectory tr, sites, forces;
-	struct trajectory softened;     /* t, then 1 or 0 per device: began softly */
+	struct trajectory softened; /* t, then 1 or 0 per device: began softly */
 	unsigned n_devices;
 	char board[IRDM_LOG_NAME_LEN];
 };

@@ -27,7 +27,7 @@ static void prefixed_progress(void *ctx, const char *stage, double fraction)
 	if (!p->o->progress)
 		return;
 	if (fraction < 0 && strncmp(stage, "warning:", 8))
-		return;         /* the precompute's notes: not the report's */
+		return; /* the precompute's notes: not the report's */
 	snprintf(s, sizeof(s), "%s: %s", p->prefix, stage);
 	p->o->progress(p->o->ctx, s, fraction);
 }
@@ -153,8 +153,7 @@ static int references(const struct irdm_report_opts *o, const struct irdm_image 
 	struct prefixed pp = { .o = o };
 
 	for (size_t k = 0; k < cfg->n_scenarios; k++) {
-		struct irdm_report_conv c = { .img = ref, .m = cfg->scenarios[k]->n_contacts,
-					      .disp_every = IRDM_REPORT_DISP_EVERY };
+		struct irdm_report_conv c = { .img = ref, .m = cfg->scenarios[k]->n_contacts, .disp_every = IRDM_REPORT_DISP_EVERY };
 		int ret;
 
 		sr[k].sc = cfg->scenarios[k];
@@ -166,7 +165,7 @@ static int references(const struct irdm_report_opts *o, const struct irdm_image 
 		snprintf(pp.prefix, sizeof(pp.prefix), "reference dt %g ms", dt_s * 1e3);
 		prefixed_progress(&pp, sr[k].sc->name, (double)(k + 1) / (double)cfg->n_scenarios);
 		ret = ref->rigid ? engine_reference(ref, &sr[k], err, errlen) :
-			irdm_report_convolve(&c, &sr[k].out, err, errlen);
+				   irdm_report_convolve(&c, &sr[k].out, err, errlen);
 		if (ret)
 			return ret;
 	}

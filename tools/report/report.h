@@ -25,17 +25,17 @@
 #include <stddef.h>
 #include <stdio.h>
 
-#include "modal/modal.h"        /* irdm_progress_fn */
+#include "modal/modal.h" /* irdm_progress_fn */
 #include "accuracy/scenario.h"
 
 struct irdm_report_repr {
-	const char *name;       /* short label for tables and plots */
-	const char *keys;       /* scene keys on top of the model's */
+	const char *name; /* short label for tables and plots */
+	const char *keys; /* scene keys on top of the model's */
 };
 
 struct irdm_report_model {
 	const char *name;
-	const char *keys;       /* mesh, material, fixed, touch, display */
+	const char *keys; /* mesh, material, fixed, touch, display */
 };
 
 /* One configuration: a model, its representations and scenarios. */
@@ -46,12 +46,12 @@ struct irdm_report_config {
 	size_t n_reprs;
 	const struct irdm_report_scenario *const *scenarios;
 	size_t n_scenarios;
-	const double *dts_s;    /* sample periods; each representation at each */
+	const double *dts_s; /* sample periods; each representation at each */
 	size_t n_dts;
 	/* the paper's setting, marked in tables and plots: a repr name and dt */
 	const char *paper_repr;
 	double paper_dt_s;
-	double check_s;         /* the reference check's length (report_check.h) */
+	double check_s; /* the reference check's length (report_check.h) */
 };
 
 /* The shipped configurations by name ("sweep", "paper", "floating", "tiny",
@@ -71,18 +71,18 @@ struct irdm_report_row {
 	/* force error relative to the reference: |F - Fref|_2 / |Fref|_2 over
 	 * the whole run, its first 10 ticks and the ticks from 100 on */
 	double force_err, force_err_first10, force_err_after100;
-	double disp_err;                /* displayed nodes, every DISP_EVERY-th tick */
+	double disp_err; /* displayed nodes, every DISP_EVERY-th tick */
 	double tick_median_us, tick_p99_us;
 	size_t image_bytes;
-	double spectral_radius;         /* largest recorded radius of the columns used */
-	bool cert_stable;               /* every column used certified stable */
-	bool run_bounded;               /* finite, no fault, not growing (report.c) */
+	double spectral_radius; /* largest recorded radius of the columns used */
+	bool cert_stable;       /* every column used certified stable */
+	bool run_bounded;       /* finite, no fault, not growing (report.c) */
 	/* FIR: the recorded recursion run without the engine's tail damping
 	 * (the step node, RAW_SECONDS): max |F| of its last second over the
 	 * reference's; NAN for modal images */
 	double raw_growth;
 	size_t ticks;
-	bool paper;                     /* the configuration's paper setting */
+	bool paper; /* the configuration's paper setting */
 };
 
 #define IRDM_REPORT_DISP_EVERY 10
@@ -90,8 +90,8 @@ struct irdm_report_row {
 
 struct irdm_report_opts {
 	const struct irdm_report_config *cfg;
-	const char *tmp_dir;            /* images are built here and removed */
-	const char *only_repr;          /* NULL: all; else only this name */
+	const char *tmp_dir;   /* images are built here and removed */
+	const char *only_repr; /* NULL: all; else only this name */
 	bool keep_images;
 	irdm_progress_fn progress;
 	void *ctx;
@@ -106,14 +106,14 @@ struct irdm_report_opts {
 struct irdm_report_check {
 	double dt_s;
 	unsigned substeps;
-	double resp_rel_diff;           /* max |R_td - R_ref| / max |R_ref| */
-	double force_rel_diff;          /* step forces from each, relative RMS */
+	double resp_rel_diff;  /* max |R_td - R_ref| / max |R_ref| */
+	double force_rel_diff; /* step forces from each, relative RMS */
 };
 
 struct irdm_report_result {
 	struct irdm_report_row *rows;
 	size_t n_rows;
-	struct irdm_report_check *checks;   /* one per dt */
+	struct irdm_report_check *checks; /* one per dt */
 	size_t n_checks;
 	/* the reference was the exact model run by the engine (a floating
 	 * object), not the convolution */

@@ -10,7 +10,10 @@
 #define N_OF(a) (sizeof(a) / sizeof((a)[0]))
 
 static const struct irdm_report_scenario *const grounded_scenarios[] = {
-	&irdm_report_step, &irdm_report_release, &irdm_report_two_points, &irdm_report_stroke,
+	&irdm_report_step,
+	&irdm_report_release,
+	&irdm_report_two_points,
+	&irdm_report_stroke,
 };
 
 /*
@@ -26,11 +29,20 @@ static const struct irdm_report_model sweep_model = {
 		"touch=box:0.0499,0.0499,0.1999,0.0751,0.0751,0.2001 display=z>=0.2",
 };
 
-#define FIR(T) { "fir:" #T, "representation=fir:" #T " modes=all precision=f32" }
+#define FIR(T) \
+	{ \
+		"fir:" #T, "representation=fir:" #T " modes=all precision=f32" \
+	}
 /* the hybrid: K modes, the dropped ones' exact head of H samples */
-#define HYBRID(K, H) { "hybrid:" #K "+" #H, "representation=modal:" #K " static_correction=yes exact_head=" #H " precision=f32" }
-#define MODAL(K) { "modal:" #K "+sc", "representation=modal:" #K " static_correction=yes precision=f32" }, \
-		 { "modal:" #K, "representation=modal:" #K " static_correction=no precision=f32" }
+#define HYBRID(K, H) \
+	{ \
+		"hybrid:" #K "+" #H, "representation=modal:" #K " static_correction=yes exact_head=" #H " precision=f32" \
+	}
+#define MODAL(K) \
+	{ "modal:" #K "+sc", "representation=modal:" #K " static_correction=yes precision=f32" }, \
+	{ \
+		"modal:" #K, "representation=modal:" #K " static_correction=no precision=f32" \
+	}
 
 static const struct irdm_report_repr sweep_reprs[] = {
 	/* the paper's own: FIR T = 500 by time integration, 500 Hz */
@@ -39,10 +51,26 @@ static const struct irdm_report_repr sweep_reprs[] = {
 	 * compliance restored (fir_tail, docs/architecture.md): certified */
 	{ "fir-td:500+win", "representation=fir:500 method=time-domain substeps=8 precision=f32 dt=0.002 fir_tail=window:1000" },
 	{ "fir:500+win", "representation=fir:500 modes=all precision=f32 fir_tail=window:1000" },
-	FIR(25), FIR(50), FIR(100), FIR(250), FIR(500), FIR(1000), FIR(2000), FIR(4000),
-	MODAL(10), MODAL(20), MODAL(40), MODAL(100), MODAL(200), MODAL(300), MODAL(400),
+	FIR(25),
+	FIR(50),
+	FIR(100),
+	FIR(250),
+	FIR(500),
+	FIR(1000),
+	FIR(2000),
+	FIR(4000),
+	MODAL(10),
+	MODAL(20),
+	MODAL(40),
+	MODAL(100),
+	MODAL(200),
+	MODAL(300),
+	MODAL(400),
 	{ "modal:all", "representation=modal:all static_correction=no precision=f32" },
-	HYBRID(300, 32), HYBRID(400, 16), HYBRID(400, 32), HYBRID(400, 64),
+	HYBRID(300, 32),
+	HYBRID(400, 16),
+	HYBRID(400, 32),
+	HYBRID(400, 64),
 	/* storage precision (FIR at the paper's period only: its certificate) */
 	{ "fir:500/f64", "representation=fir:500 modes=all precision=f64 dt=0.002" },
 	{ "fir:500/f16", "representation=fir:500 modes=all precision=f16 dt=0.002" },
@@ -55,11 +83,16 @@ static const struct irdm_report_repr sweep_reprs[] = {
 static const double sweep_dts[] = { 0.001, 0.002 };
 
 static const struct irdm_report_config sweep = {
-	.name = "sweep", .model = &sweep_model,
-	.reprs = sweep_reprs, .n_reprs = N_OF(sweep_reprs),
-	.scenarios = grounded_scenarios, .n_scenarios = N_OF(grounded_scenarios),
-	.dts_s = sweep_dts, .n_dts = N_OF(sweep_dts),
-	.paper_repr = "fir-td:500", .paper_dt_s = 0.002,
+	.name = "sweep",
+	.model = &sweep_model,
+	.reprs = sweep_reprs,
+	.n_reprs = N_OF(sweep_reprs),
+	.scenarios = grounded_scenarios,
+	.n_scenarios = N_OF(grounded_scenarios),
+	.dts_s = sweep_dts,
+	.n_dts = N_OF(sweep_dts),
+	.paper_repr = "fir-td:500",
+	.paper_dt_s = 0.002,
 	.check_s = 0.5,
 };
 
@@ -79,26 +112,34 @@ static const struct irdm_report_model paper_model = {
  * Each hybrid row is a dense eigensolve of 9504 DoFs (minutes); 1000
  * modes: a Lanczos run of many minutes, beyond the report's budget. */
 static const struct irdm_report_repr paper_reprs[] = {
-	MODAL(300), HYBRID(300, 128), HYBRID(300, 256),
+	MODAL(300),
+	HYBRID(300, 128),
+	HYBRID(300, 256),
 };
 
 static const struct irdm_report_scenario *const paper_scenarios[] = {
-	&irdm_report_step, &irdm_report_release,
+	&irdm_report_step,
+	&irdm_report_release,
 };
 
 static const double paper_dts[] = { 0.001 };
 
 static const struct irdm_report_config paper = {
-	.name = "paper", .model = &paper_model,
-	.reprs = paper_reprs, .n_reprs = N_OF(paper_reprs),
-	.scenarios = paper_scenarios, .n_scenarios = N_OF(paper_scenarios),
-	.dts_s = paper_dts, .n_dts = N_OF(paper_dts),
+	.name = "paper",
+	.model = &paper_model,
+	.reprs = paper_reprs,
+	.n_reprs = N_OF(paper_reprs),
+	.scenarios = paper_scenarios,
+	.n_scenarios = N_OF(paper_scenarios),
+	.dts_s = paper_dts,
+	.n_dts = N_OF(paper_dts),
 	/* Newmark on 9504 DoFs: the first 0.1 s only */
 	.check_s = 0.1,
 };
 
 static const struct irdm_report_scenario *const floating_scenarios[] = {
-	&irdm_report_swing, &irdm_report_tap,
+	&irdm_report_swing,
+	&irdm_report_tap,
 };
 
 /*
@@ -119,18 +160,26 @@ static const struct irdm_report_model floating_model = {
  * the rigid body at run time); the precompute builds them from the elastic
  * modes as for a grounded one. */
 static const struct irdm_report_repr floating_reprs[] = {
-	MODAL(10), MODAL(20), MODAL(40), MODAL(100),
+	MODAL(10),
+	MODAL(20),
+	MODAL(40),
+	MODAL(100),
 	{ "modal:all", "representation=modal:all static_correction=no precision=f32" },
-	FIR(100), FIR(500),
+	FIR(100),
+	FIR(500),
 };
 
 static const double floating_dts[] = { 0.001 };
 
 static const struct irdm_report_config floating = {
-	.name = "floating", .model = &floating_model,
-	.reprs = floating_reprs, .n_reprs = N_OF(floating_reprs),
-	.scenarios = floating_scenarios, .n_scenarios = N_OF(floating_scenarios),
-	.dts_s = floating_dts, .n_dts = N_OF(floating_dts),
+	.name = "floating",
+	.model = &floating_model,
+	.reprs = floating_reprs,
+	.n_reprs = N_OF(floating_reprs),
+	.scenarios = floating_scenarios,
+	.n_scenarios = N_OF(floating_scenarios),
+	.dts_s = floating_dts,
+	.n_dts = N_OF(floating_dts),
 };
 
 /* Seconds, for the test: a 2x2x4 cuboid, the exact model and the paper's FIR. */
@@ -149,11 +198,16 @@ static const struct irdm_report_scenario *const tiny_scenarios[] = { &irdm_repor
 static const double tiny_dts[] = { 0.002 };
 
 static const struct irdm_report_config tiny = {
-	.name = "tiny", .model = &tiny_model,
-	.reprs = tiny_reprs, .n_reprs = N_OF(tiny_reprs),
-	.scenarios = tiny_scenarios, .n_scenarios = N_OF(tiny_scenarios),
-	.dts_s = tiny_dts, .n_dts = N_OF(tiny_dts),
-	.paper_repr = "fir:100", .paper_dt_s = 0.002,
+	.name = "tiny",
+	.model = &tiny_model,
+	.reprs = tiny_reprs,
+	.n_reprs = N_OF(tiny_reprs),
+	.scenarios = tiny_scenarios,
+	.n_scenarios = N_OF(tiny_scenarios),
+	.dts_s = tiny_dts,
+	.n_dts = N_OF(tiny_dts),
+	.paper_repr = "fir:100",
+	.paper_dt_s = 0.002,
 	.check_s = 1.0,
 };
 
@@ -173,14 +227,22 @@ static const struct irdm_report_repr tiny_floating_reprs[] = {
 };
 
 static const struct irdm_report_config tiny_floating = {
-	.name = "tiny-floating", .model = &tiny_floating_model,
-	.reprs = tiny_floating_reprs, .n_reprs = N_OF(tiny_floating_reprs),
-	.scenarios = floating_scenarios, .n_scenarios = N_OF(floating_scenarios),
-	.dts_s = floating_dts, .n_dts = N_OF(floating_dts),
+	.name = "tiny-floating",
+	.model = &tiny_floating_model,
+	.reprs = tiny_floating_reprs,
+	.n_reprs = N_OF(tiny_floating_reprs),
+	.scenarios = floating_scenarios,
+	.n_scenarios = N_OF(floating_scenarios),
+	.dts_s = floating_dts,
+	.n_dts = N_OF(floating_dts),
 };
 
 static const struct irdm_report_config *const configs[] = {
-	&sweep, &paper, &floating, &tiny, &tiny_floating,
+	&sweep,
+	&paper,
+	&floating,
+	&tiny,
+	&tiny_floating,
 };
 
 const struct irdm_report_config *irdm_report_config_find(const char *name)

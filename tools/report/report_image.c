@@ -49,7 +49,7 @@ int irdm_report_image_build(struct irdm_report_image *ri, const char *dir, const
 	irdm_scene_defaults(&sc);
 	/* the report measures uncertified representations too: it says so */
 	sc.uncertified = true;
-	sc.max_error = 0;       /* and measures them itself, on more scenarios */
+	sc.max_error = 0; /* and measures them itself, on more scenarios */
 	snprintf(sc.name, sizeof(sc.name), "%s", name);
 	for (size_t i = 0; keys[i]; i++) {
 		ret = set_keys(&sc, keys[i], err, errlen);

@@ -11,7 +11,7 @@
 struct irdm_report_image {
 	struct irdm_image img;
 	char path[512];
-	size_t bytes;           /* the file's size */
+	size_t bytes; /* the file's size */
 };
 
 /*

@@ -12,7 +12,7 @@ struct summary {
 	const char *repr;
 	double dt_s;
 	double force_worst, step_first10, step_after100, disp_worst;
-	double tick_median_us, tick_p99_us;      /* worst scenario */
+	double tick_median_us, tick_p99_us; /* worst scenario */
 	size_t bytes;
 	double radius, raw_growth;
 	int cert_stable, bounded;
@@ -82,7 +82,8 @@ static void table(FILE *f, const struct irdm_report_config *cfg, const struct su
 	for (size_t k = 0; k < cfg->n_scenarios; k++)
 		fprintf(f, " %s |", cfg->scenarios[k]->name);
 	fputs(step ? " step, first 10 ticks | step, from tick 100 | surface, worst |\n" :
-		" surface, worst |\n", f);
+		     " surface, worst |\n",
+	      f);
 	fputs("|---|---|---|---|---|---|", f);
 	for (size_t k = 0; k < cfg->n_scenarios; k++)
 		fputs("---|", f);
@@ -214,7 +215,8 @@ static void floating_reference(FILE *f)
 	      "on a 3 cm, 1 Hz swing and 8.2e-12 on a 2 mm tap (limit 1e-4).  So the\n"
 	      "errors below measure each representation's truncation, correction and\n"
 	      "storage precision, and the reference's own error is at most that of the\n"
-	      "engine's floating path.\n", f);
+	      "engine's floating path.\n",
+	      f);
 }
 
 void irdm_report_markdown(FILE *f, const struct irdm_report_config *cfg,

@@ -9,7 +9,8 @@ void irdm_report_csv_header(FILE *f)
 {
 	fputs("config,repr,dt_ms,scenario,force_err,force_err_first10,force_err_after100,disp_err,"
 	      "tick_median_us,tick_p99_us,image_bytes,spectral_radius,cert_stable,run_bounded,"
-	      "raw_growth,ticks,paper,keys\n", f);
+	      "raw_growth,ticks,paper,keys\n",
+	      f);
 }
 
 void irdm_report_csv_row(FILE *f, const struct irdm_report_row *r)

@@ -131,7 +131,7 @@ static int parse_region(const char *s, struct irdm_region *r, bool allow_touch)
 	} else if (!strcmp(s, "surface")) {
 		r->kind = IRDM_REGION_SURFACE;
 	} else if (allow_touch && !strcmp(s, "touch")) {
-		r->kind = IRDM_REGION_NONE;   /* rows = touch only */
+		r->kind = IRDM_REGION_NONE; /* rows = touch only */
 	} else if (!strncmp(s, "box:", 4)) {
 		if (parse_list(s + 4, v, 6) != 6)
 			return -1;
@@ -278,8 +278,7 @@ static int set_damping(const struct irdm_opt *o, void *obj, const char *v, char 
 static int set_floating(const struct irdm_opt *o, void *obj, const char *v, char *why,
 			size_t len)
 {
-	static const struct irdm_opt yes_no = { .name = "floating", .type = IRDM_OPT_BOOL,
-						.size = sizeof(bool) };
+	static const struct irdm_opt yes_no = { .name = "floating", .type = IRDM_OPT_BOOL, .size = sizeof(bool) };
 	struct irdm_scene *sc = obj;
 	bool b;
 	int ret = irdm_opt_parse_value(&yes_no, &b, v, why, len);
@@ -289,7 +288,7 @@ static int set_floating(const struct irdm_opt *o, void *obj, const char *v, char
 		return ret;
 	sc->floating = b;
 	if (b && sc->fixed.kind == IRDM_REGION_PLANE && !strcmp(sc->fixed.text, "z<=0"))
-		parse_region("none", &sc->fixed, false);   /* default constraint off */
+		parse_region("none", &sc->fixed, false); /* default constraint off */
 	return IRDM_OK;
 }
 
@@ -299,7 +298,8 @@ static int set_region(const struct irdm_opt *o, void *obj, const char *v, char *
 	(void)why;
 	(void)len;
 	return parse_region(v, (struct irdm_region *)((char *)obj + o->offset), false) ?
-	       IRDM_EFORMAT : IRDM_OK;
+		       IRDM_EFORMAT :
+		       IRDM_OK;
 }
 
 /* display: a region, or "touch" (the touchable nodes only). */
@@ -308,7 +308,8 @@ static int set_display(const struct irdm_opt *o, void *obj, const char *v, char 
 	(void)why;
 	(void)len;
 	return parse_region(v, (struct irdm_region *)((char *)obj + o->offset), true) ?
-	       IRDM_EFORMAT : IRDM_OK;
+		       IRDM_EFORMAT :
+		       IRDM_OK;
 }
 
 static int set_representation(const struct irdm_opt *o, void *obj, const char *v, char *why,
@@ -323,8 +324,7 @@ static int set_representation(const struct irdm_opt *o, void *obj, const char *v
 /* "none", or "window:L": L samples past T, tapered (precompute/fir_tail.c). */
 static int set_fir_tail(const struct irdm_opt *o, void *obj, const char *v, char *why, size_t len)
 {
-	static const struct irdm_opt count = { .name = "fir_tail", .type = IRDM_OPT_UNSIGNED,
-		.size = sizeof(unsigned), .range = IRDM_OPT_GE | IRDM_OPT_LE, .min = 1, .max = 1000000 };
+	static const struct irdm_opt count = { .name = "fir_tail", .type = IRDM_OPT_UNSIGNED, .size = sizeof(unsigned), .range = IRDM_OPT_GE | IRDM_OPT_LE, .min = 1, .max = 1000000 };
 	struct irdm_scene *sc = obj;
 
 	(void)o;
@@ -342,8 +342,7 @@ static int set_fir_tail(const struct irdm_opt *o, void *obj, const char *v, char
 /* "none" (0: not measured, not checked) or a relative error in (0, 1]. */
 static int set_max_error(const struct irdm_opt *o, void *obj, const char *v, char *why, size_t len)
 {
-	static const struct irdm_opt err = { .name = "max_error", .type = IRDM_OPT_DOUBLE,
-		.size = sizeof(double), .range = IRDM_OPT_GT | IRDM_OPT_LE, .min = 0, .max = 1 };
+	static const struct irdm_opt err = { .name = "max_error", .type = IRDM_OPT_DOUBLE, .size = sizeof(double), .range = IRDM_OPT_GT | IRDM_OPT_LE, .min = 0, .max = 1 };
 	struct irdm_scene *sc = obj;
 
 	(void)o;
@@ -357,8 +356,7 @@ static int set_max_error(const struct irdm_opt *o, void *obj, const char *v, cha
 /* "all" or "0": every mode; otherwise 1 to 1000000. */
 static int set_modes(const struct irdm_opt *o, void *obj, const char *v, char *why, size_t len)
 {
-	static const struct irdm_opt count = { .name = "modes", .type = IRDM_OPT_UNSIGNED,
-		.size = sizeof(unsigned), .range = IRDM_OPT_GE | IRDM_OPT_LE, .min = 1, .max = 1000000 };
+	static const struct irdm_opt count = { .name = "modes", .type = IRDM_OPT_UNSIGNED, .size = sizeof(unsigned), .range = IRDM_OPT_GE | IRDM_OPT_LE, .min = 1, .max = 1000000 };
 	struct irdm_scene *sc = obj;
 
 	(void)o;
@@ -370,130 +368,87 @@ static int set_modes(const struct irdm_opt *o, void *obj, const char *v, char *w
 }
 
 static const struct irdm_opt_name mass_names[] = {
-	{ "lumped", IRDM_MASS_LUMPED }, { "consistent", IRDM_MASS_CONSISTENT }, { NULL, 0 },
+	{ "lumped", IRDM_MASS_LUMPED },
+	{ "consistent", IRDM_MASS_CONSISTENT },
+	{ NULL, 0 },
 };
 static const struct irdm_opt_name precision_names[] = {
-	{ "f16", IRDM_ELEM_F16 }, { "f32", IRDM_ELEM_F32 }, { "f64", IRDM_ELEM_F64 }, { NULL, 0 },
+	{ "f16", IRDM_ELEM_F16 },
+	{ "f32", IRDM_ELEM_F32 },
+	{ "f64", IRDM_ELEM_F64 },
+	{ NULL, 0 },
 };
 static const struct irdm_opt_name method_names[] = {
-	{ "modal", IRDM_METHOD_MODAL }, { "time-domain", IRDM_METHOD_TIME_DOMAIN }, { NULL, 0 },
+	{ "modal", IRDM_METHOD_MODAL },
+	{ "time-domain", IRDM_METHOD_TIME_DOMAIN },
+	{ NULL, 0 },
 };
 static const struct irdm_opt_name eig_names[] = {
-	{ "auto", IRDM_EIG_AUTO }, { "dense", IRDM_EIG_DENSE }, { "lanczos", IRDM_EIG_LANCZOS },
-	{ "slepc", IRDM_EIG_SLEPC }, { NULL, 0 },
+	{ "auto", IRDM_EIG_AUTO },
+	{ "dense", IRDM_EIG_DENSE },
+	{ "lanczos", IRDM_EIG_LANCZOS },
+	{ "slepc", IRDM_EIG_SLEPC },
+	{ NULL, 0 },
 };
 
 #define SC(member) IRDM_OPT_FIELD(struct irdm_scene, member)
 #define REGION "none | x|y|z<=V | x|y|z>=V | box:X0,Y0,Z0,X1,Y1,Z1 | nodes:I,J,..."
 
 static const struct irdm_opt scene_opts[] = {
-	{ .name = "name", .type = IRDM_OPT_STRING, SC(name), .metavar = "TEXT",
-	  .help = "scene name (provenance)" },
-	{ .name = "mesh", .type = IRDM_OPT_STRING, SC(mesh),
-	  .metavar = "cuboid | cube | box:LX,LY,LZ | FILE",
-	  .help = "builtin mesh, or a file (.node/.ele .msh .obj .off .stl)" },
-	{ .name = "resolution", .type = IRDM_OPT_CUSTOM, .parse = set_resolution,
-	  .metavar = "NX,NY,NZ",
-	  .help = "hexes per axis for builtin meshes, each 1 to 400 (cuboid 11,11,22; cube 10,10,10)" },
-	{ .name = "tets_per_hex", .type = IRDM_OPT_UNSIGNED, SC(tets_per_hex), .metavar = "5 | 6",
-	  .range = IRDM_OPT_GE | IRDM_OPT_LE, .min = 5, .max = 6,
-	  .help = "builtin split (5: the paper's cuboid, 13310 tets)" },
-	{ .name = "mesh_scale", .type = IRDM_OPT_DOUBLE, SC(mesh_scale), .metavar = "S",
-	  .range = IRDM_OPT_GT, .min = 0,
-	  .help = "multiply file coordinates by S (0.001 for mm)" },
-	{ .name = "tetgen", .type = IRDM_OPT_CUSTOM, .parse = set_tetgen, .metavar = "SWITCHES",
-	  .help = "tetgen switches for surface meshes; when given they override target_nodes "
-		  "and max_tet_volume (default: sized by target_nodes)" },
-	{ .name = "target_nodes", .type = IRDM_OPT_UNSIGNED, SC(target_nodes), .metavar = "N",
-	  .range = IRDM_OPT_GE | IRDM_OPT_LE, .min = 100, .max = 10000000,
-	  .help = "surface meshes: about N nodes (within a factor 2; tetgen re-run up to 6 "
-		  "times; default 3000 unless max_tet_volume or tetgen is given)" },
-	{ .name = "max_tet_volume", .type = IRDM_OPT_DOUBLE, SC(max_tet_volume_m3),
-	  .metavar = "M3", .unit = "m^3", .range = IRDM_OPT_GT, .min = 0,
-	  .help = "surface meshes: largest tetrahedron (tetgen -a, after mesh_scale)" },
-	{ .name = "young", .type = IRDM_OPT_DOUBLE, SC(mat.young_pa), .metavar = "PA", .unit = "Pa",
-	  .range = IRDM_OPT_GT, .min = 0,
-	  .help = "Young's modulus (default 2000: the paper)" },
-	{ .name = "poisson", .type = IRDM_OPT_DOUBLE, SC(mat.poisson), .metavar = "NU",
-	  .range = IRDM_OPT_GT | IRDM_OPT_LT, .min = -1, .max = 0.5,
-	  .help = "Poisson's ratio (default 0.49: the paper; 0.5 is incompressible)" },
-	{ .name = "density", .type = IRDM_OPT_DOUBLE, SC(mat.density_kg_m3), .metavar = "KG_M3",
-	  .unit = "kg/m^3", .range = IRDM_OPT_GT, .min = 0,
-	  .help = "density (default 110: the paper)" },
-	{ .name = "mass", .type = IRDM_OPT_ENUM, SC(mass), .names = mass_names,
-	  .help = "mass matrix (default lumped)" },
-	{ .name = "damping", .type = IRDM_OPT_CUSTOM, .parse = set_damping,
-	  .metavar = "Z1@F1,Z2@F2 | rayleigh:A,B",
-	  .help = "ratios Z at two frequencies F in Hz, F1 may be 'mode1'; or C = A M + B K "
-		  "(default 0.05@mode1,0.05@100)" },
-	{ .name = "floating", .type = IRDM_OPT_CUSTOM, .parse = set_floating, .metavar = "yes | no",
-	  .help = "non-grounded object (rigid motion separated); yes turns the default fixed = z<=0 off" },
-	{ .name = "fixed", .type = IRDM_OPT_CUSTOM, .parse = set_region, SC(fixed), .metavar = REGION,
-	  .help = "fixed nodes, called REGION below (default z<=0)" },
-	{ .name = "dt", .type = IRDM_OPT_DOUBLE, SC(dt_s), .metavar = "SECONDS", .unit = "s",
-	  .range = IRDM_OPT_GE | IRDM_OPT_LE, .min = 1e-6, .max = 1,
-	  .help = "sample period (default 0.001)" },
-	{ .name = "representation", .type = IRDM_OPT_CUSTOM, .parse = set_representation,
-	  .metavar = "auto | modal:K | modal:all | fir:T",
-	  .help = "K modes (1 to 1000000) or all, or an FIR of T samples (1 to 1000000); auto: "
-		  "the cheapest to tick of modal:all (up to 300 modes), modal:300 + static "
-		  "correction + exact_head 32, 128 or 512, modal:all whose measured error meets "
-		  "max_error (every mode solved: a dense eigensolve); with max_error = none, "
-		  "modal:300 + static correction (default auto)" },
-	{ .name = "modes", .type = IRDM_OPT_CUSTOM, .parse = set_modes, .metavar = "K | all",
-	  .help = "modes that synthesise a modal-method FIR, 1 to 1000000 (default 300)" },
-	{ .name = "fir_tail", .type = IRDM_OPT_CUSTOM, .parse = set_fir_tail,
-	  .metavar = "none | window:L",
-	  .help = "FIR stabilisation: window:L appends L samples past T tapered to zero (Hann), "
-		  "the taps' sum restored to the static compliance; the first T stay exact "
-		  "(default none: the engine damps an unstable FIR's tail by r^s)" },
-	{ .name = "static_correction", .type = IRDM_OPT_BOOL, SC(static_correction),
-	  .help = "residual compliance of dropped modes (modal; default yes)" },
-	{ .name = "static_correction_tol", .type = IRDM_OPT_DOUBLE, SC(static_corr_tol),
-	  .metavar = "TOL", .range = IRDM_OPT_GE | IRDM_OPT_LT, .min = 0, .max = 1,
-	  .help = "modal: drop the static correction's block between touchable nodes a and b when its norm is below TOL sqrt(|S_aa| |S_bb|), the diagonal blocks' norms: the force error at a contact is of about that order (default 0.02; 0 keeps every block)" },
-	{ .name = "static_correction_rank", .type = IRDM_OPT_UNSIGNED, SC(static_corr_rank),
-	  .metavar = "R", .range = IRDM_OPT_GE | IRDM_OPT_LE, .min = 0, .max = IRDM_CORR_LOWRANK_MAX,
-	  .help = "modal: the far field of the dropped static-correction blocks as a symmetric term of rank R over the touchable nodes, added to every block (image section STATIC_CORR_LOWRANK, R (1 + 3 n_cols) values); 0 leaves it out (default 96)" },
-	{ .name = "static_correction_cluster", .type = IRDM_OPT_UNSIGNED, SC(static_corr_cluster),
-	  .metavar = "N", .range = IRDM_OPT_LE, .max = IRDM_STATIC_CORR_CLUSTER_MAX,
-	  .help = "modal: keep the static correction between every pair of touchable nodes, block low-rank over clusters of at most N nearby nodes (image section STATIC_CORR_CLUSTERS): static_correction_tol then bounds every block's error, not the dropped ones', and static_correction_rank is not used; 0 drops blocks instead (default 0)" },
-	{ .name = "exact_head", .type = IRDM_OPT_UNSIGNED, SC(exact_head), .metavar = "H",
-	  .range = IRDM_OPT_LE, .max = IRDM_HEAD_SAMPLES_MAX / 2,
-	  .help = "modal: the hybrid representation: the dropped modes' exact response over the "
-		  "first H samples between touchable nodes, on top of the kept modes, tapered off "
-		  "over H more with the static compliance kept exactly; needs every mode, a dense "
-		  "eigensolve (default 0: the static correction alone)" },
-	{ .name = "max_error", .type = IRDM_OPT_CUSTOM, .parse = set_max_error,
-	  .metavar = "E | none",
-	  .help = "largest force error an image may have: after the build, its relative RMS "
-		  "force error against the exact linear model (every mode, in double) is "
-		  "measured for a step and a release at a few touchable nodes, stored in the "
-		  "image and printed; above E the image is refused.  none neither measures "
-		  "nor checks (the measurement needs every mode: a dense eigensolve) "
-		  "(default 1e-3)" },
-	{ .name = "uncertified", .type = IRDM_OPT_BOOL, SC(uncertified),
-	  .help = "write an image although some touchable node's force recursion is not "
-		  "certified stable (spectral radius >= 1; the engine then damps an FIR's tail "
-		  "by r^s); default no: such an image is refused, as `irdm image verify "
-		  "--require-stable` would reject it" },
-	{ .name = "precision", .type = IRDM_OPT_ENUM, SC(precision), .names = precision_names,
-	  .help = "storage of the responses (default f32)" },
-	{ .name = "touch", .type = IRDM_OPT_CUSTOM, .parse = set_region, SC(touch),
-	  .metavar = "surface | REGION", .help = "touchable surface nodes: columns (default surface)" },
-	{ .name = "display", .type = IRDM_OPT_CUSTOM, .parse = set_display, SC(display),
-	  .metavar = "surface | touch | REGION",
-	  .help = "displayed surface nodes: rows (default surface)" },
-	{ .name = "method", .type = IRDM_OPT_ENUM, SC(method), .names = method_names,
-	  .help = "how FIR responses are computed (default modal)" },
-	{ .name = "substeps", .type = IRDM_OPT_UNSIGNED, SC(substeps), .metavar = "N",
-	  .range = IRDM_OPT_GE | IRDM_OPT_LE, .min = 1, .max = 100000,
-	  .help = "time-domain integration steps per sample (default 8)" },
-	{ .name = "eigensolver", .type = IRDM_OPT_ENUM, SC(eigensolver), .names = eig_names,
-	  .help = "eigenvalue solver (default auto: by size); slepc: SLEPc over MPI ranks "
-		  "(run under mpirun -np N; docs/mpi.md)" },
-	{ .name = "threads", .type = IRDM_OPT_UNSIGNED, SC(threads), .metavar = "N",
-	  .range = IRDM_OPT_LE, .max = 256, .help = "worker threads (0: all cores)" },
+	{ .name = "name", .type = IRDM_OPT_STRING, SC(name), .metavar = "TEXT", .help = "scene name (provenance)" },
+	{ .name = "mesh", .type = IRDM_OPT_STRING, SC(mesh), .metavar = "cuboid | cube | box:LX,LY,LZ | FILE", .help = "builtin mesh, or a file (.node/.ele .msh .obj .off .stl)" },
+	{ .name = "resolution", .type = IRDM_OPT_CUSTOM, .parse = set_resolution, .metavar = "NX,NY,NZ", .help = "hexes per axis for builtin meshes, each 1 to 400 (cuboid 11,11,22; cube 10,10,10)" },
+	{ .name = "tets_per_hex", .type = IRDM_OPT_UNSIGNED, SC(tets_per_hex), .metavar = "5 | 6", .range = IRDM_OPT_GE | IRDM_OPT_LE, .min = 5, .max = 6, .help = "builtin split (5: the paper's cuboid, 13310 tets)" },
+	{ .name = "mesh_scale", .type = IRDM_OPT_DOUBLE, SC(mesh_scale), .metavar = "S", .range = IRDM_OPT_GT, .min = 0, .help = "multiply file coordinates by S (0.001 for mm)" },
+	{ .name = "tetgen", .type = IRDM_OPT_CUSTOM, .parse = set_tetgen, .metavar = "SWITCHES", .help = "tetgen switches for surface meshes; when given they override target_nodes "
+													 "and max_tet_volume (default: sized by target_nodes)" },
+	{ .name = "target_nodes", .type = IRDM_OPT_UNSIGNED, SC(target_nodes), .metavar = "N", .range = IRDM_OPT_GE | IRDM_OPT_LE, .min = 100, .max = 10000000, .help = "surface meshes: about N nodes (within a factor 2; tetgen re-run up to 6 "
+																					"times; default 3000 unless max_tet_volume or tetgen is given)" },
+	{ .name = "max_tet_volume", .type = IRDM_OPT_DOUBLE, SC(max_tet_volume_m3), .metavar = "M3", .unit = "m^3", .range = IRDM_OPT_GT, .min = 0, .help = "surface meshes: largest tetrahedron (tetgen -a, after mesh_scale)" },
+	{ .name = "young", .type = IRDM_OPT_DOUBLE, SC(mat.young_pa), .metavar = "PA", .unit = "Pa", .range = IRDM_OPT_GT, .min = 0, .help = "Young's modulus (default 2000: the paper)" },
+	{ .name = "poisson", .type = IRDM_OPT_DOUBLE, SC(mat.poisson), .metavar = "NU", .range = IRDM_OPT_GT | IRDM_OPT_LT, .min = -1, .max = 0.5, .help = "Poisson's ratio (default 0.49: the paper; 0.5 is incompressible)" },
+	{ .name = "density", .type = IRDM_OPT_DOUBLE, SC(mat.density_kg_m3), .metavar = "KG_M3", .unit = "kg/m^3", .range = IRDM_OPT_GT, .min = 0, .help = "density (default 110: the paper)" },
+	{ .name = "mass", .type = IRDM_OPT_ENUM, SC(mass), .names = mass_names, .help = "mass matrix (default lumped)" },
+	{ .name = "damping", .type = IRDM_OPT_CUSTOM, .parse = set_damping, .metavar = "Z1@F1,Z2@F2 | rayleigh:A,B", .help = "ratios Z at two frequencies F in Hz, F1 may be 'mode1'; or C = A M + B K "
+															     "(default 0.05@mode1,0.05@100)" },
+	{ .name = "floating", .type = IRDM_OPT_CUSTOM, .parse = set_floating, .metavar = "yes | no", .help = "non-grounded object (rigid motion separated); yes turns the default fixed = z<=0 off" },
+	{ .name = "fixed", .type = IRDM_OPT_CUSTOM, .parse = set_region, SC(fixed), .metavar = REGION, .help = "fixed nodes, called REGION below (default z<=0)" },
+	{ .name = "dt", .type = IRDM_OPT_DOUBLE, SC(dt_s), .metavar = "SECONDS", .unit = "s", .range = IRDM_OPT_GE | IRDM_OPT_LE, .min = 1e-6, .max = 1, .help = "sample period (default 0.001)" },
+	{ .name = "representation", .type = IRDM_OPT_CUSTOM, .parse = set_representation, .metavar = "auto | modal:K | modal:all | fir:T", .help = "K modes (1 to 1000000) or all, or an FIR of T samples (1 to 1000000); auto: "
+																		   "the cheapest to tick of modal:all (up to 300 modes), modal:300 + static "
+																		   "correction + exact_head 32, 128 or 512, modal:all whose measured error meets "
+																		   "max_error (every mode solved: a dense eigensolve); with max_error = none, "
+																		   "modal:300 + static correction (default auto)" },
+	{ .name = "modes", .type = IRDM_OPT_CUSTOM, .parse = set_modes, .metavar = "K | all", .help = "modes that synthesise a modal-method FIR, 1 to 1000000 (default 300)" },
+	{ .name = "fir_tail", .type = IRDM_OPT_CUSTOM, .parse = set_fir_tail, .metavar = "none | window:L", .help = "FIR stabilisation: window:L appends L samples past T tapered to zero (Hann), "
+														    "the taps' sum restored to the static compliance; the first T stay exact "
+														    "(default none: the engine damps an unstable FIR's tail by r^s)" },
+	{ .name = "static_correction", .type = IRDM_OPT_BOOL, SC(static_correction), .help = "residual compliance of dropped modes (modal; default yes)" },
+	{ .name = "static_correction_tol", .type = IRDM_OPT_DOUBLE, SC(static_corr_tol), .metavar = "TOL", .range = IRDM_OPT_GE | IRDM_OPT_LT, .min = 0, .max = 1, .help = "modal: drop the static correction's block between touchable nodes a and b when its norm is below TOL sqrt(|S_aa| |S_bb|), the diagonal blocks' norms: the force error at a contact is of about that order (default 0.02; 0 keeps every block)" },
+	{ .name = "static_correction_rank", .type = IRDM_OPT_UNSIGNED, SC(static_corr_rank), .metavar = "R", .range = IRDM_OPT_GE | IRDM_OPT_LE, .min = 0, .max = IRDM_CORR_LOWRANK_MAX, .help = "modal: the far field of the dropped static-correction blocks as a symmetric term of rank R over the touchable nodes, added to every block (image section STATIC_CORR_LOWRANK, R (1 + 3 n_cols) values); 0 leaves it out (default 96)" },
+	{ .name = "static_correction_cluster", .type = IRDM_OPT_UNSIGNED, SC(static_corr_cluster), .metavar = "N", .range = IRDM_OPT_LE, .max = IRDM_STATIC_CORR_CLUSTER_MAX, .help = "modal: keep the static correction between every pair of touchable nodes, block low-rank over clusters of at most N nearby nodes (image section STATIC_CORR_CLUSTERS): static_correction_tol then bounds every block's error, not the dropped ones', and static_correction_rank is not used; 0 drops blocks instead (default 0)" },
+	{ .name = "exact_head", .type = IRDM_OPT_UNSIGNED, SC(exact_head), .metavar = "H", .range = IRDM_OPT_LE, .max = IRDM_HEAD_SAMPLES_MAX / 2, .help = "modal: the hybrid representation: the dropped modes' exact response over the "
+																			   "first H samples between touchable nodes, on top of the kept modes, tapered off "
+																			   "over H more with the static compliance kept exactly; needs every mode, a dense "
+																			   "eigensolve (default 0: the static correction alone)" },
+	{ .name = "max_error", .type = IRDM_OPT_CUSTOM, .parse = set_max_error, .metavar = "E | none", .help = "largest force error an image may have: after the build, its relative RMS "
+													       "force error against the exact linear model (every mode, in double) is "
+													       "measured for a step and a release at a few touchable nodes, stored in the "
+													       "image and printed; above E the image is refused.  none neither measures "
+													       "nor checks (the measurement needs every mode: a dense eigensolve) "
+													       "(default 1e-3)" },
+	{ .name = "uncertified", .type = IRDM_OPT_BOOL, SC(uncertified), .help = "write an image although some touchable node's force recursion is not "
+										 "certified stable (spectral radius >= 1; the engine then damps an FIR's tail "
+										 "by r^s); default no: such an image is refused, as `irdm image verify "
+										 "--require-stable` would reject it" },
+	{ .name = "precision", .type = IRDM_OPT_ENUM, SC(precision), .names = precision_names, .help = "storage of the responses (default f32)" },
+	{ .name = "touch", .type = IRDM_OPT_CUSTOM, .parse = set_region, SC(touch), .metavar = "surface | REGION", .help = "touchable surface nodes: columns (default surface)" },
+	{ .name = "display", .type = IRDM_OPT_CUSTOM, .parse = set_display, SC(display), .metavar = "surface | touch | REGION", .help = "displayed surface nodes: rows (default surface)" },
+	{ .name = "method", .type = IRDM_OPT_ENUM, SC(method), .names = method_names, .help = "how FIR responses are computed (default modal)" },
+	{ .name = "substeps", .type = IRDM_OPT_UNSIGNED, SC(substeps), .metavar = "N", .range = IRDM_OPT_GE | IRDM_OPT_LE, .min = 1, .max = 100000, .help = "time-domain integration steps per sample (default 8)" },
+	{ .name = "eigensolver", .type = IRDM_OPT_ENUM, SC(eigensolver), .names = eig_names, .help = "eigenvalue solver (default auto: by size); slepc: SLEPc over MPI ranks "
+												     "(run under mpirun -np N; docs/mpi.md)" },
+	{ .name = "threads", .type = IRDM_OPT_UNSIGNED, SC(threads), .metavar = "N", .range = IRDM_OPT_LE, .max = 256, .help = "worker threads (0: all cores)" },
 };
 
 const struct irdm_opt_table irdm_scene_options = {
@@ -512,8 +467,7 @@ int irdm_scene_set(struct irdm_scene *sc, const char *key, const char *value,
 int irdm_scene_load(struct irdm_scene *sc, const char *path, char *err, size_t errlen)
 {
 	/* a key set twice is a mistake, not an override: say so */
-	struct irdm_opt_file file = { .table = &irdm_scene_options, .obj = sc, .name = path,
-				      .reject_duplicates = true };
+	struct irdm_opt_file file = { .table = &irdm_scene_options, .obj = sc, .name = path, .reject_duplicates = true };
 	struct irdm_text_file t;
 	char line[1024];
 	int ret;
@@ -623,43 +577,43 @@ int irdm_scene_format(const struct irdm_scene *sc, char *buf, size_t len)
 	else
 		snprintf(repr, sizeof(repr), "modal:all");
 	int n = snprintf(buf, len,
-		"name=%s\nmesh=%s\nresolution=%u,%u,%u\ntets_per_hex=%u\nmesh_scale=%.17g\n"
-		"tetgen=%s\nyoung=%.17g\npoisson=%.17g\ndensity=%.17g\nmass=%s\ndamping=%s\n"
-		"floating=%s\nfixed=%s\ndt=%.17g\nrepresentation=%s\nstatic_correction=%s\n"
-		"static_correction_tol=%.17g\nstatic_correction_rank=%u\n"
-		"precision=%s\ntouch=%s\ndisplay=%s\nmethod=%s\nsubsteps=%u\neigensolver=%s\nmodes=%u\n",
-		sc->name, sc->mesh, sc->res[0], sc->res[1], sc->res[2], sc->tets_per_hex,
-		sc->mesh_scale, sc->tetgen, sc->mat.young_pa, sc->mat.poisson,
-		sc->mat.density_kg_m3, sc->mass == IRDM_MASS_LUMPED ? "lumped" : "consistent",
-		damp, sc->floating ? "yes" : "no", region_text(&sc->fixed), sc->dt_s, repr,
-		sc->static_correction ? "yes" : "no", sc->static_corr_tol, sc->static_corr_rank,
-		prec[sc->precision & 3],
-		region_text(&sc->touch), region_text(&sc->display),
-		sc->method == IRDM_METHOD_MODAL ? "modal" : "time-domain", sc->substeps,
-		eig[sc->eigensolver], sc->modes);
+			 "name=%s\nmesh=%s\nresolution=%u,%u,%u\ntets_per_hex=%u\nmesh_scale=%.17g\n"
+			 "tetgen=%s\nyoung=%.17g\npoisson=%.17g\ndensity=%.17g\nmass=%s\ndamping=%s\n"
+			 "floating=%s\nfixed=%s\ndt=%.17g\nrepresentation=%s\nstatic_correction=%s\n"
+			 "static_correction_tol=%.17g\nstatic_correction_rank=%u\n"
+			 "precision=%s\ntouch=%s\ndisplay=%s\nmethod=%s\nsubsteps=%u\neigensolver=%s\nmodes=%u\n",
+			 sc->name, sc->mesh, sc->res[0], sc->res[1], sc->res[2], sc->tets_per_hex,
+			 sc->mesh_scale, sc->tetgen, sc->mat.young_pa, sc->mat.poisson,
+			 sc->mat.density_kg_m3, sc->mass == IRDM_MASS_LUMPED ? "lumped" : "consistent",
+			 damp, sc->floating ? "yes" : "no", region_text(&sc->fixed), sc->dt_s, repr,
+			 sc->static_correction ? "yes" : "no", sc->static_corr_tol, sc->static_corr_rank,
+			 prec[sc->precision & 3],
+			 region_text(&sc->touch), region_text(&sc->display),
+			 sc->method == IRDM_METHOD_MODAL ? "modal" : "time-domain", sc->substeps,
+			 eig[sc->eigensolver], sc->modes);
 	if (n < 0 || (size_t)n >= len)
 		return -1;
-	if (sc->fir_tail) {         /* only when set: older scenes keep their text */
+	if (sc->fir_tail) { /* only when set: older scenes keep their text */
 		int t = snprintf(buf + n, len - (size_t)n, "fir_tail=window:%u\n", sc->fir_tail);
 		if (t < 0 || (size_t)t >= len - (size_t)n)
 			return -1;
 		n += t;
 	}
-	if (sc->static_corr_cluster) {      /* only when set, as fir_tail */
+	if (sc->static_corr_cluster) { /* only when set, as fir_tail */
 		int t = snprintf(buf + n, len - (size_t)n, "static_correction_cluster=%u\n",
 				 sc->static_corr_cluster);
 		if (t < 0 || (size_t)t >= len - (size_t)n)
 			return -1;
 		n += t;
 	}
-	if (sc->exact_head) {       /* only when set, as fir_tail */
+	if (sc->exact_head) { /* only when set, as fir_tail */
 		int t = snprintf(buf + n, len - (size_t)n, "exact_head=%u\n", sc->exact_head);
 		if (t < 0 || (size_t)t >= len - (size_t)n)
 			return -1;
 		n += t;
 	}
 	if (sc->tetgen_given || irdm_scene_builtin_mesh(sc))
-		return 0;       /* as before sizing existed: the same images */
+		return 0; /* as before sizing existed: the same images */
 	int k = snprintf(buf + n, len - (size_t)n, "target_nodes=%u\nmax_tet_volume=%.17g\n",
 			 irdm_scene_target_nodes(sc), sc->max_tet_volume_m3);
 	return (k < 0 || (size_t)k >= len - (size_t)n) ? -1 : 0;

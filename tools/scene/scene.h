@@ -21,46 +21,48 @@
 
 enum irdm_region_kind {
 	IRDM_REGION_NONE = 0,
-	IRDM_REGION_SURFACE,    /* every boundary node */
-	IRDM_REGION_PLANE,      /* coordinate <= or >= value */
-	IRDM_REGION_BOX,        /* axis-aligned box, inclusive */
-	IRDM_REGION_NODES,      /* explicit 0-based mesh node list */
+	IRDM_REGION_SURFACE, /* every boundary node */
+	IRDM_REGION_PLANE,   /* coordinate <= or >= value */
+	IRDM_REGION_BOX,     /* axis-aligned box, inclusive */
+	IRDM_REGION_NODES,   /* explicit 0-based mesh node list */
 };
 
 #define IRDM_REGION_MAX_NODES 4096
 
 struct irdm_region {
 	enum irdm_region_kind kind;
-	int axis;               /* PLANE: 0, 1, 2 */
-	bool below;             /* PLANE: <= (true) or >= */
-	double value_m;         /* PLANE */
-	double box_m[6];        /* BOX: x0 y0 z0 x1 y1 z1 */
-	size_t n_nodes;         /* NODES */
+	int axis;        /* PLANE: 0, 1, 2 */
+	bool below;      /* PLANE: <= (true) or >= */
+	double value_m;  /* PLANE */
+	double box_m[6]; /* BOX: x0 y0 z0 x1 y1 z1 */
+	size_t n_nodes;  /* NODES */
 	uint32_t nodes[IRDM_REGION_MAX_NODES];
-	char text[128];         /* as written, for messages and provenance */
+	char text[128]; /* as written, for messages and provenance */
 };
 
 /* The force error an image may have by default (scene key max_error). */
 #define IRDM_MAX_ERROR_DEFAULT 1e-3
 
-enum irdm_damping_kind { IRDM_DAMP_RATIOS = 0, IRDM_DAMP_RAYLEIGH = 1 };
-enum irdm_method { IRDM_METHOD_MODAL = 0, IRDM_METHOD_TIME_DOMAIN = 1 };
+enum irdm_damping_kind { IRDM_DAMP_RATIOS = 0,
+			 IRDM_DAMP_RAYLEIGH = 1 };
+enum irdm_method { IRDM_METHOD_MODAL = 0,
+		   IRDM_METHOD_TIME_DOMAIN = 1 };
 
 struct irdm_scene {
 	char name[64];
-	char mesh[512];          /* "cuboid", "cube", "box:LX,LY,LZ" or a file path */
-	unsigned res[3];         /* builtin resolution (hexes per axis) */
-	unsigned tets_per_hex;   /* 5 or 6 */
-	double mesh_scale;       /* multiplies file coordinates */
-	char tetgen[32];         /* tetgen switches for surface meshes */
-	bool tetgen_given;       /* set by the scene: then they win over the sizes */
-	unsigned target_nodes;   /* surface meshes: about this many nodes (0: default) */
+	char mesh[512];           /* "cuboid", "cube", "box:LX,LY,LZ" or a file path */
+	unsigned res[3];          /* builtin resolution (hexes per axis) */
+	unsigned tets_per_hex;    /* 5 or 6 */
+	double mesh_scale;        /* multiplies file coordinates */
+	char tetgen[32];          /* tetgen switches for surface meshes */
+	bool tetgen_given;        /* set by the scene: then they win over the sizes */
+	unsigned target_nodes;    /* surface meshes: about this many nodes (0: default) */
 	double max_tet_volume_m3; /* surface meshes: largest tet (0: none) */
 	struct irdm_material mat;
 	enum irdm_mass_kind mass;
 	enum irdm_damping_kind damping;
 	double damp_ratio[2];
-	double damp_hz[2];       /* 0 for the first: "the first elastic mode" */
+	double damp_hz[2]; /* 0 for the first: "the first elastic mode" */
 	struct irdm_rayleigh rayleigh;
 	bool floating;
 	struct irdm_region fixed;
@@ -68,22 +70,22 @@ struct irdm_scene {
 	uint32_t representation; /* enum irdm_repr */
 	bool repr_auto;          /* chosen by the precompute to meet max_error */
 	unsigned fir_length;
-	unsigned fir_tail;       /* FIR: samples windowed past fir_length (0: none) */
-	unsigned modes;          /* modes kept (0 = all) */
+	unsigned fir_tail; /* FIR: samples windowed past fir_length (0: none) */
+	unsigned modes;    /* modes kept (0 = all) */
 	bool static_correction;
-	double static_corr_tol;   /* drop blocks below tol sqrt(|S_cc| |S_rr|) */
-	unsigned static_corr_rank; /* far field of the dropped blocks: rank (0: none) */
+	double static_corr_tol;       /* drop blocks below tol sqrt(|S_cc| |S_rr|) */
+	unsigned static_corr_rank;    /* far field of the dropped blocks: rank (0: none) */
 	unsigned static_corr_cluster; /* nodes per cluster of the clustered correction (0: off) */
-	unsigned exact_head;     /* modal: exact samples of the dropped modes' head (0: none; stored: 2x) */
-	uint32_t precision;      /* enum irdm_elem */
+	unsigned exact_head;          /* modal: exact samples of the dropped modes' head (0: none; stored: 2x) */
+	uint32_t precision;           /* enum irdm_elem */
 	struct irdm_region touch;
 	struct irdm_region display;
 	enum irdm_method method;
 	unsigned substeps;
 	enum irdm_eig_method eigensolver;
 	unsigned threads;
-	bool uncertified;        /* write an image whose stability certificate fails */
-	double max_error;        /* largest measured force error written (0: none, not measured) */
+	bool uncertified; /* write an image whose stability certificate fails */
+	double max_error; /* largest measured force error written (0: none, not measured) */
 };
 
 /* The defaults: the paper's cuboid at its resolution, modal 300 + static

@@ -2,7 +2,7 @@
 # Install the Debian packages the project builds and tests with, if any is
 # missing (idempotent; needs root, as on the project's machines).
 set -euo pipefail
-packages=(build-essential clang libclang-rt-14-dev libopenblas-dev libsuitesparse-dev
+packages=(build-essential clang clang-format-14 libclang-rt-14-dev libopenblas-dev libsuitesparse-dev
 	  libarpack2-dev libcmocka-dev tetgen python3-matplotlib rt-tests
 	  petsc-dev slepc-dev libopenmpi-dev openmpi-bin
 	  libwebsockets-dev libjs-three chromium libpng-dev)

@@ -28,8 +28,7 @@ static void cross3(const double a[3], const double b[3], double c[3])
 
 static double det3(const double m[9])
 {
-	return m[0] * (m[4] * m[8] - m[5] * m[7]) - m[1] * (m[3] * m[8] - m[5] * m[6])
-	     + m[2] * (m[3] * m[7] - m[4] * m[6]);
+	return m[0] * (m[4] * m[8] - m[5] * m[7]) - m[1] * (m[3] * m[8] - m[5] * m[6]) + m[2] * (m[3] * m[7] - m[4] * m[6]);
 }
 
 static double col_dot(const double m[9], int i, int j)
@@ -170,8 +169,7 @@ static int kabsch_rotation(const double h[9], double rot[9])
 	d = det3(u) * det3(v) < 0 ? -1.0 : 1.0;
 	for (int a = 0; a < 3; a++)
 		for (int b = 0; b < 3; b++)
-			rot[3 * a + b] = v[3 * a + 0] * u[3 * b + 0] + v[3 * a + 1] * u[3 * b + 1]
-				       + d * v[3 * a + 2] * u[3 * b + 2];
+			rot[3 * a + b] = v[3 * a + 0] * u[3 * b + 0] + v[3 * a + 1] * u[3 * b + 1] + d * v[3 * a + 2] * u[3 * b + 2];
 	return 0;
 }
 
@@ -252,11 +250,10 @@ static void extents(size_t n, const double *p, const double *u, const double t[3
 			hi[k] = fmax(hi[k], x);
 			a2 += du * du;
 		}
-		if (!(a2 <= m2))	/* also propagates NaN */
+		if (!(a2 <= m2)) /* also propagates NaN */
 			m2 = a2;
 	}
-	*diag = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1])
-		     + (hi[2] - lo[2]) * (hi[2] - lo[2]));
+	*diag = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) + (hi[2] - lo[2]) * (hi[2] - lo[2]));
 	*umax = sqrt(m2);
 }
 
@@ -301,8 +298,7 @@ int irdm_rigid_remove_kabsch(size_t n, const double *p, const double *w, const d
 		scaled_point(p, u, i, t, eps, q);
 		for (int a = 0; a < 3; a++)
 			for (int b = 0; b < 3; b++)
-				h[3 * a + b] += wi * (p[3 * i + a] - fit.c_rest[a])
-						* (q[b] - fit.c_def[b]);
+				h[3 * a + b] += wi * (p[3 * i + a] - fit.c_rest[a]) * (q[b] - fit.c_def[b]);
 	}
 	if (kabsch_rotation(h, fit.rot))
 		return IRDM_ENUMERIC;

@@ -26,9 +26,9 @@
 #include "irdm/error.h"
 
 struct irdm_rigid_fit {
-	double rot[9];     /* row-major proper rotation: q_i ~ rot (p_i - c_rest) + c_def */
-	double c_rest[3];  /* weighted centroid of p */
-	double c_def[3];   /* weighted centroid of q */
+	double rot[9];    /* row-major proper rotation: q_i ~ rot (p_i - c_rest) + c_def */
+	double c_rest[3]; /* weighted centroid of p */
+	double c_def[3];  /* weighted centroid of q */
 };
 
 /*

@@ -7,7 +7,6 @@
 
 #include "fem/fem.h"
 
-
 /* Y = A X for k columns (n x k, column-major, leading dimension n). */
 void irdm_td_matvec_block(const struct irdm_csc *a, const double *x, double *y, size_t k);
 

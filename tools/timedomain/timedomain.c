@@ -56,8 +56,8 @@ struct td_job {
 	size_t n_in;
 	const uint32_t *out_nodes;
 	size_t n_out;
-	double *R;             /* a worker writes only its own inputs' slices */
-	cholmod_factor *L;     /* shared; CHOLMOD's solve only reads it */
+	double *R;         /* a worker writes only its own inputs' slices */
+	cholmod_factor *L; /* shared; CHOLMOD's solve only reads it */
 	double h;
 	double rel_eps;
 	size_t n_blocks;
@@ -66,7 +66,7 @@ struct td_job {
 	size_t next_block;
 	size_t done;
 	bool failed;
-	int code;              /* the first failure's IRDM_E* */
+	int code; /* the first failure's IRDM_E* */
 	char *err;
 	size_t errlen;
 };
@@ -79,8 +79,8 @@ struct td_worker {
 	bool started;
 	cholmod_common cc;
 	cholmod_dense *b, *x, *y, *e;
-	double *u, *v, *ku, *mv;    /* n_free x TD_BLOCK, column-major */
-	double *full, *def;         /* 3 * n_nodes, floating only */
+	double *u, *v, *ku, *mv; /* n_free x TD_BLOCK, column-major */
+	double *full, *def;      /* 3 * n_nodes, floating only */
 	char err[200];
 };
 
@@ -207,7 +207,7 @@ static int worker_init(struct td_worker *w, struct td_job *job)
 	memset(w, 0, sizeof(*w));
 	w->job = job;
 	cholmod_l_start(&w->cc);
-	w->cc.print = 0;	/* errors come back through err, not stdout */
+	w->cc.print = 0; /* errors come back through err, not stdout */
 	w->u = malloc(nb * sizeof(double));
 	w->v = malloc(nb * sizeof(double));
 	w->ku = malloc(nb * sizeof(double));
@@ -421,8 +421,16 @@ int irdm_td_responses(const struct irdm_mesh *mesh, const struct irdm_fem *fem,
 		      char *err, size_t errlen)
 {
 	struct td_job job = {
-		.mesh = mesh, .fem = fem, .o = o, .in_dofs = in_dofs, .n_in = n_in,
-		.out_nodes = out_nodes, .n_out = n_out, .R = R, .err = err, .errlen = errlen,
+		.mesh = mesh,
+		.fem = fem,
+		.o = o,
+		.in_dofs = in_dofs,
+		.n_in = n_in,
+		.out_nodes = out_nodes,
+		.n_out = n_out,
+		.R = R,
+		.err = err,
+		.errlen = errlen,
 	};
 	struct td_worker *w = NULL;
 	cholmod_common cc;

@@ -51,18 +51,18 @@ enum irdm_td_rigid {
 #define IRDM_TD_KABSCH_REL_EPS 1e-7
 
 struct irdm_td_opts {
-	double dt_s;            /* sample period */
-	unsigned n_samples;     /* T */
-	unsigned substeps;      /* integration steps per sample (>= 1) */
+	double dt_s;        /* sample period */
+	unsigned n_samples; /* T */
+	unsigned substeps;  /* integration steps per sample (>= 1) */
 	struct irdm_rayleigh damping;
-	bool floating;          /* remove rigid motion by mass-weighted best fit */
-	unsigned threads;       /* worker threads over input DoFs (0 = online CPUs) */
+	bool floating;    /* remove rigid motion by mass-weighted best fit */
+	unsigned threads; /* worker threads over input DoFs (0 = online CPUs) */
 	/* May be NULL.  Called with the number of finished input columns, from
 	 * any worker thread but never concurrently (serialised here). */
 	void (*progress)(void *ctx, size_t done, size_t total);
 	void *progress_ctx;
-	enum irdm_td_rigid rigid;  /* floating only; 0 = linear projection */
-	double kabsch_rel_eps;     /* KABSCH only; 0 = IRDM_TD_KABSCH_REL_EPS */
+	enum irdm_td_rigid rigid; /* floating only; 0 = linear projection */
+	double kabsch_rel_eps;    /* KABSCH only; 0 = IRDM_TD_KABSCH_REL_EPS */
 };
 
 /*

@@ -8,7 +8,9 @@
 #include "irdm/posix/outdir.h"
 #include "util/interrupt.h"
 
-enum { FREE, FILLING, ACTIVE };
+enum { FREE,
+       FILLING,
+       ACTIVE };
 
 struct slot {
 	atomic_int state;

@@ -17,9 +17,9 @@
 #define IRDM_INTERRUPT_SLOTS 16
 
 enum irdm_interrupt_kind {
-	IRDM_INTERRUPT_FILE = 1,        /* unlink the path */
-	IRDM_INTERRUPT_DIR,             /* remove the files in the path, then it */
-	IRDM_INTERRUPT_PGROUP,          /* kill(-pgid, SIGTERM) */
+	IRDM_INTERRUPT_FILE = 1, /* unlink the path */
+	IRDM_INTERRUPT_DIR,      /* remove the files in the path, then it */
+	IRDM_INTERRUPT_PGROUP,   /* kill(-pgid, SIGTERM) */
 };
 
 /* Register; the handlers are installed on the first call.  Return: the

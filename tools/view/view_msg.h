@@ -16,35 +16,35 @@
 #include "irdm/image.h"
 #include "irdm/telemetry.h"
 
-#define VIEW_MAGIC 0x56445249u          /* "IRDV" */
+#define VIEW_MAGIC 0x56445249u /* "IRDV" */
 #define VIEW_VERSION 1u
 #define VIEW_KIND_HELLO 1u
 #define VIEW_KIND_FRAME 2u
 #define VIEW_MODE_LIVE 0u
 #define VIEW_MODE_PLAYBACK 1u
-#define VIEW_DEVICES 2u                 /* a frame always holds two device slots */
+#define VIEW_DEVICES 2u /* a frame always holds two device slots */
 #define VIEW_HELLO_HEAD 108u
 #define VIEW_FRAME_HEAD 200u
 #define VIEW_SAMPLE_BYTES 16u
-#define VIEW_FRAME_POSITIONS 1u         /* frame flag: node positions follow */
-#define VIEW_STATE_NONE 255u            /* a frame without the controller (irdm render's) */
+#define VIEW_FRAME_POSITIONS 1u /* frame flag: node positions follow */
+#define VIEW_STATE_NONE 255u    /* a frame without the controller (irdm render's) */
 
 struct view_hello {
 	uint32_t mode, n_nodes, n_tris, n_dev;
 	float period_s, scale_m, duration_s;
-	uint32_t n_frames;              /* playback: the recording's frames (0 live) */
-	const char *name;               /* the board's; cut to 63 bytes */
-	const float *rest_m;            /* 3 n_nodes */
-	const uint32_t *tris;           /* 3 n_tris, each < n_nodes */
+	uint32_t n_frames;    /* playback: the recording's frames (0 live) */
+	const char *name;     /* the board's; cut to 63 bytes */
+	const float *rest_m;  /* 3 n_nodes */
+	const uint32_t *tris; /* 3 n_tris, each < n_nodes */
 };
 
 struct view_dev {
-	float tip_m[3], force_n[3];     /* object frame; the force on the object */
+	float tip_m[3], force_n[3]; /* object frame; the force on the object */
 	/* (view_frame_from_record() copies the record's tip, which is in the
 	 * device frame: the caller moves it, irdm_board_device_to_object()) */
-	float bary[3], target_m[3];     /* the proxy's site (tri, bary) when in contact */
-	uint32_t tri;                   /* UINT32_MAX: no contact */
-	uint32_t proxy;                 /* enum irdm_proxy_event */
+	float bary[3], target_m[3]; /* the proxy's site (tri, bary) when in contact */
+	uint32_t tri;               /* UINT32_MAX: no contact */
+	uint32_t proxy;             /* enum irdm_proxy_event */
 };
 
 /* One tick of the strip chart. */
@@ -54,11 +54,11 @@ struct view_sample {
 
 struct view_frame {
 	uint32_t state, faults, n_dev;
-	double tick;                    /* the positions' engine tick (or the newest) */
-	double t_s;                     /* the frame's time in the run */
-	double newest_tick;             /* the loop's newest tick when the frame left */
-	double sent_ms;                 /* wall clock at publishing (ms since the epoch), 0 playback */
-	double dropped;                 /* records the view's ring dropped so far */
+	double tick;        /* the positions' engine tick (or the newest) */
+	double t_s;         /* the frame's time in the run */
+	double newest_tick; /* the loop's newest tick when the frame left */
+	double sent_ms;     /* wall clock at publishing (ms since the epoch), 0 playback */
+	double dropped;     /* records the view's ring dropped so far */
 	struct view_dev dev[VIEW_DEVICES];
 };
 

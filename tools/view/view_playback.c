@@ -21,7 +21,7 @@
 #include "view/view_msg.h"
 #include "view/view_playback.h"
 
-#define RECORDS_MAX (3600u * 1000u)     /* an hour at 1 kHz */
+#define RECORDS_MAX (3600u * 1000u) /* an hour at 1 kHz */
 
 struct playback {
 	const struct view_playback_opts *o;
@@ -63,14 +63,13 @@ static int read_log(struct playback *pb, char *err, size_t errlen)
 		pb->n_rec++;
 close:
 	irdm_log_close(r);
-	return rc < 0 ? rc : rc ? rc : IRDM_OK;
+	return rc < 0 ? rc : rc ? rc :
+				  IRDM_OK;
 }
 
 static int hello(struct playback *pb, const struct irdm_image *img, char *err, size_t errlen)
 {
-	struct view_hello h = { .mode = VIEW_MODE_PLAYBACK, .n_dev = pb->board.devices,
-				.period_s = (float)pb->dt, .duration_s = (float)(pb->n_rec * pb->dt),
-				.n_frames = (uint32_t)(pb->n_rec / pb->every), .name = pb->board.name };
+	struct view_hello h = { .mode = VIEW_MODE_PLAYBACK, .n_dev = pb->board.devices, .period_s = (float)pb->dt, .duration_s = (float)(pb->n_rec * pb->dt), .n_frames = (uint32_t)(pb->n_rec / pb->every), .name = pb->board.name };
 	unsigned char *buf;
 	size_t len = view_hello_image(&buf, img, &h);
 	int rc = len ? view_server_set_hello(pb->srv, buf, len) : IRDM_ENOMEM;
@@ -90,7 +89,8 @@ static int start(struct playback *pb, struct irdm_replay *r, char *err, size_t e
 	pb->dt = img->meta->dt_s;
 	if (!(every >= 0.5) || every > (double)pb->n_rec) {
 		snprintf(err, errlen, "--every %g: must be between the image's dt (%g s) and the "
-			 "run's length (%g s)", pb->o->every_s, pb->dt, pb->n_rec * pb->dt);
+				      "run's length (%g s)",
+			 pb->o->every_s, pb->dt, pb->n_rec * pb->dt);
 		return IRDM_EINVAL;
 	}
 	pb->every = (size_t)llround(every);
@@ -133,8 +133,7 @@ static int frame(struct playback *pb, struct irdm_replay *r, size_t row, char *e
 	f.tick = f.newest_tick = (double)(row + 1);
 	f.t_s = (double)(row + 1) * pb->dt;
 	pb->sum->frames++;
-	if (view_server_record(pb->srv, pb->msg, view_frame_write(pb->msg, &f, pb->pos,
-								  img->meta->n_nodes, pb->smp, n))) {
+	if (view_server_record(pb->srv, pb->msg, view_frame_write(pb->msg, &f, pb->pos, img->meta->n_nodes, pb->smp, n))) {
 		snprintf(err, errlen, "out of memory for frame %zu", pb->sum->frames);
 		return IRDM_ENOMEM;
 	}

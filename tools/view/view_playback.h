@@ -15,13 +15,13 @@
 
 struct view_playback_opts {
 	const char *log, *board, *image;
-	double every_s;                 /* a frame every every_s of the run (> 0) */
+	double every_s; /* a frame every every_s of the run (> 0) */
 };
 
 struct view_playback_summary {
 	size_t records, frames;
 	double duration_s;
-	double log_max_diff_n, log_peak_n;      /* the replay's forces against the log's */
+	double log_max_diff_n, log_peak_n; /* the replay's forces against the log's */
 };
 
 /* Set s's hello and recording.  Return: IRDM_OK, or the replay's or the

@@ -20,13 +20,13 @@
 #include "view/view_playback.h"
 
 #define FILE_MAX (512u << 20)
-#define FRAMES_MAX 5000u                /* irdm render's own limit */
+#define FRAMES_MAX 5000u /* irdm render's own limit */
 
 struct rdir {
 	const char *dir;
 	char path[4200];
-	char *pvd, *vtu;                /* whole files, NUL-terminated */
-	uint32_t n, m, nc;              /* points, triangles, contacts */
+	char *pvd, *vtu;   /* whole files, NUL-terminated */
+	uint32_t n, m, nc; /* points, triangles, contacts */
 	float *rest, *pos;
 	uint32_t *tris;
 	double *disp, *pt, *force;
@@ -201,7 +201,8 @@ static int frame(struct rdir *r, struct view_server *s, double t, size_t k)
 			f.dev[i].force_n[a] = (float)r->force[3 * i + a];
 		}
 		smp.force_n[i] = i < f.n_dev ? (float)sqrt(r->force[3 * i] * r->force[3 * i] +
-			r->force[3 * i + 1] * r->force[3 * i + 1] + r->force[3 * i + 2] * r->force[3 * i + 2]) : 0;
+							   r->force[3 * i + 1] * r->force[3 * i + 1] + r->force[3 * i + 2] * r->force[3 * i + 2]) :
+					       0;
 	}
 	if (view_server_record(s, r->msg, view_frame_write(r->msg, &f, r->pos, r->n, &smp, 1))) {
 		snprintf(r->err, r->errlen, "out of memory for frame %zu", k);
@@ -230,11 +231,7 @@ static const char *next_set(const char *p, double *t, char *file, size_t len)
 static int hello(struct rdir *r, struct view_server *s, double t0, double t_end, size_t frames)
 {
 	const char *base = strrchr(r->dir, '/');
-	struct view_hello h = { .mode = VIEW_MODE_PLAYBACK, .n_nodes = r->n, .n_tris = r->m,
-				.n_dev = r->nc < VIEW_DEVICES ? r->nc : VIEW_DEVICES,
-				.period_s = (float)t0, .duration_s = (float)t_end,
-				.n_frames = (uint32_t)frames, .name = base && base[1] ? base + 1 : r->dir,
-				.rest_m = r->rest, .tris = r->tris };
+	struct view_hello h = { .mode = VIEW_MODE_PLAYBACK, .n_nodes = r->n, .n_tris = r->m, .n_dev = r->nc < VIEW_DEVICES ? r->nc : VIEW_DEVICES, .period_s = (float)t0, .duration_s = (float)t_end, .n_frames = (uint32_t)frames, .name = base && base[1] ? base + 1 : r->dir, .rest_m = r->rest, .tris = r->tris };
 	unsigned char *buf = malloc(view_hello_size(r->n, r->m));
 	int rc;
 

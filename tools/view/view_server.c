@@ -23,11 +23,11 @@
 #include "view/view_server.h"
 
 #define HTTP_CHUNK 16384u
-#define HELLO_MAX (256u << 20)          /* a mesh of millions of nodes: refuse beyond */
-#define RECORD_MAX 100000u              /* messages in a recording */
+#define HELLO_MAX (256u << 20) /* a mesh of millions of nodes: refuse beyond */
+#define RECORD_MAX 100000u     /* messages in a recording */
 
 struct msg {
-	unsigned char *buf;             /* LWS_PRE bytes of room, then the message */
+	unsigned char *buf; /* LWS_PRE bytes of room, then the message */
 	size_t len;
 };
 
@@ -82,7 +82,7 @@ static bool same_origin(struct lws *wsi)
 	char origin[256], host[256], want[300];
 
 	if (lws_hdr_copy(wsi, origin, sizeof(origin), WSI_TOKEN_ORIGIN) <= 0)
-		return true;    /* not a browser: nothing to protect from */
+		return true; /* not a browser: nothing to protect from */
 	if (lws_hdr_copy(wsi, host, sizeof(host), WSI_TOKEN_HOST) <= 0)
 		return false;
 	snprintf(want, sizeof(want), "http://%s", host);
@@ -161,7 +161,7 @@ static int ws_more(struct view_server *s, struct lws *wsi, struct conn *c)
 	if (c->hello_gen != s->hello_gen) {
 		c->hello_gen = s->hello_gen;
 		c->rec_sent = 0;
-		c->frame_seq = s->frame_seq;    /* an older frame may not fit the new mesh */
+		c->frame_seq = s->frame_seq; /* an older frame may not fit the new mesh */
 		if (send_msg(wsi, &s->hello))
 			return -1;
 	} else if (c->rec_sent < s->n_rec) {
@@ -206,7 +206,7 @@ static int on_event(struct lws *wsi, enum lws_callback_reasons reason, void *use
 	case LWS_CALLBACK_HTTP:
 		return http_start(s, wsi, c, in);
 	case LWS_CALLBACK_HTTP_BODY:
-		return -1;      /* a GET has no body */
+		return -1; /* a GET has no body */
 	case LWS_CALLBACK_HTTP_WRITEABLE:
 		return http_more(s, wsi, c);
 	case LWS_CALLBACK_FILTER_PROTOCOL_CONNECTION:

@@ -30,22 +30,22 @@
 struct view_server;
 
 struct view_server_config {
-	const char *addr;               /* numeric IPv4 address to bind; NULL: 127.0.0.1 */
-	unsigned port;                  /* 0: any free port (view_server_port() says which) */
-	const char *three_js;           /* NULL: VIEW_THREE_JS */
-	size_t max_frame;               /* bytes of the largest frame view_server_publish() takes */
-	double rate_hz;                 /* tick's rate, > 0 */
-	void (*tick)(void *ctx, struct view_server *s);  /* in the server's thread */
+	const char *addr;                               /* numeric IPv4 address to bind; NULL: 127.0.0.1 */
+	unsigned port;                                  /* 0: any free port (view_server_port() says which) */
+	const char *three_js;                           /* NULL: VIEW_THREE_JS */
+	size_t max_frame;                               /* bytes of the largest frame view_server_publish() takes */
+	double rate_hz;                                 /* tick's rate, > 0 */
+	void (*tick)(void *ctx, struct view_server *s); /* in the server's thread */
 	void *ctx;
 };
 
 struct view_server_stats {
-	uint64_t http_ok, http_refused;         /* pages and files served; 404/405 */
-	uint64_t ws_opened, ws_refused;         /* sockets accepted; over the limit */
-	uint64_t ws_kicked;                     /* clients disconnected: they sent data */
+	uint64_t http_ok, http_refused; /* pages and files served; 404/405 */
+	uint64_t ws_opened, ws_refused; /* sockets accepted; over the limit */
+	uint64_t ws_kicked;             /* clients disconnected: they sent data */
 	uint64_t frames_published, frames_sent;
-	uint64_t frames_skipped;                /* a client was still busy: it got a newer one */
-	unsigned clients;                       /* open WebSockets now */
+	uint64_t frames_skipped; /* a client was still busy: it got a newer one */
+	unsigned clients;        /* open WebSockets now */
 };
 
 /* "[ADDR:]PORT" (ADDR default VIEW_DEFAULT_ADDR, PORT 0..65535, 0: any):

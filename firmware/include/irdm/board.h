@@ -37,19 +37,19 @@
 #include "irdm/engine.h"
 #include "irdm/options.h"
 
-#define IRDM_BOARD_DEVICES_MAX 2        /* two arms: the two-hand pinch */
-#define IRDM_BOARD_NAME_MAX 64          /* bytes with the terminating NUL */
+#define IRDM_BOARD_DEVICES_MAX 2 /* two arms: the two-hand pinch */
+#define IRDM_BOARD_NAME_MAX 64   /* bytes with the terminating NUL */
 #define IRDM_BOARD_HAL_MAX 32
 #define IRDM_BOARD_HAL_OPTIONS_MAX 256
-#define IRDM_BOARD_LINE_MAX 512         /* longest line, with its newline */
+#define IRDM_BOARD_LINE_MAX 512 /* longest line, with its newline */
 
 struct irdm_board {
 	char name[IRDM_BOARD_NAME_MAX];
-	char hal[IRDM_BOARD_HAL_MAX];                   /* back-end name (irdm_hal_find) */
-	char hal_options[IRDM_BOARD_HAL_OPTIONS_MAX];   /* handed to the back-end as is */
-	unsigned hal_options_line;      /* its line in the file (0: not given), for
+	char hal[IRDM_BOARD_HAL_MAX];                 /* back-end name (irdm_hal_find) */
+	char hal_options[IRDM_BOARD_HAL_OPTIONS_MAX]; /* handed to the back-end as is */
+	unsigned hal_options_line;                    /* its line in the file (0: not given), for
 					 * the back-end's messages; set by the loader */
-	unsigned devices;                               /* 1 or 2 */
+	unsigned devices;                             /* 1 or 2 */
 
 	/*
 	 * The first arm (kinematics, encoders, torque limits, masses, and the
@@ -60,22 +60,22 @@ struct irdm_board {
 	double device2_base_offset_m[3];
 
 	/* safety limits (the torque limits are in .device) */
-	double workspace_min_m[3];              /* every tip stays in this box */
+	double workspace_min_m[3]; /* every tip stays in this box */
 	double workspace_max_m[3];
 	double max_tip_speed_m_per_s;
-	unsigned overrun_fault_count;           /* this many overruns in a row fault */
-	unsigned watchdog_us;                   /* one tick longer than this faults */
+	unsigned overrun_fault_count; /* this many overruns in a row fault */
+	unsigned watchdog_us;         /* one tick longer than this faults */
 
 	/* the loop */
 	unsigned period_us;
-	int force_priority;                     /* SCHED_FIFO priority of the force thread */
-	int cpu;                                /* its CPU, -1 for any */
-	double deform_rate_hz;                  /* deformation thread, 0: off */
+	int force_priority;    /* SCHED_FIFO priority of the force thread */
+	int cpu;               /* its CPU, -1 for any */
+	double deform_rate_hz; /* deformation thread, 0: off */
 	bool telemetry;
 
 	/* virtual coupling: automatic from the device, or given */
 	bool coupling_auto;
-	double coupling_k_n_per_m;              /* when !coupling_auto; 0,0 = rigid */
+	double coupling_k_n_per_m; /* when !coupling_auto; 0,0 = rigid */
 	double coupling_b_ns_per_m;
 	/* Coulomb friction on the proxy: static, dynamic; 0,0 frictionless */
 	double friction_mu[2];
@@ -83,9 +83,9 @@ struct irdm_board {
 	/* object placement (above) */
 	double object_offset_m[3];
 	double object_rotation_deg[3];
-	double object_rotation[9];              /* R, row-major; set by the loader */
+	double object_rotation[9]; /* R, row-major; set by the loader */
 
-	double calibration_pose_rad[IRDM_DEVICE_JOINTS];        /* encoders zeroed here */
+	double calibration_pose_rad[IRDM_DEVICE_JOINTS]; /* encoders zeroed here */
 };
 
 /* The defaults of every key, the .def of its entry in irdm_board_options()
@@ -115,7 +115,7 @@ int irdm_board_parse(struct irdm_board *b, const char *name, const char *text,
  */
 void irdm_board_read_begin(struct irdm_opt_file *f, struct irdm_board *b, const char *name);
 int irdm_board_read_line(struct irdm_opt_file *f, const char *s, size_t len, char *err,
-			  size_t errlen);
+			 size_t errlen);
 
 /*
  * After every line: required keys, the keys checked against each other, and

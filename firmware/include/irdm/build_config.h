@@ -11,16 +11,16 @@
 #define IRDM_BUILD_CONFIG_H
 
 #ifndef IRDM_CONFIG_FIR
-#define IRDM_CONFIG_FIR 1       /* FIR (time-domain) images: engine_fir.c */
+#define IRDM_CONFIG_FIR 1 /* FIR (time-domain) images: engine_fir.c */
 #endif
 #ifndef IRDM_CONFIG_MODAL
-#define IRDM_CONFIG_MODAL 1     /* modal images: engine_modal.c */
+#define IRDM_CONFIG_MODAL 1 /* modal images: engine_modal.c */
 #endif
 #ifndef IRDM_CONFIG_FLOATING
-#define IRDM_CONFIG_FLOATING 1  /* floating objects: engine/floating.c, rigid/ */
+#define IRDM_CONFIG_FLOATING 1 /* floating objects: engine/floating.c, rigid/ */
 #endif
 #ifndef IRDM_CONFIG_DEFORM
-#define IRDM_CONFIG_DEFORM 1    /* the displayed surface: deform/, session_deform.c */
+#define IRDM_CONFIG_DEFORM 1 /* the displayed surface: deform/, session_deform.c */
 #endif
 
 #endif /* IRDM_BUILD_CONFIG_H */

@@ -24,8 +24,8 @@
 #include "irdm/error.h"
 #include "irdm/image.h"
 
-#define IRDM_CONTACT_STACK 64           /* > IRDM_BVH_MAX_DEPTH */
-#define IRDM_CONTACT_MAX_WALK 64        /* upper limit of max_walk */
+#define IRDM_CONTACT_STACK 64    /* > IRDM_BVH_MAX_DEPTH */
+#define IRDM_CONTACT_MAX_WALK 64 /* upper limit of max_walk */
 
 /*
  * Where a contact acts, as the force engine takes it (irdm/engine.h): on a
@@ -33,12 +33,12 @@
  * here, or by irdm_engine_site_node() / irdm_engine_site_point().
  */
 struct irdm_contact_site {
-	uint32_t n_nodes;               /* 1 (node) or 3 (triangle) */
-	uint32_t col[3];                /* column index of each node, or UINT32_MAX if fixed */
-	uint32_t row[3];                /* image node (row) index of each node */
-	double weight[3];               /* barycentric, sum 1 */
-	double rest_m[3];               /* rest position of the contact point */
-	double normal[3];               /* outward unit normal at the point */
+	uint32_t n_nodes; /* 1 (node) or 3 (triangle) */
+	uint32_t col[3];  /* column index of each node, or UINT32_MAX if fixed */
+	uint32_t row[3];  /* image node (row) index of each node */
+	double weight[3]; /* barycentric, sum 1 */
+	double rest_m[3]; /* rest position of the contact point */
+	double normal[3]; /* outward unit normal at the point */
 };
 
 /* Views of a validated image's CONTACT_BVH (set up once, read only). */
@@ -46,12 +46,12 @@ struct irdm_contact_mesh {
 	const struct irdm_image *img;
 	const struct irdm_bvh_header *hdr;
 	const struct irdm_bvh_node *nodes;
-	const uint32_t *index;          /* contactable triangles, by leaf */
-	const uint32_t *adj;            /* [n_surface_tris][3] */
-	const uint32_t *col_of_row;     /* [n_rows] */
-	const uint32_t *tris;           /* SURFACE */
-	const struct irdm_node *rest;   /* NODES */
-	uint32_t n_tris;                /* SURFACE triangles */
+	const uint32_t *index;        /* contactable triangles, by leaf */
+	const uint32_t *adj;          /* [n_surface_tris][3] */
+	const uint32_t *col_of_row;   /* [n_rows] */
+	const uint32_t *tris;         /* SURFACE */
+	const struct irdm_node *rest; /* NODES */
+	uint32_t n_tris;              /* SURFACE triangles */
 	uint32_t n_rows;
 	/* [n_tris][3]: the SURFACE triangle beyond each edge of a touchable
 	 * triangle, touchable or not (adj knows only touchable ones), or
@@ -74,11 +74,11 @@ struct irdm_contact_disp {
 
 /* Result of a closest point query. */
 struct irdm_contact_hit {
-	uint32_t tri;                   /* SURFACE triangle */
-	double bary[3];                 /* weights of its vertices v0, v1, v2; sum 1 */
-	double point_m[3];              /* closest point on the displaced surface */
-	double normal[3];               /* outward unit normal of the displaced triangle */
-	double dist_m;                  /* signed distance of the query point:
+	uint32_t tri;      /* SURFACE triangle */
+	double bary[3];    /* weights of its vertices v0, v1, v2; sum 1 */
+	double point_m[3]; /* closest point on the displaced surface */
+	double normal[3];  /* outward unit normal of the displaced triangle */
+	double dist_m;     /* signed distance of the query point:
 					 * < 0 behind the triangle (inside) */
 };
 
@@ -145,9 +145,9 @@ int irdm_contact_closest(const struct irdm_contact_mesh *cm, const struct irdm_c
 /* ------------------------------------------------------------ god-object */
 
 struct irdm_proxy_config {
-	double radius_m;                /* detection radius of the closest point query */
-	double max_disp_m;              /* bound on |u| (see irdm_contact_closest) */
-	unsigned max_walk;              /* edge crossings per update, 1..IRDM_CONTACT_MAX_WALK */
+	double radius_m;   /* detection radius of the closest point query */
+	double max_disp_m; /* bound on |u| (see irdm_contact_closest) */
+	unsigned max_walk; /* edge crossings per update, 1..IRDM_CONTACT_MAX_WALK */
 	/* Coulomb friction: static and dynamic coefficients, 0 <= mu_d <=
 	 * mu_s; mu_s = 0: frictionless (the default) */
 	double mu_s, mu_d;
@@ -156,14 +156,14 @@ struct irdm_proxy_config {
 /* State of one proxy: zero it (or irdm_proxy_reset) to start inactive. */
 struct irdm_proxy {
 	bool active;
-	uint32_t tri;                   /* SURFACE triangle of the proxy */
+	uint32_t tri; /* SURFACE triangle of the proxy */
 	double bary[3];
 	/* outputs of the last update, valid while active */
-	double point_m[3];              /* proxy on the displaced surface */
-	double normal[3];               /* outward normal of its triangle */
-	double depth_m;                 /* signed distance of the device from that
+	double point_m[3]; /* proxy on the displaced surface */
+	double normal[3];  /* outward normal of its triangle */
+	double depth_m;    /* signed distance of the device from that
 					 * plane (<= 0 while in contact) */
-	unsigned steps;                 /* edge crossings taken by the last update */
+	unsigned steps;    /* edge crossings taken by the last update */
 	/* the force the coupling put on the object at the last update's
 	 * point, when the caller gave it (irdm_proxy_force()): friction's
 	 * cone is then judged on it */
@@ -172,10 +172,10 @@ struct irdm_proxy {
 };
 
 enum irdm_proxy_event {
-	IRDM_PROXY_FREE = 0,            /* no contact before or after */
-	IRDM_PROXY_TOUCH = 1,           /* contact began this update */
-	IRDM_PROXY_SLIDE = 2,           /* contact continues */
-	IRDM_PROXY_RELEASE = 3,         /* the device left the surface: contact ended */
+	IRDM_PROXY_FREE = 0,    /* no contact before or after */
+	IRDM_PROXY_TOUCH = 1,   /* contact began this update */
+	IRDM_PROXY_SLIDE = 2,   /* contact continues */
+	IRDM_PROXY_RELEASE = 3, /* the device left the surface: contact ended */
 };
 
 void irdm_proxy_config_default(struct irdm_proxy_config *cfg);

@@ -78,18 +78,18 @@
 #define IRDM_CTRL_COUNT_NAN INT32_MIN
 
 struct irdm_ctrl_device_config {
-	struct irdm_device_config dev;          /* the arm (irdm_device_config_check) */
-	double mount_offset_m[3];               /* its frame's origin in the shared device frame */
-	double calib_q_rad[3];                  /* the known pose it is calibrated at */
+	struct irdm_device_config dev; /* the arm (irdm_device_config_check) */
+	double mount_offset_m[3];      /* its frame's origin in the shared device frame */
+	double calib_q_rad[3];         /* the known pose it is calibrated at */
 };
 
 struct irdm_ctrl_limits {
-	double max_force_n;                     /* |device force| clamp, > 0 */
-	double workspace_min_m[3];              /* tip box, each device's own frame */
+	double max_force_n;        /* |device force| clamp, > 0 */
+	double workspace_min_m[3]; /* tip box, each device's own frame */
 	double workspace_max_m[3];
-	double max_tip_speed_m_per_s;           /* > 0 */
-	unsigned overrun_fault_count;           /* K >= 1 consecutive overruns fault */
-	uint32_t watchdog_us;                   /* compute time that faults, > 0 */
+	double max_tip_speed_m_per_s; /* > 0 */
+	unsigned overrun_fault_count; /* K >= 1 consecutive overruns fault */
+	uint32_t watchdog_us;         /* compute time that faults, > 0 */
 };
 
 /*
@@ -112,80 +112,80 @@ struct irdm_ctrl_limits {
 #define IRDM_CTRL_ENGINE_FORCE_GUARD 4
 
 struct irdm_ctrl_config {
-	unsigned n_devices;                     /* 1..IRDM_CTRL_MAX_DEVICES; device i uses engine slot i */
+	unsigned n_devices; /* 1..IRDM_CTRL_MAX_DEVICES; device i uses engine slot i */
 	struct irdm_ctrl_device_config device[IRDM_CTRL_MAX_DEVICES];
-	double obj_rot[9];                      /* shared device frame -> object frame, row-major, proper rotation */
+	double obj_rot[9]; /* shared device frame -> object frame, row-major, proper rotation */
 	double obj_offset_m[3];
 	struct irdm_ctrl_limits limits;
-	uint32_t period_us;                     /* the tick period: must equal the image's dt */
+	uint32_t period_us; /* the tick period: must equal the image's dt */
 	/* the engine configuration the session was opened with (the caller
 	 * picks the coupling: coupling_k_n_per_m = 0 is rigid); the controller
 	 * checks max_contacts >= n_devices */
 	struct irdm_engine_config engine;
 	struct irdm_proxy_config proxy;
-	unsigned velocity_window;               /* adaptive windowing, 2..IRDM_VELOCITY_WINDOW_MAX */
+	unsigned velocity_window; /* adaptive windowing, 2..IRDM_VELOCITY_WINDOW_MAX */
 };
 
 /* Command word bits (struct irdm_ctrl_input.cmd), acted on in this order
  * after the faults of the tick: SHUTDOWN, CALIBRATE, RESET, DISABLE, ENABLE. */
 enum irdm_ctrl_cmd {
-	IRDM_CTRL_CMD_ENABLE = 1u << 0,         /* READY -> ENABLED */
-	IRDM_CTRL_CMD_DISABLE = 1u << 1,        /* ENABLED -> READY */
-	IRDM_CTRL_CMD_RESET = 1u << 2,          /* FAULT -> READY once the causes are gone */
-	IRDM_CTRL_CMD_SHUTDOWN = 1u << 3,       /* -> OFF */
-	IRDM_CTRL_CMD_SIGNAL = 1u << 4,         /* a signal asked the process to end: fault SIGNAL */
-	IRDM_CTRL_CMD_CALIBRATE = 1u << 5,      /* INIT -> READY: the device is at its calibration pose */
+	IRDM_CTRL_CMD_ENABLE = 1u << 0,    /* READY -> ENABLED */
+	IRDM_CTRL_CMD_DISABLE = 1u << 1,   /* ENABLED -> READY */
+	IRDM_CTRL_CMD_RESET = 1u << 2,     /* FAULT -> READY once the causes are gone */
+	IRDM_CTRL_CMD_SHUTDOWN = 1u << 3,  /* -> OFF */
+	IRDM_CTRL_CMD_SIGNAL = 1u << 4,    /* a signal asked the process to end: fault SIGNAL */
+	IRDM_CTRL_CMD_CALIBRATE = 1u << 5, /* INIT -> READY: the device is at its calibration pose */
 	/* set by the loop from the HAL's return codes */
-	IRDM_CTRL_CMD_HAL_READ_FAILED = 1u << 6,        /* this tick's read failed: counts unusable */
-	IRDM_CTRL_CMD_HAL_WRITE_FAILED = 1u << 7,       /* the last write failed */
-	IRDM_CTRL_CMD_HAL_FAULT = 1u << 8,              /* poll reported a latched fault */
+	IRDM_CTRL_CMD_HAL_READ_FAILED = 1u << 6,  /* this tick's read failed: counts unusable */
+	IRDM_CTRL_CMD_HAL_WRITE_FAILED = 1u << 7, /* the last write failed */
+	IRDM_CTRL_CMD_HAL_FAULT = 1u << 8,        /* poll reported a latched fault */
 };
 
 struct irdm_ctrl_input {
-	int32_t counts[IRDM_CTRL_MAX_DEVICES][3];       /* raw encoder counts */
-	uint64_t prev_latency_ns;                       /* previous tick's wake-up latency */
-	uint64_t prev_compute_ns;                       /* previous tick's compute time */
-	uint32_t cmd;                                   /* enum irdm_ctrl_cmd bits */
+	int32_t counts[IRDM_CTRL_MAX_DEVICES][3]; /* raw encoder counts */
+	uint64_t prev_latency_ns;                 /* previous tick's wake-up latency */
+	uint64_t prev_compute_ns;                 /* previous tick's compute time */
+	uint32_t cmd;                             /* enum irdm_ctrl_cmd bits */
 };
 
 /* Per device, everything the telemetry record needs. */
 struct irdm_ctrl_device_output {
-	double torque_nm[3];            /* commanded: ZERO unless ENABLED */
-	double q_rad[3];                /* joint angles (calibrated) */
-	double tip_m[3];                /* tip, own device frame */
-	double tip_obj_m[3];            /* tip, object frame */
-	double vel_m_per_s[3];          /* tip velocity, own device frame */
+	double torque_nm[3];   /* commanded: ZERO unless ENABLED */
+	double q_rad[3];       /* joint angles (calibrated) */
+	double tip_m[3];       /* tip, own device frame */
+	double tip_obj_m[3];   /* tip, object frame */
+	double vel_m_per_s[3]; /* tip velocity, own device frame */
 	double speed_m_per_s;
-	double force_obj_n[3];          /* engine force on the object, object frame */
-	double force_n[3];              /* force rendered on the tip, device frame, after the clamp */
-	double scale;                   /* force clamp x torque saturation (1: none) */
-	int proxy_event;                /* enum irdm_proxy_event of this tick */
-	bool softened;                  /* the contact began softly this tick
+	double force_obj_n[3]; /* engine force on the object, object frame */
+	double force_n[3];     /* force rendered on the tip, device frame, after the clamp */
+	double scale;          /* force clamp x torque saturation (1: none) */
+	int proxy_event;       /* enum irdm_proxy_event of this tick */
+	bool softened;         /* the contact began softly this tick
 					 * (irdm_engine_contact_soften()) */
-	bool contact;                   /* the engine's contact is on after the tick */
+	bool contact;          /* the engine's contact is on after the tick */
 	/*
 	 * The proxy runs on the object as it is now (a floating object in its
 	 * own, moved frame: irdm_engine_world_to_object()); its point and
 	 * normal come out in the object frame as tip_obj_m is (the world
 	 * frame, the object's at the start).
 	 */
-	uint32_t tri;                   /* proxy: SURFACE triangle, barycentrics, point */
+	uint32_t tri; /* proxy: SURFACE triangle, barycentrics, point */
 	double bary[3];
-	double proxy_m[3];              /* object frame */
+	double proxy_m[3]; /* object frame */
 	double normal[3];
-	double depth_m;                 /* <= 0 in contact */
-	double target_m[3];             /* the engine's command (p_obj - site rest point) */
+	double depth_m;     /* <= 0 in contact */
+	double target_m[3]; /* the engine's command (p_obj - site rest point) */
 };
 
 struct irdm_ctrl_output {
-	uint64_t tick;                  /* ticks run, this one included */
-	int state;                      /* enum irdm_safety_state after the tick */
-	uint32_t faults;                /* latched fatal bits | CLAMP of this tick */
-	uint32_t new_faults;            /* raised this tick */
-	uint32_t cause;                 /* the bit that entered FAULT (0 if none) */
-	bool overrun;                   /* the previous tick overran */
-	bool held;                      /* the torque is the previous tick's (overrun policy) */
-	unsigned overrun_run;           /* consecutive overruns so far */
+	uint64_t tick;        /* ticks run, this one included */
+	int state;            /* enum irdm_safety_state after the tick */
+	uint32_t faults;      /* latched fatal bits | CLAMP of this tick */
+	uint32_t new_faults;  /* raised this tick */
+	uint32_t cause;       /* the bit that entered FAULT (0 if none) */
+	bool overrun;         /* the previous tick overran */
+	bool held;            /* the torque is the previous tick's (overrun policy) */
+	unsigned overrun_run; /* consecutive overruns so far */
 	unsigned n_devices;
 	struct irdm_ctrl_device_output dev[IRDM_CTRL_MAX_DEVICES];
 };
@@ -195,9 +195,9 @@ struct irdm_ctrl_dev {
 	int32_t count_offset[3];
 	struct irdm_velocity vel[3];
 	struct irdm_proxy px;
-	double rot_t[9];                /* R^T, for forces */
-	double tau_last_nm[3];          /* the last torque commanded (the safe one to hold) */
-	bool pose_ok;                   /* this tick's q, tip, velocity are valid */
+	double rot_t[9];       /* R^T, for forces */
+	double tau_last_nm[3]; /* the last torque commanded (the safe one to hold) */
+	bool pose_ok;          /* this tick's q, tip, velocity are valid */
 	struct irdm_contact_cmd cmd;
 };
 
@@ -210,8 +210,8 @@ struct irdm_ctrl_dev {
  */
 #define IRDM_CTRL_DISP_CACHE 1024
 struct irdm_ctrl_disp_cache {
-	uint64_t stamp;                         /* this tick's; 0 is never valid */
-	uint64_t filled[IRDM_CTRL_DISP_CACHE];  /* the stamp a slot holds */
+	uint64_t stamp;                        /* this tick's; 0 is never valid */
+	uint64_t filled[IRDM_CTRL_DISP_CACHE]; /* the stamp a slot holds */
 	uint32_t row[IRDM_CTRL_DISP_CACHE];
 	double u_m[IRDM_CTRL_DISP_CACHE][3];
 };
@@ -225,9 +225,9 @@ struct irdm_ctrl {
 	struct irdm_ctrl_dev dev[IRDM_CTRL_MAX_DEVICES];
 	uint64_t tick;
 	unsigned overrun_run;
-	uint64_t overruns;              /* total */
-	uint64_t longest_ns;            /* longest latency + compute seen */
-	uint32_t active;                /* fault conditions that hold this tick */
+	uint64_t overruns;   /* total */
+	uint64_t longest_ns; /* longest latency + compute seen */
+	uint32_t active;     /* fault conditions that hold this tick */
 	struct irdm_ctrl_disp_cache disp;
 };
 

@@ -26,7 +26,7 @@
  * deform_rate_hz; the worker: irdm/posix/deform_worker.h). */
 #define IRDM_DEFORM_MAX_RATE_HZ 10000.0
 
-struct irdm_deform;   /* opaque, in caller memory */
+struct irdm_deform; /* opaque, in caller memory */
 
 /*
  * Bytes irdm_deform_init() needs for this image: three snapshots of its

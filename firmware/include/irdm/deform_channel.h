@@ -27,21 +27,21 @@
 struct deform_snap {
 	uint64_t tick;
 	struct irdm_pose pose;
-	uint32_t n_hist;                    /* FIR: ticks held, newest first */
-	struct irdm_force_tick f;           /* modal: this tick's forces */
+	uint32_t n_hist;          /* FIR: ticks held, newest first */
+	struct irdm_force_tick f; /* modal: this tick's forces */
 };
 
 struct irdm_deform {
 	const struct irdm_image *img;
 	uint32_t repr;
-	uint32_t n_modes, T;                /* modal: n_modes; FIR: T */
+	uint32_t n_modes, T; /* modal: n_modes; FIR: T */
 	size_t slot_bytes, payload_off;
 	unsigned char *slot[3];
 
 	/* one cache line each, so the two sides do not share one */
 	_Alignas(DEFORM_ALIGN) _Atomic uint32_t mid;
-	_Alignas(DEFORM_ALIGN) uint32_t back;   /* writer's */
-	_Alignas(DEFORM_ALIGN) uint32_t front;  /* reader's */
+	_Alignas(DEFORM_ALIGN) uint32_t back;  /* writer's */
+	_Alignas(DEFORM_ALIGN) uint32_t front; /* reader's */
 };
 
 static inline size_t deform_align_up(size_t x)

@@ -56,25 +56,25 @@
 
 struct irdm_device_config {
 	/* kinematics */
-	double l1_m;                            /* upper arm: shoulder to elbow */
-	double l2_m;                            /* forearm: elbow to tip */
-	double base_offset_m[3];                /* shoulder in the device frame */
+	double l1_m;             /* upper arm: shoulder to elbow */
+	double l2_m;             /* forearm: elbow to tip */
+	double base_offset_m[3]; /* shoulder in the device frame */
 
 	/* encoders, per joint */
-	double counts_per_rev[IRDM_DEVICE_JOINTS];      /* per motor turn, > 0 */
-	double gear_ratio[IRDM_DEVICE_JOINTS];          /* motor turns per joint turn, > 0 */
-	double angle_offset_rad[IRDM_DEVICE_JOINTS];    /* angle at the start of count 0's cell */
-	int sign[IRDM_DEVICE_JOINTS];                   /* +1 or -1 */
-	int32_t count_min[IRDM_DEVICE_JOINTS];          /* valid counts: [min, max] */
+	double counts_per_rev[IRDM_DEVICE_JOINTS];   /* per motor turn, > 0 */
+	double gear_ratio[IRDM_DEVICE_JOINTS];       /* motor turns per joint turn, > 0 */
+	double angle_offset_rad[IRDM_DEVICE_JOINTS]; /* angle at the start of count 0's cell */
+	int sign[IRDM_DEVICE_JOINTS];                /* +1 or -1 */
+	int32_t count_min[IRDM_DEVICE_JOINTS];       /* valid counts: [min, max] */
 	int32_t count_max[IRDM_DEVICE_JOINTS];
 
 	/* actuation */
-	double torque_limit_nm[IRDM_DEVICE_JOINTS];     /* joint side, > 0 */
+	double torque_limit_nm[IRDM_DEVICE_JOINTS]; /* joint side, > 0 */
 
 	/* mass (see the comment above for the three bodies) */
 	double mass_kg[3];
 	double com_m[3];
-	double gravity_m_per_s2;                /* along -y; >= 0 */
+	double gravity_m_per_s2; /* along -y; >= 0 */
 
 	/* the device as the engine's coupling sees it (irdm_engine_config_haptic) */
 	double max_force_n;
@@ -90,21 +90,21 @@ struct irdm_device_config {
  */
 #define IRDM_DEVICE_DEFAULT_L1_M 0.135
 #define IRDM_DEVICE_DEFAULT_L2_M 0.135
-#define IRDM_DEVICE_DEFAULT_BASE_OFFSET_M 0,0.135,-0.135        /* home-pose tip at 0 */
+#define IRDM_DEVICE_DEFAULT_BASE_OFFSET_M 0, 0.135, -0.135 /* home-pose tip at 0 */
 /* 4000 counts per motor turn (1000 lines, quadrature) through 11.6:1:
  * 1.35e-4 rad, 18 um at the tip per count. */
-#define IRDM_DEVICE_DEFAULT_COUNTS_PER_REV 4000,4000,4000
-#define IRDM_DEVICE_DEFAULT_GEAR_RATIO 11.6,11.6,11.6
-#define IRDM_DEVICE_DEFAULT_ANGLE_OFFSET_RAD 0,0,0
-#define IRDM_DEVICE_DEFAULT_SIGN 1,1,-1         /* the third motor turns against its joint */
+#define IRDM_DEVICE_DEFAULT_COUNTS_PER_REV 4000, 4000, 4000
+#define IRDM_DEVICE_DEFAULT_GEAR_RATIO 11.6, 11.6, 11.6
+#define IRDM_DEVICE_DEFAULT_ANGLE_OFFSET_RAD 0, 0, 0
+#define IRDM_DEVICE_DEFAULT_SIGN 1, 1, -1 /* the third motor turns against its joint */
 /* The counts of the joint ranges -0.42..0.42, -0.40..0.40 and -0.35..0.45
  * rad (tests/test_device.c derives them from those angles). */
-#define IRDM_DEVICE_DEFAULT_COUNT_MIN -3102,-2954,-3324
-#define IRDM_DEVICE_DEFAULT_COUNT_MAX 3101,2953,2584
+#define IRDM_DEVICE_DEFAULT_COUNT_MIN -3102, -2954, -3324
+#define IRDM_DEVICE_DEFAULT_COUNT_MAX 3101, 2953, 2584
 /* 7.9 N along any axis at the home pose: 7.9 N * 0.135 m */
-#define IRDM_DEVICE_DEFAULT_TORQUE_LIMIT_NM 1.07,1.07,1.07
-#define IRDM_DEVICE_DEFAULT_MASS_KG 0.06,0.045,0.09
-#define IRDM_DEVICE_DEFAULT_COM_M 0.065,0.08,-0.03
+#define IRDM_DEVICE_DEFAULT_TORQUE_LIMIT_NM 1.07, 1.07, 1.07
+#define IRDM_DEVICE_DEFAULT_MASS_KG 0.06, 0.045, 0.09
+#define IRDM_DEVICE_DEFAULT_COM_M 0.065, 0.08, -0.03
 #define IRDM_DEVICE_DEFAULT_GRAVITY_M_PER_S2 9.81
 #define IRDM_DEVICE_DEFAULT_MAX_FORCE_N 7.9
 #define IRDM_DEVICE_DEFAULT_K_MAX_N_PER_M 1000

@@ -23,24 +23,24 @@
 #include <stddef.h>
 #include <stdint.h>
 
-#include "irdm/contact.h"    /* struct irdm_contact_site */
+#include "irdm/contact.h" /* struct irdm_contact_site */
 #include "irdm/error.h"
 #include "irdm/image.h"
-#include "irdm/limits.h"     /* IRDM_MAX_CONTACTS */
+#include "irdm/limits.h" /* IRDM_MAX_CONTACTS */
 
 enum irdm_solve_mode {
-	IRDM_SOLVE_COUPLED = 0,     /* all contact points in one system (default) */
-	IRDM_SOLVE_PER_VERTEX = 1,  /* the paper's eq. 10-11, each contact alone */
+	IRDM_SOLVE_COUPLED = 0,    /* all contact points in one system (default) */
+	IRDM_SOLVE_PER_VERTEX = 1, /* the paper's eq. 10-11, each contact alone */
 };
 
 enum irdm_contact_mode {
 	IRDM_CONTACT_OFF = 0,
-	IRDM_CONTACT_PUSH = 1,      /* unilateral: released when the object would pull */
-	IRDM_CONTACT_GRAB = 2,      /* bilateral: held until released */
+	IRDM_CONTACT_PUSH = 1, /* unilateral: released when the object would pull */
+	IRDM_CONTACT_GRAB = 2, /* bilateral: held until released */
 };
 
 struct irdm_engine_config {
-	unsigned max_contacts;          /* 1..IRDM_MAX_CONTACTS */
+	unsigned max_contacts; /* 1..IRDM_MAX_CONTACTS */
 	enum irdm_solve_mode solve;
 	/*
 	 * Virtual coupling between the target (device) and the contact point:
@@ -66,12 +66,12 @@ struct irdm_engine_config {
 	 * and runs undamped.  0 = IRDM_ENGINE_STABLE_RADIUS.
 	 */
 	double stable_radius;
-	double max_force_n;             /* > 0: a larger force faults the engine (torque off) */
+	double max_force_n; /* > 0: a larger force faults the engine (torque off) */
 	/* sum an FIR history, or a hybrid image's head, with the portable
 	 * code even on a processor with AVX2 and FMA (the two agree to
 	 * rounding; tests compare them) */
 	bool fir_portable_sum;
-	unsigned publish_every;         /* deformation snapshot every N ticks (0: never) */
+	unsigned publish_every; /* deformation snapshot every N ticks (0: never) */
 	/*
 	 * A contact begun with irdm_engine_contact_soften() (the tool already
 	 * inside the object: out of a fault, at enable) starts at zero force
@@ -99,32 +99,32 @@ struct irdm_contact_cmd {
 };
 
 struct irdm_contact_state {
-	enum irdm_contact_mode mode;    /* OFF after a push released */
+	enum irdm_contact_mode mode; /* OFF after a push released */
 	struct irdm_contact_site site;
-	double force_n[3];              /* on the object this tick */
-	double disp_m[3];               /* contact point displacement u[t] */
+	double force_n[3]; /* on the object this tick */
+	double disp_m[3];  /* contact point displacement u[t] */
 	double target_prev_m[3];
 	double disp_prev_m[3];
-	double port_energy_j;           /* passivity observer: work done on the object */
-	double port_disp_prev_m[3];     /* the observer's last displacement: before
+	double port_energy_j;       /* passivity observer: work done on the object */
+	double port_disp_prev_m[3]; /* the observer's last displacement: before
 					 * its controller's force, like this tick's */
-	double pc_damping_ns_per_m;     /* passivity controller's damping this tick */
-	uint32_t fresh;                 /* began since the last tick */
+	double pc_damping_ns_per_m; /* passivity controller's damping this tick */
+	uint32_t fresh;             /* began since the last tick */
 	/* soft engagement (irdm_engine_contact_soften()): the coupling's
 	 * anchor is target - offset * w, w falling from 1 to 0 over the fade */
-	uint32_t engage_ticks;          /* the fade's length in ticks (0: none) */
-	uint32_t engage_done;           /* ticks of it gone */
-	double engage_offset_m[3];      /* target - free displacement at its start */
+	uint32_t engage_ticks;     /* the fade's length in ticks (0: none) */
+	uint32_t engage_done;      /* ticks of it gone */
+	double engage_offset_m[3]; /* target - free displacement at its start */
 };
 
 struct irdm_engine_stats {
 	uint64_t ticks;
-	uint64_t releases;              /* push contacts released */
-	uint64_t singular_solves;       /* regularised coupled systems */
-	uint64_t pc_activations;        /* passivity controller added damping */
+	uint64_t releases;        /* push contacts released */
+	uint64_t singular_solves; /* regularised coupled systems */
+	uint64_t pc_activations;  /* passivity controller added damping */
 };
 
-struct irdm_engine;   /* opaque; lives in the caller's memory */
+struct irdm_engine; /* opaque; lives in the caller's memory */
 
 /* Bytes irdm_engine_init() needs (0 on invalid configuration). */
 size_t irdm_engine_mem_size(const struct irdm_image *img, const struct irdm_engine_config *cfg);

@@ -16,49 +16,49 @@
 #include "irdm/precision.h"
 
 enum irdm_image_map_flags {
-	IRDM_IMAGE_MAP_LOCK = 1u << 0,  /* mlock the mapping; fail if that is refused */
+	IRDM_IMAGE_MAP_LOCK = 1u << 0, /* mlock the mapping; fail if that is refused */
 };
 
 /* Typed views into a validated image.  Pointers point into the mapping. */
 struct irdm_image {
-	const uint8_t *base;                /* mapping (or caller's buffer) */
+	const uint8_t *base; /* mapping (or caller's buffer) */
 	size_t size;
-	bool mapped;                        /* base came from mmap */
-	bool locked;                        /* mlock succeeded */
+	bool mapped; /* base came from mmap */
+	bool locked; /* mlock succeeded */
 	const struct irdm_meta *meta;
-	const char *provenance;             /* not NUL-terminated: provenance_len bytes */
+	const char *provenance; /* not NUL-terminated: provenance_len bytes */
 	size_t provenance_len;
-	const struct irdm_node *nodes;      /* meta->n_nodes */
-	const uint32_t *columns;            /* meta->n_cols */
-	const uint32_t *tris;               /* 3 * meta->n_tris */
-	const void *fir;                    /* FIR: n_cols*n_nodes*T*9 of precision */
-	const struct irdm_mode *modes;      /* modal: n_modes */
-	const void *mode_shapes;            /* modal: n_nodes*3*n_modes of precision */
+	const struct irdm_node *nodes; /* meta->n_nodes */
+	const uint32_t *columns;       /* meta->n_cols */
+	const uint32_t *tris;          /* 3 * meta->n_tris */
+	const void *fir;               /* FIR: n_cols*n_nodes*T*9 of precision */
+	const struct irdm_mode *modes; /* modal: n_modes */
+	const void *mode_shapes;       /* modal: n_nodes*3*n_modes of precision */
 	/* modal, optional (all NULL if absent): the static correction's kept
 	 * 3x3 blocks; column c's are k in [corr_start[c], corr_start[c+1]),
 	 * block k displaces column corr_rows[k] (increasing; c always there) */
-	const uint32_t *corr_start;         /* n_cols + 1 */
-	const uint32_t *corr_rows;          /* corr_start[n_cols] */
-	const void *corr_blocks;            /* corr_start[n_cols] x 9 of precision */
+	const uint32_t *corr_start; /* n_cols + 1 */
+	const uint32_t *corr_rows;  /* corr_start[n_cols] */
+	const void *corr_blocks;    /* corr_start[n_cols] x 9 of precision */
 	/* optional far field of the correction (STATIC_CORR_LOWRANK; rank 0
 	 * and NULL if absent): every block gets U[c'] diag(lambda) U[c]^T */
 	uint32_t corr_rank;
-	const void *corr_lambda;            /* corr_rank of precision */
-	const void *corr_u;                 /* 3 n_cols x corr_rank of precision */
+	const void *corr_lambda; /* corr_rank of precision */
+	const void *corr_u;      /* 3 n_cols x corr_rank of precision */
 	/* optional block low-rank correction (STATIC_CORR_CLUSTERS; all NULL
 	 * if absent): every block adds its pair's value (image_format.h) */
 	const struct irdm_corr_clusters_header *corr_clusters;
-	const uint32_t *corr_cl_start;      /* n_clusters + 1 */
-	const uint32_t *corr_cl_members;    /* n_cols */
-	const uint32_t *corr_cl_pos;        /* n_cols */
+	const uint32_t *corr_cl_start;              /* n_clusters + 1 */
+	const uint32_t *corr_cl_members;            /* n_cols */
+	const uint32_t *corr_cl_pos;                /* n_cols */
 	const struct irdm_corr_pair *corr_cl_pairs; /* n_clusters (n_clusters + 1) / 2 */
-	const void *corr_cl_values;         /* n_values of precision */
+	const void *corr_cl_values;                 /* n_values of precision */
 	/* modal, optional (NULL if absent): the dropped modes' response over
 	 * meta->head_samples samples for each kept block k, [k][s][3][3] of
 	 * precision (exact over the first half, tapered over the second); its
 	 * samples sum to block k of corr_blocks */
 	const void *exact_head;
-	const struct irdm_rigid *rigid;     /* floating only, else NULL */
+	const struct irdm_rigid *rigid;         /* floating only, else NULL */
 	const struct irdm_stability *stability; /* n_cols */
 	/* optional CONTACT_BVH (NULL if absent): validated header, payload bytes */
 	const struct irdm_bvh_header *contact_bvh;

@@ -8,7 +8,7 @@
 #define IRDM_LIMITS_H
 
 #define IRDM_MAX_CONTACTS 4
-#define IRDM_MAX_FORCE_NODES (3 * IRDM_MAX_CONTACTS)  /* a contact spreads over <= 3 nodes */
+#define IRDM_MAX_FORCE_NODES (3 * IRDM_MAX_CONTACTS) /* a contact spreads over <= 3 nodes */
 /*
  * Largest contact target the engine takes (metres, per axis).  A device
  * reports positions within a metre or two; a target of 1e300 m is a broken

@@ -18,21 +18,21 @@
 #include <stdint.h>
 
 enum irdm_opt_type {
-	IRDM_OPT_DOUBLE,        /* finite double */
-	IRDM_OPT_UNSIGNED,      /* decimal digits only; stored in 1, 2, 4 or 8 bytes */
-	IRDM_OPT_INT,           /* optional sign, decimal digits; 1, 2, 4 or 8 bytes */
-	IRDM_OPT_BOOL,          /* yes/true/on/1 or no/false/off/0, into a bool */
-	IRDM_OPT_ENUM,          /* one of .names, its value into an int-sized field */
-	IRDM_OPT_STRING,        /* copied into char[size]; size 0: the pointer is stored */
-	IRDM_OPT_FLAG,          /* arguments only: "--key" with no value sets a bool */
-	IRDM_OPT_CUSTOM,        /* .parse does it all (composite syntax) */
+	IRDM_OPT_DOUBLE,   /* finite double */
+	IRDM_OPT_UNSIGNED, /* decimal digits only; stored in 1, 2, 4 or 8 bytes */
+	IRDM_OPT_INT,      /* optional sign, decimal digits; 1, 2, 4 or 8 bytes */
+	IRDM_OPT_BOOL,     /* yes/true/on/1 or no/false/off/0, into a bool */
+	IRDM_OPT_ENUM,     /* one of .names, its value into an int-sized field */
+	IRDM_OPT_STRING,   /* copied into char[size]; size 0: the pointer is stored */
+	IRDM_OPT_FLAG,     /* arguments only: "--key" with no value sets a bool */
+	IRDM_OPT_CUSTOM,   /* .parse does it all (composite syntax) */
 };
 
 /* Range flags: which of .min and .max apply, inclusive or not. */
-#define IRDM_OPT_GE 0x1u        /* value >= min */
-#define IRDM_OPT_GT 0x2u        /* value >  min */
-#define IRDM_OPT_LE 0x4u        /* value <= max */
-#define IRDM_OPT_LT 0x8u        /* value <  max */
+#define IRDM_OPT_GE 0x1u /* value >= min */
+#define IRDM_OPT_GT 0x2u /* value >  min */
+#define IRDM_OPT_LE 0x4u /* value <= max */
+#define IRDM_OPT_LT 0x8u /* value <  max */
 
 struct irdm_opt_name {
 	const char *name;
@@ -46,15 +46,15 @@ struct irdm_opt;
  * can say more than "expected <metavar>", a reason in why.
  */
 typedef int (*irdm_opt_parse_fn)(const struct irdm_opt *o, void *obj, const char *value,
-				  char *why, size_t whylen);
+				 char *why, size_t whylen);
 
 struct irdm_opt {
-	const char *name;       /* "dt": the file key, and "--dt" */
-	char short_name;        /* 'o' for "-o", or 0 */
+	const char *name; /* "dt": the file key, and "--dt" */
+	char short_name;  /* 'o' for "-o", or 0 */
 	enum irdm_opt_type type;
-	const char *metavar;    /* the value's syntax for help: "SECONDS", "yes | no" */
-	const char *unit;       /* "s", "Pa" or NULL */
-	const char *help;       /* one line, without the default */
+	const char *metavar; /* the value's syntax for help: "SECONDS", "yes | no" */
+	const char *unit;    /* "s", "Pa" or NULL */
+	const char *help;    /* one line, without the default */
 	/*
 	 * The value a key not given takes, written as in a file and parsed by
 	 * the entry itself: help and docs print it as "(default X)" ("" prints
@@ -62,12 +62,12 @@ struct irdm_opt {
 	 * set otherwise).
 	 */
 	const char *def;
-	size_t offset;          /* where the value goes in the caller's struct */
-	size_t size;            /* of that field (IRDM_OPT_FIELD) */
-	unsigned range;         /* IRDM_OPT_GE | IRDM_OPT_LT ... */
+	size_t offset;  /* where the value goes in the caller's struct */
+	size_t size;    /* of that field (IRDM_OPT_FIELD) */
+	unsigned range; /* IRDM_OPT_GE | IRDM_OPT_LT ... */
 	double min, max;
-	const struct irdm_opt_name *names;      /* ENUM: ends with a NULL name */
-	irdm_opt_parse_fn parse;                /* CUSTOM */
+	const struct irdm_opt_name *names; /* ENUM: ends with a NULL name */
+	irdm_opt_parse_fn parse;           /* CUSTOM */
 };
 
 /* .offset and .size of a member, e.g. IRDM_OPT_FIELD(struct irdm_scene, dt_s). */
@@ -89,8 +89,8 @@ struct irdm_opt {
 #define IRDM_OPT_TEXT_REF(type, member) .offset = offsetof(type, member), .size = 0
 
 struct irdm_opt_table {
-	const char *what;       /* "scene key": "unknown scene key 'x'" */
-	const char *see;        /* "irdm precompute --help", appended to unknown-key messages, or NULL */
+	const char *what; /* "scene key": "unknown scene key 'x'" */
+	const char *see;  /* "irdm precompute --help", appended to unknown-key messages, or NULL */
 	const struct irdm_opt *opts;
 	size_t n_opts;
 };
@@ -153,10 +153,10 @@ char *irdm_opt_trim(char *s);
 struct irdm_opt_file {
 	const struct irdm_opt_table *table;
 	void *obj;
-	const char *name;       /* for messages: "board.cfg:12: ..." */
+	const char *name; /* for messages: "board.cfg:12: ..." */
 	unsigned line_no;
 	bool reject_duplicates;
-	uint64_t seen;          /* bit i: entry i was set; start at 0 */
+	uint64_t seen; /* bit i: entry i was set; start at 0 */
 	unsigned seen_line[64];
 };
 

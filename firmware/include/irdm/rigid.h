@@ -28,31 +28,31 @@
 #define IRDM_RIGID_H
 
 #include "irdm/error.h"
-#include "irdm/history.h"       /* struct irdm_pose */
-#include "irdm/image_format.h"  /* struct irdm_rigid (the image's section) */
+#include "irdm/history.h"      /* struct irdm_pose */
+#include "irdm/image_format.h" /* struct irdm_rigid (the image's section) */
 
 #define IRDM_RIGID_MAX_NEWTON 8 /* bound on the iterations of one step */
 
 struct irdm_rigid_params {
 	double mass_kg;
-	double inertia_body_kg_m2[9];           /* about the COM, body frame, row-major, SPD */
+	double inertia_body_kg_m2[9]; /* about the COM, body frame, row-major, SPD */
 };
 
 struct irdm_rigid_state {
-	double com_m[3];                        /* world position of the centre of mass */
-	double vel_m_s[3];                      /* world velocity of the centre of mass */
-	double q[4];                            /* w, x, y, z; body -> world, unit */
-	double omega_body_rad_s[3];             /* angular velocity, body frame */
+	double com_m[3];            /* world position of the centre of mass */
+	double vel_m_s[3];          /* world velocity of the centre of mass */
+	double q[4];                /* w, x, y, z; body -> world, unit */
+	double omega_body_rad_s[3]; /* angular velocity, body frame */
 };
 
 struct irdm_rigid_body {
 	double mass_kg;
-	double inertia_body_kg_m2[9];           /* symmetrised copy of the parameter */
-	double inv_inertia_body_per_kg_m2[9];   /* its inverse (symmetric) */
+	double inertia_body_kg_m2[9];         /* symmetrised copy of the parameter */
+	double inv_inertia_body_per_kg_m2[9]; /* its inverse (symmetric) */
 	struct irdm_rigid_state s;
-	double force_n[3];                      /* this tick's accumulated force, world */
-	double torque_n_m[3];                   /* and torque about the COM, world */
-	unsigned last_newton_iters;             /* of the last step (telemetry) */
+	double force_n[3];          /* this tick's accumulated force, world */
+	double torque_n_m[3];       /* and torque about the COM, world */
+	unsigned last_newton_iters; /* of the last step (telemetry) */
 };
 
 /* Mass and inertia of an image's rigid section (its com_m is the body origin). */

@@ -22,27 +22,27 @@
 #include "irdm/error.h"
 
 enum irdm_safety_state {
-	IRDM_SAFETY_INIT = 0,           /* not calibrated: torque off */
-	IRDM_SAFETY_READY = 1,          /* calibrated, torque off */
-	IRDM_SAFETY_ENABLED = 2,        /* torque on */
-	IRDM_SAFETY_FAULT = 3,          /* torque off until an explicit reset */
-	IRDM_SAFETY_OFF = 4,            /* shut down: torque off for good */
+	IRDM_SAFETY_INIT = 0,    /* not calibrated: torque off */
+	IRDM_SAFETY_READY = 1,   /* calibrated, torque off */
+	IRDM_SAFETY_ENABLED = 2, /* torque on */
+	IRDM_SAFETY_FAULT = 3,   /* torque off until an explicit reset */
+	IRDM_SAFETY_OFF = 4,     /* shut down: torque off for good */
 };
 
 /* Fault flags: a u32 bit set (bit numbers shared with the telemetry log). */
 enum irdm_safety_fault {
-	IRDM_FAULT_CLAMP = 1u << 0,             /* informational: force or torque clamped */
-	IRDM_FAULT_WORKSPACE = 1u << 1,         /* tip outside the workspace box */
-	IRDM_FAULT_VELOCITY = 1u << 2,          /* tip faster than the limit */
-	IRDM_FAULT_WATCHDOG = 1u << 3,          /* one tick computed longer than the watchdog */
-	IRDM_FAULT_OVERRUN = 1u << 4,           /* K consecutive overruns */
-	IRDM_FAULT_ENCODER_NAN = 1u << 5,       /* encoder not a number (or a non-finite pose) */
-	IRDM_FAULT_ENCODER_RANGE = 1u << 6,     /* encoder count outside its range */
-	IRDM_FAULT_SIGNAL = 1u << 7,            /* a signal asked the process to end */
-	IRDM_FAULT_HAL_READ = 1u << 8,          /* the HAL read failed */
-	IRDM_FAULT_HAL_WRITE = 1u << 9,         /* the HAL write failed */
-	IRDM_FAULT_HAL_FAULT = 1u << 10,        /* the HAL polled an asynchronous fault */
-	IRDM_FAULT_ENGINE = 1u << 11,           /* the force engine or the contact step failed */
+	IRDM_FAULT_CLAMP = 1u << 0,         /* informational: force or torque clamped */
+	IRDM_FAULT_WORKSPACE = 1u << 1,     /* tip outside the workspace box */
+	IRDM_FAULT_VELOCITY = 1u << 2,      /* tip faster than the limit */
+	IRDM_FAULT_WATCHDOG = 1u << 3,      /* one tick computed longer than the watchdog */
+	IRDM_FAULT_OVERRUN = 1u << 4,       /* K consecutive overruns */
+	IRDM_FAULT_ENCODER_NAN = 1u << 5,   /* encoder not a number (or a non-finite pose) */
+	IRDM_FAULT_ENCODER_RANGE = 1u << 6, /* encoder count outside its range */
+	IRDM_FAULT_SIGNAL = 1u << 7,        /* a signal asked the process to end */
+	IRDM_FAULT_HAL_READ = 1u << 8,      /* the HAL read failed */
+	IRDM_FAULT_HAL_WRITE = 1u << 9,     /* the HAL write failed */
+	IRDM_FAULT_HAL_FAULT = 1u << 10,    /* the HAL polled an asynchronous fault */
+	IRDM_FAULT_ENGINE = 1u << 11,       /* the force engine or the contact step failed */
 };
 
 #define IRDM_FAULT_BITS 12
@@ -53,9 +53,9 @@ enum irdm_safety_fault {
 struct irdm_safety {
 	enum irdm_safety_state state;
 	bool calibrated;
-	uint32_t faults;                /* latched fatal bits since the last reset */
-	uint32_t cause;                 /* the bit that entered FAULT (the reason to log) */
-	uint64_t n_faults;              /* entries into FAULT */
+	uint32_t faults;   /* latched fatal bits since the last reset */
+	uint32_t cause;    /* the bit that entered FAULT (the reason to log) */
+	uint64_t n_faults; /* entries into FAULT */
 };
 
 /* INIT, not calibrated, no fault. */

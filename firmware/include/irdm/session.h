@@ -47,17 +47,17 @@ struct irdm_session_config {
 
 /* Read-only for the caller; valid from open to close. */
 struct irdm_session {
-	const struct irdm_image *img;       /* the session's mapping, or the caller's image */
+	const struct irdm_image *img; /* the session's mapping, or the caller's image */
 	struct irdm_engine *eng;
-	struct irdm_deform *deform;         /* NULL unless config.deform */
-	struct irdm_deform_worker *worker;  /* NULL until irdm_session_deform_open() */
+	struct irdm_deform *deform;        /* NULL unless config.deform */
+	struct irdm_deform_worker *worker; /* NULL until irdm_session_deform_open() */
 	/* the image's contact surface with its face-beyond table, made at
 	 * open; cm.hdr NULL: the image has no CONTACT_BVH */
 	struct irdm_contact_mesh cm;
 
 	/* private */
 	struct irdm_image mapped;
-	void (*unmap)(struct irdm_image *img);      /* of mapped; NULL: borrowed image */
+	void (*unmap)(struct irdm_image *img); /* of mapped; NULL: borrowed image */
 	void *eng_mem, *deform_mem, *worker_mem, *contact_mem;
 };
 
@@ -105,7 +105,6 @@ int irdm_session_open_with(struct irdm_session **s, const char *path,
  * Return: IRDM_OK; IRDM_ENOMEM (err says which part) if allocation failed.
  */
 int irdm_session_part_mem(void **mem, size_t n, const char *part, char *err, size_t errlen);
-
 
 /* Free everything the session holds, and unmap what it mapped.  NULL is fine. */
 void irdm_session_close(struct irdm_session *s);

@@ -34,7 +34,7 @@
 /* ---- the per-tick record ---- */
 
 #define IRDM_TELEM_MAX_DEVICES 2
-#define IRDM_TELEM_NO_TRI UINT32_MAX    /* contact_tri when no proxy is active */
+#define IRDM_TELEM_NO_TRI UINT32_MAX /* contact_tri when no proxy is active */
 
 /*
  * Controller states as stored in irdm_tick_record.state.  The controller
@@ -57,18 +57,18 @@ enum irdm_telem_state {
  * changes meaning; new reasons take new bits.
  */
 enum irdm_telem_fault {
-	IRDM_TELEM_FAULT_CLAMP = 1u << 0,          /* torque clamped to the board's limit */
-	IRDM_TELEM_FAULT_WORKSPACE = 1u << 1,      /* tip outside the workspace limits */
-	IRDM_TELEM_FAULT_VELOCITY = 1u << 2,       /* tip speed over the velocity limit */
-	IRDM_TELEM_FAULT_WATCHDOG = 1u << 3,       /* a tick came too late (watchdog) */
-	IRDM_TELEM_FAULT_OVERRUN = 1u << 4,        /* compute overran the period */
-	IRDM_TELEM_FAULT_ENCODER_NAN = 1u << 5,    /* NaN/Inf joint angle or velocity */
-	IRDM_TELEM_FAULT_ENCODER_RANGE = 1u << 6,  /* encoder value out of range */
-	IRDM_TELEM_FAULT_SIGNAL = 1u << 7,         /* SIGINT/SIGTERM */
-	IRDM_TELEM_FAULT_HAL_READ = 1u << 8,       /* the HAL could not read joint state */
-	IRDM_TELEM_FAULT_HAL_WRITE = 1u << 9,      /* the HAL could not write torques */
-	IRDM_TELEM_FAULT_HAL_FAULT = 1u << 10,     /* the HAL's poll reported a fault */
-	IRDM_TELEM_FAULT_ENGINE = 1u << 11,        /* the force engine returned an error */
+	IRDM_TELEM_FAULT_CLAMP = 1u << 0,         /* torque clamped to the board's limit */
+	IRDM_TELEM_FAULT_WORKSPACE = 1u << 1,     /* tip outside the workspace limits */
+	IRDM_TELEM_FAULT_VELOCITY = 1u << 2,      /* tip speed over the velocity limit */
+	IRDM_TELEM_FAULT_WATCHDOG = 1u << 3,      /* a tick came too late (watchdog) */
+	IRDM_TELEM_FAULT_OVERRUN = 1u << 4,       /* compute overran the period */
+	IRDM_TELEM_FAULT_ENCODER_NAN = 1u << 5,   /* NaN/Inf joint angle or velocity */
+	IRDM_TELEM_FAULT_ENCODER_RANGE = 1u << 6, /* encoder value out of range */
+	IRDM_TELEM_FAULT_SIGNAL = 1u << 7,        /* SIGINT/SIGTERM */
+	IRDM_TELEM_FAULT_HAL_READ = 1u << 8,      /* the HAL could not read joint state */
+	IRDM_TELEM_FAULT_HAL_WRITE = 1u << 9,     /* the HAL could not write torques */
+	IRDM_TELEM_FAULT_HAL_FAULT = 1u << 10,    /* the HAL's poll reported a fault */
+	IRDM_TELEM_FAULT_ENGINE = 1u << 11,       /* the force engine returned an error */
 };
 #define IRDM_TELEM_N_FAULTS 12
 
@@ -84,15 +84,15 @@ enum irdm_telem_fault {
  */
 struct irdm_tick_dev {
 	double tip_pos_m[3];
-	double tip_vel_m_s[3];          /* estimated from the encoders */
+	double tip_vel_m_s[3]; /* estimated from the encoders */
 	double joint_angle_rad[3];
-	double joint_torque_nm[3];      /* commanded, after clamping */
-	double force_n[3];              /* force on the object (the device renders -force_n) */
-	uint32_t contact_tri;           /* the proxy's SURFACE triangle, IRDM_TELEM_NO_TRI: none */
-	uint8_t proxy;                  /* enum irdm_proxy_event */
-	uint8_t softened;               /* 1: the contact began softly this tick
+	double joint_torque_nm[3]; /* commanded, after clamping */
+	double force_n[3];         /* force on the object (the device renders -force_n) */
+	uint32_t contact_tri;      /* the proxy's SURFACE triangle, IRDM_TELEM_NO_TRI: none */
+	uint8_t proxy;             /* enum irdm_proxy_event */
+	uint8_t softened;          /* 1: the contact began softly this tick
 					 * (irdm_engine_contact_soften()), 0 */
-	uint8_t reserved[2];            /* zero */
+	uint8_t reserved[2];       /* zero */
 	/*
 	 * The engine's command this tick, all that `irdm replay --sites`
 	 * needs to repeat it: the site (SURFACE triangle and barycentrics;
@@ -100,7 +100,7 @@ struct irdm_tick_dev {
 	 * target (the tip less the site's rest point, object frame).
 	 */
 	uint32_t site_tri;
-	uint32_t reserved2;             /* zero */
+	uint32_t reserved2; /* zero */
 	double site_bary[3];
 	double target_m[3];
 };
@@ -112,13 +112,13 @@ struct irdm_tick_dev {
  * and reserved bytes are zero and logs are reproducible.
  */
 struct irdm_tick_record {
-	uint64_t tick;                  /* 0, 1, 2, ... since the loop started */
-	int32_t wake_latency_ns;        /* wake-up time minus the deadline (saturated) */
-	uint32_t compute_ns;            /* the tick's work, wake-up to torque written */
-	uint32_t fault_flags;           /* enum irdm_telem_fault bits */
-	uint8_t state;                  /* enum irdm_telem_state */
-	uint8_t n_devices;              /* devices filled in dev[], 0..IRDM_TELEM_MAX_DEVICES */
-	uint8_t reserved[2];            /* zero */
+	uint64_t tick;           /* 0, 1, 2, ... since the loop started */
+	int32_t wake_latency_ns; /* wake-up time minus the deadline (saturated) */
+	uint32_t compute_ns;     /* the tick's work, wake-up to torque written */
+	uint32_t fault_flags;    /* enum irdm_telem_fault bits */
+	uint8_t state;           /* enum irdm_telem_state */
+	uint8_t n_devices;       /* devices filled in dev[], 0..IRDM_TELEM_MAX_DEVICES */
+	uint8_t reserved[2];     /* zero */
 	struct irdm_tick_dev dev[IRDM_TELEM_MAX_DEVICES];
 };
 
@@ -126,7 +126,7 @@ struct irdm_tick_record {
 
 /* ---- the ring: tick -> writer, lock-free, one producer, one consumer ---- */
 
-struct irdm_telem_ring;         /* opaque, in caller memory */
+struct irdm_telem_ring; /* opaque, in caller memory */
 
 /*
  * Bytes irdm_telem_ring_init() needs for `capacity` records (any
@@ -198,23 +198,23 @@ uint32_t irdm_telem_ring_capacity(const struct irdm_telem_ring *ring);
 #define IRDM_HIST_MAX_NS 100000000
 #define IRDM_HIST_BINS_PER_DECADE 50
 #define IRDM_HIST_LOG_BINS (6 * IRDM_HIST_BINS_PER_DECADE)
-#define IRDM_HIST_BINS (IRDM_HIST_LOG_BINS + 2)         /* + under + over */
-#define IRDM_HIST_REL_WIDTH 1.0471285480508996          /* r = 10^(1/50) */
+#define IRDM_HIST_BINS (IRDM_HIST_LOG_BINS + 2) /* + under + over */
+#define IRDM_HIST_REL_WIDTH 1.0471285480508996  /* r = 10^(1/50) */
 
 struct irdm_hist {
-	uint32_t edge_ns[IRDM_HIST_LOG_BINS + 1];       /* edge_ns[0] = 100 ns ... 100 ms */
-	uint64_t count[IRDM_HIST_BINS];                 /* [0] < 100 ns, [1 + i] bin i, last: more */
+	uint32_t edge_ns[IRDM_HIST_LOG_BINS + 1]; /* edge_ns[0] = 100 ns ... 100 ms */
+	uint64_t count[IRDM_HIST_BINS];           /* [0] < 100 ns, [1 + i] bin i, last: more */
 	uint64_t n;
-	int64_t min_ns, max_ns;                         /* valid when n > 0 */
-	int64_t limit_ns;                               /* overrun threshold, 0 = none */
+	int64_t min_ns, max_ns; /* valid when n > 0 */
+	int64_t limit_ns;       /* overrun threshold, 0 = none */
 	uint64_t overruns;
-	uint64_t run;                                   /* current run of consecutive overruns */
+	uint64_t run; /* current run of consecutive overruns */
 	uint64_t longest_run;
 };
 
 struct irdm_hist_summary {
 	uint64_t n;
-	int64_t p50_ns, p99_ns, p999_ns, max_ns, min_ns;  /* 0 when n = 0 */
+	int64_t p50_ns, p99_ns, p999_ns, max_ns, min_ns; /* 0 when n = 0 */
 	uint64_t overruns, longest_run;
 };
 
@@ -252,15 +252,15 @@ void irdm_hist_summarize(const struct irdm_hist *h, struct irdm_hist_summary *s)
  * then struct irdm_log_trailer (the record count again).  A log cut short,
  * or with one bit changed, is refused naming the block.
  */
-#define IRDM_LOG_MAGIC "IRDMLOG"        /* 8 bytes with its NUL */
+#define IRDM_LOG_MAGIC "IRDMLOG" /* 8 bytes with its NUL */
 #define IRDM_LOG_VERSION 3u      /* 3: blocks with CRC-32C, a trailer; 2: the engine's command */
 #define IRDM_LOG_HEADER_SIZE 256u
-#define IRDM_LOG_COUNT_OPEN UINT64_MAX  /* record_count of a log never closed */
+#define IRDM_LOG_COUNT_OPEN UINT64_MAX /* record_count of a log never closed */
 #define IRDM_LOG_NAME_LEN 64
 #define IRDM_LOG_IMAGE_LEN 128
-#define IRDM_LOG_BLOCK_RECORDS 256u     /* records per block (the last: fewer) */
-#define IRDM_LOG_BLOCK_MAGIC "BLK"      /* 4 bytes with its NUL */
-#define IRDM_LOG_TRAILER_MAGIC "IRDMEND"        /* 8 bytes with its NUL */
+#define IRDM_LOG_BLOCK_RECORDS 256u      /* records per block (the last: fewer) */
+#define IRDM_LOG_BLOCK_MAGIC "BLK"       /* 4 bytes with its NUL */
+#define IRDM_LOG_TRAILER_MAGIC "IRDMEND" /* 8 bytes with its NUL */
 
 struct irdm_log_header {
 	char magic[8];                  /* IRDM_LOG_MAGIC */
@@ -283,24 +283,24 @@ struct irdm_log_header {
 
 /* After each block's records. */
 struct irdm_log_block_end {
-	char magic[4];                  /* IRDM_LOG_BLOCK_MAGIC */
-	uint32_t index;                 /* the block's number, from 0 */
-	uint32_t n_records;             /* in this block: block_records, the last fewer */
-	uint32_t crc32c;                /* CRC-32C of the block's records and the 12 bytes above */
+	char magic[4];      /* IRDM_LOG_BLOCK_MAGIC */
+	uint32_t index;     /* the block's number, from 0 */
+	uint32_t n_records; /* in this block: block_records, the last fewer */
+	uint32_t crc32c;    /* CRC-32C of the block's records and the 12 bytes above */
 };
 
 /* After the last block: the file's end. */
 struct irdm_log_trailer {
-	char magic[8];                  /* IRDM_LOG_TRAILER_MAGIC */
-	uint64_t record_count;          /* as the header's */
-	uint64_t dropped;               /* as the header's */
+	char magic[8];         /* IRDM_LOG_TRAILER_MAGIC */
+	uint64_t record_count; /* as the header's */
+	uint64_t dropped;      /* as the header's */
 	uint32_t n_blocks;
-	uint32_t crc32c;                /* CRC-32C of the 28 bytes above */
+	uint32_t crc32c; /* CRC-32C of the 28 bytes above */
 };
 
 /* Names for the numbers in a record ("?" outside the range). */
 const char *irdm_telem_state_name(unsigned state);
 const char *irdm_telem_proxy_name(unsigned proxy);
-const char *irdm_telem_fault_name(unsigned bit);   /* bit 0..IRDM_TELEM_N_FAULTS-1 */
+const char *irdm_telem_fault_name(unsigned bit); /* bit 0..IRDM_TELEM_N_FAULTS-1 */
 
 #endif /* IRDM_TELEMETRY_H */

@@ -11,8 +11,12 @@
 static void metavar(const struct irdm_opt *o, char *buf, size_t len)
 {
 	static const char *const by_type[] = {
-		[IRDM_OPT_DOUBLE] = "NUMBER", [IRDM_OPT_UNSIGNED] = "N", [IRDM_OPT_INT] = "N",
-		[IRDM_OPT_BOOL] = "yes | no", [IRDM_OPT_STRING] = "TEXT", [IRDM_OPT_FLAG] = "",
+		[IRDM_OPT_DOUBLE] = "NUMBER",
+		[IRDM_OPT_UNSIGNED] = "N",
+		[IRDM_OPT_INT] = "N",
+		[IRDM_OPT_BOOL] = "yes | no",
+		[IRDM_OPT_STRING] = "TEXT",
+		[IRDM_OPT_FLAG] = "",
 		[IRDM_OPT_CUSTOM] = "VALUE",
 	};
 	size_t at = 0;

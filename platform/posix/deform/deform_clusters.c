@@ -13,10 +13,10 @@
 
 /* Where S(a, b) sits in the values, seen from the displaced cluster a. */
 struct pair_view {
-	size_t o;                           /* element of values[] it starts at */
-	uint32_t rank;                      /* IRDM_CORR_PAIR_DENSE or the rank */
-	size_t row_stride, col_stride;      /* dense: S(a, b)[r][c] at o + r rs + c cs */
-	size_t disp_off, force_off;         /* low-rank: S(a, b) = D F^T, D [3|a|][rank] */
+	size_t o;                      /* element of values[] it starts at */
+	uint32_t rank;                 /* IRDM_CORR_PAIR_DENSE or the rank */
+	size_t row_stride, col_stride; /* dense: S(a, b)[r][c] at o + r rs + c cs */
+	size_t disp_off, force_off;    /* low-rank: S(a, b) = D F^T, D [3|a|][rank] */
 };
 
 static void view_pair(const struct irdm_image *img, uint32_t a, uint32_t b,
@@ -25,7 +25,7 @@ static void view_pair(const struct irdm_image *img, uint32_t a, uint32_t b,
 	const struct irdm_corr_pair *q = irdm_image_corr_pair(img, a, b);
 	const uint32_t *st = img->corr_cl_start;
 	size_t na = 3 * (size_t)(st[a + 1] - st[a]), nb = 3 * (size_t)(st[b + 1] - st[b]);
-	bool stored = a <= b;               /* else S(a, b) is pair (b, a) transposed */
+	bool stored = a <= b; /* else S(a, b) is pair (b, a) transposed */
 
 	v->o = (size_t)q->offset;
 	v->rank = q->rank;

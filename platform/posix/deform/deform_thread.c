@@ -119,8 +119,7 @@ static bool caller_is_rt(void)
 }
 
 int irdm_deform_thread_start(struct irdm_deform_thread **thp, struct irdm_deform_worker *w,
-			     double rate_hz, void (*frame)(void *ctx, const double *pos_m,
-							   uint64_t tick),
+			     double rate_hz, void (*frame)(void *ctx, const double *pos_m, uint64_t tick),
 			     void *ctx, char *err, size_t errlen)
 {
 	struct irdm_deform_thread *th = &w->th;
@@ -156,7 +155,8 @@ int irdm_deform_thread_start(struct irdm_deform_thread **thp, struct irdm_deform
 	if (rc && caller_is_rt()) {
 		/* e.g. no RLIMIT_RTPRIO left: run, but say so */
 		snprintf(err, errlen, "deform thread: cannot use SCHED_FIFO below the caller (%s); "
-			 "running at SCHED_OTHER", strerror(rc));
+				      "running at SCHED_OTHER",
+			 strerror(rc));
 		rc = spawn(th, false);
 	}
 	if (rc) {

@@ -49,10 +49,10 @@ static void worker_layout(const struct irdm_image *img, struct worker_layout *l)
 		l->off_frame += deform_align_up(n3 * K * sizeof(float));
 	l->off_far = l->off_frame + deform_align_up(n3 * sizeof(double));
 	l->off_cl = l->off_far;
-	if (modal && img->corr_rank)    /* the far field's weights */
+	if (modal && img->corr_rank) /* the far field's weights */
 		l->off_cl += deform_align_up(img->corr_rank * sizeof(double));
 	l->total = l->off_cl;
-	if (modal && img->corr_clusters)        /* one low-rank pair's weights */
+	if (modal && img->corr_clusters) /* one low-rank pair's weights */
 		l->total += deform_align_up(img->corr_clusters->max_rank * sizeof(double));
 }
 
@@ -63,7 +63,7 @@ size_t irdm_deform_worker_mem_size(const struct irdm_image *img)
 	if (!image_usable(img))
 		return 0;
 	worker_layout(img, &l);
-	return l.total + DEFORM_ALIGN;          /* room to align the caller's memory */
+	return l.total + DEFORM_ALIGN; /* room to align the caller's memory */
 }
 
 /* BLAS takes f32 or f64: an f16 image's shapes are widened once, here. */
@@ -153,9 +153,15 @@ static void apply_pose(const struct irdm_rigid *rg, const struct irdm_pose *ps, 
 	double w = ps->q[0], x = ps->q[1], y = ps->q[2], z = ps->q[3];
 	double nn = w * w + x * x + y * y + z * z, k = nn > 0 ? 2 / nn : 0;
 	double R[9] = {
-		1 - k * (y * y + z * z), k * (x * y - w * z), k * (x * z + w * y),
-		k * (x * y + w * z), 1 - k * (x * x + z * z), k * (y * z - w * x),
-		k * (x * z - w * y), k * (y * z + w * x), 1 - k * (x * x + y * y),
+		1 - k * (y * y + z * z),
+		k * (x * y - w * z),
+		k * (x * z + w * y),
+		k * (x * y + w * z),
+		1 - k * (x * x + z * z),
+		k * (y * z - w * x),
+		k * (x * z - w * y),
+		k * (y * z + w * x),
+		1 - k * (x * x + y * y),
 	};
 
 	for (uint32_t r = 0; r < n; r++) {

@@ -19,13 +19,13 @@ struct irdm_deform_thread {
 	void *ctx;
 	struct timespec period;
 	atomic_bool stop;
-	sem_t started;                      /* init-time handshake only */
-	int prio_errno;                     /* nice + 5 failed in the thread */
+	sem_t started;  /* init-time handshake only */
+	int prio_errno; /* nice + 5 failed in the thread */
 	bool running;
 };
 
 struct irdm_deform_worker {
-	struct irdm_deform *d;              /* the channel read */
+	struct irdm_deform *d; /* the channel read */
 	const struct irdm_image *img;
 	uint32_t repr, prec;
 	uint32_t n_nodes, n_cols, n_modes, T;
@@ -34,9 +34,9 @@ struct irdm_deform_worker {
 	 * image's own for f32/f64, converted for f16 */
 	const void *shapes;
 	bool shapes_f64;
-	void *y;                            /* n_modes of the matrix's type */
-	float *uf;                          /* f32 product, 3 n_nodes */
-	double *frame_pos;                  /* the thread's frame, 3 n_nodes */
+	void *y;           /* n_modes of the matrix's type */
+	float *uf;         /* f32 product, 3 n_nodes */
+	double *frame_pos; /* the thread's frame, 3 n_nodes */
 	/* the static correction's far field (NULL without one): the weights
 	 * diag(lambda) U^T f, corr_rank */
 	double *far_g;

@@ -18,7 +18,7 @@
 #include "irdm/version.h"
 
 #define MARKER_MAGIC "irdm-output 1\n"
-#define MARKER_MAX (1u << 20)           /* 5000 frames' names fit many times */
+#define MARKER_MAX (1u << 20) /* 5000 frames' names fit many times */
 #define SCRATCH (IRDM_OUTDIR_PATH_MAX + 512)
 
 /* A marker read: its text (NUL-terminated), and the fields the checks use. */
@@ -30,8 +30,7 @@ struct marker {
 };
 
 /* od->why (a long path is cut short: the message stays one line) */
-__attribute__((format(printf, 2, 3)))
-static void say(struct irdm_outdir *od, const char *fmt, ...)
+__attribute__((format(printf, 2, 3))) static void say(struct irdm_outdir *od, const char *fmt, ...)
 {
 	va_list ap;
 
@@ -167,7 +166,8 @@ static int check_entries(struct irdm_outdir *od, DIR *h, const struct marker *m,
 			continue;
 		if (!plain) {
 			say(od, "%s/%s: a directory inside the output (%s writes files only); "
-			    "%s not replaced", od->dir, d->d_name, od->tool, od->dir);
+				"%s not replaced",
+			    od->dir, d->d_name, od->tool, od->dir);
 			return IRDM_EEXIST;
 		}
 		if (!od->force) {
@@ -366,7 +366,7 @@ static void remove_old(const struct irdm_outdir *od, const char *path)
 	if (!marker_read(path, &m))
 		remove_files(path, &m);
 	else
-		rmdir(path);            /* an empty directory */
+		rmdir(path); /* an empty directory */
 	free(m.text);
 }
 

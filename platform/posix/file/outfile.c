@@ -134,7 +134,7 @@ int irdm_outfile_commit(struct irdm_outfile *o, char *err, size_t errlen)
 		return IRDM_EIO;
 	}
 	o->tmp[0] = 0;
-	irdm_outfile_abort(o);          /* the lock */
+	irdm_outfile_abort(o); /* the lock */
 	return IRDM_OK;
 }
 

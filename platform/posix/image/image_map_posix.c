@@ -75,8 +75,7 @@ static int lock_pages(struct irdm_image *raw, char *msg, size_t msglen)
 	e = errno;
 	format_size(sz, sizeof(sz), raw->size);
 	return map_report(msg, msglen, IRDM_EIO, "cannot lock %s: %s%s", sz,
-			  strerror(e), e == EPERM || e == ENOMEM ?
-			  " (raise RLIMIT_MEMLOCK or run with CAP_IPC_LOCK)" : "");
+			  strerror(e), e == EPERM || e == ENOMEM ? " (raise RLIMIT_MEMLOCK or run with CAP_IPC_LOCK)" : "");
 }
 
 /*
@@ -98,7 +97,8 @@ static int read_all(int fd, uint8_t *base, size_t size, char *msg, size_t msglen
 		if (n == 0)
 			return map_report(msg, msglen, IRDM_ETRUNC,
 					  "image is truncated: the file shrank to %zu bytes while "
-					  "it was read (%zu expected)", done, size);
+					  "it was read (%zu expected)",
+					  done, size);
 		done += (size_t)n;
 	}
 	if (pread(fd, &extra, 1, (off_t)size) > 0)
@@ -185,7 +185,7 @@ int irdm_image_map(const char *path, unsigned flags, struct irdm_image *img,
 		goto out_msg;
 	}
 	ret = map_fd(fd, flags, &raw, msg, sizeof(msg));
-	close(fd);              /* the copy needs the file no more */
+	close(fd); /* the copy needs the file no more */
 	if (ret)
 		goto out_msg;
 	ret = irdm_image_parse(raw.base, raw.size, img, msg, sizeof(msg));
@@ -195,7 +195,7 @@ int irdm_image_map(const char *path, unsigned flags, struct irdm_image *img,
 	img->locked = raw.locked;
 	return IRDM_OK;
 unmap:
-	munmap((void *)raw.base, raw.size);     /* also unlocks */
+	munmap((void *)raw.base, raw.size); /* also unlocks */
 out_msg:
 	if (err && errlen)
 		snprintf(err, errlen, "%s: %s", path, msg);

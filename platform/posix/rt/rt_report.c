@@ -53,7 +53,8 @@ static int read_kernel(struct irdm_rt_report *r)
 	if (uname(&u))
 		return IRDM_EIO;
 	r->preempt_rt = irdm_rt_kernel_is_preempt_rt(first_line("/sys/kernel/realtime", rt,
-								  sizeof(rt)), u.version);
+								sizeof(rt)),
+						     u.version);
 	return IRDM_OK;
 }
 
@@ -152,8 +153,10 @@ static void put_policy(struct line *l, int policy, int priority)
 		int policy;
 		const char *name;
 	} names[] = {
-		{ SCHED_OTHER, "SCHED_OTHER" }, { SCHED_FIFO, "SCHED_FIFO" },
-		{ SCHED_RR, "SCHED_RR" }, { SCHED_BATCH, "SCHED_BATCH" },
+		{ SCHED_OTHER, "SCHED_OTHER" },
+		{ SCHED_FIFO, "SCHED_FIFO" },
+		{ SCHED_RR, "SCHED_RR" },
+		{ SCHED_BATCH, "SCHED_BATCH" },
 		{ SCHED_IDLE, "SCHED_IDLE" },
 	};
 	const char *name = NULL;

@@ -73,7 +73,7 @@ _Static_assert(offsetof(struct irdm_log_trailer, crc32c) == 28, "trailer layout"
 
 #define BLOCK_BYTES ((uint64_t)IRDM_LOG_BLOCK_RECORDS * IRDM_TICK_RECORD_SIZE + \
 		     sizeof(struct irdm_log_block_end))
-#define LOG_MAX_BYTES (1ull << 44)      /* 16 TiB: months at 1 kHz */
+#define LOG_MAX_BYTES (1ull << 44) /* 16 TiB: months at 1 kHz */
 
 static uint64_t n_blocks(uint64_t records)
 {
@@ -118,8 +118,8 @@ static int say(char *err, size_t errlen, int code, const char *fmt, ...)
 struct irdm_log_file {
 	struct irdm_outfile out;
 	uint64_t count;
-	uint32_t in_block, block, crc;  /* the open block: records, number, CRC so far */
-	int error;                      /* the first write error (errno), sticky */
+	uint32_t in_block, block, crc; /* the open block: records, number, CRC so far */
+	int error;                     /* the first write error (errno), sticky */
 	char why[256];
 	struct irdm_log_header hdr;
 };

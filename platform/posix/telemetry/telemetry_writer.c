@@ -28,10 +28,10 @@ struct irdm_log_writer {
 	struct irdm_log_file *lf;
 	struct irdm_telem_ring *ring;
 	pthread_t tid;
-	bool lowest_nice;               /* default scheduling: nice 19 in the thread */
-	atomic_bool stop;               /* set by irdm_log_writer_stop() */
+	bool lowest_nice; /* default scheduling: nice 19 in the thread */
+	atomic_bool stop; /* set by irdm_log_writer_stop() */
 	atomic_ullong written;
-	int error;                      /* first append error; read after the join */
+	int error; /* first append error; read after the join */
 	char err[256];
 	struct irdm_tick_record chunk[IRDM_LOG_WRITER_CHUNK];
 };

@@ -25,8 +25,8 @@
 
 #include "fw.h"
 
-#define CHILD_ALIVE 42  /* the child came back from every signal */
-#define CHILD_WRONG 43  /* the flag did not say what it should */
+#define CHILD_ALIVE 42 /* the child came back from every signal */
+#define CHILD_WRONG 43 /* the flag did not say what it should */
 
 static volatile sig_atomic_t flag;
 
@@ -47,7 +47,7 @@ static int child_raises(bool loop_running, const int *sigs, size_t n, const char
 	pid = fork();
 	assert_true(pid >= 0);
 	if (pid == 0) {
-		static struct fw fw;    /* nothing open: the emergency path's "0 of 0" */
+		static struct fw fw; /* nothing open: the emergency path's "0 of 0" */
 
 		close(fds[0]);
 		dup2(fds[1], STDERR_FILENO);
@@ -59,8 +59,7 @@ static int child_raises(bool loop_running, const int *sigs, size_t n, const char
 			raise(sigs[i]);
 		if (name && strcmp(fw_signal_name(sigs[n - 1]), name))
 			_exit(CHILD_WRONG);
-		_exit(flag == (n && sigs[n - 1] != SIGXFSZ ? sigs[n - 1] : 0) ? CHILD_ALIVE
-									  : CHILD_WRONG);
+		_exit(flag == (n && sigs[n - 1] != SIGXFSZ ? sigs[n - 1] : 0) ? CHILD_ALIVE : CHILD_WRONG);
 	}
 	close(fds[1]);
 	while (total + 1 < (ssize_t)errlen &&
@@ -79,7 +78,8 @@ static void expect_soft(int sig, const char *name)
 
 	if (rc != CHILD_ALIVE)
 		fail_msg("%s (signal %d): expected the flag set, so named, and the child alive, "
-			 "got %d: %s", name, sig, rc, err);
+			 "got %d: %s",
+			 name, sig, rc, err);
 }
 
 static void expect_emergency(const int *sigs, size_t n, bool loop_running, const char *line)
@@ -97,10 +97,17 @@ static void test_requests_set_the_flag(void **state)
 		int sig;
 		const char *name;
 	} soft[] = {
-		{ SIGINT, "SIGINT" }, { SIGTERM, "SIGTERM" }, { SIGHUP, "SIGHUP" },
-		{ SIGQUIT, "SIGQUIT" }, { SIGPIPE, "SIGPIPE" }, { SIGXCPU, "SIGXCPU" },
-		{ SIGUSR1, "SIGUSR1" }, { SIGUSR2, "SIGUSR2" }, { SIGALRM, "SIGALRM" },
-		{ SIGVTALRM, "SIGVTALRM" }, { SIGPROF, "SIGPROF" },
+		{ SIGINT, "SIGINT" },
+		{ SIGTERM, "SIGTERM" },
+		{ SIGHUP, "SIGHUP" },
+		{ SIGQUIT, "SIGQUIT" },
+		{ SIGPIPE, "SIGPIPE" },
+		{ SIGXCPU, "SIGXCPU" },
+		{ SIGUSR1, "SIGUSR1" },
+		{ SIGUSR2, "SIGUSR2" },
+		{ SIGALRM, "SIGALRM" },
+		{ SIGVTALRM, "SIGVTALRM" },
+		{ SIGPROF, "SIGPROF" },
 #ifdef SIGPWR
 		{ SIGPWR, "SIGPWR" },
 #endif
@@ -135,11 +142,13 @@ static void test_bug_signals_take_the_emergency_path(void **state)
 
 	(void)state;
 	snprintf(line, sizeof(line), "irdm-fw: SIGTRAP (signal %d): emergency torque off on 0 of 0 "
-		 "devices\n", SIGTRAP);
+				     "devices\n",
+		 SIGTRAP);
 	expect_emergency(&trap, 1, true, line);
 	snprintf(line, sizeof(line), "irdm-fw: SIGSYS (signal %d): emergency torque off on 0 of 0 "
-		 "devices\n", SIGSYS);
-	expect_emergency(&sys, 1, false, line);         /* at any time */
+				     "devices\n",
+		 SIGSYS);
+	expect_emergency(&sys, 1, false, line); /* at any time */
 }
 
 /* A second request while the loop runs: it is not listening. */
@@ -150,7 +159,8 @@ static void test_second_signal_in_the_loop_escalates(void **state)
 
 	(void)state;
 	snprintf(line, sizeof(line), "irdm-fw: SIGINT (signal %d): emergency torque off on 0 of 0 "
-		 "devices\n", SIGINT);
+				     "devices\n",
+		 SIGINT);
 	expect_emergency(sigs, 2, true, line);
 }
 

@@ -138,12 +138,12 @@ static void mpi_abort(const char *line)
 	fprintf(stderr, "%s\n", line);
 	fflush(stderr);
 	MPI_Abort(MPI_COMM_WORLD, 1);
-	_exit(1);       /* MPI_Abort does not return; if it did, still stop */
+	_exit(1); /* MPI_Abort does not return; if it did, still stop */
 }
 
 static void mpi_wait_all(void)
 {
-	const struct timespec nap = { 0, 2000000 };     /* 2 ms */
+	const struct timespec nap = { 0, 2000000 }; /* 2 ms */
 	MPI_Request req;
 	int done = 0;
 
@@ -157,7 +157,7 @@ static void mpi_wait_all(void)
 }
 
 static int mpi_gather(const double *mine, const size_t *counts, double *all,
-		     char *err, size_t errlen)
+		      char *err, size_t errlen)
 {
 	int *cnt = NULL, *off = NULL, ret = IRDM_ENUMERIC;
 	size_t total = 0;

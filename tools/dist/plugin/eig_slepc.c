@@ -275,8 +275,7 @@ static PetscErrorCode solve_loads(EPS eps, Mat K, const struct irdm_modes_want *
 	PetscCall(MatCreateVecs(K, &col, NULL));
 	PetscCall(kept_scatter(col, want->keep, n, &to_kept, &x_kept, &idx_kept, &n_kept));
 	for (size_t j0 = 0; j0 < want->n_loads; j0 += LOADS_PER_SOLVE) {
-		PetscInt nb = (PetscInt)(want->n_loads - j0 < LOADS_PER_SOLVE ? want->n_loads - j0
-									    : LOADS_PER_SOLVE);
+		PetscInt nb = (PetscInt)(want->n_loads - j0 < LOADS_PER_SOLVE ? want->n_loads - j0 : LOADS_PER_SOLVE);
 		PetscCall(MatCreateDense(PETSC_COMM_WORLD, hi - lo, PETSC_DECIDE, n, nb, NULL, &B));
 		PetscCall(MatCreateDense(PETSC_COMM_WORLD, hi - lo, PETSC_DECIDE, n, nb, NULL, &X));
 		for (PetscInt j = 0; j < nb; j++) {
@@ -352,7 +351,7 @@ static int solve(Mat K, Mat M, PetscInt nev, double sigma, const struct irdm_mod
 		raise(SIGKILL);
 	if (mon->progress && irdm_mpi_rank() == 0)
 		mon->progress(mon->pctx, "MUMPS factorisation", 0.0);
-	if (!perr)      /* the shift-and-invert factorisation */
+	if (!perr) /* the shift-and-invert factorisation */
 		perr = EPSSetUp(eps);
 	t[2] = irdm_now_s();
 	if (!perr)

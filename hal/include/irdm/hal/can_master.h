@@ -26,66 +26,66 @@
 #define IRDM_CAN_AXES_MAX 3
 #define IRDM_CAN_WHY_MAX 160
 #define IRDM_CAN_SYNC_COUNTER_MAX 240
-#define IRDM_CAN_RX_MAX 256             /* frames one receive takes at most */   /* the counter runs 1..240, then 1 again */
+#define IRDM_CAN_RX_MAX 256 /* frames one receive takes at most */ /* the counter runs 1..240, then 1 again */
 
 struct irdm_can_axis_cfg {
-	unsigned node;                  /* 1..127 */
-	uint32_t rated_torque_mnm;      /* 0x6076, motor side, mN m (> 0) */
-	double gear_ratio;              /* motor turns per joint turn (> 0) */
+	unsigned node;             /* 1..127 */
+	uint32_t rated_torque_mnm; /* 0x6076, motor side, mN m (> 0) */
+	double gear_ratio;         /* motor turns per joint turn (> 0) */
 };
 
 /* Constant for the life of a master. */
 struct irdm_can_master_cfg {
-	unsigned n_axes;                /* 1..IRDM_CAN_AXES_MAX */
+	unsigned n_axes; /* 1..IRDM_CAN_AXES_MAX */
 	struct irdm_can_axis_cfg axis[IRDM_CAN_AXES_MAX];
-	uint32_t period_us;             /* the cycle: one SYNC per period */
-	uint32_t bitrate;               /* bit/s, 10 000..1 000 000 */
-	bool sync_counter;              /* SYNC with a counter byte (1..240) */
-	uint16_t heartbeat_ms;          /* written to each drive's 0x1017 (> 0) */
-	uint32_t heartbeat_timeout_ms;  /* no heartbeat for longer: lost (> heartbeat_ms) */
-	unsigned tpdo_missing_periods;  /* this many periods in a row without a TPDO: lost */
-	unsigned master_node;           /* 1..127, not a drive's: the master's heartbeat */
-	uint16_t rpdo_timeout_ms;       /* each drive's RPDO1 deadline, 0x1400:05 (> 0) */
-	unsigned sdo_timeout_polls;     /* idle() calls to wait for one SDO answer (> 0) */
-	void (*idle)(void *ctx);        /* set-up's wait (a sleep, or the emulator's turn) */
+	uint32_t period_us;            /* the cycle: one SYNC per period */
+	uint32_t bitrate;              /* bit/s, 10 000..1 000 000 */
+	bool sync_counter;             /* SYNC with a counter byte (1..240) */
+	uint16_t heartbeat_ms;         /* written to each drive's 0x1017 (> 0) */
+	uint32_t heartbeat_timeout_ms; /* no heartbeat for longer: lost (> heartbeat_ms) */
+	unsigned tpdo_missing_periods; /* this many periods in a row without a TPDO: lost */
+	unsigned master_node;          /* 1..127, not a drive's: the master's heartbeat */
+	uint16_t rpdo_timeout_ms;      /* each drive's RPDO1 deadline, 0x1400:05 (> 0) */
+	unsigned sdo_timeout_polls;    /* idle() calls to wait for one SDO answer (> 0) */
+	void (*idle)(void *ctx);       /* set-up's wait (a sleep, or the emulator's turn) */
 	void *idle_ctx;
 };
 
 /* What the master knows of one drive (mutable). */
 struct irdm_can_master_axis {
-	uint16_t cw;                    /* the last controlword sent */
-	uint16_t sw;                    /* the latest statusword */
-	int32_t counts;                 /* the latest position actual */
-	bool fresh;                     /* a TPDO came since the last receive */
-	bool seen;                      /* a TPDO ever came */
-	unsigned missing;               /* periods in a row without one */
-	uint64_t heartbeat_period;      /* the period of the last heartbeat */
-	enum irdm_co_nmt_state nmt;     /* as the last heartbeat said */
+	uint16_t cw;                /* the last controlword sent */
+	uint16_t sw;                /* the latest statusword */
+	int32_t counts;             /* the latest position actual */
+	bool fresh;                 /* a TPDO came since the last receive */
+	bool seen;                  /* a TPDO ever came */
+	unsigned missing;           /* periods in a row without one */
+	uint64_t heartbeat_period;  /* the period of the last heartbeat */
+	enum irdm_co_nmt_state nmt; /* as the last heartbeat said */
 	enum irdm_cia402_state state;
-	bool was_enabled;               /* reached operation enabled since enable */
-	uint32_t device_type;           /* 0x1000, read at set-up */
-	uint32_t identity[4];           /* 0x1018:01..04: vendor, product, revision, serial */
-	uint16_t abort_option;          /* 0x6007 as written (2, or 1 if refused) */
+	bool was_enabled;      /* reached operation enabled since enable */
+	uint32_t device_type;  /* 0x1000, read at set-up */
+	uint32_t identity[4];  /* 0x1018:01..04: vendor, product, revision, serial */
+	uint16_t abort_option; /* 0x6007 as written (2, or 1 if refused) */
 };
 
 struct irdm_can_master {
 	struct irdm_can_master_cfg cfg;
 	struct irdm_can_port port;
 	struct irdm_can_master_axis ax[IRDM_CAN_AXES_MAX];
-	uint64_t period;                /* cycles sent */
-	uint64_t beats;                 /* heartbeats the master produced */
-	unsigned sync_count;            /* the last SYNC counter sent (0: none yet) */
-	bool enable;                    /* drive the axes toward operation enabled */
-	bool reset_request;             /* fault reset asked for (operator) */
-	bool faulted;                   /* latched: torque off until a reset */
-	bool link_lost;                 /* the fault is the link's, not a drive's */
-	char why[IRDM_CAN_WHY_MAX];     /* the first fault, one line */
-	struct irdm_can_frame off[IRDM_CAN_AXES_MAX];   /* each axis's torque-off RPDO1 */
-	uint64_t bad_frames;            /* malformed frames of ours (wrong DLC, content) */
-	uint64_t unknown_frames;        /* identifiers we do not expect */
-	uint64_t sdo_stragglers;        /* SDO answers after set-up */
+	uint64_t period;                              /* cycles sent */
+	uint64_t beats;                               /* heartbeats the master produced */
+	unsigned sync_count;                          /* the last SYNC counter sent (0: none yet) */
+	bool enable;                                  /* drive the axes toward operation enabled */
+	bool reset_request;                           /* fault reset asked for (operator) */
+	bool faulted;                                 /* latched: torque off until a reset */
+	bool link_lost;                               /* the fault is the link's, not a drive's */
+	char why[IRDM_CAN_WHY_MAX];                   /* the first fault, one line */
+	struct irdm_can_frame off[IRDM_CAN_AXES_MAX]; /* each axis's torque-off RPDO1 */
+	uint64_t bad_frames;                          /* malformed frames of ours (wrong DLC, content) */
+	uint64_t unknown_frames;                      /* identifiers we do not expect */
+	uint64_t sdo_stragglers;                      /* SDO answers after set-up */
 	uint64_t emcy_frames;
-	uint64_t tx_dropped;            /* sends refused: transmit queue full */
+	uint64_t tx_dropped; /* sends refused: transmit queue full */
 };
 
 /*

@@ -19,8 +19,8 @@
 #include "irdm/error.h"
 
 struct irdm_can_frame {
-	uint32_t id;            /* 11-bit COB-ID */
-	uint8_t dlc;            /* data bytes, 0..8 */
+	uint32_t id; /* 11-bit COB-ID */
+	uint8_t dlc; /* data bytes, 0..8 */
 	uint8_t data[8];
 };
 
@@ -28,7 +28,7 @@ struct irdm_can_frame {
 enum irdm_co_function {
 	IRDM_CO_NMT = 0x000,
 	IRDM_CO_SYNC = 0x080,
-	IRDM_CO_EMCY = 0x080,   /* + node id 1..127 (SYNC is node id 0) */
+	IRDM_CO_EMCY = 0x080, /* + node id 1..127 (SYNC is node id 0) */
 	IRDM_CO_TPDO1 = 0x180,
 	IRDM_CO_RPDO1 = 0x200,
 	IRDM_CO_TPDO2 = 0x280,

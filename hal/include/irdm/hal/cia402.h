@@ -15,22 +15,22 @@
 #include <stdint.h>
 
 enum irdm_cia402_state {
-	IRDM_CIA402_NOT_READY = 0,              /* self-test after power-on */
+	IRDM_CIA402_NOT_READY = 0, /* self-test after power-on */
 	IRDM_CIA402_SWITCH_ON_DISABLED,
 	IRDM_CIA402_READY_TO_SWITCH_ON,
 	IRDM_CIA402_SWITCHED_ON,
-	IRDM_CIA402_OPERATION_ENABLED,          /* the only state that applies torque */
+	IRDM_CIA402_OPERATION_ENABLED, /* the only state that applies torque */
 	IRDM_CIA402_QUICK_STOP_ACTIVE,
 	IRDM_CIA402_FAULT_REACTION_ACTIVE,
 	IRDM_CIA402_FAULT,
-	IRDM_CIA402_UNKNOWN,                    /* a statusword no state has */
+	IRDM_CIA402_UNKNOWN, /* a statusword no state has */
 };
 
 /* Controlword commands (0x6040); fault reset is bit 7's rising edge. */
 #define IRDM_CIA402_CW_DISABLE_VOLTAGE 0x0000
 #define IRDM_CIA402_CW_QUICK_STOP 0x0002
 #define IRDM_CIA402_CW_SHUTDOWN 0x0006
-#define IRDM_CIA402_CW_SWITCH_ON 0x0007         /* also "disable operation" */
+#define IRDM_CIA402_CW_SWITCH_ON 0x0007 /* also "disable operation" */
 #define IRDM_CIA402_CW_ENABLE_OPERATION 0x000F
 #define IRDM_CIA402_CW_FAULT_RESET 0x0080
 

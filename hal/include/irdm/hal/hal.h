@@ -50,29 +50,29 @@
 
 #define IRDM_HAL_JOINTS IRDM_DEVICE_JOINTS
 #define IRDM_HAL_BACKENDS_MAX 8
-#define IRDM_HAL_WHY_MAX 192    /* bytes of a back-end's one-line reason */
-#define IRDM_HAL_INFO_MAX 640   /* bytes of what to print after open (lines) */
+#define IRDM_HAL_WHY_MAX 192  /* bytes of a back-end's one-line reason */
+#define IRDM_HAL_INFO_MAX 640 /* bytes of what to print after open (lines) */
 
 /* Asynchronous fault bits (poll); a back-end sets the ones it can detect. */
 enum irdm_hal_fault {
-	IRDM_HAL_FAULT_LINK = 1u << 0,          /* link to the drives lost or timed out */
-	IRDM_HAL_FAULT_DRIVE = 1u << 1,         /* a drive faulted (current, temperature) */
-	IRDM_HAL_FAULT_ENCODER = 1u << 2,       /* an encoder reported an error */
-	IRDM_HAL_FAULT_ESTOP = 1u << 3,         /* the emergency stop was pressed */
-	IRDM_HAL_FAULT_POWER = 1u << 4,         /* supply under- or over-voltage */
+	IRDM_HAL_FAULT_LINK = 1u << 0,    /* link to the drives lost or timed out */
+	IRDM_HAL_FAULT_DRIVE = 1u << 1,   /* a drive faulted (current, temperature) */
+	IRDM_HAL_FAULT_ENCODER = 1u << 2, /* an encoder reported an error */
+	IRDM_HAL_FAULT_ESTOP = 1u << 3,   /* the emergency stop was pressed */
+	IRDM_HAL_FAULT_POWER = 1u << 4,   /* supply under- or over-voltage */
 };
 
 struct irdm_hal_joint_state {
-	int32_t counts[IRDM_HAL_JOINTS];        /* raw encoder counts */
-	uint64_t seq;                           /* sample number: +1 per successful read */
+	int32_t counts[IRDM_HAL_JOINTS]; /* raw encoder counts */
+	uint64_t seq;                    /* sample number: +1 per successful read */
 };
 
 /* Constant for the life of an instance. */
 struct irdm_hal_config {
-	const struct irdm_device_config *device;        /* the board's arm */
-	const char *options;    /* the back-end's options from the board file:
+	const struct irdm_device_config *device; /* the board's arm */
+	const char *options;                     /* the back-end's options from the board file:
 				 * "key=value key=value" (may be NULL or empty) */
-	double period_s;        /* the force tick's period */
+	double period_s;                         /* the force tick's period */
 };
 
 struct irdm_hal_dev;
@@ -144,9 +144,9 @@ struct irdm_hal_ops {
 };
 
 struct irdm_hal_backend {
-	const char *name;                       /* as the board file names it */
+	const char *name; /* as the board file names it */
 	const struct irdm_hal_ops *ops;
-	size_t data_size;                       /* bytes of mutable state per instance */
+	size_t data_size; /* bytes of mutable state per instance */
 	/*
 	 * Its hal_options keys, for help and docs/hal-options.md (NULL: it
 	 * takes none).  open parses config->options through this table.
@@ -165,7 +165,7 @@ struct irdm_hal_backend {
 struct irdm_hal_dev {
 	const struct irdm_hal_backend *backend;
 	const struct irdm_hal_config *config;
-	void *data;             /* backend->data_size bytes, max_align_t aligned */
+	void *data; /* backend->data_size bytes, max_align_t aligned */
 	/*
 	 * Written by the back-end, read by the caller (both may stay empty):
 	 * why   the reason of the last error or of the latched fault, one line

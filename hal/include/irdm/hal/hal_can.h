@@ -33,7 +33,7 @@
 #include "irdm/hal/hal.h"
 
 #define IRDM_HAL_CAN_IFNAME_MAX 16
-#define IRDM_HAL_CAN_STEADY_PERIODS 5   /* start: disabled SYNCs answered in a row first */
+#define IRDM_HAL_CAN_STEADY_PERIODS 5 /* start: disabled SYNCs answered in a row first */
 
 /* The board's hal_options, parsed. */
 struct irdm_hal_can_opts {
@@ -48,16 +48,16 @@ struct irdm_hal_can_opts {
 	bool sync_counter;
 	uint32_t sdo_timeout_ms;
 	uint32_t enable_timeout_ms;
-	unsigned substeps;              /* canemu only: the emulated arm's steps a period */
-	unsigned master_node;           /* the master's own node id (its heartbeat) */
-	uint32_t rpdo_timeout_ms;       /* each drive's RPDO1 deadline (0: 3 periods) */
-	unsigned emcy_drive;            /* canemu only: drive (1..) that faults, 0: none */
-	uint32_t emcy_at_ms;            /*   at this virtual time, with EMCY 0x2310 */
+	unsigned substeps;        /* canemu only: the emulated arm's steps a period */
+	unsigned master_node;     /* the master's own node id (its heartbeat) */
+	uint32_t rpdo_timeout_ms; /* each drive's RPDO1 deadline (0: 3 periods) */
+	unsigned emcy_drive;      /* canemu only: drive (1..) that faults, 0: none */
+	uint32_t emcy_at_ms;      /*   at this virtual time, with EMCY 0x2310 */
 };
 
 /* Which options a back-end takes beyond the common ones. */
 enum irdm_hal_can_extra {
-	IRDM_HAL_CAN_IFACE = 1u << 0,   /* iface= (required) */
+	IRDM_HAL_CAN_IFACE = 1u << 0, /* iface= (required) */
 	IRDM_HAL_CAN_SUBSTEPS = 1u << 1,
 	IRDM_HAL_CAN_EMCY_AT = 1u << 2, /* emcy_at=DRIVE:MS (an injected fault) */
 };
@@ -93,7 +93,10 @@ struct irdm_hal_can_link {
 	void (*close)(struct irdm_hal_dev *dev);
 };
 
-enum irdm_hal_can_state { HAL_CAN_CLOSED = 0, HAL_CAN_OPEN, HAL_CAN_RUNNING, HAL_CAN_OFF };
+enum irdm_hal_can_state { HAL_CAN_CLOSED = 0,
+			  HAL_CAN_OPEN,
+			  HAL_CAN_RUNNING,
+			  HAL_CAN_OFF };
 
 /* The start of every CAN back-end's data (dev->data points at it). */
 struct irdm_hal_can {
@@ -101,7 +104,7 @@ struct irdm_hal_can {
 	struct irdm_hal_can_opts opts;
 	struct irdm_can_master m;
 	enum irdm_hal_can_state state;
-	bool written;                   /* this period's SYNC already sent */
+	bool written; /* this period's SYNC already sent */
 	uint64_t seq;
 };
 
@@ -121,12 +124,12 @@ void irdm_hal_can_close(struct irdm_hal_dev *dev);
 int irdm_hal_can_emergency_off(struct irdm_hal_dev *dev);
 
 /* A CAN back-end's ops table: its own open, the shared rest. */
-#define IRDM_HAL_CAN_OPS(open_fn, emergency_fn)                                                \
-	{                                                                                      \
-		.open = (open_fn), .start = irdm_hal_can_start, .read = irdm_hal_can_read,     \
-		.write = irdm_hal_can_write, .safe_off = irdm_hal_can_safe_off,                \
-		.poll = irdm_hal_can_poll, .close = irdm_hal_can_close,                        \
-		.emergency_off = (emergency_fn),                                               \
+#define IRDM_HAL_CAN_OPS(open_fn, emergency_fn) \
+	{ \
+		.open = (open_fn), .start = irdm_hal_can_start, .read = irdm_hal_can_read, \
+		.write = irdm_hal_can_write, .safe_off = irdm_hal_can_safe_off, \
+		.poll = irdm_hal_can_poll, .close = irdm_hal_can_close, \
+		.emergency_off = (emergency_fn), \
 	}
 
 /* The operator's fault reset (tests; the controller has no such command yet). */

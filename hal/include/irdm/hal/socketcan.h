@@ -27,16 +27,16 @@
 
 #include "irdm/hal/can_port.h"
 
-#define IRDM_SOCKETCAN_IFNAME_MAX 16    /* IFNAMSIZ */
+#define IRDM_SOCKETCAN_IFNAME_MAX 16 /* IFNAMSIZ */
 
 struct irdm_socketcan {
-	int fd;                         /* -1: closed */
+	int fd; /* -1: closed */
 	char ifname[IRDM_SOCKETCAN_IFNAME_MAX];
-	bool bus_off;                   /* latched: an error frame said bus-off */
-	bool error_passive;             /* latched: an error frame said error passive */
-	uint64_t error_frames;          /* error frames seen */
-	uint64_t tx_dropped;            /* sends refused: queue full (ENOBUFS/EAGAIN) */
-	uint64_t rx_rejected;           /* frames read but not data: RTR, extended id, size */
+	bool bus_off;          /* latched: an error frame said bus-off */
+	bool error_passive;    /* latched: an error frame said error passive */
+	uint64_t error_frames; /* error frames seen */
+	uint64_t tx_dropped;   /* sends refused: queue full (ENOBUFS/EAGAIN) */
+	uint64_t rx_rejected;  /* frames read but not data: RTR, extended id, size */
 };
 
 /*

@@ -19,20 +19,20 @@
 #include <stdbool.h>
 #include <stdint.h>
 
-#define IRDM_CAN_PDO_INVALID 0x80000000u   /* COB-ID bit 31: the PDO does not exist */
-#define IRDM_CAN_PDO_NO_RTR 0x40000000u    /* COB-ID bit 30: no remote request allowed */
-#define IRDM_CAN_PDO_EXTENDED 0x20000000u  /* COB-ID bit 29: a 29-bit identifier */
-#define IRDM_CAN_PDO_ENTRIES 2             /* the CST mapping's entries */
-#define IRDM_CAN_PDO_SYNC_EVERY 1          /* transmission type: synchronous, every SYNC */
-#define IRDM_CAN_PDO_ASYNC 0xFF            /* transmission type: event-driven (as booted) */
+#define IRDM_CAN_PDO_INVALID 0x80000000u  /* COB-ID bit 31: the PDO does not exist */
+#define IRDM_CAN_PDO_NO_RTR 0x40000000u   /* COB-ID bit 30: no remote request allowed */
+#define IRDM_CAN_PDO_EXTENDED 0x20000000u /* COB-ID bit 29: a 29-bit identifier */
+#define IRDM_CAN_PDO_ENTRIES 2            /* the CST mapping's entries */
+#define IRDM_CAN_PDO_SYNC_EVERY 1         /* transmission type: synchronous, every SYNC */
+#define IRDM_CAN_PDO_ASYNC 0xFF           /* transmission type: event-driven (as booted) */
 
 struct irdm_can_pdo {
-	uint32_t cob_id;                /* :01, with bit 31 */
-	uint8_t transmission;           /* :02 */
-	uint8_t n_mapped;               /* mapping :00 */
-	bool no_rtr;                    /* a TPDO of a drive that serves no RTR */
-	uint16_t event_timer_ms;        /* :05 (0: none) */
-	const uint32_t *map;            /* the entries it takes, IRDM_CAN_PDO_ENTRIES */
+	uint32_t cob_id;         /* :01, with bit 31 */
+	uint8_t transmission;    /* :02 */
+	uint8_t n_mapped;        /* mapping :00 */
+	bool no_rtr;             /* a TPDO of a drive that serves no RTR */
+	uint16_t event_timer_ms; /* :05 (0: none) */
+	const uint32_t *map;     /* the entries it takes, IRDM_CAN_PDO_ENTRIES */
 };
 
 /* The stored configuration a drive boots with, as many real drives ship:

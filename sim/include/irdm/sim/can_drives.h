@@ -49,29 +49,29 @@ struct irdm_can_drive {
 	unsigned node;
 	enum irdm_co_nmt_state nmt;
 	struct irdm_cia402_drive fsa;
-	int8_t mode;                    /* 0x6060: 10 = cyclic synchronous torque */
-	uint16_t heartbeat_ms;          /* 0x1017: 0 = none */
-	uint32_t rated_torque_mnm;      /* 0x6076: motor side, mN m */
-	struct irdm_can_pdo rpdo1;      /* 0x1400, 0x1600: controlword + target torque */
-	struct irdm_can_pdo tpdo1;      /* 0x1800, 0x1A00: statusword + position */
-	uint32_t cycle_us;              /* 0x1006: communication cycle period (0: none) */
-	uint8_t sync_overflow;          /* 0x1019: 0 SYNC without counter; 2..240 with */
-	uint32_t hb_consumer;           /* 0x1016:01: node << 16 | time ms (0: off) */
-	int16_t abort_option;           /* 0x6007: reaction to a lost connection */
-	bool master_beat_seen, rpdo_seen;       /* deadlines run from the first frame */
-	uint64_t master_beat_us, rpdo_us;       /* the last one (deadline clock) */
-	uint16_t lost_code;             /* the time-out taken (EMCY code), 0: none */
+	int8_t mode;                      /* 0x6060: 10 = cyclic synchronous torque */
+	uint16_t heartbeat_ms;            /* 0x1017: 0 = none */
+	uint32_t rated_torque_mnm;        /* 0x6076: motor side, mN m */
+	struct irdm_can_pdo rpdo1;        /* 0x1400, 0x1600: controlword + target torque */
+	struct irdm_can_pdo tpdo1;        /* 0x1800, 0x1A00: statusword + position */
+	uint32_t cycle_us;                /* 0x1006: communication cycle period (0: none) */
+	uint8_t sync_overflow;            /* 0x1019: 0 SYNC without counter; 2..240 with */
+	uint32_t hb_consumer;             /* 0x1016:01: node << 16 | time ms (0: off) */
+	int16_t abort_option;             /* 0x6007: reaction to a lost connection */
+	bool master_beat_seen, rpdo_seen; /* deadlines run from the first frame */
+	uint64_t master_beat_us, rpdo_us; /* the last one (deadline clock) */
+	uint16_t lost_code;               /* the time-out taken (EMCY code), 0: none */
 	uint64_t lost_at_us;
-	uint16_t rpdo_cw;               /* the latest RPDO1 */
+	uint16_t rpdo_cw; /* the latest RPDO1 */
 	int16_t rpdo_torque_permille;
 	uint64_t heartbeat_next_us;
 	/* injected faults */
 	bool no_heartbeat;
-	unsigned drop_tpdos;            /* the next k TPDOs are not sent */
-	bool sdo_wrong;                 /* SDO answers name another object */
-	unsigned delay_tpdos;           /* the next k TPDOs are held delay_us (wall) */
+	unsigned drop_tpdos;  /* the next k TPDOs are not sent */
+	bool sdo_wrong;       /* SDO answers name another object */
+	unsigned delay_tpdos; /* the next k TPDOs are held delay_us (wall) */
 	uint32_t delay_us;
-	bool held;                      /* a delayed TPDO waits for held_due_us */
+	bool held; /* a delayed TPDO waits for held_due_us */
 	struct irdm_can_frame held_frame;
 	uint64_t held_due_us;
 };
@@ -87,13 +87,13 @@ struct irdm_can_drives {
 	struct irdm_can_drive d[IRDM_CAN_DRIVES_MAX];
 	double period_s;
 	uint64_t now_us;
-	uint8_t sync_counter;           /* the last SYNC's counter byte (0: none) */
+	uint8_t sync_counter; /* the last SYNC's counter byte (0: none) */
 	uint64_t syncs, bad_frames, sync_length_errors;
 	uint64_t tpdos_sent, tpdos_dropped, tpdos_delayed, flood_sent, faults_fired;
-	bool wall_heartbeat;            /* heartbeats on irdm_can_drives_wall()'s clock */
-	bool docked;                    /* the arm rests in its calibration dock (no
+	bool wall_heartbeat; /* heartbeats on irdm_can_drives_wall()'s clock */
+	bool docked;         /* the arm rests in its calibration dock (no
 					 * steps) until a drive first applies torque */
-	uint64_t wall_us;               /* the last wall time given */
+	uint64_t wall_us;    /* the last wall time given */
 	irdm_can_drives_hook before_step;
 	void *hook_ctx;
 	struct irdm_can_fault fault[IRDM_CAN_FAULTS_MAX];

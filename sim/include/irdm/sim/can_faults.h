@@ -21,10 +21,10 @@
 #include <stdint.h>
 
 #define IRDM_CAN_FAULTS_MAX 16
-#define IRDM_CAN_FAULT_K_MAX 100000u            /* periods a drop or delay may last */
-#define IRDM_CAN_FAULT_DELAY_US_MAX 1000000u    /* one second: past every time-out */
-#define IRDM_CAN_FAULT_FLOOD_MAX 10000u         /* frames of one flood */
-#define IRDM_CAN_FLOOD_ID 0x001u                /* wins arbitration over all but NMT */
+#define IRDM_CAN_FAULT_K_MAX 100000u         /* periods a drop or delay may last */
+#define IRDM_CAN_FAULT_DELAY_US_MAX 1000000u /* one second: past every time-out */
+#define IRDM_CAN_FAULT_FLOOD_MAX 10000u      /* frames of one flood */
+#define IRDM_CAN_FLOOD_ID 0x001u             /* wins arbitration over all but NMT */
 
 enum irdm_can_fault_kind {
 	IRDM_CAN_FAULT_DROP,
@@ -38,11 +38,11 @@ enum irdm_can_fault_kind {
 
 struct irdm_can_fault {
 	enum irdm_can_fault_kind kind;
-	unsigned node;                  /* 1..127; 0 for a flood */
-	uint64_t at_sync;               /* 0: from the start (sdo-wrong) */
-	uint32_t count;                 /* drop/delay: periods; flood: frames */
+	unsigned node;    /* 1..127; 0 for a flood */
+	uint64_t at_sync; /* 0: from the start (sdo-wrong) */
+	uint32_t count;   /* drop/delay: periods; flood: frames */
 	uint32_t delay_us;
-	uint16_t code;                  /* EMCY error code */
+	uint16_t code; /* EMCY error code */
 };
 
 /*

@@ -21,17 +21,17 @@ struct irdm_can_membus;
 struct irdm_can_endpoint {
 	struct irdm_can_membus *bus;
 	unsigned index;
-	uint64_t next;          /* the next frame this endpoint reads */
-	uint64_t lost;          /* frames overwritten before it read them */
+	uint64_t next; /* the next frame this endpoint reads */
+	uint64_t lost; /* frames overwritten before it read them */
 };
 
 struct irdm_can_membus {
 	struct irdm_can_frame ring[IRDM_CAN_MEMBUS_FRAMES];
-	unsigned from[IRDM_CAN_MEMBUS_FRAMES];  /* sender endpoint of each */
-	uint64_t sent;                          /* frames ever sent */
+	unsigned from[IRDM_CAN_MEMBUS_FRAMES]; /* sender endpoint of each */
+	uint64_t sent;                         /* frames ever sent */
 	struct irdm_can_endpoint ep[IRDM_CAN_MEMBUS_ENDPOINTS];
 	unsigned n_endpoints;
-	void (*tap)(void *ctx, const struct irdm_can_frame *f, unsigned from);  /* or NULL */
+	void (*tap)(void *ctx, const struct irdm_can_frame *f, unsigned from); /* or NULL */
 	void *tap_ctx;
 };
 

@@ -48,7 +48,7 @@
 
 #include "irdm/device.h"
 
-#define IRDM_SIM_DELAY_MAX 16           /* ticks, either direction */
+#define IRDM_SIM_DELAY_MAX 16 /* ticks, either direction */
 #define IRDM_SIM_SUBSTEPS_MAX 1000
 /* irdm_sim_params_default()'s, and the sim back-end's option defaults */
 #define IRDM_SIM_DEFAULT_SUBSTEPS 10
@@ -56,29 +56,29 @@
 #define IRDM_SIM_DEFAULT_DELAY_TICKS 0
 
 struct irdm_sim_params {
-	double joint_inertia_kg_m2[3];          /* added to the mass matrix's diagonal, > 0 */
-	double viscous_nm_s_per_rad[3];         /* >= 0 */
-	double coulomb_nm[3];                   /* >= 0 */
-	double stick_velocity_rad_per_s;        /* > 0 */
-	unsigned substeps;                      /* RK4 steps per tick, 1..IRDM_SIM_SUBSTEPS_MAX */
-	unsigned write_delay_ticks;             /* 0..IRDM_SIM_DELAY_MAX */
-	unsigned read_delay_ticks;              /* 0..IRDM_SIM_DELAY_MAX */
-	double q0_rad[3];                       /* initial pose, at rest */
-	int end_stops;                          /* 1: stops inside the count range (above) */
-	double stop_inset_rad;                  /* >= 0; the range must be wider than 2x it */
-	double stop_stiffness_nm_per_rad;       /* > 0 */
-	double stop_damping_nm_s_per_rad;       /* >= 0 */
+	double joint_inertia_kg_m2[3];    /* added to the mass matrix's diagonal, > 0 */
+	double viscous_nm_s_per_rad[3];   /* >= 0 */
+	double coulomb_nm[3];             /* >= 0 */
+	double stick_velocity_rad_per_s;  /* > 0 */
+	unsigned substeps;                /* RK4 steps per tick, 1..IRDM_SIM_SUBSTEPS_MAX */
+	unsigned write_delay_ticks;       /* 0..IRDM_SIM_DELAY_MAX */
+	unsigned read_delay_ticks;        /* 0..IRDM_SIM_DELAY_MAX */
+	double q0_rad[3];                 /* initial pose, at rest */
+	int end_stops;                    /* 1: stops inside the count range (above) */
+	double stop_inset_rad;            /* >= 0; the range must be wider than 2x it */
+	double stop_stiffness_nm_per_rad; /* > 0 */
+	double stop_damping_nm_s_per_rad; /* >= 0 */
 };
 
 struct irdm_sim_device {
 	struct irdm_device_config dev;
 	struct irdm_sim_params p;
-	double stop_lo_rad[3], stop_hi_rad[3];  /* the stops (+-inf without end_stops) */
+	double stop_lo_rad[3], stop_hi_rad[3]; /* the stops (+-inf without end_stops) */
 	double q_rad[3];
 	double qd_rad_per_s[3];
-	double cmd_nm[3];                       /* last command (clipped) */
-	double motor_nm[3];                     /* reaching the motors this tick */
-	double hand_n[3];                       /* external force on the tip */
+	double cmd_nm[3];   /* last command (clipped) */
+	double motor_nm[3]; /* reaching the motors this tick */
+	double hand_n[3];   /* external force on the tip */
 	uint64_t ticks;
 	double cmd_ring[IRDM_SIM_DELAY_MAX + 1][3];
 	int32_t count_ring[IRDM_SIM_DELAY_MAX + 1][3];

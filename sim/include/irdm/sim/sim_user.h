@@ -72,15 +72,15 @@
 #include <stddef.h>
 
 #define IRDM_SIM_USER_HANDS 2
-#define IRDM_SIM_USER_SEGMENTS_MAX 256          /* per hand */
-#define IRDM_SIM_USER_LINE_MAX 256              /* reader buffer: line, newline, NUL */
+#define IRDM_SIM_USER_SEGMENTS_MAX 256 /* per hand */
+#define IRDM_SIM_USER_LINE_MAX 256     /* reader buffer: line, newline, NUL */
 #define IRDM_SIM_USER_TIME_MAX_S 3600.0
-#define IRDM_SIM_USER_COORD_MAX_M 1.0           /* a desktop device reaches ~0.2 m */
-#define IRDM_SIM_USER_K_MAX_N_PER_M 10000.0     /* well above a clenched grip */
+#define IRDM_SIM_USER_COORD_MAX_M 1.0       /* a desktop device reaches ~0.2 m */
+#define IRDM_SIM_USER_K_MAX_N_PER_M 10000.0 /* well above a clenched grip */
 #define IRDM_SIM_USER_B_MAX_NS_PER_M 100.0
 #define IRDM_SIM_USER_K_DEFAULT_N_PER_M 300.0
 #define IRDM_SIM_USER_B_DEFAULT_NS_PER_M 2.0
-#define IRDM_SIM_USER_GRASP_MAX_M 0.01          /* first place to home, at most */
+#define IRDM_SIM_USER_GRASP_MAX_M 0.01 /* first place to home, at most */
 
 /*
  * From t0_s on the hand is `active`; its target eases from from_m (at t0_s)
@@ -91,18 +91,18 @@ struct irdm_sim_user_seg {
 	double from_m[3], to_m[3];
 	double k_n_per_m, b_ns_per_m;
 	int active;
-	int from_home, to_home;                 /* 1: that end is an offset from home */
+	int from_home, to_home; /* 1: that end is an offset from home */
 };
 
 struct irdm_sim_user_hand {
-	unsigned n;                             /* segments used, t0_s non-decreasing */
-	int needs_home;                         /* 'home' used, not yet resolved */
+	unsigned n;     /* segments used, t0_s non-decreasing */
+	int needs_home; /* 'home' used, not yet resolved */
 	struct irdm_sim_user_seg seg[IRDM_SIM_USER_SEGMENTS_MAX];
 };
 
 struct irdm_sim_user {
-	unsigned hands;                         /* 1 + the highest hand the script names */
-	double end_s;                           /* when the last command ends */
+	unsigned hands; /* 1 + the highest hand the script names */
+	double end_s;   /* when the last command ends */
 	struct irdm_sim_user_hand hand[IRDM_SIM_USER_HANDS];
 };
 

@@ -24,9 +24,9 @@ enum irdm_clock_mode {
 struct irdm_clock {
 	enum irdm_clock_mode mode;
 	uint32_t period_ns;
-	uint64_t tick;                  /* periods started so far */
-	struct timespec next;           /* real: start of the next period */
-	struct timespec wake;           /* real: when this period's wait returned */
+	uint64_t tick;        /* periods started so far */
+	struct timespec next; /* real: start of the next period */
+	struct timespec wake; /* real: when this period's wait returned */
 };
 
 /*

@@ -30,7 +30,7 @@
 
 #define IRDM_DEFORM_BLAS_THREADS 1
 
-struct irdm_deform_worker;   /* opaque, in caller memory */
+struct irdm_deform_worker; /* opaque, in caller memory */
 
 /*
  * Bytes irdm_deform_worker_init() needs for this image (0 if the update
@@ -82,8 +82,7 @@ uint32_t irdm_deform_rows(const struct irdm_deform_worker *w);
  */
 struct irdm_deform_thread;
 int irdm_deform_thread_start(struct irdm_deform_thread **th, struct irdm_deform_worker *w,
-			     double rate_hz, void (*frame)(void *ctx, const double *pos_m,
-							   uint64_t tick),
+			     double rate_hz, void (*frame)(void *ctx, const double *pos_m, uint64_t tick),
 			     void *ctx, char *err, size_t errlen);
 /* Stop (within one period) and join.  NULL is fine. */
 void irdm_deform_thread_stop(struct irdm_deform_thread *th);

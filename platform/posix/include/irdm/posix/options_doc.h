@@ -13,8 +13,8 @@
 #include "irdm/options.h"
 
 enum irdm_opt_style {
-	IRDM_OPT_STYLE_KEY,     /* "  dt = SECONDS    help" (file keys) */
-	IRDM_OPT_STYLE_ARG,     /* "  --dt SECONDS    help" (arguments) */
+	IRDM_OPT_STYLE_KEY, /* "  dt = SECONDS    help" (file keys) */
+	IRDM_OPT_STYLE_ARG, /* "  --dt SECONDS    help" (arguments) */
 };
 
 /* One line per entry (two if the syntax is long): syntax, help, default, range. */

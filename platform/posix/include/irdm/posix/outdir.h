@@ -27,16 +27,16 @@
 
 #define IRDM_OUTDIR_PATH_MAX 4096
 #define IRDM_OUTDIR_MARKER ".irdm-output"
-#define IRDM_OUTDIR_TMP ".irdm-tmp."            /* DIR.irdm-tmp.XXXXXX */
+#define IRDM_OUTDIR_TMP ".irdm-tmp." /* DIR.irdm-tmp.XXXXXX */
 
 struct irdm_outdir {
 	char dir[IRDM_OUTDIR_PATH_MAX];
-	char tmp[IRDM_OUTDIR_PATH_MAX + 32];    /* where the files go; "" when none */
-	char tool[64];                          /* "irdm-fw", "irdm render" */
+	char tmp[IRDM_OUTDIR_PATH_MAX + 32]; /* where the files go; "" when none */
+	char tool[64];                       /* "irdm-fw", "irdm render" */
 	bool force;
-	bool replace_foreign;                   /* forced over a directory we did not write */
-	unsigned debris_removed;                /* killed runs' directories removed at begin */
-	char why[IRDM_OUTDIR_PATH_MAX + 256];   /* one line naming the path, after a failure */
+	bool replace_foreign;                 /* forced over a directory we did not write */
+	unsigned debris_removed;              /* killed runs' directories removed at begin */
+	char why[IRDM_OUTDIR_PATH_MAX + 256]; /* one line naming the path, after a failure */
 };
 
 /*

@@ -19,9 +19,9 @@
 #define IRDM_OUTFILE_PATH_MAX 4096
 
 struct irdm_outfile {
-	FILE *f;                                /* write here; NULL when none */
-	int lock_fd;                            /* holds the temporary's lock; -1 when none */
-	unsigned debris_removed;                /* killed writers' temporaries removed at open */
+	FILE *f;                 /* write here; NULL when none */
+	int lock_fd;             /* holds the temporary's lock; -1 when none */
+	unsigned debris_removed; /* killed writers' temporaries removed at open */
 	char path[IRDM_OUTFILE_PATH_MAX];
 	char tmp[IRDM_OUTFILE_PATH_MAX + 32];
 };

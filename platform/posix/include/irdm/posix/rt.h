@@ -52,22 +52,22 @@
 
 /* How a thread is to be scheduled. */
 struct irdm_rt_sched {
-	int policy;     /* SCHED_FIFO or SCHED_OTHER */
-	int priority;   /* SCHED_FIFO: 1..99; SCHED_OTHER: 0 */
-	int cpu;        /* the one CPU it may run on, IRDM_RT_ANY_CPU or IRDM_RT_CPU_EXCEPT(n) */
+	int policy;   /* SCHED_FIFO or SCHED_OTHER */
+	int priority; /* SCHED_FIFO: 1..99; SCHED_OTHER: 0 */
+	int cpu;      /* the one CPU it may run on, IRDM_RT_ANY_CPU or IRDM_RT_CPU_EXCEPT(n) */
 };
 
 /* What the system granted, read back by irdm_rt_report_get(). */
 struct irdm_rt_report {
-	bool preempt_rt;            /* the kernel is PREEMPT_RT */
-	int policy;                 /* the calling thread's, -1 if unknown */
-	int priority;               /* its static priority (0 outside SCHED_FIFO/RR) */
-	int cpu;                    /* the CPU it ran on during the call, -1 if unknown */
-	uint64_t cpu_mask;          /* its affinity, CPUs 0..63: bit n is CPU n */
-	unsigned n_cpus;            /* CPUs in its affinity (any number), 0 if unknown */
-	bool memory_locked;         /* everything mapped is locked (VmLck covers VmSize) */
-	unsigned long locked_kb;    /* VmLck of /proc/self/status */
-	unsigned long mapped_kb;    /* VmSize */
+	bool preempt_rt;         /* the kernel is PREEMPT_RT */
+	int policy;              /* the calling thread's, -1 if unknown */
+	int priority;            /* its static priority (0 outside SCHED_FIFO/RR) */
+	int cpu;                 /* the CPU it ran on during the call, -1 if unknown */
+	uint64_t cpu_mask;       /* its affinity, CPUs 0..63: bit n is CPU n */
+	unsigned n_cpus;         /* CPUs in its affinity (any number), 0 if unknown */
+	bool memory_locked;      /* everything mapped is locked (VmLck covers VmSize) */
+	unsigned long locked_kb; /* VmLck of /proc/self/status */
+	unsigned long mapped_kb; /* VmSize */
 };
 
 /* ---- memory ---- */
@@ -217,12 +217,12 @@ int irdm_rt_report_format(const struct irdm_rt_report *r, char *buf, size_t len)
 struct irdm_rt_task {
 	pid_t tid;
 	char name[16];
-	int policy;                 /* -1 if unknown (the thread ended meanwhile) */
+	int policy; /* -1 if unknown (the thread ended meanwhile) */
 	int priority;
-	uint64_t cpu_mask;          /* CPUs 0..63, as irdm_rt_report */
-	unsigned n_cpus;            /* 0 if unknown */
-	bool loop;                  /* the loop's thread: set by irdm_rt_isolation_check() */
-	bool intrudes;              /* not the loop's and may run on its CPU: likewise */
+	uint64_t cpu_mask; /* CPUs 0..63, as irdm_rt_report */
+	unsigned n_cpus;   /* 0 if unknown */
+	bool loop;         /* the loop's thread: set by irdm_rt_isolation_check() */
+	bool intrudes;     /* not the loop's and may run on its CPU: likewise */
 };
 
 /*
@@ -274,8 +274,8 @@ int irdm_rt_sleep_until(const struct timespec *t);
  * Timespec arithmetic on normalised values (0 <= tv_nsec < 1e9; a negative
  * time has a negative tv_sec, -0.25 s is { -1, 750000000 }).
  */
-void irdm_rt_timespec_add(struct timespec *t, const struct timespec *dt);   /* t += dt */
+void irdm_rt_timespec_add(struct timespec *t, const struct timespec *dt);             /* t += dt */
 int64_t irdm_rt_timespec_diff_ns(const struct timespec *a, const struct timespec *b); /* b - a */
-int irdm_rt_timespec_cmp(const struct timespec *a, const struct timespec *b); /* <0, 0, >0 */
+int irdm_rt_timespec_cmp(const struct timespec *a, const struct timespec *b);         /* <0, 0, >0 */
 
 #endif /* IRDM_RT_H */

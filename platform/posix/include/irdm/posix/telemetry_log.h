@@ -18,11 +18,11 @@ uint64_t irdm_log_size(uint64_t n);
 
 /* What the caller says about a run; names are cut to fit the header. */
 struct irdm_log_info {
-	uint32_t period_us;             /* > 0 */
-	uint32_t n_devices;             /* 0..IRDM_TELEM_MAX_DEVICES */
+	uint32_t period_us; /* > 0 */
+	uint32_t n_devices; /* 0..IRDM_TELEM_MAX_DEVICES */
 	int64_t start_time_ns;
-	const char *board;              /* NULL: "" */
-	const char *image;              /* NULL: "" */
+	const char *board; /* NULL: "" */
+	const char *image; /* NULL: "" */
 };
 
 /* A log being written, synchronously (the writer thread runs on one). */
@@ -75,8 +75,8 @@ uint64_t irdm_log_file_count(const struct irdm_log_file *lf);
 struct irdm_log_writer;
 struct irdm_rt_sched;
 
-#define IRDM_LOG_WRITER_CHUNK 256       /* records per fwrite at most */
-#define IRDM_LOG_WRITER_IDLE_US 2000    /* sleep when the ring is empty */
+#define IRDM_LOG_WRITER_CHUNK 256    /* records per fwrite at most */
+#define IRDM_LOG_WRITER_IDLE_US 2000 /* sleep when the ring is empty */
 
 /*
  * Open the log (irdm_log_file_open) and start a thread that pops `ring`

@@ -19,7 +19,7 @@
 
 /* Bounds of the project's text inputs: far above any real one. */
 #define IRDM_TEXT_MAX_BYTES (16u << 20)
-#define IRDM_DATA_MAX_BYTES (4ull << 30)        /* trajectories, logs, parts */
+#define IRDM_DATA_MAX_BYTES (4ull << 30) /* trajectories, logs, parts */
 
 /*
  * Open path for reading; *fd on success.  Return: IRDM_OK; IRDM_EIO (cannot
@@ -35,7 +35,7 @@ int irdm_file_fopen(const char *path, size_t max_bytes, FILE **f, char *err, siz
 struct irdm_text_file {
 	FILE *f;
 	const char *name;
-	unsigned line_no;               /* of the line last read, from 1 */
+	unsigned line_no; /* of the line last read, from 1 */
 	size_t bytes, max_bytes;
 };
 
