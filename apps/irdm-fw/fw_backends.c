@@ -77,25 +77,6 @@ const struct fw_backend *fw_backend_of(const char *name)
 	return i < 0 ? NULL : known[i].built;
 }
 
-/* The line of the board file that names the back-end (0: not found). */
-static unsigned hal_line(const char *path)
-{
-	char line[IRDM_BOARD_LINE_MAX];
-	unsigned n = 0, found = 0;
-	FILE *f = fopen(path, "r");
-
-	while (f && !found && fgets(line, sizeof(line), f)) {
-		const char *p = line + strspn(line, " \t");
-
-		n++;
-		if (!strncmp(p, "hal", 3) && p[3 + strspn(p + 3, " \t")] == '=')
-			found = n;
-	}
-	if (f)
-		fclose(f);
-	return found;
-}
-
 int fw_backend_check_built(struct fw *fw)
 {
 	int i = known_index(fw->board.hal);
@@ -103,7 +84,7 @@ int fw_backend_check_built(struct fw *fw)
 	if (i < 0 || known[i].built)
 		return IRDM_OK;
 	snprintf(fw->err, sizeof(fw->err), "%s:%u: hal = %s: not built in this irdm-fw (%s)",
-		 fw->args.board, hal_line(fw->args.board), fw->board.hal, known[i].config);
+		 fw->args.board, fw->board.hal_line, fw->board.hal, known[i].config);
 	return IRDM_ENOTSUP;
 }
 

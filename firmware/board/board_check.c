@@ -214,6 +214,7 @@ int irdm_board_finish(struct irdm_board *b, const struct irdm_opt_file *f, char 
 		ret = checks[i](&c);
 	if (!ret) {
 		irdm_board_set_rotation(b);
+		b->hal_line = line_of(&c, "hal");
 		b->hal_options_line = line_of(&c, "hal_options");
 	}
 	return ret;

@@ -46,6 +46,8 @@
 struct irdm_board {
 	char name[IRDM_BOARD_NAME_MAX];
 	char hal[IRDM_BOARD_HAL_MAX];                 /* back-end name (irdm_hal_find) */
+	unsigned hal_line;                            /* its line in the file (0: not given), for
+					 * refusals naming it; set by the loader */
 	char hal_options[IRDM_BOARD_HAL_OPTIONS_MAX]; /* handed to the back-end as is */
 	unsigned hal_options_line;                    /* its line in the file (0: not given), for
 					 * the back-end's messages; set by the loader */
