@@ -28,6 +28,9 @@
 #                   board keys in boards.md, the test index in testing.md);
 #                   make docs-check: fails if one is stale
 #   make sizes      irdm-fw built with each configs/*.config (CONFIG=FILE: one)
+#   make material-grid  the precompute over a grid of materials, ticks and
+#                   precisions: each image certified and within max_error or
+#                   refused (docs/measurements/material-grid.md)
 #   make format-check  every C source and header against .clang-format
 #                   (clang-format 14); make format rewrites them
 #
@@ -173,7 +176,7 @@ CORE_TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(CORE_TEST_SRC))
 FWAPP_TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(FWAPP_TEST_SRC))
 BENCHES  := $(patsubst tests/bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC))
 
-.PHONY: all test test-variants san fuzz bench bench-precompute bench-mpi run render view-shots jitter-view stability report jitter check deps clean docs docs-check cfg-fws sizes hil format format-check
+.PHONY: all test test-variants san fuzz material-grid bench bench-precompute bench-mpi run render view-shots jitter-view stability report jitter check deps clean docs docs-check cfg-fws sizes hil format format-check
 .SECONDARY:
 all: $(if $(CONFIG),,$(IRDM) $(SLEPC_PLUGIN)) $(FW_LIB) $(POSIX_LIB) $(HAL_LIB) $(SIM_LIB) $(if $(FWMAIN_SRC),$(IRDM_FW)) \
   $(if $(CDMAIN_SRC),$(IRDM_CD))
@@ -408,6 +411,13 @@ stability-run:
 	IRDM_STAB_OUT=$(STAB_OUT) $(BUILD)/tests/test_stability_spin
 	IRDM_STAB_OUT=$(STAB_OUT) IRDM_SOAK_SECONDS=$(STAB_SOAK_SECONDS) $(BUILD)/tests/test_stability_soak
 	/usr/bin/python3 tools/scripts/stability-report.py $(STAB_OUT)
+
+# Every case written within max_error and certified, or refused with a
+# message (tools/scripts/material-grid.sh); GRID_JOBS precomputes at once.
+GRID_JOBS ?= 2
+material-grid: $(IRDM)
+	$(MEASURE) -m material-grid 'make material-grid GRID_JOBS=$(GRID_JOBS)' -- \
+	  tools/scripts/material-grid.sh $(IRDM) $(GRID_JOBS)
 
 # Each benchmark alone: make bench_tick, make bench_ctrl, ... (the names of
 # tests/bench/*.c), each writing docs/measurements/NAME.md.
