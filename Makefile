@@ -11,6 +11,8 @@
 #                   variants, then the tests
 #   make bench      benchmarks (print figures; never pass/fail on time), each
 #                   into docs/measurements/NAME.md (make bench_tick: one)
+#   make head-tick  the hybrid tick timed and its instructions counted
+#                   (callgrind), beside an earlier one: BEFORE=its bench_tick
 #   make bench-mpi  the precompute of a 100k-node model, serial and over MPI ranks
 #   make stability  the stability suite's long run (10^7-tick soak): a Markdown
 #                   table and a plot of the worst cases in out/stability/

@@ -91,6 +91,18 @@ void irdm_head_ring_sum_wide(const struct irdm_engine *e, uint32_t col, double u
 	}
 }
 
+static inline size_t elem_bytes(uint32_t prec)
+{
+	switch (prec) {
+	case IRDM_ELEM_F64:
+		return 8;
+	case IRDM_ELEM_F32:
+		return 4;
+	default:
+		return 2;
+	}
+}
+
 static WIDE_INLINE void fold_add(const struct row_acc *a, double u[3])
 {
 	double v[3];
@@ -132,7 +144,7 @@ static WIDE_INLINE void lanes_pass(const struct irdm_engine *e, uint32_t prec, u
 				   uint32_t n_spans, const struct head_span *sp,
 				   const uint32_t *cols, double (*u)[3])
 {
-	size_t elem = prec == IRDM_ELEM_F64 ? 8 : prec == IRDM_ELEM_F32 ? 4 : 2;
+	size_t elem = elem_bytes(prec);
 	const char *D = e->img->exact_head;
 	/* one variable a row, not an array: they stay in registers */
 	struct row_acc a0, a1, a2;
