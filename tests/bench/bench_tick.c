@@ -11,7 +11,7 @@
  * Itanium2 times; never fails on time.
  *
  * Run from the repository root: images are reused from out/bench/ and made
- * there when missing.  IRDM_BENCH_ONLY and IRDM_BENCH_TICKS select cases
+ * there when missing, those of the selected cases only.  IRDM_BENCH_ONLY and IRDM_BENCH_TICKS select cases
  * and shorten them, for instructions per tick under callgrind
  * (bench_util.h; --toggle-collect=irdm_engine_tick), e.g.
  * IRDM_BENCH_ONLY=hybrid,fir-500 (2 ms).  Runs under SCHED_FIFO on CPU 1 with mlockall when it
