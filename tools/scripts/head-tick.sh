@@ -45,7 +45,7 @@ figures() {
 	sed -n "s/.*$pat *median *\([0-9.]*\) us *p99 *\([0-9.]*\) us.*/\1 \2/p" "$1"
 }
 
-echo "# The hybrid tick: time and instructions"
+echo "The hybrid tick: time and instructions per tick."
 echo
 for i in "${!names[@]}"; do
 	echo "- ${names[$i]}: \`${bins[$i]}\` (built $(date -u -r "${bins[$i]}" '+%Y-%m-%d %H:%M UTC'))"
