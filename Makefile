@@ -11,6 +11,8 @@
 #                   variants, then the tests
 #   make bench      benchmarks (print figures; never pass/fail on time), each
 #                   into docs/measurements/NAME.md (make bench_tick: one)
+#   make head-tick  the hybrid tick timed and its instructions counted
+#                   (callgrind), beside an earlier one: BEFORE=its bench_tick
 #   make bench-mpi  the precompute of a 100k-node model, serial and over MPI ranks
 #   make stability  the stability suite's long run (10^7-tick soak): a Markdown
 #                   table and a plot of the worst cases in out/stability/
@@ -176,7 +178,7 @@ CORE_TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(CORE_TEST_SRC))
 FWAPP_TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(FWAPP_TEST_SRC))
 BENCHES  := $(patsubst tests/bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC))
 
-.PHONY: all test test-variants san fuzz material-grid bench bench-precompute bench-mpi run render view-shots jitter-view stability report jitter check deps clean docs docs-check cfg-fws sizes hil format format-check
+.PHONY: all test test-variants san fuzz material-grid bench bench-precompute bench-mpi run render view-shots jitter-view stability report jitter check deps clean docs docs-check cfg-fws sizes hil format format-check head-tick
 .SECONDARY:
 all: $(if $(CONFIG),,$(IRDM) $(SLEPC_PLUGIN)) $(FW_LIB) $(POSIX_LIB) $(HAL_LIB) $(SIM_LIB) $(if $(FWMAIN_SRC),$(IRDM_FW)) \
   $(if $(CDMAIN_SRC),$(IRDM_CD))
@@ -430,6 +432,15 @@ bench: $(BENCHES) $(IRDM) bench-precompute
 	for b in $(BENCH_NAMES); do $(MAKE) --no-print-directory $$b; done
 	@echo "== ticks paced at 1 kHz, deformation thread running (make jitter, 5 x 2 s)"
 	$(MAKE) --no-print-directory jitter JITTER_ROUNDS=5 JITTER_SECONDS=2
+
+# The hybrid tick (bench_tick's hybrid cases) timed and its instructions
+# per tick counted under callgrind, with where they went; beside a
+# bench_tick built earlier when BEFORE names it (make head-tick
+# BEFORE=path/to/bench_tick): docs/measurements/head-tick.md.
+BEFORE ?=
+head-tick: $(BUILD)/bench/bench_tick
+	$(MEASURE) -m head-tick 'make head-tick$(if $(BEFORE), BEFORE=$(BEFORE))' -- \
+	  tools/scripts/head-tick.sh $< $(BEFORE)
 
 # Accuracy, tick time and image size of every representation against the
 # exact full model (irdm report --help); CSVs in out/report/, the report

@@ -745,6 +745,100 @@ static void test_stroke(void **state)
 	stroke(&clustered, "modal 40 + clustered f32");
 }
 
+/*
+ * A hybrid's head keeps each force column's history apart (a lane a
+ * column) for as many columns as two ticks can hold; more columns within
+ * one head send the sum back to its ring of ticks until they are older
+ * than the head.  A contact that hops to another top triangle every tick
+ * for N_HOP ticks (every top node within one head), then holds still:
+ * the sum from the ring, then from lanes that start afresh.
+ */
+#define N_HOP 300
+
+static void hop_sites(const struct irdm_image *img, struct irdm_engine *e,
+		      struct irdm_contact_site *sites)
+{
+	static const double bary[3] = { 0.5, 0.3, 0.2 };
+	uint32_t top[256], n_top = 0;
+
+	for (uint32_t t = 0; t < img->meta->n_tris && n_top < 256; t++) {
+		const uint32_t *v = &img->tris[3 * t];
+		bool all = true;
+		for (int a = 0; a < 3; a++)
+			all &= img->nodes[v[a]].pos_m[2] >= 0.2 - 1e-9;
+		if (all)
+			top[n_top++] = t;
+	}
+	assert_true(n_top >= 16);
+	for (size_t t = 0; t < N_STROKE; t++) {
+		uint32_t tri = top[t < N_HOP ? (7 * t) % n_top : 0];
+		assert_int_equal(irdm_engine_site_point(e, tri, bary, &sites[t]), 0);
+	}
+}
+
+/* Forces of the hop; ask: every site node's free displacement read
+ * before each tick, one node at a time (as the proxy reads them). */
+static void hop_run(const struct irdm_image *img, bool portable, bool ask,
+		    struct irdm_contact_site *sites, const double *u, double *F)
+{
+	struct irdm_engine_config cfg;
+	struct irdm_contact_cmd cmd[IRDM_MAX_CONTACTS];
+
+	irdm_engine_config_default(&cfg);
+	cfg.max_contacts = 1;
+	cfg.fir_portable_sum = portable;
+	struct irdm_session *ses = efx_session(img, &cfg);
+	struct irdm_engine *e = ses->eng;
+	hop_sites(img, e, sites);
+	for (size_t t = 0; t < N_STROKE; t++) {
+		assert_int_equal(irdm_engine_contact_begin(e, 0, &sites[t], IRDM_CONTACT_GRAB), 0);
+		for (uint32_t v = 0; ask && v < 3; v++) {
+			double un[3];
+			irdm_engine_node_disp(e, sites[t].row[v], un);
+		}
+		memset(cmd, 0, sizeof(cmd));
+		cmd[0].mode = IRDM_CONTACT_GRAB;
+		memcpy(cmd[0].target_m, &u[3 * t], 3 * sizeof(double));
+		assert_int_equal(irdm_engine_tick(e, cmd), 0);
+		memcpy(&F[3 * t], irdm_engine_contact(e, 0)->force_n, 3 * sizeof(double));
+	}
+	irdm_session_close(ses);
+}
+
+static void test_hop(void **state)
+{
+	struct irdm_contact_site *sites = malloc(N_STROKE * sizeof(*sites));
+	double *u = calloc(N_STROKE * 3, sizeof(double)), *R = malloc(N_STROKE * 3 * sizeof(double));
+	double *F[2][2];
+
+	(void)state;
+	for (int p = 0; p < 2; p++)
+		for (int a = 0; a < 2; a++)
+			F[p][a] = malloc(N_STROKE * 3 * sizeof(double));
+	for (size_t t = 0; t < N_STROKE; t++)
+		u[3 * t + 2] = -0.002 * fmin(1.0, (double)t / 50.0);
+	for (int p = 0; p < 2; p++)
+		for (int a = 0; a < 2; a++)
+			hop_run(&hybrid, p, a, sites, u, F[p][a]);
+	stroke_reference(&hybrid, sites, u, R);
+	for (int p = 0; p < 2; p++) {
+		double err = efx_rel_rms(F[p][0], R, N_STROKE * 3);
+		double hop_err = efx_rel_rms(F[p][0], R, N_HOP * 3);
+		print_message("hop, hybrid 300 + 32 f32, %s sum: relative RMS force error %.2e (hops alone %.2e)\n",
+			      p ? "portable" : "default", err, hop_err);
+		assert_true(err <= TOL_STROKE);
+		assert_true(hop_err <= TOL_STROKE);
+		/* a node summed alone or with the site's others: the same figure */
+		assert_memory_equal(F[p][0], F[p][1], N_STROKE * 3 * sizeof(double));
+	}
+	for (int p = 0; p < 2; p++)
+		for (int a = 0; a < 2; a++)
+			free(F[p][a]);
+	free(sites);
+	free(u);
+	free(R);
+}
+
 /* Each error the engine's header documents, from the call that returns it. */
 static void test_errors(void **state)
 {
@@ -859,6 +953,7 @@ int main(void)
 		cmocka_unit_test(test_coupling),
 		cmocka_unit_test(test_push_release),
 		cmocka_unit_test(test_stroke),
+		cmocka_unit_test(test_hop),
 		cmocka_unit_test(test_errors),
 		cmocka_unit_test(test_node_disp_between_ticks),
 	};

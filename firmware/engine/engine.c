@@ -18,7 +18,7 @@ static size_t up(size_t n)
 }
 
 struct layout {
-	size_t engine, col_of_row, phi, x, y, ring, tail, bound, head_bound, total;
+	size_t engine, col_of_row, phi, x, y, ring, tail, bound, head_bound, lanes, zeros, total;
 };
 
 static int plan(const struct irdm_image *img, const struct irdm_engine_config *cfg,
@@ -44,7 +44,9 @@ static int plan(const struct irdm_image *img, const struct irdm_engine_config *c
 	l->tail = l->ring + up((T + H) * sizeof(struct irdm_force_tick));
 	l->bound = l->tail + up(T * sizeof(double));
 	l->head_bound = l->bound + up((K + T) * sizeof(double));
-	l->total = l->head_bound + up(2 * H * sizeof(double)); /* bound weights, slot norms */
+	l->lanes = l->head_bound + up(2 * H * sizeof(double)); /* bound weights, slot norms */
+	l->zeros = l->lanes + up((H > 1 ? HEAD_LANES : 0) * H * HEAD_SAMPLE * sizeof(double));
+	l->total = l->zeros + up(H * 9 * sizeof(double)); /* H blocks at most f64 */
 	return 0;
 }
 
@@ -224,6 +226,7 @@ int irdm_engine_init(struct irdm_engine **out, const struct irdm_image *img,
 		irdm_head_bound_init(e, (double *)(base + l.head_bound));
 	e->head_bound_w = (const double *)(base + l.head_bound);
 	e->head_norm = (double *)(base + l.head_bound) + e->H;
+	irdm_head_lanes_init(e, (double *)(base + l.lanes), base + l.zeros);
 	if (img->rigid && start_rigid(e)) {
 		snprintf(err, errlen, "engine: the image's rigid-body data is not usable (mass %g kg)",
 			 img->rigid->mass_kg);
@@ -244,6 +247,7 @@ void irdm_engine_reset(struct irdm_engine *e)
 		e->ring.tick[s].n = 0;
 	for (uint32_t s = 0; s < e->H; s++)
 		e->head_norm[s] = 0;
+	irdm_head_lanes_reset(e);
 	for (unsigned i = 0; i < IRDM_MAX_CONTACTS; i++)
 		irdm_engine_contact_end(e, i);
 	e->port_energy_left_j = 0;

@@ -7,9 +7,10 @@
  * kept modes' recursion it adds
  *   u_v[t] += sum_{s=0}^{H-1} D_s(e -> v) f_e[t-s],
  * with D_0 in R[0] (in place of the whole correction block, which is the
- * sum of the D_s) and the older samples summed over a ring of the last
- * H - 1 ticks' forces.  Modal images without a head have H = 0 and never
- * reach the ring.
+ * sum of the D_s) and the older samples summed over the last H - 1 ticks'
+ * forces, as the lanes hold them by column (head_lanes.c), or from the
+ * ring of ticks while the lanes miss one.  Modal images without a head
+ * have H = 0 and never reach either.
  */
 #include "engine_priv.h"
 
@@ -73,14 +74,10 @@ HEAD_SUM(head_sum_f64, double, LOAD_F)
 HEAD_SUM(head_sum_f32, float, LOAD_F)
 HEAD_SUM(head_sum_f16, uint16_t, LOAD_H)
 
-void irdm_head_free_disp(const struct irdm_engine *e, uint32_t col, double u[3])
+void irdm_head_ring_sum(const struct irdm_engine *e, uint32_t col, double u[3])
 {
 	double acc[9];
 
-	if (e->head_wide) {
-		irdm_head_sum_wide(e, col, u);
-		return;
-	}
 	switch (e->img->meta->precision) {
 	case IRDM_ELEM_F64:
 		head_sum_f64(e, col, acc);
@@ -96,6 +93,83 @@ void irdm_head_free_disp(const struct irdm_engine *e, uint32_t col, double u[3])
 		u[i] += acc[3 * i] + acc[3 * i + 1] + acc[3 * i + 2];
 }
 
+/*
+ * acc[3 i + j] += sum over a run's samples of D_s[i][j] f_j: nine sums
+ * side by side, in the order of the ages.
+ */
+#define RUN_SUM(NAME, TYPE, LOAD) \
+	static void NAME(const TYPE *d, const struct head_run *r, double acc[9]) \
+	{ \
+		const double *f = r->f; \
+		double a0 = acc[0], a1 = acc[1], a2 = acc[2], a3 = acc[3], a4 = acc[4]; \
+		double a5 = acc[5], a6 = acc[6], a7 = acc[7], a8 = acc[8]; \
+\
+		d += (size_t)r->s * 9; \
+		for (uint32_t i = 0; i < r->n; i++, d += 9, f += HEAD_SAMPLE) { \
+			double f0 = f[0], f1 = f[1], f2 = f[2]; \
+			a0 += LOAD(d[0]) * f0, a1 += LOAD(d[1]) * f1; \
+			a2 += LOAD(d[2]) * f2, a3 += LOAD(d[3]) * f0; \
+			a4 += LOAD(d[4]) * f1, a5 += LOAD(d[5]) * f2; \
+			a6 += LOAD(d[6]) * f0, a7 += LOAD(d[7]) * f1; \
+			a8 += LOAD(d[8]) * f2; \
+		} \
+		acc[0] = a0, acc[1] = a1, acc[2] = a2, acc[3] = a3, acc[4] = a4; \
+		acc[5] = a5, acc[6] = a6, acc[7] = a7, acc[8] = a8; \
+	}
+
+RUN_SUM(run_sum_f64, double, LOAD_F)
+RUN_SUM(run_sum_f32, float, LOAD_F)
+RUN_SUM(run_sum_f16, uint16_t, LOAD_H)
+
+/* The lanes' sum at one column: each lane whose block to col was kept. */
+static void lane_sum(const struct irdm_engine *e, uint32_t n_spans, const struct head_span *sp,
+		     uint32_t col, double u[3])
+{
+	uint32_t prec = e->img->meta->precision;
+	double acc[9] = { 0 };
+
+	for (uint32_t l = 0; l < n_spans; l++) {
+		long k = irdm_image_corr_block(e->img, sp[l].col, col);
+		if (k < 0)
+			continue; /* a dropped block: no head either */
+		size_t base = (size_t)k * e->H * 9;
+		for (uint32_t r = 0; r < sp[l].n_runs; r++) {
+			if (prec == IRDM_ELEM_F64)
+				run_sum_f64((const double *)e->img->exact_head + base, &sp[l].run[r], acc);
+			else if (prec == IRDM_ELEM_F32)
+				run_sum_f32((const float *)e->img->exact_head + base, &sp[l].run[r], acc);
+			else
+				run_sum_f16((const uint16_t *)e->img->exact_head + base, &sp[l].run[r],
+					    acc);
+		}
+	}
+	for (int i = 0; i < 3; i++)
+		u[i] += acc[3 * i] + acc[3 * i + 1] + acc[3 * i + 2];
+}
+
+void irdm_head_free_disps(const struct irdm_engine *e, uint32_t n, const uint32_t *cols,
+			  double (*u)[3])
+{
+	struct head_span sp[HEAD_LANES];
+	int n_spans = irdm_head_spans(e, sp);
+
+	if (n_spans < 0) {
+		for (uint32_t v = 0; v < n; v++) {
+			if (e->head_wide)
+				irdm_head_ring_sum_wide(e, cols[v], u[v]);
+			else
+				irdm_head_ring_sum(e, cols[v], u[v]);
+		}
+		return;
+	}
+	if (e->head_wide) {
+		irdm_head_lane_sums_wide(e, (uint32_t)n_spans, sp, n, cols, u);
+		return;
+	}
+	for (uint32_t v = 0; v < n; v++)
+		lane_sum(e, (uint32_t)n_spans, sp, cols[v], u[v]);
+}
+
 void irdm_head_apply(struct irdm_engine *e, const struct irdm_force_tick *f)
 {
 	struct irdm_fir_ring *r = &e->ring;
@@ -104,6 +178,7 @@ void irdm_head_apply(struct irdm_engine *e, const struct irdm_force_tick *f)
 		return;
 	r->head = (r->head + 1) % e->H;
 	r->tick[r->head] = *f;
+	irdm_head_lanes_apply(e, f);
 	/* the tick's force norms, once: the displacement bound reads them
 	 * every tick for every age */
 	double sum = 0;

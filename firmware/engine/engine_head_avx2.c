@@ -61,41 +61,186 @@ static WIDE_INLINE void head_wide(const struct irdm_engine *e, uint32_t prec, ui
 		u[i] += v[i];
 }
 
-static WIDE void head_f64(const struct irdm_engine *e, uint32_t col, double u[3])
+static WIDE void ring_f64(const struct irdm_engine *e, uint32_t col, double u[3])
 {
 	head_wide(e, IRDM_ELEM_F64, col, u);
 }
 
-static WIDE void head_f32(const struct irdm_engine *e, uint32_t col, double u[3])
+static WIDE void ring_f32(const struct irdm_engine *e, uint32_t col, double u[3])
 {
 	head_wide(e, IRDM_ELEM_F32, col, u);
 }
 
-static WIDE void head_f16(const struct irdm_engine *e, uint32_t col, double u[3])
+static WIDE void ring_f16(const struct irdm_engine *e, uint32_t col, double u[3])
 {
 	head_wide(e, IRDM_ELEM_F16, col, u);
 }
 
-void irdm_head_sum_wide(const struct irdm_engine *e, uint32_t col, double u[3])
+void irdm_head_ring_sum_wide(const struct irdm_engine *e, uint32_t col, double u[3])
 {
 	switch (e->img->meta->precision) {
 	case IRDM_ELEM_F64:
-		head_f64(e, col, u);
+		ring_f64(e, col, u);
 		break;
 	case IRDM_ELEM_F32:
-		head_f32(e, col, u);
+		ring_f32(e, col, u);
 		break;
 	default: /* the image checks admit f64, f32, f16 */
-		head_f16(e, col, u);
+		ring_f16(e, col, u);
+		break;
+	}
+}
+
+static inline size_t elem_bytes(uint32_t prec)
+{
+	switch (prec) {
+	case IRDM_ELEM_F64:
+		return 8;
+	case IRDM_ELEM_F32:
+		return 4;
+	default:
+		return 2;
+	}
+}
+
+static WIDE_INLINE void fold_add(const struct row_acc *a, double u[3])
+{
+	double v[3];
+
+	row_fold(a, v);
+	for (int i = 0; i < 3; i++)
+		u[i] += v[i];
+}
+
+/*
+ * One run of a lane against the blocks d[0 .. n_rows - 1] (n_rows a
+ * constant at each call site, as prec is): a sample's force loads once for
+ * every row.
+ */
+static WIDE_INLINE void run_acc(uint32_t prec, uint32_t n_rows, const void *const *d,
+				const struct head_run *run, struct row_acc *a0, struct row_acc *a1,
+				struct row_acc *a2)
+{
+	const double *f = run->f;
+	size_t i = (size_t)run->s * 9;
+
+	for (uint32_t j = 0; j < run->n; j++, i += 9, f += HEAD_SAMPLE) {
+		__m256d p0 = _mm256_loadu_pd(f), p1 = _mm256_loadu_pd(f + 4);
+		double p2 = f[2];
+		block_acc(d[0], prec, i, p0, p1, p2, a0);
+		if (n_rows > 1)
+			block_acc(d[1], prec, i, p0, p1, p2, a1);
+		if (n_rows > 2)
+			block_acc(d[2], prec, i, p0, p1, p2, a2);
+	}
+}
+
+/*
+ * The lanes' sums at n_rows columns in one pass.  A block dropped for one
+ * of them reads zeros, which leave its sums as they were: each column's
+ * sums take the same steps in the same order as when it is summed alone.
+ */
+static WIDE_INLINE void lanes_pass(const struct irdm_engine *e, uint32_t prec, uint32_t n_rows,
+				   uint32_t n_spans, const struct head_span *sp,
+				   const uint32_t *cols, double (*u)[3])
+{
+	size_t elem = elem_bytes(prec);
+	const char *D = e->img->exact_head;
+	/* one variable a row, not an array: they stay in registers */
+	struct row_acc a0, a1, a2;
+
+	a0.a0 = a0.a1 = a1.a0 = a1.a1 = a2.a0 = a2.a1 = _mm256_setzero_pd();
+	a0.a2 = a1.a2 = a2.a2 = 0;
+	for (uint32_t l = 0; l < n_spans; l++) {
+		const void *d[3];
+		bool kept = false;
+		for (uint32_t r = 0; r < n_rows; r++) {
+			long k = irdm_image_corr_block(e->img, sp[l].col, cols[r]);
+			d[r] = k < 0 ? e->lanes.zeros : D + (size_t)k * e->H * 9 * elem;
+			kept |= k >= 0;
+		}
+		if (!kept)
+			continue; /* dropped blocks: no head either */
+		for (uint32_t r = 0; r < sp[l].n_runs; r++)
+			run_acc(prec, n_rows, d, &sp[l].run[r], &a0, &a1, &a2);
+	}
+	fold_add(&a0, u[0]);
+	if (n_rows > 1)
+		fold_add(&a1, u[1]);
+	if (n_rows > 2)
+		fold_add(&a2, u[2]);
+}
+
+/* Three columns a pass, the last with what is left. */
+static WIDE_INLINE void lanes_wide(const struct irdm_engine *e, uint32_t prec, uint32_t n_spans,
+				   const struct head_span *sp, uint32_t n, const uint32_t *cols,
+				   double (*u)[3])
+{
+	for (uint32_t v = 0; v < n; v += 3) {
+		switch (n - v) {
+		case 1:
+			lanes_pass(e, prec, 1, n_spans, sp, cols + v, u + v);
+			break;
+		case 2:
+			lanes_pass(e, prec, 2, n_spans, sp, cols + v, u + v);
+			break;
+		default:
+			lanes_pass(e, prec, 3, n_spans, sp, cols + v, u + v);
+			break;
+		}
+	}
+}
+
+static WIDE void lanes_f64(const struct irdm_engine *e, uint32_t n_spans,
+			   const struct head_span *sp, uint32_t n, const uint32_t *cols,
+			   double (*u)[3])
+{
+	lanes_wide(e, IRDM_ELEM_F64, n_spans, sp, n, cols, u);
+}
+
+static WIDE void lanes_f32(const struct irdm_engine *e, uint32_t n_spans,
+			   const struct head_span *sp, uint32_t n, const uint32_t *cols,
+			   double (*u)[3])
+{
+	lanes_wide(e, IRDM_ELEM_F32, n_spans, sp, n, cols, u);
+}
+
+static WIDE void lanes_f16(const struct irdm_engine *e, uint32_t n_spans,
+			   const struct head_span *sp, uint32_t n, const uint32_t *cols,
+			   double (*u)[3])
+{
+	lanes_wide(e, IRDM_ELEM_F16, n_spans, sp, n, cols, u);
+}
+
+void irdm_head_lane_sums_wide(const struct irdm_engine *e, uint32_t n_spans,
+			      const struct head_span *sp, uint32_t n, const uint32_t *cols,
+			      double (*u)[3])
+{
+	switch (e->img->meta->precision) {
+	case IRDM_ELEM_F64:
+		lanes_f64(e, n_spans, sp, n, cols, u);
+		break;
+	case IRDM_ELEM_F32:
+		lanes_f32(e, n_spans, sp, n, cols, u);
+		break;
+	default: /* the image checks admit f64, f32, f16 */
+		lanes_f16(e, n_spans, sp, n, cols, u);
 		break;
 	}
 }
 
 #else /* no AVX2 path on this target: the portable sum is used */
 
-void irdm_head_sum_wide(const struct irdm_engine *e, uint32_t col, double u[3])
+void irdm_head_ring_sum_wide(const struct irdm_engine *e, uint32_t col, double u[3])
 {
 	(void)e, (void)col, (void)u;
+}
+
+void irdm_head_lane_sums_wide(const struct irdm_engine *e, uint32_t n_spans,
+			      const struct head_span *sp, uint32_t n, const uint32_t *cols,
+			      double (*u)[3])
+{
+	(void)e, (void)n_spans, (void)sp, (void)n, (void)cols, (void)u;
 }
 
 #endif

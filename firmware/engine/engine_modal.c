@@ -41,19 +41,39 @@ static void evolve(struct irdm_engine *e, const struct irdm_mode *m, uint32_t k)
 	e->y[2 * k + 1] = m[k].a[2] * q + m[k].a[3] * v;
 }
 
-void irdm_modal_free_disp(const struct irdm_engine *e, uint32_t col, double u[3])
+static struct free_memo *memo_of(const struct irdm_engine *e, uint32_t col)
 {
 	/* a memo: the engine's state is the caller's to change, never here */
-	struct free_memo *mm = (struct free_memo *)&e->free_memo[col % FREE_MEMO];
+	return (struct free_memo *)&e->free_memo[col % FREE_MEMO];
+}
+
+static bool memo_get(const struct irdm_engine *e, uint32_t col, double u[3])
+{
+	const struct free_memo *mm = memo_of(e, col);
+
+	if (mm->stamp != e->tick + 1 || mm->col != col)
+		return false;
+	memcpy(u, mm->u, sizeof(mm->u));
+	return true;
+}
+
+static void memo_put(const struct irdm_engine *e, uint32_t col, const double u[3])
+{
+	struct free_memo *mm = memo_of(e, col);
+
+	mm->stamp = e->tick + 1;
+	mm->col = col;
+	memcpy(mm->u, u, sizeof(mm->u));
+}
+
+/* The kept modes' part of the free displacement at col. */
+static void modes_free_disp(const struct irdm_engine *e, uint32_t col, double u[3])
+{
 	const uint32_t K = e->K;
 	const double *p0 = &e->phi[(size_t)col * 3 * K], *p1 = p0 + K, *p2 = p1 + K;
 	const double *y = e->y;
 	double s0 = 0, s1 = 0, s2 = 0;
 
-	if (mm->stamp == e->tick + 1 && mm->col == col) {
-		memcpy(u, mm->u, sizeof(mm->u));
-		return;
-	}
 	/* three sums side by side, each in the order of k */
 	for (uint32_t k = 0; k < K; k++) {
 		double yk = y[2 * k];
@@ -65,11 +85,34 @@ void irdm_modal_free_disp(const struct irdm_engine *e, uint32_t col, double u[3]
 	u[0] = s0;
 	u[1] = s1;
 	u[2] = s2;
-	if (e->H)
-		irdm_head_free_disp(e, col, u);
-	mm->stamp = e->tick + 1;
-	mm->col = col;
-	memcpy(mm->u, u, sizeof(mm->u));
+}
+
+void irdm_modal_free_disp(const struct irdm_engine *e, uint32_t col, double u[3])
+{
+	irdm_modal_free_disps(e, 1, &col, (double(*)[3])u);
+}
+
+/* n <= IRDM_MAX_FORCE_NODES distinct columns.  Those the memo lacks are
+ * summed together: a head's columns share one pass over its history. */
+void irdm_modal_free_disps(const struct irdm_engine *e, uint32_t n, const uint32_t *cols,
+			   double (*u)[3])
+{
+	uint32_t miss[IRDM_MAX_FORCE_NODES], mc[IRDM_MAX_FORCE_NODES], n_miss = 0;
+	double um[IRDM_MAX_FORCE_NODES][3];
+
+	for (uint32_t v = 0; v < n; v++) {
+		if (memo_get(e, cols[v], u[v]))
+			continue;
+		modes_free_disp(e, cols[v], um[n_miss]);
+		mc[n_miss] = cols[v];
+		miss[n_miss++] = v;
+	}
+	if (e->H && n_miss)
+		irdm_head_free_disps(e, n_miss, mc, um);
+	for (uint32_t i = 0; i < n_miss; i++) {
+		memcpy(u[miss[i]], um[i], sizeof(um[i]));
+		memo_put(e, mc[i], um[i]);
+	}
 }
 
 void irdm_modal_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp, double blk[9])

@@ -26,6 +26,47 @@ struct r0_table {
 
 #define FREE_MEMO 16 /* entries, direct-mapped by column */
 
+/*
+ * A hybrid image's force history by column (head_lanes.c), beside the ring
+ * of ticks: a lane holds one force column's samples, one per tick and zero
+ * at a tick without its force, so that the head sum for one kept block is
+ * a dot product over contiguous samples.  A sample is eight doubles, the
+ * force in the pattern of a block's elements, (f0 f1 f2 f0)(f1 f2 f0 f1),
+ * f2 at [2]: two vector loads (wide_block.h).  The newest sample sits one
+ * place before the previous one, so that ages run forward through memory.
+ * Twice the columns one tick can hold: a sliding contact's old columns stay
+ * in the window for H ticks after it left them.
+ */
+#define HEAD_LANES (2 * IRDM_MAX_FORCE_NODES)
+#define HEAD_SAMPLE 8 /* doubles */
+
+struct head_lane {
+	uint32_t col;        /* NO_COL: free */
+	uint64_t first;      /* the lane's first sample (a count of samples applied) */
+	uint64_t last_force; /* its newest sample with a force */
+};
+
+struct head_lanes {
+	uint64_t applied;       /* samples applied since init or reset */
+	uint64_t complete_from; /* a force found no free lane: the ring until then */
+	struct head_lane lane[HEAD_LANES];
+	double *f;         /* HEAD_LANES x H samples, fixed memory */
+	const void *zeros; /* H blocks of zeros in any precision: a dropped block */
+};
+
+/* Where a lane's samples of ages s .. s + n - 1 are: at most two runs (they
+ * wrap around the lane's end). */
+struct head_run {
+	const double *f; /* the first sample */
+	uint32_t s, n;   /* its age, the number of samples */
+};
+
+struct head_span {
+	uint32_t col; /* the lane's force column */
+	uint32_t n_runs;
+	struct head_run run[2];
+};
+
 struct irdm_engine {
 	const struct irdm_image *img;
 	struct irdm_engine_config cfg;
@@ -50,6 +91,7 @@ struct irdm_engine {
 	const double *head_bound_w; /* H: max ||D_s||_F over kept blocks */
 	double *head_norm;          /* H: sum of |f| of each ring slot (0 if empty) */
 	bool head_wide;             /* head sum by engine_head_avx2.c */
+	struct head_lanes lanes;    /* head_lanes.c */
 	/* contacts and solve */
 	struct irdm_contact_state c[IRDM_MAX_CONTACTS];
 	/* passivity observer (passivity.c): the work done on the object
@@ -78,6 +120,8 @@ struct irdm_engine {
 
 /* engine_modal.c / engine_fir.c: the history term and the R[0] blocks. */
 void irdm_modal_free_disp(const struct irdm_engine *e, uint32_t col, double u[3]);
+void irdm_modal_free_disps(const struct irdm_engine *e, uint32_t n, const uint32_t *cols,
+			   double (*u)[3]);
 void irdm_modal_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp, double blk[9]);
 void irdm_modal_apply(struct irdm_engine *e, const struct irdm_force_tick *f);
 void irdm_fir_free_disp(const struct irdm_engine *e, uint32_t col, double u[3]);
@@ -119,12 +163,30 @@ static inline long irdm_head_cached_block(const struct irdm_engine *e, struct ir
 
 /* D_0 of the kept block into blk; false (blk untouched) if the block was dropped */
 bool irdm_head_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp, double blk[9]);
-void irdm_head_free_disp(const struct irdm_engine *e, uint32_t col, double u[3]);
+/* u[v] += the head sum at cols[v], n <= IRDM_MAX_FORCE_NODES distinct
+ * columns; each column's figure is the same whether it is summed alone or
+ * with others (a memo may hold either). */
+void irdm_head_free_disps(const struct irdm_engine *e, uint32_t n, const uint32_t *cols,
+			  double (*u)[3]);
 void irdm_head_apply(struct irdm_engine *e, const struct irdm_force_tick *f);
 void irdm_head_bound_init(const struct irdm_engine *e, double *w);
 double irdm_head_bound(const struct irdm_engine *e, const double *w);
-/* engine_head_avx2.c: the head sum with AVX2 + FMA (head_wide only). */
-void irdm_head_sum_wide(const struct irdm_engine *e, uint32_t col, double u[3]);
+/* The ring's sum at one column, for while the lanes are incomplete; the
+ * kept block of a force column to col, cached for the sum. */
+void irdm_head_ring_sum(const struct irdm_engine *e, uint32_t col, double u[3]);
+/* engine_head_avx2.c: the head sums with AVX2 + FMA (head_wide only). */
+void irdm_head_ring_sum_wide(const struct irdm_engine *e, uint32_t col, double u[3]);
+void irdm_head_lane_sums_wide(const struct irdm_engine *e, uint32_t n_spans,
+			      const struct head_span *sp, uint32_t n, const uint32_t *cols,
+			      double (*u)[3]);
+
+/* head_lanes.c: the history by column (struct head_lanes). */
+void irdm_head_lanes_init(struct irdm_engine *e, double *f, const void *zeros);
+void irdm_head_lanes_reset(struct irdm_engine *e);
+void irdm_head_lanes_apply(struct irdm_engine *e, const struct irdm_force_tick *f);
+/* The lanes' samples the head sum reads now, into sp[HEAD_LANES]; the
+ * number of spans, or -1 while the lanes miss a force (the ring then). */
+int irdm_head_spans(const struct irdm_engine *e, struct head_span *sp);
 
 /* disp_bound.c: fill bound_w (K or T doubles) once phi or the FIR is set. */
 void irdm_bound_init(const struct irdm_engine *e, double *w);

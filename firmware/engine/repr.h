@@ -33,14 +33,14 @@ static inline void repr_free_disp(const struct irdm_engine *e, uint32_t col, dou
 }
 
 /* The free displacement at n distinct columns: FIR images sum them in one
- * pass over the ring (fir_sum.c), modal ones column by column. */
+ * pass over the ring (fir_sum.c), a hybrid's head in one pass over its
+ * lanes. */
 static inline void repr_free_disps(const struct irdm_engine *e, uint32_t n, const uint32_t *cols,
 				   double (*u)[3])
 {
 #if IRDM_CONFIG_MODAL
 	if (repr_is_modal(e)) {
-		for (uint32_t v = 0; v < n; v++)
-			irdm_modal_free_disp(e, cols[v], u[v]);
+		irdm_modal_free_disps(e, n, cols, u);
 		return;
 	}
 #endif

@@ -11,7 +11,7 @@
  * Itanium2 times; never fails on time.
  *
  * Run from the repository root: images are reused from out/bench/ and made
- * there when missing.  IRDM_BENCH_ONLY and IRDM_BENCH_TICKS select cases
+ * there when missing, those of the selected cases only.  IRDM_BENCH_ONLY and IRDM_BENCH_TICKS select cases
  * and shorten them, for instructions per tick under callgrind
  * (bench_util.h; --toggle-collect=irdm_engine_tick), e.g.
  * IRDM_BENCH_ONLY=hybrid,fir-500 (2 ms).  Runs under SCHED_FIFO on CPU 1 with mlockall when it
@@ -242,6 +242,27 @@ static struct figures bench_case(const char *scene, const char *repr, const stru
 
 static uint32_t all_modes; /* of the all-modes image */
 
+/* One of repr's cases is selected (IRDM_BENCH_ONLY): its image is wanted,
+ * and a missing one is worth minutes of precompute. */
+static bool repr_selected(const char *repr)
+{
+	char name[64];
+
+	for (int k = 0; k < K_COUNT; k++) {
+		snprintf(name, sizeof(name), "%s %s", repr, kase_name[k]);
+		if (bench_selected(name))
+			return true;
+	}
+	return false;
+}
+
+/* The image at path if one of repr's cases is selected, made when missing. */
+static bool want_image(const char *repr, const char *path, const char *scene_file,
+		       const char *const *kv)
+{
+	return repr_selected(repr) && !bench_ensure_image("tick", path, scene_file, kv);
+}
+
 static void bench_image(const char *scene, const char *repr, const char *path,
 			struct figures fig[K_COUNT])
 {
@@ -414,17 +435,16 @@ int main(void)
 	 *    patch of the top touchable.  The modal tick is linear in the
 	 *    number of modes.
 	 */
-	int have_fir = !bench_ensure_image("tick", "out/bench/cuboid-fir500-patch.img", NULL,
-					   fir_kv);
-	int have_m300 = !bench_ensure_image("tick", "out/bench/cuboid-paper.img",
-					    "scenes/cuboid-paper.scene", NULL);
-	int have_mall = !bench_ensure_image("tick", "out/bench/cuboid-6x6x12-all.img", NULL,
-					    all_kv);
+	bool have_fir = (repr_selected("fir-500 portable") || repr_selected("fir-500 (2 ms)")) &&
+			!bench_ensure_image("tick", "out/bench/cuboid-fir500-patch.img", NULL, fir_kv);
+	bool have_m300 = want_image("modal-300+sc", "out/bench/cuboid-paper.img",
+				    "scenes/cuboid-paper.scene", NULL);
+	bool have_mall = want_image("modal-all", "out/bench/cuboid-6x6x12-all.img", NULL, all_kv);
 	/* a dense eigensolve of the paper mesh's 9504 DoFs: minutes, once */
-	int have_hybrid = !bench_ensure_image("tick", "out/bench/cuboid-hybrid128-patch.img", NULL,
-					      hybrid_kv);
-	int have_bunny = bench_file_exists("out/bench/bunny.img");
-	if (!have_bunny && bench_file_exists("build/data/bunny.off"))
+	bool have_hybrid = want_image("hybrid-300+128", "out/bench/cuboid-hybrid128-patch.img",
+				      NULL, hybrid_kv);
+	bool have_bunny = repr_selected("modal-300+sc") && bench_file_exists("out/bench/bunny.img");
+	if (!have_bunny && repr_selected("modal-300+sc") && bench_file_exists("build/data/bunny.off"))
 		have_bunny = !bench_ensure_image("tick", "out/bench/bunny.img", "scenes/bunny.scene",
 						 NULL);
 
@@ -447,7 +467,7 @@ int main(void)
 	}
 	if (have_bunny)
 		bench_image("bunny", "modal-300+sc", "out/bench/bunny.img", bunny);
-	else
+	else if (repr_selected("modal-300+sc"))
 		printf("tick  bunny skipped: neither out/bench/bunny.img nor build/data/bunny.off (make bench-precompute)\n");
 
 	printf("tick  -- targets (figures include the timer overhead) --\n");
