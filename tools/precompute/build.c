@@ -22,6 +22,7 @@
 #include "modal/static_lowrank.h"
 #include "modal/static_clusters.h"
 #include "modal/static_sparse.h"
+#include "precompute/col_scale.h"
 #include "precompute/fir_tail.h"
 #include "precompute/precompute.h"
 #include "precompute/td_part.h"
@@ -45,6 +46,7 @@ struct build {
 	struct irdm_corr_clusters clusters; /* modal: every block, clustered (0 clusters if not) */
 	void *stored[6];                    /* converted to the scene's precision */
 	size_t stored_bytes[6];
+	float *col_scale; /* f16: COLUMN_SCALE (col_scale.h), else NULL */
 	struct irdm_stability *stab;
 	struct irdm_meta meta;
 	struct irdm_rigid rigid;
@@ -613,7 +615,9 @@ static void repr_text(const struct irdm_scene *sc, char *buf, size_t len)
 /* What may make an uncertified image certified. */
 static void certify_hint(const struct irdm_scene *sc, char *buf, size_t len)
 {
-	if (sc->representation == IRDM_REPR_FIR && !sc->fir_tail)
+	if (sc->precision == IRDM_ELEM_F16)
+		snprintf(buf, len, "try precision = f32 (f16 rounds the responses the certificate judges)");
+	else if (sc->representation == IRDM_REPR_FIR && !sc->fir_tail)
 		snprintf(buf, len, "try fir_tail = window:%u or longer, or a modal representation",
 			 2 * sc->fir_length);
 	else if (sc->representation == IRDM_REPR_FIR)
@@ -713,7 +717,8 @@ static void fill_meta(struct build *b)
 		    (sc->mass == IRDM_MASS_CONSISTENT ? IRDM_META_CONSISTENT_MASS : 0) |
 		    (sc->method == IRDM_METHOD_TIME_DOMAIN ? IRDM_META_TIME_DOMAIN : 0) |
 		    (mt->fir_exact ? IRDM_META_FIR_TAIL_WINDOW : 0) |
-		    (b->head ? IRDM_META_EXACT_HEAD : 0);
+		    (b->head ? IRDM_META_EXACT_HEAD : 0) |
+		    (b->col_scale ? IRDM_META_COLUMN_SCALE : 0);
 	mt->head_samples = b->head ? 2 * sc->exact_head : 0;
 	mt->dt_s = sc->dt_s;
 	mt->young_pa = sc->mat.young_pa;
@@ -822,6 +827,9 @@ static int add_sections(struct build *b, struct irdm_image_writer *w, const void
 	}
 	if (b->sc->floating)
 		ret |= irdm_iw_add(w, IRDM_SEC_RIGID, IRDM_ELEM_BYTES, &b->rigid, sizeof(b->rigid));
+	if (b->col_scale)
+		ret |= irdm_iw_add(w, IRDM_SEC_COLUMN_SCALE, IRDM_ELEM_F32, b->col_scale,
+				   m->n_cols * sizeof(*b->col_scale));
 	ret |= irdm_iw_add(w, IRDM_SEC_STABILITY, IRDM_ELEM_BYTES, b->stab, m->n_cols * sizeof(*b->stab));
 	ret |= irdm_iw_add(w, IRDM_SEC_CONTACT_BVH, IRDM_ELEM_BYTES, bvh, bvh_bytes);
 	if (ret) {
@@ -907,6 +915,45 @@ static void *store_clusters(const struct irdm_corr_clusters *cl, uint32_t prec, 
 	return p;
 }
 
+/*
+ * f16: a power of two per force column over the values it divides (the
+ * FIR, or the kept correction blocks and their head: col_scale.h), and
+ * those stored scaled, so that stiff objects do not underflow.  The
+ * certificate and the error measurement then see the values as stored.
+ */
+static int store_f16_scaled(struct build *b)
+{
+	size_t nc = b->m.n_cols, fir_per = b->m.n_rows * fir_taps(b) * 9;
+	size_t head_per = 2 * (size_t)b->sc->exact_head * 9;
+	uint32_t p = b->sc->precision;
+	double *mx = calloc(nc ? nc : 1, sizeof(*mx));
+
+	b->col_scale = malloc((nc ? nc : 1) * sizeof(*b->col_scale));
+	if (!mx || !b->col_scale) {
+		free(mx);
+		return IRDM_ENOMEM;
+	}
+	if (b->fir)
+		irdm_col_absmax(b->fir, nc, NULL, fir_per, mx);
+	if (b->sparse.start)
+		irdm_col_absmax(b->sparse.blocks, nc, b->sparse.start, 9, mx);
+	if (b->head)
+		irdm_col_absmax(b->head, nc, b->sparse.start, head_per, mx);
+	for (size_t c = 0; c < nc; c++)
+		b->col_scale[c] = irdm_col_scale_for(mx[c]);
+	free(mx);
+	if (b->fir)
+		b->stored[0] = irdm_store_scaled(b->fir, nc, NULL, fir_per, b->col_scale, p,
+						 &b->stored_bytes[0]);
+	if (b->sparse.start)
+		b->stored[2] = irdm_store_scaled(b->sparse.blocks, nc, b->sparse.start, 9,
+						 b->col_scale, p, &b->stored_bytes[2]);
+	if (b->head)
+		b->stored[4] = irdm_store_scaled(b->head, nc, b->sparse.start, head_per,
+						 b->col_scale, p, &b->stored_bytes[4]);
+	return IRDM_OK;
+}
+
 static int responses(struct build *b, char *err, size_t errlen)
 {
 	struct irdm_model *m = &b->m;
@@ -926,18 +973,22 @@ static int responses(struct build *b, char *err, size_t errlen)
 		if (ret)
 			return ret;
 	}
-	if (b->fir)
+	if (b->sc->precision == IRDM_ELEM_F16 && store_f16_scaled(b)) {
+		snprintf(err, errlen, "precompute: out of memory");
+		return IRDM_ENOMEM;
+	}
+	if (b->fir && !b->col_scale)
 		b->stored[0] = store(b->fir, m->n_cols * m->n_rows * fir_taps(b) * 9,
 				     b->sc->precision, &b->stored_bytes[0]);
 	if (b->shapes && b->sc->representation == IRDM_REPR_MODAL)
 		b->stored[1] = store(b->shapes, m->n_rows * 3 * b->n_modes, b->sc->precision,
 				     &b->stored_bytes[1]);
-	if (b->sparse.start)
+	if (b->sparse.start && !b->col_scale)
 		b->stored[2] = store(b->sparse.blocks, b->sparse.n_blocks * 9, b->sc->precision,
 				     &b->stored_bytes[2]);
 	if (b->far.rank)
 		b->stored[3] = store_far(&b->far, b->sc->precision, &b->stored_bytes[3]);
-	if (b->head)
+	if (b->head && !b->col_scale)
 		b->stored[4] = store(b->head, b->sparse.n_blocks * 2 * b->sc->exact_head * 9,
 				     b->sc->precision, &b->stored_bytes[4]);
 	if (b->clusters.n_clusters)
@@ -965,6 +1016,7 @@ static void build_free(struct build *b)
 	irdm_corr_clusters_free(&b->clusters);
 	for (int i = 0; i < 6; i++)
 		free(b->stored[i]);
+	free(b->col_scale);
 	free(b->stab);
 	free(b->nodes);
 	free(b->prov);
@@ -1051,6 +1103,7 @@ static int reference_from_model(void *ctx, const struct irdm_scene *rsc, const c
 	free(r.shapes);
 	for (int i = 0; i < 6; i++)
 		free(r.stored[i]);
+	free(r.col_scale);
 	free(r.stab);
 	free(r.nodes);
 	free(r.prov);
@@ -1220,6 +1273,8 @@ static void reset_try(struct build *b, size_t n_all)
 		free(b->stored[i]);
 		b->stored[i] = NULL;
 	}
+	free(b->col_scale);
+	b->col_scale = NULL;
 	b->n_modes = 0;
 	memset(&b->meta, 0, sizeof(b->meta));
 	b->m.modes.n_modes = n_all;
