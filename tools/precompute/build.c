@@ -601,7 +601,8 @@ static int hybrid_stable(const struct build *b, char *err, size_t errlen)
 static void repr_text(const struct irdm_scene *sc, char *buf, size_t len)
 {
 	if (sc->representation == IRDM_REPR_FIR)
-		snprintf(buf, len, "fir:%u%s", sc->fir_length, sc->fir_tail ? " with fir_tail" : "");
+		snprintf(buf, len, sc->fir_tail ? "fir:%u with fir_tail = window:%u" : "fir:%u",
+			 sc->fir_length, sc->fir_tail);
 	else if (!sc->modes)
 		snprintf(buf, len, "modal:all");
 	else if (sc->exact_head)
@@ -618,8 +619,7 @@ static void certify_hint(const struct irdm_scene *sc, char *buf, size_t len)
 	if (sc->precision == IRDM_ELEM_F16)
 		snprintf(buf, len, "try precision = f32 (f16 rounds the responses the certificate judges)");
 	else if (sc->representation == IRDM_REPR_FIR && !sc->fir_tail)
-		snprintf(buf, len, "try fir_tail = window:%u or longer, or a modal representation",
-			 2 * sc->fir_length);
+		snprintf(buf, len, "try fir_tail = window (the default), or a modal representation");
 	else if (sc->representation == IRDM_REPR_FIR)
 		snprintf(buf, len, "try a longer fir_tail than window:%u, or a modal representation",
 			 sc->fir_tail);
@@ -1116,8 +1116,7 @@ static void error_hint(const struct irdm_scene *sc, char *buf, size_t len)
 	if (sc->precision == IRDM_ELEM_F16)
 		snprintf(buf, len, "precision = f32");
 	else if (sc->representation == IRDM_REPR_FIR && !sc->fir_tail)
-		snprintf(buf, len, "fir_tail = window:%u (no tail damping), a longer FIR, or a modal representation with exact_head",
-			 2 * sc->fir_length);
+		snprintf(buf, len, "fir_tail = window (no tail damping), a longer FIR, or a modal representation with exact_head");
 	else if (sc->representation == IRDM_REPR_FIR)
 		snprintf(buf, len, "a longer FIR (fir:%u), or a modal representation with exact_head",
 			 2 * sc->fir_length);
@@ -1335,24 +1334,94 @@ static int choose(struct build *b, struct irdm_precompute_report *rep, char *err
 	return ret;
 }
 
+/* Columns whose force recursion is not certified stable. */
+static size_t unstable_cols(const struct build *b)
+{
+	size_t n = 0;
+
+	for (size_t c = 0; b->stab && c < b->m.n_cols; c++)
+		n += !(b->stab[c].flags & IRDM_STAB_STABLE);
+	return n;
+}
+
+#define FIR_TAIL_FACTOR_MAX 16 /* fir_tail = window: L up to this many T */
+
+/* fir_tail = window on an FIR: the precompute chooses L. */
+static bool fir_tail_auto(const struct irdm_scene *sc)
+{
+	return sc->representation == IRDM_REPR_FIR && sc->fir_tail_auto && !sc->fir_tail;
+}
+
+/* The first L fir_tail = window tries, and the last: 2T .. 16T, T + L at
+ * most the 1000000 samples an FIR may have. */
+static unsigned fir_tail_first(unsigned T)
+{
+	return T <= 1000000 / 3 ? 2 * T : 1000000 - T;
+}
+
+static unsigned fir_tail_last(unsigned T)
+{
+	return (uint64_t)T * (FIR_TAIL_FACTOR_MAX + 1) <= 1000000 ? FIR_TAIL_FACTOR_MAX * T : 1000000 - T;
+}
+
+/*
+ * fir_tail = window: L = 2T, doubled until the image is certified stable
+ * (a longer window tapers more gently: the tail's ripple that makes the
+ * truncated recursion unstable shrinks), up to 16T.  A certified image
+ * that misses max_error is refused as it is (the window's error is past
+ * T; a longer FIR is the fix), one that none certifies with the longest
+ * window's reasons.  Over MPI ranks or in time-domain parts the first L
+ * alone is tried: every rank and part must compute the same samples.
+ */
+static int fir_tail_search(struct build *b, struct irdm_precompute_report *rep, char *err,
+			   size_t errlen)
+{
+	struct irdm_scene *eff = (struct irdm_scene *)b->sc;
+	size_t n_all = b->m.modes.n_modes;
+	unsigned T = eff->fir_length, last = fir_tail_last(T);
+	bool one = irdm_dist_size() > 1 || b->o->part_out || b->o->n_merge;
+	char why[768];
+	int ret;
+
+	for (;;) {
+		ret = one_try(b, rep, err, errlen);
+		if (one || eff->fir_tail >= last || (ret && ret != IRDM_ENUMERIC) || !unstable_cols(b))
+			break;
+		if (b->o->progress)
+			b->o->progress(b->o->ctx, "fir_tail = window: a longer window", -1.0);
+		reset_try(b, n_all);
+		eff->fir_tail = (unsigned)((uint64_t)eff->fir_tail * 2 < last ? eff->fir_tail * 2 : last);
+	}
+	if (ret == IRDM_ENUMERIC && unstable_cols(b) && !one) {
+		snprintf(why, sizeof(why), "%s", err);
+		snprintf(err, errlen, "%s (fir_tail = window tried window:%u to window:%u)", why,
+			 fir_tail_first(T), eff->fir_tail);
+	}
+	return ret;
+}
+
 int irdm_precompute(const struct irdm_scene *sc, const struct irdm_precompute_opts *o,
 		    struct irdm_precompute_report *rep, char *err, size_t errlen)
 {
 	struct build b = { .sc = sc, .o = o };
-	/* auto resolves to a representation: the image's provenance says which */
-	struct irdm_scene *eff = sc->repr_auto ? malloc(sizeof(*eff)) : NULL;
+	/* auto resolves to a representation (fir_tail = window to a length):
+	 * the image's provenance says which */
+	struct irdm_scene *eff = sc->repr_auto || fir_tail_auto(sc) ? malloc(sizeof(*eff)) : NULL;
 	bool auto_choice = sc->repr_auto && sc->max_error > 0 && irdm_dist_size() == 1;
 	double t0 = irdm_now_s();
 	int ret;
 
 	memset(rep, 0, sizeof(*rep));
-	if (sc->repr_auto && !eff) {
+	if ((sc->repr_auto || fir_tail_auto(sc)) && !eff) {
 		snprintf(err, errlen, "precompute: out of memory");
 		return IRDM_ENOMEM;
 	}
 	if (eff) {
 		*eff = *sc;
 		eff->repr_auto = false;
+		if (fir_tail_auto(sc))
+			eff->fir_tail = fir_tail_first(sc->fir_length);
+		eff->fir_tail_auto = false;
 		b.sc = eff;
 	}
 	b.scene_hash = scene_hash(sc);
@@ -1371,7 +1440,10 @@ int irdm_precompute(const struct irdm_scene *sc, const struct irdm_precompute_op
 			ret = td_distributed(&b, list_inputs(&b.m, NULL, NULL), err, errlen);
 		goto out_worker;
 	}
-	ret = auto_choice ? choose(&b, rep, err, errlen) : one_try(&b, rep, err, errlen);
+	if (auto_choice)
+		ret = choose(&b, rep, err, errlen);
+	else
+		ret = fir_tail_auto(sc) ? fir_tail_search(&b, rep, err, errlen) : one_try(&b, rep, err, errlen);
 	if (ret || o->part_out)
 		goto out_done;
 	if (o->progress)
