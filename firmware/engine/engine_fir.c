@@ -6,12 +6,8 @@
  * cancellation; docs/architecture.md, "Numerical hazards").  w[s] = r^s
  * damps the tail of images whose truncated recursion is unstable (r = 1
  * otherwise): it moves every pole of the recursion by the factor r.
- *
- * An image with column scales (COLUMN_SCALE) stores column c's taps
- * divided by scale[c]; the ring holds each force times its column's scale
- * instead, so that the sums read the stored taps as they are:
- * sum R'[s] f' = sum R[s] f.  The ring is working memory in double, where
- * the product is exact (a power of two).
+ * An image with column scales (COLUMN_SCALE) has its ring in scaled
+ * forces (force_ring.c).
  */
 #include <string.h>
 
@@ -37,20 +33,6 @@ void irdm_fir_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_d
 
 	for (int k = 0; k < 9; k++)
 		blk[k] = irdm_image_value(e->img, e->img->fir, col_force, o + (size_t)k);
-}
-
-/* The ring's copy of a tick's forces: each in its column's storage scale. */
-void irdm_ring_put(const struct irdm_engine *e, struct irdm_force_tick *slot,
-		   const struct irdm_force_tick *f)
-{
-	*slot = *f;
-	if (!e->img->col_scale)
-		return;
-	for (uint32_t n = 0; n < f->n; n++) {
-		double s = irdm_image_col_scale(e->img, f->col[n]);
-		for (int j = 0; j < 3; j++)
-			slot->f_n[n][j] *= s;
-	}
 }
 
 void irdm_fir_apply(struct irdm_engine *e, const struct irdm_force_tick *f)
