@@ -1111,11 +1111,9 @@ static int reference_from_model(void *ctx, const struct irdm_scene *rsc, const c
 }
 
 /* What may bring an image's measured error under max_error. */
-static void error_hint(const struct irdm_scene *sc, char *buf, size_t len)
+static void repr_hint(const struct irdm_scene *sc, char *buf, size_t len)
 {
-	if (sc->precision == IRDM_ELEM_F16)
-		snprintf(buf, len, "precision = f32");
-	else if (sc->representation == IRDM_REPR_FIR && !sc->fir_tail)
+	if (sc->representation == IRDM_REPR_FIR && !sc->fir_tail)
 		snprintf(buf, len, "fir_tail = window (no tail damping), a longer FIR, or a modal representation with exact_head");
 	else if (sc->representation == IRDM_REPR_FIR)
 		snprintf(buf, len, "a longer FIR (fir:%u), or a modal representation with exact_head",
@@ -1131,11 +1129,30 @@ static void error_hint(const struct irdm_scene *sc, char *buf, size_t len)
 			 2 * sc->exact_head, 2 * sc->modes);
 }
 
+/* The same, f16 first: its 11 bits may be what misses (a soft object's
+ * long FIR sums thousands of taps that the force cancels), or the
+ * representation may be whatever the precision. */
+static void error_hint(const struct irdm_scene *sc, char *buf, size_t len)
+{
+	char rest[160];
+
+	if (sc->precision != IRDM_ELEM_F16) {
+		repr_hint(sc, buf, len);
+		return;
+	}
+	if (sc->representation == IRDM_REPR_MODAL && !sc->modes) {
+		snprintf(buf, len, "precision = f32");
+		return;
+	}
+	repr_hint(sc, rest, sizeof(rest));
+	snprintf(buf, len, "precision = f32, and if that is not enough %s", rest);
+}
+
 /* Refuse an image whose measured error is above the scene's max_error. */
 static int within_target(const struct build *b, const struct irdm_precompute_report *rep,
 			 char *err, size_t errlen)
 {
-	char repr[64], hint[160];
+	char repr[64], hint[224];
 
 	if (!rep->error_measured || rep->measured_error <= b->sc->max_error)
 		return IRDM_OK;
