@@ -316,7 +316,7 @@ static int setup(void **state)
 	}
 	read_config("configs/full.config", on[FULL]);
 	precompute(img_modal, "modal", (const char *const[]){ "--scene", "scenes/cuboid-paper.scene", "--resolution", "2,2,4", "--representation", "modal:10", NULL });
-	precompute(img_fir, "fir", (const char *const[]){ "--scene", "scenes/cuboid-paper.scene", "--resolution", "2,2,4", "--representation", "fir:20", "--dt", "0.001", "--uncertified", "yes", NULL });
+	precompute(img_fir, "fir", (const char *const[]){ "--scene", "scenes/cuboid-paper.scene", "--resolution", "2,2,4", "--representation", "fir:20", "--dt", "0.001", "--uncertified", "yes", "--fir_tail", "none", NULL });
 	precompute(img_cube, "cube", (const char *const[]){ "--scene", "scenes/cube-floating.scene", "--resolution", "2,2,2", "--representation", "modal:10", NULL });
 	/* the shipped board without the deformed surface */
 	tf_read_text("boards/sim-phantom.board", text, sizeof(text));

@@ -49,7 +49,7 @@ enum { IMG_MODAL64,
        IMG_CL32,
        IMG_N };
 
-static const char *const scene_kv[IMG_N][16] = {
+static const char *const scene_kv[IMG_N][18] = {
 	[IMG_MODAL64] = { "mesh", "box:0.1,0.1,0.2", "resolution", "2,2,4", "representation",
 			  "modal:20", "precision", "f64", NULL },
 	[IMG_MODAL32] = { "mesh", "box:0.1,0.1,0.2", "resolution", "2,2,4", "representation",
@@ -58,7 +58,7 @@ static const char *const scene_kv[IMG_N][16] = {
 			  "modal:20", "precision", "f16", NULL },
 	[IMG_FIR] = { "mesh", "box:0.1,0.1,0.2", "resolution", "2,2,4", "representation",
 		      "fir:50", "precision", "f64", "touch", "z>=0.2", "display", "surface", "uncertified",
-		      "yes", NULL },
+		      "yes", "fir_tail", "none", NULL },
 	[IMG_FLOAT] = { "mesh", "box:0.1,0.1,0.1", "resolution", "2,2,2", "representation",
 			"modal:20", "precision", "f64", "floating", "yes", NULL },
 	/* the clustered correction: 313 touchable columns in 32 clusters of at

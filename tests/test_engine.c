@@ -46,14 +46,25 @@ static const char *const fir_prec[3] = { "f64", "f32", "f16" };
  * Limits, about 5x the largest relative RMS error measured (gcc -O2, clang
  * -O2, ASan -O1; 2026-11-24): modal f64 3.6e-13, modal 40 f32 5.3e-15,
  * stroke 1.7e-12, FIR 200 (f64, f32, f16) 5.6e-14, hybrid 300 + 32 f32 (step,
- * two points, stroke) 6.7e-13, 1.4e-13, 1.9e-12.  All are rounding: the
- * engine and the reference read the same numbers from the image.
+ * two points, stroke) 6.7e-13, 1.4e-13, 1.9e-12; FIR 200 f16 with its
+ * column scales (2026-11-27) 5.3e-13 at the two triangle points: scaled,
+ * the small taps that raw f16 rounded to zero are there, and this unstable
+ * FIR's damped recursion amplifies the rounding of more terms.  All are
+ * rounding: the engine and the reference read the same numbers from the
+ * image.
  */
 #define TOL_MODAL_F64 2e-12
 #define TOL_MODAL_F32 3e-14
 #define TOL_HYBRID 3e-12
 #define TOL_STROKE 1e-11
 #define TOL_FIR 3e-13
+#define TOL_FIR_F16 3e-12
+
+/* The limit of fir[k]: f16's is its own (above). */
+static double fir_tol(int k)
+{
+	return k == 2 ? TOL_FIR_F16 : TOL_FIR;
+}
 
 static int setup(void **state)
 {
@@ -384,14 +395,14 @@ static void test_fir(void **state)
 		assert_true(fir_tail_r(&fir[k]) < 1.0); /* the damped path runs */
 		node_site(&fir[k], top, &s);
 		snprintf(what, sizeof(what), "step + release, FIR 200 %s", fir_prec[k]);
-		compare(what, &fir[k], &s, 1, N, u, TOL_FIR);
+		compare(what, &fir[k], &s, 1, N, u, fir_tol(k));
 		/* six site nodes: the history summed several rows a pass
 		 * (fir_sum.c: a pass of four, then one of two) */
 		point_site(&fir[k], pa, &tri[0]);
 		point_site(&fir[k], pb, &tri[1]);
 		assert_true(distinct_rows(tri, 2) > 4); /* more than one pass */
 		snprintf(what, sizeof(what), "two triangle points, FIR 200 %s", fir_prec[k]);
-		compare(what, &fir[k], tri, 2, N, u2, TOL_FIR);
+		compare(what, &fir[k], tri, 2, N, u2, fir_tol(k));
 	}
 	free(u);
 	free(u2);
@@ -463,8 +474,8 @@ static void test_fir_sum_paths(void **state)
 				double err = efx_rel_rms(F[portable], R, n);
 				print_message("FIR 200 %s, %d row(s), %-8s sum: error %.2e (limit %.0e)\n",
 					      fir_prec[k], distinct_rows(s, m), portable ? "portable" : "wide",
-					      err, TOL_FIR);
-				assert_true(err <= TOL_FIR);
+					      err, fir_tol(k));
+				assert_true(err <= fir_tol(k));
 			}
 			double diff = efx_rel_rms(F[0], F[1], n);
 			print_message("  wide vs portable: %.2e\n", diff);

@@ -13,6 +13,11 @@
  * static force is S^-1 u with S = sum_k phi_k phi_k^T / omega_k^2 summed
  * here from that image's modes.  The old stabilisation (the whole tail
  * damped by r^s) runs on the same FIR without the window, for the figures.
+ *
+ * fir_tail = window, the FIR default, chooses L: the paper's fir:500 gets
+ * window:1000 (the image fir_tail = window:1000 makes), fir:100 doubles to
+ * window:800, fir:20 is refused after window:320 (16T); fir_tail = none
+ * by name still makes the bare FIR.
  */
 #include <math.h>
 #include <setjmp.h>
@@ -28,6 +33,7 @@
 #include "image/image_response.h"
 #include "support/engine_fixture.h"
 #include "irdm/posix/image_map.h"
+#include "precompute/precompute.h"
 
 #define T_HEAD 500  /* the paper's T */
 #define L_TAIL 1000 /* fir_tail = window:1000 */
@@ -330,6 +336,128 @@ static void test_window_floating(void **state)
 	irdm_image_unmap(&w);
 }
 
+/* ---- fir_tail = window: the FIR default, its length chosen ---------- */
+
+/* A scene from the defaults and pairs (NULL-terminated), precomputed into
+ * dir/name; mapped into img (if not NULL) when written. */
+static int scene_image(const char *name, const char *const *kv, struct irdm_image *img, char *err,
+		       size_t errlen)
+{
+	struct irdm_scene sc;
+	struct irdm_precompute_opts o = { 0 };
+	struct irdm_precompute_report rep;
+	char path[128];
+	int ret;
+
+	irdm_scene_defaults(&sc);
+	for (; *kv; kv += 2)
+		if (irdm_scene_set(&sc, kv[0], kv[1], "test", err, errlen))
+			return -1;
+	if (irdm_scene_check(&sc, err, errlen))
+		return -1;
+	snprintf(path, sizeof(path), "%s/%s.img", dir, name);
+	o.out_path = path;
+	ret = irdm_precompute(&sc, &o, &rep, err, errlen);
+	if (!ret && img)
+		ret = irdm_image_map(path, 0, img, err, errlen);
+	return ret;
+}
+
+/* The image's provenance has the line text. */
+static bool has_line(const struct irdm_image *img, const char *text)
+{
+	char *p = malloc(img->provenance_len + 2), line[128];
+	bool found;
+
+	assert_non_null(p);
+	p[0] = '\n';
+	memcpy(p + 1, img->provenance, img->provenance_len);
+	p[img->provenance_len + 1] = '\0';
+	snprintf(line, sizeof(line), "\n%s\n", text);
+	found = strstr(p, line) != NULL;
+	free(p);
+	return found;
+}
+
+#define PAPER_FIR(T) \
+	"resolution", "4,4,8", "representation", T, "modes", "all", "dt", "0.002", "precision", "f64", \
+		"touch", TOP_NODE, "display", "touch"
+
+/* The paper's fir:500 with no fir_tail key: window:2T certifies, and the
+ * image is the one fir_tail = window:1000 makes, measured within the
+ * default max_error. */
+static void test_default_is_window(void **state)
+{
+	static const char *const kv[] = { PAPER_FIR("fir:500"), NULL };
+	const struct irdm_image_section *a, *b;
+	struct irdm_image img;
+	char err[1024];
+
+	(void)state;
+	if (scene_image("default", kv, &img, err, sizeof(err)))
+		fail_msg("%s", err);
+	assert_true(img.meta->flags & IRDM_META_FIR_TAIL_WINDOW);
+	assert_int_equal(img.meta->fir_exact, T_HEAD);
+	assert_int_equal(img.meta->fir_length, T_HEAD + L_TAIL);
+	assert_true(img.meta->max_spectral_radius < 1);
+	assert_true(img.meta->flags & IRDM_META_ERROR_MEASURED);
+	assert_true(img.meta->measured_error <= 1e-3);
+	assert_true(has_line(&img, "fir_tail=window:1000"));
+	a = irdm_image_find(&img, IRDM_SEC_FIR);
+	b = irdm_image_find(&win, IRDM_SEC_FIR);
+	assert_int_equal(a->size, b->size);
+	assert_memory_equal(img.base + a->offset, win.base + b->offset, a->size);
+	irdm_image_unmap(&img);
+}
+
+/* fir:100: window:200 and window:400 do not certify, window:800 does. */
+static void test_window_doubles(void **state)
+{
+	static const char *const kv[] = { PAPER_FIR("fir:100"), "max_error", "none", NULL };
+	struct irdm_image img;
+	char err[1024];
+
+	(void)state;
+	if (scene_image("doubled", kv, &img, err, sizeof(err)))
+		fail_msg("%s", err);
+	assert_int_equal(img.meta->fir_exact, 100);
+	assert_int_equal(img.meta->fir_length, 100 + 800);
+	assert_true(img.meta->max_spectral_radius < 1);
+	assert_true(has_line(&img, "fir_tail=window:800"));
+	irdm_image_unmap(&img);
+}
+
+/* fir:20: no window up to 16T certifies: refused, with what was tried. */
+static void test_window_refused(void **state)
+{
+	static const char *const kv[] = { PAPER_FIR("fir:20"), "max_error", "none", NULL };
+	char err[1024];
+
+	(void)state;
+	assert_int_equal(scene_image("refused", kv, NULL, err, sizeof(err)), IRDM_ENUMERIC);
+	assert_non_null(strstr(err, "fir:20 with fir_tail = window:320 is not certified stable"));
+	assert_non_null(strstr(err, "(fir_tail = window tried window:40 to window:320)"));
+}
+
+/* fir_tail = none by name: the bare FIR, as before the window was the
+ * default (the engine damps its tail). */
+static void test_none_by_name(void **state)
+{
+	static const char *const kv[] = { PAPER_FIR("fir:100"), "fir_tail", "none", "uncertified", "yes",
+					  "max_error", "none", NULL };
+	struct irdm_image img;
+	char err[1024];
+
+	(void)state;
+	if (scene_image("none", kv, &img, err, sizeof(err)))
+		fail_msg("%s", err);
+	assert_false(img.meta->flags & IRDM_META_FIR_TAIL_WINDOW);
+	assert_int_equal(img.meta->fir_length, 100);
+	assert_true(img.meta->max_spectral_radius >= 1);
+	assert_true(has_line(&img, "fir_tail=none"));
+	irdm_image_unmap(&img);
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -337,6 +465,10 @@ int main(void)
 		cmocka_unit_test(test_window_hold),
 		cmocka_unit_test(test_window_undamped),
 		cmocka_unit_test(test_window_floating),
+		cmocka_unit_test(test_default_is_window),
+		cmocka_unit_test(test_window_doubles),
+		cmocka_unit_test(test_window_refused),
+		cmocka_unit_test(test_none_by_name),
 	};
 
 	return cmocka_run_group_tests(tests, setup, teardown);

@@ -657,7 +657,7 @@ static int setup(void **state)
 		return -1;
 	/* the cuboid scenes small; touch = surface as cuboid-paper, for the pinch */
 	if (precompute(IMG_CUBOID, "cuboid", (const char *const[]){ "--scene", "scenes/cuboid-paper.scene", "--resolution", "4,4,8", "--representation", "modal:40", NULL }) ||
-	    precompute(IMG_FIR, "fir", (const char *const[]){ "--scene", "scenes/cuboid-paper.scene", "--resolution", "4,4,8", "--representation", "fir:100", "--dt", "0.001", "--uncertified", "yes", NULL }) ||
+	    precompute(IMG_FIR, "fir", (const char *const[]){ "--scene", "scenes/cuboid-paper.scene", "--resolution", "4,4,8", "--representation", "fir:100", "--dt", "0.001", "--uncertified", "yes", "--fir_tail", "none", NULL }) ||
 	    precompute(IMG_CUBE, "cube", (const char *const[]){ "--scene", "scenes/cube-floating.scene", "--resolution", "4,4,4", "--representation", "modal:40", NULL }) ||
 	    precompute(IMG_TOP, "top", (const char *const[]){ "--scene", "scenes/cuboid-top.scene", "--resolution", "4,4,8", "--representation", "modal:40", NULL }))
 		return -1;

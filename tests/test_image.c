@@ -1668,6 +1668,39 @@ static void w_clusters_f64(struct irdm_image_writer *w)
 	w_set_elem(w, IRDM_SEC_STATIC_CORR_CLUSTERS, IRDM_ELEM_F64);
 }
 
+/* COLUMN_SCALE (format 2.4) on the fixture's 2 columns */
+FX(m_scale, fx->meta.flags |= IRDM_META_COLUMN_SCALE)
+
+static const float scales_ok[2] = { 0.25f, 0x1p-30f };
+static const float scales_three[2] = { 0.25f, 3.0f };
+static const float scales_zero[2] = { 0.0f, 1.0f };
+static const float scales_sub[2] = { 1.0f, 0x1p-140f };
+
+static void w_add_scales(struct irdm_image_writer *w)
+{
+	irdm_iw_add(w, IRDM_SEC_COLUMN_SCALE, IRDM_ELEM_F32, scales_ok, sizeof(scales_ok));
+}
+
+static void w_add_scales_three(struct irdm_image_writer *w)
+{
+	irdm_iw_add(w, IRDM_SEC_COLUMN_SCALE, IRDM_ELEM_F32, scales_three, sizeof(scales_three));
+}
+
+static void w_add_scales_zero(struct irdm_image_writer *w)
+{
+	irdm_iw_add(w, IRDM_SEC_COLUMN_SCALE, IRDM_ELEM_F32, scales_zero, sizeof(scales_zero));
+}
+
+static void w_add_scales_sub(struct irdm_image_writer *w)
+{
+	irdm_iw_add(w, IRDM_SEC_COLUMN_SCALE, IRDM_ELEM_F32, scales_sub, sizeof(scales_sub));
+}
+
+static void w_add_scales_short(struct irdm_image_writer *w)
+{
+	irdm_iw_add(w, IRDM_SEC_COLUMN_SCALE, IRDM_ELEM_F32, scales_ok, sizeof(float));
+}
+
 enum base { FIR,
 	    MODAL };
 
@@ -1783,6 +1816,14 @@ static const struct sem_case sem_cases[] = {
 	{ "head short", MODAL, m_head2, w_add_head_short, IRDM_EFORMAT, "section EXACT_HEAD has 288 bytes, expected 576" },
 	{ "head NaN", MODAL, m_head2, w_add_head_nan, IRDM_EFORMAT, "EXACT_HEAD element 40 is not finite" },
 	{ "FIR + head", FIR, NULL, w_add_head, IRDM_EFORMAT, "EXACT_HEAD must not be present (FIR image)" },
+	{ "column scales", FIR, m_scale, w_add_scales, IRDM_OK, NULL },
+	{ "column scales, modal", MODAL, m_scale, w_add_scales, IRDM_OK, NULL },
+	{ "column scales missing", FIR, m_scale, NULL, IRDM_EMISSING, "COLUMN_SCALE is missing" },
+	{ "column scales without the flag", FIR, NULL, w_add_scales, IRDM_EFORMAT, "COLUMN_SCALE must not be present" },
+	{ "column scale 3", FIR, m_scale, w_add_scales_three, IRDM_EFORMAT, "column 1: scale 3 is not a normal power of two" },
+	{ "column scale 0", FIR, m_scale, w_add_scales_zero, IRDM_EFORMAT, "column 0: scale 0 is not a normal power of two" },
+	{ "column scale subnormal", FIR, m_scale, w_add_scales_sub, IRDM_EFORMAT, "column 1: scale 7.17465e-43 is not a normal power of two" },
+	{ "column scales short", FIR, m_scale, w_add_scales_short, IRDM_EFORMAT, "section COLUMN_SCALE has 4 bytes, expected 8" },
 	{ "no MODES", MODAL, NULL, w_no_modes, IRDM_EMISSING, "MODES is missing" },
 	{ "no MODE_SHAPES", MODAL, NULL, w_no_shapes, IRDM_EMISSING, "MODE_SHAPES is missing" },
 	{ "modal + FIR", MODAL, NULL, w_add_fir, IRDM_EFORMAT, "FIR must not be present (modal image)" },
@@ -1830,6 +1871,43 @@ static const struct sem_case sem_cases[] = {
 	{ "FIR + clusters", FIR, NULL, w_add_clusters, IRDM_EFORMAT, "STATIC_CORR_CLUSTERS must not be present (FIR image)" },
 #undef CL
 };
+
+/* irdm_image_value(): the stored value times its column's scale; an
+ * image without COLUMN_SCALE (every image before 2.4) reads as written. */
+static void test_column_scale_values(void **state)
+{
+	struct irdm_image_writer w;
+	struct img_fixture fx;
+	struct irdm_image img;
+	char err[256];
+	size_t size, per;
+	void *buf;
+
+	(void)state;
+	for (int scaled = 0; scaled < 2; scaled++) {
+		small_fir(&fx);
+		if (scaled)
+			m_scale(&fx);
+		irdm_iw_init(&w);
+		img_fixture_add(&fx, &w);
+		if (scaled)
+			w_add_scales(&w);
+		assert_int_equal(irdm_iw_to_buffer(&w, &buf, &size), 0);
+		assert_int_equal(irdm_image_parse(buf, size, &img, err, sizeof(err)), IRDM_OK);
+		assert_true(!img.col_scale == !scaled);
+		per = (size_t)img.meta->n_nodes * img.meta->fir_length * 9;
+		for (uint32_t c = 0; c < img.meta->n_cols; c++) {
+			double sc = scaled ? scales_ok[c] : 1.0;
+			assert_true(irdm_image_col_scale(&img, c) == sc);
+			for (size_t i = c * per; i < (c + 1) * per; i++)
+				assert_true(irdm_image_value(&img, img.fir, c, i) ==
+					    irdm_elem_get(img.fir, img.meta->precision, i) * sc);
+		}
+		assert_true(irdm_elem_get(img.fir, img.meta->precision, per + 1) != 0);
+		free(buf);
+		img_fixture_free(&fx);
+	}
+}
 
 static void test_semantic_validation(void **state)
 {
@@ -2109,6 +2187,7 @@ int main(void)
 		cmocka_unit_test(test_crc32c_check_value),
 		cmocka_unit_test(test_crc32c_all_lengths_and_alignments),
 		cmocka_unit_test(test_f16_known_patterns),
+		cmocka_unit_test(test_column_scale_values),
 		cmocka_unit_test(test_f16_roundtrip_all),
 		cmocka_unit_test(test_f16_rounding_all_midpoints),
 		cmocka_unit_test(test_elem_size_and_get),

@@ -110,7 +110,8 @@ static void test_fir_modal_f16(void **state)
 {
 	(void)state;
 	precompute_twice("fir-f16", (const char *const[]){
-					    BOX, "--representation", "fir:50", "--precision", "f16", "--uncertified", "yes", NULL });
+					    BOX, "--representation", "fir:50", "--precision", "f16", "--uncertified", "yes",
+					    "--fir_tail", "none", NULL });
 }
 
 /* Threads split the inputs of the time-domain method: their order must not
@@ -120,7 +121,7 @@ static void test_fir_time_domain_threads(void **state)
 	(void)state;
 	precompute_twice("fir-td", (const char *const[]){
 					   BOX, "--representation", "fir:40", "--method", "time-domain",
-					   "--substeps", "4", "--threads", "2", "--uncertified", "yes", NULL });
+					   "--substeps", "4", "--threads", "2", "--uncertified", "yes", "--fir_tail", "none", NULL });
 }
 
 static void test_floating_modal(void **state)

@@ -105,10 +105,10 @@ static int teardown(void **state)
 		 "--fixed", "none", "--touch", "z>=0.07", "--precision", "f64", "--representation", "modal:24"
 #define FIR "--mesh", "box:0.03,0.04,0.06", "--resolution", "2,3,4", "--fixed", "z<=0", \
 	    "--touch", "z>=0.06", "--precision", "f64", "--representation", "fir:48", "--modes", "30", \
-	    "--uncertified", "yes"
+	    "--uncertified", "yes", "--fir_tail", "none"
 
 #define TIME_DOMAIN "--mesh", "box:0.03,0.04,0.06", "--resolution", "2,3,4", "--fixed", "z<=0", \
-		    "--touch", "z>=0.06", "--precision", "f64", "--representation", "fir:32", "--uncertified", "yes", \
+		    "--touch", "z>=0.06", "--precision", "f64", "--representation", "fir:32", "--uncertified", "yes", "--fir_tail", "none", \
 		    "--method", "time-domain", "--substeps", "4"
 
 /* irdm precompute ARGS... -o OUT, under mpirun -np np (np 0: no mpirun). */

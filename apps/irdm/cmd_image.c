@@ -37,7 +37,7 @@ static const char *kind_name(uint32_t k)
 	static const char *const names[] = { "?", "META", "PROVENANCE", "NODES", "COLUMNS",
 					     "SURFACE", "FIR", "MODES", "MODE_SHAPES", "STATIC_CORR", "RIGID", "STABILITY",
 					     "CONTACT_BVH", "STATIC_CORR_INDEX", "STATIC_CORR_LOWRANK", "EXACT_HEAD",
-					     "STATIC_CORR_CLUSTERS" };
+					     "STATIC_CORR_CLUSTERS", "COLUMN_SCALE" };
 
 	return k < sizeof(names) / sizeof(names[0]) ? names[k] : "unknown";
 }
@@ -52,6 +52,19 @@ static int open_image(const char *path, struct irdm_image *img)
 		return -1;
 	}
 	return 0;
+}
+
+/* COLUMN_SCALE: the range of the force columns' storage scales. */
+static void print_scales(const struct irdm_image *img)
+{
+	double lo = INFINITY, hi = 0;
+
+	for (uint32_t c = 0; c < img->meta->n_cols; c++) {
+		lo = fmin(lo, irdm_image_col_scale(img, c));
+		hi = fmax(hi, irdm_image_col_scale(img, c));
+	}
+	printf("scales        per force column, 2^%d to 2^%d (the values stored divided by them)\n",
+	       ilogb(lo), ilogb(hi));
 }
 
 /* STATIC_CORR_CLUSTERS: its clusters, its pairs by kind, its bytes. */
@@ -110,6 +123,8 @@ static int cmd_info(const char *path)
 		       "0..%u exact, %u..%u tapered, sum = static correction (hybrid)\n",
 		       m->n_modes_total - m->n_modes, m->head_samples / 2 - 1, m->head_samples / 2,
 		       m->head_samples - 1);
+	if (img.col_scale)
+		print_scales(&img);
 	printf("dt            %g s (%g Hz)\n", m->dt_s, 1.0 / m->dt_s);
 	printf("material      E %g Pa, nu %g, rho %g kg/m^3, %s mass\n", m->young_pa, m->poisson,
 	       m->density_kg_m3, m->flags & IRDM_META_CONSISTENT_MASS ? "consistent" : "lumped");

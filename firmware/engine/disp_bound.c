@@ -45,7 +45,7 @@ static double fir_block_norm(const struct irdm_engine *e, uint32_t cf, uint32_t 
 	double ss = 0;
 
 	for (size_t i = 0; i < 9; i++) {
-		double r = irdm_elem_get(img->fir, img->meta->precision, o + i);
+		double r = irdm_image_value(img, img->fir, cf, o + i);
 
 		ss += r * r;
 	}
@@ -93,8 +93,9 @@ static double fir_bound(const struct irdm_engine *e)
 		const struct irdm_force_tick *t = &r->tick[(r->head + e->T + 1 - s) % e->T];
 		double f = 0;
 
+		/* the ring's forces are in their columns' storage scale */
 		for (uint32_t n = 0; n < t->n; n++)
-			f += irdm_v3_norm(t->f_n[n]);
+			f += irdm_v3_norm(t->f_n[n]) / irdm_image_col_scale(e->img, t->col[n]);
 		b += e->tail_w[s] * e->bound_w[s] * f;
 	}
 	return b;

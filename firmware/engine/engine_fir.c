@@ -6,6 +6,8 @@
  * cancellation; docs/architecture.md, "Numerical hazards").  w[s] = r^s
  * damps the tail of images whose truncated recursion is unstable (r = 1
  * otherwise): it moves every pole of the recursion by the factor r.
+ * An image with column scales (COLUMN_SCALE) has its ring in scaled
+ * forces (force_ring.c).
  */
 #include <string.h>
 
@@ -30,7 +32,7 @@ void irdm_fir_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_d
 	size_t o = fir_index(e, col_force, e->img->columns[col_disp], 0);
 
 	for (int k = 0; k < 9; k++)
-		blk[k] = irdm_elem_get(e->img->fir, e->img->meta->precision, o + (size_t)k);
+		blk[k] = irdm_image_value(e->img, e->img->fir, col_force, o + (size_t)k);
 }
 
 void irdm_fir_apply(struct irdm_engine *e, const struct irdm_force_tick *f)
@@ -38,5 +40,5 @@ void irdm_fir_apply(struct irdm_engine *e, const struct irdm_force_tick *f)
 	struct irdm_fir_ring *r = &e->ring;
 
 	r->head = (r->head + 1) % e->T;
-	r->tick[r->head] = *f;
+	irdm_ring_put(e, &r->tick[r->head], f);
 }

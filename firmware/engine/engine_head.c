@@ -14,13 +14,13 @@
  */
 #include "engine_priv.h"
 
-/* D_s of kept block k into blk (row-major 3x3). */
-static void head_block(const struct irdm_engine *e, long k, uint32_t s, double blk[9])
+/* D_s of kept block k, a block of force column col, into blk (row-major 3x3). */
+static void head_block(const struct irdm_engine *e, uint32_t col, long k, uint32_t s, double blk[9])
 {
 	size_t base = ((size_t)k * e->H + s) * 9;
 
 	for (size_t i = 0; i < 9; i++)
-		blk[i] = irdm_elem_get(e->img->exact_head, e->img->meta->precision, base + i);
+		blk[i] = irdm_image_value(e->img, e->img->exact_head, col, base + i);
 }
 
 bool irdm_head_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp, double blk[9])
@@ -29,7 +29,7 @@ bool irdm_head_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_
 
 	if (k < 0)
 		return false; /* dropped: the far field alone, instantly */
-	head_block(e, k, 0, blk);
+	head_block(e, col_force, k, 0, blk);
 	return true;
 }
 
@@ -177,8 +177,9 @@ void irdm_head_apply(struct irdm_engine *e, const struct irdm_force_tick *f)
 	if (e->H < 2)
 		return;
 	r->head = (r->head + 1) % e->H;
-	r->tick[r->head] = *f;
-	irdm_head_lanes_apply(e, f);
+	irdm_ring_put(e, &r->tick[r->head], f);
+	/* the lanes hold the ring's values: scaled as the stored columns */
+	irdm_head_lanes_apply(e, &r->tick[r->head]);
 	/* the tick's force norms, once: the displacement bound reads them
 	 * every tick for every age */
 	double sum = 0;
@@ -194,9 +195,11 @@ void irdm_head_bound_init(const struct irdm_engine *e, double *w)
 
 	for (uint32_t s = 0; s < e->H; s++) {
 		double mx = 0;
-		for (uint32_t k = 0; k < n_blocks; k++) {
+		for (uint32_t k = 0, c = 0; k < n_blocks; k++) {
 			double blk[9], ss = 0;
-			head_block(e, k, s, blk);
+			while (k >= img->corr_start[c + 1])
+				c++;
+			head_block(e, c, k, s, blk);
 			for (int i = 0; i < 9; i++)
 				ss += blk[i] * blk[i];
 			mx = fmax(mx, sqrt(ss));

@@ -137,6 +137,11 @@ void irdm_fir_sum_wide(const struct irdm_engine *e, uint32_t n, const uint32_t *
 		       double (*u)[3]);
 void irdm_fir_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp, double blk[9]);
 void irdm_fir_apply(struct irdm_engine *e, const struct irdm_force_tick *f);
+/* force_ring.c: f into a ring slot, each force times its column's storage
+ * scale (irdm_image_col_scale()): the FIR and head sums read the stored
+ * values unscaled.  Readers of the ring's forces divide it back out. */
+void irdm_ring_put(const struct irdm_engine *e, struct irdm_force_tick *slot,
+		   const struct irdm_force_tick *f);
 
 /* engine_head.c: a modal image's exact head (H >= 1 only).  The kept
  * blocks from force columns to one column, looked up once a sum: the ring

@@ -12,6 +12,7 @@
  *                      (image_static_corr.c, its clusters and far field
  *                      image_corr_clusters.c, image_corr_lowrank.c,
  *                      image_exact_head.c)
+ *   image_col_scale.c  COLUMN_SCALE
  *   image_bvh.c        CONTACT_BVH
  *
  * The calls go one way, down this list: image_parse.c (the entry point,
@@ -43,7 +44,7 @@
 #error "IRDM images are little-endian and used in place"
 #endif
 
-#define KIND_MAX IRDM_SEC_STATIC_CORR_CLUSTERS
+#define KIND_MAX IRDM_SEC_COLUMN_SCALE
 #define TABLE_ENTRY sizeof(struct irdm_image_section)
 #define HEADER_SIZE sizeof(struct irdm_image_header)
 
@@ -116,6 +117,8 @@ int img_check_corr_lowrank(struct parse *p);
 int img_check_corr_clusters(struct parse *p);
 /* image_exact_head.c: EXACT_HEAD against the STATIC_CORR index (checked first) */
 int img_check_exact_head(struct parse *p);
+/* image_col_scale.c: COLUMN_SCALE iff its flag, after COLUMNS */
+int img_check_col_scale(struct parse *p);
 /* image_bvh.c */
 int img_check_contact_bvh(struct parse *p);
 

@@ -161,7 +161,7 @@ void irdm_image_corr_value(const struct irdm_image *img, uint32_t col_force,
 	long k = irdm_image_corr_block(img, col_force, col_disp);
 
 	for (size_t i = 0; i < 9; i++)
-		blk[i] = k < 0 ? 0.0 : irdm_elem_get(img->corr_blocks, img->meta->precision, (size_t)k * 9 + i);
+		blk[i] = k < 0 ? 0.0 : irdm_image_value(img, img->corr_blocks, col_force, (size_t)k * 9 + i);
 	if (img->corr_rank)
 		add_far_field(img, col_force, col_disp, blk);
 	if (img->corr_clusters)

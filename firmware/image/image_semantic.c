@@ -18,6 +18,7 @@ int img_check_contents(struct parse *p)
 		img_check_surface,
 		img_check_stability,
 		img_check_rigid,
+		img_check_col_scale,
 	};
 	int ret;
 

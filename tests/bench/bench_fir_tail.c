@@ -68,6 +68,8 @@ int main(void)
 		"fir:500",
 		"modes",
 		"all",
+		"fir_tail",
+		"none",
 		"touch",
 		"box:0.035,0.035,0.199,0.065,0.065,0.201",
 		"display",

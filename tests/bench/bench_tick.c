@@ -374,6 +374,8 @@ int main(void)
 		"0.002",
 		"representation",
 		"fir:500",
+		"fir_tail",
+		"none",
 		"touch",
 		"box:0.035,0.035,0.199,0.065,0.065,0.201",
 		"display",

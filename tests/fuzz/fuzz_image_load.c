@@ -124,7 +124,9 @@ static void walk_views(const struct irdm_image *img)
 		walk_clusters(img);
 	if (img->rigid)
 		read_bytes(img->rigid, sizeof(*img->rigid));
-	for (uint32_t k = 0; k <= IRDM_SEC_STATIC_CORR_CLUSTERS + 1; k++) {
+	if (img->col_scale)
+		read_bytes(img->col_scale, img->meta->n_cols * sizeof(*img->col_scale));
+	for (uint32_t k = 0; k <= IRDM_SEC_COLUMN_SCALE + 1; k++) {
 		const struct irdm_image_section *s = irdm_image_find(img, k);
 
 		if (s)

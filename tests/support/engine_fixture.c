@@ -28,6 +28,10 @@ void efx_image(struct irdm_image *img, const char *path, ...)
 	/* the accuracy measurement is what test_measure tests: elsewhere it
 	 * would only cost a dense eigensolve per image */
 	sc.max_error = 0;
+	/* an FIR with the tail its test names (fir_tail = window by name):
+	 * these tests run the engine on a given FIR, the precompute's search
+	 * for a certified window is test_fir_tail's */
+	sc.fir_tail_auto = false;
 	va_start(ap, path);
 	for (const char *k = va_arg(ap, const char *); k; k = va_arg(ap, const char *)) {
 		const char *v = va_arg(ap, const char *);
@@ -308,7 +312,7 @@ void efx_corr_block(const struct irdm_image *img, uint32_t col_force, uint32_t c
 	     img->corr_start && k < img->corr_start[col_force + 1]; k++)
 		if (img->corr_rows[k] == col_disp)
 			for (size_t e = 0; e < 9; e++)
-				blk[e] = irdm_elem_get(img->corr_blocks, prec, (size_t)k * 9 + e);
+				blk[e] = irdm_image_value(img, img->corr_blocks, col_force, (size_t)k * 9 + e);
 	for (size_t i = 0; i < 3; i++)
 		for (size_t j = 0; j < 3; j++)
 			for (size_t k = 0; k < r; k++)

@@ -8,7 +8,8 @@
 #include "irdm/session.h"
 
 /* Build an image with the library from "key=value" pairs (NULL-terminated),
- * map it.  Aborts the test on failure. */
+ * map it.  Aborts the test on failure.  Unlike a scene's defaults, no
+ * max_error and no fir_tail unless the pairs name them. */
 void efx_image(struct irdm_image *img, const char *path, ...);
 
 /* A session (engine only) on img, which it borrows; aborts the test on

@@ -29,7 +29,7 @@ static void fir_response(const struct irdm_image *img, uint32_t col, uint32_t ro
 	memset(out, 0, n * 9 * sizeof(double));
 	for (size_t s = 0; s < n && s < T; s++)
 		for (int e = 0; e < 9; e++)
-			out[9 * s + (size_t)e] = irdm_elem_get(img->fir, m->precision, base + 9 * s + (size_t)e);
+			out[9 * s + (size_t)e] = irdm_image_value(img, img->fir, col, base + 9 * s + (size_t)e);
 }
 
 static int modal_response(const struct irdm_image *img, uint32_t col, uint32_t row,
@@ -70,8 +70,8 @@ static int modal_response(const struct irdm_image *img, uint32_t col, uint32_t r
 	size_t H = m->head_samples;
 	for (size_t s = 0; blk >= 0 && s < H && s < n; s++)
 		for (int e = 0; e < 9; e++)
-			out[9 * s + (size_t)e] += irdm_elem_get(img->exact_head, m->precision,
-								((size_t)blk * H + s) * 9 + (size_t)e);
+			out[9 * s + (size_t)e] += irdm_image_value(img, img->exact_head, col,
+								   ((size_t)blk * H + s) * 9 + (size_t)e);
 	if (rc >= 0 && blk < 0) {
 		double s[9];
 		irdm_image_corr_value(img, col, (uint32_t)rc, s);

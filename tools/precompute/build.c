@@ -22,6 +22,7 @@
 #include "modal/static_lowrank.h"
 #include "modal/static_clusters.h"
 #include "modal/static_sparse.h"
+#include "precompute/col_scale.h"
 #include "precompute/fir_tail.h"
 #include "precompute/precompute.h"
 #include "precompute/td_part.h"
@@ -45,6 +46,7 @@ struct build {
 	struct irdm_corr_clusters clusters; /* modal: every block, clustered (0 clusters if not) */
 	void *stored[6];                    /* converted to the scene's precision */
 	size_t stored_bytes[6];
+	float *col_scale; /* f16: COLUMN_SCALE (col_scale.h), else NULL */
 	struct irdm_stability *stab;
 	struct irdm_meta meta;
 	struct irdm_rigid rigid;
@@ -599,7 +601,8 @@ static int hybrid_stable(const struct build *b, char *err, size_t errlen)
 static void repr_text(const struct irdm_scene *sc, char *buf, size_t len)
 {
 	if (sc->representation == IRDM_REPR_FIR)
-		snprintf(buf, len, "fir:%u%s", sc->fir_length, sc->fir_tail ? " with fir_tail" : "");
+		snprintf(buf, len, sc->fir_tail ? "fir:%u with fir_tail = window:%u" : "fir:%u",
+			 sc->fir_length, sc->fir_tail);
 	else if (!sc->modes)
 		snprintf(buf, len, "modal:all");
 	else if (sc->exact_head)
@@ -613,9 +616,10 @@ static void repr_text(const struct irdm_scene *sc, char *buf, size_t len)
 /* What may make an uncertified image certified. */
 static void certify_hint(const struct irdm_scene *sc, char *buf, size_t len)
 {
-	if (sc->representation == IRDM_REPR_FIR && !sc->fir_tail)
-		snprintf(buf, len, "try fir_tail = window:%u or longer, or a modal representation",
-			 2 * sc->fir_length);
+	if (sc->precision == IRDM_ELEM_F16)
+		snprintf(buf, len, "try precision = f32 (f16 rounds the responses the certificate judges)");
+	else if (sc->representation == IRDM_REPR_FIR && !sc->fir_tail)
+		snprintf(buf, len, "try fir_tail = window (the default), or a modal representation");
 	else if (sc->representation == IRDM_REPR_FIR)
 		snprintf(buf, len, "try a longer fir_tail than window:%u, or a modal representation",
 			 sc->fir_tail);
@@ -713,7 +717,8 @@ static void fill_meta(struct build *b)
 		    (sc->mass == IRDM_MASS_CONSISTENT ? IRDM_META_CONSISTENT_MASS : 0) |
 		    (sc->method == IRDM_METHOD_TIME_DOMAIN ? IRDM_META_TIME_DOMAIN : 0) |
 		    (mt->fir_exact ? IRDM_META_FIR_TAIL_WINDOW : 0) |
-		    (b->head ? IRDM_META_EXACT_HEAD : 0);
+		    (b->head ? IRDM_META_EXACT_HEAD : 0) |
+		    (b->col_scale ? IRDM_META_COLUMN_SCALE : 0);
 	mt->head_samples = b->head ? 2 * sc->exact_head : 0;
 	mt->dt_s = sc->dt_s;
 	mt->young_pa = sc->mat.young_pa;
@@ -822,6 +827,9 @@ static int add_sections(struct build *b, struct irdm_image_writer *w, const void
 	}
 	if (b->sc->floating)
 		ret |= irdm_iw_add(w, IRDM_SEC_RIGID, IRDM_ELEM_BYTES, &b->rigid, sizeof(b->rigid));
+	if (b->col_scale)
+		ret |= irdm_iw_add(w, IRDM_SEC_COLUMN_SCALE, IRDM_ELEM_F32, b->col_scale,
+				   m->n_cols * sizeof(*b->col_scale));
 	ret |= irdm_iw_add(w, IRDM_SEC_STABILITY, IRDM_ELEM_BYTES, b->stab, m->n_cols * sizeof(*b->stab));
 	ret |= irdm_iw_add(w, IRDM_SEC_CONTACT_BVH, IRDM_ELEM_BYTES, bvh, bvh_bytes);
 	if (ret) {
@@ -907,6 +915,45 @@ static void *store_clusters(const struct irdm_corr_clusters *cl, uint32_t prec, 
 	return p;
 }
 
+/*
+ * f16: a power of two per force column over the values it divides (the
+ * FIR, or the kept correction blocks and their head: col_scale.h), and
+ * those stored scaled, so that stiff objects do not underflow.  The
+ * certificate and the error measurement then see the values as stored.
+ */
+static int store_f16_scaled(struct build *b)
+{
+	size_t nc = b->m.n_cols, fir_per = b->m.n_rows * fir_taps(b) * 9;
+	size_t head_per = 2 * (size_t)b->sc->exact_head * 9;
+	uint32_t p = b->sc->precision;
+	double *mx = calloc(nc ? nc : 1, sizeof(*mx));
+
+	b->col_scale = malloc((nc ? nc : 1) * sizeof(*b->col_scale));
+	if (!mx || !b->col_scale) {
+		free(mx);
+		return IRDM_ENOMEM;
+	}
+	if (b->fir)
+		irdm_col_absmax(b->fir, nc, NULL, fir_per, mx);
+	if (b->sparse.start)
+		irdm_col_absmax(b->sparse.blocks, nc, b->sparse.start, 9, mx);
+	if (b->head)
+		irdm_col_absmax(b->head, nc, b->sparse.start, head_per, mx);
+	for (size_t c = 0; c < nc; c++)
+		b->col_scale[c] = irdm_col_scale_for(mx[c]);
+	free(mx);
+	if (b->fir)
+		b->stored[0] = irdm_store_scaled(b->fir, nc, NULL, fir_per, b->col_scale, p,
+						 &b->stored_bytes[0]);
+	if (b->sparse.start)
+		b->stored[2] = irdm_store_scaled(b->sparse.blocks, nc, b->sparse.start, 9,
+						 b->col_scale, p, &b->stored_bytes[2]);
+	if (b->head)
+		b->stored[4] = irdm_store_scaled(b->head, nc, b->sparse.start, head_per,
+						 b->col_scale, p, &b->stored_bytes[4]);
+	return IRDM_OK;
+}
+
 static int responses(struct build *b, char *err, size_t errlen)
 {
 	struct irdm_model *m = &b->m;
@@ -926,18 +973,22 @@ static int responses(struct build *b, char *err, size_t errlen)
 		if (ret)
 			return ret;
 	}
-	if (b->fir)
+	if (b->sc->precision == IRDM_ELEM_F16 && store_f16_scaled(b)) {
+		snprintf(err, errlen, "precompute: out of memory");
+		return IRDM_ENOMEM;
+	}
+	if (b->fir && !b->col_scale)
 		b->stored[0] = store(b->fir, m->n_cols * m->n_rows * fir_taps(b) * 9,
 				     b->sc->precision, &b->stored_bytes[0]);
 	if (b->shapes && b->sc->representation == IRDM_REPR_MODAL)
 		b->stored[1] = store(b->shapes, m->n_rows * 3 * b->n_modes, b->sc->precision,
 				     &b->stored_bytes[1]);
-	if (b->sparse.start)
+	if (b->sparse.start && !b->col_scale)
 		b->stored[2] = store(b->sparse.blocks, b->sparse.n_blocks * 9, b->sc->precision,
 				     &b->stored_bytes[2]);
 	if (b->far.rank)
 		b->stored[3] = store_far(&b->far, b->sc->precision, &b->stored_bytes[3]);
-	if (b->head)
+	if (b->head && !b->col_scale)
 		b->stored[4] = store(b->head, b->sparse.n_blocks * 2 * b->sc->exact_head * 9,
 				     b->sc->precision, &b->stored_bytes[4]);
 	if (b->clusters.n_clusters)
@@ -965,6 +1016,7 @@ static void build_free(struct build *b)
 	irdm_corr_clusters_free(&b->clusters);
 	for (int i = 0; i < 6; i++)
 		free(b->stored[i]);
+	free(b->col_scale);
 	free(b->stab);
 	free(b->nodes);
 	free(b->prov);
@@ -1051,6 +1103,7 @@ static int reference_from_model(void *ctx, const struct irdm_scene *rsc, const c
 	free(r.shapes);
 	for (int i = 0; i < 6; i++)
 		free(r.stored[i]);
+	free(r.col_scale);
 	free(r.stab);
 	free(r.nodes);
 	free(r.prov);
@@ -1058,13 +1111,10 @@ static int reference_from_model(void *ctx, const struct irdm_scene *rsc, const c
 }
 
 /* What may bring an image's measured error under max_error. */
-static void error_hint(const struct irdm_scene *sc, char *buf, size_t len)
+static void repr_hint(const struct irdm_scene *sc, char *buf, size_t len)
 {
-	if (sc->precision == IRDM_ELEM_F16)
-		snprintf(buf, len, "precision = f32");
-	else if (sc->representation == IRDM_REPR_FIR && !sc->fir_tail)
-		snprintf(buf, len, "fir_tail = window:%u (no tail damping), a longer FIR, or a modal representation with exact_head",
-			 2 * sc->fir_length);
+	if (sc->representation == IRDM_REPR_FIR && !sc->fir_tail)
+		snprintf(buf, len, "fir_tail = window (no tail damping), a longer FIR, or a modal representation with exact_head");
 	else if (sc->representation == IRDM_REPR_FIR)
 		snprintf(buf, len, "a longer FIR (fir:%u), or a modal representation with exact_head",
 			 2 * sc->fir_length);
@@ -1079,11 +1129,30 @@ static void error_hint(const struct irdm_scene *sc, char *buf, size_t len)
 			 2 * sc->exact_head, 2 * sc->modes);
 }
 
+/* The same, f16 first: its 11 bits may be what misses (a soft object's
+ * long FIR sums thousands of taps that the force cancels), or the
+ * representation may be whatever the precision. */
+static void error_hint(const struct irdm_scene *sc, char *buf, size_t len)
+{
+	char rest[160];
+
+	if (sc->precision != IRDM_ELEM_F16) {
+		repr_hint(sc, buf, len);
+		return;
+	}
+	if (sc->representation == IRDM_REPR_MODAL && !sc->modes) {
+		snprintf(buf, len, "precision = f32");
+		return;
+	}
+	repr_hint(sc, rest, sizeof(rest));
+	snprintf(buf, len, "precision = f32, and if that is not enough %s", rest);
+}
+
 /* Refuse an image whose measured error is above the scene's max_error. */
 static int within_target(const struct build *b, const struct irdm_precompute_report *rep,
 			 char *err, size_t errlen)
 {
-	char repr[64], hint[160];
+	char repr[64], hint[224];
 
 	if (!rep->error_measured || rep->measured_error <= b->sc->max_error)
 		return IRDM_OK;
@@ -1220,6 +1289,8 @@ static void reset_try(struct build *b, size_t n_all)
 		free(b->stored[i]);
 		b->stored[i] = NULL;
 	}
+	free(b->col_scale);
+	b->col_scale = NULL;
 	b->n_modes = 0;
 	memset(&b->meta, 0, sizeof(b->meta));
 	b->m.modes.n_modes = n_all;
@@ -1280,24 +1351,94 @@ static int choose(struct build *b, struct irdm_precompute_report *rep, char *err
 	return ret;
 }
 
+/* Columns whose force recursion is not certified stable. */
+static size_t unstable_cols(const struct build *b)
+{
+	size_t n = 0;
+
+	for (size_t c = 0; b->stab && c < b->m.n_cols; c++)
+		n += !(b->stab[c].flags & IRDM_STAB_STABLE);
+	return n;
+}
+
+#define FIR_TAIL_FACTOR_MAX 16 /* fir_tail = window: L up to this many T */
+
+/* fir_tail = window on an FIR: the precompute chooses L. */
+static bool fir_tail_auto(const struct irdm_scene *sc)
+{
+	return sc->representation == IRDM_REPR_FIR && sc->fir_tail_auto && !sc->fir_tail;
+}
+
+/* The first L fir_tail = window tries, and the last: 2T .. 16T, T + L at
+ * most the 1000000 samples an FIR may have. */
+static unsigned fir_tail_first(unsigned T)
+{
+	return T <= 1000000 / 3 ? 2 * T : 1000000 - T;
+}
+
+static unsigned fir_tail_last(unsigned T)
+{
+	return (uint64_t)T * (FIR_TAIL_FACTOR_MAX + 1) <= 1000000 ? FIR_TAIL_FACTOR_MAX * T : 1000000 - T;
+}
+
+/*
+ * fir_tail = window: L = 2T, doubled until the image is certified stable
+ * (a longer window tapers more gently: the tail's ripple that makes the
+ * truncated recursion unstable shrinks), up to 16T.  A certified image
+ * that misses max_error is refused as it is (the window's error is past
+ * T; a longer FIR is the fix), one that none certifies with the longest
+ * window's reasons.  Over MPI ranks or in time-domain parts the first L
+ * alone is tried: every rank and part must compute the same samples.
+ */
+static int fir_tail_search(struct build *b, struct irdm_precompute_report *rep, char *err,
+			   size_t errlen)
+{
+	struct irdm_scene *eff = (struct irdm_scene *)b->sc;
+	size_t n_all = b->m.modes.n_modes;
+	unsigned T = eff->fir_length, last = fir_tail_last(T);
+	bool one = irdm_dist_size() > 1 || b->o->part_out || b->o->n_merge;
+	char why[768];
+	int ret;
+
+	for (;;) {
+		ret = one_try(b, rep, err, errlen);
+		if (one || eff->fir_tail >= last || (ret && ret != IRDM_ENUMERIC) || !unstable_cols(b))
+			break;
+		if (b->o->progress)
+			b->o->progress(b->o->ctx, "fir_tail = window: a longer window", -1.0);
+		reset_try(b, n_all);
+		eff->fir_tail = (unsigned)((uint64_t)eff->fir_tail * 2 < last ? eff->fir_tail * 2 : last);
+	}
+	if (ret == IRDM_ENUMERIC && unstable_cols(b) && !one) {
+		snprintf(why, sizeof(why), "%s", err);
+		snprintf(err, errlen, "%s (fir_tail = window tried window:%u to window:%u)", why,
+			 fir_tail_first(T), eff->fir_tail);
+	}
+	return ret;
+}
+
 int irdm_precompute(const struct irdm_scene *sc, const struct irdm_precompute_opts *o,
 		    struct irdm_precompute_report *rep, char *err, size_t errlen)
 {
 	struct build b = { .sc = sc, .o = o };
-	/* auto resolves to a representation: the image's provenance says which */
-	struct irdm_scene *eff = sc->repr_auto ? malloc(sizeof(*eff)) : NULL;
+	/* auto resolves to a representation (fir_tail = window to a length):
+	 * the image's provenance says which */
+	struct irdm_scene *eff = sc->repr_auto || fir_tail_auto(sc) ? malloc(sizeof(*eff)) : NULL;
 	bool auto_choice = sc->repr_auto && sc->max_error > 0 && irdm_dist_size() == 1;
 	double t0 = irdm_now_s();
 	int ret;
 
 	memset(rep, 0, sizeof(*rep));
-	if (sc->repr_auto && !eff) {
+	if ((sc->repr_auto || fir_tail_auto(sc)) && !eff) {
 		snprintf(err, errlen, "precompute: out of memory");
 		return IRDM_ENOMEM;
 	}
 	if (eff) {
 		*eff = *sc;
 		eff->repr_auto = false;
+		if (fir_tail_auto(sc))
+			eff->fir_tail = fir_tail_first(sc->fir_length);
+		eff->fir_tail_auto = false;
 		b.sc = eff;
 	}
 	b.scene_hash = scene_hash(sc);
@@ -1316,7 +1457,10 @@ int irdm_precompute(const struct irdm_scene *sc, const struct irdm_precompute_op
 			ret = td_distributed(&b, list_inputs(&b.m, NULL, NULL), err, errlen);
 		goto out_worker;
 	}
-	ret = auto_choice ? choose(&b, rep, err, errlen) : one_try(&b, rep, err, errlen);
+	if (auto_choice)
+		ret = choose(&b, rep, err, errlen);
+	else
+		ret = fir_tail_auto(sc) ? fir_tail_search(&b, rep, err, errlen) : one_try(&b, rep, err, errlen);
 	if (ret || o->part_out)
 		goto out_done;
 	if (o->progress)

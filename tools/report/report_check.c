@@ -99,7 +99,7 @@ int irdm_report_check_reference(const struct irdm_report_opts *o, const struct i
 	/* the step node of the reference, as the only column of the check */
 	irdm_report_scenario_cmds(step, ref, dt_s, 0, &cmd);
 	snprintf(keys, sizeof(keys),
-		 "dt=%.17g method=time-domain representation=fir:%zu substeps=%d precision=f64 touch=nodes:%u display=touch",
+		 "dt=%.17g method=time-domain representation=fir:%zu fir_tail=none substeps=%d precision=f64 touch=nodes:%u display=touch",
 		 dt_s, N, IRDM_REPORT_CHECK_SUBSTEPS, ref->nodes[cmd.row].mesh_node);
 	snprintf(name, sizeof(name), "%s-check-%gms", o->cfg->name, dt_s * 1e3);
 	ret = irdm_report_image_build(&td, o->tmp_dir, name, kl, check_progress, (void *)o, err, errlen);

@@ -31,7 +31,7 @@ static const struct irdm_report_model sweep_model = {
 
 #define FIR(T) \
 	{ \
-		"fir:" #T, "representation=fir:" #T " modes=all precision=f32" \
+		"fir:" #T, "representation=fir:" #T " modes=all precision=f32 fir_tail=none" \
 	}
 /* the hybrid: K modes, the dropped ones' exact head of H samples */
 #define HYBRID(K, H) \
@@ -46,7 +46,7 @@ static const struct irdm_report_model sweep_model = {
 
 static const struct irdm_report_repr sweep_reprs[] = {
 	/* the paper's own: FIR T = 500 by time integration, 500 Hz */
-	{ "fir-td:500", "representation=fir:500 method=time-domain substeps=8 precision=f32 dt=0.002" },
+	{ "fir-td:500", "representation=fir:500 method=time-domain substeps=8 precision=f32 dt=0.002 fir_tail=none" },
 	/* the same with its tail windowed over 2T more samples and the static
 	 * compliance restored (fir_tail, docs/architecture.md): certified */
 	{ "fir-td:500+win", "representation=fir:500 method=time-domain substeps=8 precision=f32 dt=0.002 fir_tail=window:1000" },
@@ -72,8 +72,8 @@ static const struct irdm_report_repr sweep_reprs[] = {
 	HYBRID(400, 32),
 	HYBRID(400, 64),
 	/* storage precision (FIR at the paper's period only: its certificate) */
-	{ "fir:500/f64", "representation=fir:500 modes=all precision=f64 dt=0.002" },
-	{ "fir:500/f16", "representation=fir:500 modes=all precision=f16 dt=0.002" },
+	{ "fir:500/f64", "representation=fir:500 modes=all precision=f64 dt=0.002 fir_tail=none" },
+	{ "fir:500/f16", "representation=fir:500 modes=all precision=f16 dt=0.002 fir_tail=none" },
 	{ "modal:100+sc/f64", "representation=modal:100 static_correction=yes precision=f64" },
 	{ "modal:100+sc/f16", "representation=modal:100 static_correction=yes precision=f16" },
 	{ "modal:all/f64", "representation=modal:all static_correction=no precision=f64" },
@@ -190,7 +190,7 @@ static const struct irdm_report_model tiny_model = {
 
 static const struct irdm_report_repr tiny_reprs[] = {
 	{ "modal:all/f64", "representation=modal:all static_correction=no precision=f64" },
-	{ "fir:100", "representation=fir:100 modes=all precision=f64" },
+	{ "fir:100", "representation=fir:100 modes=all precision=f64 fir_tail=none" },
 	{ "modal:20+sc", "representation=modal:20 static_correction=yes precision=f32" },
 };
 

@@ -35,6 +35,7 @@ void irdm_scene_defaults(struct irdm_scene *sc)
 	sc->representation = IRDM_REPR_MODAL;
 	sc->repr_auto = true;
 	sc->modes = 300;
+	sc->fir_tail_auto = true;
 	sc->static_correction = true;
 	sc->static_corr_tol = IRDM_STATIC_CORR_TOL_DEFAULT;
 	sc->static_corr_rank = IRDM_STATIC_CORR_RANK_DEFAULT;
@@ -321,19 +322,20 @@ static int set_representation(const struct irdm_opt *o, void *obj, const char *v
 	return parse_representation(obj, v) ? IRDM_EFORMAT : IRDM_OK;
 }
 
-/* "none", or "window:L": L samples past T, tapered (precompute/fir_tail.c). */
+/* "window" (L chosen by the precompute), "window:L": L samples past T,
+ * tapered (precompute/fir_tail.c), or "none". */
 static int set_fir_tail(const struct irdm_opt *o, void *obj, const char *v, char *why, size_t len)
 {
 	static const struct irdm_opt count = { .name = "fir_tail", .type = IRDM_OPT_UNSIGNED, .size = sizeof(unsigned), .range = IRDM_OPT_GE | IRDM_OPT_LE, .min = 1, .max = 1000000 };
 	struct irdm_scene *sc = obj;
 
 	(void)o;
-	if (!strcmp(v, "none")) {
-		sc->fir_tail = 0;
+	sc->fir_tail = 0;
+	sc->fir_tail_auto = !strcmp(v, "window");
+	if (sc->fir_tail_auto || !strcmp(v, "none"))
 		return IRDM_OK;
-	}
 	if (strncmp(v, "window:", 7)) {
-		snprintf(why, len, "expected none or window:L");
+		snprintf(why, len, "expected window, window:L or none");
 		return IRDM_EFORMAT;
 	}
 	return irdm_opt_parse_value(&count, &sc->fir_tail, v + 7, why, len);
@@ -420,9 +422,12 @@ static const struct irdm_opt scene_opts[] = {
 																		   "max_error (every mode solved: a dense eigensolve); with max_error = none, "
 																		   "modal:300 + static correction (default auto)" },
 	{ .name = "modes", .type = IRDM_OPT_CUSTOM, .parse = set_modes, .metavar = "K | all", .help = "modes that synthesise a modal-method FIR, 1 to 1000000 (default 300)" },
-	{ .name = "fir_tail", .type = IRDM_OPT_CUSTOM, .parse = set_fir_tail, .metavar = "none | window:L", .help = "FIR stabilisation: window:L appends L samples past T tapered to zero (Hann), "
-														    "the taps' sum restored to the static compliance; the first T stay exact "
-														    "(default none: the engine damps an unstable FIR's tail by r^s)" },
+	{ .name = "fir_tail", .type = IRDM_OPT_CUSTOM, .parse = set_fir_tail, .metavar = "window | window:L | none", .help = "FIR stabilisation: window:L appends L samples past T tapered to zero (Hann), "
+															     "the taps' sum restored to the static compliance; the first T stay exact; "
+															     "window chooses L: 2T, doubled until every touchable node's force recursion is "
+															     "certified stable, up to 16T (refused if none is); none: no window, the engine "
+															     "damps an unstable FIR's tail by r^s, which distorts it from the first sample "
+															     "(default window)" },
 	{ .name = "static_correction", .type = IRDM_OPT_BOOL, SC(static_correction), .help = "residual compliance of dropped modes (modal; default yes)" },
 	{ .name = "static_correction_tol", .type = IRDM_OPT_DOUBLE, SC(static_corr_tol), .metavar = "TOL", .range = IRDM_OPT_GE | IRDM_OPT_LT, .min = 0, .max = 1, .help = "modal: drop the static correction's block between touchable nodes a and b when its norm is below TOL sqrt(|S_aa| |S_bb|), the diagonal blocks' norms: the force error at a contact is of about that order (default 0.02; 0 keeps every block)" },
 	{ .name = "static_correction_rank", .type = IRDM_OPT_UNSIGNED, SC(static_corr_rank), .metavar = "R", .range = IRDM_OPT_GE | IRDM_OPT_LE, .min = 0, .max = IRDM_CORR_LOWRANK_MAX, .help = "modal: the far field of the dropped static-correction blocks as a symmetric term of rank R over the touchable nodes, added to every block (image section STATIC_CORR_LOWRANK, R (1 + 3 n_cols) values); 0 leaves it out (default 96)" },
@@ -593,8 +598,13 @@ int irdm_scene_format(const struct irdm_scene *sc, char *buf, size_t len)
 			 eig[sc->eigensolver], sc->modes);
 	if (n < 0 || (size_t)n >= len)
 		return -1;
-	if (sc->fir_tail) { /* only when set: older scenes keep their text */
-		int t = snprintf(buf + n, len - (size_t)n, "fir_tail=window:%u\n", sc->fir_tail);
+	if (sc->representation == IRDM_REPR_FIR) { /* only for an FIR: older scenes keep their text */
+		char tail[32];
+		if (sc->fir_tail)
+			snprintf(tail, sizeof(tail), "window:%u", sc->fir_tail);
+		else
+			snprintf(tail, sizeof(tail), "%s", sc->fir_tail_auto ? "window" : "none");
+		int t = snprintf(buf + n, len - (size_t)n, "fir_tail=%s\n", tail);
 		if (t < 0 || (size_t)t >= len - (size_t)n)
 			return -1;
 		n += t;

@@ -71,7 +71,10 @@ struct irdm_scene {
 	bool repr_auto;          /* chosen by the precompute to meet max_error */
 	unsigned fir_length;
 	unsigned fir_tail; /* FIR: samples windowed past fir_length (0: none) */
-	unsigned modes;    /* modes kept (0 = all) */
+	/* FIR, fir_tail = window (the default): the precompute chooses
+	 * fir_tail, the shortest of 2T, 4T, ... 16T that certifies */
+	bool fir_tail_auto;
+	unsigned modes; /* modes kept (0 = all) */
 	bool static_correction;
 	double static_corr_tol;       /* drop blocks below tol sqrt(|S_cc| |S_rr|) */
 	unsigned static_corr_rank;    /* far field of the dropped blocks: rank (0: none) */

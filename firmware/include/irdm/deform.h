@@ -59,7 +59,10 @@ void irdm_deform_publish_modal(struct irdm_deform *d, uint64_t tick, const doubl
 /*
  * FIR: the ring (ring[(head - s) mod T] = tick t - s), copied newest first:
  * min(ring->T, image T) ticks, and of each only its n force nodes, so the
- * cost is bounded by T (IRDM_MAX_FORCE_NODES + 1) small copies.
+ * cost is bounded by T (IRDM_MAX_FORCE_NODES + 1) small copies.  The
+ * engine's ring holds each force times its column's storage scale
+ * (irdm_image_col_scale(), 1 unless the image has COLUMN_SCALE), and the
+ * worker reads the FIR's stored taps unscaled against it, as the tick does.
  */
 void irdm_deform_publish_fir(struct irdm_deform *d, uint64_t tick,
 			     const struct irdm_fir_ring *ring, const struct irdm_pose *pose);

@@ -58,6 +58,10 @@ struct irdm_image {
 	 * precision (exact over the first half, tapered over the second); its
 	 * samples sum to block k of corr_blocks */
 	const void *exact_head;
+	/* optional COLUMN_SCALE (NULL if absent: every scale 1): FIR,
+	 * corr_blocks and exact_head hold force column c's values divided
+	 * by col_scale[c]; read them through irdm_image_value() */
+	const float *col_scale;                 /* n_cols */
 	const struct irdm_rigid *rigid;         /* floating only, else NULL */
 	const struct irdm_stability *stability; /* n_cols */
 	/* optional CONTACT_BVH (NULL if absent): validated header, payload bytes */
@@ -103,6 +107,25 @@ static inline size_t irdm_upper_index(size_t n, size_t i, size_t j)
 
 const struct irdm_corr_pair *irdm_image_corr_pair(const struct irdm_image *img, uint32_t a,
 						  uint32_t b);
+
+/* Force column col's storage scale: a power of two, 1 without COLUMN_SCALE. */
+static inline double irdm_image_col_scale(const struct irdm_image *img, uint32_t col)
+{
+	return img->col_scale ? (double)img->col_scale[col] : 1.0;
+}
+
+/*
+ * Element i of data, a response array in the image's precision (FIR,
+ * corr_blocks or exact_head) whose element i belongs to force column col:
+ * the value as stored times the column's scale, i.e. what it means.  The
+ * one way to read those arrays outside the tick's sums, which instead
+ * fold the scale into the force history they keep (engine_fir.c).
+ */
+static inline double irdm_image_value(const struct irdm_image *img, const void *data, uint32_t col,
+				      size_t i)
+{
+	return irdm_elem_get(data, img->meta->precision, i) * irdm_image_col_scale(img, col);
+}
 
 /* Section lookup in a validated image: the table entry of kind, or NULL if
  * absent (or img holds no image).  Cannot fail otherwise. */

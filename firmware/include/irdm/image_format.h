@@ -16,7 +16,7 @@
 
 #define IRDM_IMAGE_MAGIC "IRDMIMG"  /* 7 chars + NUL = 8 bytes */
 #define IRDM_IMAGE_VERSION_MAJOR 2u /* incompatible layout change */
-#define IRDM_IMAGE_VERSION_MINOR 3u /* compatible additions: 2.1 STATIC_CORR_LOWRANK, EXACT_HEAD; 2.2 STATIC_CORR_CLUSTERS; 2.3 measured_error */
+#define IRDM_IMAGE_VERSION_MINOR 4u /* compatible additions: 2.1 STATIC_CORR_LOWRANK, EXACT_HEAD; 2.2 STATIC_CORR_CLUSTERS; 2.3 measured_error; 2.4 COLUMN_SCALE */
 #define IRDM_IMAGE_ALIGN 64u        /* payload alignment, bytes */
 #define IRDM_IMAGE_MAX_SECTIONS 32u
 
@@ -70,6 +70,7 @@ enum irdm_section_kind {
 	IRDM_SEC_STATIC_CORR_LOWRANK = 14,  /* optional, with STATIC_CORR: far field U diag(lambda) U^T */
 	IRDM_SEC_EXACT_HEAD = 15,           /* modal, optional: [k][s][3][3] of the STATIC_CORR blocks, s < head_samples */
 	IRDM_SEC_STATIC_CORR_CLUSTERS = 16, /* optional, with STATIC_CORR: every block, block low-rank over clusters */
+	IRDM_SEC_COLUMN_SCALE = 17,         /* optional: n_cols x f32, a power of two per force column */
 };
 
 enum irdm_repr {
@@ -89,6 +90,9 @@ enum irdm_meta_flags {
 	IRDM_META_EXACT_HEAD = 1u << 5,
 	/* measured_error holds the precompute's measured force error */
 	IRDM_META_ERROR_MEASURED = 1u << 6,
+	/* COLUMN_SCALE present: FIR, STATIC_CORR and EXACT_HEAD hold each
+	 * force column's values divided by its scale (2.4) */
+	IRDM_META_COLUMN_SCALE = 1u << 7,
 };
 
 /* Longest head (samples): the engine keeps a ring of that many ticks. */

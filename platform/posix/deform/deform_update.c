@@ -42,9 +42,9 @@ static void static_correction(const struct irdm_deform_worker *w,
 			double *u = pos + 3 * (size_t)img->columns[img->corr_rows[k]];
 			size_t base = (size_t)k * 9;
 			for (size_t i = 0; i < 3; i++)
-				u[i] += irdm_elem_get(S, w->prec, base + 3 * i) * fe[0] +
-					irdm_elem_get(S, w->prec, base + 3 * i + 1) * fe[1] +
-					irdm_elem_get(S, w->prec, base + 3 * i + 2) * fe[2];
+				u[i] += irdm_image_value(img, S, c, base + 3 * i) * fe[0] +
+					irdm_image_value(img, S, c, base + 3 * i + 1) * fe[1] +
+					irdm_image_value(img, S, c, base + 3 * i + 2) * fe[2];
 		}
 	}
 }
@@ -137,6 +137,9 @@ void deform_modal(struct irdm_deform_worker *w, struct deform_snap *s, double *p
  * u_r = sum_{s < T} sum_e R[s](col_e -> r) f_e[t - s], row by row: for one
  * row and column the blocks of successive s are contiguous ([col][row][s]),
  * so each force node is a forward stream; the history itself stays in L1.
+ * The history is the engine's ring, whose forces are in their columns'
+ * storage scale (COLUMN_SCALE): the taps are read as stored, as the
+ * engine's sums read them, and R' f' = R f.
  */
 static void fir_row(const struct irdm_deform_worker *w, const struct irdm_force_tick *h,
 		    uint32_t n_hist, uint32_t r, double *u)
