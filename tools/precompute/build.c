@@ -1301,8 +1301,9 @@ static void say_candidates(const struct build *b, const struct irdm_auto_candida
 	if (!b->o->progress)
 		return;
 	for (size_t k = 0; k < n && len > 0 && (size_t)len < sizeof(line); k++)
-		len += snprintf(line + len, sizeof(line) - (size_t)len, "%s %zu modes%s%.0u (%.2f us)",
-				k ? "," : "", c[k].modes, c[k].head ? " + head " : "", c[k].head,
+		len += snprintf(line + len, sizeof(line) - (size_t)len,
+				"%s %zu modes to %.0f Hz%s%.0u (%.2f us)", k ? "," : "", c[k].modes,
+				c[k].kept_max_hz, c[k].head ? " + head " : "", c[k].head,
 				c[k].tick_us);
 	b->o->progress(b->o->ctx, line, -1.0);
 }
@@ -1356,7 +1357,9 @@ static int choose(struct build *b, struct irdm_precompute_report *rep, char *err
 		return IRDM_ENOMEM;
 	}
 	if (n_all <= AUTO_ALL_MODES) {
-		cand[0] = (struct irdm_auto_candidate){ n_all, 0, irdm_auto_tick_us(n_all, 0) };
+		cand[0] = (struct irdm_auto_candidate){
+			n_all, 0, irdm_auto_tick_us(n_all, 0),
+			sqrt(b->m.modes.omega2[n_all - 1]) / (2 * M_PI) };
 		n_cand = 1;
 	} else {
 		n_cand = irdm_auto_candidates(&b->m.modes, &b->m.damping, b->sc->dt_s,

@@ -1,5 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /* representation = auto's candidates (candidates.h). */
+#include <math.h>
 #include <stdlib.h>
 
 #include "modal/decay.h"
@@ -22,6 +23,15 @@ double irdm_auto_tick_us(size_t modes, unsigned head)
 	return (NS_PER_MODE * (double)modes + NS_PER_HEAD_SAMPLE * 2.0 * head) * 1e-3;
 }
 
+static double max_hz(const struct irdm_modes *m, const size_t *order, size_t k)
+{
+	double w2 = 0;
+
+	for (size_t i = 0; i < k; i++)
+		w2 = fmax(w2, m->omega2[order[i]]);
+	return sqrt(w2) / (2 * M_PI);
+}
+
 static int by_cost(const void *a, const void *b)
 {
 	const struct irdm_auto_candidate *x = a, *y = b;
@@ -42,12 +52,14 @@ size_t irdm_auto_candidates(const struct irdm_modes *m, const struct irdm_raylei
 		out[n].modes = k ? k : 1;
 		out[n].head = heads[i];
 		out[n].tick_us = irdm_auto_tick_us(out[n].modes, heads[i]);
+		out[n].kept_max_hz = max_hz(m, order, out[n].modes);
 		n++;
 	}
 	free(order);
 	out[n].modes = m->n_modes;
 	out[n].head = 0;
 	out[n].tick_us = irdm_auto_tick_us(m->n_modes, 0);
+	out[n].kept_max_hz = m->n_modes ? sqrt(m->omega2[m->n_modes - 1]) / (2 * M_PI) : 0;
 	n++;
 	qsort(out, n, sizeof(*out), by_cost);
 	return n;
