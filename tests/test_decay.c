@@ -5,9 +5,9 @@
  *  - the slowest decay rate against hand-computed values, under-,
  *    critically and overdamped, and a free mass;
  *  - on eight modes under Rayleigh damping C = 0.01 s K, where the
- *    overdamped high modes decay at about 1/b = 100 /s while two
- *    underdamped ones in between decay faster: the modes kept for a
- *    horizon are the ones ringing past it, not the lowest;
+ *    overdamped high modes decay at about 1/b = 100 /s while two in
+ *    between (z 0.9 and 1) decay faster: the modes kept for a horizon
+ *    are the ones ringing past it, not the lowest;
  *  - the permutation that puts them first moves omega^2 and the mode
  *    shapes together, and its inverse restores them;
  *  - auto's candidates on a model: each head's kept modes are the ones
