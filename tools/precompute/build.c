@@ -1272,11 +1272,12 @@ static int kept_undo(struct build *b, const size_t *order, size_t *inv)
 	return irdm_modes_permute(&b->m.modes, inv);
 }
 
-/* One candidate's line: what it is, what it costs, what it measured. */
+/* One candidate's line: what it is, what it costs, what it measured;
+ * refused before a measurement, why (err). */
 static void say_candidate(const struct build *b, const struct irdm_auto_candidate *c,
-			  const struct irdm_precompute_report *rep, int ret)
+			  const struct irdm_precompute_report *rep, int ret, const char *err)
 {
-	char line[512], repr[64], size[48] = "not written", meas[64] = "not measured";
+	char line[768], repr[64], size[48] = "not written", meas[64] = "not measured";
 
 	if (!b->o->progress)
 		return;
@@ -1285,10 +1286,11 @@ static void say_candidate(const struct build *b, const struct irdm_auto_candidat
 		snprintf(size, sizeof(size), "image %.1f MiB", (double)b->try_bytes / (1 << 20));
 	if (rep->error_measured)
 		snprintf(meas, sizeof(meas), "measured error %.3g", rep->measured_error);
-	snprintf(line, sizeof(line), "auto: %s%s: estimated tick %.2f us, %s, %s: %s", repr,
+	snprintf(line, sizeof(line), "auto: %s%s: estimated tick %.2f us, %s, %s: %s%.400s", repr,
 		 c->head ? " (the modes ringing past the head kept)" : "", c->tick_us, size, meas,
 		 !ret ? "kept, the cheapest estimated to tick that is certified and meets max_error" :
-		 rep->error_measured ? "over max_error" : "not certified");
+		 rep->error_measured ? "over max_error" : "refused: ",
+		 ret && !rep->error_measured ? err : "");
 	b->o->progress(b->o->ctx, line, -1.0);
 }
 
@@ -1330,7 +1332,7 @@ static int try_candidate(struct build *b, const struct irdm_auto_candidate *c, s
 	}
 	ret = one_try(b, rep, err, errlen);
 	rep->auto_tries++;
-	say_candidate(b, c, rep, ret);
+	say_candidate(b, c, rep, ret, err);
 	if (ret && c->modes < n_all && kept_undo(b, order, &order[n_all])) {
 		snprintf(err, errlen, "precompute: out of memory");
 		return IRDM_ENOMEM;
