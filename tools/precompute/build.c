@@ -15,6 +15,7 @@
 #include "irdm/error.h"
 #include "irdm/image.h"
 #include "irdm/posix/image_map.h"
+#include "modal/decay.h"
 #include "modal/exact_head.h"
 #include "modal/lapack.h"
 #include "modal/response.h"
@@ -22,6 +23,7 @@
 #include "modal/static_lowrank.h"
 #include "modal/static_clusters.h"
 #include "modal/static_sparse.h"
+#include "precompute/candidates.h"
 #include "precompute/col_scale.h"
 #include "precompute/fir_tail.h"
 #include "precompute/precompute.h"
@@ -54,6 +56,8 @@ struct build {
 	char *prov;
 	uint64_t scene_hash;
 	size_t n_solved; /* modes the eigensolve gave (all: the exact model's) */
+	bool kept_not_lowest; /* auto's hybrid keeps modes above a dropped one */
+	size_t try_bytes;     /* the measured image's size (0: none written) */
 };
 
 /* Modes the scene needs solved (0: all). */
@@ -786,6 +790,10 @@ static int provenance(struct build *b)
 		 (unsigned long long)b->meta.mesh_hash, b->m.fem.map.n_free,
 		 b->m.damping.a_per_s, b->m.damping.b_s, b->m.modes.n_modes,
 		 b->m.modes.n_elastic_total, b->meta.first_elastic_hz, scene);
+	/* the scene's modal:K would keep the lowest K: say that it did not */
+	if (b->kept_not_lowest)
+		snprintf(b->prov + strlen(b->prov), len - strlen(b->prov),
+			 "modes_kept=the ones ringing past the head (not the lowest)\n");
 	return IRDM_OK;
 }
 
@@ -1204,6 +1212,7 @@ static int measure(struct build *b, struct irdm_precompute_report *rep, char *er
 	snprintf(tmp, n, "%s.unmeasured", out);
 	snprintf(ref, n, "%s.exact", out);
 	ret = write_image(b, tmp, &bytes, err, errlen);
+	b->try_bytes = ret ? 0 : bytes;
 	if (!ret)
 		ret = irdm_image_map(tmp, 0, &img, err, errlen);
 	if (ret)
@@ -1296,58 +1305,156 @@ static void reset_try(struct build *b, size_t n_all)
 	b->m.modes.n_modes = n_all;
 }
 
-/* representation = auto's candidates, in increasing tick cost. */
-struct candidate {
-	unsigned modes; /* 0: all */
-	bool corr;
-	unsigned head;
-};
-
-static const struct candidate auto_candidates[] = {
-	{ 300, true, 0 },
-	{ 300, true, 32 },
-	{ 300, true, 128 },
-	{ 300, true, 512 },
-	{ 0, false, 0 },
-};
-
 #define AUTO_ALL_MODES 300 /* at most this many modes: modal:all, exact and as cheap */
 
 /*
- * representation = auto: every mode is solved; the first candidate whose
- * image is certified and measures within max_error is kept.  A model of
- * at most AUTO_ALL_MODES modes takes them all.
+ * Put the candidate's kept modes first (the ones ringing past its head;
+ * modal/decay.h), as split_modes() and the static correction take the
+ * first K; order[] receives the permutation, to undo it.
+ */
+static int kept_first(struct build *b, const struct irdm_auto_candidate *c, size_t *order,
+		      char *err, size_t errlen)
+{
+	struct irdm_modes *md = &b->m.modes;
+	size_t k = irdm_modes_by_decay(md, &b->m.damping, c->head * b->sc->dt_s, b->sc->max_error,
+				       order);
+
+	if (k != c->modes && !(k == 0 && c->modes == 1)) {
+		snprintf(err, errlen, "precompute: representation = auto: the modes ringing past the head changed (%zu, not %zu)",
+			 k, c->modes);
+		return IRDM_EINVAL;
+	}
+	b->kept_not_lowest = false;
+	for (size_t i = 0; i < c->modes; i++)
+		b->kept_not_lowest |= order[i] >= c->modes;
+	if (irdm_modes_permute(md, order)) {
+		snprintf(err, errlen, "precompute: out of memory");
+		return IRDM_ENOMEM;
+	}
+	return IRDM_OK;
+}
+
+/* Back to ascending frequency: order[] made kept_first()'s permutation. */
+static int kept_undo(struct build *b, const size_t *order, size_t *inv)
+{
+	for (size_t k = 0; k < b->m.modes.n_modes; k++)
+		inv[order[k]] = k;
+	b->kept_not_lowest = false;
+	return irdm_modes_permute(&b->m.modes, inv);
+}
+
+/* One candidate's line: what it is, what it costs, what it measured;
+ * refused before a measurement, why (err). */
+static void say_candidate(const struct build *b, const struct irdm_auto_candidate *c,
+			  const struct irdm_precompute_report *rep, int ret, const char *err)
+{
+	char line[768], repr[64], size[48] = "not written", meas[64] = "not measured";
+
+	if (!b->o->progress)
+		return;
+	repr_text(b->sc, repr, sizeof(repr));
+	if (b->try_bytes)
+		snprintf(size, sizeof(size), "image %.1f MiB", (double)b->try_bytes / (1 << 20));
+	if (rep->error_measured)
+		snprintf(meas, sizeof(meas), "measured error %.3g", rep->measured_error);
+	snprintf(line, sizeof(line), "auto: %s%s: estimated tick %.2f us, %s, %s: %s%.400s", repr,
+		 c->head ? " (the modes ringing past the head kept)" : "", c->tick_us, size, meas,
+		 !ret ? "kept, the cheapest estimated to tick that is certified and meets max_error" :
+		 rep->error_measured ? "over max_error" : "refused: ",
+		 ret && !rep->error_measured ? err : "");
+	b->o->progress(b->o->ctx, line, -1.0);
+}
+
+/* The list, before any is built. */
+static void say_candidates(const struct build *b, const struct irdm_auto_candidate *c, size_t n)
+{
+	char line[512];
+	int len = snprintf(line, sizeof(line), "auto: candidates, cheapest estimated tick first:");
+
+	if (!b->o->progress)
+		return;
+	for (size_t k = 0; k < n && len > 0 && (size_t)len < sizeof(line); k++)
+		len += snprintf(line + len, sizeof(line) - (size_t)len,
+				"%s %zu modes to %.0f Hz%s%.0u (%.2f us)", k ? "," : "", c[k].modes,
+				c[k].kept_max_hz,
+				c[k].head ? " + head " :
+				c[k].modes < b->m.modes.n_modes ? " + static correction" : "",
+				c[k].head, c[k].tick_us);
+	b->o->progress(b->o->ctx, line, -1.0);
+}
+
+/* Try candidate c on the model (every mode in it, ascending). */
+static int try_candidate(struct build *b, const struct irdm_auto_candidate *c, size_t n_all,
+			 struct irdm_precompute_report *rep, size_t *order, char *err,
+			 size_t errlen)
+{
+	struct irdm_scene *eff = (struct irdm_scene *)b->sc;
+	bool hybrid = c->modes < n_all && c->head;
+	int ret;
+
+	reset_try(b, n_all);
+	eff->modes = c->modes < n_all ? (unsigned)c->modes : 0;
+	eff->static_correction = c->modes < n_all;
+	eff->exact_head = hybrid ? c->head : 0;
+	eff->static_corr_cluster = 0;
+	rep->error_measured = false;
+	b->try_bytes = 0;
+	if (hybrid) {
+		ret = kept_first(b, c, order, err, errlen);
+		if (ret)
+			return ret;
+	} else if (c->modes < n_all) {
+		b->kept_not_lowest = false;
+		b->m.modes.n_modes = c->modes; /* truncated: the lowest K */
+	}
+	ret = one_try(b, rep, err, errlen);
+	rep->auto_tries++;
+	say_candidate(b, c, rep, ret, err);
+	if (ret && hybrid && kept_undo(b, order, &order[n_all])) {
+		snprintf(err, errlen, "precompute: out of memory");
+		return IRDM_ENOMEM;
+	}
+	return ret;
+}
+
+/*
+ * representation = auto: every mode is solved; the candidates
+ * (candidates.h), cheapest to tick first, are built until one is
+ * certified and measures within max_error.  A model of at most
+ * AUTO_ALL_MODES modes takes them all.
  */
 static int choose(struct build *b, struct irdm_precompute_report *rep, char *err, size_t errlen)
 {
-	struct irdm_scene *eff = (struct irdm_scene *)b->sc;
-	size_t n_all = b->m.modes.n_modes, first = n_all <= AUTO_ALL_MODES ? 4 : 0;
+	struct irdm_auto_candidate cand[IRDM_AUTO_MAX_CANDIDATES];
+	size_t n_all = b->m.modes.n_modes, n_cand;
+	size_t *order = malloc(2 * n_all * sizeof(*order));
 	char last[768] = "";
 	int ret = IRDM_ENUMERIC;
 
-	for (size_t k = first; k < sizeof(auto_candidates) / sizeof(auto_candidates[0]); k++) {
-		const struct candidate *c = &auto_candidates[k];
-
-		reset_try(b, n_all);
-		eff->modes = c->modes;
-		eff->static_correction = c->corr;
-		eff->exact_head = c->head;
-		eff->static_corr_cluster = 0;
-		/* a head splits the modes itself (split_modes); else keep K */
-		if (c->modes && !c->head && c->modes < n_all)
-			b->m.modes.n_modes = c->modes;
-		ret = one_try(b, rep, err, errlen);
-		rep->auto_tries++;
-		if (!ret)
-			return IRDM_OK;
-		if (ret != IRDM_ENUMERIC)
-			return ret;
-		snprintf(last, sizeof(last), "%s", err);
-		if (b->o->progress)
-			b->o->progress(b->o->ctx, "representation = auto: next candidate", -1.0);
+	if (!order) {
+		snprintf(err, errlen, "precompute: out of memory");
+		return IRDM_ENOMEM;
 	}
-	snprintf(err, errlen, "precompute: representation = auto: no candidate met max_error = %g (set max_error higher or none); the last: %s",
-		 eff->max_error, last);
+	if (n_all <= AUTO_ALL_MODES) {
+		cand[0] = (struct irdm_auto_candidate){
+			n_all, 0, irdm_auto_tick_us(n_all, 0),
+			sqrt(b->m.modes.omega2[n_all - 1]) / (2 * M_PI) };
+		n_cand = 1;
+	} else {
+		n_cand = irdm_auto_candidates(&b->m.modes, &b->m.damping, b->sc->dt_s,
+					      b->sc->max_error, cand);
+	}
+	say_candidates(b, cand, n_cand);
+	for (size_t k = 0; k < n_cand; k++) {
+		ret = try_candidate(b, &cand[k], n_all, rep, order, err, errlen);
+		if (ret != IRDM_ENUMERIC)
+			break;
+		snprintf(last, sizeof(last), "%s", err);
+	}
+	free(order);
+	if (ret == IRDM_ENUMERIC)
+		snprintf(err, errlen, "precompute: representation = auto: no candidate met max_error = %g (set max_error higher or none); the last: %s",
+			 b->sc->max_error, last);
 	return ret;
 }
 

@@ -1,0 +1,47 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * representation = auto's candidates: for each head length H of a few,
+ * the hybrid that keeps in its modal recursion the modes ringing past the
+ * head (modal/decay.h) and gives the head the rest; the lowest modes
+ * with the static correction alone; then every mode.
+ * They are tried cheapest to tick first.
+ */
+#ifndef IRDM_TOOLS_CANDIDATES_H
+#define IRDM_TOOLS_CANDIDATES_H
+
+#include <stddef.h>
+
+#include "fem/fem.h"
+#include "modal/modal.h"
+
+#define IRDM_AUTO_MAX_CANDIDATES 7
+#define IRDM_AUTO_TRUNCATED 300 /* modes of the truncated candidate */
+
+struct irdm_auto_candidate {
+	size_t modes;   /* kept in the recursion; all of them: no head */
+	unsigned head;  /* samples of the dropped modes' exact head (0: none) */
+	double tick_us; /* estimated tick cost, one touching node */
+	double kept_max_hz; /* the highest frequency kept */
+};
+
+/*
+ * Estimated tick cost (us) of one touching node on an image of `modes`
+ * modes and a head of `head` samples (plus as many tapered): the modal
+ * recursion costs per mode, the head's sum per sample of age.
+ */
+double irdm_auto_tick_us(size_t modes, unsigned head);
+
+/*
+ * The candidates for m (every elastic mode, ascending) under damp at
+ * dt_s, a mode outlasting a head when its envelope after the head is
+ * above tol: a hybrid per head length whose ringing modes are not all of
+ * m (at least one mode kept), the lowest IRDM_AUTO_TRUNCATED modes with
+ * the static correction and no head (when m has more), then every mode,
+ * ordered by estimated tick cost.  A candidate with a head and fewer than
+ * every mode is a hybrid; without a head and fewer, the truncated one.  out: IRDM_AUTO_MAX_CANDIDATES entries.
+ * Return: how many.
+ */
+size_t irdm_auto_candidates(const struct irdm_modes *m, const struct irdm_rayleigh *damp,
+			    double dt_s, double tol, struct irdm_auto_candidate *out);
+
+#endif
