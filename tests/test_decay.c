@@ -63,8 +63,7 @@ static void modes_of(struct irdm_modes *m, double *w2, double *phi, size_t n)
 		for (size_t i = 0; i < n; i++)
 			phi[k * n + i] = (double)(10 * k + i); /* column k tells its mode */
 	}
-	*m = (struct irdm_modes){ .n = n, .n_modes = 8, .n_elastic_total = 8, .omega2 = w2,
-				  .phi = phi };
+	*m = (struct irdm_modes){ .n = n, .n_modes = 8, .n_elastic_total = 8, .omega2 = w2, .phi = phi };
 }
 
 static void test_kept_by_decay_not_frequency(void **state)

@@ -55,7 +55,7 @@ struct build {
 	struct irdm_node *nodes;
 	char *prov;
 	uint64_t scene_hash;
-	size_t n_solved; /* modes the eigensolve gave (all: the exact model's) */
+	size_t n_solved;      /* modes the eigensolve gave (all: the exact model's) */
 	bool kept_not_lowest; /* auto's hybrid keeps modes above a dropped one */
 	size_t try_bytes;     /* the measured image's size (0: none written) */
 };
@@ -1359,8 +1359,9 @@ static void say_candidate(const struct build *b, const struct irdm_auto_candidat
 		snprintf(meas, sizeof(meas), "measured error %.3g", rep->measured_error);
 	snprintf(line, sizeof(line), "auto: %s%s: estimated tick %.2f us, %s, %s: %s%.400s", repr,
 		 c->head ? " (the modes ringing past the head kept)" : "", c->tick_us, size, meas,
-		 !ret ? "kept, the cheapest estimated to tick that is certified and meets max_error" :
-		 rep->error_measured ? "over max_error" : "refused: ",
+		 !ret                ? "kept, the cheapest estimated to tick that is certified and meets max_error" :
+		 rep->error_measured ? "over max_error" :
+				       "refused: ",
 		 ret && !rep->error_measured ? err : "");
 	b->o->progress(b->o->ctx, line, -1.0);
 }
@@ -1377,8 +1378,9 @@ static void say_candidates(const struct build *b, const struct irdm_auto_candida
 		len += snprintf(line + len, sizeof(line) - (size_t)len,
 				"%s %zu modes to %.0f Hz%s%.0u (%.2f us)", k ? "," : "", c[k].modes,
 				c[k].kept_max_hz,
-				c[k].head ? " + head " :
-				c[k].modes < b->m.modes.n_modes ? " + static correction" : "",
+				c[k].head                       ? " + head " :
+				c[k].modes < b->m.modes.n_modes ? " + static correction" :
+								  "",
 				c[k].head, c[k].tick_us);
 	b->o->progress(b->o->ctx, line, -1.0);
 }
@@ -1438,7 +1440,8 @@ static int choose(struct build *b, struct irdm_precompute_report *rep, char *err
 	if (n_all <= AUTO_ALL_MODES) {
 		cand[0] = (struct irdm_auto_candidate){
 			n_all, 0, irdm_auto_tick_us(n_all, 0),
-			sqrt(b->m.modes.omega2[n_all - 1]) / (2 * M_PI) };
+			sqrt(b->m.modes.omega2[n_all - 1]) / (2 * M_PI)
+		};
 		n_cand = 1;
 	} else {
 		n_cand = irdm_auto_candidates(&b->m.modes, &b->m.damping, b->sc->dt_s,

@@ -18,9 +18,9 @@
 #define IRDM_AUTO_TRUNCATED 300 /* modes of the truncated candidate */
 
 struct irdm_auto_candidate {
-	size_t modes;   /* kept in the recursion; all of them: no head */
-	unsigned head;  /* samples of the dropped modes' exact head (0: none) */
-	double tick_us; /* estimated tick cost, one touching node */
+	size_t modes;       /* kept in the recursion; all of them: no head */
+	unsigned head;      /* samples of the dropped modes' exact head (0: none) */
+	double tick_us;     /* estimated tick cost, one touching node */
 	double kept_max_hz; /* the highest frequency kept */
 };
 

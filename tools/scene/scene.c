@@ -417,9 +417,10 @@ static const struct irdm_opt scene_opts[] = {
 	{ .name = "fixed", .type = IRDM_OPT_CUSTOM, .parse = set_region, SC(fixed), .metavar = REGION, .help = "fixed nodes, called REGION below (default z<=0)" },
 	{ .name = "dt", .type = IRDM_OPT_DOUBLE, SC(dt_s), .metavar = "SECONDS", .unit = "s", .range = IRDM_OPT_GE | IRDM_OPT_LE, .min = 1e-6, .max = 1, .help = "sample period (default 0.001)" },
 	{ .name = "representation", .type = IRDM_OPT_CUSTOM, .parse = set_representation, .metavar = "auto | modal:K | modal:all | fir:T", .help = "K modes (1 to 1000000) or all, or an FIR of T samples (1 to 1000000); auto: "
-																		   "the cheapest to tick of modal:all (up to 300 modes), modal:300 + static "
-																		   "correction + exact_head 32, 128 or 512, modal:all whose measured error meets "
-																		   "max_error (every mode solved: a dense eigensolve); with max_error = none, "
+																		   "every mode solved (a dense eigensolve), the cheapest estimated to tick of "
+																		   "modal:all (up to 300 modes), modal:300 + static correction, hybrids with "
+																		   "heads of 16 to 256 samples keeping the modes that ring past them, and "
+																		   "modal:all, whose measured error meets max_error; with max_error = none, "
 																		   "modal:300 + static correction (default auto)" },
 	{ .name = "modes", .type = IRDM_OPT_CUSTOM, .parse = set_modes, .metavar = "K | all", .help = "modes that synthesise a modal-method FIR, 1 to 1000000 (default 300)" },
 	{ .name = "fir_tail", .type = IRDM_OPT_CUSTOM, .parse = set_fir_tail, .metavar = "window | window:L | none", .help = "FIR stabilisation: window:L appends L samples past T tapered to zero (Hann), "
