@@ -22,6 +22,8 @@
 #                   the exact model (irdm report; REPORT_CONFIGS, <= 10 min)
 #   make run        the main job: the built-in default scene, end to end
 #   make view-shots after make run: its run in the browser view, docs/view/*.png
+#   make run-vs-exact after make run: its press replayed on its image and on
+#                   the all-modes image (docs/measurements/run-vs-exact.md)
 #   make jitter     irdm-fw's wake-up latency beside cyclictest's, alternating
 #                   (JITTER_ROUNDS x JITTER_SECONDS; docs/measurements/jitter.md)
 #   make jitter-view the same loop with and without a browser on its live view
@@ -178,7 +180,7 @@ CORE_TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(CORE_TEST_SRC))
 FWAPP_TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(FWAPP_TEST_SRC))
 BENCHES  := $(patsubst tests/bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC))
 
-.PHONY: all test test-variants san fuzz material-grid bench bench-precompute bench-mpi run render view-shots jitter-view stability report jitter check deps clean docs docs-check cfg-fws sizes hil format format-check head-tick
+.PHONY: all test test-variants san fuzz material-grid run-vs-exact bench bench-precompute bench-mpi run render view-shots jitter-view stability report jitter check deps clean docs docs-check cfg-fws sizes hil format format-check head-tick
 .SECONDARY:
 all: $(if $(CONFIG),,$(IRDM) $(SLEPC_PLUGIN)) $(FW_LIB) $(POSIX_LIB) $(HAL_LIB) $(SIM_LIB) $(if $(FWMAIN_SRC),$(IRDM_FW)) \
   $(if $(CDMAIN_SRC),$(IRDM_CD))
@@ -413,6 +415,10 @@ stability-run:
 	IRDM_STAB_OUT=$(STAB_OUT) $(BUILD)/tests/test_stability_spin
 	IRDM_STAB_OUT=$(STAB_OUT) IRDM_SOAK_SECONDS=$(STAB_SOAK_SECONDS) $(BUILD)/tests/test_stability_soak
 	/usr/bin/python3 tools/scripts/stability-report.py $(STAB_OUT)
+
+# make run's press replayed on the default image and on the exact model's.
+run-vs-exact: $(IRDM)
+	$(MEASURE) -m run-vs-exact 'make run-vs-exact' -- tools/scripts/run-vs-exact.sh $(IRDM)
 
 # Every case written within max_error and certified, or refused with a
 # message (tools/scripts/material-grid.sh); GRID_JOBS precomputes at once.
