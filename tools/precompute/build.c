@@ -57,6 +57,7 @@ struct build {
 	uint64_t scene_hash;
 	size_t n_solved;      /* modes the eigensolve gave (all: the exact model's) */
 	bool kept_not_lowest; /* auto's hybrid keeps modes above a dropped one */
+	bool auto_try;        /* building one of auto's candidates */
 	size_t try_bytes;     /* the measured image's size (0: none written) */
 };
 
@@ -84,6 +85,19 @@ static bool truncated(const struct build *b)
 }
 
 /*
+ * auto skips a hybrid whose head would be larger than this: on a large
+ * touchable surface the kept blocks times the head's samples grow past
+ * what an image should hold, and building them takes as long.
+ */
+#define AUTO_HEAD_MAX_BYTES (256u << 20)
+
+/* The head's stored bytes: n_blocks 3x3 blocks over 2H samples. */
+static size_t head_bytes(const struct build *b, size_t n_blocks, size_t H)
+{
+	return n_blocks * 2 * H * 9 * irdm_elem_size(b->sc->precision);
+}
+
+/*
  * The hybrid representation (scene key exact_head): every mode was solved;
  * the image keeps the scene's K, and the dropped ones' exact response over
  * the head's samples at the static correction's kept blocks.  Called once
@@ -100,6 +114,13 @@ static int exact_head(struct build *b, const struct irdm_mode *zoh_all, size_t n
 	int ret = IRDM_ENOMEM;
 
 	all.n_modes = n_all;
+	if (b->auto_try && head_bytes(b, sp->n_blocks, H) > AUTO_HEAD_MAX_BYTES) {
+		free(target);
+		snprintf(err, errlen, "precompute: auto: the head would take %.0f MiB (%zu blocks x %zu samples), more than auto builds (%u MiB)",
+			 (double)head_bytes(b, sp->n_blocks, H) / (1 << 20), sp->n_blocks, 2 * H,
+			 AUTO_HEAD_MAX_BYTES >> 20);
+		return IRDM_ENUMERIC;
+	}
 	b->head = malloc(sp->n_blocks * 2 * H * 9 * sizeof(double));
 	if (!b->head || !target) {
 		snprintf(err, errlen, "precompute: the exact head (%zu blocks x %zu samples) does not fit in memory",
@@ -1395,6 +1416,7 @@ static int try_candidate(struct build *b, const struct irdm_auto_candidate *c, s
 	int ret;
 
 	reset_try(b, n_all);
+	b->auto_try = true;
 	eff->modes = c->modes < n_all ? (unsigned)c->modes : 0;
 	eff->static_correction = c->modes < n_all;
 	eff->exact_head = hybrid ? c->head : 0;
