@@ -4,8 +4,10 @@
 # (resolution 4,4,8, fixed at its base, touched on top) over a grid of
 # materials from a soft gel to steel-like stiffness, incompressible ones
 # and a very light and a very heavy one, two ticks (1 and 2 ms), the three
-# stored precisions and three ways of asking (the default, a hybrid of 100
-# modes + a 128-sample head, an FIR of 500 samples with its default tail).
+# stored precisions and two ways of asking (the default, and a hybrid of
+# 100 modes + a 128-sample head).  FIRs are left out: fir_tail = window
+# finds its window by building the FIR again for each length it tries,
+# over ten minutes a case on the soft materials here.
 #
 # Each case must end one of two ways: an image written that is certified
 # (irdm image verify --require-stable accepts it) and whose measured error
@@ -45,7 +47,7 @@ materials=(
 )
 dts=(0.001 0.002)
 precs=(f16 f32 f64)
-reprs=("default" "modal:100+head:128" "fir:500")
+reprs=("default" "modal:100+head:128")
 if [ "${MATERIAL_GRID_QUICK:-0}" = 1 ]; then
 	dts=(0.002)
 	precs=(f32)
@@ -58,7 +60,6 @@ run_case() {
 	case $repr in
 	default) ;;
 	modal:100+head:128) args=(--representation modal:100 --static_correction yes --exact_head 128) ;;
-	fir:500) args=(--representation fir:500) ;;
 	esac
 	local rc=0 t0 t1 verdict err radius msg head
 	t0=$(date +%s.%N)
@@ -112,7 +113,6 @@ for m in "${materials[@]}"; do
 	for dt in "${dts[@]}"; do
 		for prec in "${precs[@]}"; do
 			for repr in "${reprs[@]}"; do
-				[ "$repr" != fir:500 ] || [ "$dt" = 0.002 ] || continue
 				# shellcheck disable=SC2086
 				printf '%03d %s %s %s %s %s %s\n' "$n" $m "$dt" "$prec" "$repr"
 				n=$((n + 1))
