@@ -7,7 +7,8 @@
  * the lowest 100 modes with a 128-sample head leaves them to a head
  * they outlast:
  *  - that hybrid, asked for by name, is refused and not written;
- *  - auto's first candidate is certified and within max_error = 1e-3;
+ *  - auto's first hybrid (after the truncated 300 modes, over the target)
+ *    is certified and within max_error = 1e-3;
  *    the modes it keeps are exactly those of the exact model (every mode,
  *    its discretised recursions read from its image) whose spectral
  *    radius to the head's length is above 1e-3: the ones ringing past
