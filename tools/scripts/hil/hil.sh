@@ -43,9 +43,10 @@ step "the default scene (cuboid-top) at dt = $dt_s s, 300 modes + static correct
 # The VM tests the CAN path, not the image's accuracy: the representation
 # is pinned (the default's accurate image is large for the VM's 512 MB and
 # its all-mode eigensolve would add minutes), and not measured.
-sed -e "s/^dt *=.*/dt = $dt_s/" -e "s/^representation *=.*/representation = modal:300/" \
-	-e "/^max_error *=/d" scenes/cuboid-top.scene > "$out/cuboid-top-vm.scene"
-printf 'static_correction = yes\nmax_error = none\n' >> "$out/cuboid-top-vm.scene"
+sed -e "s/^dt *=.*/dt = $dt_s/" -e "/^\(representation\|static_correction\|max_error\) *=/d" \
+	scenes/cuboid-top.scene > "$out/cuboid-top-vm.scene"
+printf 'representation = modal:300\nstatic_correction = yes\nmax_error = none\n' \
+	>> "$out/cuboid-top-vm.scene"
 key="$(sha256sum "$out/cuboid-top-vm.scene" | cut -c1-16) $("$irdm" --version)"
 if [ -f "$img" ] && [ "$(cat "$img.key" 2>/dev/null)" = "$key" ]; then
 	echo "hil: $img is up to date"
