@@ -14,10 +14,10 @@
  *  - an image over max_error is refused, not written, with what would meet
  *    it; max_error = none neither measures nor flags;
  *  - representation = auto takes every mode of a small model, and on the
- *    4 x 4 x 8 cuboid (600 modes, 2 ms, top face) its first candidate,
- *    the hybrid cheapest to tick: a 32-sample head, the 317 modes that
- *    ring past it kept, within 1e-3; modal:300 + static correction is
- *    refused there when asked for by name.
+ *    4 x 4 x 8 cuboid (600 modes, 2 ms, top face) a hybrid within 1e-3
+ *    that keeps fewer modes than the 317 whose envelope alone rings past
+ *    a 32-sample head (the predicted force error sized it); modal:300 +
+ *    static correction is refused there when asked for by name.
  */
 #include <math.h>
 #include <setjmp.h>
@@ -272,8 +272,8 @@ static void test_auto_cuboid_chooses_hybrid(void **state)
 	assert_int_equal(cuboid("auto.img", &rep, err, sizeof(err), NULL, NULL), 0);
 	print_message("auto on 600 modes: %s after %zu candidates, measured %.3g\n",
 		      rep.representation, rep.auto_tries, rep.measured_error);
-	assert_string_equal(rep.representation, "modal:317 + static correction + exact_head 32");
-	assert_int_equal(rep.auto_tries, 2); /* after modal:300 + static correction */
+	assert_non_null(strstr(rep.representation, "exact_head"));
+	assert_true(rep.modes < 317);
 	assert_true(rep.measured_error <= 1e-3);
 	/* the lowest 300 modes and no head, by name: refused */
 	assert_int_equal(cuboid("m300.img", &rep, err, sizeof(err), "modal:300", NULL), IRDM_ENUMERIC);

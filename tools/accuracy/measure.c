@@ -15,9 +15,7 @@
 #include "accuracy/run.h"
 #include "util/clock.h"
 
-/* Oblique, so that every axis of the contact's 3x3 response is excited. */
-static const double push_dir[3] = { 0.3, 0.2, -0.9327379 };
-#define PUSH_M 1e-3 /* the model is linear: the size only sets the units */
+const double irdm_measure_push_m[3] = { 0.3e-3, 0.2e-3, -0.9327379e-3 };
 
 size_t irdm_measure_ticks(double dt_s)
 {
@@ -26,12 +24,12 @@ size_t irdm_measure_ticks(double dt_s)
 	return n < 300 ? 300 : (n > 3000 ? 3000 : n);
 }
 
-static double dist2(const float *a, const float *b)
+static double dist2(const double *a, const double *b)
 {
 	double d = 0;
 
 	for (int k = 0; k < 3; k++)
-		d += ((double)a[k] - b[k]) * ((double)a[k] - b[k]);
+		d += (a[k] - b[k]) * (a[k] - b[k]);
 	return d;
 }
 
@@ -43,22 +41,21 @@ static bool have(const uint32_t *cols, size_t n, uint32_t c)
 	return false;
 }
 
-/* Farthest-point samples of the columns, then the largest radii. */
-static size_t pick_columns(const struct irdm_image *img, uint32_t *cols)
+size_t irdm_measure_spread(const double *pos, size_t n_pos, size_t k, uint32_t *cols)
 {
-	uint32_t nc = img->meta->n_cols;
 	size_t n = 0;
 
+	if (!n_pos || !k)
+		return 0;
 	cols[n++] = 0;
-	while (n < IRDM_MEASURE_SPREAD && n < nc) {
+	while (n < k && n < n_pos) {
 		double best = -1;
 		uint32_t bc = 0;
 
-		for (uint32_t c = 0; c < nc; c++) {
+		for (uint32_t c = 0; c < n_pos; c++) {
 			double dmin = INFINITY;
 			for (size_t i = 0; i < n; i++)
-				dmin = fmin(dmin, dist2(img->nodes[img->columns[c]].pos_m,
-							img->nodes[img->columns[cols[i]]].pos_m));
+				dmin = fmin(dmin, dist2(&pos[3 * (size_t)c], &pos[3 * (size_t)cols[i]]));
 			if (dmin > best) {
 				best = dmin;
 				bc = c;
@@ -68,6 +65,23 @@ static size_t pick_columns(const struct irdm_image *img, uint32_t *cols)
 			break;
 		cols[n++] = bc;
 	}
+	return n;
+}
+
+/* The spread of the columns, then the largest radii. */
+static size_t pick_columns(const struct irdm_image *img, uint32_t *cols)
+{
+	uint32_t nc = img->meta->n_cols;
+	double *pos = nc ? malloc(3 * (size_t)nc * sizeof(double)) : NULL;
+	size_t n;
+
+	if (!pos)
+		return 0;
+	for (uint32_t c = 0; c < nc; c++)
+		for (int a = 0; a < 3; a++)
+			pos[3 * (size_t)c + (size_t)a] = img->nodes[img->columns[c]].pos_m[a];
+	n = irdm_measure_spread(pos, nc, IRDM_MEASURE_SPREAD, cols);
+	free(pos);
 	for (int k = 0; k < IRDM_MEASURE_WORST && n < nc; k++) {
 		float best = -1;
 		uint32_t bc = UINT32_MAX;
@@ -98,14 +112,14 @@ static void make_cmds(bool release, uint32_t row, size_t N, struct irdm_report_c
 {
 	for (size_t t = 0; t < N; t++) {
 		struct irdm_report_cmd *c = &cmds[t];
-		bool held = !release || t < N / 3;
+		bool held = irdm_measure_held(release, t, N);
 
 		memset(c, 0, sizeof(*c));
 		c->on_node = true;
 		c->row = row;
-		c->active = !release || t < N / 3 || t >= 2 * N / 3;
+		c->active = irdm_measure_active(release, t, N);
 		for (int a = 0; a < 3; a++)
-			c->target_m[a] = held ? PUSH_M * push_dir[a] : 0;
+			c->target_m[a] = held ? irdm_measure_push_m[a] : 0;
 	}
 }
 
@@ -243,6 +257,10 @@ int irdm_measure_error(const struct irdm_scene *sc, const struct irdm_image *img
 	memset(res, 0, sizeof(*res));
 	res->error = -1;
 	res->n_cols = pick_columns(img, cols);
+	if (!res->n_cols) {
+		snprintf(err, errlen, "error measurement: no column to measure (none touchable, or out of memory)");
+		return IRDM_ENOMEM;
+	}
 	for (size_t i = 0; i < res->n_cols; i++)
 		res->nodes[i] = img->nodes[img->columns[cols[i]]].mesh_node;
 	res->ticks = irdm_measure_ticks(img->meta->dt_s);

@@ -27,6 +27,7 @@
 #ifndef IRDM_TOOLS_ACCURACY_MEASURE_H
 #define IRDM_TOOLS_ACCURACY_MEASURE_H
 
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -68,7 +69,31 @@ int irdm_measure_error(const struct irdm_scene *sc, const struct irdm_image *img
 		       irdm_progress_fn fn, void *ctx, struct irdm_measure *res,
 		       char *err, size_t errlen);
 
+/*
+ * k columns spread over positions pos ([n_pos][3]): farthest-point
+ * sampling from the first.  cols: k entries.  Return: how many (fewer
+ * when the positions repeat).
+ */
+size_t irdm_measure_spread(const double *pos, size_t n_pos, size_t k, uint32_t *cols);
+
 /* The number of ticks each run lasts at dt_s: about a second. */
 size_t irdm_measure_ticks(double dt_s);
+
+/* The push, oblique so that every axis of the contact's 3x3 response is
+ * excited; the model is linear: its size only sets the units. */
+extern const double irdm_measure_push_m[3];
+
+/* Tick t of a run of N: the contact holds the push (a step always, a
+ * release its first third) ... */
+static inline bool irdm_measure_held(bool release, size_t t, size_t N)
+{
+	return !release || t < N / 3;
+}
+
+/* ... and is on (a release lets go for the second third). */
+static inline bool irdm_measure_active(bool release, size_t t, size_t N)
+{
+	return !release || t < N / 3 || t >= 2 * N / 3;
+}
 
 #endif

@@ -22,28 +22,6 @@ double irdm_decay_left(double rate, double t)
 	return exp(-rate * t);
 }
 
-size_t irdm_modes_by_decay(const struct irdm_modes *m, const struct irdm_rayleigh *damp,
-			   double horizon_s, double tol, size_t *order)
-{
-	size_t n = m->n_modes, k_ring = 0, k_done;
-
-	for (size_t k = 0; k < n; k++) {
-		double w = sqrt(fmax(m->omega2[k], 0.0));
-		double rate = irdm_decay_rate(w, w > 0 ? irdm_rayleigh_ratio(damp, w) : 0.0);
-
-		if (irdm_decay_left(rate, horizon_s) > tol)
-			order[k_ring++] = k;
-	}
-	k_done = k_ring;
-	for (size_t k = 0, r = 0; k < n; k++) {
-		if (r < k_ring && order[r] == k)
-			r++;
-		else
-			order[k_done++] = k;
-	}
-	return k_ring;
-}
-
 /* Follow each cycle of the permutation with one column in hand. */
 int irdm_modes_permute(struct irdm_modes *m, const size_t *order)
 {

@@ -17,6 +17,8 @@
 #include "irdm/posix/image_map.h"
 #include "modal/decay.h"
 #include "modal/exact_head.h"
+#include "modal/head_split.h"
+#include "accuracy/split.h"
 #include "modal/lapack.h"
 #include "modal/response.h"
 #include "modal/stability.h"
@@ -1329,21 +1331,28 @@ static void reset_try(struct build *b, size_t n_all)
 #define AUTO_ALL_MODES 300 /* at most this many modes: modal:all, exact and as cheap */
 
 /*
- * Put the candidate's kept modes first (the ones ringing past its head;
- * modal/decay.h), as split_modes() and the static correction take the
- * first K; order[] receives the permutation, to undo it.
+ * Put the candidate's kept modes first (modal/head_split.h: the first
+ * c->modes of the rank for its head, as it was sized), as split_modes()
+ * and the static correction take the first K; order[] receives the
+ * permutation, to undo it.
  */
 static int kept_first(struct build *b, const struct irdm_auto_candidate *c, size_t *order,
 		      char *err, size_t errlen)
 {
 	struct irdm_modes *md = &b->m.modes;
-	size_t k = irdm_modes_by_decay(md, &b->m.damping, c->head * b->sc->dt_s, b->sc->max_error,
-				       order);
+	size_t n = md->n_modes, *rank = malloc((n ? n : 1) * sizeof(*rank));
+	bool *dropped = malloc((n ? n : 1) * sizeof(*dropped));
+	int ret = IRDM_ENOMEM;
 
-	if (k != c->modes && !(k == 0 && c->modes == 1)) {
-		snprintf(err, errlen, "precompute: representation = auto: the modes ringing past the head changed (%zu, not %zu)",
-			 k, c->modes);
-		return IRDM_EINVAL;
+	if (rank && dropped)
+		ret = irdm_head_split_rank(md, &b->m.damping, c->head * b->sc->dt_s, rank);
+	if (!ret)
+		irdm_head_split_order(rank, n, c->modes, order, dropped);
+	free(rank);
+	free(dropped);
+	if (ret) {
+		snprintf(err, errlen, "precompute: out of memory");
+		return ret;
 	}
 	b->kept_not_lowest = false;
 	for (size_t i = 0; i < c->modes; i++)
@@ -1355,10 +1364,12 @@ static int kept_first(struct build *b, const struct irdm_auto_candidate *c, size
 	return IRDM_OK;
 }
 
-/* Back to ascending frequency: order[] made kept_first()'s permutation. */
-static int kept_undo(struct build *b, const size_t *order, size_t *inv)
+/* Back to ascending frequency: order[] made kept_first()'s permutation of
+ * all n_all modes (the try left n_modes at the kept ones). */
+static int kept_undo(struct build *b, size_t n_all, const size_t *order, size_t *inv)
 {
-	for (size_t k = 0; k < b->m.modes.n_modes; k++)
+	b->m.modes.n_modes = n_all;
+	for (size_t k = 0; k < n_all; k++)
 		inv[order[k]] = k;
 	b->kept_not_lowest = false;
 	return irdm_modes_permute(&b->m.modes, inv);
@@ -1369,7 +1380,7 @@ static int kept_undo(struct build *b, const size_t *order, size_t *inv)
 static void say_candidate(const struct build *b, const struct irdm_auto_candidate *c,
 			  const struct irdm_precompute_report *rep, int ret, const char *err)
 {
-	char line[768], repr[64], size[48] = "not written", meas[64] = "not measured";
+	char line[768], repr[64], size[48] = "not written", meas[64] = "not measured", pred[48] = "";
 
 	if (!b->o->progress)
 		return;
@@ -1378,8 +1389,11 @@ static void say_candidate(const struct build *b, const struct irdm_auto_candidat
 		snprintf(size, sizeof(size), "image %.1f MiB", (double)b->try_bytes / (1 << 20));
 	if (rep->error_measured)
 		snprintf(meas, sizeof(meas), "measured error %.3g", rep->measured_error);
-	snprintf(line, sizeof(line), "auto: %s%s: estimated tick %.2f us, %s, %s: %s%.400s", repr,
-		 c->head ? " (the modes ringing past the head kept)" : "", c->tick_us, size, meas,
+	if (c->predicted >= 0)
+		snprintf(pred, sizeof(pred), ", predicted error %.3g", c->predicted);
+	snprintf(line, sizeof(line), "auto: %s%s: estimated tick %.2f us%s, %s, %s: %s%.400s", repr,
+		 c->head ? " (kept: the modes ringing longest past the head)" : "", c->tick_us, pred,
+		 size, meas,
 		 !ret                ? "kept, the cheapest estimated to tick that is certified and meets max_error" :
 		 rep->error_measured ? "over max_error" :
 				       "refused: ",
@@ -1434,10 +1448,52 @@ static int try_candidate(struct build *b, const struct irdm_auto_candidate *c, s
 	ret = one_try(b, rep, err, errlen);
 	rep->auto_tries++;
 	say_candidate(b, c, rep, ret, err);
-	if (ret && hybrid && kept_undo(b, order, &order[n_all])) {
+	if (ret && hybrid && kept_undo(b, n_all, order, &order[n_all])) {
 		snprintf(err, errlen, "precompute: out of memory");
 		return IRDM_ENOMEM;
 	}
+	return ret;
+}
+
+/*
+ * The probe auto sizes its hybrids on (accuracy/split.h): the columns of
+ * the measurement's spread, every mode discretised.
+ */
+static int candidates(struct build *b, struct irdm_auto_candidate *cand, size_t *n_cand,
+		      char *err, size_t errlen)
+{
+	struct irdm_model *m = &b->m;
+	struct irdm_split_probe probe;
+	uint32_t cols[IRDM_MEASURE_SPREAD];
+	int64_t dofs[3 * IRDM_MEASURE_SPREAD];
+	double *pos = malloc(3 * (m->n_cols ? m->n_cols : 1) * sizeof(double));
+	struct irdm_mode *zoh = malloc(m->modes.n_modes * sizeof(*zoh));
+	size_t n;
+	int ret = IRDM_ENOMEM;
+
+	if (!pos || !zoh)
+		goto out_free;
+	for (size_t c = 0; c < m->n_cols; c++)
+		memcpy(&pos[3 * c], &m->mesh.pos_m[3 * (size_t)m->rows[m->cols[c]]], 3 * sizeof(double));
+	n = irdm_measure_spread(pos, m->n_cols, IRDM_MEASURE_SPREAD, cols);
+	for (size_t i = 0; i < n; i++)
+		memcpy(&dofs[3 * i], &m->col_dofs[3 * (size_t)cols[i]], 3 * sizeof(int64_t));
+	irdm_modes_discretise(&m->modes, &m->damping, b->sc->dt_s, zoh);
+	if (b->o->progress)
+		b->o->progress(b->o->ctx, "auto: sizing the hybrids", 0.0);
+	ret = irdm_split_probe_init(&probe, &m->modes, zoh, dofs, n, irdm_measure_ticks(b->sc->dt_s));
+	if (ret)
+		goto out_free;
+	*n_cand = irdm_auto_candidates(&m->modes, &m->damping, b->sc->dt_s, b->sc->max_error, &probe,
+				       cand);
+	irdm_split_probe_free(&probe);
+	if (b->o->progress)
+		b->o->progress(b->o->ctx, "auto: sizing the hybrids", 1.0);
+out_free:
+	if (ret)
+		snprintf(err, errlen, ret == IRDM_ENOMEM ? "precompute: out of memory for auto's candidates" : "precompute: auto: a probed column's first response sample is singular");
+	free(pos);
+	free(zoh);
 	return ret;
 }
 
@@ -1461,13 +1517,18 @@ static int choose(struct build *b, struct irdm_precompute_report *rep, char *err
 	}
 	if (n_all <= AUTO_ALL_MODES) {
 		cand[0] = (struct irdm_auto_candidate){
-			n_all, 0, irdm_auto_tick_us(n_all, 0),
-			sqrt(b->m.modes.omega2[n_all - 1]) / (2 * M_PI)
+			.modes = n_all,
+			.predicted = -1,
+			.tick_us = irdm_auto_tick_us(n_all, 0),
+			.kept_max_hz = sqrt(b->m.modes.omega2[n_all - 1]) / (2 * M_PI),
 		};
 		n_cand = 1;
 	} else {
-		n_cand = irdm_auto_candidates(&b->m.modes, &b->m.damping, b->sc->dt_s,
-					      b->sc->max_error, cand);
+		ret = candidates(b, cand, &n_cand, err, errlen);
+		if (ret) {
+			free(order);
+			return ret;
+		}
 	}
 	say_candidates(b, cand, n_cand);
 	for (size_t k = 0; k < n_cand; k++) {

@@ -3,7 +3,7 @@
 #include <math.h>
 #include <stdlib.h>
 
-#include "modal/decay.h"
+#include "modal/head_split.h"
 #include "precompute/candidates.h"
 
 /* The heads tried: short ones tick cheaply but keep more modes. */
@@ -39,34 +39,95 @@ static int by_cost(const void *a, const void *b)
 	return (x->tick_us > y->tick_us) - (x->tick_us < y->tick_us);
 }
 
-size_t irdm_auto_candidates(const struct irdm_modes *m, const struct irdm_rayleigh *damp,
-			    double dt_s, double tol, struct irdm_auto_candidate *out)
+/*
+ * The share of max_error a hybrid is sized to by the prediction: the
+ * rest is room for what the prediction leaves out (accuracy/split.h).
+ */
+#define PREDICTED_SHARE 0.5
+
+/*
+ * The fewest modes of rank a head of H may keep with the predicted error
+ * within budget: halving the step from every mode but one, each drop
+ * tried on top of the ones that held (the prediction's error grows as
+ * modes are dropped).  Return: 0 if even every mode but one misses it.
+ */
+static size_t fewest(struct irdm_split_probe *p, const size_t *rank, size_t n, size_t n_free,
+		     unsigned H, double budget, double *predicted)
 {
-	size_t n = 0, *order = malloc((m->n_modes ? m->n_modes : 1) * sizeof(*order));
+	size_t hi = n - 1, lo = n_free > 1 ? n_free : 1;
+	double e;
 
-	for (size_t i = 0; order && i < sizeof(heads) / sizeof(heads[0]); i++) {
-		size_t k = irdm_modes_by_decay(m, damp, heads[i] * dt_s, tol, order);
+	irdm_split_begin(p);
+	e = irdm_split_try(p, &rank[hi], n - hi, H);
+	if (!(e <= budget))
+		return 0;
+	irdm_split_commit(p);
+	*predicted = e;
+	while (lo < hi) {
+		size_t mid = lo + (hi - lo) / 2;
 
-		if (k >= m->n_modes)
-			continue; /* nothing rings down within it: every mode */
-		out[n].modes = k ? k : 1;
+		e = irdm_split_try(p, &rank[mid], hi - mid, H);
+		if (e <= budget) {
+			irdm_split_commit(p);
+			*predicted = e;
+			hi = mid;
+		} else {
+			lo = mid + 1;
+		}
+	}
+	return hi;
+}
+
+static size_t hybrids(const struct irdm_modes *m, const struct irdm_rayleigh *damp, double dt_s,
+		      double tol, struct irdm_split_probe *probe, size_t *rank,
+		      struct irdm_auto_candidate *out)
+{
+	size_t n = 0, n_free = 0;
+
+	for (size_t d = 0; d < m->n_modes; d++)
+		n_free += !(m->omega2[d] > 0);
+	for (size_t i = 0; i < sizeof(heads) / sizeof(heads[0]) && m->n_modes > 1; i++) {
+		double predicted = 0;
+		size_t k;
+
+		if (irdm_head_split_rank(m, damp, heads[i] * dt_s, rank))
+			break;
+		k = fewest(probe, rank, m->n_modes, n_free, heads[i], tol * PREDICTED_SHARE,
+			   &predicted);
+		if (!k)
+			continue; /* not even every mode but one */
+		out[n].modes = k;
 		out[n].head = heads[i];
-		out[n].tick_us = irdm_auto_tick_us(out[n].modes, heads[i]);
-		out[n].kept_max_hz = max_hz(m, order, out[n].modes);
+		out[n].predicted = predicted;
+		out[n].tick_us = irdm_auto_tick_us(k, heads[i]);
+		out[n].kept_max_hz = max_hz(m, rank, k);
 		n++;
 	}
-	free(order);
+	return n;
+}
+
+size_t irdm_auto_candidates(const struct irdm_modes *m, const struct irdm_rayleigh *damp,
+			    double dt_s, double tol, struct irdm_split_probe *probe,
+			    struct irdm_auto_candidate *out)
+{
+	size_t n = 0, *rank = malloc((m->n_modes ? m->n_modes : 1) * sizeof(*rank));
+
+	if (rank)
+		n = hybrids(m, damp, dt_s, tol, probe, rank, out);
+	free(rank);
 	if (m->n_modes > IRDM_AUTO_TRUNCATED) {
 		/* the lowest modes and the static correction, no head: the
 		 * cheapest tick, right where the dropped modes matter little */
 		out[n].modes = IRDM_AUTO_TRUNCATED;
 		out[n].head = 0;
+		out[n].predicted = -1;
 		out[n].tick_us = irdm_auto_tick_us(IRDM_AUTO_TRUNCATED, 0);
 		out[n].kept_max_hz = sqrt(m->omega2[IRDM_AUTO_TRUNCATED - 1]) / (2 * M_PI);
 		n++;
 	}
 	out[n].modes = m->n_modes;
 	out[n].head = 0;
+	out[n].predicted = -1;
 	out[n].tick_us = irdm_auto_tick_us(m->n_modes, 0);
 	out[n].kept_max_hz = m->n_modes ? sqrt(m->omega2[m->n_modes - 1]) / (2 * M_PI) : 0;
 	n++;

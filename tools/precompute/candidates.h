@@ -1,8 +1,10 @@
 /* SPDX-License-Identifier: MIT */
 /*
  * representation = auto's candidates: for each head length H of a few,
- * the hybrid that keeps in its modal recursion the modes ringing past the
- * head (modal/decay.h) and gives the head the rest; the lowest modes
+ * the hybrid that keeps in its modal recursion the fewest of the modes
+ * ringing longest past the head (modal/head_split.h) whose predicted
+ * force error is within half the target (accuracy/split.h), and gives
+ * the head the rest; the lowest modes
  * with the static correction alone; then every mode.
  * They are tried cheapest to tick first.
  */
@@ -12,6 +14,7 @@
 #include <stddef.h>
 
 #include "fem/fem.h"
+#include "accuracy/split.h"
 #include "modal/modal.h"
 
 #define IRDM_AUTO_MAX_CANDIDATES 7
@@ -20,6 +23,7 @@
 struct irdm_auto_candidate {
 	size_t modes;       /* kept in the recursion; all of them: no head */
 	unsigned head;      /* samples of the dropped modes' exact head (0: none) */
+	double predicted;   /* a hybrid's predicted error (-1: none) */
 	double tick_us;     /* estimated tick cost, one touching node */
 	double kept_max_hz; /* the highest frequency kept */
 };
@@ -33,15 +37,18 @@ double irdm_auto_tick_us(size_t modes, unsigned head);
 
 /*
  * The candidates for m (every elastic mode, ascending) under damp at
- * dt_s, a mode outlasting a head when its envelope after the head is
- * above tol: a hybrid per head length whose ringing modes are not all of
- * m (at least one mode kept), the lowest IRDM_AUTO_TRUNCATED modes with
- * the static correction and no head (when m has more), then every mode,
- * ordered by estimated tick cost.  A candidate with a head and fewer than
- * every mode is a hybrid; without a head and fewer, the truncated one.  out: IRDM_AUTO_MAX_CANDIDATES entries.
+ * dt_s for an error target tol: per head length, the hybrid of the
+ * fewest modes by irdm_head_split_rank() whose error predicted on probe
+ * (made from m) is within tol / 2, when one keeps fewer than every mode;
+ * the lowest IRDM_AUTO_TRUNCATED modes with the static correction and
+ * no head (when m has more); then every mode; ordered by estimated tick
+ * cost.  A candidate with a head and fewer than every mode is a hybrid;
+ * without a head and fewer, the truncated one.
+ * out: IRDM_AUTO_MAX_CANDIDATES entries.
  * Return: how many.
  */
 size_t irdm_auto_candidates(const struct irdm_modes *m, const struct irdm_rayleigh *damp,
-			    double dt_s, double tol, struct irdm_auto_candidate *out);
+			    double dt_s, double tol, struct irdm_split_probe *probe,
+			    struct irdm_auto_candidate *out);
 
 #endif
