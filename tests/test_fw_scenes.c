@@ -659,7 +659,7 @@ static int setup(void **state)
 	if (precompute(IMG_CUBOID, "cuboid", (const char *const[]){ "--scene", "scenes/cuboid-paper.scene", "--resolution", "4,4,8", "--representation", "modal:40", NULL }) ||
 	    precompute(IMG_FIR, "fir", (const char *const[]){ "--scene", "scenes/cuboid-paper.scene", "--resolution", "4,4,8", "--representation", "fir:100", "--dt", "0.001", "--uncertified", "yes", "--fir_tail", "none", NULL }) ||
 	    precompute(IMG_CUBE, "cube", (const char *const[]){ "--scene", "scenes/cube-floating.scene", "--resolution", "4,4,4", "--representation", "modal:40", NULL }) ||
-	    precompute(IMG_TOP, "top", (const char *const[]){ "--scene", "scenes/cuboid-top.scene", "--resolution", "4,4,8", "--representation", "modal:40", NULL }))
+	    precompute(IMG_TOP, "top", (const char *const[]){ "--scene", "scenes/cuboid-top.scene", "--resolution", "4,4,8", "--representation", "modal:40", "--static_correction", "yes", "--max_error", "none", NULL }))
 		return -1;
 	have_bunny = access("build/data/bunny.off", R_OK) == 0;
 	if (have_bunny && precompute(IMG_BUNNY, "bunny", (const char *const[]){ "--scene", "scenes/bunny.scene", "--representation", "modal:40", NULL }))

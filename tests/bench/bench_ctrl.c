@@ -3,7 +3,8 @@
  * Whole-controller tick benchmark: irdm_ctrl_tick() (encoders, device
  * model, limits, proxy on the deformed surface, engine, force to torque)
  * timed one tick at a time with CLOCK_MONOTONIC, median / p99 / max, on the
- * default scene (scenes/cuboid-top.scene, modal 300 + static correction):
+ * default scene (scenes/cuboid-top.scene) pinned to modal 300 + static
+ * correction:
  *  - hover:      the tip 1 mm above the top face, moving (free ticks: the
  *                proxy's closest-point query every tick);
  *  - slide/1:    pressed 3 mm in and sliding 50 um per tick, so the
@@ -294,10 +295,12 @@ static void realtime(void)
 
 int main(int argc, char **argv)
 {
+	static const char *const pinned[] = { "representation", "modal:300", "static_correction", "yes",
+					      "max_error", "none", NULL };
 	const char *img = argc > 1 ? argv[1] : "out/bench/cuboid-top.img";
 	int rc = 0;
 
-	if (argc < 2 && bench_ensure_image("ctrl", img, "scenes/cuboid-top.scene", NULL))
+	if (argc < 2 && bench_ensure_image("ctrl", img, "scenes/cuboid-top.scene", pinned))
 		return 1;
 	n_ticks = bench_ticks(N_TICKS);
 	samples = malloc(n_ticks * sizeof(*samples));

@@ -136,6 +136,10 @@ static void miss(struct irdm_split_probe *p, size_t d, unsigned H)
 	irdm_zoh_response(&p->zoh[d], N, h);
 	for (size_t s = 0; s < N; s++)
 		e[s] = s < H ? 0.0 : h[s];
+	if (!H) { /* no head: the static correction, all of it at R[0] */
+		e[0] -= 1.0 / p->omega2[d];
+		return;
+	}
 	for (size_t s = 0; s < H && s < N; s++)
 		kept += h[s];
 	for (size_t i = 0; i < H; i++) {

@@ -11,7 +11,9 @@
  *   the hybrid's: the same, less what the head misses of each dropped
  *   mode d past the head: its response from 2H on, the taper's cut over
  *   [H, 2H), and the static remainder the head adds back along the sine
- *   bump (modal/exact_head.h), all times phi_d phi_d^T.
+ *   bump (modal/exact_head.h), all times phi_d phi_d^T; with no head
+ *   (H = 0: the modes kept and the static correction), all of its
+ *   response but its static compliance at the first sample.
  * The forces come from direct convolution, as the reference's
  * (accuracy/reference.h).  What it leaves out: the far field and the
  * sparse static correction's dropped blocks (they do not touch a

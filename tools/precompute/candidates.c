@@ -106,21 +106,42 @@ static size_t hybrids(const struct irdm_modes *m, const struct irdm_rayleigh *da
 	return n;
 }
 
+/* The truncated candidate's predicted error: the modes past the lowest
+ * IRDM_AUTO_TRUNCATED dropped to the static correction. */
+static double predict_truncated(const struct irdm_modes *m, struct irdm_split_probe *probe)
+{
+	size_t n_drop = m->n_modes - IRDM_AUTO_TRUNCATED;
+	size_t *drop = malloc(n_drop * sizeof(*drop));
+	double e;
+
+	if (!drop)
+		return 0; /* built and measured instead */
+	for (size_t i = 0; i < n_drop; i++)
+		drop[i] = IRDM_AUTO_TRUNCATED + i;
+	irdm_split_begin(probe);
+	e = irdm_split_try(probe, drop, n_drop, 0);
+	free(drop);
+	return e;
+}
+
 size_t irdm_auto_candidates(const struct irdm_modes *m, const struct irdm_rayleigh *damp,
 			    double dt_s, double tol, struct irdm_split_probe *probe,
 			    struct irdm_auto_candidate *out)
 {
 	size_t n = 0, *rank = malloc((m->n_modes ? m->n_modes : 1) * sizeof(*rank));
+	double truncated;
 
 	if (rank)
 		n = hybrids(m, damp, dt_s, tol, probe, rank, out);
 	free(rank);
-	if (m->n_modes > IRDM_AUTO_TRUNCATED) {
+	if (m->n_modes > IRDM_AUTO_TRUNCATED &&
+	    (truncated = predict_truncated(m, probe)) <= tol) {
 		/* the lowest modes and the static correction, no head: the
-		 * cheapest tick, right where the dropped modes matter little */
+		 * cheapest tick, right where the dropped modes matter little;
+		 * not built when predicted over the target */
 		out[n].modes = IRDM_AUTO_TRUNCATED;
 		out[n].head = 0;
-		out[n].predicted = -1;
+		out[n].predicted = truncated;
 		out[n].tick_us = irdm_auto_tick_us(IRDM_AUTO_TRUNCATED, 0);
 		out[n].kept_max_hz = sqrt(m->omega2[IRDM_AUTO_TRUNCATED - 1]) / (2 * M_PI);
 		n++;

@@ -23,7 +23,7 @@
 struct irdm_auto_candidate {
 	size_t modes;       /* kept in the recursion; all of them: no head */
 	unsigned head;      /* samples of the dropped modes' exact head (0: none) */
-	double predicted;   /* a hybrid's predicted error (-1: none) */
+	double predicted;   /* its predicted error (-1: every mode, none) */
 	double tick_us;     /* estimated tick cost, one touching node */
 	double kept_max_hz; /* the highest frequency kept */
 };
@@ -41,8 +41,8 @@ double irdm_auto_tick_us(size_t modes, unsigned head);
  * fewest modes by irdm_head_split_rank() whose error predicted on probe
  * (made from m) is within tol / 2, when one keeps fewer than every mode;
  * the lowest IRDM_AUTO_TRUNCATED modes with the static correction and
- * no head (when m has more); then every mode; ordered by estimated tick
- * cost.  A candidate with a head and fewer than every mode is a hybrid;
+ * no head (when m has more and its predicted error is within tol); then
+ * every mode; ordered by estimated tick cost.  A candidate with a head and fewer than every mode is a hybrid;
  * without a head and fewer, the truncated one.
  * out: IRDM_AUTO_MAX_CANDIDATES entries.
  * Return: how many.
