@@ -37,24 +37,10 @@
 #include "irdm/posix/image_map.h"
 #include "precompute/precompute.h"
 #include "scene/scene.h"
+#include "support/model_fixture.h"
 #include "support/test_files.h"
 
 static char dir[64];
-
-static const char *const soft[] = { "resolution", "4,4,8", "touch", "z>=0.2", "display", "touch",
-				    "dt", "0.002", "young", "2e3", "poisson", "0.4999",
-				    "density", "2e4", NULL };
-
-static void scene_of(struct irdm_scene *sc, const char *const *keys)
-{
-	char err[256];
-
-	irdm_scene_defaults(sc);
-	for (const char *const *kv = soft; *kv; kv += 2)
-		assert_int_equal(irdm_scene_set(sc, kv[0], kv[1], "test", err, sizeof(err)), 0);
-	for (const char *const *kv = keys; *kv; kv += 2)
-		assert_int_equal(irdm_scene_set(sc, kv[0], kv[1], "test", err, sizeof(err)), 0);
-}
 
 static int build(const char *name, struct irdm_precompute_report *rep, char *err, size_t errlen,
 		 const char *const *keys)
@@ -63,7 +49,7 @@ static int build(const char *name, struct irdm_precompute_report *rep, char *err
 	struct irdm_precompute_opts o = { 0 };
 	char path[128];
 
-	scene_of(&sc, keys);
+	fixture_soft_scene(&sc, keys);
 	snprintf(path, sizeof(path), "%s/%s", dir, name);
 	o.out_path = path;
 	err[0] = 0;
@@ -201,7 +187,7 @@ static void test_auto_meets_target(void **state)
 	assert_int_equal(all.meta->n_modes, 600);
 	check_kept(&img, &all);
 	irdm_image_unmap(&all);
-	scene_of(&sc, (const char *const[]){ NULL });
+	fixture_soft_scene(&sc, (const char *const[]){ NULL });
 	assert_int_equal(irdm_measure_error(&sc, &img, ref, exact_by_precompute, NULL, NULL, NULL,
 					    &res, err, sizeof(err)),
 			 0);

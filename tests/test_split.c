@@ -32,24 +32,10 @@
 #include "precompute/model.h"
 #include "precompute/precompute.h"
 #include "scene/scene.h"
+#include "support/model_fixture.h"
 #include "support/test_files.h"
 
 static char dir[64];
-
-static const char *const soft[] = { "resolution", "4,4,8", "touch", "z>=0.2", "display", "touch",
-				    "dt", "0.002", "young", "2e3", "poisson", "0.4999",
-				    "density", "2e4", NULL };
-
-static void scene_of(struct irdm_scene *sc, const char *const *keys)
-{
-	char err[256];
-
-	irdm_scene_defaults(sc);
-	for (const char *const *kv = soft; *kv; kv += 2)
-		assert_int_equal(irdm_scene_set(sc, kv[0], kv[1], "test", err, sizeof(err)), 0);
-	for (const char *const *kv = keys; *kv; kv += 2)
-		assert_int_equal(irdm_scene_set(sc, kv[0], kv[1], "test", err, sizeof(err)), 0);
-}
 
 static int exact_by_precompute(void *ctx, const struct irdm_scene *rsc, const char *path,
 			       char *err, size_t errlen)
@@ -73,13 +59,13 @@ static void measured(const char *H, struct irdm_measure *res)
 	struct irdm_image img;
 	char err[512], path[128], ref[128];
 
-	scene_of(&sc, hybrid);
+	fixture_soft_scene(&sc, hybrid);
 	snprintf(path, sizeof(path), "%s/h.img", dir);
 	snprintf(ref, sizeof(ref), "%s/exact.img", dir);
 	o.out_path = path;
 	assert_int_equal(irdm_precompute(&sc, &o, &rep, err, sizeof(err)), 0);
 	assert_int_equal(irdm_image_map(path, 0, &img, err, sizeof(err)), 0);
-	scene_of(&sc, (const char *const[]){ NULL });
+	fixture_soft_scene(&sc, (const char *const[]){ NULL });
 	assert_int_equal(irdm_measure_error(&sc, &img, ref, exact_by_precompute, NULL, NULL, NULL,
 					    res, err, sizeof(err)),
 			 0);
@@ -133,7 +119,7 @@ static void test_predicted_as_measured(void **state)
 	char err[256];
 
 	(void)state;
-	scene_of(&sc, (const char *const[]){ NULL });
+	fixture_soft_scene(&sc, (const char *const[]){ NULL });
 	assert_int_equal(irdm_model_build(&sc, 0, NULL, NULL, &m, err, sizeof(err)), 0);
 	assert_int_equal(m.modes.n_modes, 600);
 	irdm_modes_discretise(&m.modes, &m.damping, sc.dt_s, zoh);

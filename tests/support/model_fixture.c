@@ -120,3 +120,17 @@ double fixture_rigid_outside(const struct irdm_mesh *mesh, const struct irdm_fem
 	free(mv);
 	return worst;
 }
+
+void fixture_soft_scene(struct irdm_scene *sc, const char *const *keys)
+{
+	static const char *const soft[] = { "resolution", "4,4,8", "touch", "z>=0.2", "display",
+					    "touch", "dt", "0.002", "young", "2e3", "poisson",
+					    "0.4999", "density", "2e4", NULL };
+	char err[256];
+
+	irdm_scene_defaults(sc);
+	for (const char *const *kv = soft; *kv; kv += 2)
+		assert_int_equal(irdm_scene_set(sc, kv[0], kv[1], "test", err, sizeof(err)), 0);
+	for (const char *const *kv = keys; kv && *kv; kv += 2)
+		assert_int_equal(irdm_scene_set(sc, kv[0], kv[1], "test", err, sizeof(err)), 0);
+}

@@ -11,6 +11,14 @@ void fixture_model(struct irdm_model *m, double lx, double ly, double lz, unsign
 		   unsigned ny, unsigned nz, unsigned tph, double poisson, bool floating,
 		   size_t n_modes, enum irdm_eig_method eig, double dt_s);
 
+/*
+ * The soft, heavy cuboid the hybrid's tests share: the paper cuboid at
+ * 4 x 4 x 8 hexes, E 2e3 Pa, nu 0.4999, rho 2e4 kg/m^3 (first mode
+ * 0.15 Hz), 2 ms, top face touchable and displayed; then keys
+ * (NULL-terminated pairs) over it.  Fails the test on a refused key.
+ */
+void fixture_soft_scene(struct irdm_scene *sc, const char *const *keys);
+
 /* Free DoF index of (node, axis), asserting it is free. */
 int64_t fixture_free_dof(const struct irdm_model *m, uint32_t node, int axis);
 

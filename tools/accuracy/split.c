@@ -1,5 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /* A hybrid's force error predicted from the modes (split.h). */
+#include <complex.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -7,6 +8,7 @@
 #include "accuracy/measure.h"
 #include "accuracy/split.h"
 #include "irdm/error.h"
+#include "modal/mat3c.h"
 #include "modal/window.h"
 
 void irdm_split_probe_free(struct irdm_split_probe *p)
@@ -25,22 +27,16 @@ void irdm_split_probe_free(struct irdm_split_probe *p)
 /* inv = R0^-1 of a 3x3 (row-major); false when singular. */
 static bool inverse3(const double *a, double *inv)
 {
-	double det;
+	double complex ac[9], adj[9], det;
 
-	inv[0] = a[4] * a[8] - a[5] * a[7];
-	inv[1] = a[2] * a[7] - a[1] * a[8];
-	inv[2] = a[1] * a[5] - a[2] * a[4];
-	inv[3] = a[5] * a[6] - a[3] * a[8];
-	inv[4] = a[0] * a[8] - a[2] * a[6];
-	inv[5] = a[2] * a[3] - a[0] * a[5];
-	inv[6] = a[3] * a[7] - a[4] * a[6];
-	inv[7] = a[1] * a[6] - a[0] * a[7];
-	inv[8] = a[0] * a[4] - a[1] * a[3];
-	det = a[0] * inv[0] + a[1] * inv[3] + a[2] * inv[6];
-	if (!(fabs(det) > 0))
-		return false;
 	for (int i = 0; i < 9; i++)
-		inv[i] /= det;
+		ac[i] = a[i];
+	det = irdm_det3c(ac);
+	if (!(fabs(creal(det)) > 0))
+		return false;
+	irdm_adj3c(ac, adj);
+	for (int i = 0; i < 9; i++)
+		inv[i] = creal(adj[i]) / creal(det);
 	return true;
 }
 
