@@ -10,9 +10,11 @@
  *   dsyevr           MRRR driver, JOBZ = V, RANGE = I over every mode
  *   dsyevd           divide-and-conquer driver, JOBZ = V
  *   phases           dsytrd, then on its tridiagonal dsterf (values),
- *                    dstemr and dstedc (vectors), then dormtr on dstemr's
- *                    vectors: where a driver's time goes; dsytrd + dsterf
- *                    is the eigenvalues-only ceiling
+ *                    dstemr (MRRR vectors, which may fail: dsyevr then
+ *                    falls back to dstebz + dstein) and dstedc (divide and
+ *                    conquer vectors), then dormtr on dstedc's: where a
+ *                    driver's time goes; dsytrd + dsterf is the
+ *                    eigenvalues-only ceiling
  *
  * each with OpenBLAS on 2 threads and on 1, the cases alternating within
  * a round (the host is shared: compare rows of one run), ROUNDS rounds,
@@ -37,18 +39,11 @@
 void dsyevd_(const char *jobz, const char *uplo, const int *n, double *a, const int *lda,
 	     double *w, double *work, const int *lwork, int *iwork, const int *liwork,
 	     int *info);
-void dsytrd_(const char *uplo, const int *n, double *a, const int *lda, double *d, double *e,
-	     double *tau, double *work, const int *lwork, int *info);
 void dsterf_(const int *n, double *d, double *e, int *info);
 void dstemr_(const char *jobz, const char *range, const int *n, double *d, double *e,
 	     const double *vl, const double *vu, const int *il, const int *iu, int *m,
 	     double *w, double *z, const int *ldz, const int *nzc, int *isuppz, int *tryrac,
 	     double *work, const int *lwork, int *iwork, const int *liwork, int *info);
-void dstedc_(const char *compz, const int *n, double *d, double *e, double *z, const int *ldz,
-	     double *work, const int *lwork, int *iwork, const int *liwork, int *info);
-void dormtr_(const char *side, const char *uplo, const char *trans, const int *m, const int *n,
-	     const double *a, const int *lda, const double *tau, double *c, const int *ldc,
-	     double *work, const int *lwork, int *info);
 
 #define MAX_ROUNDS 5
 #define N_SAMPLE 64 /* columns whose residuals are checked */
@@ -382,7 +377,7 @@ static void run(struct bench *b, enum route r, int ti, int round)
 		run_phases(b, ph);
 	for (int p = 0; p < P_COUNT; p++)
 		t[p * MAX_ROUNDS + round] = ph[p];
-	printf("eig-dense   round %d, %d thread%s: %-15s %8.2f s\n", round + 1, threads[ti],
+	printf("eig-dense  round %d, %d thread%s: %-15s %8.2f s\n", round + 1, threads[ti],
 	       threads[ti] > 1 ? "s" : "", route_name[r], ph[P_TOTAL]);
 	fflush(stdout);
 	if (!b->wref) {
@@ -410,46 +405,54 @@ static double median(const double *x, int k)
 
 static void report(const struct bench *b, const bool *sel, int rounds)
 {
-	printf("\n### Medians of %d round%s (s)\n\n", rounds, rounds > 1 ? "s" : "");
-	printf("| route | 2 threads | 1 thread |\n|---|---|---|\n");
+	char title[64];
+
+	snprintf(title, sizeof(title), "-- medians of %d round%s (s) --", rounds, rounds > 1 ? "s" : "");
+	printf("eig-dense  %-36s %9s  %9s\n", title, "2 threads", "1 thread");
 	for (int r = 0; r < R_COUNT; r++) {
 		if (!sel[r])
 			continue;
 		for (int p = 0; p < P_COUNT; p++) {
-			const char *what = r != R_PHASES ? route_name[r] : p == P_TOTAL ? "dsytrd + dstedc + dormtr" : phase_name[p];
+			char what[64];
 
 			if (r != R_PHASES && p != P_TOTAL)
 				continue;
-			printf("| %s%s%s | %.2f | %.2f |\n", r == R_PHASES ? "phases: " : "", what,
-			       r == R_PHASES && p == P_STEMR && b->stemr_info ? " (failed)" : "",
-			       median(b->t[r][0][p], rounds), median(b->t[r][1][p], rounds));
+			if (r != R_PHASES)
+				snprintf(what, sizeof(what), "%s", route_name[r]);
+			else if (p == P_TOTAL)
+				snprintf(what, sizeof(what), "dsytrd + dstedc + dormtr");
+			else
+				snprintf(what, sizeof(what), "  %s%s", phase_name[p],
+					 p == P_STEMR && b->stemr_info ? " (failed)" : "");
+			printf("eig-dense  %-36s %9.2f  %9.2f\n", what, median(b->t[r][0][p], rounds),
+			       median(b->t[r][1][p], rounds));
 		}
 		if (r == R_PHASES) {
 			double v[2][MAX_ROUNDS];
 			for (int ti = 0; ti < 2; ti++)
 				for (int k = 0; k < rounds; k++)
 					v[ti][k] = b->t[r][ti][P_SYTRD][k] + b->t[r][ti][P_STERF][k];
-			printf("| phases: eigenvalues only (dsytrd + dsterf) | %.2f | %.2f |\n",
+			printf("eig-dense  %-36s %9.2f  %9.2f\n", "eigenvalues only (dsytrd + dsterf)",
 			       median(v[0], rounds), median(v[1], rounds));
 		}
 	}
 	if (sel[R_PHASES] && b->stemr_info)
-		printf("\ndstemr failed (info %d): dsyevr then computes the vectors again by "
-		       "bisection and inverse iteration (dstebz, dstein).\n",
+		printf("eig-dense  dstemr failed (info %d): dsyevr then computes the vectors again by\n"
+		       "eig-dense  bisection and inverse iteration (dstebz, dstein)\n",
 		       b->stemr_info);
-	printf("\n### Eigenpairs against the first dsyevr's (worst over runs; %d sampled columns)\n\n",
+	printf("eig-dense  -- eigenpairs against the first dsyevr's, worst over runs --\n"
+	       "eig-dense  dw: eigenvalue difference, relative to the largest eigenvalue and to\n"
+	       "eig-dense  its own; on %d columns y_s spread over the spectrum: the residual\n"
+	       "eig-dense  max|A y_s - w_s y_s| / max w, the orthonormality max|Y^T y_s - e_s|,\n"
+	       "eig-dense  and 1 - |projection of y_s on the reference's eigenspace of w_s|^2\n"
+	       "eig-dense  (eigenvalues within 1e-6: a sign or a rotation in a cluster is free)\n",
 	       N_SAMPLE);
-	printf("Eigenvalue differences dw relative to the largest eigenvalue and to each; "
-	       "on the sampled columns y_s: the residual max abs(A y_s - w_s y_s) / max w, "
-	       "the orthonormality max abs(Y^T y_s - e_s) and 1 - the squared norm of "
-	       "y_s's projection on the reference's eigenspace of w_s (eigenvalues within "
-	       "1e-6 relative: a sign or a rotation within a cluster is free).\n\n");
-	printf("| route | dw / max w | dw / w | residual | orthonormality | 1 - projection |\n"
-	       "|---|---|---|---|---|---|\n");
+	printf("eig-dense  %-16s %10s %10s %10s %10s %10s\n", "route", "dw/max w", "dw/w", "residual",
+	       "orthonorm", "1 - proj");
 	for (int r = 0; r < R_COUNT; r++)
 		if (sel[r])
-			printf("| %s | %.1e | %.1e | %.1e | %.1e | %.1e |\n", route_name[r], b->dw_abs[r],
-			       b->dw_rel[r], b->res[r], b->orth[r], b->proj[r]);
+			printf("eig-dense  %-16s %10.1e %10.1e %10.1e %10.1e %10.1e\n", route_name[r],
+			       b->dw_abs[r], b->dw_rel[r], b->res[r], b->orth[r], b->proj[r]);
 }
 
 int main(void)
@@ -477,9 +480,9 @@ int main(void)
 	b.dsqrt = xmalloc((size_t)b.n * sizeof(double));
 	if (reduce(&b))
 		return 1;
-	printf("## Dense all-modes eigensolve: %s, %zu nodes, %d free DoFs\n\n", b.m.mesh.name,
-	       b.m.mesh.n_nodes, b.n);
-	printf("OpenBLAS threads 2 and 1 alternating, routes alternating within a round.\n\n```\n");
+	printf("eig-dense  every mode of %s (scenes/cuboid-top.scene): %zu nodes, %d free DoFs\n"
+	       "eig-dense  OpenBLAS on 2 and 1 threads, the routes alternating; %d round%s\n",
+	       b.m.mesh.name, b.m.mesh.n_nodes, b.n, rounds, rounds > 1 ? "s" : "");
 	for (int k = 0; k < rounds; k++)
 		for (int ti = 0; ti < 2; ti++)
 			for (int i = 0; i < R_COUNT; i++) {
@@ -488,7 +491,6 @@ int main(void)
 				if (sel[r])
 					run(&b, (enum route)r, ti, k);
 			}
-	printf("```\n");
 	report(&b, sel, rounds);
 	free(b.a0);
 	free(b.a);
