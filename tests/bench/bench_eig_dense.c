@@ -17,13 +17,14 @@
  *                    eigenvalues-only ceiling
  *
  * each with OpenBLAS on 2 threads and on 1, the cases alternating within
- * a round (the host is shared: compare rows of one run), ROUNDS rounds,
+ * a round (the host is shared: compare rows of one run), IRDM_BENCH_ROUNDS rounds,
  * medians printed.  Each route's eigenpairs are checked against the first
  * dsyevr's: eigenvalues, and on a sample of columns the residual, the
  * orthonormality and the projection on the reference eigenspace.
  *
  * Run from the repository root.  IRDM_BENCH_RES=NX,NY,NZ shrinks the mesh
- * (a quick try); IRDM_BENCH_ROUNDS sets the rounds (default 2);
+ * (a quick try); IRDM_BENCH_ROUNDS sets the rounds (default 1:
+ * a round of the full model takes tens of minutes);
  * IRDM_BENCH_ONLY=dsyevd,phases selects routes (bench_util.h; dsyevr, the
  * reference, always runs, and irdm_eig_dense only when named there).
  */
@@ -465,7 +466,7 @@ int main(void)
 {
 	static struct bench b;
 	const char *rs = getenv("IRDM_BENCH_ROUNDS");
-	int rounds = rs ? atoi(rs) : 2;
+	int rounds = rs ? atoi(rs) : 1;
 	bool sel[R_COUNT];
 
 	if (rounds < 1 || rounds > MAX_ROUNDS) {

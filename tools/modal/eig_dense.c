@@ -8,11 +8,15 @@
  * Every mode: dsyevd's steps (Householder tridiagonalisation dsytrd,
  * divide and conquer dstedc on the tridiagonal, back-transformation
  * dormtr), written out so that the tridiagonal's eigenvectors land in phi
- * and no second n x n copy is made.  Not dsyevr: on a mesh's spectrum,
+ * and no second n x n copy is made.  Not dsyevr: on some meshes' spectra,
  * full of nearly equal eigenvalues, its MRRR step (dstemr) gives up and
- * it starts again by bisection and inverse iteration, several times
- * slower (make bench_eig_dense).  A subset (n_lowest < n): dsyevr, RANGE
- * = I, which computes only the vectors asked for.
+ * it starts again by bisection and inverse iteration, about 3 times
+ * slower in all (the 8 x 8 x 16 cuboid: IRDM_BENCH_RES=8,8,16
+ * build/bench/bench_eig_dense); where dstemr succeeds (the paper's
+ * cuboid) the two take the same time, the reduction and the
+ * back-transformation being most of it (make bench_eig_dense).  A subset
+ * (n_lowest < n): dsyevr, RANGE = I, which computes only the vectors
+ * asked for.
  */
 #include <limits.h>
 #include <math.h>
