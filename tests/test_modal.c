@@ -88,6 +88,33 @@ static void check_eigenpairs(const struct irdm_fem *fem, const double *w2, const
 	free(mp);
 }
 
+/*
+ * Each of the k vectors pb lies in the eigenspace that (wa, pa), ka pairs,
+ * gives its eigenvalue: its M-projection there has norm 1 (a sign, and a
+ * rotation within a cluster of equal eigenvalues, are free).
+ */
+static void check_same_eigenspaces(const struct irdm_fem *fem, const double *wa, const double *pa,
+				   size_t ka, const double *wb, const double *pb, size_t k)
+{
+	size_t n = fem->K.n;
+	double *mp = malloc(n * sizeof(double));
+
+	for (size_t a = 0; a < k; a++) {
+		irdm_csc_matvec(&fem->M, &pb[a * n], mp);
+		double proj = 0;
+		for (size_t b = 0; b < ka; b++) {
+			if (fabs(wa[b] - wb[a]) > 1e-7 * wb[a])
+				continue;
+			double dot = 0;
+			for (size_t i = 0; i < n; i++)
+				dot += pa[b * n + i] * mp[i];
+			proj += dot * dot;
+		}
+		assert_true(fabs(proj - 1) < 1e-8);
+	}
+	free(mp);
+}
+
 static void test_dense_and_lanczos_agree(void **state)
 {
 	struct irdm_model m;
@@ -106,25 +133,64 @@ static void test_dense_and_lanczos_agree(void **state)
 	check_eigenpairs(&m.fem, wd, pd, k);
 	check_eigenpairs(&m.fem, wl, pl, k);
 	/* each Lanczos vector lies in the dense eigenspace of its eigenvalue */
-	double *mp = malloc(n * sizeof(double));
-	for (size_t a = 0; a < k; a++) {
-		irdm_csc_matvec(&m.fem.M, &pl[a * n], mp);
-		double proj = 0;
-		for (size_t b = 0; b < k; b++) {
-			if (fabs(wd[b] - wl[a]) > 1e-7 * wl[a])
-				continue;
-			double dot = 0;
-			for (size_t i = 0; i < n; i++)
-				dot += pd[b * n + i] * mp[i];
-			proj += dot * dot;
-		}
-		assert_true(fabs(proj - 1) < 1e-8);
-	}
-	free(mp);
+	check_same_eigenspaces(&m.fem, wd, pd, k, wl, pl, k);
 	free(wd);
 	free(pd);
 	free(wl);
 	free(pl);
+	irdm_model_free(&m);
+}
+
+/*
+ * Every mode (dsytrd, dstedc, dormtr) and the lowest third (dsyevr) go
+ * through different LAPACK routes: each must be a complete set of
+ * M-orthonormal eigenpairs, and the two must agree on the lowest third,
+ * with the lumped mass (a diagonal square root) and the consistent one
+ * (a Cholesky factor).  The square cross-section gives pairs of equal
+ * bending frequencies.
+ */
+static void dense_all_and_lowest_agree(const struct irdm_fem *fem)
+{
+	size_t n = fem->K.n, k = n / 3;
+	double *wa = malloc(n * sizeof(double)), *pa = malloc(n * n * sizeof(double));
+	double *wk = malloc(k * sizeof(double)), *pk = malloc(n * k * sizeof(double));
+	char err[256];
+
+	assert_int_equal(irdm_eig_dense(fem, n, wa, pa, err, sizeof(err)), 0);
+	assert_int_equal(irdm_eig_dense(fem, k, wk, pk, err, sizeof(err)), 0);
+	for (size_t a = 1; a < n; a++)
+		assert_true(wa[a] >= wa[a - 1] && wa[0] > 0);
+	for (size_t a = 0; a < k; a++)
+		if (fabs(wa[a] - wk[a]) > 1e-10 * wk[a])
+			fail_msg("mode %zu: every mode's w2 %.17g, the lowest third's %.17g", a, wa[a],
+				 wk[a]);
+	check_eigenpairs(fem, wa, pa, n);
+	check_eigenpairs(fem, wk, pk, k);
+	check_same_eigenspaces(fem, wa, pa, n, wk, pk, k);
+	free(wa);
+	free(pa);
+	free(wk);
+	free(pk);
+}
+
+static void test_dense_all_and_lowest_agree(void **state)
+{
+	struct irdm_model m;
+	struct irdm_scene sc;
+	struct irdm_fem consistent;
+	char err[256];
+
+	(void)state;
+	fixture_model(&m, 0.1, 0.1, 0.2, 2, 2, 4, 5, 0.3, false, 1, IRDM_EIG_DENSE, 0.002);
+	irdm_scene_defaults(&sc);
+	sc.mat.poisson = 0.3;
+	assert_int_equal(irdm_fem_assemble(&m.mesh, &sc.mat, IRDM_MASS_CONSISTENT, m.fixed,
+					   &consistent, err, sizeof(err)),
+			 0);
+	assert_int_equal(m.fem.mass_kind, IRDM_MASS_LUMPED);
+	dense_all_and_lowest_agree(&m.fem);
+	dense_all_and_lowest_agree(&consistent);
+	irdm_fem_free(&consistent);
 	irdm_model_free(&m);
 }
 
@@ -204,6 +270,7 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_zoh_matches_closed_form),
 		cmocka_unit_test(test_dense_and_lanczos_agree),
+		cmocka_unit_test(test_dense_all_and_lowest_agree),
 		cmocka_unit_test(test_cantilever_matches_euler_bernoulli),
 		cmocka_unit_test(test_free_body_has_six_rigid_modes),
 		cmocka_unit_test(test_grounded_mechanism_is_an_error),

@@ -9,6 +9,13 @@ void dsyevr_(const char *jobz, const char *range, const char *uplo, const int *n
 	     const int *il, const int *iu, const double *abstol, int *m, double *w,
 	     double *z, const int *ldz, int *isuppz, double *work, const int *lwork,
 	     int *iwork, const int *liwork, int *info);
+void dsytrd_(const char *uplo, const int *n, double *a, const int *lda, double *d, double *e,
+	     double *tau, double *work, const int *lwork, int *info);
+void dstedc_(const char *compz, const int *n, double *d, double *e, double *z, const int *ldz,
+	     double *work, const int *lwork, int *iwork, const int *liwork, int *info);
+void dormtr_(const char *side, const char *uplo, const char *trans, const int *m, const int *n,
+	     const double *a, const int *lda, const double *tau, double *c, const int *ldc,
+	     double *work, const int *lwork, int *info);
 void dpotrf_(const char *uplo, const int *n, double *a, const int *lda, int *info);
 void dsygst_(const int *itype, const char *uplo, const int *n, double *a, const int *lda,
 	     const double *b, const int *ldb, int *info);
