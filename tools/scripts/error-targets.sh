@@ -154,13 +154,14 @@ awk '$1 == "paper" { print $2, $7 }' "$work/cases" | while read -r id t; do
 	run_case "$id" "$work/paper.scene" "$t"
 done
 
-# the ticks, one image at a time: "median p99" of slide/1 into ID.tick
+# the ticks, one image at a time: "median p99 triangle-changes" of
+# slide/1 into ID.tick
 for row in "$work"/[0-9]*.row; do
 	id=$(basename "$row" .row)
 	[ -f "$work/$id.img" ] || continue
 	if IRDM_BENCH_ONLY="slide/1 " IRDM_BENCH_TICKS=$ticks "$bench" "$work/$id.img" \
 		> "$work/$id.bench" 2>&1; then
-		sed -n 's/^ctrl  slide\/1  *median *\([0-9.]*\) us *p99 *\([0-9.]*\) us.*/\1 \2/p' \
+		sed -n 's/^ctrl  slide\/1  *median *\([0-9.]*\) us *p99 *\([0-9.]*\) us.*triangle changes \([0-9]*\).*/\1 \2 \3/p' \
 			"$work/$id.bench" > "$work/$id.tick"
 	fi
 	if [ ! -s "$work/$id.tick" ]; then
@@ -173,23 +174,24 @@ done
 rt=$(cat "$work"/*.bench 2>/dev/null | sed -n 's/^ctrl  \(real-time: .*\)/\1/p' | head -n 1 || true)
 
 # the row of case ID with its tick: VERDICT REPR ERR EST BYTES SECS MSG
-# TICK_MEDIAN TICK_P99, tab-separated ("-" for a figure not there)
+# TICK_MEDIAN TICK_P99 TRI_CHANGES, tab-separated ("-" for a figure not
+# there)
 row_of() {
-	local tick="- -"
+	local tick="- - -"
 	[ -s "$work/$1.tick" ] && tick=$(cat "$work/$1.tick")
-	printf '%s\t%s\n' "$(cat "$work/$1.row")" "${tick/ /$'\t'}"
+	printf '%s\t%s\n' "$(cat "$work/$1.row")" "${tick// /$'\t'}"
 }
 
 # one table's rows: the cases of SET, in the order they were listed
 rows() {
-	local set=$1 id E nu rho dt t verdict repr err est bytes secs msg med p99 cells
+	local set=$1 id E nu rho dt t verdict repr err est bytes secs msg med p99 tri cells
 	awk -v s="$set" '$1 == s { print $2, $3, $4, $5, $6, $7 }' "$work/cases" |
 		while read -r id E nu rho dt t; do
-			IFS=$'\t' read -r verdict repr err est bytes secs msg med p99 < <(row_of "$id")
+			IFS=$'\t' read -r verdict repr err est bytes secs msg med p99 tri < <(row_of "$id")
 			[ "$bytes" = - ] ||
 				bytes=$(awk -v b="$bytes" 'BEGIN { printf "%d (%.2f MiB)", b, b / 1048576 }')
 			[ "$msg" = - ] || repr=$msg
-			cells="$t | $verdict | $repr | $err | $est | $med / $p99 | $bytes | $secs |"
+			cells="$t | $verdict | $repr | $err | $est | $med / $p99 | $tri | $bytes | $secs |"
 			if [ "$set" = small ]; then
 				echo "| $E | $nu | $rho | $dt | $cells"
 			else
@@ -234,9 +236,14 @@ echo "and its stored measured error within the target; *refused*: the"
 echo "precompute's one-line message.  *estimated*: the tick auto ranked its"
 echo "candidates by (us); *tick*: measured, median / p99 us of \`bench_ctrl\`'s"
 echo "slide/1 case on the image (the whole controller tick, irdm_ctrl_tick(),"
-echo "pressed 3 mm in and sliding so the contact site changes every tick;"
-echo "$ticks ticks at the image's dt, the images timed one at a time after the"
-echo "precomputes).  *s*: the precompute's wall time ($jobs at a time)."
+echo "pressed 3 mm in and sliding 50 um a tick so the contact site moves every"
+echo "tick; $ticks ticks at the image's dt, the images timed one at a time after"
+echo "the precomputes).  *triangle changes*: of those ticks, how many moved the"
+echo "contact to another triangle, each a refresh of the contact's R[0] that"
+echo "the tick pays (on the small cuboid the slide runs along a row of mesh"
+echo "edges, and how often it crosses from one side to the other differs from"
+echo "image to image: compare ticks with this column).  *s*: the precompute's"
+echo "wall time ($jobs at a time)."
 [ -z "$rt" ] || echo "Tick conditions: $rt."
 echo
 echo "## Small models: the 4x4x8 cuboid over materials"
@@ -244,8 +251,8 @@ echo
 echo "Cuboid resolution 4,4,8 (225 nodes, 25 touchable), fixed base,"
 echo "precision f32, the materials of \`make material-grid\`."
 echo
-echo "| E (Pa) | nu | rho (kg/m^3) | dt (s) | target | result | representation (candidates built) or message | error | estimated | tick median / p99 | image bytes | s |"
-echo "|---|---|---|---|---|---|---|---|---|---|---|---|"
+echo "| E (Pa) | nu | rho (kg/m^3) | dt (s) | target | result | representation (candidates built) or message | error | estimated | tick median / p99 | triangle changes | image bytes | s |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 rows small
 echo
 summary small
@@ -257,8 +264,8 @@ if [ "$paper" = 1 ]; then
 	echo "touchable, 1 ms, f32) with \`representation = auto\` and the target's"
 	echo "max_error in place of its pinned modal:300 + static correction."
 	echo
-	echo "| target | result | representation (candidates built) or message | error | estimated | tick median / p99 | image bytes | s |"
-	echo "|---|---|---|---|---|---|---|---|"
+	echo "| target | result | representation (candidates built) or message | error | estimated | tick median / p99 | triangle changes | image bytes | s |"
+	echo "|---|---|---|---|---|---|---|---|---|"
 	rows paper
 	echo
 	summary paper
