@@ -20,8 +20,8 @@
 #
 # The tick is bench_ctrl's slide/1 case on the image (tests/bench/
 # bench_ctrl.c): the whole controller tick, the tip pressed 3 mm into the
-# top face and sliding 50 um a tick so the contact site changes every tick,
-# at the image's dt, SCHED_FIFO on one CPU, ERROR_TARGETS_TICKS timed ticks
+# top face and sliding 50 um a tick so the contact site moves every tick
+# (how often it changes triangle printed beside), at the image's dt, SCHED_FIFO on one CPU, ERROR_TARGETS_TICKS timed ticks
 # (default 5000).  The images are timed one at a time after every
 # precompute has ended, so JOBS parallel precomputes do not load the timing.
 #
@@ -260,9 +260,9 @@ echo
 echo "## The paper's cuboid"
 echo
 if [ "$paper" = 1 ]; then
-	echo "The default scene (\`scenes/cuboid-top.scene\`: 3312 nodes, 1068"
-	echo "touchable, 1 ms, f32) with \`representation = auto\` and the target's"
-	echo "max_error in place of its pinned modal:300 + static correction."
+	echo "The default scene (\`scenes/cuboid-top.scene\`: 3312 nodes, its top"
+	echo "face's 144 touchable, 1 ms, f32) with \`representation = auto\` and the"
+	echo "target's max_error in place of its pinned modal:300 + static correction."
 	echo
 	echo "| target | result | representation (candidates built) or message | error | estimated | tick median / p99 | triangle changes | image bytes | s |"
 	echo "|---|---|---|---|---|---|---|---|---|"
