@@ -35,6 +35,10 @@
 #   make material-grid  the precompute over a grid of materials, ticks and
 #                   precisions: each image certified and within max_error or
 #                   refused (docs/measurements/material-grid.md)
+#   make error-targets  for max_error 1e-2, 1e-3, 1e-4: what auto chooses,
+#                   its error, tick, bytes and precompute time, on the small
+#                   cuboid's materials (PAPER=1: and the paper's cuboid;
+#                   docs/measurements/error-targets.md)
 #   make format-check  every C source and header against .clang-format
 #                   (clang-format 14); make format rewrites them
 #
@@ -180,7 +184,7 @@ CORE_TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(CORE_TEST_SRC))
 FWAPP_TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(FWAPP_TEST_SRC))
 BENCHES  := $(patsubst tests/bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC))
 
-.PHONY: all test test-variants san fuzz material-grid run-vs-exact bench bench-precompute bench-mpi run render view-shots jitter-view stability report jitter check deps clean docs docs-check cfg-fws sizes hil format format-check head-tick
+.PHONY: all test test-variants san fuzz material-grid error-targets run-vs-exact bench bench-precompute bench-mpi run render view-shots jitter-view stability report jitter check deps clean docs docs-check cfg-fws sizes hil format format-check head-tick
 .SECONDARY:
 all: $(if $(CONFIG),,$(IRDM) $(SLEPC_PLUGIN)) $(FW_LIB) $(POSIX_LIB) $(HAL_LIB) $(SIM_LIB) $(if $(FWMAIN_SRC),$(IRDM_FW)) \
   $(if $(CDMAIN_SRC),$(IRDM_CD))
@@ -426,6 +430,18 @@ GRID_JOBS ?= 2
 material-grid: $(IRDM)
 	$(MEASURE) -m material-grid 'make material-grid GRID_JOBS=$(GRID_JOBS)' -- \
 	  tools/scripts/material-grid.sh $(IRDM) $(GRID_JOBS)
+
+# For each max_error of 1e-2, 1e-3 and 1e-4, what representation = auto
+# chooses, its measured error, its tick timed by bench_ctrl, its bytes and
+# its precompute time (tools/scripts/error-targets.sh): material-grid's
+# small cuboid over its materials at 1 and 2 ms; PAPER=1 adds the paper's
+# cuboid (the default scene, minutes a precompute).  GRID_JOBS precomputes
+# at once (the ticks are timed one at a time after them).
+PAPER ?=
+error-targets: $(IRDM) $(BUILD)/bench/bench_ctrl
+	$(MEASURE) -m error-targets 'make error-targets GRID_JOBS=$(GRID_JOBS)$(if $(filter 1,$(PAPER)), PAPER=1)' -- \
+	  env ERROR_TARGETS_PAPER=$(if $(filter 1,$(PAPER)),1,0) \
+	  tools/scripts/error-targets.sh $(IRDM) $(BUILD)/bench/bench_ctrl $(GRID_JOBS)
 
 # Each benchmark alone: make bench_tick, make bench_ctrl, ... (the names of
 # tests/bench/*.c), each writing docs/measurements/NAME.md.

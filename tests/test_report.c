@@ -200,7 +200,8 @@ static void test_errors_recomputed(void **state)
 	free(target);
 }
 
-/* The Markdown names the paper's setting of this configuration unstable. */
+/* The Markdown names the paper's setting of this configuration unstable,
+ * and points to the error-target view. */
 static void test_markdown(void **state)
 {
 	char path[512], text[65536];
@@ -211,6 +212,7 @@ static void test_markdown(void **state)
 	assert_non_null(strstr(text, "**The paper's setting** (fir:100 at 2 ms)"));
 	assert_non_null(strstr(text, "(**unstable**)"));
 	assert_non_null(strstr(text, "| **fir:100 (paper)** | 2 ms | **no**"));
+	assert_non_null(strstr(text, "(measurements/error-targets.md)"));
 }
 
 /* How many entries of d begin with prefix. */

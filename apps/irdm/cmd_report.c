@@ -178,7 +178,15 @@ static void header(FILE *f, const double load[3], const double load_end[3], doub
 		"truncated image with a static correction has a soft R[0] and no such\n"
 		"ringing, so its whole-run error is mostly that ringing: the `first 10 ticks`\n"
 		"column.  The `from tick 100` column is the settled force; at 1 ms it still\n"
-		"holds the ringing's tail.\n\n",
+		"holds the ringing's tail.\n\n"
+		"**By error target.**  A user asks for an error, not a representation:\n"
+		"what `representation = auto` chooses for a max_error of 1e-2, 1e-3 and\n"
+		"1e-4, with its measured error, its tick (timed), its image bytes and its\n"
+		"precompute time, is in\n"
+		"[measurements/error-targets.md](measurements/error-targets.md) (`make\n"
+		"error-targets`: the 4x4x8 cuboid over a grid of materials; `PAPER=1`\n"
+		"adds the paper's cuboid).  Not run here: its 48 precomputes and their\n"
+		"ticks would add about a minute to this report.\n\n",
 		date, IRDM_TOOL_VERSION, seconds, load[0], load_end[0], IRDM_REPORT_CHECK_SUBSTEPS,
 		IRDM_REPORT_DISP_EVERY, IRDM_REPORT_RAW_SECONDS);
 }

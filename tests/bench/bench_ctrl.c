@@ -23,7 +23,8 @@
  * tick can remove (on this VM an interrupt costs 40-90 us).
  *
  * Run from the repository root; the image is reused from out/bench/ and
- * made there when missing, or given as the first argument.  Instructions
+ * made there when missing, or given as the first argument (ticked at its
+ * own dt: the controller's period and coupling follow it).  Instructions
  * per tick, independent of the host's load (bench_util.h):
  *   valgrind --tool=callgrind --collect-atstart=no \
  *     --toggle-collect=irdm_ctrl_tick build/bench/bench_ctrl
@@ -166,21 +167,48 @@ static void top_of(struct bench *b)
 	}
 }
 
-static int open_bench(struct bench *b, const char *path)
+/*
+ * The session on the image at path, its controller ticking at the image's
+ * dt (an image at 2 ms is timed at 500 Hz, as a board for it would run):
+ * opened at the default period, and again at the image's if they differ.
+ */
+static int open_session(struct bench *b, const char *path)
 {
 	struct irdm_session_config sc = { .deform = false };
+	const struct irdm_ctrl_device_config *d = &b->cfg.device[0];
 	char err[512];
+	double dt;
 
-	memset(b, 0, sizeof(*b));
-	irdm_ctrl_config_default(&b->cfg);
-	memcpy(b->cfg.obj_rot, rot, sizeof(rot));
-	b->cfg.limits.max_tip_speed_m_per_s = 10; /* the steps of slide/10 */
-	b->cfg.limits.watchdog_us = 1000000;      /* a preempted tick is a figure here */
 	sc.engine = b->cfg.engine;
 	if (irdm_session_open(&b->s, path, &sc, err, sizeof(err))) {
 		printf("ctrl  %s: %s\n", path, err);
 		return -1;
 	}
+	dt = b->s->img->meta->dt_s;
+	if (fabs(dt - b->cfg.period_us * 1e-6) <= 1e-6)
+		return 0;
+	irdm_session_close(b->s);
+	b->cfg.period_us = (uint32_t)lround(dt * 1e6);
+	irdm_engine_config_haptic(&b->cfg.engine, b->cfg.period_us * 1e-6, d->dev.k_max_n_per_m,
+				  d->dev.b_device_ns_per_m, b->cfg.limits.max_force_n);
+	b->cfg.engine.max_force_n = IRDM_CTRL_ENGINE_FORCE_GUARD * b->cfg.limits.max_force_n;
+	sc.engine = b->cfg.engine;
+	if (irdm_session_open(&b->s, path, &sc, err, sizeof(err))) {
+		printf("ctrl  %s: %s\n", path, err);
+		return -1;
+	}
+	return 0;
+}
+
+static int open_bench(struct bench *b, const char *path)
+{
+	memset(b, 0, sizeof(*b));
+	irdm_ctrl_config_default(&b->cfg);
+	memcpy(b->cfg.obj_rot, rot, sizeof(rot));
+	b->cfg.limits.max_tip_speed_m_per_s = 10; /* the steps of slide/10 */
+	b->cfg.limits.watchdog_us = 1000000;      /* a preempted tick is a figure here */
+	if (open_session(b, path))
+		return -1;
 	top_of(b);
 	b->cfg.obj_offset_m[0] = b->cx;
 	b->cfg.obj_offset_m[1] = b->cy;
