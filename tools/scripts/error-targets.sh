@@ -53,18 +53,10 @@ sed -e '/^\(representation\|static_correction\|max_error\) *=/d' scenes/cuboid-t
 	> "$work/paper.scene"
 echo "representation = auto" >> "$work/paper.scene"
 
-# young (Pa) poisson density (kg/m^3): material-grid.sh's
-materials=(
-	"2e3 0.3 110"
-	"2e3 0.4999 2e4"
-	"2e3 0.45 1"
-	"2e5 0.4 1000"
-	"2e6 0.4999 110"
-	"2e7 0.3 2e4"
-	"2e9 0.3 1"
-	"2e9 0.4999 2e4"
-)
-dts=(0.001 0.002)
+# shellcheck source=tools/scripts/grid-materials.sh
+. "$(dirname "$0")/grid-materials.sh"
+materials=("${grid_materials[@]}")
+dts=("${grid_dts[@]}")
 targets=(1e-2 1e-3 1e-4)
 if [ "${ERROR_TARGETS_QUICK:-0}" = 1 ]; then
 	materials=("2e5 0.4 1000")

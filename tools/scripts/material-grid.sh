@@ -34,18 +34,10 @@ touch = z>=0.2
 display = surface
 EOF
 
-# young (Pa) poisson density (kg/m^3)
-materials=(
-	"2e3 0.3 110"
-	"2e3 0.4999 2e4"
-	"2e3 0.45 1"
-	"2e5 0.4 1000"
-	"2e6 0.4999 110"
-	"2e7 0.3 2e4"
-	"2e9 0.3 1"
-	"2e9 0.4999 2e4"
-)
-dts=(0.001 0.002)
+# shellcheck source=tools/scripts/grid-materials.sh
+. "$(dirname "$0")/grid-materials.sh"
+materials=("${grid_materials[@]}")
+dts=("${grid_dts[@]}")
 precs=(f16 f32 f64)
 reprs=("default" "modal:100+head:128")
 if [ "${MATERIAL_GRID_QUICK:-0}" = 1 ]; then
