@@ -64,17 +64,6 @@ static bool written(const char *name)
 	return access(path, F_OK) == 0;
 }
 
-/* The exact model by a precompute of its own. */
-static int exact_by_precompute(void *ctx, const struct irdm_scene *rsc, const char *path,
-			       char *err, size_t errlen)
-{
-	struct irdm_precompute_opts o = { .out_path = path };
-	struct irdm_precompute_report rep;
-
-	(void)ctx;
-	return irdm_precompute(rsc, &o, &rep, err, errlen);
-}
-
 static int descending(const void *a, const void *b)
 {
 	double x = *(const double *)a, y = *(const double *)b;
@@ -188,7 +177,7 @@ static void test_auto_meets_target(void **state)
 	check_kept(&img, &all);
 	irdm_image_unmap(&all);
 	fixture_soft_scene(&sc, (const char *const[]){ NULL });
-	assert_int_equal(irdm_measure_error(&sc, &img, ref, exact_by_precompute, NULL, NULL, NULL,
+	assert_int_equal(irdm_measure_error(&sc, &img, ref, fixture_exact_by_precompute, NULL, NULL, NULL,
 					    &res, err, sizeof(err)),
 			 0);
 	irdm_image_unmap(&img);

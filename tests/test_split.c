@@ -37,16 +37,6 @@
 
 static char dir[64];
 
-static int exact_by_precompute(void *ctx, const struct irdm_scene *rsc, const char *path,
-			       char *err, size_t errlen)
-{
-	struct irdm_precompute_opts o = { .out_path = path };
-	struct irdm_precompute_report rep;
-
-	(void)ctx;
-	return irdm_precompute(rsc, &o, &rep, err, errlen);
-}
-
 /* The hybrid with a head of H built, then measured: res. */
 static void measured(const char *H, struct irdm_measure *res)
 {
@@ -66,7 +56,7 @@ static void measured(const char *H, struct irdm_measure *res)
 	assert_int_equal(irdm_precompute(&sc, &o, &rep, err, sizeof(err)), 0);
 	assert_int_equal(irdm_image_map(path, 0, &img, err, sizeof(err)), 0);
 	fixture_soft_scene(&sc, (const char *const[]){ NULL });
-	assert_int_equal(irdm_measure_error(&sc, &img, ref, exact_by_precompute, NULL, NULL, NULL,
+	assert_int_equal(irdm_measure_error(&sc, &img, ref, fixture_exact_by_precompute, NULL, NULL, NULL,
 					    res, err, sizeof(err)),
 			 0);
 	irdm_image_unmap(&img);

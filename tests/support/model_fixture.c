@@ -10,6 +10,7 @@
 #include <cmocka.h>
 
 #include "model_fixture.h"
+#include "precompute/precompute.h"
 
 void dpotrf_(const char *uplo, const int *n, double *a, const int *lda, int *info);
 void dpotrs_(const char *uplo, const int *n, const int *nrhs, const double *a, const int *lda,
@@ -133,4 +134,14 @@ void fixture_soft_scene(struct irdm_scene *sc, const char *const *keys)
 		assert_int_equal(irdm_scene_set(sc, kv[0], kv[1], "test", err, sizeof(err)), 0);
 	for (const char *const *kv = keys; kv && *kv; kv += 2)
 		assert_int_equal(irdm_scene_set(sc, kv[0], kv[1], "test", err, sizeof(err)), 0);
+}
+
+int fixture_exact_by_precompute(void *ctx, const struct irdm_scene *rsc, const char *path,
+				char *err, size_t errlen)
+{
+	struct irdm_precompute_opts o = { .out_path = path };
+	struct irdm_precompute_report rep;
+
+	(void)ctx;
+	return irdm_precompute(rsc, &o, &rep, err, errlen);
 }

@@ -19,6 +19,11 @@ void fixture_model(struct irdm_model *m, double lx, double ly, double lz, unsign
  */
 void fixture_soft_scene(struct irdm_scene *sc, const char *const *keys);
 
+/* An irdm_measure_ref_fn (accuracy/measure.h): the exact model as a
+ * precompute of its own, not the measured build's reference. */
+int fixture_exact_by_precompute(void *ctx, const struct irdm_scene *rsc, const char *path,
+				char *err, size_t errlen);
+
 /* Free DoF index of (node, axis), asserting it is free. */
 int64_t fixture_free_dof(const struct irdm_model *m, uint32_t node, int axis);
 
