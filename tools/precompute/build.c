@@ -60,6 +60,7 @@ struct build {
 	size_t n_solved;      /* modes the eigensolve gave (all: the exact model's) */
 	bool kept_not_lowest; /* auto's hybrid keeps modes above a dropped one */
 	bool auto_try;        /* building one of auto's candidates */
+	bool head_capped;     /* and its head was over AUTO_HEAD_MAX_BYTES */
 	size_t try_bytes;     /* the measured image's size (0: none written) */
 };
 
@@ -117,6 +118,7 @@ static int exact_head(struct build *b, const struct irdm_mode *zoh_all, size_t n
 
 	all.n_modes = n_all;
 	if (b->auto_try && head_bytes(b, sp->n_blocks, H) > AUTO_HEAD_MAX_BYTES) {
+		b->head_capped = true;
 		free(target);
 		snprintf(err, errlen, "precompute: auto: the head would take %.0f MiB (%zu blocks x %zu samples), more than auto builds (%u MiB)",
 			 (double)head_bytes(b, sp->n_blocks, H) / (1 << 20), sp->n_blocks, 2 * H,
@@ -1431,6 +1433,7 @@ static int try_candidate(struct build *b, const struct irdm_auto_candidate *c, s
 
 	reset_try(b, n_all);
 	b->auto_try = true;
+	b->head_capped = false;
 	eff->modes = c->modes < n_all ? (unsigned)c->modes : 0;
 	eff->static_correction = c->modes < n_all;
 	eff->exact_head = hybrid ? c->head : 0;
@@ -1498,6 +1501,24 @@ out_free:
 }
 
 /*
+ * A hybrid whose head was over the cap, with twice the modes: the static
+ * correction of fewer dropped modes keeps fewer blocks, so its head may
+ * fit, and more of the rank's modes only lower the error.  Not once it
+ * would tick no cheaper than all n_all modes.
+ */
+static bool grow(struct irdm_auto_candidate *c, size_t n_all)
+{
+	size_t k = 2 * c->modes;
+
+	if (k >= n_all || irdm_auto_tick_us(k, c->head) >= irdm_auto_tick_us(n_all, 0))
+		return false;
+	c->modes = k;
+	c->tick_us = irdm_auto_tick_us(k, c->head);
+	c->predicted = -1; /* under the one predicted for fewer */
+	return true;
+}
+
+/*
  * representation = auto: every mode is solved; the candidates
  * (candidates.h), cheapest to tick first, are built until one is
  * certified and measures within max_error.  A model of at most
@@ -1533,6 +1554,8 @@ static int choose(struct build *b, struct irdm_precompute_report *rep, char *err
 	say_candidates(b, cand, n_cand);
 	for (size_t k = 0; k < n_cand; k++) {
 		ret = try_candidate(b, &cand[k], n_all, rep, order, err, errlen);
+		while (ret == IRDM_ENUMERIC && b->head_capped && grow(&cand[k], n_all))
+			ret = try_candidate(b, &cand[k], n_all, rep, order, err, errlen);
 		if (ret != IRDM_ENUMERIC)
 			break;
 		snprintf(last, sizeof(last), "%s", err);
