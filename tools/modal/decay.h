@@ -2,8 +2,8 @@
 /*
  * How long a mode rings.  A hybrid image holds the dropped modes' exact
  * response over its head only: what a mode still does past the head is
- * lost unless it stays in the modal recursion (modal/head_split.h weighs
- * it), whatever its frequency.  On a soft, heavy material the low modes
+ * lost unless it stays in the modal recursion (modal/head_split.h ranks
+ * the modes by it), whatever its frequency.  On a soft, heavy material the low modes
  * past the first hundred can ring for thousands of ticks, so choosing the
  * kept modes by frequency alone leaves a certified image far off the
  * exact model.  Also: putting the kept modes first.
