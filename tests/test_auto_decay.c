@@ -17,6 +17,9 @@
  *    asks for (accuracy/split.h); the image written carries its measured
  *    figure, and measuring it again here against an exact model
  *    precomputed on its own (not the build's reference) gives the same;
+ *  - with every surface node shown, the modes it keeps have whole shapes
+ *    (the eigensolve gives every mode at the touchable rows only): each
+ *    the all-modes image's at every row;
  *  - a tighter max_error that no candidate meets is refused with a
  *    message, and no image is written.
  */
@@ -35,6 +38,7 @@
 #include "accuracy/measure.h"
 #include "irdm/error.h"
 #include "irdm/posix/image_map.h"
+#include "irdm/precision.h"
 #include "precompute/precompute.h"
 #include "scene/scene.h"
 #include "support/model_fixture.h"
@@ -186,6 +190,75 @@ static void test_auto_meets_target(void **state)
 	assert_float_equal(res.error, measured, 0.01 * measured + 1e-9);
 }
 
+/*
+ * Every node of the surface shown, not only the touchable ones: the
+ * eigensolve gives every mode at the columns only, and an auto hybrid
+ * makes whole the modes it keeps.  Each kept mode's shape at every row is
+ * the one of the all-modes image of the same scene (its vectors all made
+ * whole), to f32 rounding, up to sign.
+ */
+/* The largest difference between img's mode k and all's mode j over every
+ * row, up to sign; *top: the largest of all's. */
+static double shape_gap(const struct irdm_image *img, uint32_t k, const struct irdm_image *all,
+			uint32_t j, double *top)
+{
+	uint32_t K = img->meta->n_modes, n = all->meta->n_modes, rows = img->meta->n_nodes;
+	double dot = 0, worst = 0;
+
+	for (uint32_t r = 0; r < 3 * rows; r++)
+		dot += irdm_elem_get(img->mode_shapes, img->meta->precision, (size_t)r * K + k) *
+		       irdm_elem_get(all->mode_shapes, all->meta->precision, (size_t)r * n + j);
+	for (uint32_t r = 0; r < 3 * rows; r++) {
+		double a = irdm_elem_get(img->mode_shapes, img->meta->precision, (size_t)r * K + k);
+		double b = irdm_elem_get(all->mode_shapes, all->meta->precision, (size_t)r * n + j);
+
+		worst = fmax(worst, fabs(a - (dot < 0 ? -b : b)));
+		*top = fmax(*top, fabs(b));
+	}
+	return worst;
+}
+
+static void test_auto_shows_whole_shapes(void **state)
+{
+	static const char *const shown[] = { "display", "surface", NULL };
+	static const char *const all_shown[] = { "display", "surface", "representation", "modal:all",
+						 "static_correction", "no", "max_error", "none",
+						 "precision", "f64", NULL };
+	struct irdm_precompute_report rep;
+	struct irdm_image img, all;
+	char err[768], path[128];
+	uint32_t K, n, rows;
+
+	(void)state;
+	assert_int_equal(build("shown.img", &rep, err, sizeof(err), shown), 0);
+	assert_int_equal(build("all-shown.img", &rep, err, sizeof(err), all_shown), 0);
+	snprintf(path, sizeof(path), "%s/shown.img", dir);
+	assert_int_equal(irdm_image_map(path, 0, &img, err, sizeof(err)), 0);
+	snprintf(path, sizeof(path), "%s/all-shown.img", dir);
+	assert_int_equal(irdm_image_map(path, 0, &all, err, sizeof(err)), 0);
+	K = img.meta->n_modes;
+	n = all.meta->n_modes;
+	rows = img.meta->n_nodes;
+	assert_true(img.meta->head_samples > 0 && K < n);
+	assert_int_equal(rows, all.meta->n_nodes);
+	assert_true(rows > 2 * img.meta->n_cols); /* rows beyond the touchable ones */
+	for (uint32_t k = 0; k < K; k++) {
+		double best = INFINITY, top = 0;
+
+		/* a square section's bending modes come in equal pairs: the
+		 * closest of those with this frequency */
+		for (uint32_t j = 0; j < n; j++)
+			if (fabs(all.modes[j].omega_rad_s - img.modes[k].omega_rad_s) <=
+			    1e-9 * img.modes[k].omega_rad_s)
+				best = fmin(best, shape_gap(&img, k, &all, j, &top));
+		if (!(best <= 1e-6 * top))
+			fail_msg("kept mode %u (%.4g rad/s): shape off by %.3g of %.3g", k,
+				 img.modes[k].omega_rad_s, best, top);
+	}
+	irdm_image_unmap(&img);
+	irdm_image_unmap(&all);
+}
+
 static void test_unmet_target_refused(void **state)
 {
 	struct irdm_precompute_report rep;
@@ -206,6 +279,7 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_lowest_modes_refused),
 		cmocka_unit_test(test_auto_meets_target),
+		cmocka_unit_test(test_auto_shows_whole_shapes),
 		cmocka_unit_test(test_unmet_target_refused),
 	};
 

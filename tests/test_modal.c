@@ -14,6 +14,7 @@
 
 #include <cmocka.h>
 
+#include "modal/decay.h"
 #include "modal/modal.h"
 #include "support/model_fixture.h"
 
@@ -195,6 +196,130 @@ static void test_dense_all_and_lowest_agree(void **state)
 }
 
 /*
+ * Every mode at a few rows (irdm_eig_dense_at), the rest made whole on
+ * demand: at those rows each vector is the whole solve's (which
+ * check_eigenpairs holds to K and M), elsewhere NaN until made whole, and
+ * the vectors made whole are eigenpairs themselves; through the modes
+ * (want->every), the columns follow a permutation and only the ones asked
+ * for are made whole.  A consistent mass gives every vector whole.
+ */
+static void dense_at_as_whole(const struct irdm_fem *fem, const double *wa, const double *pa)
+{
+	size_t n = fem->K.n, n_at = 0, pick[3] = { 0, n / 2, n - 1 };
+	double *wb = malloc(n * sizeof(double)), *pb = malloc(n * n * sizeof(double));
+	double *filled = malloc(3 * n * sizeof(double)), scale = 0;
+	int64_t *at = malloc(n * sizeof(int64_t));
+	struct irdm_eig_rest *rest;
+	char err[256];
+
+	for (size_t i = 0; i < n; i += 5)
+		at[n_at++] = (int64_t)i;
+	for (size_t i = 0; i < n * n; i++)
+		scale = fmax(scale, fabs(pa[i]));
+	assert_int_equal(irdm_eig_dense_at(fem, at, n_at, NULL, NULL, wb, pb, &rest, err, sizeof(err)), 0);
+	assert_non_null(rest);
+	for (size_t k = 0; k < n; k++) {
+		assert_true(fabs(wb[k] - wa[k]) <= 1e-12 * wa[n - 1]);
+		for (size_t i = 0; i < n; i++) {
+			double v = pb[k * n + i];
+			if (i % 5)
+				assert_true(isnan(v));
+			else if (fabs(v - pa[k * n + i]) > 1e-9 * scale)
+				fail_msg("mode %zu, DoF %zu: %.17g at a row, %.17g whole", k, i, v,
+					 pa[k * n + i]);
+		}
+	}
+	assert_int_equal(irdm_eig_rest_fill(rest, pick, 3, filled), 0);
+	for (size_t j = 0; j < 3; j++)
+		for (size_t i = 0; i < n; i++)
+			assert_true(fabs(filled[j * n + i] - pa[pick[j] * n + i]) <= 1e-9 * scale);
+	check_eigenpairs(fem, &wa[n - 1], &filled[2 * n], 1);
+	irdm_eig_rest_free(rest);
+	free(wb);
+	free(pb);
+	free(filled);
+	free(at);
+}
+
+static void test_dense_at_rows_as_whole(void **state)
+{
+	struct irdm_model m;
+	struct irdm_scene sc;
+	struct irdm_fem consistent;
+	struct irdm_modes md;
+	struct irdm_eig_rest *rest;
+	char err[256];
+	size_t n, *order;
+	double *wa, *pa, *wc, *pc, scale = 0;
+	bool *every;
+	int64_t all_rows[1] = { 0 };
+
+	(void)state;
+	fixture_model(&m, 0.1, 0.1, 0.2, 2, 2, 4, 5, 0.3, false, 1, IRDM_EIG_DENSE, 0.002);
+	n = m.fem.K.n;
+	wa = malloc(n * sizeof(double));
+	pa = malloc(n * n * sizeof(double));
+	wc = malloc(n * sizeof(double));
+	pc = malloc(n * n * sizeof(double));
+	every = calloc(n, sizeof(bool));
+	order = malloc(n * sizeof(size_t));
+	assert_int_equal(irdm_eig_dense(&m.fem, n, wa, pa, err, sizeof(err)), 0);
+	check_eigenpairs(&m.fem, wa, pa, n);
+	dense_at_as_whole(&m.fem, wa, pa);
+	for (size_t i = 0; i < n * n; i++)
+		scale = fmax(scale, fabs(pa[i]));
+
+	/* the modes: columns reversed, the first two made whole at DoF 1 */
+	for (size_t i = 0; i < n; i += 4)
+		every[i] = true;
+	assert_int_equal(irdm_modes_solve_kept(&m.fem, 0, false, IRDM_EIG_DENSE, NULL,
+					       &(struct irdm_modes_want){ .every = every }, NULL,
+					       NULL, &md, err, sizeof(err)),
+			 0);
+	assert_non_null(md.rest);
+	for (size_t k = 0; k < n; k++)
+		order[k] = n - 1 - k;
+	assert_int_equal(irdm_modes_permute(&md, order), 0);
+	all_rows[0] = 4; /* held by every column: nothing to make whole */
+	assert_int_equal(irdm_modes_complete(&md, 0, 2, all_rows, 1, err, sizeof(err)), 0);
+	assert_false(irdm_modes_whole(&md, 0));
+	all_rows[0] = 1;
+	assert_int_equal(irdm_modes_complete(&md, 0, 2, all_rows, 1, err, sizeof(err)), 0);
+	for (size_t k = 0; k < n; k++) {
+		assert_true(irdm_modes_whole(&md, k) == (k < 2));
+		assert_true(fabs(md.omega2[k] - wa[n - 1 - k]) <= 1e-12 * wa[n - 1]);
+		for (size_t i = 0; i < n; i++) {
+			double v = md.phi[k * n + i];
+			if (k >= 2 && !every[i])
+				assert_true(isnan(v));
+			else
+				assert_true(fabs(v - pa[(n - 1 - k) * n + i]) <= 1e-9 * scale);
+		}
+	}
+	irdm_modes_free(&md);
+
+	/* a consistent mass: every vector whole, nothing deferred */
+	irdm_scene_defaults(&sc);
+	sc.mat.poisson = 0.3;
+	assert_int_equal(irdm_fem_assemble(&m.mesh, &sc.mat, IRDM_MASS_CONSISTENT, m.fixed,
+					   &consistent, err, sizeof(err)),
+			 0);
+	assert_int_equal(irdm_eig_dense_at(&consistent, (int64_t[]){ 0 }, 1, NULL, NULL, wc, pc, &rest,
+					   err, sizeof(err)),
+			 0);
+	assert_null(rest);
+	check_eigenpairs(&consistent, wc, pc, n);
+	irdm_fem_free(&consistent);
+	free(wa);
+	free(pa);
+	free(wc);
+	free(pc);
+	free(every);
+	free(order);
+	irdm_model_free(&m);
+}
+
+/*
  * Euler-Bernoulli cantilever: f_i = (beta_i L)^2 / (2 pi L^2) sqrt(EI / rho A),
  * beta_1 L = 1.87510, beta_2 L = 4.69409.  nu = 0 (the theory has no Poisson
  * effect), slenderness 20.
@@ -271,6 +396,7 @@ int main(void)
 		cmocka_unit_test(test_zoh_matches_closed_form),
 		cmocka_unit_test(test_dense_and_lanczos_agree),
 		cmocka_unit_test(test_dense_all_and_lowest_agree),
+		cmocka_unit_test(test_dense_at_rows_as_whole),
 		cmocka_unit_test(test_cantilever_matches_euler_bernoulli),
 		cmocka_unit_test(test_free_body_has_six_rigid_modes),
 		cmocka_unit_test(test_grounded_mechanism_is_an_error),

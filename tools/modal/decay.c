@@ -29,7 +29,7 @@ int irdm_modes_permute(struct irdm_modes *m, const size_t *order)
 	bool *done = calloc(n ? n : 1, sizeof(*done));
 	double *col = malloc((len ? len : 1) * sizeof(*col));
 
-	if (!done || !col) {
+	if (!done || !col || irdm_modes_rest_permute(m, order)) {
 		free(done);
 		free(col);
 		return IRDM_ENOMEM;

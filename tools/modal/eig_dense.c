@@ -110,6 +110,91 @@ out:
 	return ret;
 }
 
+struct irdm_eig_rest {
+	int n;
+	double *a;     /* dsytrd's Householder vectors, lower triangle */
+	double *tau;   /* their scalar factors, n - 1 */
+	double *z;     /* the tridiagonal's eigenvectors, n x n */
+	double *dsqrt; /* the lumped mass's square root */
+};
+
+void irdm_eig_rest_free(struct irdm_eig_rest *r)
+{
+	if (!r)
+		return;
+	free(r->a);
+	free(r->tau);
+	free(r->z);
+	free(r->dsqrt);
+	free(r);
+}
+
+/* C <- op(Q) C, C n x k; trans "N" or "T".  0, -1 out of memory, or info. */
+static int apply_q(const struct irdm_eig_rest *r, const char *trans, double *c, int k)
+{
+	double q = 0, *work;
+	int lwork = -1, info = 0;
+
+	if (k == 0)
+		return 0;
+	dormtr_("L", "L", trans, &r->n, &k, r->a, &r->n, r->tau, c, &r->n, &q, &lwork, &info);
+	lwork = work_size(q);
+	work = lwork > 0 ? malloc((size_t)lwork * sizeof(double)) : NULL;
+	if (!work)
+		return -1;
+	dormtr_("L", "L", trans, &r->n, &k, r->a, &r->n, r->tau, c, &r->n, work, &lwork, &info);
+	free(work);
+	return info;
+}
+
+int irdm_eig_rest_fill(const struct irdm_eig_rest *r, const size_t *z_cols, size_t k, double *out)
+{
+	size_t n = (size_t)r->n;
+	int ret;
+
+	for (size_t j = 0; j < k; j++)
+		memcpy(&out[j * n], &r->z[z_cols[j] * n], n * sizeof(double));
+	ret = apply_q(r, "N", out, (int)k);
+	if (ret)
+		return ret < 0 ? IRDM_ENOMEM : IRDM_ENUMERIC;
+	for (size_t j = 0; j < k; j++)
+		for (size_t i = 0; i < n; i++)
+			out[j * n + i] /= r->dsqrt[i];
+	return IRDM_OK;
+}
+
+/* phi's rows at[] of every mode: (Q^T E_at)^T Z, scaled by M^-1/2; NaN
+ * at every other row. */
+static int rows_at(const struct irdm_eig_rest *r, const int64_t *at, size_t n_at, double *phi)
+{
+	size_t n = (size_t)r->n;
+	int t = (int)n_at, ni = r->n, ret;
+	double one = 1.0, zero = 0.0;
+	double *c = calloc(n * (n_at ? n_at : 1), sizeof(double));
+	double *y = malloc(n * (n_at ? n_at : 1) * sizeof(double));
+
+	ret = -1;
+	if (!c || !y)
+		goto out;
+	for (size_t i = 0; i < n_at; i++)
+		c[i * n + (size_t)at[i]] = 1.0;
+	ret = apply_q(r, "T", c, t);
+	if (ret)
+		goto out;
+	/* y (t x n) = C^T Z: row i, mode k */
+	if (t)
+		dgemm_("T", "N", &t, &ni, &ni, &one, c, &ni, r->z, &ni, &zero, y, &t);
+	for (size_t i = 0; i < n * n; i++)
+		phi[i] = NAN;
+	for (size_t k = 0; k < n; k++)
+		for (size_t i = 0; i < n_at; i++)
+			phi[k * n + (size_t)at[i]] = y[k * n_at + i] / r->dsqrt[at[i]];
+out:
+	free(c);
+	free(y);
+	return ret;
+}
+
 /* The lowest iu eigenpairs of A (destroyed), MRRR.  Same returns; m:
  * how many it found. */
 static int solve_lowest(double *a, int n, int iu, double *w2, double *phi, int *m)
@@ -191,5 +276,83 @@ out_free:
 	free(a);
 	free(l);
 	free(dsqrt);
+	return ret;
+}
+
+/*
+ * Every eigenpair of a lumped-mass model, each vector only at the n_at
+ * free DoFs at[] (NaN elsewhere, in phi: n x n); *rest makes chosen
+ * vectors whole (irdm_eig_rest_fill).  A consistent mass: every vector
+ * whole and *rest NULL (its L^-T mixes the rows).  Progress (NULL: none)
+ * after each step, by its share of the flops on the paper's cuboid.
+ */
+int irdm_eig_dense_at(const struct irdm_fem *fem, const int64_t *at, size_t n_at,
+		      irdm_progress_fn progress, void *ctx, double *w2, double *phi,
+		      struct irdm_eig_rest **rest, char *err, size_t errlen)
+{
+	struct irdm_eig_rest *r = NULL;
+	double *e = NULL, *work = NULL, q[2] = { 0, 0 };
+	int *iwork = NULL, lwork = -1, liwork = -1, iq = 0, info = 0, n = (int)fem->K.n;
+	const char *step = "dsytrd";
+	int ret = IRDM_ENOMEM;
+
+	*rest = NULL;
+	if (!mass_is_diagonal(&fem->M))
+		return irdm_eig_dense(fem, fem->K.n, w2, phi, err, errlen);
+	r = calloc(1, sizeof(*r));
+	if (!r)
+		goto out_nomem;
+	r->n = n;
+	r->a = irdm_csc_to_dense(&fem->K);
+	r->tau = malloc((size_t)n * sizeof(double));
+	r->z = malloc((size_t)n * (size_t)n * sizeof(double));
+	r->dsqrt = malloc((size_t)n * sizeof(double));
+	e = malloc((size_t)n * sizeof(double));
+	if (!r->a || !r->tau || !r->z || !r->dsqrt || !e)
+		goto out_nomem;
+	reduce_to_standard(fem, r->a, NULL, r->dsqrt, true);
+	dsytrd_("L", &n, r->a, &n, w2, e, r->tau, &q[0], &lwork, &info);
+	dstedc_("I", &n, w2, e, r->z, &n, &q[1], &lwork, &iq, &liwork, &info);
+	lwork = work_size(fmax(q[0], q[1]));
+	liwork = iq;
+	if (lwork < 0)
+		goto out_nomem;
+	work = malloc((size_t)lwork * sizeof(double));
+	iwork = malloc((size_t)liwork * sizeof(int));
+	if (!work || !iwork)
+		goto out_nomem;
+	dsytrd_("L", &n, r->a, &n, w2, e, r->tau, work, &lwork, &info);
+	if (!info) {
+		if (progress)
+			progress(ctx, "dense eigensolve: tridiagonal", 0.75);
+		step = "dstedc";
+		dstedc_("I", &n, w2, e, r->z, &n, work, &lwork, iwork, &liwork, &info);
+	}
+	if (!info) {
+		if (progress)
+			progress(ctx, "dense eigensolve: its eigenvectors", 0.95);
+		step = "dormtr";
+		info = rows_at(r, at, n_at, phi);
+	}
+	if (info < 0)
+		goto out_nomem;
+	if (info) {
+		snprintf(err, errlen, "dense eigensolver: %s failed (info %d)", step, info);
+		ret = IRDM_ENUMERIC;
+		goto out_free;
+	}
+	*rest = r;
+	r = NULL;
+	ret = IRDM_OK;
+	goto out_free;
+
+out_nomem:
+	snprintf(err, errlen, "dense eigensolver: out of memory for n = %d (needs %.1f GiB)", n,
+		 3.0 * n * (double)n * 8 / (1 << 30));
+out_free:
+	irdm_eig_rest_free(r);
+	free(e);
+	free(work);
+	free(iwork);
 	return ret;
 }

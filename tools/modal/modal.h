@@ -22,6 +22,11 @@ enum irdm_eig_method {
 	IRDM_EIG_SLEPC = 3, /* SLEPc over MPI ranks (tools/dist/), if built in */
 };
 
+/* What makes a dense solve's vectors whole later (eig_dense.c). */
+struct irdm_eig_rest;
+/* Which of phi's columns are whole, and where to make the others so. */
+struct irdm_modes_rest;
+
 struct irdm_modes {
 	size_t n;               /* vector length (free DoFs) */
 	size_t n_modes;         /* elastic modes stored, ascending */
@@ -36,6 +41,9 @@ struct irdm_modes {
 	 * kept DoFs); NULL: the static correction solves for itself */
 	double *compliance;
 	size_t n_compliance;
+	/* non-NULL: some columns of phi hold only want->every's DoFs (NaN
+	 * elsewhere) until irdm_modes_complete() makes them whole */
+	struct irdm_modes_rest *rest;
 };
 
 /* What the caller will read of the modes (irdm_modes_solve_kept). */
@@ -43,6 +51,10 @@ struct irdm_modes_want {
 	const bool *keep;         /* free DoFs read of elastic modes (NULL: all) */
 	const int64_t *load_dofs; /* free DoFs of the static correction's unit loads */
 	size_t n_loads;
+	/* free DoFs read of every elastic mode (NULL: every DoF of every
+	 * mode); a dense all-modes solve then gives each mode at those DoFs
+	 * only, the others made whole on demand (irdm_modes_complete) */
+	const bool *every;
 };
 
 /* Progress of a stage in [0, 1]; a negative fraction: `stage` is a line to
@@ -87,9 +99,33 @@ int irdm_modes_solve_kept(const struct irdm_fem *fem, size_t n_wanted, bool floa
 			  void *ctx, struct irdm_modes *out, char *err, size_t errlen);
 void irdm_modes_free(struct irdm_modes *m);
 
+/*
+ * Elastic columns [first, first + count) of m->phi readable at the free
+ * DoFs dofs[0..n_dofs) (-1 entries skipped): made whole unless every
+ * column already holds all of those (see want->every).
+ * Return: IRDM_OK; IRDM_ENOMEM; IRDM_ENUMERIC (LAPACK).
+ */
+int irdm_modes_complete(struct irdm_modes *m, size_t first, size_t count, const int64_t *dofs,
+			size_t n_dofs, char *err, size_t errlen);
+/* Whether column k of m->phi is whole. */
+bool irdm_modes_whole(const struct irdm_modes *m, size_t k);
+/* The columns reordered as irdm_modes_permute() reorders phi:
+ * new k = old order[k]. */
+int irdm_modes_rest_permute(struct irdm_modes *m, const size_t *order);
+
 /* Internal solvers (exposed for tests: a second method to compare with). */
 int irdm_eig_dense(const struct irdm_fem *fem, size_t n_lowest, double *w2, double *phi,
 		   char *err, size_t errlen);
+/* Every eigenpair of a lumped-mass model, each vector at the n_at free
+ * DoFs at[] only (NaN elsewhere); *rest makes chosen ones whole.  A
+ * consistent mass: all whole, *rest NULL. */
+int irdm_eig_dense_at(const struct irdm_fem *fem, const int64_t *at, size_t n_at,
+		      irdm_progress_fn progress, void *ctx, double *w2, double *phi,
+		      struct irdm_eig_rest **rest, char *err, size_t errlen);
+/* Vectors z_cols[0..k) made whole into out (n x k).  Return as
+ * irdm_modes_complete(). */
+int irdm_eig_rest_fill(const struct irdm_eig_rest *r, const size_t *z_cols, size_t k, double *out);
+void irdm_eig_rest_free(struct irdm_eig_rest *r);
 int irdm_eig_lanczos(const struct irdm_fem *fem, size_t n_lowest, double sigma,
 		     irdm_progress_fn progress, void *ctx, double *w2, double *phi,
 		     char *err, size_t errlen);

@@ -29,13 +29,110 @@
 #define GRADED 1e3
 #define ZERO_TOL 1e-14
 
+struct irdm_modes_rest {
+	struct irdm_eig_rest *eig;
+	bool *every;   /* n: the DoFs every column holds */
+	size_t n_cols; /* elastic columns */
+	size_t *z_col; /* each column's vector in the solve */
+	bool *whole;   /* each column whole */
+};
+
+static void rest_free(struct irdm_modes_rest *r)
+{
+	if (!r)
+		return;
+	irdm_eig_rest_free(r->eig);
+	free(r->every);
+	free(r->z_col);
+	free(r->whole);
+	free(r);
+}
+
 void irdm_modes_free(struct irdm_modes *m)
 {
+	rest_free(m->rest);
 	free(m->omega2);
 	free(m->phi);
 	free(m->rigid_phi);
 	free(m->compliance);
 	memset(m, 0, sizeof(*m));
+}
+
+bool irdm_modes_whole(const struct irdm_modes *m, size_t k)
+{
+	return !m->rest || m->rest->whole[k];
+}
+
+int irdm_modes_rest_permute(struct irdm_modes *m, const size_t *order)
+{
+	struct irdm_modes_rest *r = m->rest;
+	size_t n = m->n_modes;
+	size_t *z = r ? malloc((n ? n : 1) * sizeof(*z)) : NULL;
+	bool *w = r ? malloc((n ? n : 1) * sizeof(*w)) : NULL;
+
+	if (!r)
+		return IRDM_OK;
+	if (!z || !w) {
+		free(z);
+		free(w);
+		return IRDM_ENOMEM;
+	}
+	for (size_t k = 0; k < n; k++) {
+		z[k] = r->z_col[order[k]];
+		w[k] = r->whole[order[k]];
+	}
+	memcpy(r->z_col, z, n * sizeof(*z));
+	memcpy(r->whole, w, n * sizeof(*w));
+	free(z);
+	free(w);
+	return IRDM_OK;
+}
+
+/* Whether every one of dofs (-1: none) is held by every column. */
+static bool held_everywhere(const struct irdm_modes_rest *r, const int64_t *dofs, size_t n_dofs)
+{
+	for (size_t i = 0; i < n_dofs; i++)
+		if (dofs[i] >= 0 && !r->every[dofs[i]])
+			return false;
+	return true;
+}
+
+#define COMPLETE_CHUNK 512 /* columns made whole at a time: bounds the scratch */
+
+int irdm_modes_complete(struct irdm_modes *m, size_t first, size_t count, const int64_t *dofs,
+			size_t n_dofs, char *err, size_t errlen)
+{
+	struct irdm_modes_rest *r = m->rest;
+	size_t n = m->n, idx[COMPLETE_CHUNK], zc[COMPLETE_CHUNK], k = first;
+	double *buf;
+	int ret = IRDM_OK;
+
+	if (!r || held_everywhere(r, dofs, n_dofs))
+		return IRDM_OK;
+	buf = malloc(n * COMPLETE_CHUNK * sizeof(double));
+	if (!buf) {
+		snprintf(err, errlen, "modes: out of memory making %zu modes whole", count);
+		return IRDM_ENOMEM;
+	}
+	while (k < first + count && !ret) {
+		size_t c = 0;
+
+		for (; k < first + count && c < COMPLETE_CHUNK; k++)
+			if (!r->whole[k]) {
+				idx[c] = k;
+				zc[c++] = r->z_col[k];
+			}
+		ret = irdm_eig_rest_fill(r->eig, zc, c, buf);
+		for (size_t j = 0; j < c && !ret; j++) {
+			memcpy(&m->phi[idx[j] * n], &buf[j * n], n * sizeof(double));
+			r->whole[idx[j]] = true;
+		}
+	}
+	free(buf);
+	if (ret)
+		snprintf(err, errlen, "modes: making %zu modes whole failed (%s)", count,
+			 ret == IRDM_ENOMEM ? "out of memory" : "LAPACK dormtr");
+	return ret;
 }
 
 static int cmp_double(const void *a, const void *b)
@@ -123,6 +220,64 @@ static int split_rigid(struct irdm_modes *out, size_t n_req, const double *w2,
 	return 0;
 }
 
+/*
+ * Every mode densely, each at the DoFs every[] marks only (the rest on
+ * demand: *eig); a floating object's rigid modes, the first n_rigid, whole
+ * at once (they project every static load).
+ */
+static int dense_at(const struct irdm_fem *fem, const bool *every, size_t n_rigid,
+		    irdm_progress_fn progress, void *ctx, double *w2, double *phi,
+		    struct irdm_eig_rest **eig, char *err, size_t errlen)
+{
+	size_t n = fem->K.n, n_at = 0, rigid[6] = { 0, 1, 2, 3, 4, 5 };
+	int64_t *at = malloc((n ? n : 1) * sizeof(*at));
+	int ret;
+
+	if (!at) {
+		snprintf(err, errlen, "modes: out of memory");
+		return IRDM_ENOMEM;
+	}
+	for (size_t i = 0; i < n; i++)
+		if (every[i])
+			at[n_at++] = (int64_t)i;
+	ret = irdm_eig_dense_at(fem, at, n_at, progress, ctx, w2, phi, eig, err, errlen);
+	free(at);
+	if (!ret && *eig && n_rigid) {
+		ret = irdm_eig_rest_fill(*eig, rigid, n_rigid, phi);
+		if (ret)
+			snprintf(err, errlen, "modes: the rigid modes could not be made whole");
+	}
+	return ret;
+}
+
+/* out's columns, none whole yet, each the solve's vector n_rigid on. */
+static int rest_init(struct irdm_modes *out, struct irdm_eig_rest *eig, const bool *every,
+		     char *err, size_t errlen)
+{
+	struct irdm_modes_rest *r = calloc(1, sizeof(*r));
+	size_t n = out->n, k = out->n_modes;
+
+	if (r) {
+		r->eig = eig;
+		r->n_cols = k;
+		r->every = malloc((n ? n : 1) * sizeof(bool));
+		r->z_col = malloc((k ? k : 1) * sizeof(size_t));
+		r->whole = calloc(k ? k : 1, sizeof(bool));
+	} else {
+		irdm_eig_rest_free(eig);
+	}
+	if (!r || !r->every || !r->z_col || !r->whole) {
+		rest_free(r);
+		snprintf(err, errlen, "modes: out of memory");
+		return IRDM_ENOMEM;
+	}
+	memcpy(r->every, every, n * sizeof(bool));
+	for (size_t j = 0; j < k; j++)
+		r->z_col[j] = j + out->n_rigid;
+	out->rest = r;
+	return IRDM_OK;
+}
+
 int irdm_modes_solve(const struct irdm_fem *fem, size_t n_wanted, bool floating,
 		     enum irdm_eig_method method, irdm_progress_fn progress, void *ctx,
 		     struct irdm_modes *out, char *err, size_t errlen)
@@ -139,7 +294,7 @@ static int solve_slepc(const struct irdm_fem *fem, size_t n_req, bool floating, 
 		       struct irdm_modes *out, char *err, size_t errlen)
 {
 	size_t n = fem->K.n, n_loads = floating || !want ? 0 : want->n_loads;
-	struct irdm_modes_want w = want ? *want : (struct irdm_modes_want){ NULL, NULL, 0 };
+	struct irdm_modes_want w = want ? *want : (struct irdm_modes_want){ NULL, NULL, 0, NULL };
 	int ret;
 
 	w.n_loads = n_loads;
@@ -165,6 +320,7 @@ int irdm_modes_solve_kept(const struct irdm_fem *fem, size_t n_wanted, bool floa
 	size_t n = fem->K.n, n_rigid = floating ? 6 : 0, n_req;
 	double max_scale, scale = typical_scale(fem, &max_scale);
 	double *w2 = NULL, *phi = NULL;
+	struct irdm_eig_rest *eig = NULL;
 	/* the slepc path gathers the eigenvectors on rank 0 only */
 	bool has_phi;
 	int ret;
@@ -212,7 +368,9 @@ int irdm_modes_solve_kept(const struct irdm_fem *fem, size_t n_wanted, bool floa
 		progress(ctx, method == IRDM_EIG_DENSE ? "dense eigensolve" : method == IRDM_EIG_SLEPC ? "SLEPc eigensolve" :
 													 "Lanczos eigensolve",
 			 0.0);
-	if (method == IRDM_EIG_DENSE)
+	if (method == IRDM_EIG_DENSE && n_req == n && want && want->every)
+		ret = dense_at(fem, want->every, n_rigid, progress, ctx, w2, phi, &eig, err, errlen);
+	else if (method == IRDM_EIG_DENSE)
 		ret = irdm_eig_dense(fem, n_req, w2, phi, err, errlen);
 	else if (method == IRDM_EIG_SLEPC)
 		ret = solve_slepc(fem, n_req, floating, scale, dist, want, progress, ctx, w2, phi,
@@ -226,7 +384,12 @@ int irdm_modes_solve_kept(const struct irdm_fem *fem, size_t n_wanted, bool floa
 		progress(ctx, "eigensolve", 1.0);
 	ret = split_rigid(out, n_req, w2, phi, scale, floating, err, errlen);
 	out->n_elastic_total = n - out->n_rigid;
+	if (!ret && eig) {
+		ret = rest_init(out, eig, want->every, err, errlen);
+		eig = NULL;
+	}
 out_free:
+	irdm_eig_rest_free(eig);
 	if (ret)
 		irdm_modes_free(out);
 	free(w2);

@@ -207,6 +207,12 @@ static int modal_data(struct build *b, char *err, size_t errlen)
 			return ret;
 	}
 	K = m->modes.n_modes;
+	/* the shapes at the rows: whole vectors of the modes kept only */
+	ret = irdm_modes_complete(&m->modes, 0, K, m->row_dofs, 3 * m->n_rows, err, errlen);
+	if (ret) {
+		free(zoh_all);
+		return ret;
+	}
 
 	b->n_modes = K;
 	b->zoh = malloc(K * sizeof(*b->zoh));

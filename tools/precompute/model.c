@@ -137,19 +137,53 @@ static void say_stats(const struct irdm_mesh *mesh, irdm_progress_fn progress, v
 }
 
 /*
+ * Where every mode is read: the columns (an auto hybrid's prediction, head
+ * and static correction) and each vertex of a triangle that has a
+ * touchable one (the rows of the error measurement's exact model, whose
+ * columns are some of these columns).  Other rows: only of the modes an
+ * image keeps, made whole on demand (irdm_modes_complete).
+ */
+static void every_mode_at(const struct irdm_model *m, bool *every)
+{
+	bool *is_col = calloc(m->n_rows ? m->n_rows : 1, sizeof(bool));
+
+	for (size_t c = 0; c < 3 * m->n_cols; c++)
+		if (m->col_dofs[c] >= 0)
+			every[m->col_dofs[c]] = true;
+	if (!is_col) /* only slower: every row's whole */
+		return;
+	for (size_t c = 0; c < m->n_cols; c++)
+		is_col[m->cols[c]] = true;
+	for (size_t t = 0; t < m->n_tris; t++) {
+		const uint32_t *v = &m->tris[3 * t];
+
+		if (!is_col[v[0]] && !is_col[v[1]] && !is_col[v[2]])
+			continue;
+		for (int k = 0; k < 3; k++)
+			for (int a = 0; a < 3; a++)
+				if (m->row_dofs[3 * (size_t)v[k] + (size_t)a] >= 0)
+					every[m->row_dofs[3 * (size_t)v[k] + (size_t)a]] = true;
+	}
+	free(is_col);
+}
+
+/*
  * What the image reads of the modes: the free DoFs of the scene's rows and
- * columns (shapes, static correction, FIR from modes), and the static
- * correction's unit loads, in its order (tools/modal/static.c).
+ * columns (shapes, static correction, FIR from modes), the static
+ * correction's unit loads, in its order (tools/modal/static.c), and
+ * where every mode is read (every_mode_at).
  */
 static int wanted_of_modes(const struct irdm_scene *sc, const struct irdm_model *m,
 			   struct irdm_modes_want *w)
 {
 	bool *keep = calloc(m->fem.map.n_free ? m->fem.map.n_free : 1, sizeof(bool));
+	bool *every = calloc(m->fem.map.n_free ? m->fem.map.n_free : 1, sizeof(bool));
 	int64_t *loads = malloc((3 * m->n_cols + 1) * sizeof(int64_t));
 	size_t n_loads = 0;
 
-	if (!keep || !loads) {
+	if (!keep || !every || !loads) {
 		free(keep);
+		free(every);
 		free(loads);
 		return IRDM_ENOMEM;
 	}
@@ -161,7 +195,8 @@ static int wanted_of_modes(const struct irdm_scene *sc, const struct irdm_model 
 			keep[m->col_dofs[c]] = true;
 			loads[n_loads++] = m->col_dofs[c];
 		}
-	*w = (struct irdm_modes_want){ keep, loads, n_loads };
+	every_mode_at(m, every);
+	*w = (struct irdm_modes_want){ keep, loads, n_loads, every };
 	if (!sc->static_correction || sc->method == IRDM_METHOD_TIME_DOMAIN)
 		w->n_loads = 0;
 	return IRDM_OK;
@@ -224,6 +259,7 @@ int irdm_model_build(const struct irdm_scene *sc, size_t n_modes_needed,
 	ret = irdm_modes_solve_kept(&m->fem, n_modes_needed, sc->floating, sc->eigensolver, &dist,
 				    &want, progress, ctx, &m->modes, err, errlen);
 	free((void *)want.keep);
+	free((void *)want.every);
 	free((void *)want.load_dofs);
 	if (ret)
 		goto out_fail;
