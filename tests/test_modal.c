@@ -232,7 +232,8 @@ static void dense_at_as_whole(const struct irdm_fem *fem, const double *wa, cons
 	assert_int_equal(irdm_eig_rest_fill(rest, pick, 3, filled), 0);
 	for (size_t j = 0; j < 3; j++)
 		for (size_t i = 0; i < n; i++)
-			assert_true(fabs(filled[j * n + i] - pa[pick[j] * n + i]) <= 1e-9 * scale);
+			if (!(fabs(filled[j * n + i] - pa[pick[j] * n + i]) <= 1e-9 * scale))
+				fail_msg("pick %zu dof %zu: %.17g vs %.17g", j, i, filled[j * n + i], pa[pick[j] * n + i]);
 	check_eigenpairs(fem, &wa[n - 1], &filled[2 * n], 1);
 	irdm_eig_rest_free(rest);
 	free(wb);

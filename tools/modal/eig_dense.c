@@ -305,14 +305,15 @@ int irdm_eig_dense_at(const struct irdm_fem *fem, const int64_t *at, size_t n_at
 	r->n = n;
 	r->a = irdm_csc_to_dense(&fem->K);
 	r->tau = malloc((size_t)n * sizeof(double));
-	r->z = malloc((size_t)n * (size_t)n * sizeof(double));
 	r->dsqrt = malloc((size_t)n * sizeof(double));
 	e = malloc((size_t)n * sizeof(double));
-	if (!r->a || !r->tau || !r->z || !r->dsqrt || !e)
+	if (!r->a || !r->tau || !r->dsqrt || !e)
 		goto out_nomem;
 	reduce_to_standard(fem, r->a, NULL, r->dsqrt, true);
+	/* Z first lands in phi, moved out once dstedc's n^2 workspace is
+	 * given back: three n x n arrays at most, as the whole solve */
 	dsytrd_("L", &n, r->a, &n, w2, e, r->tau, &q[0], &lwork, &info);
-	dstedc_("I", &n, w2, e, r->z, &n, &q[1], &lwork, &iq, &liwork, &info);
+	dstedc_("I", &n, w2, e, phi, &n, &q[1], &lwork, &iq, &liwork, &info);
 	lwork = work_size(fmax(q[0], q[1]));
 	liwork = iq;
 	if (lwork < 0)
@@ -326,9 +327,15 @@ int irdm_eig_dense_at(const struct irdm_fem *fem, const int64_t *at, size_t n_at
 		if (progress)
 			progress(ctx, "dense eigensolve: tridiagonal", 0.75);
 		step = "dstedc";
-		dstedc_("I", &n, w2, e, r->z, &n, work, &lwork, iwork, &liwork, &info);
+		dstedc_("I", &n, w2, e, phi, &n, work, &lwork, iwork, &liwork, &info);
 	}
+	free(work);
+	work = NULL;
 	if (!info) {
+		r->z = malloc((size_t)n * (size_t)n * sizeof(double));
+		if (!r->z)
+			goto out_nomem;
+		memcpy(r->z, phi, (size_t)n * (size_t)n * sizeof(double));
 		if (progress)
 			progress(ctx, "dense eigensolve: its eigenvectors", 0.95);
 		step = "dormtr";

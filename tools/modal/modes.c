@@ -175,8 +175,9 @@ static double typical_scale(const struct irdm_fem *fem, double *max_out)
 }
 
 static int split_rigid(struct irdm_modes *out, size_t n_req, const double *w2,
-		       const double *phi, double scale, bool floating, char *err, size_t errlen)
+		       double **phi_owned, double scale, bool floating, char *err, size_t errlen)
 {
+	double *phi = *phi_owned;
 	size_t n = out->n, r = floating ? 6 : 0;
 
 	if (!floating && !(w2[0] > ZERO_TOL * scale)) {
@@ -209,14 +210,17 @@ static int split_rigid(struct irdm_modes *out, size_t n_req, const double *w2,
 	memcpy(out->omega2, w2 + r, out->n_modes * sizeof(double));
 	if (!phi) /* an MPI rank other than 0: eigenvalues only */
 		return 0;
-	out->phi = malloc(n * out->n_modes * sizeof(double));
 	out->rigid_phi = malloc(n * (r ? r : 1) * sizeof(double));
-	if (!out->phi || !out->rigid_phi) {
+	if (!out->rigid_phi) {
 		snprintf(err, errlen, "modes: out of memory");
 		return IRDM_ENOMEM;
 	}
-	memcpy(out->phi, phi + n * r, n * out->n_modes * sizeof(double));
+	/* the elastic vectors taken over where they lie, moved down past the
+	 * rigid ones: every mode of a large model is no second copy */
 	memcpy(out->rigid_phi, phi, n * r * sizeof(double));
+	memmove(phi, phi + n * r, n * out->n_modes * sizeof(double));
+	out->phi = phi;
+	*phi_owned = NULL;
 	return 0;
 }
 
@@ -382,7 +386,7 @@ int irdm_modes_solve_kept(const struct irdm_fem *fem, size_t n_wanted, bool floa
 		goto out_free;
 	if (progress)
 		progress(ctx, "eigensolve", 1.0);
-	ret = split_rigid(out, n_req, w2, phi, scale, floating, err, errlen);
+	ret = split_rigid(out, n_req, w2, &phi, scale, floating, err, errlen);
 	out->n_elastic_total = n - out->n_rigid;
 	if (!ret && eig) {
 		ret = rest_init(out, eig, want->every, err, errlen);
