@@ -66,6 +66,30 @@ static int work_size(double q)
 }
 
 /*
+ * One workspace for dsytrd, dstedc into z and, with_ormtr, dormtr on A
+ * (n x n), as their queries ask (dstedc's n^2 is the largest).  Returns
+ * 0, or -1 out of memory (*work and *iwork then whatever was allocated).
+ */
+static int workspace(double *a, int n, double *d, double *e, double *tau, double *z,
+		     bool with_ormtr, double **work, int *lwork, int **iwork, int *liwork)
+{
+	double q[3] = { 0, 0, 0 };
+	int query = -1, iq = 0, info = 0;
+
+	dsytrd_("L", &n, a, &n, d, e, tau, &q[0], &query, &info);
+	dstedc_("I", &n, d, e, z, &n, &q[1], &query, &iq, &query, &info);
+	if (with_ormtr)
+		dormtr_("L", "L", "N", &n, &n, a, &n, tau, z, &n, &q[2], &query, &info);
+	*lwork = work_size(fmax(q[0], fmax(q[1], q[2])));
+	*liwork = iq;
+	if (*lwork < 0)
+		return -1;
+	*work = malloc((size_t)*lwork * sizeof(double));
+	*iwork = malloc((size_t)*liwork * sizeof(int));
+	return *work && *iwork ? 0 : -1;
+}
+
+/*
  * Every eigenpair of A (destroyed: it keeps the Householder vectors):
  * w2 ascending, y in phi.  Returns 0, -1 out of memory, or LAPACK's info
  * (> 0: dstedc failed to converge).
@@ -74,22 +98,12 @@ static int solve_all(double *a, int n, double *w2, double *phi, const char **ste
 {
 	double *e = malloc((size_t)n * sizeof(double));
 	double *tau = malloc((size_t)n * sizeof(double));
-	double *work = NULL, q[3] = { 0, 0, 0 };
-	int *iwork = NULL, lwork = -1, liwork = -1, iq = 0, info = 0, ret = -1;
+	double *work = NULL;
+	int *iwork = NULL, lwork = -1, liwork = -1, info = 0, ret = -1;
 
 	if (!e || !tau)
 		goto out;
-	/* one workspace for the three steps: dstedc's n^2 is the largest */
-	dsytrd_("L", &n, a, &n, w2, e, tau, &q[0], &lwork, &info);
-	dstedc_("I", &n, w2, e, phi, &n, &q[1], &lwork, &iq, &liwork, &info);
-	dormtr_("L", "L", "N", &n, &n, a, &n, tau, phi, &n, &q[2], &lwork, &info);
-	lwork = work_size(fmax(q[0], fmax(q[1], q[2])));
-	liwork = iq;
-	if (lwork < 0)
-		goto out;
-	work = malloc((size_t)lwork * sizeof(double));
-	iwork = malloc((size_t)liwork * sizeof(int));
-	if (!work || !iwork)
+	if (workspace(a, n, w2, e, tau, phi, true, &work, &lwork, &iwork, &liwork))
 		goto out;
 	*step = "dsytrd";
 	dsytrd_("L", &n, a, &n, w2, e, tau, work, &lwork, &info);
@@ -291,8 +305,8 @@ int irdm_eig_dense_at(const struct irdm_fem *fem, const int64_t *at, size_t n_at
 		      struct irdm_eig_rest **rest, char *err, size_t errlen)
 {
 	struct irdm_eig_rest *r = NULL;
-	double *e = NULL, *work = NULL, q[2] = { 0, 0 };
-	int *iwork = NULL, lwork = -1, liwork = -1, iq = 0, info = 0, n = (int)fem->K.n;
+	double *e = NULL, *work = NULL;
+	int *iwork = NULL, lwork = -1, liwork = -1, info = 0, n = (int)fem->K.n;
 	const char *step = "dsytrd";
 	int ret = IRDM_ENOMEM;
 
@@ -312,15 +326,7 @@ int irdm_eig_dense_at(const struct irdm_fem *fem, const int64_t *at, size_t n_at
 	reduce_to_standard(fem, r->a, NULL, r->dsqrt, true);
 	/* Z first lands in phi, moved out once dstedc's n^2 workspace is
 	 * given back: three n x n arrays at most, as the whole solve */
-	dsytrd_("L", &n, r->a, &n, w2, e, r->tau, &q[0], &lwork, &info);
-	dstedc_("I", &n, w2, e, phi, &n, &q[1], &lwork, &iq, &liwork, &info);
-	lwork = work_size(fmax(q[0], q[1]));
-	liwork = iq;
-	if (lwork < 0)
-		goto out_nomem;
-	work = malloc((size_t)lwork * sizeof(double));
-	iwork = malloc((size_t)liwork * sizeof(int));
-	if (!work || !iwork)
+	if (workspace(r->a, n, w2, e, r->tau, phi, false, &work, &lwork, &iwork, &liwork))
 		goto out_nomem;
 	dsytrd_("L", &n, r->a, &n, w2, e, r->tau, work, &lwork, &info);
 	if (!info) {
