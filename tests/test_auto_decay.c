@@ -20,6 +20,9 @@
  *  - with every surface node shown, the modes it keeps have whole shapes
  *    (the eigensolve gives every mode at the touchable rows only): each
  *    the all-modes image's at every row;
+ *  - max_head_mib bounds the head auto builds: a capped hybrid is tried
+ *    again with twice the modes, then the next candidate; under a cap no
+ *    head meets, every mode;
  *  - a tighter max_error that no candidate meets is refused with a
  *    message, and no image is written.
  */
@@ -259,6 +262,54 @@ static void test_auto_shows_whole_shapes(void **state)
 	irdm_image_unmap(&all);
 }
 
+/* The image's exact head as stored, MiB (0: none). */
+static double head_mib(const struct irdm_image *img)
+{
+	if (!img->exact_head)
+		return 0;
+	return (double)img->corr_start[img->meta->n_cols] * img->meta->head_samples * 9 *
+	       irdm_elem_size(img->meta->precision) / (1 << 20);
+}
+
+/*
+ * max_head_mib bounds the head auto builds.  At max_error = 1e-2 its first
+ * candidate (measured: 235 modes + a 32-sample head of 1.1 MiB) is over a
+ * 1 MiB cap, is tried again with twice the modes (still over: 497 of its
+ * 501 blocks stay), and the next candidate, a smaller head, is written:
+ * three tries where the default cap makes two.  Under a cap no hybrid's
+ * head meets, auto keeps every mode (no head).
+ */
+static void test_head_cap(void **state)
+{
+	static const char *const loose[] = { "max_error", "1e-2", NULL };
+	static const char *const capped[] = { "max_error", "1e-2", "max_head_mib", "1", NULL };
+	static const char *const tiny[] = { "max_error", "1e-2", "max_head_mib", "0.1", NULL };
+	struct irdm_precompute_report rep;
+	struct irdm_image img;
+	char err[768], path[128];
+	size_t tries_loose;
+
+	(void)state;
+	assert_int_equal(build("loose.img", &rep, err, sizeof(err), loose), 0);
+	tries_loose = rep.auto_tries;
+	assert_int_equal(build("capped.img", &rep, err, sizeof(err), capped), 0);
+	print_message("max_error 1e-2: %zu tries; under 1 MiB: %zu tries, %s\n", tries_loose,
+		      rep.auto_tries, rep.representation);
+	assert_int_equal(rep.auto_tries, tries_loose + 1); /* the regrown try */
+	snprintf(path, sizeof(path), "%s/capped.img", dir);
+	assert_int_equal(irdm_image_map(path, 0, &img, err, sizeof(err)), 0);
+	assert_true(head_mib(&img) > 0 && head_mib(&img) <= 1.0);
+	irdm_image_unmap(&img);
+
+	assert_int_equal(build("tiny.img", &rep, err, sizeof(err), tiny), 0);
+	print_message("under 0.1 MiB: %s\n", rep.representation);
+	snprintf(path, sizeof(path), "%s/tiny.img", dir);
+	assert_int_equal(irdm_image_map(path, 0, &img, err, sizeof(err)), 0);
+	assert_true(head_mib(&img) == 0);
+	assert_int_equal(img.meta->n_modes, 600);
+	irdm_image_unmap(&img);
+}
+
 static void test_unmet_target_refused(void **state)
 {
 	struct irdm_precompute_report rep;
@@ -280,6 +331,7 @@ int main(void)
 		cmocka_unit_test(test_lowest_modes_refused),
 		cmocka_unit_test(test_auto_meets_target),
 		cmocka_unit_test(test_auto_shows_whole_shapes),
+		cmocka_unit_test(test_head_cap),
 		cmocka_unit_test(test_unmet_target_refused),
 	};
 

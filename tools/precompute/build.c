@@ -60,7 +60,7 @@ struct build {
 	size_t n_solved;      /* modes the eigensolve gave (all: the exact model's) */
 	bool kept_not_lowest; /* auto's hybrid keeps modes above a dropped one */
 	bool auto_try;        /* building one of auto's candidates */
-	bool head_capped;     /* and its head was over AUTO_HEAD_MAX_BYTES */
+	bool head_capped;     /* and its head was over max_head_mib */
 	size_t try_bytes;     /* the measured image's size (0: none written) */
 };
 
@@ -92,7 +92,6 @@ static bool truncated(const struct build *b)
  * touchable surface the kept blocks times the head's samples grow past
  * what an image should hold, and building them takes as long.
  */
-#define AUTO_HEAD_MAX_BYTES (256u << 20)
 
 /* The head's stored bytes: n_blocks 3x3 blocks over 2H samples. */
 static size_t head_bytes(const struct build *b, size_t n_blocks, size_t H)
@@ -117,12 +116,12 @@ static int exact_head(struct build *b, const struct irdm_mode *zoh_all, size_t n
 	int ret = IRDM_ENOMEM;
 
 	all.n_modes = n_all;
-	if (b->auto_try && head_bytes(b, sp->n_blocks, H) > AUTO_HEAD_MAX_BYTES) {
+	if (b->auto_try && (double)head_bytes(b, sp->n_blocks, H) > b->sc->max_head_mib * (1 << 20)) {
 		b->head_capped = true;
 		free(target);
-		snprintf(err, errlen, "precompute: auto: the head would take %.0f MiB (%zu blocks x %zu samples), more than auto builds (%u MiB)",
+		snprintf(err, errlen, "precompute: auto: the head would take %.3g MiB (%zu blocks x %zu samples), more than max_head_mib = %g",
 			 (double)head_bytes(b, sp->n_blocks, H) / (1 << 20), sp->n_blocks, 2 * H,
-			 AUTO_HEAD_MAX_BYTES >> 20);
+			 b->sc->max_head_mib);
 		return IRDM_ENUMERIC;
 	}
 	b->head = malloc(sp->n_blocks * 2 * H * 9 * sizeof(double));

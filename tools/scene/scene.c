@@ -52,6 +52,7 @@ void irdm_scene_defaults(struct irdm_scene *sc)
 	sc->substeps = 8;
 	sc->eigensolver = IRDM_EIG_AUTO;
 	sc->max_error = IRDM_MAX_ERROR_DEFAULT;
+	sc->max_head_mib = IRDM_MAX_HEAD_MIB_DEFAULT;
 }
 
 /* Strict number parsing: the whole token, finite. */
@@ -444,6 +445,10 @@ static const struct irdm_opt scene_opts[] = {
 													       "image and printed; above E the image is refused.  none neither measures "
 													       "nor checks (the measurement needs every mode: a dense eigensolve) "
 													       "(default 1e-3)" },
+	{ .name = "max_head_mib", .type = IRDM_OPT_DOUBLE, SC(max_head_mib), .metavar = "MIB", .range = IRDM_OPT_GT | IRDM_OPT_LE, .min = 0, .max = 65536, .help = "representation = auto: the largest exact head it builds, in MiB as stored; a hybrid "
+																				   "whose head would be larger is tried again with twice the modes (fewer "
+																				   "dropped, fewer kept blocks) while that still ticks cheaper than every "
+																				   "mode, else left for the next candidate (default 256)" },
 	{ .name = "uncertified", .type = IRDM_OPT_BOOL, SC(uncertified), .help = "write an image although some touchable node's force recursion is not "
 										 "certified stable (spectral radius >= 1; the engine then damps an FIR's tail "
 										 "by r^s); default no: such an image is refused, as `irdm image verify "
@@ -620,6 +625,12 @@ int irdm_scene_format(const struct irdm_scene *sc, char *buf, size_t len)
 	}
 	if (sc->exact_head) { /* only when set, as fir_tail */
 		int t = snprintf(buf + n, len - (size_t)n, "exact_head=%u\n", sc->exact_head);
+		if (t < 0 || (size_t)t >= len - (size_t)n)
+			return -1;
+		n += t;
+	}
+	if (sc->max_head_mib != IRDM_MAX_HEAD_MIB_DEFAULT) { /* only when set */
+		int t = snprintf(buf + n, len - (size_t)n, "max_head_mib=%.17g\n", sc->max_head_mib);
 		if (t < 0 || (size_t)t >= len - (size_t)n)
 			return -1;
 		n += t;

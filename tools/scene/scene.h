@@ -42,6 +42,8 @@ struct irdm_region {
 
 /* The force error an image may have by default (scene key max_error). */
 #define IRDM_MAX_ERROR_DEFAULT 1e-3
+/* The largest exact head auto builds by default, MiB (scene key max_head_mib). */
+#define IRDM_MAX_HEAD_MIB_DEFAULT 256.0
 
 enum irdm_damping_kind { IRDM_DAMP_RATIOS = 0,
 			 IRDM_DAMP_RAYLEIGH = 1 };
@@ -87,8 +89,9 @@ struct irdm_scene {
 	unsigned substeps;
 	enum irdm_eig_method eigensolver;
 	unsigned threads;
-	bool uncertified; /* write an image whose stability certificate fails */
-	double max_error; /* largest measured force error written (0: none, not measured) */
+	bool uncertified;    /* write an image whose stability certificate fails */
+	double max_error;    /* largest measured force error written (0: none, not measured) */
+	double max_head_mib; /* auto: the largest exact head it builds, MiB */
 };
 
 /* The defaults: the paper's cuboid at its resolution, modal 300 + static
