@@ -32,7 +32,6 @@
 struct irdm_modes_rest {
 	struct irdm_eig_rest *eig;
 	bool *every;   /* n: the DoFs every column holds */
-	size_t n_cols; /* elastic columns */
 	size_t *z_col; /* each column's vector in the solve */
 	bool *whole;   /* each column whole */
 };
@@ -263,7 +262,6 @@ static int rest_init(struct irdm_modes *out, struct irdm_eig_rest *eig, const bo
 
 	if (r) {
 		r->eig = eig;
-		r->n_cols = k;
 		r->every = malloc((n ? n : 1) * sizeof(bool));
 		r->z_col = malloc((k ? k : 1) * sizeof(size_t));
 		r->whole = calloc(k ? k : 1, sizeof(bool));

@@ -87,12 +87,6 @@ static bool truncated(const struct build *b)
 	return b->m.modes.n_modes < b->m.modes.n_elastic_total;
 }
 
-/*
- * auto skips a hybrid whose head would be larger than this: on a large
- * touchable surface the kept blocks times the head's samples grow past
- * what an image should hold, and building them takes as long.
- */
-
 /* The head's stored bytes: n_blocks 3x3 blocks over 2H samples. */
 static size_t head_bytes(const struct build *b, size_t n_blocks, size_t H)
 {
@@ -116,6 +110,9 @@ static int exact_head(struct build *b, const struct irdm_mode *zoh_all, size_t n
 	int ret = IRDM_ENOMEM;
 
 	all.n_modes = n_all;
+	/* on a large touchable surface the kept blocks times the head's
+	 * samples grow past what an image should hold (max_head_mib), and
+	 * building them takes as long */
 	if (b->auto_try && (double)head_bytes(b, sp->n_blocks, H) > b->sc->max_head_mib * (1 << 20)) {
 		b->head_capped = true;
 		free(target);
