@@ -20,9 +20,9 @@
  *  - with every surface node shown, the modes it keeps have whole shapes
  *    (the eigensolve gives every mode at the touchable rows only): each
  *    the all-modes image's at every row;
- *  - max_head_mib bounds the head auto builds: a capped hybrid is tried
- *    again with twice the modes, then the next candidate; under a cap no
- *    head meets, every mode;
+ *  - max_head_mib bounds the head auto builds: a capped hybrid grows to
+ *    twice the modes and waits its turn at its new cost, one sure to be
+ *    over the cap is not built; under a cap no head meets, every mode;
  *  - a tighter max_error that no candidate meets is refused with a
  *    message, and no image is written.
  */
@@ -272,34 +272,46 @@ static double head_mib(const struct irdm_image *img)
 }
 
 /*
- * max_head_mib bounds the head auto builds.  At max_error = 1e-2 its first
- * candidate (measured: 235 modes + a 32-sample head of 1.1 MiB) is over a
- * 1 MiB cap, is tried again with twice the modes (still over: 497 of its
- * 501 blocks stay), and the next candidate, a smaller head, is written:
- * three tries where the default cap makes two.  Under a cap no hybrid's
- * head meets, auto keeps every mode (no head).
+ * max_head_mib bounds the head auto builds.  At max_error = 1e-2 (measured
+ * candidates, cheapest to tick first: 235 modes + a 32-sample head, 1.91
+ * us; 294 + 16, 1.98 us; 218 + 64; 199 + 128; every mode, 3.48 us):
+ *  - under 1 MiB the first is over the cap (501 blocks x 64 samples,
+ *    1.1 MiB) and is not measured; regrown to 470 modes (3.28 us) it waits
+ *    its turn behind 294 + 16, which is written: two builds, as without
+ *    the cap (where the first is built and measured over the target);
+ *  - under 0.25 MiB 294 + 16 is over it too (409 blocks); 218 + 64 and
+ *    199 + 128 keep fewer modes than a head that was over it, so their
+ *    heads would be larger still: grown without a build; 470 + 32 is
+ *    built and over; every mode is written (four builds, not six);
+ *  - under 0.1 MiB no hybrid's head fits: every mode again.
  */
 static void test_head_cap(void **state)
 {
 	static const char *const loose[] = { "max_error", "1e-2", NULL };
 	static const char *const capped[] = { "max_error", "1e-2", "max_head_mib", "1", NULL };
+	static const char *const tight[] = { "max_error", "1e-2", "max_head_mib", "0.25", NULL };
 	static const char *const tiny[] = { "max_error", "1e-2", "max_head_mib", "0.1", NULL };
 	struct irdm_precompute_report rep;
 	struct irdm_image img;
 	char err[768], path[128];
-	size_t tries_loose;
 
 	(void)state;
 	assert_int_equal(build("loose.img", &rep, err, sizeof(err), loose), 0);
-	tries_loose = rep.auto_tries;
+	print_message("max_error 1e-2: %zu tries, %s\n", rep.auto_tries, rep.representation);
+	assert_int_equal(rep.auto_tries, 2);
 	assert_int_equal(build("capped.img", &rep, err, sizeof(err), capped), 0);
-	print_message("max_error 1e-2: %zu tries; under 1 MiB: %zu tries, %s\n", tries_loose,
-		      rep.auto_tries, rep.representation);
-	assert_int_equal(rep.auto_tries, tries_loose + 1); /* the regrown try */
+	print_message("under 1 MiB: %zu tries, %s\n", rep.auto_tries, rep.representation);
+	assert_int_equal(rep.auto_tries, 2); /* not the regrown 470 before 294 + 16 */
 	snprintf(path, sizeof(path), "%s/capped.img", dir);
 	assert_int_equal(irdm_image_map(path, 0, &img, err, sizeof(err)), 0);
 	assert_true(head_mib(&img) > 0 && head_mib(&img) <= 1.0);
+	assert_int_equal(img.meta->n_modes, 294);
 	irdm_image_unmap(&img);
+
+	assert_int_equal(build("quarter.img", &rep, err, sizeof(err), tight), 0);
+	print_message("under 0.25 MiB: %zu tries, %s\n", rep.auto_tries, rep.representation);
+	assert_int_equal(rep.auto_tries, 4);
+	assert_non_null(strstr(rep.representation, "modal:all"));
 
 	assert_int_equal(build("tiny.img", &rep, err, sizeof(err), tiny), 0);
 	print_message("under 0.1 MiB: %s\n", rep.representation);

@@ -60,7 +60,7 @@ struct build {
 	size_t n_solved;      /* modes the eigensolve gave (all: the exact model's) */
 	bool kept_not_lowest; /* auto's hybrid keeps modes above a dropped one */
 	bool auto_try;        /* building one of auto's candidates */
-	bool head_capped;     /* and its head was over max_head_mib */
+	size_t head_capped;   /* and its head was over max_head_mib: its blocks (0: not) */
 	size_t try_bytes;     /* the measured image's size (0: none written) */
 };
 
@@ -114,7 +114,7 @@ static int exact_head(struct build *b, const struct irdm_mode *zoh_all, size_t n
 	 * samples grow past what an image should hold (max_head_mib), and
 	 * building them takes as long */
 	if (b->auto_try && (double)head_bytes(b, sp->n_blocks, H) > b->sc->max_head_mib * (1 << 20)) {
-		b->head_capped = true;
+		b->head_capped = sp->n_blocks;
 		free(target);
 		snprintf(err, errlen, "precompute: auto: the head would take %.3g MiB (%zu blocks x %zu samples), more than max_head_mib = %g",
 			 (double)head_bytes(b, sp->n_blocks, H) / (1 << 20), sp->n_blocks, 2 * H,
@@ -1435,7 +1435,7 @@ static int try_candidate(struct build *b, const struct irdm_auto_candidate *c, s
 
 	reset_try(b, n_all);
 	b->auto_try = true;
-	b->head_capped = false;
+	b->head_capped = 0;
 	eff->modes = c->modes < n_all ? (unsigned)c->modes : 0;
 	eff->static_correction = c->modes < n_all;
 	eff->exact_head = hybrid ? c->head : 0;
@@ -1521,15 +1521,73 @@ static bool grow(struct irdm_auto_candidate *c, size_t n_all)
 }
 
 /*
+ * The heads found over the cap: a hybrid that keeps K modes kept n_blocks
+ * correction blocks.  Keeping more modes leaves less static correction,
+ * so one of at most K modes keeps at least as many blocks (near enough:
+ * each head length ranks the modes its own way).
+ */
+struct capped {
+	size_t n;
+	size_t modes[4 * IRDM_AUTO_MAX_CANDIDATES];
+	size_t blocks[4 * IRDM_AUTO_MAX_CANDIDATES];
+};
+
+static void capped_add(struct capped *cp, size_t modes, size_t blocks)
+{
+	if (cp->n < sizeof(cp->modes) / sizeof(cp->modes[0])) {
+		cp->modes[cp->n] = modes;
+		cp->blocks[cp->n++] = blocks;
+	}
+}
+
+/* Is c's head sure to be over the cap, from the blocks a head of no fewer
+ * modes kept?  Then building it would only be refused: say so. */
+static bool capped_sure(const struct build *b, const struct capped *cp,
+			const struct irdm_auto_candidate *c, size_t n_all)
+{
+	size_t blocks = 0;
+	char line[256];
+
+	if (!c->head || c->modes >= n_all)
+		return false;
+	for (size_t i = 0; i < cp->n; i++)
+		if (cp->modes[i] >= c->modes && cp->blocks[i] > blocks)
+			blocks = cp->blocks[i];
+	if (!((double)head_bytes(b, blocks, c->head) > b->sc->max_head_mib * (1 << 20)))
+		return false;
+	if (b->o->progress) {
+		snprintf(line, sizeof(line), "auto: modal:%zu + static correction + exact_head %u: not built: its head would be over max_head_mib = %g (a head of more modes kept %zu blocks)",
+			 c->modes, c->head, b->sc->max_head_mib, blocks);
+		b->o->progress(b->o->ctx, line, -1.0);
+	}
+	return true;
+}
+
+/* The candidate not yet settled that is cheapest to tick (n: none). */
+static size_t cheapest(const struct irdm_auto_candidate *c, const bool *settled, size_t n)
+{
+	size_t best = n;
+
+	for (size_t k = 0; k < n; k++)
+		if (!settled[k] && (best == n || c[k].tick_us < c[best].tick_us))
+			best = k;
+	return best;
+}
+
+/*
  * representation = auto: every mode is solved; the candidates
  * (candidates.h), cheapest to tick first, are built until one is
- * certified and measures within max_error.  A model of at most
+ * certified and measures within max_error.  A hybrid whose head is over
+ * max_head_mib grows (grow()) and waits its turn at its new cost, and
+ * one sure to be over it is grown without a build.  A model of at most
  * AUTO_ALL_MODES modes takes them all.
  */
 static int choose(struct build *b, struct irdm_precompute_report *rep, char *err, size_t errlen)
 {
 	struct irdm_auto_candidate cand[IRDM_AUTO_MAX_CANDIDATES];
-	size_t n_all = b->m.modes.n_modes, n_cand;
+	bool settled[IRDM_AUTO_MAX_CANDIDATES] = { false };
+	struct capped cp = { .n = 0 };
+	size_t n_all = b->m.modes.n_modes, n_cand, k;
 	size_t *order = malloc(2 * n_all * sizeof(*order));
 	char last[768] = "";
 	int ret = IRDM_ENUMERIC;
@@ -1554,13 +1612,18 @@ static int choose(struct build *b, struct irdm_precompute_report *rep, char *err
 		}
 	}
 	say_candidates(b, cand, n_cand);
-	for (size_t k = 0; k < n_cand; k++) {
+	while ((k = cheapest(cand, settled, n_cand)) < n_cand) {
+		if (capped_sure(b, &cp, &cand[k], n_all)) {
+			settled[k] = !grow(&cand[k], n_all);
+			continue;
+		}
 		ret = try_candidate(b, &cand[k], n_all, rep, order, err, errlen);
-		while (ret == IRDM_ENUMERIC && b->head_capped && grow(&cand[k], n_all))
-			ret = try_candidate(b, &cand[k], n_all, rep, order, err, errlen);
 		if (ret != IRDM_ENUMERIC)
 			break;
 		snprintf(last, sizeof(last), "%s", err);
+		if (b->head_capped)
+			capped_add(&cp, cand[k].modes, b->head_capped);
+		settled[k] = !b->head_capped || !grow(&cand[k], n_all);
 	}
 	free(order);
 	if (ret == IRDM_ENUMERIC)

@@ -7,7 +7,8 @@
 #include "precompute/candidates.h"
 
 /* The heads tried: short ones tick cheaply but keep more modes. */
-static const unsigned heads[] = { 16, 32, 64, 128, 256 };
+static const unsigned heads[] = { 1, 2, 4, 8, 16, 32, 64, 128, 256 };
+_Static_assert(sizeof(heads) / sizeof(heads[0]) == IRDM_AUTO_N_HEADS, "IRDM_AUTO_N_HEADS");
 
 /*
  * Per-unit costs estimated from docs/measurements/bench_tick.md, one

@@ -17,7 +17,9 @@
 #include "accuracy/split.h"
 #include "modal/modal.h"
 
-#define IRDM_AUTO_MAX_CANDIDATES 7
+#define IRDM_AUTO_N_HEADS 9 /* head lengths tried (candidates.c) */
+/* a hybrid per head, the truncated one, every mode */
+#define IRDM_AUTO_MAX_CANDIDATES (IRDM_AUTO_N_HEADS + 2)
 #define IRDM_AUTO_TRUNCATED 300 /* modes of the truncated candidate */
 
 struct irdm_auto_candidate {
