@@ -20,4 +20,12 @@
  * Return: 0, or -1 if the file cannot be written. */
 int torus_write_off(const char *path, unsigned nu, unsigned nv);
 
+/* The same torus as a generator writes it: (nu + 1) x (nv + 1) vertices,
+ * the last row and column of each ring repeating the first, computed
+ * from their own angle (2 pi) and moved by about 1e-9 (a generator's
+ * rounding), so that the seams are equal but not bit for bit: the
+ * precompute welds them (mesh/surface_weld.c).
+ * Return: 0, or -1 if the file cannot be written. */
+int torus_write_off_seams(const char *path, unsigned nu, unsigned nv);
+
 #endif

@@ -420,7 +420,7 @@ static const struct irdm_opt scene_opts[] = {
 	{ .name = "representation", .type = IRDM_OPT_CUSTOM, .parse = set_representation, .metavar = "auto | modal:K | modal:all | fir:T", .help = "K modes (1 to 1000000) or all, or an FIR of T samples (1 to 1000000); auto: "
 																		   "every mode solved (a dense eigensolve), the cheapest estimated to tick of "
 																		   "modal:all (up to 300 modes), modal:300 + static correction, hybrids with "
-																		   "heads of 16 to 256 samples, each keeping the fewest modes ringing longest "
+																		   "heads of 1 to 256 samples, each keeping the fewest modes ringing longest "
 																		   "past it whose predicted error is within half of max_error, and "
 																		   "modal:all, whose measured error meets max_error; with max_error = none, "
 																		   "modal:300 + static correction (default auto)" },
