@@ -34,18 +34,19 @@ static double *dropped_shapes(const struct irdm_modes *m, size_t k_kept, const i
 #define HEAD_CHUNK 128 /* blocks gathered per product: bounds the scratch */
 
 /*
- * One column's blocks as one product per chunk, so that BLAS does the
- * Kd-long sums (a block's head is 9 x 2H such sums, and a column has
- * hundreds of blocks):
+ * Blocks [k_begin, end) of column c as one product per chunk, so that BLAS
+ * does the Kd-long sums (a block's head is 9 x 2H such sums, and a column
+ * has hundreds of blocks):
  *   C[(3 b + i), (j, s)] = sum_d P[rows_b, i][d] W[d, (j, s)],
  *   W[d, (j, s)] = Pc[j][d] h[s][d].
  * P is [dof][d]: a column-major Kd x (3 n_cols) matrix, so a block's rows
  * are gathered (G) before the product.
  */
-static void column_head(const struct irdm_corr_sparse *corr, size_t c, const double *P,
-			const double *W, size_t Kd, size_t S, double *G, double *C, double *head)
+static void column_head(const struct irdm_corr_sparse *corr, uint32_t k_begin, size_t c,
+			const double *P, const double *W, size_t Kd, size_t S, double *G, double *C,
+			double *head)
 {
-	for (uint32_t k0 = corr->start[c]; k0 < corr->start[c + 1]; k0 += HEAD_CHUNK) {
+	for (uint32_t k0 = k_begin; k0 < corr->start[c + 1]; k0 += HEAD_CHUNK) {
 		uint32_t nb = corr->start[c + 1] - k0 < HEAD_CHUNK ? corr->start[c + 1] - k0 : HEAD_CHUNK;
 		int m = (int)(3 * nb), n = (int)(3 * S), kd = (int)Kd;
 		double one = 1.0, zero = 0.0;
@@ -63,6 +64,51 @@ static void column_head(const struct irdm_corr_sparse *corr, size_t c, const dou
 							C[(size_t)(3 * b + (uint32_t)i) +
 							  (size_t)m * ((size_t)j * S + s)];
 		}
+	}
+}
+
+/* Block (column c, row r)'s index in corr, or -1 (rows increase). */
+static long find_block(const struct irdm_corr_sparse *corr, size_t c, uint32_t r)
+{
+	uint32_t lo = corr->start[c], hi = corr->start[c + 1];
+
+	while (lo < hi) {
+		uint32_t mid = lo + (hi - lo) / 2;
+
+		if (corr->rows[mid] < r)
+			lo = mid + 1;
+		else
+			hi = mid;
+	}
+	return lo < corr->start[c + 1] && corr->rows[lo] == r ? (long)lo : -1;
+}
+
+/*
+ * The first of column c's blocks to compute: R[s] is symmetric, so block
+ * (c, r) with r < c is block (r, c) transposed, once column r has it
+ * (mirror()); the static correction keeps both of a pair or neither.
+ */
+static uint32_t upper_begin(const struct irdm_corr_sparse *corr, size_t c)
+{
+	uint32_t k = corr->start[c];
+
+	while (k < corr->start[c + 1] && corr->rows[k] < c && find_block(corr, corr->rows[k], (uint32_t)c) >= 0)
+		k++;
+	return k;
+}
+
+/* Column c's blocks before k_end, from their mirror images. */
+static void mirror(const struct irdm_corr_sparse *corr, size_t c, uint32_t k_end, size_t S,
+		   double *head)
+{
+	for (uint32_t k = corr->start[c]; k < k_end; k++) {
+		const double *src = &head[(size_t)find_block(corr, corr->rows[k], (uint32_t)c) * S * 9];
+		double *out = &head[(size_t)k * S * 9];
+
+		for (size_t s = 0; s < S; s++)
+			for (int i = 0; i < 3; i++)
+				for (int j = 0; j < 3; j++)
+					out[9 * s + 3 * (size_t)i + (size_t)j] = src[9 * s + 3 * (size_t)j + (size_t)i];
 	}
 }
 
@@ -126,14 +172,18 @@ int irdm_exact_head(const struct irdm_modes *modes, const struct irdm_mode *zoh_
 		for (size_t s = 0; s < S; s++)
 			h[s * Kd + d] = hd[s];
 	}
+	/* the blocks on and below the diagonal (row >= column), then the
+	 * rest mirrored, then every block tapered: its own target */
 	for (size_t c = 0; c < n_cols; c++) {
 		column_weights(&P[3 * c * Kd], h, Kd, S, W);
-		column_head(corr, c, P, W, Kd, S, G, C, head);
-		for (uint32_t k = corr->start[c]; k < corr->start[c + 1]; k++)
-			taper(&head[(size_t)k * S * 9], H, &target[9 * (size_t)k]);
+		column_head(corr, upper_begin(corr, c), c, P, W, Kd, S, G, C, head);
 		if (progress && (c % 16 == 0 || c + 1 == n_cols))
 			progress(ctx, "exact head", (double)(c + 1) / (double)n_cols);
 	}
+	for (size_t c = 0; c < n_cols; c++)
+		mirror(corr, c, upper_begin(corr, c), S, head);
+	for (size_t k = 0; k < corr->n_blocks; k++)
+		taper(&head[k * S * 9], H, &target[9 * k]);
 	ret = IRDM_OK;
 out_free:
 	free(P);
