@@ -13,7 +13,11 @@
  *    mode, f64), the error is the one recorded;
  *  - the same modes with a 16-sample head (the shortest auto once tried)
  *    hold a head 16 times larger, for an error (2.6e-8) far below what
- *    the target asks.
+ *    the target asks;
+ *  - with static_correction_cluster set, auto tries no hybrid (its head
+ *    needs the dropped-block correction) and keeps the cluster in the
+ *    truncated candidate it writes: 300 modes and the clustered static
+ *    correction, within max_error.
  */
 #include <math.h>
 #include <stdbool.h>
@@ -122,6 +126,25 @@ static void test_short_head(void **state)
 	irdm_image_unmap(&img);
 }
 
+static void test_cluster_kept(void **state)
+{
+	struct irdm_precompute_report rep;
+	struct irdm_image img;
+
+	(void)state;
+	assert_int_equal(build("cluster.img", &rep,
+			       (const char *const[]){ "static_correction_cluster", "16", NULL }),
+			 0);
+	print_message("auto with static_correction_cluster = 16: %s, measured %.3g\n",
+		      rep.representation, rep.measured_error);
+	assert_true(rep.error_measured && rep.measured_error <= 1e-3);
+	map("cluster.img", &img);
+	assert_int_equal(img.meta->n_modes, 300);
+	assert_int_equal(img.meta->head_samples, 0);
+	assert_non_null(img.corr_clusters);
+	irdm_image_unmap(&img);
+}
+
 static int setup(void **state)
 {
 	(void)state;
@@ -138,6 +161,7 @@ int main(void)
 {
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_short_head),
+		cmocka_unit_test(test_cluster_kept),
 	};
 
 	return cmocka_run_group_tests(tests, setup, teardown);

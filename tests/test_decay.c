@@ -175,7 +175,7 @@ static void test_candidates(void **state)
 	}
 	irdm_modes_discretise(&m, &d, 1e-3, zoh);
 	assert_int_equal(irdm_split_probe_init(&p, &m, zoh, col_dofs, 1, 1000), 0);
-	n = irdm_auto_candidates(&m, &d, 1e-3, 1e-3, &p, c);
+	n = irdm_auto_candidates(&m, &d, 1e-3, 1e-3, true, &p, c);
 	assert_true(n >= 3);
 	for (size_t i = 0; i < n; i++) {
 		if (i)

@@ -62,6 +62,7 @@ struct build {
 	bool auto_try;        /* building one of auto's candidates */
 	size_t head_capped;   /* and its head was over max_head_mib: its blocks (0: not) */
 	size_t try_bytes;     /* the measured image's size (0: none written) */
+	unsigned cluster;     /* the scene's static_correction_cluster, for auto's tries */
 };
 
 /* Modes the scene needs solved (0: all). */
@@ -1439,7 +1440,8 @@ static int try_candidate(struct build *b, const struct irdm_auto_candidate *c, s
 	eff->modes = c->modes < n_all ? (unsigned)c->modes : 0;
 	eff->static_correction = c->modes < n_all;
 	eff->exact_head = hybrid ? c->head : 0;
-	eff->static_corr_cluster = 0;
+	/* a hybrid's head needs the dropped-block correction */
+	eff->static_corr_cluster = !hybrid && c->modes < n_all ? b->cluster : 0;
 	rep->error_measured = false;
 	b->try_bytes = 0;
 	if (hybrid) {
@@ -1489,8 +1491,8 @@ static int candidates(struct build *b, struct irdm_auto_candidate *cand, size_t 
 	ret = irdm_split_probe_init(&probe, &m->modes, zoh, dofs, n, irdm_measure_ticks(b->sc->dt_s));
 	if (ret)
 		goto out_free;
-	*n_cand = irdm_auto_candidates(&m->modes, &m->damping, b->sc->dt_s, b->sc->max_error, &probe,
-				       cand);
+	*n_cand = irdm_auto_candidates(&m->modes, &m->damping, b->sc->dt_s, b->sc->max_error,
+				       !b->cluster, &probe, cand);
 	irdm_split_probe_free(&probe);
 	if (b->o->progress)
 		b->o->progress(b->o->ctx, "auto: sizing the hybrids", 1.0);
@@ -1614,6 +1616,9 @@ static int choose(struct build *b, struct irdm_precompute_report *rep, char *err
 		snprintf(err, errlen, "precompute: out of memory");
 		return IRDM_ENOMEM;
 	}
+	b->cluster = b->sc->static_corr_cluster;
+	if (b->cluster && b->o->progress)
+		b->o->progress(b->o->ctx, "auto: static_correction_cluster is set: no hybrid (a hybrid's head needs the dropped-block correction)", -1.0);
 	if (n_all <= AUTO_ALL_MODES) {
 		cand[0] = (struct irdm_auto_candidate){
 			.modes = n_all,

@@ -126,13 +126,13 @@ static double predict_truncated(const struct irdm_modes *m, struct irdm_split_pr
 }
 
 size_t irdm_auto_candidates(const struct irdm_modes *m, const struct irdm_rayleigh *damp,
-			    double dt_s, double tol, struct irdm_split_probe *probe,
+			    double dt_s, double tol, bool with_hybrids, struct irdm_split_probe *probe,
 			    struct irdm_auto_candidate *out)
 {
 	size_t n = 0, *rank = malloc((m->n_modes ? m->n_modes : 1) * sizeof(*rank));
 	double truncated;
 
-	if (rank)
+	if (rank && with_hybrids)
 		n = hybrids(m, damp, dt_s, tol, probe, rank, out);
 	free(rank);
 	if (m->n_modes > IRDM_AUTO_TRUNCATED &&

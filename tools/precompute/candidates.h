@@ -11,6 +11,7 @@
 #ifndef IRDM_TOOLS_CANDIDATES_H
 #define IRDM_TOOLS_CANDIDATES_H
 
+#include <stdbool.h>
 #include <stddef.h>
 
 #include "fem/fem.h"
@@ -39,7 +40,8 @@ double irdm_auto_tick_us(size_t modes, unsigned head);
 
 /*
  * The candidates for m (every elastic mode, ascending) under damp at
- * dt_s for an error target tol: per head length, the hybrid of the
+ * dt_s for an error target tol: per head length (unless !with_hybrids),
+ * the hybrid of the
  * fewest modes by irdm_head_split_rank() whose error predicted on probe
  * (made from m) is within tol / 2, when one keeps fewer than every mode;
  * the lowest IRDM_AUTO_TRUNCATED modes with the static correction and
@@ -50,7 +52,7 @@ double irdm_auto_tick_us(size_t modes, unsigned head);
  * Return: how many.
  */
 size_t irdm_auto_candidates(const struct irdm_modes *m, const struct irdm_rayleigh *damp,
-			    double dt_s, double tol, struct irdm_split_probe *probe,
+			    double dt_s, double tol, bool with_hybrids, struct irdm_split_probe *probe,
 			    struct irdm_auto_candidate *out);
 
 #endif
