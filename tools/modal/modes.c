@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "modal/modal.h"
+#include "util/memory.h"
 
 /* Dense is cheaper than Lanczos below this many DoFs, and always used when
  * every mode is wanted. */
@@ -35,6 +36,26 @@ struct irdm_modes_rest {
 	size_t *z_col; /* each column's vector in the solve */
 	bool *whole;   /* each column whole */
 };
+
+/*
+ * Does the dense eigensolve of n DoFs for n_req modes fit the memory
+ * budget (util/memory.h)?  It holds the matrix, the eigenvectors of the
+ * tridiagonal or the Cholesky factor, and the n_req vectors: about
+ * 8 n (2 n + n_req) bytes, 2.1 GiB for every mode of the paper's cuboid
+ * (its measured peak: 2.5 GiB).  If not, say so in err.
+ */
+static bool dense_fits(size_t n, size_t n_req, char *err, size_t errlen)
+{
+	const char *what;
+	double need = 8.0 * (double)n * (2.0 * (double)n + (double)n_req);
+	double budget = irdm_memory_budget(&what);
+
+	if (!(budget > 0) || need <= budget)
+		return true;
+	snprintf(err, errlen, "modes: the dense eigensolve of %zu modes of %zu free DoFs needs %.1f GiB, more than the %.1f GiB of %s",
+		 n_req, n, need / (1 << 30), budget / (1 << 30), what);
+	return false;
+}
 
 static void rest_free(struct irdm_modes_rest *r)
 {
@@ -357,6 +378,8 @@ int irdm_modes_solve_kept(const struct irdm_fem *fem, size_t n_wanted, bool floa
 		snprintf(err, errlen, "slepc: no distributed eigensolver given");
 		return IRDM_EINVAL;
 	}
+	if (method == IRDM_EIG_DENSE && !dense_fits(n, n_req, err, errlen))
+		return IRDM_ENOMEM;
 	has_phi = method != IRDM_EIG_SLEPC || dist->rank == 0;
 	w2 = malloc(n_req * sizeof(double));
 	if (has_phi)

@@ -202,6 +202,20 @@ static int wanted_of_modes(const struct irdm_scene *sc, const struct irdm_model 
 	return IRDM_OK;
 }
 
+/* Why every mode was wanted, and what wants fewer, after err. */
+static void say_all_modes(const struct irdm_scene *sc, char *err, size_t errlen)
+{
+	size_t len = strlen(err);
+
+	if (sc->repr_auto && sc->max_error > 0)
+		snprintf(err + len, errlen - len, "; representation = auto with max_error = %g needs every mode (to choose and to measure): representation = modal:K with max_error = none needs K (a Lanczos solve), unmeasured; or a coarser mesh",
+			 sc->max_error);
+	else if (sc->exact_head)
+		snprintf(err + len, errlen - len, "; exact_head needs every mode: modal:K without it needs K (a Lanczos solve)");
+	else
+		snprintf(err + len, errlen - len, "; every mode was asked for: modal:K needs K (a Lanczos solve)");
+}
+
 int irdm_model_build(const struct irdm_scene *sc, size_t n_modes_needed,
 		     irdm_progress_fn progress, void *ctx, struct irdm_model *m,
 		     char *err, size_t errlen)
@@ -261,6 +275,8 @@ int irdm_model_build(const struct irdm_scene *sc, size_t n_modes_needed,
 	free((void *)want.keep);
 	free((void *)want.every);
 	free((void *)want.load_dofs);
+	if (ret == IRDM_ENOMEM && n_modes_needed == 0)
+		say_all_modes(sc, err, errlen);
 	if (ret)
 		goto out_fail;
 	m->seconds_eig = irdm_now_s() - t0;

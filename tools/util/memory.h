@@ -1,0 +1,16 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * The memory a tool may plan for: the machine's physical memory, lowered
+ * by the process's address-space and data limits (ulimit -v, ulimit -d)
+ * when set.  A step that would need more is refused before it starts:
+ * on Linux a large malloc() succeeds on overcommitted memory and the
+ * kernel kills the process later, hours into a dense eigensolve.
+ */
+#ifndef IRDM_TOOLS_MEMORY_H
+#define IRDM_TOOLS_MEMORY_H
+
+/* The budget in bytes, and in *what (static text) where it comes from:
+ * "physical memory", "ulimit -v" or "ulimit -d".  0 if unknown. */
+double irdm_memory_budget(const char **what);
+
+#endif
