@@ -1409,7 +1409,7 @@ static void say_candidate(const struct build *b, const struct irdm_auto_candidat
 /* The list, before any is built. */
 static void say_candidates(const struct build *b, const struct irdm_auto_candidate *c, size_t n)
 {
-	char line[512];
+	char line[1024]; /* every candidate: up to IRDM_AUTO_MAX_CANDIDATES of about 50 */
 	int len = snprintf(line, sizeof(line), "auto: candidates, cheapest estimated tick first:");
 
 	if (!b->o->progress)
