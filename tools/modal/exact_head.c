@@ -67,22 +67,6 @@ static void column_head(const struct irdm_corr_sparse *corr, uint32_t k_begin, s
 	}
 }
 
-/* Block (column c, row r)'s index in corr, or -1 (rows increase). */
-static long find_block(const struct irdm_corr_sparse *corr, size_t c, uint32_t r)
-{
-	uint32_t lo = corr->start[c], hi = corr->start[c + 1];
-
-	while (lo < hi) {
-		uint32_t mid = lo + (hi - lo) / 2;
-
-		if (corr->rows[mid] < r)
-			lo = mid + 1;
-		else
-			hi = mid;
-	}
-	return lo < corr->start[c + 1] && corr->rows[lo] == r ? (long)lo : -1;
-}
-
 /*
  * The first of column c's blocks to compute: R[s] is symmetric, so block
  * (c, r) with r < c is block (r, c) transposed, once column r has it
@@ -92,7 +76,7 @@ static uint32_t upper_begin(const struct irdm_corr_sparse *corr, size_t c)
 {
 	uint32_t k = corr->start[c];
 
-	while (k < corr->start[c + 1] && corr->rows[k] < c && find_block(corr, corr->rows[k], (uint32_t)c) >= 0)
+	while (k < corr->start[c + 1] && corr->rows[k] < c && irdm_corr_sparse_find(corr, corr->rows[k], (uint32_t)c) >= 0)
 		k++;
 	return k;
 }
@@ -102,7 +86,7 @@ static void mirror(const struct irdm_corr_sparse *corr, size_t c, uint32_t k_end
 		   double *head)
 {
 	for (uint32_t k = corr->start[c]; k < k_end; k++) {
-		const double *src = &head[(size_t)find_block(corr, corr->rows[k], (uint32_t)c) * S * 9];
+		const double *src = &head[(size_t)irdm_corr_sparse_find(corr, corr->rows[k], (uint32_t)c) * S * 9];
 		double *out = &head[(size_t)k * S * 9];
 
 		for (size_t s = 0; s < S; s++)

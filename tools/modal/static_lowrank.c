@@ -232,20 +232,6 @@ static double frob9(const double b[9])
 	return sqrt(s);
 }
 
-static bool is_kept(const struct irdm_corr_sparse *s, size_t c, size_t r)
-{
-	uint32_t lo = s->start[c], hi = s->start[c + 1];
-
-	while (lo < hi) {
-		uint32_t mid = lo + (hi - lo) / 2;
-		if (s->rows[mid] < r)
-			lo = mid + 1;
-		else
-			hi = mid;
-	}
-	return lo < s->start[c + 1] && s->rows[lo] == r;
-}
-
 /* |S_cc| of every column, from the kept diagonal blocks. */
 static void diag_norms(const struct irdm_corr_sparse *s, double *dn)
 {
@@ -277,7 +263,7 @@ static int check(struct far *f, struct irdm_corr_lowrank *lr, const double *dn, 
 		size_t c = (2 * j + 1) * nc / (2 * nk);
 		for (size_t r = 0; r < nc; r++) {
 			double fb[9], lb[9], scale = sqrt(dn[c] * dn[r]), before, after;
-			if (is_kept(f->s, c, r) || !(scale > 0))
+			if (irdm_corr_sparse_find(f->s, c, (uint32_t)r) >= 0 || !(scale > 0))
 				continue;
 			irdm_corr_lowrank_block(lr, c, r, lb);
 			for (size_t i = 0; i < 3; i++)

@@ -283,6 +283,21 @@ out_free:
 	return ret;
 }
 
+long irdm_corr_sparse_find(const struct irdm_corr_sparse *s, size_t c, uint32_t r)
+{
+	uint32_t lo = s->start[c], hi = s->start[c + 1];
+
+	while (lo < hi) {
+		uint32_t mid = lo + (hi - lo) / 2;
+
+		if (s->rows[mid] < r)
+			lo = mid + 1;
+		else
+			hi = mid;
+	}
+	return lo < s->start[c + 1] && s->rows[lo] == r ? (long)lo : -1;
+}
+
 void irdm_corr_sparse_free(struct irdm_corr_sparse *s)
 {
 	free(s->start);

@@ -50,6 +50,10 @@ int irdm_static_correction_sparse(const struct irdm_fem *fem, const struct irdm_
 int irdm_corr_modal_basis(const struct irdm_modes *m, const int64_t *col_dofs, size_t n_cols,
 			  double **P, double **Ps);
 
+/* Block (column c, row r)'s index in s, or -1 if dropped (a column's
+ * rows increase: a binary search). */
+long irdm_corr_sparse_find(const struct irdm_corr_sparse *s, size_t c, uint32_t r);
+
 /* Free what irdm_static_correction_sparse() allocated and zero s. */
 void irdm_corr_sparse_free(struct irdm_corr_sparse *s);
 
