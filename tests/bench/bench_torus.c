@@ -71,8 +71,8 @@ static void print_log(const struct torus_case *c)
 
 	while (f && fgets(line, sizeof(line), f))
 		for (size_t k = 0; k < sizeof(keys) / sizeof(keys[0]); k++)
-			if (strncmp(line, keys[k], strlen(keys[k])) == 0 ||
-			    (k == 0 && strstr(line, keys[k])))
+			if (k == 0 ? strstr(line, keys[k]) != NULL : /* within the mesh line */
+				     strncmp(line, keys[k], strlen(keys[k])) == 0)
 				printf("torus %-9s %s", c->tag, line);
 	if (f)
 		fclose(f);

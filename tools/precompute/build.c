@@ -1562,10 +1562,10 @@ static size_t capped_blocks(const struct capped *cp, size_t K)
 	return least;
 }
 
-/* Is c's head sure to be over the cap by capped_blocks()?  Then building
+/* Is c's head estimated over the cap by capped_blocks()?  Then building
  * it would only be refused: say so. */
-static bool capped_sure(const struct build *b, const struct capped *cp,
-			const struct irdm_auto_candidate *c, size_t n_all)
+static bool over_cap_estimated(const struct build *b, const struct capped *cp,
+			       const struct irdm_auto_candidate *c, size_t n_all)
 {
 	size_t blocks;
 	char line[256];
@@ -1599,7 +1599,7 @@ static size_t cheapest(const struct irdm_auto_candidate *c, const bool *settled,
  * (candidates.h), cheapest to tick first, are built until one is
  * certified and measures within max_error.  A hybrid whose head is over
  * max_head_mib grows (grow()) and waits its turn at its new cost, and
- * one sure to be over it is grown without a build.  A model of at most
+ * one estimated over it is grown without a build.  A model of at most
  * AUTO_ALL_MODES modes takes them all.
  */
 static int choose(struct build *b, struct irdm_precompute_report *rep, char *err, size_t errlen)
@@ -1636,7 +1636,7 @@ static int choose(struct build *b, struct irdm_precompute_report *rep, char *err
 	}
 	say_candidates(b, cand, n_cand);
 	while ((k = cheapest(cand, settled, n_cand)) < n_cand) {
-		if (capped_sure(b, &cp, &cand[k], n_all)) {
+		if (over_cap_estimated(b, &cp, &cand[k], n_all)) {
 			settled[k] = !grow(&cand[k], n_all);
 			continue;
 		}
