@@ -25,9 +25,10 @@
 #include <string.h>
 
 #include "modal/lapack.h"
+#include "modal/eig_dense_priv.h"
 #include "modal/modal.h"
 
-static bool mass_is_diagonal(const struct irdm_csc *m)
+bool irdm_eig_mass_is_diagonal(const struct irdm_csc *m)
 {
 	for (size_t j = 0; j < m->n; j++)
 		for (int64_t p = m->colptr[j]; p < m->colptr[j + 1]; p++)
@@ -60,7 +61,7 @@ static int reduce_to_standard(const struct irdm_fem *fem, double *a, double *l,
 }
 
 /* A LAPACK workspace query's answer as a count; -1 past int. */
-static int work_size(double q)
+int irdm_eig_work_size(double q)
 {
 	return q < INT_MAX ? (int)q : -1;
 }
@@ -70,8 +71,8 @@ static int work_size(double q)
  * (n x n), as their queries ask (dstedc's n^2 is the largest).  Returns
  * 0, or -1 out of memory (*work and *iwork then whatever was allocated).
  */
-static int workspace(double *a, int n, double *d, double *e, double *tau, double *z,
-		     bool with_ormtr, double **work, int *lwork, int **iwork, int *liwork)
+int irdm_eig_workspace(double *a, int n, double *d, double *e, double *tau, double *z,
+		       bool with_ormtr, double **work, int *lwork, int **iwork, int *liwork)
 {
 	double q[3] = { 0, 0, 0 };
 	int query = -1, iq = 0, info = 0;
@@ -80,7 +81,7 @@ static int workspace(double *a, int n, double *d, double *e, double *tau, double
 	dstedc_("I", &n, d, e, z, &n, &q[1], &query, &iq, &query, &info);
 	if (with_ormtr)
 		dormtr_("L", "L", "N", &n, &n, a, &n, tau, z, &n, &q[2], &query, &info);
-	*lwork = work_size(fmax(q[0], fmax(q[1], q[2])));
+	*lwork = irdm_eig_work_size(fmax(q[0], fmax(q[1], q[2])));
 	*liwork = iq;
 	if (*lwork < 0)
 		return -1;
@@ -103,7 +104,7 @@ static int solve_all(double *a, int n, double *w2, double *phi, const char **ste
 
 	if (!e || !tau)
 		goto out;
-	if (workspace(a, n, w2, e, tau, phi, true, &work, &lwork, &iwork, &liwork))
+	if (irdm_eig_workspace(a, n, w2, e, tau, phi, true, &work, &lwork, &iwork, &liwork))
 		goto out;
 	*step = "dsytrd";
 	dsytrd_("L", &n, a, &n, w2, e, tau, work, &lwork, &info);
@@ -124,91 +125,6 @@ out:
 	return ret;
 }
 
-struct irdm_eig_rest {
-	int n;
-	double *a;     /* dsytrd's Householder vectors, lower triangle */
-	double *tau;   /* their scalar factors, n - 1 */
-	double *z;     /* the tridiagonal's eigenvectors, n x n */
-	double *dsqrt; /* the lumped mass's square root */
-};
-
-void irdm_eig_rest_free(struct irdm_eig_rest *r)
-{
-	if (!r)
-		return;
-	free(r->a);
-	free(r->tau);
-	free(r->z);
-	free(r->dsqrt);
-	free(r);
-}
-
-/* C <- op(Q) C, C n x k; trans "N" or "T".  0, -1 out of memory, or info. */
-static int apply_q(const struct irdm_eig_rest *r, const char *trans, double *c, int k)
-{
-	double q = 0, *work;
-	int lwork = -1, info = 0;
-
-	if (k == 0)
-		return 0;
-	dormtr_("L", "L", trans, &r->n, &k, r->a, &r->n, r->tau, c, &r->n, &q, &lwork, &info);
-	lwork = work_size(q);
-	work = lwork > 0 ? malloc((size_t)lwork * sizeof(double)) : NULL;
-	if (!work)
-		return -1;
-	dormtr_("L", "L", trans, &r->n, &k, r->a, &r->n, r->tau, c, &r->n, work, &lwork, &info);
-	free(work);
-	return info;
-}
-
-int irdm_eig_rest_fill(const struct irdm_eig_rest *r, const size_t *z_cols, size_t k, double *out)
-{
-	size_t n = (size_t)r->n;
-	int ret;
-
-	for (size_t j = 0; j < k; j++)
-		memcpy(&out[j * n], &r->z[z_cols[j] * n], n * sizeof(double));
-	ret = apply_q(r, "N", out, (int)k);
-	if (ret)
-		return ret < 0 ? IRDM_ENOMEM : IRDM_ENUMERIC;
-	for (size_t j = 0; j < k; j++)
-		for (size_t i = 0; i < n; i++)
-			out[j * n + i] /= r->dsqrt[i];
-	return IRDM_OK;
-}
-
-/* phi's rows at[] of every mode: (Q^T E_at)^T Z, scaled by M^-1/2; NaN
- * at every other row. */
-static int rows_at(const struct irdm_eig_rest *r, const int64_t *at, size_t n_at, double *phi)
-{
-	size_t n = (size_t)r->n;
-	int t = (int)n_at, ni = r->n, ret;
-	double one = 1.0, zero = 0.0;
-	double *c = calloc(n * (n_at ? n_at : 1), sizeof(double));
-	double *y = malloc(n * (n_at ? n_at : 1) * sizeof(double));
-
-	ret = -1;
-	if (!c || !y)
-		goto out;
-	for (size_t i = 0; i < n_at; i++)
-		c[i * n + (size_t)at[i]] = 1.0;
-	ret = apply_q(r, "T", c, t);
-	if (ret)
-		goto out;
-	/* y (t x n) = C^T Z: row i, mode k */
-	if (t)
-		dgemm_("T", "N", &t, &ni, &ni, &one, c, &ni, r->z, &ni, &zero, y, &t);
-	for (size_t i = 0; i < n * n; i++)
-		phi[i] = NAN;
-	for (size_t k = 0; k < n; k++)
-		for (size_t i = 0; i < n_at; i++)
-			phi[k * n + (size_t)at[i]] = y[k * n_at + i] / r->dsqrt[at[i]];
-out:
-	free(c);
-	free(y);
-	return ret;
-}
-
 /* The lowest iu eigenpairs of A (destroyed), MRRR.  Same returns; m:
  * how many it found. */
 static int solve_lowest(double *a, int n, int iu, double *w2, double *phi, int *m)
@@ -223,7 +139,7 @@ static int solve_lowest(double *a, int n, int iu, double *w2, double *phi, int *
 		goto out;
 	dsyevr_("V", "I", "L", &n, a, &n, &vl, &vu, &il, &iu, &abstol, m, w2, phi, &n,
 		isuppz, &wq, &lwork, &iwq, &liwork, &info);
-	lwork = work_size(wq);
+	lwork = irdm_eig_work_size(wq);
 	liwork = iwq;
 	if (lwork < 0)
 		goto out;
@@ -246,7 +162,7 @@ int irdm_eig_dense(const struct irdm_fem *fem, size_t n_lowest, double *w2, doub
 {
 	int n = (int)fem->K.n, m = (int)n_lowest, info = 0;
 	double one = 1.0;
-	bool diag = mass_is_diagonal(&fem->M), all = n_lowest == fem->K.n;
+	bool diag = irdm_eig_mass_is_diagonal(&fem->M), all = n_lowest == fem->K.n;
 	double *a = irdm_csc_to_dense(&fem->K);
 	double *l = diag ? NULL : irdm_csc_to_dense(&fem->M);
 	double *dsqrt = malloc((size_t)n * sizeof(double));
@@ -290,82 +206,5 @@ out_free:
 	free(a);
 	free(l);
 	free(dsqrt);
-	return ret;
-}
-
-/*
- * Every eigenpair of a lumped-mass model, each vector only at the n_at
- * free DoFs at[] (NaN elsewhere, in phi: n x n); *rest makes chosen
- * vectors whole (irdm_eig_rest_fill).  A consistent mass: every vector
- * whole and *rest NULL (its L^-T mixes the rows).  Progress (NULL: none)
- * after each step, by its share of the flops on the paper's cuboid.
- */
-int irdm_eig_dense_at(const struct irdm_fem *fem, const int64_t *at, size_t n_at,
-		      irdm_progress_fn progress, void *ctx, double *w2, double *phi,
-		      struct irdm_eig_rest **rest, char *err, size_t errlen)
-{
-	struct irdm_eig_rest *r = NULL;
-	double *e = NULL, *work = NULL;
-	int *iwork = NULL, lwork = -1, liwork = -1, info = 0, n = (int)fem->K.n;
-	const char *step = "dsytrd";
-	int ret = IRDM_ENOMEM;
-
-	*rest = NULL;
-	if (!mass_is_diagonal(&fem->M))
-		return irdm_eig_dense(fem, fem->K.n, w2, phi, err, errlen);
-	r = calloc(1, sizeof(*r));
-	if (!r)
-		goto out_nomem;
-	r->n = n;
-	r->a = irdm_csc_to_dense(&fem->K);
-	r->tau = malloc((size_t)n * sizeof(double));
-	r->dsqrt = malloc((size_t)n * sizeof(double));
-	e = malloc((size_t)n * sizeof(double));
-	if (!r->a || !r->tau || !r->dsqrt || !e)
-		goto out_nomem;
-	reduce_to_standard(fem, r->a, NULL, r->dsqrt, true);
-	/* Z first lands in phi, moved out once dstedc's n^2 workspace is
-	 * given back: three n x n arrays at most, as the whole solve */
-	if (workspace(r->a, n, w2, e, r->tau, phi, false, &work, &lwork, &iwork, &liwork))
-		goto out_nomem;
-	dsytrd_("L", &n, r->a, &n, w2, e, r->tau, work, &lwork, &info);
-	if (!info) {
-		if (progress)
-			progress(ctx, "dense eigensolve: tridiagonal", 0.75);
-		step = "dstedc";
-		dstedc_("I", &n, w2, e, phi, &n, work, &lwork, iwork, &liwork, &info);
-	}
-	free(work);
-	work = NULL;
-	if (!info) {
-		r->z = malloc((size_t)n * (size_t)n * sizeof(double));
-		if (!r->z)
-			goto out_nomem;
-		memcpy(r->z, phi, (size_t)n * (size_t)n * sizeof(double));
-		if (progress)
-			progress(ctx, "dense eigensolve: its eigenvectors", 0.95);
-		step = "dormtr";
-		info = rows_at(r, at, n_at, phi);
-	}
-	if (info < 0)
-		goto out_nomem;
-	if (info) {
-		snprintf(err, errlen, "dense eigensolver: %s failed (info %d)", step, info);
-		ret = IRDM_ENUMERIC;
-		goto out_free;
-	}
-	*rest = r;
-	r = NULL;
-	ret = IRDM_OK;
-	goto out_free;
-
-out_nomem:
-	snprintf(err, errlen, "dense eigensolver: out of memory for n = %d (needs %.1f GiB)", n,
-		 3.0 * n * (double)n * 8 / (1 << 30));
-out_free:
-	irdm_eig_rest_free(r);
-	free(e);
-	free(work);
-	free(iwork);
 	return ret;
 }

@@ -24,6 +24,7 @@ enum irdm_eig_method {
 
 /* What makes a dense solve's vectors whole later (eig_dense.c). */
 struct irdm_eig_rest;
+struct irdm_sym;
 /* Which of phi's columns are whole, and where to make the others so. */
 struct irdm_modes_rest;
 
@@ -55,6 +56,9 @@ struct irdm_modes_want {
 	 * mode); a dense all-modes solve then gives each mode at those DoFs
 	 * only, the others made whole on demand (irdm_modes_complete) */
 	const bool *every;
+	/* the model's symmetries (modal/symmetry.h; NULL: none): they split
+	 * the dense all-modes solve */
+	const struct irdm_sym *sym;
 };
 
 /* Progress of a stage in [0, 1]; a negative fraction: `stage` is a line to
@@ -118,9 +122,10 @@ int irdm_eig_dense(const struct irdm_fem *fem, size_t n_lowest, double *w2, doub
 		   char *err, size_t errlen);
 /* Every eigenpair of a lumped-mass model, each vector at the n_at free
  * DoFs at[] only (NaN elsewhere); *rest makes chosen ones whole.  A
- * consistent mass: all whole, *rest NULL. */
-int irdm_eig_dense_at(const struct irdm_fem *fem, const int64_t *at, size_t n_at,
-		      irdm_progress_fn progress, void *ctx, double *w2, double *phi,
+ * consistent mass: all whole, *rest NULL.  sym (NULL: none): the model's
+ * symmetries, which split the solve (eig_dense_at.c). */
+int irdm_eig_dense_at(const struct irdm_fem *fem, const struct irdm_sym *sym, const int64_t *at,
+		      size_t n_at, irdm_progress_fn progress, void *ctx, double *w2, double *phi,
 		      struct irdm_eig_rest **rest, char *err, size_t errlen);
 /* Vectors z_cols[0..k) made whole into out (n x k).  Return as
  * irdm_modes_complete(). */

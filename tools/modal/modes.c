@@ -249,7 +249,7 @@ static int split_rigid(struct irdm_modes *out, size_t n_req, const double *w2,
  * demand: *eig); a floating object's rigid modes, the first n_rigid, whole
  * at once (they project every static load).
  */
-static int dense_at(const struct irdm_fem *fem, const bool *every, size_t n_rigid,
+static int dense_at(const struct irdm_fem *fem, const struct irdm_modes_want *want, size_t n_rigid,
 		    irdm_progress_fn progress, void *ctx, double *w2, double *phi,
 		    struct irdm_eig_rest **eig, char *err, size_t errlen)
 {
@@ -262,9 +262,9 @@ static int dense_at(const struct irdm_fem *fem, const bool *every, size_t n_rigi
 		return IRDM_ENOMEM;
 	}
 	for (size_t i = 0; i < n; i++)
-		if (every[i])
+		if (want->every[i])
 			at[n_at++] = (int64_t)i;
-	ret = irdm_eig_dense_at(fem, at, n_at, progress, ctx, w2, phi, eig, err, errlen);
+	ret = irdm_eig_dense_at(fem, want->sym, at, n_at, progress, ctx, w2, phi, eig, err, errlen);
 	free(at);
 	if (!ret && *eig && n_rigid) {
 		ret = irdm_eig_rest_fill(*eig, rigid, n_rigid, phi);
@@ -317,7 +317,7 @@ static int solve_slepc(const struct irdm_fem *fem, size_t n_req, bool floating, 
 		       struct irdm_modes *out, char *err, size_t errlen)
 {
 	size_t n = fem->K.n, n_loads = floating || !want ? 0 : want->n_loads;
-	struct irdm_modes_want w = want ? *want : (struct irdm_modes_want){ NULL, NULL, 0, NULL };
+	struct irdm_modes_want w = want ? *want : (struct irdm_modes_want){ NULL, NULL, 0, NULL, NULL };
 	int ret;
 
 	w.n_loads = n_loads;
@@ -394,7 +394,7 @@ int irdm_modes_solve_kept(const struct irdm_fem *fem, size_t n_wanted, bool floa
 													 "Lanczos eigensolve",
 			 0.0);
 	if (method == IRDM_EIG_DENSE && n_req == n && want && want->every)
-		ret = dense_at(fem, want->every, n_rigid, progress, ctx, w2, phi, &eig, err, errlen);
+		ret = dense_at(fem, want, n_rigid, progress, ctx, w2, phi, &eig, err, errlen);
 	else if (method == IRDM_EIG_DENSE)
 		ret = irdm_eig_dense(fem, n_req, w2, phi, err, errlen);
 	else if (method == IRDM_EIG_SLEPC)

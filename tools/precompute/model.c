@@ -6,6 +6,7 @@
 #include <time.h>
 
 #include "dist/dist.h"
+#include "modal/symmetry.h"
 #include "precompute/model.h"
 #include "util/clock.h"
 
@@ -196,9 +197,27 @@ static int wanted_of_modes(const struct irdm_scene *sc, const struct irdm_model 
 			loads[n_loads++] = m->col_dofs[c];
 		}
 	every_mode_at(m, every);
-	*w = (struct irdm_modes_want){ keep, loads, n_loads, every };
+	*w = (struct irdm_modes_want){ keep, loads, n_loads, every, NULL };
 	if (!sc->static_correction || sc->method == IRDM_METHOD_TIME_DOMAIN)
 		w->n_loads = 0;
+	return IRDM_OK;
+}
+
+/*
+ * The model's symmetries, which split a dense all-modes solve into
+ * independent blocks (modal/symmetry.h), and a line saying so.
+ */
+static int find_symmetry(const struct irdm_model *m, struct irdm_sym *sym,
+			 irdm_progress_fn progress, void *ctx, char *err, size_t errlen)
+{
+	char line[256];
+	int ret = irdm_sym_find(m->mesh.pos_m, m->mesh.n_nodes, &m->fem, sym, err, errlen);
+
+	if (ret || !sym->n_gens || !progress)
+		return ret;
+	snprintf(line, sizeof(line), "symmetry: %s (to %.1e): a dense solve splits into %u blocks",
+		 sym->what, sym->mismatch, 1u << sym->n_gens);
+	progress(ctx, line, -1.0);
 	return IRDM_OK;
 }
 
@@ -270,8 +289,15 @@ int irdm_model_build(const struct irdm_scene *sc, size_t n_modes_needed,
 	}
 	if (sc->eigensolver == IRDM_EIG_SLEPC)
 		dist.rank = irdm_dist_rank();
-	ret = irdm_modes_solve_kept(&m->fem, n_modes_needed, sc->floating, sc->eigensolver, &dist,
-				    &want, progress, ctx, &m->modes, err, errlen);
+	struct irdm_sym sym = { 0 };
+	/* only the lumped-mass all-modes solve splits (eig_dense_at.c) */
+	if (n_modes_needed == 0 && sc->eigensolver != IRDM_EIG_SLEPC && sc->mass == IRDM_MASS_LUMPED)
+		ret = find_symmetry(m, &sym, progress, ctx, err, errlen);
+	want.sym = &sym;
+	if (!ret)
+		ret = irdm_modes_solve_kept(&m->fem, n_modes_needed, sc->floating, sc->eigensolver,
+					    &dist, &want, progress, ctx, &m->modes, err, errlen);
+	irdm_sym_free(&sym);
 	free((void *)want.keep);
 	free((void *)want.every);
 	free((void *)want.load_dofs);
