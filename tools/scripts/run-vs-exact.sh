@@ -14,7 +14,7 @@ board=boards/sim-phantom.board
 for f in out/default.img out/run.log; do
 	[ -f "$f" ] || { echo "run-vs-exact: needs $f: make run first" >&2; exit 1; }
 done
-key="$(sha256sum scenes/cuboid-top.scene | cut -c1-16) $("$irdm" --version) exact"
+key="$(sha256sum scenes/cuboid-top.scene | cut -c1-16) $("$irdm" --version) $(sha256sum "$irdm" | cut -c1-16) exact"
 if [ -f out/exact.img ] && [ "$(cat out/exact.img.key 2>/dev/null)" = "$key" ]; then
 	echo "out/exact.img is up to date: precompute skipped" >&2
 else
