@@ -291,9 +291,11 @@ int irdm_model_build(const struct irdm_scene *sc, size_t n_modes_needed,
 		dist.rank = irdm_dist_rank();
 	struct irdm_sym sym = { 0 };
 	/* only the lumped-mass all-modes solve splits (eig_dense_at.c) */
-	if (n_modes_needed == 0 && sc->eigensolver != IRDM_EIG_SLEPC && sc->mass == IRDM_MASS_LUMPED)
+	if (n_modes_needed == 0 && sc->eigensolver != IRDM_EIG_SLEPC && sc->mass == IRDM_MASS_LUMPED &&
+	    sc->symmetry)
 		ret = find_symmetry(m, &sym, progress, ctx, err, errlen);
 	want.sym = &sym;
+	m->eig_blocks = 1u << sym.n_gens;
 	if (!ret)
 		ret = irdm_modes_solve_kept(&m->fem, n_modes_needed, sc->floating, sc->eigensolver,
 					    &dist, &want, progress, ctx, &m->modes, err, errlen);

@@ -51,6 +51,7 @@ void irdm_scene_defaults(struct irdm_scene *sc)
 	sc->method = IRDM_METHOD_MODAL;
 	sc->substeps = 8;
 	sc->eigensolver = IRDM_EIG_AUTO;
+	sc->symmetry = true;
 	sc->max_error = IRDM_MAX_ERROR_DEFAULT;
 	sc->max_head_mib = IRDM_MAX_HEAD_MIB_DEFAULT;
 }
@@ -458,6 +459,7 @@ static const struct irdm_opt scene_opts[] = {
 	{ .name = "display", .type = IRDM_OPT_CUSTOM, .parse = set_display, SC(display), .metavar = "surface | touch | REGION", .help = "displayed surface nodes: rows (default surface)" },
 	{ .name = "method", .type = IRDM_OPT_ENUM, SC(method), .names = method_names, .help = "how FIR responses are computed (default modal)" },
 	{ .name = "substeps", .type = IRDM_OPT_UNSIGNED, SC(substeps), .metavar = "N", .range = IRDM_OPT_GE | IRDM_OPT_LE, .min = 1, .max = 100000, .help = "time-domain integration steps per sample (default 8)" },
+	{ .name = "symmetry", .type = IRDM_OPT_BOOL, SC(symmetry), .help = "split every-mode dense eigensolves by the model's mirror and half-turn symmetries, when it has exact ones (the same eigenpairs, about 4^g times faster for g symmetries; lumped mass; default yes)" },
 	{ .name = "eigensolver", .type = IRDM_OPT_ENUM, SC(eigensolver), .names = eig_names, .help = "eigenvalue solver (default auto: by size); slepc: SLEPc over MPI ranks "
 												     "(run under mpirun -np N; docs/mpi.md)" },
 	{ .name = "threads", .type = IRDM_OPT_UNSIGNED, SC(threads), .metavar = "N", .range = IRDM_OPT_LE, .max = 256, .help = "worker threads (0: all cores)" },
@@ -625,6 +627,12 @@ int irdm_scene_format(const struct irdm_scene *sc, char *buf, size_t len)
 	}
 	if (sc->exact_head) { /* only when set, as fir_tail */
 		int t = snprintf(buf + n, len - (size_t)n, "exact_head=%u\n", sc->exact_head);
+		if (t < 0 || (size_t)t >= len - (size_t)n)
+			return -1;
+		n += t;
+	}
+	if (!sc->symmetry) { /* only when set: the same eigenpairs either way */
+		int t = snprintf(buf + n, len - (size_t)n, "symmetry=no\n");
 		if (t < 0 || (size_t)t >= len - (size_t)n)
 			return -1;
 		n += t;

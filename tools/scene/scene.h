@@ -62,6 +62,7 @@ struct irdm_scene {
 	double max_tet_volume_m3; /* surface meshes: largest tet (0: none) */
 	struct irdm_material mat;
 	enum irdm_mass_kind mass;
+	bool symmetry; /* split a dense all-modes eigensolve by the model's symmetries */
 	enum irdm_damping_kind damping;
 	double damp_ratio[2];
 	double damp_hz[2]; /* 0 for the first: "the first elastic mode" */
