@@ -2,7 +2,7 @@
 /*
  * The symmetric split of the every-mode eigensolve, end to end: the soft
  * 4 x 4 x 8 cuboid (E 2e3 Pa, nu 0.4999, rho 2e4 kg/m^3, 2 ms; its mesh
- * has the y mirror and the half-turn, tools/modal/symmetry.h) precomputed
+ * has the x and the y mirror, tools/modal/symmetry.h) precomputed
  * with symmetry = yes and with symmetry = no (the whole solve, which
  * test_modal holds to K, M and Lanczos).  Every mode, and the hybrid auto
  * chooses at max_error 1e-3 (294 modes and a 32-sample head): the two
