@@ -184,7 +184,7 @@ CORE_TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(CORE_TEST_SRC))
 FWAPP_TESTS := $(patsubst tests/%.c,$(BUILD)/tests/%,$(FWAPP_TEST_SRC))
 BENCHES  := $(patsubst tests/bench/%.c,$(BUILD)/bench/%,$(BENCH_SRC))
 
-.PHONY: all test test-variants san fuzz material-grid error-targets run-vs-exact bench bench-precompute bench-mpi run render view-shots jitter-view stability report jitter check deps clean docs docs-check cfg-fws sizes hil format format-check head-tick
+.PHONY: all test test-variants san fuzz material-grid error-targets scale run-vs-exact bench bench-precompute bench-mpi run render view-shots jitter-view stability report jitter check deps clean docs docs-check cfg-fws sizes hil format format-check head-tick
 .SECONDARY:
 all: $(if $(CONFIG),,$(IRDM) $(SLEPC_PLUGIN)) $(FW_LIB) $(POSIX_LIB) $(HAL_LIB) $(SIM_LIB) $(if $(FWMAIN_SRC),$(IRDM_FW)) \
   $(if $(CDMAIN_SRC),$(IRDM_CD))
@@ -480,6 +480,12 @@ report: $(IRDM)
 	for c in $(REPORT_CONFIGS); do \
 	  /usr/bin/python3 tools/scripts/plot-report.py out/report/report-$$c.csv docs/report/report-$$c; \
 	done
+
+# The default scene at finer meshes (tools/scripts/scale.sh): how far the
+# symmetric split of the every-mode eigensolve carries the default target;
+# figures to docs/measurements/scale.md.
+scale: $(IRDM)
+	$(MEASURE) -m scale 'make scale' -- tools/scripts/scale.sh $(IRDM)
 
 # Paper-scale images (cuboid, bunny): time and size beside the paper's.
 bench-precompute: $(IRDM) $(BUILD)/data/bunny.off

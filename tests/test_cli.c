@@ -303,7 +303,9 @@ static void test_read_failure_is_eio(void **state)
 /*
  * Memory the precompute cannot have.  The built-in cuboid with the dense
  * eigensolver (every mode: auto at its default max_error) needs about
- * 2.0 GiB (two 9504 x 9504 matrices and the vectors).  Under a 300 MB
+ * 1.0 GiB (the 9504 x 9504 vectors, and two matrices of a quarter of that
+ * size for each of the four blocks its symmetries split it into).  Under
+ * a 300 MB
  * address-space cap the precompute refuses it before allocating, by name:
  * the GiB it needs, the cap and where the cap comes from, and why every
  * mode was wanted.  AddressSanitizer reserves terabytes of shadow memory,
@@ -340,7 +342,7 @@ static void test_alloc_failure_is_enomem(void **state)
 #ifdef BUILT_WITH_ASAN
 	assert_non_null(strstr(err_text, "out of memory"));
 #else
-	assert_non_null(strstr(err_text, "the dense eigensolve of 9504 modes of 9504 free DoFs needs 2.0 GiB, more than the 0.3 GiB of ulimit -v"));
+	assert_non_null(strstr(err_text, "the dense eigensolve of 9504 modes of 9504 free DoFs (split by symmetry) needs 1.0 GiB, more than the 0.3 GiB of ulimit -v"));
 	assert_non_null(strstr(err_text, "representation = auto with max_error = 0.001 needs every mode"));
 #endif
 	assert_false(exists(img));

@@ -5,7 +5,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "modal/eig_dense_priv.h"
 #include "modal/modal.h"
+#include "modal/symmetry.h"
 #include "util/memory.h"
 
 /* Dense is cheaper than Lanczos below this many DoFs, and always used when
@@ -39,22 +41,36 @@ struct irdm_modes_rest {
 
 /*
  * Does the dense eigensolve of n DoFs for n_req modes fit the memory
- * budget (util/memory.h)?  It holds the matrix, the eigenvectors of the
- * tridiagonal or the Cholesky factor, and the n_req vectors: about
+ * budget (util/memory.h)?  It holds the n_req vectors, and the matrix and
+ * the eigenvectors of its tridiagonal (or the Cholesky factor): about
  * 8 n (2 n + n_req) bytes, 2.1 GiB for every mode of the paper's cuboid
- * (its measured peak: 2.5 GiB).  If not, say so in err.
+ * (its measured peak: 2.5 GiB).  Split into `blocks` by symmetry
+ * (eig_dense_at.c), each block's matrix and vectors are (n / blocks)^2:
+ * 8 n (2 n / blocks + n_req).  If not, say so in err.
  */
-static bool dense_fits(size_t n, size_t n_req, char *err, size_t errlen)
+static bool dense_fits(size_t n, size_t n_req, unsigned blocks, char *err, size_t errlen)
 {
 	const char *what;
-	double need = 8.0 * (double)n * (2.0 * (double)n + (double)n_req);
+	double need = 8.0 * (double)n * (2.0 * (double)n / blocks + (double)n_req);
 	double budget = irdm_memory_budget(&what);
 
 	if (!(budget > 0) || need <= budget)
 		return true;
-	snprintf(err, errlen, "modes: the dense eigensolve of %zu modes of %zu free DoFs needs %.1f GiB, more than the %.1f GiB of %s",
-		 n_req, n, need / (1 << 30), budget / (1 << 30), what);
+	snprintf(err, errlen, "modes: the dense eigensolve of %zu modes of %zu free DoFs%s needs %.1f GiB, more than the %.1f GiB of %s",
+		 n_req, n, blocks > 1 ? " (split by symmetry)" : "", need / (1 << 30),
+		 budget / (1 << 30), what);
 	return false;
+}
+
+/* The blocks a dense solve splits into: only the every-mode solve of a
+ * lumped mass splits (dense_at, eig_dense_at.c). */
+static unsigned split_blocks(const struct irdm_fem *fem, const struct irdm_modes_want *want,
+			     size_t n_req)
+{
+	if (!want || !want->every || !want->sym || n_req != fem->K.n ||
+	    !irdm_eig_mass_is_diagonal(&fem->M))
+		return 1;
+	return 1u << want->sym->n_gens;
 }
 
 static void rest_free(struct irdm_modes_rest *r)
@@ -378,7 +394,7 @@ int irdm_modes_solve_kept(const struct irdm_fem *fem, size_t n_wanted, bool floa
 		snprintf(err, errlen, "slepc: no distributed eigensolver given");
 		return IRDM_EINVAL;
 	}
-	if (method == IRDM_EIG_DENSE && !dense_fits(n, n_req, err, errlen))
+	if (method == IRDM_EIG_DENSE && !dense_fits(n, n_req, split_blocks(fem, want, n_req), err, errlen))
 		return IRDM_ENOMEM;
 	has_phi = method != IRDM_EIG_SLEPC || dist->rank == 0;
 	w2 = malloc(n_req * sizeof(double));
