@@ -379,6 +379,40 @@ static void test_symmetry_found(void **state)
 	irdm_model_free(&m);
 }
 
+/*
+ * A character no DoF has: the 2 x 2 x 2 cube with only the centre of its
+ * top face free has the x and y mirrors (four characters), and that
+ * node's three DoFs lie in three of them (x odd, y odd, z even under
+ * both).  The empty block is skipped, not solved, and the three modes are
+ * the whole solve's.
+ */
+static void test_symmetry_empty_blocks(void **state)
+{
+	struct irdm_scene sc;
+	struct irdm_model m;
+	char err[256], fixed[128] = "nodes:";
+	double w[3], phi[9];
+
+	(void)state;
+	irdm_scene_defaults(&sc);
+	assert_int_equal(irdm_scene_set(&sc, "mesh", "box:0.1,0.1,0.1", "test", err, sizeof(err)), 0);
+	sc.res[0] = sc.res[1] = sc.res[2] = 2;
+	for (int i = 0; i < 27; i++)
+		if (i != 22) /* the top face's centre */
+			snprintf(fixed + strlen(fixed), sizeof(fixed) - strlen(fixed), "%s%d",
+				 i ? "," : "", i);
+	assert_int_equal(irdm_scene_set(&sc, "fixed", fixed, "test", err, sizeof(err)), 0);
+	assert_int_equal(irdm_scene_set(&sc, "touch", "nodes:22", "test", err, sizeof(err)), 0);
+	if (irdm_model_build(&sc, 0, NULL, NULL, &m, err, sizeof(err)))
+		fail_msg("%s", err);
+	assert_int_equal(m.fem.K.n, 3);
+	assert_int_equal(m.modes.eig_blocks, 4);
+	assert_int_equal(irdm_eig_dense(&m.fem, 3, w, phi, err, sizeof(err)), 0);
+	for (int k = 0; k < 3; k++)
+		assert_true(fabs(m.modes.omega2[k] - w[k]) <= 1e-13 * w[2]);
+	irdm_model_free(&m);
+}
+
 /* The characters' bases: orthonormal, and together every DoF once. */
 static void check_bases(const struct irdm_sym *sym)
 {
@@ -595,6 +629,7 @@ int main(void)
 		cmocka_unit_test(test_dense_at_rows_as_whole),
 		cmocka_unit_test(test_symmetry_found),
 		cmocka_unit_test(test_symmetry_split_solve),
+		cmocka_unit_test(test_symmetry_empty_blocks),
 		cmocka_unit_test(test_cantilever_matches_euler_bernoulli),
 		cmocka_unit_test(test_free_body_has_six_rigid_modes),
 		cmocka_unit_test(test_grounded_mechanism_is_an_error),

@@ -11,6 +11,7 @@
  * block, B = I.  The blocks of 1/2^g the size cost about 1/4^g of the
  * whole in time and 1/2^g in memory.
  */
+#include <limits.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -22,6 +23,8 @@
 #include "modal/symmetry.h"
 
 #define MAX_PARTS (1 << IRDM_SYM_MAX_GENS)
+/* Out of memory, apart from LAPACK's infos (negative: a bad argument). */
+#define EIG_NOMEM INT_MIN
 
 /* One character's block: its basis, dsytrd's Householder vectors (lower
  * triangle) and scalar factors, the tridiagonal's eigenvectors. */
@@ -56,7 +59,7 @@ void irdm_eig_rest_free(struct irdm_eig_rest *r)
 	free(r);
 }
 
-/* C <- op(Q) C, C n x k; trans "N" or "T".  0, -1 out of memory, or info. */
+/* C <- op(Q) C, C n x k; trans "N" or "T".  0, EIG_NOMEM, or info. */
 static int apply_q(const struct eig_part *p, const char *trans, double *c, int k)
 {
 	double q = 0, *work;
@@ -68,7 +71,7 @@ static int apply_q(const struct eig_part *p, const char *trans, double *c, int k
 	lwork = irdm_eig_work_size(q);
 	work = lwork > 0 ? malloc((size_t)lwork * sizeof(double)) : NULL;
 	if (!work)
-		return -1;
+		return EIG_NOMEM;
 	dormtr_("L", "L", trans, &n, &k, p->a, &n, p->tau, c, &n, work, &lwork, &info);
 	free(work);
 	return info;
@@ -89,7 +92,7 @@ static int fill_part(const struct irdm_eig_rest *r, unsigned pi, const size_t *z
 		return 0;
 	y = malloc(np * cnt * sizeof(double));
 	if (!y)
-		return -1;
+		return EIG_NOMEM;
 	for (j = 0, c = 0; j < k; j++)
 		if (r->part_of[z_cols[j]] == pi)
 			memcpy(&y[c++ * np], &p->z[(size_t)r->local_of[z_cols[j]] * np], np * sizeof(double));
@@ -115,7 +118,7 @@ int irdm_eig_rest_fill(const struct irdm_eig_rest *r, const size_t *z_cols, size
 	for (unsigned p = 0; p < r->n_parts && !ret; p++)
 		ret = fill_part(r, p, z_cols, k, out);
 	if (ret)
-		return ret < 0 ? IRDM_ENOMEM : IRDM_ENUMERIC;
+		return ret == EIG_NOMEM ? IRDM_ENOMEM : IRDM_ENUMERIC;
 	for (size_t j = 0; j < k; j++)
 		for (size_t i = 0; i < n; i++)
 			out[j * n + i] /= r->dsqrt[i];
@@ -132,12 +135,16 @@ static int rows_part(const struct irdm_eig_rest *r, unsigned pi, const int64_t *
 {
 	const struct eig_part *p = &r->part[pi];
 	size_t n = (size_t)r->n, np = (size_t)p->n, t = 0;
-	int ti, ni = p->n, ret = -1;
+	int ti, ni = p->n, ret = EIG_NOMEM;
 	double one = 1.0, zero = 0.0;
-	size_t *sel = malloc((n_at ? n_at : 1) * sizeof(size_t));
-	double *c = calloc(np * (n_at ? n_at : 1), sizeof(double));
-	double *y = malloc(np * (n_at ? n_at : 1) * sizeof(double));
+	size_t *sel, w = np * (n_at ? n_at : 1) + 1;
+	double *c, *y;
 
+	if (!np)
+		return 0; /* a character no DoF has: no modes */
+	sel = malloc((n_at ? n_at : 1) * sizeof(size_t));
+	c = calloc(w, sizeof(double));
+	y = malloc(w * sizeof(double));
 	if (!sel || !c || !y)
 		goto out;
 	for (size_t i = 0; i < n_at; i++)
@@ -165,16 +172,19 @@ out:
 /*
  * Block p's eigenvalues into w (ascending) and its tridiagonal's vectors
  * into p->z, by way of scratch (at least n_p^2: dstedc's own n_p^2
- * workspace is given back before p->z is taken).  0, -1 out of memory,
- * or LAPACK's info; *step the LAPACK step that failed.
+ * workspace is given back before p->z is taken).  0, EIG_NOMEM, or
+ * LAPACK's info; *step the LAPACK step that failed.
  */
 static int solve_part(const struct irdm_fem *fem, const double *dsqrt, struct eig_part *p,
 		      double *w, double *scratch, const char **step)
 {
 	int n = p->n, lwork = -1, liwork = -1, info = 0;
-	double *e = malloc(((size_t)n + 1) * sizeof(double)), *work = NULL;
+	double *e, *work = NULL;
 	int *iwork = NULL;
 
+	if (!n)
+		return 0; /* a character no DoF has: no modes */
+	e = malloc(((size_t)n + 1) * sizeof(double));
 	p->a = malloc(((size_t)n * (size_t)n + 1) * sizeof(double));
 	p->tau = malloc(((size_t)n + 1) * sizeof(double));
 	if (!e || !p->a || !p->tau)
@@ -203,7 +213,27 @@ out_nomem:
 	free(e);
 	free(work);
 	free(iwork);
-	return -1;
+	return EIG_NOMEM;
+}
+
+/* The blocks' sizes squared, summed (n^2 before they are known). */
+static double eig_sum_sq(const struct irdm_eig_rest *r)
+{
+	double sum = 0;
+
+	if (!r->n_parts)
+		return (double)r->n * (double)r->n;
+	for (unsigned p = 0; p < r->n_parts; p++)
+		sum += (double)r->part[p].n * (double)r->part[p].n;
+	return sum;
+}
+
+double irdm_eig_dense_at_bytes(size_t n, double sum_sq)
+{
+	/* phi (n x n), then each block's matrix and its tridiagonal's
+	 * vectors (dstedc's workspace, of the block's size, in place of
+	 * the vectors while it runs) */
+	return 8.0 * ((double)n * (double)n + 2.0 * sum_sq);
 }
 
 struct eig_entry {
@@ -231,7 +261,7 @@ static int merge(struct irdm_eig_rest *r, const double *wl, double *w2, size_t *
 	struct eig_entry *all = malloc((n ? n : 1) * sizeof(*all));
 
 	if (!all)
-		return -1;
+		return EIG_NOMEM;
 	for (unsigned p = 0; p < r->n_parts; off += (size_t)r->part[p++].n)
 		for (int l = 0; l < r->part[p].n; l++)
 			all[k++] = (struct eig_entry){ wl[off + (size_t)l], p, l };
@@ -270,7 +300,7 @@ static int solve_parts(const struct irdm_fem *fem, struct irdm_eig_rest *r, cons
 	size_t n = (size_t)r->n, off = 0;
 	size_t *global[MAX_PARTS] = { NULL };
 	double *wl = malloc((n ? n : 1) * sizeof(double));
-	int info = wl ? 0 : -1;
+	int info = wl ? 0 : EIG_NOMEM;
 
 	for (unsigned p = 0; p < r->n_parts && !info; off += (size_t)r->part[p++].n) {
 		info = solve_part(fem, r->dsqrt, &r->part[p], wl + off, phi, step);
@@ -279,7 +309,7 @@ static int solve_parts(const struct irdm_fem *fem, struct irdm_eig_rest *r, cons
 	for (unsigned p = 0; p < r->n_parts && !info; p++) {
 		global[p] = malloc(((size_t)r->part[p].n + 1) * sizeof(size_t));
 		if (!global[p])
-			info = -1;
+			info = EIG_NOMEM;
 	}
 	if (!info)
 		info = merge(r, wl, w2, global);
@@ -299,17 +329,30 @@ static int solve_parts(const struct irdm_fem *fem, struct irdm_eig_rest *r, cons
 	return info;
 }
 
-/* r's blocks: sym's characters (NULL or no generator: one, the whole). */
+/*
+ * r's blocks: sym's characters (NULL or no generator: one, the whole).
+ * Bases that do not add up to every DoF (not a group, which
+ * irdm_sym_find() rules out) fall back to the whole.  0 or EIG_NOMEM.
+ */
 static int parts_init(struct irdm_eig_rest *r, const struct irdm_fem *fem,
 		      const struct irdm_sym *sym)
 {
 	struct irdm_sym none = { .n = fem->K.n };
 	const struct irdm_sym *s = sym && sym->n_gens ? sym : &none;
 	struct irdm_sym_class cls[MAX_PARTS];
+	size_t total = 0;
+	unsigned n_cls = 1u << s->n_gens;
 
 	if (irdm_sym_classes(s, cls))
-		return -1;
-	r->n_parts = 1u << s->n_gens;
+		return EIG_NOMEM;
+	for (unsigned p = 0; p < n_cls; p++)
+		total += cls[p].n;
+	if (total != fem->K.n) {
+		for (unsigned p = 0; p < n_cls; p++)
+			irdm_sym_class_free(&cls[p]);
+		return s == &none ? EIG_NOMEM : parts_init(r, fem, NULL);
+	}
+	r->n_parts = n_cls;
 	for (unsigned p = 0; p < r->n_parts; p++) {
 		r->part[p].basis = cls[p];
 		r->part[p].n = (int)cls[p].n;
@@ -350,7 +393,7 @@ int irdm_eig_dense_at(const struct irdm_fem *fem, const struct irdm_sym *sym, co
 	if (!r->dsqrt || !r->part_of || !r->local_of || parts_init(r, fem, sym))
 		goto out_nomem;
 	info = solve_parts(fem, r, at, n_at, progress, ctx, w2, phi, &step);
-	if (info < 0)
+	if (info == EIG_NOMEM)
 		goto out_nomem;
 	if (info) {
 		snprintf(err, errlen, "dense eigensolver: %s failed (info %d)", step, info);
@@ -364,7 +407,12 @@ int irdm_eig_dense_at(const struct irdm_fem *fem, const struct irdm_sym *sym, co
 
 out_nomem:
 	snprintf(err, errlen, "dense eigensolver: out of memory for n = %zu (needs %.1f GiB)", n,
-		 3.0 * (double)n * (double)n * 8 / (1 << 30));
+		 irdm_eig_dense_at_bytes(n, r ? eig_sum_sq(r) : (double)n * (double)n) / (1 << 30));
 	irdm_eig_rest_free(r);
 	return IRDM_ENOMEM;
+}
+
+unsigned irdm_eig_rest_blocks(const struct irdm_eig_rest *r)
+{
+	return r ? r->n_parts : 1;
 }

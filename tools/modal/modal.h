@@ -45,6 +45,7 @@ struct irdm_modes {
 	/* non-NULL: some columns of phi hold only want->every's DoFs (NaN
 	 * elsewhere) until irdm_modes_complete() makes them whole */
 	struct irdm_modes_rest *rest;
+	unsigned eig_blocks; /* blocks the solve was split into by symmetry (1: whole) */
 };
 
 /* What the caller will read of the modes (irdm_modes_solve_kept). */
@@ -131,6 +132,11 @@ int irdm_eig_dense_at(const struct irdm_fem *fem, const struct irdm_sym *sym, co
  * irdm_modes_complete(). */
 int irdm_eig_rest_fill(const struct irdm_eig_rest *r, const size_t *z_cols, size_t k, double *out);
 void irdm_eig_rest_free(struct irdm_eig_rest *r);
+/* The blocks r's solve was split into (NULL: 1). */
+unsigned irdm_eig_rest_blocks(const struct irdm_eig_rest *r);
+/* Bytes irdm_eig_dense_at() holds for n DoFs split into blocks whose
+ * sizes squared sum to sum_sq (n^2: whole). */
+double irdm_eig_dense_at_bytes(size_t n, double sum_sq);
 int irdm_eig_lanczos(const struct irdm_fem *fem, size_t n_lowest, double sigma,
 		     irdm_progress_fn progress, void *ctx, double *w2, double *phi,
 		     char *err, size_t errlen);

@@ -44,33 +44,40 @@ struct irdm_modes_rest {
  * budget (util/memory.h)?  It holds the n_req vectors, and the matrix and
  * the eigenvectors of its tridiagonal (or the Cholesky factor): about
  * 8 n (2 n + n_req) bytes, 2.1 GiB for every mode of the paper's cuboid
- * (its measured peak: 2.5 GiB).  Split into `blocks` by symmetry
- * (eig_dense_at.c), each block's matrix and vectors are (n / blocks)^2:
- * 8 n (2 n / blocks + n_req).  If not, say so in err.
+ * (its measured peak: 2.5 GiB).  Split by symmetry (eig_dense_at.c), a
+ * block's matrix and vectors are of its own size: 8 (n n_req + 2 sum_sq),
+ * sum_sq the blocks' sizes squared, summed.  If not, say so in err.
  */
-static bool dense_fits(size_t n, size_t n_req, unsigned blocks, char *err, size_t errlen)
+static bool dense_fits(size_t n, size_t n_req, double sum_sq, char *err, size_t errlen)
 {
 	const char *what;
-	double need = 8.0 * (double)n * (2.0 * (double)n / blocks + (double)n_req);
+	double need = 8.0 * ((double)n * (double)n_req + 2.0 * sum_sq);
 	double budget = irdm_memory_budget(&what);
 
 	if (!(budget > 0) || need <= budget)
 		return true;
 	snprintf(err, errlen, "modes: the dense eigensolve of %zu modes of %zu free DoFs%s needs %.1f GiB, more than the %.1f GiB of %s",
-		 n_req, n, blocks > 1 ? " (split by symmetry)" : "", need / (1 << 30),
-		 budget / (1 << 30), what);
+		 n_req, n, sum_sq < (double)n * (double)n ? " (split by symmetry)" : "",
+		 need / (1 << 30), budget / (1 << 30), what);
 	return false;
 }
 
-/* The blocks a dense solve splits into: only the every-mode solve of a
- * lumped mass splits (dense_at, eig_dense_at.c). */
-static unsigned split_blocks(const struct irdm_fem *fem, const struct irdm_modes_want *want,
-			     size_t n_req)
+/* The dense solve's blocks' sizes squared, summed: n^2 unless it is the
+ * every-mode solve of a lumped mass, which splits by symmetry (dense_at). */
+static double blocks_sum_sq(const struct irdm_fem *fem, const struct irdm_modes_want *want,
+			    size_t n_req)
 {
-	if (!want || !want->every || !want->sym || n_req != fem->K.n ||
-	    !irdm_eig_mass_is_diagonal(&fem->M))
-		return 1;
-	return 1u << want->sym->n_gens;
+	struct irdm_sym_class cls[1 << IRDM_SYM_MAX_GENS];
+	double n = (double)fem->K.n, sum = 0;
+
+	if (!want || !want->every || !want->sym || !want->sym->n_gens || n_req != fem->K.n ||
+	    !irdm_eig_mass_is_diagonal(&fem->M) || irdm_sym_classes(want->sym, cls))
+		return n * n;
+	for (unsigned p = 0; p < 1u << want->sym->n_gens; p++) {
+		sum += (double)cls[p].n * (double)cls[p].n;
+		irdm_sym_class_free(&cls[p]);
+	}
+	return sum;
 }
 
 static void rest_free(struct irdm_modes_rest *r)
@@ -366,6 +373,7 @@ int irdm_modes_solve_kept(const struct irdm_fem *fem, size_t n_wanted, bool floa
 
 	memset(out, 0, sizeof(*out));
 	out->n = n;
+	out->eig_blocks = 1;
 	if (n_wanted == 0 || n_wanted + n_rigid >= n)
 		n_wanted = n > n_rigid ? n - n_rigid : 0;
 	if (n_wanted == 0) {
@@ -394,7 +402,7 @@ int irdm_modes_solve_kept(const struct irdm_fem *fem, size_t n_wanted, bool floa
 		snprintf(err, errlen, "slepc: no distributed eigensolver given");
 		return IRDM_EINVAL;
 	}
-	if (method == IRDM_EIG_DENSE && !dense_fits(n, n_req, split_blocks(fem, want, n_req), err, errlen))
+	if (method == IRDM_EIG_DENSE && !dense_fits(n, n_req, blocks_sum_sq(fem, want, n_req), err, errlen))
 		return IRDM_ENOMEM;
 	has_phi = method != IRDM_EIG_SLEPC || dist->rank == 0;
 	w2 = malloc(n_req * sizeof(double));
@@ -426,6 +434,7 @@ int irdm_modes_solve_kept(const struct irdm_fem *fem, size_t n_wanted, bool floa
 	ret = split_rigid(out, n_req, w2, &phi, scale, floating, err, errlen);
 	out->n_elastic_total = n - out->n_rigid;
 	if (!ret && eig) {
+		out->eig_blocks = irdm_eig_rest_blocks(eig);
 		ret = rest_init(out, eig, want->every, err, errlen);
 		eig = NULL;
 	}

@@ -260,31 +260,36 @@ static void map3_nth(int k, struct map3 *q)
 	}
 }
 
-/* Q's DoF map into s as generator g, if Q is a symmetry of the model. */
-static int try_map(const struct map3 *q, const struct node_index *ix, const double *c,
-		   const struct irdm_fem *fem, struct irdm_sym *s, unsigned g, bool *ok)
+static void free_gen(struct irdm_sym *s, unsigned g)
 {
-	size_t n = fem->K.n;
-	double dev;
-
-	*ok = false;
-	s->to[g] = malloc((n ? n : 1) * sizeof(int64_t));
-	s->sign[g] = malloc(n ? n : 1);
-	if (!s->to[g] || !s->sign[g])
-		return IRDM_ENOMEM;
-	if (dof_map(q, ix, c, fem, s->to[g], s->sign[g])) {
-		dev = fmax(matrix_dev(&fem->K, s->to[g], s->sign[g]),
-			   matrix_dev(&fem->M, s->to[g], s->sign[g]));
-		if (dev <= MATRIX_TOL) {
-			s->mismatch = fmax(s->mismatch, dev);
-			*ok = true;
-			return IRDM_OK;
-		}
-	}
 	free(s->to[g]);
 	free(s->sign[g]);
 	s->to[g] = NULL;
 	s->sign[g] = NULL;
+}
+
+/* Q's DoF map into s as generator g, if Q is a symmetry of the model
+ * (*dev: its mismatch); *ok false, and nothing kept, if not. */
+static int try_map(const struct map3 *q, const struct node_index *ix, const double *c,
+		   const struct irdm_fem *fem, struct irdm_sym *s, unsigned g, bool *ok,
+		   double *dev)
+{
+	size_t n = fem->K.n;
+
+	*ok = false;
+	s->to[g] = malloc((n ? n : 1) * sizeof(int64_t));
+	s->sign[g] = malloc(n ? n : 1);
+	if (!s->to[g] || !s->sign[g]) {
+		free_gen(s, g);
+		return IRDM_ENOMEM;
+	}
+	if (dof_map(q, ix, c, fem, s->to[g], s->sign[g])) {
+		*dev = fmax(matrix_dev(&fem->K, s->to[g], s->sign[g]),
+			    matrix_dev(&fem->M, s->to[g], s->sign[g]));
+		*ok = *dev <= MATRIX_TOL;
+	}
+	if (!*ok)
+		free_gen(s, g);
 	return IRDM_OK;
 }
 
@@ -315,13 +320,65 @@ static bool candidate(const struct map3 *q, int group[][3][3], unsigned n_gens,
 	return true;
 }
 
+/*
+ * Is generator g, as mapped on the DoFs, an involution with signs that
+ * commutes with the generators before it?  The node tolerance could pair
+ * two near-coincident nodes with one; the bases need true orbits.
+ */
+static bool dof_group_ok(const struct irdm_sym *s, unsigned g)
+{
+	const int64_t *t = s->to[g];
+	const signed char *sg = s->sign[g];
+
+	for (size_t d = 0; d < s->n; d++) {
+		if (t[t[d]] != (int64_t)d || sg[d] * sg[t[d]] != 1)
+			return false;
+		for (unsigned h = 0; h < g; h++) {
+			const int64_t *u = s->to[h];
+			if (t[u[d]] != u[t[d]] || sg[u[d]] * s->sign[h][d] != s->sign[h][t[d]] * sg[d])
+				return false;
+		}
+	}
+	return true;
+}
+
+/* The centre of the nodes' bounding box. */
+static void box_centre(const struct node_index *ix, double c[3])
+{
+	double hi[3];
+
+	for (int i = 0; i < 3; i++)
+		hi[i] = ix->lo[i];
+	for (size_t a = 0; a < ix->n; a++)
+		for (int i = 0; i < 3; i++)
+			hi[i] = fmax(hi[i], ix->pos[3 * a + (size_t)i]);
+	for (int i = 0; i < 3; i++)
+		c[i] = 0.5 * (ix->lo[i] + hi[i]);
+}
+
+/* q taken as generator s->n_gens: the group doubled, its name added. */
+static void add_generator(struct irdm_sym *s, const struct map3 *q, int group[][3][3],
+			  struct map3 *gens)
+{
+	int m[3][3];
+	size_t len = strlen(s->what);
+
+	map3_mat(q, m);
+	for (unsigned e = 0; e < 1u << s->n_gens; e++)
+		mat_mul(group[e], m, group[e + (1u << s->n_gens)]);
+	if (len)
+		len += (size_t)snprintf(s->what + len, sizeof(s->what) - len, "; ");
+	describe(q, s->what + len, sizeof(s->what) - len);
+	gens[s->n_gens++] = *q;
+}
+
 int irdm_sym_find(const double *pos_m, size_t n_nodes, const struct irdm_fem *fem,
 		  struct irdm_sym *s, char *err, size_t errlen)
 {
 	struct node_index ix = { 0 };
 	struct map3 gens[IRDM_SYM_MAX_GENS];
-	int group[1 << IRDM_SYM_MAX_GENS][3][3];
-	double c[3], hi[3];
+	int group[1 << IRDM_SYM_MAX_GENS][3][3] = { { { 1, 0, 0 }, { 0, 1, 0 }, { 0, 0, 1 } } };
+	double c[3];
 	int ret;
 
 	memset(s, 0, sizeof(*s));
@@ -333,40 +390,28 @@ int irdm_sym_find(const double *pos_m, size_t n_nodes, const struct irdm_fem *fe
 			snprintf(err, errlen, "symmetry: out of memory for %zu nodes", n_nodes);
 		return ret == IRDM_ENOMEM ? ret : IRDM_OK; /* a point: nothing to split */
 	}
-	for (int i = 0; i < 3; i++)
-		hi[i] = ix.lo[i];
-	for (size_t a = 0; a < n_nodes; a++)
-		for (int i = 0; i < 3; i++)
-			hi[i] = fmax(hi[i], pos_m[3 * a + (size_t)i]);
-	for (int i = 0; i < 3; i++)
-		c[i] = 0.5 * (ix.lo[i] + hi[i]);
-	memset(group, 0, sizeof(group));
-	for (int i = 0; i < 3; i++)
-		group[0][i][i] = 1;
-	for (int k = 0; k < 48 && s->n_gens < IRDM_SYM_MAX_GENS; k++) {
+	box_centre(&ix, c);
+	for (int k = 0; k < 48 && s->n_gens < IRDM_SYM_MAX_GENS && !ret; k++) {
 		struct map3 q;
+		double dev = 0;
 		bool ok;
 
 		map3_nth(k, &q);
 		if (!candidate(&q, group, s->n_gens, gens))
 			continue;
-		ret = try_map(&q, &ix, c, fem, s, s->n_gens, &ok);
-		if (ret) {
-			snprintf(err, errlen, "symmetry: out of memory for %zu DoFs", s->n);
-			irdm_sym_free(s);
-			break;
-		}
-		if (!ok)
+		ret = try_map(&q, &ix, c, fem, s, s->n_gens, &ok, &dev);
+		if (ret || !ok)
 			continue;
-		int m[3][3];
-		size_t len = strlen(s->what);
-		map3_mat(&q, m);
-		for (unsigned e = 0; e < 1u << s->n_gens; e++)
-			mat_mul(group[e], m, group[e + (1u << s->n_gens)]);
-		if (len)
-			len += (size_t)snprintf(s->what + len, sizeof(s->what) - len, "; ");
-		describe(&q, s->what + len, sizeof(s->what) - len);
-		gens[s->n_gens++] = q;
+		if (dof_group_ok(s, s->n_gens)) {
+			s->mismatch = fmax(s->mismatch, dev);
+			add_generator(s, &q, group, gens);
+		} else {
+			free_gen(s, s->n_gens);
+		}
+	}
+	if (ret) {
+		snprintf(err, errlen, "symmetry: out of memory for %zu DoFs", s->n);
+		irdm_sym_free(s);
 	}
 	index_free(&ix);
 	return ret;
@@ -462,6 +507,8 @@ int irdm_sym_classes(const struct irdm_sym *s, struct irdm_sym_class *cls)
 	unsigned n_el = 1u << s->n_gens;
 	bool *seen = calloc(s->n ? s->n : 1, sizeof(bool));
 	int ret = seen ? IRDM_OK : IRDM_ENOMEM;
+
+	memset(cls, 0, n_el * sizeof(*cls)); /* each freeable, allocated or not */
 
 	for (unsigned c = 0; c < n_el && !ret; c++)
 		ret = class_alloc(&cls[c], s->n);

@@ -205,20 +205,21 @@ static int wanted_of_modes(const struct irdm_scene *sc, const struct irdm_model 
 
 /*
  * The model's symmetries, which split a dense all-modes solve into
- * independent blocks (modal/symmetry.h), and a line saying so.
+ * independent blocks (modal/symmetry.h), and a line saying so.  Only a
+ * saving: without the memory to look, the solve is whole.
  */
-static int find_symmetry(const struct irdm_model *m, struct irdm_sym *sym,
-			 irdm_progress_fn progress, void *ctx, char *err, size_t errlen)
+static void find_symmetry(const struct irdm_model *m, struct irdm_sym *sym,
+			  irdm_progress_fn progress, void *ctx)
 {
-	char line[256];
-	int ret = irdm_sym_find(m->mesh.pos_m, m->mesh.n_nodes, &m->fem, sym, err, errlen);
+	char line[256], err[128];
 
-	if (ret || !sym->n_gens || !progress)
-		return ret;
+	if (irdm_sym_find(m->mesh.pos_m, m->mesh.n_nodes, &m->fem, sym, err, sizeof(err)))
+		return; /* irdm_sym_find() left no generator */
+	if (!sym->n_gens || !progress)
+		return;
 	snprintf(line, sizeof(line), "symmetry: %s (to %.1e): a dense solve splits into %u blocks",
 		 sym->what, sym->mismatch, 1u << sym->n_gens);
 	progress(ctx, line, -1.0);
-	return IRDM_OK;
 }
 
 /* Why every mode was wanted, and what wants fewer, after err. */
@@ -293,13 +294,12 @@ int irdm_model_build(const struct irdm_scene *sc, size_t n_modes_needed,
 	/* only the lumped-mass all-modes solve splits (eig_dense_at.c) */
 	if (n_modes_needed == 0 && sc->eigensolver != IRDM_EIG_SLEPC && sc->mass == IRDM_MASS_LUMPED &&
 	    sc->symmetry)
-		ret = find_symmetry(m, &sym, progress, ctx, err, errlen);
+		find_symmetry(m, &sym, progress, ctx);
 	want.sym = &sym;
-	m->eig_blocks = 1u << sym.n_gens;
-	if (!ret)
-		ret = irdm_modes_solve_kept(&m->fem, n_modes_needed, sc->floating, sc->eigensolver,
-					    &dist, &want, progress, ctx, &m->modes, err, errlen);
+	ret = irdm_modes_solve_kept(&m->fem, n_modes_needed, sc->floating, sc->eigensolver, &dist,
+				    &want, progress, ctx, &m->modes, err, errlen);
 	irdm_sym_free(&sym);
+	m->eig_blocks = m->modes.eig_blocks ? m->modes.eig_blocks : 1;
 	free((void *)want.keep);
 	free((void *)want.every);
 	free((void *)want.load_dofs);
