@@ -39,6 +39,9 @@
 #                   its error, tick, bytes and precompute time, on the small
 #                   cuboid's materials (PAPER=1: and the paper's cuboid;
 #                   docs/measurements/error-targets.md)
+#   make scale      the default scene at the paper's mesh and at 11,340
+#                   nodes, its every-mode eigensolve split by symmetry
+#                   (docs/measurements/scale.md)
 #   make format-check  every C source and header against .clang-format
 #                   (clang-format 14); make format rewrites them
 #
