@@ -37,6 +37,14 @@ bool irdm_eig_mass_is_diagonal(const struct irdm_csc *m)
 	return true;
 }
 
+void irdm_eig_mass_sqrt(const struct irdm_csc *m, double *dsqrt)
+{
+	for (size_t j = 0; j < m->n; j++)
+		for (int64_t p = m->colptr[j]; p < m->colptr[j + 1]; p++)
+			if ((size_t)m->rowind[p] == j)
+				dsqrt[j] = sqrt(m->val[p]);
+}
+
 /* A <- L^-1 K L^-T in place; l holds the factor (dense) or NULL when diag. */
 static int reduce_to_standard(const struct irdm_fem *fem, double *a, double *l,
 			      double *dsqrt, bool diag)
@@ -44,10 +52,7 @@ static int reduce_to_standard(const struct irdm_fem *fem, double *a, double *l,
 	int n = (int)fem->K.n, info = 0, one = 1;
 
 	if (diag) {
-		for (size_t j = 0; j < fem->M.n; j++)
-			for (int64_t p = fem->M.colptr[j]; p < fem->M.colptr[j + 1]; p++)
-				if ((size_t)fem->M.rowind[p] == j)
-					dsqrt[j] = sqrt(fem->M.val[p]);
+		irdm_eig_mass_sqrt(&fem->M, dsqrt);
 		for (int j = 0; j < n; j++)
 			for (int i = 0; i < n; i++)
 				a[(size_t)j * n + i] /= dsqrt[i] * dsqrt[j];

@@ -357,10 +357,7 @@ static int parts_init(struct irdm_eig_rest *r, const struct irdm_fem *fem,
 		r->part[p].basis = cls[p];
 		r->part[p].n = (int)cls[p].n;
 	}
-	for (size_t j = 0; j < fem->M.n; j++)
-		for (int64_t p = fem->M.colptr[j]; p < fem->M.colptr[j + 1]; p++)
-			if ((size_t)fem->M.rowind[p] == j)
-				r->dsqrt[j] = sqrt(fem->M.val[p]);
+	irdm_eig_mass_sqrt(&fem->M, r->dsqrt);
 	return 0;
 }
 

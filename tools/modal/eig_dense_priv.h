@@ -11,6 +11,8 @@
 
 /* Whether M has no off-diagonal nonzero (a lumped mass). */
 bool irdm_eig_mass_is_diagonal(const struct irdm_csc *m);
+/* dsqrt[j] = sqrt(M_jj), M lumped. */
+void irdm_eig_mass_sqrt(const struct irdm_csc *m, double *dsqrt);
 /* A LAPACK workspace query's answer as a count; -1 past int. */
 int irdm_eig_work_size(double q);
 /*

@@ -1065,7 +1065,7 @@ static void report(const struct build *b, struct irdm_precompute_report *rep)
 	rep->seconds_mesh = m->seconds_mesh;
 	rep->seconds_fem = m->seconds_fem;
 	rep->seconds_eig = m->seconds_eig;
-	rep->eig_blocks = m->eig_blocks;
+	rep->eig_blocks = m->modes.eig_blocks;
 	rep->mesh_nodes = m->mesh.n_nodes;
 	rep->mesh_tets = m->mesh.n_tets;
 	rep->free_dofs = m->fem.map.n_free;

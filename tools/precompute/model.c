@@ -299,7 +299,6 @@ int irdm_model_build(const struct irdm_scene *sc, size_t n_modes_needed,
 	ret = irdm_modes_solve_kept(&m->fem, n_modes_needed, sc->floating, sc->eigensolver, &dist,
 				    &want, progress, ctx, &m->modes, err, errlen);
 	irdm_sym_free(&sym);
-	m->eig_blocks = m->modes.eig_blocks ? m->modes.eig_blocks : 1;
 	free((void *)want.keep);
 	free((void *)want.every);
 	free((void *)want.load_dofs);

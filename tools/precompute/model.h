@@ -28,7 +28,6 @@ struct irdm_model {
 	size_t n_tris;
 	uint32_t *tris; /* 3 * n_tris, image node indices */
 	double seconds_mesh, seconds_fem, seconds_eig;
-	unsigned eig_blocks; /* the all-modes solve split by symmetry (1: whole) */
 };
 
 /* Builtin or file mesh of the scene (validated, boundary computed); note:

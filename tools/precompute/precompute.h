@@ -27,7 +27,7 @@ struct irdm_precompute_opts {
 struct irdm_precompute_report {
 	double seconds_total, seconds_mesh, seconds_fem, seconds_eig;
 	double seconds_responses, seconds_stability;
-	/* blocks the eigensolve was split into by symmetry (1: whole) */
+	/* blocks the eigensolve was split into by symmetry (1: whole; 0: none ran) */
 	unsigned eig_blocks;
 	size_t image_bytes;
 	size_t mesh_nodes, mesh_tets, free_dofs, rows, cols, tris, modes, modes_total;
