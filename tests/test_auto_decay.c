@@ -267,30 +267,31 @@ static double head_mib(const struct irdm_image *img)
 {
 	if (!img->exact_head)
 		return 0;
-	return (double)img->corr_start[img->meta->n_cols] * img->meta->head_samples * 9 *
-	       irdm_elem_size(img->meta->precision) / (1 << 20);
+	return (double)irdm_image_find(img, IRDM_SEC_EXACT_HEAD)->size / (1 << 20);
 }
 
 /*
  * max_head_mib bounds the head auto builds.  At max_error = 1e-2 (measured
  * candidates, cheapest to tick first: 235 modes + a 32-sample head, 1.91
  * us; 294 + 16, 1.98 us; 218 + 64; 199 + 128; every mode, 3.48 us):
- *  - under 1 MiB the first is over the cap (501 blocks x 64 samples,
- *    1.1 MiB) and is not measured; regrown to 470 modes (3.28 us) it waits
- *    its turn behind 294 + 16, which is written: two builds, as without
- *    the cap (where the first is built and measured over the target);
- *  - under 0.25 MiB, from the first's 501 blocks, 294 + 16 would keep
- *    some 250 or more (it keeps 409): over the cap, as are 218 + 64,
+ *  - under 0.5 MiB the first is over the cap (501 blocks x 64 samples,
+ *    stored as 263 runs of the 25 columns' pairs: 0.58 MiB) and is not
+ *    measured; regrown to 470 modes (3.28 us) it waits its turn behind
+ *    294 + 16 (409 blocks, 0.24 MiB), which is written: two builds, as
+ *    without the cap (where the first is built and measured over the
+ *    target);
+ *  - under 0.125 MiB, from the first's 501 blocks, 294 + 16 would keep
+ *    some 250 or more (0.15 MiB): over the cap, as are 218 + 64,
  *    199 + 128 and the regrown 470 + 32: each is grown without a build,
  *    and every mode is written (two builds, not six);
- *  - under 0.1 MiB no hybrid's head fits: every mode again.
+ *  - under 0.05 MiB no hybrid's head fits: every mode again.
  */
 static void test_head_cap(void **state)
 {
 	static const char *const loose[] = { "max_error", "1e-2", NULL };
-	static const char *const capped[] = { "max_error", "1e-2", "max_head_mib", "1", NULL };
-	static const char *const tight[] = { "max_error", "1e-2", "max_head_mib", "0.25", NULL };
-	static const char *const tiny[] = { "max_error", "1e-2", "max_head_mib", "0.1", NULL };
+	static const char *const capped[] = { "max_error", "1e-2", "max_head_mib", "0.5", NULL };
+	static const char *const tight[] = { "max_error", "1e-2", "max_head_mib", "0.125", NULL };
+	static const char *const tiny[] = { "max_error", "1e-2", "max_head_mib", "0.05", NULL };
 	struct irdm_precompute_report rep;
 	struct irdm_image img;
 	char err[768], path[128];
@@ -300,21 +301,21 @@ static void test_head_cap(void **state)
 	print_message("max_error 1e-2: %zu tries, %s\n", rep.auto_tries, rep.representation);
 	assert_int_equal(rep.auto_tries, 2);
 	assert_int_equal(build("capped.img", &rep, err, sizeof(err), capped), 0);
-	print_message("under 1 MiB: %zu tries, %s\n", rep.auto_tries, rep.representation);
+	print_message("under 0.5 MiB: %zu tries, %s\n", rep.auto_tries, rep.representation);
 	assert_int_equal(rep.auto_tries, 2); /* not the regrown 470 before 294 + 16 */
 	snprintf(path, sizeof(path), "%s/capped.img", dir);
 	assert_int_equal(irdm_image_map(path, 0, &img, err, sizeof(err)), 0);
-	assert_true(head_mib(&img) > 0 && head_mib(&img) <= 1.0);
+	assert_true(head_mib(&img) > 0 && head_mib(&img) <= 0.5);
 	assert_int_equal(img.meta->n_modes, 294);
 	irdm_image_unmap(&img);
 
 	assert_int_equal(build("quarter.img", &rep, err, sizeof(err), tight), 0);
-	print_message("under 0.25 MiB: %zu tries, %s\n", rep.auto_tries, rep.representation);
+	print_message("under 0.125 MiB: %zu tries, %s\n", rep.auto_tries, rep.representation);
 	assert_int_equal(rep.auto_tries, 2);
 	assert_non_null(strstr(rep.representation, "modal:all"));
 
 	assert_int_equal(build("tiny.img", &rep, err, sizeof(err), tiny), 0);
-	print_message("under 0.1 MiB: %s\n", rep.representation);
+	print_message("under 0.05 MiB: %s\n", rep.representation);
 	snprintf(path, sizeof(path), "%s/tiny.img", dir);
 	assert_int_equal(irdm_image_map(path, 0, &img, err, sizeof(err)), 0);
 	assert_true(head_mib(&img) == 0);

@@ -23,6 +23,7 @@
 #include <cmocka.h>
 
 #include "image/image_response.h"
+#include "image/image_writer.h"
 #include "replay/replay.h"
 #include "support/engine_fixture.h"
 #include "irdm/posix/image_map.h"
@@ -850,6 +851,96 @@ static void test_hop(void **state)
 	free(R);
 }
 
+/*
+ * The hybrid's head by pairs (HEAD_PAIRS: a block read as its mirror's run
+ * transposed) against the same image with every block's run written out
+ * here from the format's rule: the hop's forces, both sums, to the bit
+ * (the same numbers in the same order).
+ */
+static void *whole_head(const struct irdm_image *img, uint64_t *bytes)
+{
+	uint32_t n_blocks = img->corr_start[img->meta->n_cols], S = img->meta->head_samples;
+	const float *runs = img->exact_head;
+	float *out = malloc((size_t)n_blocks * S * 9 * sizeof(float));
+
+	assert_non_null(out);
+	assert_int_equal(img->meta->precision, IRDM_ELEM_F32);
+	for (size_t k = 0; k < n_blocks; k++) {
+		uint32_t v = img->head_index[k];
+		bool tr = v & IRDM_HEAD_TRANSPOSED;
+		const float *src = &runs[(size_t)(v & IRDM_HEAD_RUN_MASK) * S * 9];
+		for (size_t s = 0; s < S; s++)
+			for (size_t i = 0; i < 9; i++)
+				out[(k * S + s) * 9 + i] = src[s * 9 + (tr ? 3 * (i % 3) + i / 3 : i)];
+	}
+	*bytes = (uint64_t)n_blocks * S * 9 * sizeof(float);
+	return out;
+}
+
+static void write_whole(const struct irdm_image *img, const char *path)
+{
+	const struct irdm_image_header *h = (const void *)img->base;
+	const struct irdm_image_section *sec = (const void *)(img->base + h->section_table_offset);
+	struct irdm_meta meta = *img->meta;
+	struct irdm_image_writer w;
+	uint64_t head_bytes;
+	void *head = whole_head(img, &head_bytes);
+	char err[256];
+
+	meta.flags &= ~IRDM_META_HEAD_PAIRS;
+	irdm_iw_init(&w);
+	for (uint32_t i = 0; i < h->section_count; i++) {
+		const void *data = img->base + sec[i].offset;
+		uint64_t size = sec[i].size;
+		if (sec[i].kind == IRDM_SEC_EXACT_HEAD_INDEX)
+			continue;
+		if (sec[i].kind == IRDM_SEC_META)
+			data = &meta;
+		if (sec[i].kind == IRDM_SEC_EXACT_HEAD)
+			data = head, size = head_bytes;
+		assert_int_equal(irdm_iw_add(&w, sec[i].kind, sec[i].elem, data, size), 0);
+	}
+	assert_int_equal(irdm_iw_write(&w, path, err, sizeof(err)), 0);
+	free(head);
+}
+
+static void test_head_pairs(void **state)
+{
+	struct irdm_contact_site *sites = malloc(N_STROKE * sizeof(*sites));
+	double *u = calloc(N_STROKE * 3, sizeof(double));
+	double *F = malloc(N_STROKE * 3 * sizeof(double)), *W = malloc(N_STROKE * 3 * sizeof(double));
+	uint32_t n_blocks = hybrid.corr_start[hybrid.meta->n_cols], n_tr = 0;
+	struct irdm_image whole;
+	char path[128], err[256];
+
+	(void)state;
+	assert_true(sites && u && F && W);
+	assert_non_null(hybrid.head_index);
+	for (uint32_t k = 0; k < n_blocks; k++)
+		n_tr += (hybrid.head_index[k] & IRDM_HEAD_TRANSPOSED) != 0;
+	snprintf(path, sizeof(path), "%s/hybrid-whole.img", dir);
+	write_whole(&hybrid, path);
+	assert_int_equal(irdm_image_map(path, 0, &whole, err, sizeof(err)), 0);
+	assert_null(whole.head_index);
+	print_message("hybrid head: %u blocks in %u runs (%u read transposed); whole: %llu bytes more\n",
+		      n_blocks, n_blocks - n_tr, n_tr,
+		      (unsigned long long)(irdm_image_find(&whole, IRDM_SEC_EXACT_HEAD)->size -
+					   irdm_image_find(&hybrid, IRDM_SEC_EXACT_HEAD)->size));
+	assert_true(2 * n_tr + hybrid.meta->n_cols == n_blocks);
+	for (size_t t = 0; t < N_STROKE; t++)
+		u[3 * t + 2] = -0.002 * fmin(1.0, (double)t / 50.0);
+	for (int p = 0; p < 2; p++) {
+		hop_run(&hybrid, p, false, sites, u, F);
+		hop_run(&whole, p, false, sites, u, W);
+		assert_memory_equal(F, W, N_STROKE * 3 * sizeof(double));
+	}
+	irdm_image_unmap(&whole);
+	free(sites);
+	free(u);
+	free(F);
+	free(W);
+}
+
 /* Each error the engine's header documents, from the call that returns it. */
 static void test_errors(void **state)
 {
@@ -965,6 +1056,7 @@ int main(void)
 		cmocka_unit_test(test_push_release),
 		cmocka_unit_test(test_stroke),
 		cmocka_unit_test(test_hop),
+		cmocka_unit_test(test_head_pairs),
 		cmocka_unit_test(test_errors),
 		cmocka_unit_test(test_node_disp_between_ticks),
 	};

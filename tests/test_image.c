@@ -1377,6 +1377,62 @@ static void w_add_head_nan(struct irdm_image_writer *w)
 	head_blocks[40] = NAN;
 }
 
+static void w_add_scales(struct irdm_image_writer *w);
+
+/* The head by pairs (2.5) of the modal fixture's 2 x 2 blocks: runs for
+ * (0, 0), (0, 1) and (1, 1); block (1, 0) reads (0, 1)'s transposed. */
+static const uint32_t pairs_ok[4] = { 0, 1, 1 | IRDM_HEAD_TRANSPOSED, 2 };
+static const uint32_t pairs_skip[4] = { 0, 2, 2 | IRDM_HEAD_TRANSPOSED, 3 };
+static const uint32_t pairs_upright[4] = { 0, 1, 1, 2 };
+static const uint32_t pairs_other[4] = { 0, 1, 0 | IRDM_HEAD_TRANSPOSED, 2 };
+
+static void w_add_pairs_runs(struct irdm_image_writer *w, const uint32_t *index)
+{
+	for (size_t i = 0; i < sizeof(head_blocks) / sizeof(head_blocks[0]); i++)
+		head_blocks[i] = (double)i / 64;
+	irdm_iw_add(w, IRDM_SEC_EXACT_HEAD, IRDM_ELEM_F64, head_blocks, sizeof(head_blocks) * 3 / 4);
+	if (index)
+		irdm_iw_add(w, IRDM_SEC_EXACT_HEAD_INDEX, IRDM_ELEM_U32, index, 4 * sizeof(uint32_t));
+}
+
+static void w_add_pairs(struct irdm_image_writer *w)
+{
+	w_add_pairs_runs(w, pairs_ok);
+}
+
+static void w_add_pairs_skip(struct irdm_image_writer *w)
+{
+	w_add_pairs_runs(w, pairs_skip);
+}
+
+static void w_add_pairs_upright(struct irdm_image_writer *w)
+{
+	w_add_pairs_runs(w, pairs_upright);
+}
+
+static void w_add_pairs_other(struct irdm_image_writer *w)
+{
+	w_add_pairs_runs(w, pairs_other);
+}
+
+static void w_add_pairs_no_index(struct irdm_image_writer *w)
+{
+	w_add_pairs_runs(w, NULL);
+}
+
+/* every block's run, as without pairs, but the index too */
+static void w_add_pairs_whole(struct irdm_image_writer *w)
+{
+	w_add_head(w);
+	irdm_iw_add(w, IRDM_SEC_EXACT_HEAD_INDEX, IRDM_ELEM_U32, pairs_ok, sizeof(pairs_ok));
+}
+
+static void w_add_pairs_scales(struct irdm_image_writer *w)
+{
+	w_add_pairs(w);
+	w_add_scales(w);
+}
+
 /* an index in a FIR image */
 static void w_add_corr_index(struct irdm_image_writer *w)
 {
@@ -1473,6 +1529,11 @@ FX(m_head_samples_only, fx->meta.head_samples = 2)
 FX(m_head_no_corr, (fx->meta.flags = (fx->meta.flags & ~IRDM_META_STATIC_CORR) | IRDM_META_EXACT_HEAD,
 		    fx->meta.head_samples = 2))
 FX(m_head_big, (fx->meta.flags |= IRDM_META_EXACT_HEAD, fx->meta.head_samples = IRDM_HEAD_SAMPLES_MAX + 1))
+/* the head by pairs (format 2.5) */
+FX(m_pairs, (fx->meta.flags |= IRDM_META_EXACT_HEAD | IRDM_META_HEAD_PAIRS, fx->meta.head_samples = 2))
+FX(m_pairs_no_head, fx->meta.flags |= IRDM_META_HEAD_PAIRS)
+FX(m_pairs_scale, (fx->meta.flags |= IRDM_META_EXACT_HEAD | IRDM_META_HEAD_PAIRS | IRDM_META_COLUMN_SCALE,
+		   fx->meta.head_samples = 2))
 FX(m_tool_nul, memset(fx->meta.tool_version, 'x', 32))
 FX(m_name_nul, memset(fx->meta.mesh_name, 'x', 64))
 FX(m_node_nan, fx->nodes[3].pos_m[1] = NAN)
@@ -1816,6 +1877,15 @@ static const struct sem_case sem_cases[] = {
 	{ "head short", MODAL, m_head2, w_add_head_short, IRDM_EFORMAT, "section EXACT_HEAD has 288 bytes, expected 576" },
 	{ "head NaN", MODAL, m_head2, w_add_head_nan, IRDM_EFORMAT, "EXACT_HEAD element 40 is not finite" },
 	{ "FIR + head", FIR, NULL, w_add_head, IRDM_EFORMAT, "EXACT_HEAD must not be present (FIR image)" },
+	{ "head by pairs", MODAL, m_pairs, w_add_pairs, IRDM_OK, NULL },
+	{ "head pairs, no index", MODAL, m_pairs, w_add_pairs_no_index, IRDM_EMISSING, "EXACT_HEAD_INDEX is missing" },
+	{ "head index without the flag", MODAL, m_head2, w_add_pairs_whole, IRDM_EFORMAT, "EXACT_HEAD_INDEX must not be present (meta flags lack HEAD_PAIRS)" },
+	{ "head pairs without a head", MODAL, m_pairs_no_head, NULL, IRDM_EFORMAT, "HEAD_PAIRS without EXACT_HEAD" },
+	{ "head pairs, column scales", MODAL, m_pairs_scale, w_add_pairs_scales, IRDM_EFORMAT, "both HEAD_PAIRS and COLUMN_SCALE" },
+	{ "head pairs, a run skipped", MODAL, m_pairs, w_add_pairs_skip, IRDM_EFORMAT, "EXACT_HEAD_INDEX entry 1 (column 0, row 1) is 0x2, expected 1 (the next stored run)" },
+	{ "head pairs, mirror upright", MODAL, m_pairs, w_add_pairs_upright, IRDM_EFORMAT, "EXACT_HEAD_INDEX entry 2 (column 1, row 0) is 0x1, expected its mirror's run 1 transposed" },
+	{ "head pairs, another's run", MODAL, m_pairs, w_add_pairs_other, IRDM_EFORMAT, "EXACT_HEAD_INDEX entry 2 (column 1, row 0) is 0x80000000, expected its mirror's run 1 transposed" },
+	{ "head pairs, every block's run", MODAL, m_pairs, w_add_pairs_whole, IRDM_EFORMAT, "section EXACT_HEAD has 576 bytes, expected 432 (runs in EXACT_HEAD_INDEX x head_samples x 9 x 8)" },
 	{ "column scales", FIR, m_scale, w_add_scales, IRDM_OK, NULL },
 	{ "column scales, modal", MODAL, m_scale, w_add_scales, IRDM_OK, NULL },
 	{ "column scales missing", FIR, m_scale, NULL, IRDM_EMISSING, "COLUMN_SCALE is missing" },

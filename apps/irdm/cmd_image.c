@@ -32,16 +32,6 @@ static const char *elem_name(uint32_t e)
 	return e < 5 ? names[e] : "?";
 }
 
-static const char *kind_name(uint32_t k)
-{
-	static const char *const names[] = { "?", "META", "PROVENANCE", "NODES", "COLUMNS",
-					     "SURFACE", "FIR", "MODES", "MODE_SHAPES", "STATIC_CORR", "RIGID", "STABILITY",
-					     "CONTACT_BVH", "STATIC_CORR_INDEX", "STATIC_CORR_LOWRANK", "EXACT_HEAD",
-					     "STATIC_CORR_CLUSTERS", "COLUMN_SCALE" };
-
-	return k < sizeof(names) / sizeof(names[0]) ? names[k] : "unknown";
-}
-
 static int open_image(const char *path, struct irdm_image *img)
 {
 	char err[512];
@@ -120,9 +110,10 @@ static int cmd_info(const char *path)
 		print_clusters(&img);
 	if (img.exact_head)
 		printf("exact head    the %u dropped modes' response at the kept blocks: samples "
-		       "0..%u exact, %u..%u tapered, sum = static correction (hybrid)\n",
+		       "0..%u exact, %u..%u tapered, sum = static correction (hybrid)%s\n",
 		       m->n_modes_total - m->n_modes, m->head_samples / 2 - 1, m->head_samples / 2,
-		       m->head_samples - 1);
+		       m->head_samples - 1,
+		       img.head_index ? "; each symmetric pair of blocks stored once" : "");
 	if (img.col_scale)
 		print_scales(&img);
 	printf("dt            %g s (%g Hz)\n", m->dt_s, 1.0 / m->dt_s);
@@ -152,7 +143,7 @@ static int cmd_info(const char *path)
 	printf("sections\n");
 	const struct irdm_image_section *s = (const void *)(img.base + h->section_table_offset);
 	for (uint32_t i = 0; i < h->section_count; i++)
-		printf("  %-20s %-5s offset %10llu  size %12llu  crc32c %08x\n", kind_name(s[i].kind),
+		printf("  %-20s %-5s offset %10llu  size %12llu  crc32c %08x\n", irdm_image_kind_name(s[i].kind),
 		       elem_name(s[i].elem), (unsigned long long)s[i].offset,
 		       (unsigned long long)s[i].size, s[i].crc32c);
 	printf("columns (mesh nodes):");

@@ -9,18 +9,22 @@
  * with D_0 in R[0] (in place of the whole correction block, which is the
  * sum of the D_s) and the older samples summed over the last H - 1 ticks'
  * forces, as the lanes hold them by column (head_lanes.c), or from the
- * ring of ticks while the lanes miss one.  Modal images without a head
- * have H = 0 and never reach either.
+ * ring of ticks while the lanes miss one.  A block stored as its
+ * mirror's run (HEAD_PAIRS) is read transposed: its loads permuted, the
+ * same sums.  Modal images without a head have H = 0 and never reach
+ * either.
  */
 #include "engine_priv.h"
 
 /* D_s of kept block k, a block of force column col, into blk (row-major 3x3). */
 static void head_block(const struct irdm_engine *e, uint32_t col, long k, uint32_t s, double blk[9])
 {
-	size_t base = ((size_t)k * e->H + s) * 9;
+	bool tr;
+	size_t base = (irdm_image_head_run(e->img, (size_t)k, &tr) * e->H + s) * 9;
 
 	for (size_t i = 0; i < 9; i++)
-		blk[i] = irdm_image_value(e->img, e->img->exact_head, col, base + i);
+		blk[i] = irdm_image_value(e->img, e->img->exact_head, col,
+					  base + irdm_head_elem(tr, i));
 }
 
 bool irdm_head_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp, double blk[9])
@@ -32,6 +36,10 @@ bool irdm_head_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_
 	head_block(e, col_force, k, 0, blk);
 	return true;
 }
+
+/* The element each of a block's nine sums loads: upright, transposed. */
+static const uint8_t block_elem[2][9] = { { 0, 1, 2, 3, 4, 5, 6, 7, 8 },
+					  { 0, 3, 6, 1, 4, 7, 2, 5, 8 } };
 
 /*
  * acc[3 i + j] += sum over the ring's ticks of age s in [1, H) of
@@ -53,15 +61,18 @@ bool irdm_head_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_
 			slot = slot ? slot - 1 : e->H - 1; \
 			for (uint32_t n = 0; n < t->n; n++) { \
 				long k = irdm_head_cached_block(e, &cache, t->col[n], col); \
+				bool tr; \
 				if (k < 0) \
 					continue; /* a dropped block: no head either */ \
-				const TYPE *d = &D[((size_t)k * e->H + s) * 9]; \
+				size_t run = irdm_image_head_run(e->img, (size_t)k, &tr); \
+				const TYPE *d = &D[(run * e->H + s) * 9]; \
+				const uint8_t *x = block_elem[tr]; \
 				double f0 = t->f_n[n][0], f1 = t->f_n[n][1], f2 = t->f_n[n][2]; \
-				a0 += LOAD(d[0]) * f0, a1 += LOAD(d[1]) * f1; \
-				a2 += LOAD(d[2]) * f2, a3 += LOAD(d[3]) * f0; \
-				a4 += LOAD(d[4]) * f1, a5 += LOAD(d[5]) * f2; \
-				a6 += LOAD(d[6]) * f0, a7 += LOAD(d[7]) * f1; \
-				a8 += LOAD(d[8]) * f2; \
+				a0 += LOAD(d[x[0]]) * f0, a1 += LOAD(d[x[1]]) * f1; \
+				a2 += LOAD(d[x[2]]) * f2, a3 += LOAD(d[x[3]]) * f0; \
+				a4 += LOAD(d[x[4]]) * f1, a5 += LOAD(d[x[5]]) * f2; \
+				a6 += LOAD(d[x[6]]) * f0, a7 += LOAD(d[x[7]]) * f1; \
+				a8 += LOAD(d[x[8]]) * f2; \
 			} \
 		} \
 		acc[0] = a0, acc[1] = a1, acc[2] = a2, acc[3] = a3, acc[4] = a4; \
@@ -95,10 +106,11 @@ void irdm_head_ring_sum(const struct irdm_engine *e, uint32_t col, double u[3])
 
 /*
  * acc[3 i + j] += sum over a run's samples of D_s[i][j] f_j: nine sums
- * side by side, in the order of the ages.
+ * side by side, in the order of the ages (x: block_elem[transposed]).
  */
 #define RUN_SUM(NAME, TYPE, LOAD) \
-	static void NAME(const TYPE *d, const struct head_run *r, double acc[9]) \
+	static void NAME(const TYPE *d, const uint8_t *x, const struct head_run *r, \
+			 double acc[9]) \
 	{ \
 		const double *f = r->f; \
 		double a0 = acc[0], a1 = acc[1], a2 = acc[2], a3 = acc[3], a4 = acc[4]; \
@@ -107,11 +119,11 @@ void irdm_head_ring_sum(const struct irdm_engine *e, uint32_t col, double u[3])
 		d += (size_t)r->s * 9; \
 		for (uint32_t i = 0; i < r->n; i++, d += 9, f += HEAD_SAMPLE) { \
 			double f0 = f[0], f1 = f[1], f2 = f[2]; \
-			a0 += LOAD(d[0]) * f0, a1 += LOAD(d[1]) * f1; \
-			a2 += LOAD(d[2]) * f2, a3 += LOAD(d[3]) * f0; \
-			a4 += LOAD(d[4]) * f1, a5 += LOAD(d[5]) * f2; \
-			a6 += LOAD(d[6]) * f0, a7 += LOAD(d[7]) * f1; \
-			a8 += LOAD(d[8]) * f2; \
+			a0 += LOAD(d[x[0]]) * f0, a1 += LOAD(d[x[1]]) * f1; \
+			a2 += LOAD(d[x[2]]) * f2, a3 += LOAD(d[x[3]]) * f0; \
+			a4 += LOAD(d[x[4]]) * f1, a5 += LOAD(d[x[5]]) * f2; \
+			a6 += LOAD(d[x[6]]) * f0, a7 += LOAD(d[x[7]]) * f1; \
+			a8 += LOAD(d[x[8]]) * f2; \
 		} \
 		acc[0] = a0, acc[1] = a1, acc[2] = a2, acc[3] = a3, acc[4] = a4; \
 		acc[5] = a5, acc[6] = a6, acc[7] = a7, acc[8] = a8; \
@@ -130,17 +142,21 @@ static void lane_sum(const struct irdm_engine *e, uint32_t n_spans, const struct
 
 	for (uint32_t l = 0; l < n_spans; l++) {
 		long k = irdm_image_corr_block(e->img, sp[l].col, col);
+		bool tr;
 		if (k < 0)
 			continue; /* a dropped block: no head either */
-		size_t base = (size_t)k * e->H * 9;
+		size_t base = irdm_image_head_run(e->img, (size_t)k, &tr) * e->H * 9;
+		const uint8_t *x = block_elem[tr];
 		for (uint32_t r = 0; r < sp[l].n_runs; r++) {
 			if (prec == IRDM_ELEM_F64)
-				run_sum_f64((const double *)e->img->exact_head + base, &sp[l].run[r], acc);
-			else if (prec == IRDM_ELEM_F32)
-				run_sum_f32((const float *)e->img->exact_head + base, &sp[l].run[r], acc);
-			else
-				run_sum_f16((const uint16_t *)e->img->exact_head + base, &sp[l].run[r],
+				run_sum_f64((const double *)e->img->exact_head + base, x, &sp[l].run[r],
 					    acc);
+			else if (prec == IRDM_ELEM_F32)
+				run_sum_f32((const float *)e->img->exact_head + base, x, &sp[l].run[r],
+					    acc);
+			else
+				run_sum_f16((const uint16_t *)e->img->exact_head + base, x,
+					    &sp[l].run[r], acc);
 		}
 	}
 	for (int i = 0; i < 3; i++)

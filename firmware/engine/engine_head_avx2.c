@@ -5,8 +5,10 @@
  *   acc(col) = sum_{s=1}^{H-1} sum_e D_s(e -> col) f_e[t-s],
  * each block by three fused multiply-adds (wide_block.h), two sets of
  * accumulators over alternate samples so that consecutive multiply-adds do
- * not wait on each other.  Same sum, different rounding than the portable
- * loop (a different order, fused products): 1e-14 apart (test_engine).
+ * not wait on each other.  A block stored as its mirror's run (HEAD_PAIRS)
+ * loads transposed (block_acc_t()).  Same sum, different rounding than the
+ * portable loop (a different order, fused products): 1e-14 apart
+ * (test_engine).
  */
 #include <stdbool.h>
 
@@ -24,10 +26,15 @@ static WIDE_INLINE void tick_acc(const struct irdm_engine *e, uint32_t prec, con
 		long k = irdm_head_cached_block(e, cache, t->col[n], col);
 		__m256d p0, p1;
 		double p2;
+		bool tr;
 		if (k < 0)
 			continue; /* a dropped block: no head either */
+		size_t i = (irdm_image_head_run(e->img, (size_t)k, &tr) * e->H + s) * 9;
 		force_pattern(t->f_n[n], 1.0, &p0, &p1, &p2);
-		block_acc(D, prec, ((size_t)k * e->H + s) * 9, p0, p1, p2, acc);
+		if (tr)
+			block_acc_t(D, prec, i, p0, p1, p2, acc);
+		else
+			block_acc(D, prec, i, p0, p1, p2, acc);
 	}
 }
 
@@ -112,14 +119,24 @@ static WIDE_INLINE void fold_add(const struct row_acc *a, double u[3])
 		u[i] += v[i];
 }
 
+/* Block d of one row, upright or transposed (tr: the same every sample). */
+static WIDE_INLINE void row_block(const void *d, bool tr, uint32_t prec, size_t i, __m256d p0,
+				  __m256d p1, double p2, struct row_acc *a)
+{
+	if (tr)
+		block_acc_t(d, prec, i, p0, p1, p2, a);
+	else
+		block_acc(d, prec, i, p0, p1, p2, a);
+}
+
 /*
  * One run of a lane against the blocks d[0 .. n_rows - 1] (n_rows a
- * constant at each call site, as prec is): a sample's force loads once for
- * every row.
+ * constant at each call site, as prec is; tr[r]: d[r] read transposed): a
+ * sample's force loads once for every row.
  */
 static WIDE_INLINE void run_acc(uint32_t prec, uint32_t n_rows, const void *const *d,
-				const struct head_run *run, struct row_acc *a0, struct row_acc *a1,
-				struct row_acc *a2)
+				const bool *tr, const struct head_run *run, struct row_acc *a0,
+				struct row_acc *a1, struct row_acc *a2)
 {
 	const double *f = run->f;
 	size_t i = (size_t)run->s * 9;
@@ -127,11 +144,11 @@ static WIDE_INLINE void run_acc(uint32_t prec, uint32_t n_rows, const void *cons
 	for (uint32_t j = 0; j < run->n; j++, i += 9, f += HEAD_SAMPLE) {
 		__m256d p0 = _mm256_loadu_pd(f), p1 = _mm256_loadu_pd(f + 4);
 		double p2 = f[2];
-		block_acc(d[0], prec, i, p0, p1, p2, a0);
+		row_block(d[0], tr[0], prec, i, p0, p1, p2, a0);
 		if (n_rows > 1)
-			block_acc(d[1], prec, i, p0, p1, p2, a1);
+			row_block(d[1], tr[1], prec, i, p0, p1, p2, a1);
 		if (n_rows > 2)
-			block_acc(d[2], prec, i, p0, p1, p2, a2);
+			row_block(d[2], tr[2], prec, i, p0, p1, p2, a2);
 	}
 }
 
@@ -153,16 +170,17 @@ static WIDE_INLINE void lanes_pass(const struct irdm_engine *e, uint32_t prec, u
 	a0.a2 = a1.a2 = a2.a2 = 0;
 	for (uint32_t l = 0; l < n_spans; l++) {
 		const void *d[3];
-		bool kept = false;
+		bool kept = false, tr[3] = { false, false, false };
 		for (uint32_t r = 0; r < n_rows; r++) {
 			long k = irdm_image_corr_block(e->img, sp[l].col, cols[r]);
-			d[r] = k < 0 ? e->lanes.zeros : D + (size_t)k * e->H * 9 * elem;
+			d[r] = k < 0 ? e->lanes.zeros :
+				       D + irdm_image_head_run(e->img, (size_t)k, &tr[r]) * e->H * 9 * elem;
 			kept |= k >= 0;
 		}
 		if (!kept)
 			continue; /* dropped blocks: no head either */
 		for (uint32_t r = 0; r < sp[l].n_runs; r++)
-			run_acc(prec, n_rows, d, &sp[l].run[r], &a0, &a1, &a2);
+			run_acc(prec, n_rows, d, tr, &sp[l].run[r], &a0, &a1, &a2);
 	}
 	fold_add(&a0, u[0]);
 	if (n_rows > 1)

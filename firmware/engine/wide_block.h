@@ -67,6 +67,40 @@ static WIDE_INLINE void block_acc(const void *fir, uint32_t prec, size_t i, __m2
 	acc->a2 = __builtin_fma(load1(fir, prec, i + 8), p2, acc->a2);
 }
 
+/*
+ * The same for a block stored transposed (a hybrid image's HEAD_PAIRS):
+ * its first eight elements loaded in the order 0 3 6 1 4 7 2 5, so that
+ * the sums are those of the block upright.
+ */
+static WIDE_INLINE void block_acc_t(const void *fir, uint32_t prec, size_t i, __m256d p0,
+				    __m256d p1, double p2, struct row_acc *acc)
+{
+	__m256d t0, t1;
+	__m256 v;
+
+	switch (prec) {
+	case IRDM_ELEM_F64: {
+		const double *d = (const double *)fir + i;
+		t0 = _mm256_setr_pd(d[0], d[3], d[6], d[1]);
+		t1 = _mm256_setr_pd(d[4], d[7], d[2], d[5]);
+		break;
+	}
+	case IRDM_ELEM_F32:
+		v = _mm256_loadu_ps((const float *)fir + i);
+		goto permute;
+	default:
+		v = _mm256_cvtph_ps(_mm_loadu_si128((const __m128i *)((const uint16_t *)fir + i)));
+permute:
+		v = _mm256_permutevar8x32_ps(v, _mm256_setr_epi32(0, 3, 6, 1, 4, 7, 2, 5));
+		t0 = _mm256_cvtps_pd(_mm256_castps256_ps128(v));
+		t1 = _mm256_cvtps_pd(_mm256_extractf128_ps(v, 1));
+		break;
+	}
+	acc->a0 = _mm256_fmadd_pd(t0, p0, acc->a0);
+	acc->a1 = _mm256_fmadd_pd(t1, p1, acc->a1);
+	acc->a2 = __builtin_fma(load1(fir, prec, i + 8), p2, acc->a2);
+}
+
 /* u[i] = A[3i] + A[3i+1] + A[3i+2] */
 static WIDE_INLINE void row_fold(const struct row_acc *acc, double u[3])
 {

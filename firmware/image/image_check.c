@@ -30,6 +30,7 @@ static const struct {
 	[IRDM_SEC_EXACT_HEAD] = { "EXACT_HEAD", ELEM_PRECISION },
 	[IRDM_SEC_STATIC_CORR_CLUSTERS] = { "STATIC_CORR_CLUSTERS", IRDM_ELEM_BYTES },
 	[IRDM_SEC_COLUMN_SCALE] = { "COLUMN_SCALE", IRDM_ELEM_F32 },
+	[IRDM_SEC_EXACT_HEAD_INDEX] = { "EXACT_HEAD_INDEX", IRDM_ELEM_U32 },
 };
 
 static const char *const elem_names[] = {
@@ -74,6 +75,11 @@ const char *img_kind_name(uint32_t kind)
 	if (kind <= KIND_MAX && kinds[kind].name)
 		return kinds[kind].name;
 	return "unknown kind";
+}
+
+const char *irdm_image_kind_name(uint32_t kind)
+{
+	return img_kind_name(kind);
 }
 
 const char *img_elem_name(uint32_t elem)

@@ -44,7 +44,7 @@
 #error "IRDM images are little-endian and used in place"
 #endif
 
-#define KIND_MAX IRDM_SEC_COLUMN_SCALE
+#define KIND_MAX IRDM_SEC_EXACT_HEAD_INDEX
 #define TABLE_ENTRY sizeof(struct irdm_image_section)
 #define HEADER_SIZE sizeof(struct irdm_image_header)
 

@@ -16,6 +16,7 @@
  * img_fixture_clusters(3 clusters, cross pairs of rank 2), written by
  * img_fixture_write (tests/support/image_fixture.h).
  */
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -105,9 +106,24 @@ static void walk_views(const struct irdm_image *img)
 			(void)irdm_image_corr_block(img, c, 0);
 			(void)irdm_image_corr_block(img, c, (uint32_t)cols - 1);
 		}
-		/* the hybrid's head: head_samples runs of 9 per kept block */
-		if (img->exact_head)
-			read_values(img->exact_head, m->precision, n_blocks * m->head_samples * 9);
+		/* the hybrid's head: head_samples x 9 per run, and each kept
+		 * block's run through the index (HEAD_PAIRS) */
+		if (img->exact_head) {
+			uint64_t per = (uint64_t)m->head_samples * 9;
+			read_values(img->exact_head, m->precision,
+				    irdm_image_find(img, IRDM_SEC_EXACT_HEAD)->size /
+					    irdm_elem_size(m->precision));
+			for (uint64_t k = 0; k < n_blocks; k++) {
+				bool tr;
+				size_t run = irdm_image_head_run(img, (size_t)k, &tr);
+				double v[2] = {
+					irdm_elem_get(img->exact_head, m->precision,
+						      run * per + irdm_head_elem(tr, 1)),
+					irdm_elem_get(img->exact_head, m->precision, run * per + per - 1),
+				};
+				read_bytes(v, sizeof(v));
+			}
+		}
 	}
 	if (img->corr_rank) {
 		/* the far field: every value, and a whole block at the ends

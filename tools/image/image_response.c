@@ -68,10 +68,12 @@ static int modal_response(const struct irdm_image *img, uint32_t col, uint32_t r
 	int64_t rc = img->corr_start && n > 0 ? irdm_image_col_of(img, row) : -1;
 	long blk = rc >= 0 && img->exact_head ? irdm_image_corr_block(img, col, (uint32_t)rc) : -1;
 	size_t H = m->head_samples;
+	bool tr = false;
+	size_t run = blk >= 0 ? irdm_image_head_run(img, (size_t)blk, &tr) : 0;
 	for (size_t s = 0; blk >= 0 && s < H && s < n; s++)
-		for (int e = 0; e < 9; e++)
-			out[9 * s + (size_t)e] += irdm_image_value(img, img->exact_head, col,
-								   ((size_t)blk * H + s) * 9 + (size_t)e);
+		for (size_t e = 0; e < 9; e++)
+			out[9 * s + e] += irdm_image_value(img, img->exact_head, col,
+							   (run * H + s) * 9 + irdm_head_elem(tr, e));
 	if (rc >= 0 && blk < 0) {
 		double s[9];
 		irdm_image_corr_value(img, col, (uint32_t)rc, s);

@@ -28,6 +28,7 @@
 #include "precompute/candidates.h"
 #include "precompute/col_scale.h"
 #include "precompute/fir_tail.h"
+#include "precompute/head_pairs.h"
 #include "precompute/precompute.h"
 #include "precompute/td_part.h"
 #include "accuracy/measure.h"
@@ -50,7 +51,8 @@ struct build {
 	struct irdm_corr_clusters clusters; /* modal: every block, clustered (0 clusters if not) */
 	void *stored[6];                    /* converted to the scene's precision */
 	size_t stored_bytes[6];
-	float *col_scale; /* f16: COLUMN_SCALE (col_scale.h), else NULL */
+	float *col_scale;     /* f16: COLUMN_SCALE (col_scale.h), else NULL */
+	uint32_t *head_index; /* the head by pairs: EXACT_HEAD_INDEX (head_pairs.h), else NULL */
 	struct irdm_stability *stab;
 	struct irdm_meta meta;
 	struct irdm_rigid rigid;
@@ -88,10 +90,14 @@ static bool truncated(const struct build *b)
 	return b->m.modes.n_modes < b->m.modes.n_elastic_total;
 }
 
-/* The head's stored bytes: n_blocks 3x3 blocks over 2H samples. */
+/* The head's stored bytes: n_blocks 3x3 blocks over 2H samples, each
+ * symmetric pair once (head_pairs.h: the diagonal blocks and half the
+ * rest) unless f16's column scales keep them apart. */
 static size_t head_bytes(const struct build *b, size_t n_blocks, size_t H)
 {
-	return n_blocks * 2 * H * 9 * irdm_elem_size(b->sc->precision);
+	size_t runs = b->sc->precision == IRDM_ELEM_F16 ? n_blocks : (n_blocks + b->m.n_cols) / 2;
+
+	return runs * 2 * H * 9 * irdm_elem_size(b->sc->precision);
 }
 
 /*
@@ -750,7 +756,8 @@ static void fill_meta(struct build *b)
 		    (sc->method == IRDM_METHOD_TIME_DOMAIN ? IRDM_META_TIME_DOMAIN : 0) |
 		    (mt->fir_exact ? IRDM_META_FIR_TAIL_WINDOW : 0) |
 		    (b->head ? IRDM_META_EXACT_HEAD : 0) |
-		    (b->col_scale ? IRDM_META_COLUMN_SCALE : 0);
+		    (b->col_scale ? IRDM_META_COLUMN_SCALE : 0) |
+		    (b->head_index ? IRDM_META_HEAD_PAIRS : 0);
 	mt->head_samples = b->head ? 2 * sc->exact_head : 0;
 	mt->dt_s = sc->dt_s;
 	mt->young_pa = sc->mat.young_pa;
@@ -860,6 +867,9 @@ static int add_sections(struct build *b, struct irdm_image_writer *w, const void
 		}
 		if (b->stored[4])
 			ret |= irdm_iw_add(w, IRDM_SEC_EXACT_HEAD, p, b->stored[4], b->stored_bytes[4]);
+		if (b->head_index)
+			ret |= irdm_iw_add(w, IRDM_SEC_EXACT_HEAD_INDEX, IRDM_ELEM_U32, b->head_index,
+					   b->sparse.n_blocks * sizeof(uint32_t));
 	}
 	if (b->sc->floating)
 		ret |= irdm_iw_add(w, IRDM_SEC_RIGID, IRDM_ELEM_BYTES, &b->rigid, sizeof(b->rigid));
@@ -1024,9 +1034,18 @@ static int responses(struct build *b, char *err, size_t errlen)
 				     &b->stored_bytes[2]);
 	if (b->far.rank)
 		b->stored[3] = store_far(&b->far, b->sc->precision, &b->stored_bytes[3]);
-	if (b->head && !b->col_scale)
-		b->stored[4] = store(b->head, b->sparse.n_blocks * 2 * b->sc->exact_head * 9,
-				     b->sc->precision, &b->stored_bytes[4]);
+	if (b->head && !b->col_scale) {
+		struct irdm_head_pairs hp;
+		ret = irdm_head_pairs_store(&b->sparse, 2 * (size_t)b->sc->exact_head,
+					    b->sc->precision, b->head, &hp);
+		if (ret == IRDM_EINVAL) {
+			snprintf(err, errlen, "precompute: the static correction kept a block without its mirror");
+			return ret;
+		}
+		b->stored[4] = hp.runs;
+		b->stored_bytes[4] = hp.bytes;
+		b->head_index = hp.index;
+	}
 	if (b->clusters.n_clusters)
 		b->stored[5] = store_clusters(&b->clusters, b->sc->precision, &b->stored_bytes[5]);
 	if ((b->fir && !b->stored[0]) ||
@@ -1053,6 +1072,7 @@ static void build_free(struct build *b)
 	for (int i = 0; i < 6; i++)
 		free(b->stored[i]);
 	free(b->col_scale);
+	free(b->head_index);
 	free(b->stab);
 	free(b->nodes);
 	free(b->prov);
@@ -1329,6 +1349,8 @@ static void reset_try(struct build *b, size_t n_all)
 	}
 	free(b->col_scale);
 	b->col_scale = NULL;
+	free(b->head_index);
+	b->head_index = NULL;
 	b->n_modes = 0;
 	memset(&b->meta, 0, sizeof(b->meta));
 	b->m.modes.n_modes = n_all;

@@ -13,7 +13,10 @@
 #
 #   tools/scripts/head-tick.sh AFTER [BEFORE]
 #
-# Run from the repository root (the image is out/bench/, made when missing).
+# Each binary runs from the root of its own tree (two levels above it:
+# ROOT/build/bench/bench_tick), so that a BEFORE built from another
+# checkout ticks the image its own precompute made (out/bench/ there,
+# made when missing) even when the image format changed between them.
 set -euo pipefail
 [ $# -ge 1 ] && [ $# -le 2 ] || {
 	echo "usage: head-tick.sh AFTER_BENCH_TICK [BEFORE_BENCH_TICK]" >&2
@@ -34,9 +37,19 @@ else
 	names=(this)
 	bins=("$after")
 fi
-for b in "${bins[@]}"; do
+roots=()
+for i in "${!bins[@]}"; do
+	b=${bins[$i]}
 	[ -x "$b" ] || { echo "head-tick: $b: not an executable" >&2; exit 2; }
+	bins[$i]=$(realpath "$b")
+	roots[$i]=$(cd "$(dirname "${bins[$i]}")/../.." && pwd)
 done
+# binary i, run from its tree's root
+run() {
+	local i=$1
+	shift
+	(cd "${roots[$i]}" && "$@")
+}
 
 # "median X us  p99 Y us" of a case in one bench_tick output (which pads
 # the case's words with spaces)
@@ -48,7 +61,7 @@ figures() {
 echo "The hybrid tick: time and instructions per tick."
 echo
 for i in "${!names[@]}"; do
-	echo "- ${names[$i]}: \`${bins[$i]}\` (built $(date -u -r "${bins[$i]}" '+%Y-%m-%d %H:%M UTC'))"
+	echo "- ${names[$i]}: \`${bins[$i]}\` (built $(date -u -r "${bins[$i]}" '+%Y-%m-%d %H:%M UTC'), run from \`${roots[$i]}\`)"
 done
 echo "- cases: \`IRDM_BENCH_ONLY=\"$IRDM_BENCH_ONLY\"\` (tests/bench/bench_tick.c)"
 echo
@@ -56,7 +69,7 @@ echo "## Time (median / p99 us, each round the binaries in turn)"
 echo
 for r in $(seq 1 "$rounds"); do
 	for i in "${!names[@]}"; do
-		"${bins[$i]}" > "$tmp/time.$r.$i" 2>&1 ||
+		run "$i" "${bins[$i]}" > "$tmp/time.$r.$i" 2>&1 ||
 			{ cat "$tmp/time.$r.$i" >&2; exit 1; }
 	done
 done
@@ -81,7 +94,7 @@ echo
 echo "## Instructions per tick (callgrind, $ticks timed ticks a case)"
 echo
 for i in "${!names[@]}"; do
-	IRDM_BENCH_TICKS=$ticks valgrind --tool=callgrind --collect-atstart=no \
+	run "$i" env IRDM_BENCH_TICKS=$ticks valgrind --tool=callgrind --collect-atstart=no \
 		--toggle-collect=irdm_engine_tick --callgrind-out-file="$tmp/cg.$i.%p" \
 		"${bins[$i]}" > "$tmp/cg.$i.log" 2>&1 || { cat "$tmp/cg.$i.log" >&2; exit 1; }
 done

@@ -58,6 +58,9 @@ struct irdm_image {
 	 * precision (exact over the first half, tapered over the second); its
 	 * samples sum to block k of corr_blocks */
 	const void *exact_head;
+	/* HEAD_PAIRS (NULL if not): block k's run in exact_head is
+	 * head_index[k] (image_format.h); read it through irdm_image_head_run() */
+	const uint32_t *head_index;
 	/* optional COLUMN_SCALE (NULL if absent: every scale 1): FIR,
 	 * corr_blocks and exact_head hold force column c's values divided
 	 * by col_scale[c]; read them through irdm_image_value() */
@@ -126,6 +129,35 @@ static inline double irdm_image_value(const struct irdm_image *img, const void *
 {
 	return irdm_elem_get(data, img->meta->precision, i) * irdm_image_col_scale(img, col);
 }
+
+/*
+ * Block k's run in exact_head ([s][3][3], head_samples samples), and
+ * whether it is stored transposed (HEAD_PAIRS: block (c, r) is block
+ * (r, c) transposed); k itself, not transposed, without HEAD_PAIRS.
+ */
+static inline size_t irdm_image_head_run(const struct irdm_image *img, size_t k, bool *transposed)
+{
+	uint32_t v;
+
+	if (!img->head_index) {
+		*transposed = false;
+		return k;
+	}
+	v = img->head_index[k];
+	*transposed = v & IRDM_HEAD_TRANSPOSED;
+	return v & IRDM_HEAD_RUN_MASK;
+}
+
+/* Element i (row-major 3x3) of a block read transposed or not: the
+ * element of its run to read. */
+static inline size_t irdm_head_elem(bool transposed, size_t i)
+{
+	return transposed ? 3 * (i % 3) + i / 3 : i;
+}
+
+/* A section kind's name as docs/image-format.md gives it ("META", ...),
+ * "unknown kind" for one this build does not know. */
+const char *irdm_image_kind_name(uint32_t kind);
 
 /* Section lookup in a validated image: the table entry of kind, or NULL if
  * absent (or img holds no image).  Cannot fail otherwise. */

@@ -16,7 +16,7 @@
 
 #define IRDM_IMAGE_MAGIC "IRDMIMG"  /* 7 chars + NUL = 8 bytes */
 #define IRDM_IMAGE_VERSION_MAJOR 2u /* incompatible layout change */
-#define IRDM_IMAGE_VERSION_MINOR 4u /* compatible additions: 2.1 STATIC_CORR_LOWRANK, EXACT_HEAD; 2.2 STATIC_CORR_CLUSTERS; 2.3 measured_error; 2.4 COLUMN_SCALE */
+#define IRDM_IMAGE_VERSION_MINOR 5u /* compatible additions: 2.1 STATIC_CORR_LOWRANK, EXACT_HEAD; 2.2 STATIC_CORR_CLUSTERS; 2.3 measured_error; 2.4 COLUMN_SCALE; 2.5 EXACT_HEAD_INDEX */
 #define IRDM_IMAGE_ALIGN 64u        /* payload alignment, bytes */
 #define IRDM_IMAGE_MAX_SECTIONS 32u
 
@@ -71,6 +71,7 @@ enum irdm_section_kind {
 	IRDM_SEC_EXACT_HEAD = 15,           /* modal, optional: [k][s][3][3] of the STATIC_CORR blocks, s < head_samples */
 	IRDM_SEC_STATIC_CORR_CLUSTERS = 16, /* optional, with STATIC_CORR: every block, block low-rank over clusters */
 	IRDM_SEC_COLUMN_SCALE = 17,         /* optional: n_cols x f32, a power of two per force column */
+	IRDM_SEC_EXACT_HEAD_INDEX = 18,     /* with HEAD_PAIRS: u32 per STATIC_CORR block, its EXACT_HEAD run */
 };
 
 enum irdm_repr {
@@ -93,7 +94,20 @@ enum irdm_meta_flags {
 	/* COLUMN_SCALE present: FIR, STATIC_CORR and EXACT_HEAD hold each
 	 * force column's values divided by its scale (2.4) */
 	IRDM_META_COLUMN_SCALE = 1u << 7,
+	/* with EXACT_HEAD, without COLUMN_SCALE: EXACT_HEAD holds each
+	 * symmetric pair of blocks once, EXACT_HEAD_INDEX says where (2.5) */
+	IRDM_META_HEAD_PAIRS = 1u << 8,
 };
+
+/*
+ * EXACT_HEAD_INDEX entry of a block k: its run in EXACT_HEAD is
+ * entry & IRDM_HEAD_RUN_MASK, read transposed if IRDM_HEAD_TRANSPOSED is
+ * set.  R[s] is symmetric, so block (force c, displacement r) is block
+ * (r, c) transposed: the blocks with r >= c are stored, in the order of
+ * k, and those with r < c point at their mirror's run.
+ */
+#define IRDM_HEAD_TRANSPOSED 0x80000000u
+#define IRDM_HEAD_RUN_MASK 0x7fffffffu
 
 /* Longest head (samples): the engine keeps a ring of that many ticks. */
 #define IRDM_HEAD_SAMPLES_MAX 8192u
