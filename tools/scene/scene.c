@@ -449,7 +449,7 @@ static const struct irdm_opt scene_opts[] = {
 	{ .name = "max_head_mib", .type = IRDM_OPT_DOUBLE, SC(max_head_mib), .metavar = "MIB", .range = IRDM_OPT_GT | IRDM_OPT_LE, .min = 0, .max = 65536, .help = "representation = auto: the largest exact head it builds, in MiB as stored; a hybrid "
 																				   "whose head would be larger is tried again with twice the modes (fewer "
 																				   "dropped, fewer kept blocks) while that still ticks cheaper than every "
-																				   "mode, else left for the next candidate (default 256)" },
+																				   "mode, else left for the next candidate (default 128)" },
 	{ .name = "uncertified", .type = IRDM_OPT_BOOL, SC(uncertified), .help = "write an image although some touchable node's force recursion is not "
 										 "certified stable (spectral radius >= 1; the engine then damps an FIR's tail "
 										 "by r^s); default no: such an image is refused, as `irdm image verify "

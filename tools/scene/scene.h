@@ -42,8 +42,12 @@ struct irdm_region {
 
 /* The force error an image may have by default (scene key max_error). */
 #define IRDM_MAX_ERROR_DEFAULT 1e-3
-/* The largest exact head auto builds by default, MiB (scene key max_head_mib). */
-#define IRDM_MAX_HEAD_MIB_DEFAULT 256.0
+/* The largest exact head auto builds by default, MiB as stored (scene key
+ * max_head_mib): stored by pairs, some 256 MiB of blocks.  The cap decides
+ * image size, which auto's cheapest-tick order does not weigh: a lower tick
+ * from a head twice the size is not worth it when every candidate ticks in
+ * microseconds of a millisecond. */
+#define IRDM_MAX_HEAD_MIB_DEFAULT 128.0
 
 enum irdm_damping_kind { IRDM_DAMP_RATIOS = 0,
 			 IRDM_DAMP_RAYLEIGH = 1 };
