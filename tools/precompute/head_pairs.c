@@ -5,7 +5,7 @@
 
 #include "image/elem_store.h"
 #include "irdm/error.h"
-#include "irdm/image_format.h"
+#include "irdm/image.h"
 #include "irdm/precision.h"
 #include "precompute/head_pairs.h"
 
@@ -40,7 +40,7 @@ static void write_back(const struct irdm_corr_sparse *sp, size_t S, const uint32
 		double *out = &head[k * S * 9];
 		for (size_t s = 0; s < S; s++)
 			for (size_t i = 0; i < 9; i++)
-				out[9 * s + i] = src[9 * s + (tr ? 3 * (i % 3) + i / 3 : i)];
+				out[9 * s + i] = src[9 * s + irdm_head_elem(tr, i)];
 	}
 }
 
