@@ -37,7 +37,8 @@ bool irdm_head_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_
 	return true;
 }
 
-/* The element each of a block's nine sums loads: upright, transposed. */
+/* The element each of a block's nine sums loads, upright and transposed:
+ * irdm_head_elem() as a table, an indexed load in the sums' loops. */
 static const uint8_t block_elem[2][9] = { { 0, 1, 2, 3, 4, 5, 6, 7, 8 },
 					  { 0, 3, 6, 1, 4, 7, 2, 5, 8 } };
 

@@ -90,12 +90,18 @@ static bool truncated(const struct build *b)
 	return b->m.modes.n_modes < b->m.modes.n_elastic_total;
 }
 
-/* The head's stored bytes: n_blocks 3x3 blocks over 2H samples, each
- * symmetric pair once (head_pairs.h: the diagonal blocks and half the
- * rest) unless f16's column scales keep them apart. */
+/* Is the head stored by pairs (head_pairs.h)?  Not in f16, whose column
+ * scales (col_scale.h) keep the two blocks of a pair apart. */
+static bool head_by_pairs(const struct build *b)
+{
+	return b->sc->precision != IRDM_ELEM_F16;
+}
+
+/* The head's stored bytes: n_blocks 3x3 blocks over 2H samples, by pairs
+ * the diagonal blocks and half the rest. */
 static size_t head_bytes(const struct build *b, size_t n_blocks, size_t H)
 {
-	size_t runs = b->sc->precision == IRDM_ELEM_F16 ? n_blocks : (n_blocks + b->m.n_cols) / 2;
+	size_t runs = head_by_pairs(b) ? (n_blocks + b->m.n_cols) / 2 : n_blocks;
 
 	return runs * 2 * H * 9 * irdm_elem_size(b->sc->precision);
 }
@@ -1034,7 +1040,7 @@ static int responses(struct build *b, char *err, size_t errlen)
 				     &b->stored_bytes[2]);
 	if (b->far.rank)
 		b->stored[3] = store_far(&b->far, b->sc->precision, &b->stored_bytes[3]);
-	if (b->head && !b->col_scale) {
+	if (b->head && head_by_pairs(b)) {
 		struct irdm_head_pairs hp;
 		ret = irdm_head_pairs_store(&b->sparse, 2 * (size_t)b->sc->exact_head,
 					    b->sc->precision, b->head, &hp);
