@@ -89,7 +89,7 @@ $(foreach b,$(HAL_BACKENDS),$(if $(filter y n,$(or $(CONFIG_IRDM_HAL_$(b)),y)),,
   $(error $(CONFIG): CONFIG_IRDM_HAL_$(b) must be y or n, got '$(CONFIG_IRDM_HAL_$(b))')))
 endif
 feature = $(if $(CONFIG),$(filter y,$(CONFIG_IRDM_$(1))),y)
-FEATURE_SRC_MODAL    = firmware/engine/engine_modal.c
+FEATURE_SRC_MODAL    = firmware/engine/engine_modal.c firmware/engine/engine_modal_avx2.c
 FEATURE_SRC_FIR      = firmware/engine/engine_fir.c firmware/engine/fir_sum.c firmware/engine/fir_sum_avx2.c
 FEATURE_SRC_FLOATING = firmware/engine/floating.c $(wildcard firmware/rigid/*.c)
 FEATURE_SRC_DEFORM   = $(wildcard firmware/deform/*.c platform/posix/deform/*.c) \

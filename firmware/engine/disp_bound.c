@@ -28,8 +28,8 @@ static void modal_bound_init(const struct irdm_engine *e, double *w)
 		double mx = 0;
 
 		for (uint32_t c = 0; c < e->n_cols; c++) {
-			const double *p = &e->phi[(size_t)c * 3 * e->K];
-			double x = p[k], y = p[e->K + k], z = p[2 * (size_t)e->K + k];
+			const double *p = &e->phi[(size_t)c * 3 * e->Kp];
+			double x = p[k], y = p[e->Kp + k], z = p[2 * (size_t)e->Kp + k];
 
 			mx = fmax(mx, sqrt(x * x + y * y + z * z));
 		}

@@ -18,15 +18,22 @@ static size_t up(size_t n)
 }
 
 struct layout {
-	size_t engine, col_of_row, phi, x, y, ring, tail, bound, head_bound, lanes, zeros, total;
+	size_t engine, col_of_row, phi, x, y, coef, ring, tail, bound, head_bound, lanes, zeros,
+		total;
 };
+
+/* K modes padded to whole groups of MODE_LANES (engine_priv.h) */
+static size_t padded_modes(size_t K)
+{
+	return (K + MODE_LANES - 1) / MODE_LANES * MODE_LANES;
+}
 
 static int plan(const struct irdm_image *img, const struct irdm_engine_config *cfg,
 		struct layout *l)
 {
 	const struct irdm_meta *m = img->meta;
 	bool modal = m->representation == IRDM_REPR_MODAL;
-	size_t K = modal ? m->n_modes : 0, T = modal ? 0 : m->fir_length;
+	size_t K = modal ? m->n_modes : 0, T = modal ? 0 : m->fir_length, Kp = padded_modes(K);
 	size_t H = modal ? m->head_samples : 0;
 
 	if (!cfg || cfg->max_contacts < 1 || cfg->max_contacts > IRDM_MAX_CONTACTS ||
@@ -38,9 +45,10 @@ static int plan(const struct irdm_image *img, const struct irdm_engine_config *c
 	l->engine = 0;
 	l->col_of_row = up(sizeof(struct irdm_engine));
 	l->phi = l->col_of_row + up(m->n_nodes * sizeof(uint32_t));
-	l->x = l->phi + up((size_t)m->n_cols * 3 * K * sizeof(double));
-	l->y = l->x + up(2 * K * sizeof(double));
-	l->ring = l->y + up(2 * K * sizeof(double));
+	l->x = l->phi + up((size_t)m->n_cols * 3 * Kp * sizeof(double));
+	l->y = l->x + up(2 * Kp * sizeof(double));
+	l->coef = l->y + up(2 * Kp * sizeof(double));
+	l->ring = l->coef + up(Kp / 2 * sizeof(struct mode_coef));
 	l->tail = l->ring + up((T + H) * sizeof(struct irdm_force_tick));
 	l->bound = l->tail + up(T * sizeof(double));
 	l->head_bound = l->bound + up((K + T) * sizeof(double));
@@ -116,9 +124,26 @@ static void convert_shapes(struct irdm_engine *e, double *phi)
 
 	for (uint32_t c = 0; c < e->n_cols; c++) {
 		size_t row = img->columns[c];
-		for (size_t i = 0; i < 3 * (size_t)e->K; i++)
-			phi[(size_t)c * 3 * e->K + i] =
-				irdm_elem_get(img->mode_shapes, img->meta->precision, row * 3 * e->K + i);
+		for (size_t a = 0; a < 3; a++)
+			for (size_t k = 0; k < e->K; k++)
+				phi[((size_t)c * 3 + a) * e->Kp + k] =
+					irdm_elem_get(img->mode_shapes, img->meta->precision,
+						      (row * 3 + a) * e->K + k);
+	}
+}
+
+/* The recursion's coefficients by pairs of modes (struct mode_coef); the
+ * padding modes' stay zero. */
+static void mode_coefs(struct irdm_engine *e, struct mode_coef *c)
+{
+	for (uint32_t k = 0; k < e->K; k++) {
+		const struct irdm_mode *m = &e->img->modes[k];
+		struct mode_coef *p = &c[k / 2];
+		uint32_t i = 2 * (k % 2);
+
+		p->b[i] = m->b[0], p->b[i + 1] = m->b[1];
+		p->aq[i] = m->a[0], p->aq[i + 1] = m->a[2];
+		p->av[i] = m->a[1], p->av[i + 1] = m->a[3];
 	}
 }
 
@@ -198,6 +223,7 @@ int irdm_engine_init(struct irdm_engine **out, const struct irdm_image *img,
 	e->n_nodes = img->meta->n_nodes;
 	e->n_cols = img->meta->n_cols;
 	e->K = e->repr == IRDM_REPR_MODAL ? img->meta->n_modes : 0;
+	e->Kp = (uint32_t)padded_modes(e->K);
 	e->T = e->repr == IRDM_REPR_FIR ? img->meta->fir_length : 0;
 	e->H = e->repr == IRDM_REPR_MODAL ? img->meta->head_samples : 0;
 	uint32_t *cor = (uint32_t *)(base + l.col_of_row);
@@ -208,9 +234,13 @@ int irdm_engine_init(struct irdm_engine **out, const struct irdm_image *img,
 	e->col_of_row = cor;
 	e->x = (double *)(base + l.x);
 	e->y = (double *)(base + l.y);
-	if (e->K)
+	if (e->K) {
 		convert_shapes(e, (double *)(base + l.phi));
+		mode_coefs(e, (struct mode_coef *)(base + l.coef));
+	}
 	e->phi = (const double *)(base + l.phi);
+	e->coef = (const struct mode_coef *)(base + l.coef);
+	e->modal_wide = e->K && !cfg->fir_portable_sum && irdm_wide_usable();
 	e->ring.T = e->T + e->H; /* one of the two is 0 */
 	e->ring.tick = (struct irdm_force_tick *)(base + l.ring);
 	if (e->T)
@@ -240,7 +270,7 @@ void irdm_engine_reset(struct irdm_engine *e)
 {
 	if (e->floating)
 		start_rigid(e);
-	for (uint32_t k = 0; k < 2 * e->K; k++)
+	for (uint32_t k = 0; k < 2 * e->Kp; k++)
 		e->x[k] = e->y[k] = 0;
 	memset(e->free_memo, 0, sizeof(e->free_memo));
 	for (uint32_t s = 0; s < e->ring.T; s++)
@@ -387,9 +417,9 @@ const char *irdm_engine_fault_reason(const struct irdm_engine *e)
 
 const char *irdm_engine_fir_sum_name(const struct irdm_engine *e)
 {
-	bool wide = e->T ? e->fir_wide : e->head_wide;
+	bool wide = e->T ? e->fir_wide : e->modal_wide;
 
-	return !e->T && !e->H ? "none" : wide ? "avx2" :
+	return !e->T && !e->K ? "none" : wide ? "avx2" :
 						"portable";
 }
 

@@ -12,33 +12,22 @@
  * starts from it.  A column's free displacement is remembered until the
  * state changes: the proxy and the contacts' history term ask for the
  * same nodes.
+ *
+ * Both per-tick loops over the modes are written for four modes side by
+ * side (MODE_LANES; the arrays padded to Kp with zero modes), and
+ * engine_modal_avx2.c runs them four at a time where the processor has
+ * AVX2: the recursion is mode by mode, the displacement sums four
+ * partial sums (lane j the modes k = j mod 4, in the order of k) folded
+ * as (s0 + s2) + (s1 + s3), the order a vector's halves fold in.  The
+ * two paths give the same bits (test_engine).
  */
 #include <string.h>
 
 #include "engine_priv.h"
 
-/*
- * A mode let go decays geometrically (|A_k| < 1) through the subnormal
- * range, where a multiply-add on a subnormal operand can cost a hundred
- * cycles on x86 (microcode assist); a released cuboid handed 10^6
- * subnormal displacements to the contact query in 600 s.
- * A state below 1e-200 (metres, metres per second) is no physics any
- * more: it is set to zero, where it stays until a force excites the mode.
- */
-#define STATE_FLUSH 1e-200
-
 static double flush_tiny(double x)
 {
-	return fabs(x) < STATE_FLUSH ? 0.0 : x;
-}
-
-/* y = A x for mode k: the free evolution of the state x just set. */
-static void evolve(struct irdm_engine *e, const struct irdm_mode *m, uint32_t k)
-{
-	double q = e->x[2 * k], v = e->x[2 * k + 1];
-
-	e->y[2 * k] = m[k].a[0] * q + m[k].a[1] * v;
-	e->y[2 * k + 1] = m[k].a[2] * q + m[k].a[3] * v;
+	return fabs(x) < MODE_STATE_FLUSH ? 0.0 : x;
 }
 
 static struct free_memo *memo_of(const struct irdm_engine *e, uint32_t col)
@@ -66,25 +55,28 @@ static void memo_put(const struct irdm_engine *e, uint32_t col, const double u[3
 	memcpy(mm->u, u, sizeof(mm->u));
 }
 
-/* The kept modes' part of the free displacement at col. */
+/* The kept modes' part of the free displacement at col: per axis four
+ * partial sums, folded as a vector's halves fold. */
 static void modes_free_disp(const struct irdm_engine *e, uint32_t col, double u[3])
 {
-	const uint32_t K = e->K;
-	const double *p0 = &e->phi[(size_t)col * 3 * K], *p1 = p0 + K, *p2 = p1 + K;
+	const uint32_t Kp = e->Kp;
+	const double *p = &e->phi[(size_t)col * 3 * Kp];
 	const double *y = e->y;
-	double s0 = 0, s1 = 0, s2 = 0;
+	double s[3][MODE_LANES] = { { 0 } };
 
-	/* three sums side by side, each in the order of k */
-	for (uint32_t k = 0; k < K; k++) {
-		double yk = y[2 * k];
-
-		s0 += p0[k] * yk;
-		s1 += p1[k] * yk;
-		s2 += p2[k] * yk;
+	if (e->modal_wide) {
+		irdm_modal_disp_wide(e, col, u);
+		return;
 	}
-	u[0] = s0;
-	u[1] = s1;
-	u[2] = s2;
+	for (uint32_t k = 0; k < Kp; k += MODE_LANES)
+		for (uint32_t j = 0; j < MODE_LANES; j++) {
+			double yk = y[2 * (k + j)];
+
+			for (uint32_t a = 0; a < 3; a++)
+				s[a][j] += p[a * (size_t)Kp + k + j] * yk;
+		}
+	for (uint32_t a = 0; a < 3; a++)
+		u[a] = (s[a][0] + s[a][2]) + (s[a][1] + s[a][3]);
 }
 
 void irdm_modal_free_disp(const struct irdm_engine *e, uint32_t col, double u[3])
@@ -118,9 +110,9 @@ void irdm_modal_free_disps(const struct irdm_engine *e, uint32_t n, const uint32
 void irdm_modal_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp, double blk[9])
 {
 	const struct irdm_mode *m = e->img->modes;
-	const uint32_t K = e->K;
-	const double *pd = &e->phi[(size_t)col_disp * 3 * K];
-	const double *pf = &e->phi[(size_t)col_force * 3 * K];
+	const uint32_t K = e->K, Kp = e->Kp;
+	const double *pd = &e->phi[(size_t)col_disp * 3 * Kp];
+	const double *pf = &e->phi[(size_t)col_force * 3 * Kp];
 	double s0 = 0, s1 = 0, s2 = 0, s3 = 0, s4 = 0, s5 = 0, s6 = 0, s7 = 0, s8 = 0;
 
 	/* the static correction: kept block (zero where dropped) + far field;
@@ -132,8 +124,8 @@ void irdm_modal_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col
 	 * blocks in one tick), each in the order of k */
 	for (uint32_t k = 0; k < K; k++) {
 		double b = m[k].b[0];
-		double d0 = pd[k], d1 = pd[K + k], d2 = pd[2 * (size_t)K + k];
-		double f0 = pf[k], f1 = pf[K + k], f2 = pf[2 * (size_t)K + k];
+		double d0 = pd[k], d1 = pd[Kp + k], d2 = pd[2 * (size_t)Kp + k];
+		double f0 = pf[k], f1 = pf[Kp + k], f2 = pf[2 * (size_t)Kp + k];
 
 		s0 += d0 * f0 * b, s1 += d0 * f1 * b, s2 += d0 * f2 * b;
 		s3 += d1 * f0 * b, s4 += d1 * f1 * b, s5 += d1 * f2 * b;
@@ -144,22 +136,39 @@ void irdm_modal_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col
 	blk[6] += s6, blk[7] += s7, blk[8] += s8;
 }
 
-void irdm_modal_apply(struct irdm_engine *e, const struct irdm_force_tick *f)
+/* The modes' recursion for this tick's forces f, mode by mode:
+ *   g = sum over force nodes of ((phi_x f_x + phi_y f_y) + phi_z f_z),
+ *   x = y + b g (flushed), y = (a00 q + a01 q', a10 q + a11 q'). */
+static void recur(struct irdm_engine *e, const struct irdm_force_tick *f)
 {
-	const struct irdm_mode *m = e->img->modes;
-	const uint32_t K = e->K, nf = f->n;
+	const uint32_t Kp = e->Kp, nf = f->n;
 	const double *p[IRDM_MAX_FORCE_NODES];
 
 	for (uint32_t n = 0; n < nf; n++)
-		p[n] = &e->phi[(size_t)f->col[n] * 3 * K];
-	for (uint32_t k = 0; k < K; k++) {
+		p[n] = &e->phi[(size_t)f->col[n] * 3 * Kp];
+	for (uint32_t k = 0; k < Kp; k++) {
+		const struct mode_coef *c = &e->coef[k / 2];
+		const uint32_t i = 2 * (k % 2);
 		double g = 0;
+
 		for (uint32_t n = 0; n < nf; n++)
-			g += p[n][k] * f->f_n[n][0] + p[n][K + k] * f->f_n[n][1] + p[n][2 * (size_t)K + k] * f->f_n[n][2];
-		e->x[2 * k] = flush_tiny(e->y[2 * k] + m[k].b[0] * g);
-		e->x[2 * k + 1] = flush_tiny(e->y[2 * k + 1] + m[k].b[1] * g);
-		evolve(e, m, k);
+			g += p[n][k] * f->f_n[n][0] + p[n][Kp + k] * f->f_n[n][1] +
+			     p[n][2 * (size_t)Kp + k] * f->f_n[n][2];
+		double q = flush_tiny(e->y[2 * k] + c->b[i] * g);
+		double v = flush_tiny(e->y[2 * k + 1] + c->b[i + 1] * g);
+		e->x[2 * k] = q;
+		e->x[2 * k + 1] = v;
+		e->y[2 * k] = c->aq[i] * q + c->av[i] * v;
+		e->y[2 * k + 1] = c->aq[i + 1] * q + c->av[i + 1] * v;
 	}
+}
+
+void irdm_modal_apply(struct irdm_engine *e, const struct irdm_force_tick *f)
+{
+	if (e->modal_wide)
+		irdm_modal_recur_wide(e, f);
+	else
+		recur(e, f);
 	if (e->H)
 		irdm_head_apply(e, f);
 }

@@ -75,12 +75,17 @@ struct irdm_engine {
 	uint32_t repr, n_nodes, n_cols, K, T;
 	uint32_t H;                 /* modal: exact head samples (0: none; engine_head.c) */
 	const uint32_t *col_of_row; /* n_nodes, NO_COL if not touchable */
-	/* modal */
-	const double *phi; /* [col][3][K], converted at init */
-	double *x;         /* 2K: (q, q') per mode, x[t] */
-	double *y;         /* 2K: A x[t], the free evolution: kept
-					     * with x (irdm_modal_apply()), so it is
-					     * current between ticks too */
+	/* modal: arrays of Kp = K rounded up to a multiple of MODE_LANES
+	 * modes, the padding modes zero (their shapes, A, b and state), so
+	 * that the sums over modes run in whole groups of four */
+	uint32_t Kp;
+	const double *phi;            /* [col][3][Kp], converted at init */
+	double *x;                    /* 2 Kp: (q, q') per mode, x[t] */
+	double *y;                    /* 2 Kp: A x[t], the free evolution: kept
+			    * with x (irdm_modal_apply()), so it is
+			    * current between ticks too */
+	const struct mode_coef *coef; /* Kp / 2: A and b of two modes each */
+	bool modal_wide;              /* recursion and sums by engine_modal_avx2.c */
 	/* FIR, and a modal image's exact head (ring of H ticks) */
 	struct irdm_fir_ring ring;
 	const double *tail_w; /* T: r^s tail damping (1 when stable) */
@@ -118,12 +123,44 @@ struct irdm_engine {
 	double com_rest_m[3]; /* body origin in the object frame */
 };
 
+/*
+ * A pair of modes' recursion coefficients in the order the state is laid
+ * out, (q_k, q'_k, q_k+1, q'_k+1): x = y + b g takes b, y = A x takes
+ * (a00 a10) times q and (a01 a11) times q'.  Made at init from the image's
+ * MODES (struct irdm_mode), so that four coefficients load as one vector.
+ */
+struct mode_coef {
+	double b[4];  /* b0 b1 of mode k, of mode k + 1 */
+	double aq[4]; /* a[0] a[2] of mode k, of mode k + 1 */
+	double av[4]; /* a[1] a[3] of mode k, of mode k + 1 */
+};
+
+/*
+ * A mode let go decays geometrically (|A_k| < 1) through the subnormal
+ * range, where a multiply-add on a subnormal operand can cost a hundred
+ * cycles on x86 (microcode assist); a released cuboid handed 10^6
+ * subnormal displacements to the contact query in 600 s.
+ * A state below 1e-200 (metres, metres per second) is no physics any
+ * more: it is set to zero, where it stays until a force excites the mode.
+ */
+#define MODE_STATE_FLUSH 1e-200
+
+/* The sums over modes run in groups of this many (the lanes of an AVX2
+ * vector of doubles); Kp is K rounded up to it. */
+#define MODE_LANES 4
+
 /* engine_modal.c / engine_fir.c: the history term and the R[0] blocks. */
 void irdm_modal_free_disp(const struct irdm_engine *e, uint32_t col, double u[3]);
 void irdm_modal_free_disps(const struct irdm_engine *e, uint32_t n, const uint32_t *cols,
 			   double (*u)[3]);
 void irdm_modal_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp, double blk[9]);
 void irdm_modal_apply(struct irdm_engine *e, const struct irdm_force_tick *f);
+/* engine_modal_avx2.c: the modes' recursion and a column's kept-modes
+ * displacement with AVX2 (modal_wide only), to the bit what the portable
+ * loops of engine_modal.c give: the same products and sums in the same
+ * order, none fused. */
+void irdm_modal_recur_wide(struct irdm_engine *e, const struct irdm_force_tick *f);
+void irdm_modal_disp_wide(const struct irdm_engine *e, uint32_t col, double u[3]);
 void irdm_fir_free_disp(const struct irdm_engine *e, uint32_t col, double u[3]);
 /* fir_sum.c: the free displacement at n <= IRDM_MAX_FORCE_NODES columns,
  * one pass over the ring for all of them. */
