@@ -67,9 +67,10 @@ struct irdm_engine_config {
 	 */
 	double stable_radius;
 	double max_force_n; /* > 0: a larger force faults the engine (torque off) */
-	/* sum an FIR history, or a hybrid image's head, with the portable
-	 * code even on a processor with AVX2 and FMA (the two agree to
-	 * rounding; tests compare them) */
+	/* sum an FIR history, a hybrid image's head and the modes'
+	 * recursion with the portable code even on a processor with AVX2
+	 * and FMA (the history sums agree to rounding, the modes' to the
+	 * bit; tests compare them) */
 	bool fir_portable_sum;
 	unsigned publish_every; /* deformation snapshot every N ticks (0: never) */
 	/*
