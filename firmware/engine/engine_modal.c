@@ -16,7 +16,7 @@
  * Both per-tick loops over the modes are written for four modes side by
  * side (MODE_LANES; the arrays padded to Kp with zero modes), and
  * engine_modal_avx2.c runs them four at a time where the processor has
- * AVX2: the recursion is mode by mode, the displacement sums four
+ * AVX2: the recursion is mode by mode, the displacement and R[0] sums four
  * partial sums (lane j the modes k = j mod 4, in the order of k) folded
  * as (s0 + s2) + (s1 + s3), the order a vector's halves fold in.  The
  * two paths give the same bits (test_engine).
@@ -107,33 +107,47 @@ void irdm_modal_free_disps(const struct irdm_engine *e, uint32_t n, const uint32
 	}
 }
 
-void irdm_modal_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp, double blk[9])
+/* The kept modes' part of R[0] from col_force to col_disp: per element
+ * sum_k phi_d,k phi_f,k b_k,q, four partial sums folded as a vector's
+ * halves fold. */
+static void modes_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp,
+		     double s[9])
 {
-	const struct irdm_mode *m = e->img->modes;
-	const uint32_t K = e->K, Kp = e->Kp;
+	const uint32_t Kp = e->Kp;
 	const double *pd = &e->phi[(size_t)col_disp * 3 * Kp];
 	const double *pf = &e->phi[(size_t)col_force * 3 * Kp];
-	double s0 = 0, s1 = 0, s2 = 0, s3 = 0, s4 = 0, s5 = 0, s6 = 0, s7 = 0, s8 = 0;
+	double acc[9][MODE_LANES] = { { 0 } };
+
+	if (e->modal_wide) {
+		irdm_modal_r0_wide(e, col_force, col_disp, s);
+		return;
+	}
+	for (uint32_t k = 0; k < Kp; k += MODE_LANES)
+		for (uint32_t j = 0; j < MODE_LANES; j++) {
+			uint32_t i = k + j;
+			double b = e->coef[i / 2].b[2 * (i % 2)];
+
+			for (uint32_t r = 0; r < 3; r++)
+				for (uint32_t c = 0; c < 3; c++)
+					acc[3 * r + c][j] += pd[r * (size_t)Kp + i] *
+							     pf[c * (size_t)Kp + i] * b;
+		}
+	for (uint32_t n = 0; n < 9; n++)
+		s[n] = (acc[n][0] + acc[n][2]) + (acc[n][1] + acc[n][3]);
+}
+
+void irdm_modal_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp, double blk[9])
+{
+	double s[9];
 
 	/* the static correction: kept block (zero where dropped) + far field;
 	 * a hybrid image's kept blocks take the head's first sample instead
 	 * (the head's samples sum to the whole block, far field included) */
 	if (!e->H || !irdm_head_r0(e, col_force, col_disp, blk))
 		irdm_image_corr_value(e->img, col_force, col_disp, blk);
-	/* the nine sums side by side (a site change computes up to nine
-	 * blocks in one tick), each in the order of k */
-	for (uint32_t k = 0; k < K; k++) {
-		double b = m[k].b[0];
-		double d0 = pd[k], d1 = pd[Kp + k], d2 = pd[2 * (size_t)Kp + k];
-		double f0 = pf[k], f1 = pf[Kp + k], f2 = pf[2 * (size_t)Kp + k];
-
-		s0 += d0 * f0 * b, s1 += d0 * f1 * b, s2 += d0 * f2 * b;
-		s3 += d1 * f0 * b, s4 += d1 * f1 * b, s5 += d1 * f2 * b;
-		s6 += d2 * f0 * b, s7 += d2 * f1 * b, s8 += d2 * f2 * b;
-	}
-	blk[0] += s0, blk[1] += s1, blk[2] += s2;
-	blk[3] += s3, blk[4] += s4, blk[5] += s5;
-	blk[6] += s6, blk[7] += s7, blk[8] += s8;
+	modes_r0(e, col_force, col_disp, s);
+	for (uint32_t n = 0; n < 9; n++)
+		blk[n] += s[n];
 }
 
 /* The modes' recursion for this tick's forces f, mode by mode:

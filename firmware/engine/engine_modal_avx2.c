@@ -1,11 +1,11 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * The modes' recursion and a column's kept-modes displacement
- * (engine_modal.c) four modes at a time with AVX2, on the processors that
- * have it (irdm_wide_usable(), checked at init).  Every product and sum is
- * the portable loop's, in its order, and none is fused: the two paths give
- * the same bits (test_engine), so a machine without AVX2 runs the same
- * forces.
+ * The modes' recursion, a column's kept-modes displacement and their part
+ * of an R[0] block (engine_modal.c) four modes at a time with AVX2, on the
+ * processors that have it (irdm_wide_usable(), checked at init).  Every
+ * product and sum is the portable loop's, in its order, and none is
+ * fused: the two paths give the same bits (test_engine), so a machine
+ * without AVX2 runs the same forces.
  *
  * The state is laid out (q, q') per mode, two modes to a vector; the
  * force's generalised component g comes four modes to a vector (the shapes
@@ -100,6 +100,36 @@ WIDE void irdm_modal_disp_wide(const struct irdm_engine *e, uint32_t col, double
 	u[2] = fold(s2);
 }
 
+WIDE void irdm_modal_r0_wide(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp,
+			     double s[9])
+{
+	const uint32_t Kp = e->Kp;
+	const double *pd = &e->phi[(size_t)col_disp * 3 * Kp];
+	const double *pf = &e->phi[(size_t)col_force * 3 * Kp];
+	__m256d acc[9];
+
+	for (int n = 0; n < 9; n++)
+		acc[n] = _mm256_setzero_pd();
+	for (uint32_t k = 0; k < Kp; k += MODE_LANES) {
+		/* b_k,q of modes k..k+3 from the pairs' (b_q, b_q') */
+		__m256d b = _mm256_permute4x64_pd(_mm256_unpacklo_pd(_mm256_loadu_pd(e->coef[k / 2].b),
+								     _mm256_loadu_pd(e->coef[k / 2 + 1].b)),
+						  0xd8);
+		__m256d d[3], f[3];
+
+		for (int r = 0; r < 3; r++) {
+			d[r] = _mm256_loadu_pd(pd + r * (size_t)Kp + k);
+			f[r] = _mm256_loadu_pd(pf + r * (size_t)Kp + k);
+		}
+		for (int r = 0; r < 3; r++)
+			for (int c = 0; c < 3; c++)
+				acc[3 * r + c] = _mm256_add_pd(acc[3 * r + c],
+							       _mm256_mul_pd(_mm256_mul_pd(d[r], f[c]), b));
+	}
+	for (int n = 0; n < 9; n++)
+		s[n] = fold(acc[n]);
+}
+
 #else /* no AVX2 path on this target: modal_wide is never set */
 
 void irdm_modal_recur_wide(struct irdm_engine *e, const struct irdm_force_tick *f)
@@ -113,6 +143,16 @@ void irdm_modal_disp_wide(const struct irdm_engine *e, uint32_t col, double u[3]
 	(void)e;
 	(void)col;
 	u[0] = u[1] = u[2] = 0;
+}
+
+void irdm_modal_r0_wide(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp,
+			double s[9])
+{
+	(void)e;
+	(void)col_force;
+	(void)col_disp;
+	for (int n = 0; n < 9; n++)
+		s[n] = 0;
 }
 
 #endif

@@ -155,12 +155,14 @@ void irdm_modal_free_disps(const struct irdm_engine *e, uint32_t n, const uint32
 			   double (*u)[3]);
 void irdm_modal_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp, double blk[9]);
 void irdm_modal_apply(struct irdm_engine *e, const struct irdm_force_tick *f);
-/* engine_modal_avx2.c: the modes' recursion and a column's kept-modes
- * displacement with AVX2 (modal_wide only), to the bit what the portable
+/* engine_modal_avx2.c: the modes' recursion, a column's kept-modes
+ * displacement and their part of an R[0] block with AVX2 (modal_wide only), to the bit what the portable
  * loops of engine_modal.c give: the same products and sums in the same
  * order, none fused. */
 void irdm_modal_recur_wide(struct irdm_engine *e, const struct irdm_force_tick *f);
 void irdm_modal_disp_wide(const struct irdm_engine *e, uint32_t col, double u[3]);
+void irdm_modal_r0_wide(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp,
+			double s[9]);
 void irdm_fir_free_disp(const struct irdm_engine *e, uint32_t col, double u[3]);
 /* fir_sum.c: the free displacement at n <= IRDM_MAX_FORCE_NODES columns,
  * one pass over the ring for all of them. */
