@@ -26,6 +26,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <dirent.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cmocka.h>
@@ -94,6 +95,7 @@ static int teardown(void **state)
 {
 	(void)state;
 	unsetenv("IRDM_TEST_FAULT");
+	unsetenv("OMPI_MCA_orte_tmpdir_base");
 	mpi_leak_options(false);
 	return tf_rmdir(dir);
 }
@@ -111,6 +113,22 @@ static int teardown(void **state)
 		    "--touch", "z>=0.06", "--precision", "f64", "--representation", "fir:32", "--uncertified", "yes", "--fir_tail", "none", \
 		    "--method", "time-domain", "--substeps", "4"
 
+/*
+ * Each run its own Open MPI session directory: a singleton's daemon
+ * removes the shared one (/tmp/ompi.HOST.UID) as it exits, which can
+ * pull it from under the next run's mpirun ("A call to mkdir was unable
+ * to create the desired directory"), more often the busier the machine.
+ */
+static void own_session_dir(void)
+{
+	static unsigned runs;
+	static char base[300];
+
+	snprintf(base, sizeof(base), "%s/ompi.%u", dir, runs++);
+	assert_int_equal(mkdir(base, 0700), 0);
+	setenv("OMPI_MCA_orte_tmpdir_base", base, 1);
+}
+
 /* irdm precompute ARGS... -o OUT, under mpirun -np np (np 0: no mpirun). */
 static int precompute(int np, const char *out, const char *const *scene)
 {
@@ -118,6 +136,7 @@ static int precompute(int np, const char *out, const char *const *scene)
 	char nps[16];
 	int n = 0;
 
+	own_session_dir();
 	snprintf(nps, sizeof(nps), "%d", np);
 	/* a rank left waiting for one that failed would hang: bounded */
 	args[n++] = "-k";
