@@ -59,15 +59,15 @@ static void memo_put(const struct irdm_engine *e, uint32_t col, const double u[3
  * partial sums, folded as a vector's halves fold. */
 static void modes_free_disp(const struct irdm_engine *e, uint32_t col, double u[3])
 {
+	if (e->modal_wide) {
+		irdm_modal_disp_wide(e, col, u);
+		return;
+	}
 	const uint32_t Kp = e->Kp;
 	const double *p = &e->phi[(size_t)col * 3 * Kp];
 	const double *y = e->y;
 	double s[3][MODE_LANES] = { { 0 } };
 
-	if (e->modal_wide) {
-		irdm_modal_disp_wide(e, col, u);
-		return;
-	}
 	for (uint32_t k = 0; k < Kp; k += MODE_LANES)
 		for (uint32_t j = 0; j < MODE_LANES; j++) {
 			double yk = y[2 * (k + j)];
@@ -113,15 +113,15 @@ void irdm_modal_free_disps(const struct irdm_engine *e, uint32_t n, const uint32
 static void modes_r0(const struct irdm_engine *e, uint32_t col_force, uint32_t col_disp,
 		     double s[9])
 {
+	if (e->modal_wide) {
+		irdm_modal_r0_wide(e, col_force, col_disp, s);
+		return;
+	}
 	const uint32_t Kp = e->Kp;
 	const double *pd = &e->phi[(size_t)col_disp * 3 * Kp];
 	const double *pf = &e->phi[(size_t)col_force * 3 * Kp];
 	double acc[9][MODE_LANES] = { { 0 } };
 
-	if (e->modal_wide) {
-		irdm_modal_r0_wide(e, col_force, col_disp, s);
-		return;
-	}
 	for (uint32_t k = 0; k < Kp; k += MODE_LANES)
 		for (uint32_t j = 0; j < MODE_LANES; j++) {
 			uint32_t i = k + j;
