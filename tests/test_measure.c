@@ -13,6 +13,8 @@
  *  - f16 storage shows in the figure (the values as stored are measured);
  *  - an image over max_error is refused, not written, with what would meet
  *    it; max_error = none neither measures nor flags;
+ *  - error_every_column: the figure is the worst of every touchable
+ *    column, each recomputed here, with their median and p90;
  *  - representation = auto takes every mode of a small model, and on the
  *    4 x 4 x 8 cuboid (600 modes, 2 ms, top face) a hybrid within 1e-3
  *    that keeps fewer modes than the 317 whose envelope alone rings past
@@ -61,6 +63,14 @@ static int build(const char *name, struct irdm_precompute_report *rep, char *err
 	o.out_path = path;
 	err[0] = 0;
 	return irdm_precompute(&sc, &o, rep, err, errlen);
+}
+
+static bool written(const char *name)
+{
+	char path[128];
+
+	snprintf(path, sizeof(path), "%s/%s", dir, name);
+	return access(path, F_OK) == 0;
 }
 
 static void map(const char *name, struct irdm_image *img)
@@ -154,7 +164,8 @@ static void test_exact_measures_exact(void **state)
 	print_message("modal:all f64: measured %.3g over %zu columns x %zu ticks in %.2f s\n",
 		      rep.measured_error, rep.error_cols, rep.error_ticks, rep.seconds_error);
 	assert_true(rep.error_measured);
-	assert_int_equal(rep.error_cols, IRDM_MEASURE_MAX_COLS);
+	/* every mode: nothing dropped, nothing screened */
+	assert_int_equal(rep.error_cols, IRDM_MEASURE_SPREAD + IRDM_MEASURE_WORST);
 	assert_int_equal(rep.error_ticks, 500); /* 1 s at 2 ms */
 	assert_true(rep.measured_error < 1e-9);
 	map("all.img", &img);
@@ -285,6 +296,68 @@ static void test_auto_cuboid_chooses_hybrid(void **state)
 	assert_false(rep.error_measured);
 }
 
+static int by_value(const void *a, const void *b)
+{
+	double x = *(const double *)a, y = *(const double *)b;
+
+	return (x > y) - (x < y);
+}
+
+/*
+ * error_every_column: the figure is the worst of every touchable column,
+ * recomputed here at each against the test's own exact image (fresh
+ * engines, the reference's convolution), with the median and p90 of the
+ * columns; it needs every mode solved.
+ */
+static void test_every_column(void **state)
+{
+	static const char *const keys[] = { "representation", "modal:80", "exact_head", "16",
+					    "precision", "f64", "max_error", "1",
+					    "error_every_column", "yes", NULL };
+	struct irdm_precompute_report rep;
+	struct irdm_image img, exact;
+	double e[64], worst = 0;
+	uint32_t worst_node = 0;
+	char err[512];
+	size_t n;
+
+	(void)state;
+	assert_int_equal(build("every.img", &rep, err, sizeof(err), keys), 0);
+	map("every.img", &img);
+	map("exact.img", &exact);
+	n = img.meta->n_cols;
+	print_message("modal:80 + head 16, every column: %.6g at node %u, median %.4g, p90 %.4g over %zu columns\n",
+		      rep.measured_error, rep.error_worst_node, rep.error_median, rep.error_p90,
+		      rep.error_cols);
+	assert_true(rep.error_every_column);
+	assert_int_equal(rep.error_cols, n);
+	assert_true(n >= 9 && n <= 64);
+	for (size_t c = 0; c < n; c++) {
+		uint32_t node = img.nodes[img.columns[c]].mesh_node;
+
+		e[c] = fmax(run_error(&img, &exact, node, false, rep.error_ticks),
+			    run_error(&img, &exact, node, true, rep.error_ticks));
+		if (e[c] > worst) {
+			worst = e[c];
+			worst_node = node;
+		}
+	}
+	assert_true(worst > 1e-4); /* something to find */
+	assert_float_equal(rep.measured_error, worst, 1e-9 * worst);
+	assert_int_equal(rep.error_worst_node, worst_node);
+	qsort(e, n, sizeof(e[0]), by_value);
+	assert_float_equal(rep.error_median, e[n / 2], 1e-9 * e[n / 2]);
+	assert_float_equal(rep.error_p90, e[9 * n / 10], 1e-9 * e[9 * n / 10]);
+	assert_true(img.meta->measured_error == (float)worst);
+	irdm_image_unmap(&img);
+	irdm_image_unmap(&exact);
+	/* without every mode there is no exact model to scan against */
+	assert_int_equal(build("every40.img", &rep, err, sizeof(err), (const char *const[]){ "representation", "modal:40", "error_every_column", "yes", NULL }), IRDM_EINVAL);
+	print_message("%s\n", err);
+	assert_non_null(strstr(err, "error_every_column needs a grounded object whose every mode is solved"));
+	assert_false(written("every40.img"));
+}
+
 int main(void)
 {
 	const struct CMUnitTest tests[] = {
@@ -294,6 +367,7 @@ int main(void)
 		cmocka_unit_test(test_over_target_refused),
 		cmocka_unit_test(test_auto_small_takes_all),
 		cmocka_unit_test(test_auto_cuboid_chooses_hybrid),
+		cmocka_unit_test(test_every_column),
 	};
 
 	return cmocka_run_group_tests(tests, setup, teardown);

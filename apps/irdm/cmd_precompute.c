@@ -210,7 +210,11 @@ static void print_report(const struct irdm_scene *sc, const struct irdm_precompu
 	if (o->part_out)
 		return;
 	/* last: the figure a user reads first */
-	if (r->error_measured)
+	if (r->error_measured && r->error_every_column)
+		printf("force error   %.3g against the exact model (relative RMS, worst of a step and a release at every one of the %zu touchable nodes over %zu ticks, first ticks included; worst: %s at mesh node %u; median %.3g, p90 %.3g); max_error %g\n",
+		       r->measured_error, r->error_cols, r->error_ticks, r->error_worst_run,
+		       r->error_worst_node, r->error_median, r->error_p90, sc->max_error);
+	else if (r->error_measured)
 		printf("force error   %.3g against the exact model (relative RMS, worst of a step and a release at %zu touchable nodes over %zu ticks, first ticks included; worst: %s at mesh node %u); max_error %g\n",
 		       r->measured_error, r->error_cols, r->error_ticks, r->error_worst_run,
 		       r->error_worst_node, sc->max_error);

@@ -68,8 +68,9 @@ size_t irdm_measure_spread(const double *pos, size_t n_pos, size_t k, uint32_t *
 	return n;
 }
 
-/* The spread of the columns, then the largest radii. */
-static size_t pick_columns(const struct irdm_image *img, uint32_t *cols)
+/* The spread of the columns, the screened ones, then the largest radii. */
+static size_t pick_columns(const struct irdm_image *img, const uint32_t *screened,
+			   size_t n_screened, uint32_t *cols)
 {
 	uint32_t nc = img->meta->n_cols;
 	double *pos = nc ? malloc(3 * (size_t)nc * sizeof(double)) : NULL;
@@ -82,6 +83,9 @@ static size_t pick_columns(const struct irdm_image *img, uint32_t *cols)
 			pos[3 * (size_t)c + (size_t)a] = img->nodes[img->columns[c]].pos_m[a];
 	n = irdm_measure_spread(pos, nc, IRDM_MEASURE_SPREAD, cols);
 	free(pos);
+	for (size_t i = 0; i < n_screened && i < IRDM_MEASURE_SCREENED; i++)
+		if (screened[i] < nc && !have(cols, n, screened[i]))
+			cols[n++] = screened[i];
 	for (int k = 0; k < IRDM_MEASURE_WORST && n < nc; k++) {
 		float best = -1;
 		uint32_t bc = UINT32_MAX;
@@ -107,8 +111,7 @@ static int64_t row_of_mesh_node(const struct irdm_image *img, uint32_t mesh_node
 	return -1;
 }
 
-/* The commands of one run at image row `row`. */
-static void make_cmds(bool release, uint32_t row, size_t N, struct irdm_report_cmd *cmds)
+void irdm_measure_cmds(bool release, uint32_t row, size_t N, struct irdm_report_cmd *cmds)
 {
 	for (size_t t = 0; t < N; t++) {
 		struct irdm_report_cmd *c = &cmds[t];
@@ -134,13 +137,20 @@ static double rel_rms(const double *F, const double *Fref, size_t n)
 	return den > 0 ? sqrt(num / den) : (num > 0 ? INFINITY : 0);
 }
 
+/* The engines the runs share: the image's, and a floating reference's. */
+struct runners {
+	struct irdm_report_runner *img, *ref;
+	double *F; /* N x 3 */
+};
+
 /* The exact model's forces for one run. */
-static int reference(const struct irdm_image *ref, const struct irdm_report_cmd *cmds, size_t N,
-		     double **F, char *err, size_t errlen)
+static int reference(const struct irdm_image *ref, struct runners *rn,
+		     const struct irdm_report_cmd *cmds, size_t N, double **F, char *err,
+		     size_t errlen)
 {
 	struct irdm_report_conv c = { .img = ref, .cmds = cmds, .m = 1, .N = N, .n_resp = N };
 	struct irdm_report_conv_out co;
-	struct irdm_report_engine_out eo;
+	bool faulted;
 	int ret;
 
 	if (!ref->rigid) {
@@ -151,23 +161,26 @@ static int reference(const struct irdm_image *ref, const struct irdm_report_cmd 
 		free(co.disp);
 		return IRDM_OK;
 	}
-	ret = irdm_report_engine_run(ref, cmds, 1, N, 0, &eo, err, errlen);
-	if (ret)
-		return ret;
-	if (eo.faulted) {
-		irdm_report_engine_free(&eo);
-		snprintf(err, errlen, "error measurement: the exact model's engine run faulted");
-		return IRDM_ECONTACT;
+	*F = malloc(N * 3 * sizeof(double));
+	if (!*F) {
+		snprintf(err, errlen, "error measurement: out of memory");
+		return IRDM_ENOMEM;
 	}
-	*F = eo.F;
-	eo.F = NULL;
-	irdm_report_engine_free(&eo);
-	return IRDM_OK;
+	ret = irdm_report_runner_run(rn->ref, cmds, N, *F, &faulted, err, errlen);
+	if (!ret && faulted) {
+		snprintf(err, errlen, "error measurement: the exact model's engine run faulted");
+		ret = IRDM_ECONTACT;
+	}
+	if (ret) {
+		free(*F);
+		*F = NULL;
+	}
+	return ret;
 }
 
 /* One column, both runs: the larger error into res. */
 static int measure_column(const struct irdm_image *img, const struct irdm_image *ref,
-			  uint32_t col, size_t N, struct irdm_report_cmd *cmds,
+			  struct runners *rn, uint32_t col, size_t N, struct irdm_report_cmd *cmds,
 			  struct irdm_measure *res, char *err, size_t errlen)
 {
 	uint32_t mesh_node = img->nodes[img->columns[col]].mesh_node;
@@ -178,27 +191,26 @@ static int measure_column(const struct irdm_image *img, const struct irdm_image 
 		return IRDM_EINVAL;
 	}
 	for (int release = 0; release < 2; release++) {
-		struct irdm_report_engine_out eo;
 		double *Fref = NULL, e;
+		bool faulted;
 		int ret;
 
-		make_cmds(release, (uint32_t)ref_row, N, cmds);
-		ret = reference(ref, cmds, N, &Fref, err, errlen);
+		irdm_measure_cmds(release, (uint32_t)ref_row, N, cmds);
+		ret = reference(ref, rn, cmds, N, &Fref, err, errlen);
 		if (ret)
 			return ret;
-		make_cmds(release, img->columns[col], N, cmds);
-		ret = irdm_report_engine_run(img, cmds, 1, N, 0, &eo, err, errlen);
+		irdm_measure_cmds(release, img->columns[col], N, cmds);
+		ret = irdm_report_runner_run(rn->img, cmds, N, rn->F, &faulted, err, errlen);
 		if (ret) {
 			free(Fref);
 			return ret;
 		}
-		e = eo.faulted ? INFINITY : rel_rms(eo.F, Fref, 3 * N);
+		e = faulted ? INFINITY : rel_rms(rn->F, Fref, 3 * N);
 		if (!(e <= res->error)) {
 			res->error = e;
 			res->worst_node = mesh_node;
 			res->worst_run = release ? "release" : "step";
 		}
-		irdm_report_engine_free(&eo);
 		free(Fref);
 	}
 	return IRDM_OK;
@@ -248,15 +260,25 @@ int irdm_measure_error(const struct irdm_scene *sc, const struct irdm_image *img
 		       irdm_progress_fn fn, void *ctx, struct irdm_measure *res,
 		       char *err, size_t errlen)
 {
+	return irdm_measure_error_at(sc, img, NULL, 0, ref_path, build_ref, ref_ctx, fn, ctx, res,
+				     err, errlen);
+}
+
+int irdm_measure_error_at(const struct irdm_scene *sc, const struct irdm_image *img,
+			  const uint32_t *screened, size_t n_screened, const char *ref_path,
+			  irdm_measure_ref_fn build_ref, void *ref_ctx, irdm_progress_fn fn,
+			  void *ctx, struct irdm_measure *res, char *err, size_t errlen)
+{
 	uint32_t cols[IRDM_MEASURE_MAX_COLS];
 	struct irdm_image ref;
-	struct irdm_report_cmd *cmds;
+	struct irdm_report_cmd *cmds = NULL;
+	struct runners rn = { NULL, NULL, NULL };
 	double t0 = irdm_now_s();
 	int ret;
 
 	memset(res, 0, sizeof(*res));
 	res->error = -1;
-	res->n_cols = pick_columns(img, cols);
+	res->n_cols = pick_columns(img, screened, n_screened, cols);
 	if (!res->n_cols) {
 		snprintf(err, errlen, "error measurement: no column to measure (none touchable, or out of memory)");
 		return IRDM_ENOMEM;
@@ -281,17 +303,24 @@ int irdm_measure_error(const struct irdm_scene *sc, const struct irdm_image *img
 	}
 	ret = IRDM_ENOMEM;
 	cmds = malloc(res->ticks * sizeof(*cmds));
-	if (!cmds) {
+	rn.F = malloc(res->ticks * 3 * sizeof(double));
+	if (!cmds || !rn.F) {
 		snprintf(err, errlen, "error measurement: out of memory");
-		goto out_unmap;
+		goto out_free;
 	}
-	ret = IRDM_OK;
+	ret = irdm_report_runner_open(&rn.img, img, 1, err, errlen);
+	if (!ret && ref.rigid)
+		ret = irdm_report_runner_open(&rn.ref, &ref, 1, err, errlen);
 	for (size_t i = 0; i < res->n_cols && !ret; i++) {
-		ret = measure_column(img, &ref, cols[i], res->ticks, cmds, res, err, errlen);
+		ret = measure_column(img, &ref, &rn, cols[i], res->ticks, cmds, res, err, errlen);
 		if (fn)
 			fn(ctx, "error measurement", (double)(i + 1) / (double)res->n_cols);
 	}
+	irdm_report_runner_close(rn.img);
+	irdm_report_runner_close(rn.ref);
+out_free:
 	free(cmds);
+	free(rn.F);
 out_unmap:
 	irdm_image_unmap(&ref);
 out_unlink:

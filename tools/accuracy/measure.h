@@ -5,8 +5,9 @@
  * the machinery irdm report also uses (this folder) on a few touchable columns.
  *
  * The columns: some spread over the touchable surface (farthest-point
- * sampling of their rest positions) and the worst-conditioned ones (the
- * largest recorded spectral radius).  At each, two runs of a grab contact
+ * sampling of their rest positions), the ones the caller screened as
+ * likely worst (screen.h: the precompute, from the modes it dropped) and
+ * the worst-conditioned ones (the largest recorded spectral radius).  At each, two runs of a grab contact
  * at that node, pushed along a fixed oblique direction:
  *   step:    pushed at tick 0 and held to the end;
  *   release: pushed for the first third, let go for the second, then
@@ -32,12 +33,14 @@
 #include <stdint.h>
 
 #include "irdm/image.h"
+#include "accuracy/scenario.h"
 #include "modal/modal.h"
 #include "scene/scene.h"
 
-#define IRDM_MEASURE_SPREAD 4 /* columns spread over the surface */
-#define IRDM_MEASURE_WORST 2  /* and the largest spectral radii */
-#define IRDM_MEASURE_MAX_COLS (IRDM_MEASURE_SPREAD + IRDM_MEASURE_WORST)
+#define IRDM_MEASURE_SPREAD 4    /* columns spread over the surface */
+#define IRDM_MEASURE_SCREENED 12 /* the caller's likely worst, at most */
+#define IRDM_MEASURE_WORST 2     /* and the largest spectral radii */
+#define IRDM_MEASURE_MAX_COLS (IRDM_MEASURE_SPREAD + IRDM_MEASURE_SCREENED + IRDM_MEASURE_WORST)
 
 struct irdm_measure {
 	double error;                          /* the worst relative RMS force error */
@@ -70,6 +73,15 @@ int irdm_measure_error(const struct irdm_scene *sc, const struct irdm_image *img
 		       char *err, size_t errlen);
 
 /*
+ * The same, measuring also the first IRDM_MEASURE_SCREENED of screened
+ * (n_screened columns of img, likeliest worst first; repeats skipped).
+ */
+int irdm_measure_error_at(const struct irdm_scene *sc, const struct irdm_image *img,
+			  const uint32_t *screened, size_t n_screened, const char *ref_path,
+			  irdm_measure_ref_fn build_ref, void *ref_ctx, irdm_progress_fn fn,
+			  void *ctx, struct irdm_measure *res, char *err, size_t errlen);
+
+/*
  * k columns spread over positions pos ([n_pos][3]): farthest-point
  * sampling from the first.  cols: k entries.  Return: how many (fewer
  * when the positions repeat).
@@ -78,6 +90,10 @@ size_t irdm_measure_spread(const double *pos, size_t n_pos, size_t k, uint32_t *
 
 /* The number of ticks each run lasts at dt_s: about a second. */
 size_t irdm_measure_ticks(double dt_s);
+
+/* The commands of one run (a step, or a release) of N ticks at image row
+ * `row`: cmds, N of them. */
+void irdm_measure_cmds(bool release, uint32_t row, size_t N, struct irdm_report_cmd *cmds);
 
 /* The push, oblique so that every axis of the contact's 3x3 response is
  * excited; the model is linear: its size only sets the units. */

@@ -204,3 +204,73 @@ void irdm_report_engine_free(struct irdm_report_engine_out *out)
 	free(out->tick_us);
 	memset(out, 0, sizeof(*out));
 }
+
+struct irdm_report_runner {
+	struct irdm_session *s;
+	unsigned m;
+	struct irdm_contact_site *sites;
+	size_t n_sites;
+};
+
+int irdm_report_runner_open(struct irdm_report_runner **rp, const struct irdm_image *img,
+			    unsigned m, char *err, size_t errlen)
+{
+	struct irdm_report_runner *r = calloc(1, sizeof(*r));
+	int ret;
+
+	*rp = NULL;
+	if (!r) {
+		snprintf(err, errlen, "engine run: out of memory");
+		return IRDM_ENOMEM;
+	}
+	r->m = m;
+	ret = open_session(&r->s, img, m, 0, err, errlen);
+	if (ret) {
+		free(r);
+		return ret;
+	}
+	*rp = r;
+	return IRDM_OK;
+}
+
+int irdm_report_runner_run(struct irdm_report_runner *r, const struct irdm_report_cmd *cmds,
+			   size_t N, double *F, bool *faulted, char *err, size_t errlen)
+{
+	size_t n = N * r->m;
+	int ret;
+
+	if (n > r->n_sites) {
+		struct irdm_contact_site *sites = realloc(r->sites, n * sizeof(*sites));
+		if (!sites) {
+			snprintf(err, errlen, "engine run: out of memory");
+			return IRDM_ENOMEM;
+		}
+		r->sites = sites;
+		r->n_sites = n;
+	}
+	ret = make_sites(r->s->eng, cmds, n, r->sites);
+	if (ret) {
+		snprintf(err, errlen, "engine run: a scenario's contact site is not touchable");
+		return ret;
+	}
+	irdm_engine_reset(r->s->eng);
+	*faulted = false;
+	for (size_t t = 0; t < N; t++)
+		if (step(r->s->eng, cmds, r->sites, r->m, t, &F[t * 3 * r->m])) {
+			*faulted = true;
+			for (size_t k = t * 3 * r->m; k < n * 3; k++)
+				F[k] = NAN;
+			break;
+		}
+	irdm_engine_reset(r->s->eng);
+	return IRDM_OK;
+}
+
+void irdm_report_runner_close(struct irdm_report_runner *r)
+{
+	if (!r)
+		return;
+	irdm_session_close(r->s);
+	free(r->sites);
+	free(r);
+}

@@ -40,9 +40,7 @@ static bool inverse3(const double *a, double *inv)
 	return true;
 }
 
-/* The grab's forces on response R (N x 3x3): each active tick the force
- * that puts the column at its target, given every earlier force. */
-static bool forces(const double *R, size_t N, bool release, double *F)
+bool irdm_split_forces(const double *R, size_t N, bool release, double *F)
 {
 	double inv[9];
 
@@ -115,25 +113,23 @@ int irdm_split_probe_init(struct irdm_split_probe *p, const struct irdm_modes *m
 	}
 	for (size_t c = 0; c < n_cols; c++)
 		for (int run = 0; run < 2; run++)
-			if (!forces(&p->R[c * N * 9], N, run, &p->F[(2 * c + (size_t)run) * N * 3])) {
+			if (!irdm_split_forces(&p->R[c * N * 9], N, run, &p->F[(2 * c + (size_t)run) * N * 3])) {
 				irdm_split_probe_free(p);
 				return IRDM_EINVAL;
 			}
 	return IRDM_OK;
 }
 
-/* p->e = what the head misses of mode d's response (exact_head.c's
- * taper and bump, one mode at a time: they are linear). */
-static void miss(struct irdm_split_probe *p, size_t d, unsigned H)
+void irdm_split_miss(const struct irdm_mode *zoh, double omega2, unsigned H, size_t N, double *h,
+		     double *e)
 {
-	size_t N = p->N;
-	double *h = p->h, *e = p->e, kept = 0, bump_sum = 0, rem;
+	double kept = 0, bump_sum = 0, rem;
 
-	irdm_zoh_response(&p->zoh[d], N, h);
+	irdm_zoh_response(zoh, N, h);
 	for (size_t s = 0; s < N; s++)
 		e[s] = s < H ? 0.0 : h[s];
 	if (!H) { /* no head: the static correction, all of it at R[0] */
-		e[0] -= 1.0 / p->omega2[d];
+		e[0] -= 1.0 / omega2;
 		return;
 	}
 	for (size_t s = 0; s < H && s < N; s++)
@@ -143,7 +139,7 @@ static void miss(struct irdm_split_probe *p, size_t d, unsigned H)
 		if (H + i < N) /* the head's samples past N: the run never sees them */
 			kept += h[H + i] * irdm_window_taper(i, H);
 	}
-	rem = 1.0 / p->omega2[d] - kept;
+	rem = 1.0 / omega2 - kept;
 	for (size_t i = 0; i < H && H + i < N; i++)
 		e[H + i] = h[H + i] * (1.0 - irdm_window_taper(i, H)) -
 			   rem * irdm_window_bump(i, H) / bump_sum;
@@ -163,7 +159,7 @@ double irdm_split_try(struct irdm_split_probe *p, const size_t *drop, size_t n_d
 	for (size_t i = 0; i < n_drop; i++) {
 		size_t d = drop[i];
 
-		miss(p, d, H);
+		irdm_split_miss(&p->zoh[d], p->omega2[d], H, p->N, p->h, p->e);
 		for (size_t c = 0; c < p->n_cols; c++)
 			add_outer(&p->Rt[c * N * 9], &p->phi[3 * (p->n_cols * d + c)], p->e, -1.0, N);
 	}
@@ -172,7 +168,7 @@ double irdm_split_try(struct irdm_split_probe *p, const size_t *drop, size_t n_d
 			const double *Fr = &p->F[(2 * c + (size_t)run) * N * 3];
 			double num = 0, den = 0;
 
-			if (!forces(&p->Rt[c * N * 9], N, run, p->Fh))
+			if (!irdm_split_forces(&p->Rt[c * N * 9], N, run, p->Fh))
 				return INFINITY;
 			for (size_t k = 0; k < 3 * N; k++) {
 				num += (p->Fh[k] - Fr[k]) * (p->Fh[k] - Fr[k]);

@@ -69,4 +69,20 @@ void irdm_split_commit(struct irdm_split_probe *p);
 
 void irdm_split_probe_free(struct irdm_split_probe *p);
 
+/*
+ * The grab's forces F (N x 3) on a column's response to itself R (N x
+ * 3x3), in a step run or a release run (measure.h): each active tick the
+ * force that puts the column at its target, given every earlier force.
+ * Return: false if R[0] is singular.
+ */
+bool irdm_split_forces(const double *R, size_t N, bool release, double *F);
+
+/*
+ * What the hybrid misses of one dropped mode (zoh: it discretised, omega2
+ * its w^2 > 0) over N samples, as above (H = 0: the static correction);
+ * h: N of scratch, e: the N missed samples.
+ */
+void irdm_split_miss(const struct irdm_mode *zoh, double omega2, unsigned H, size_t N, double *h,
+		     double *e);
+
 #endif

@@ -18,6 +18,8 @@
 #include "modal/decay.h"
 #include "modal/exact_head.h"
 #include "modal/head_split.h"
+#include "accuracy/scan.h"
+#include "accuracy/screen.h"
 #include "accuracy/split.h"
 #include "modal/lapack.h"
 #include "modal/response.h"
@@ -1246,8 +1248,87 @@ static int reference_by_precompute(void *ctx, const struct irdm_scene *rsc, cons
 	return irdm_precompute(rsc, &o, &rep, err, errlen);
 }
 
+/*
+ * The columns the image is likely worst at (accuracy/screen.h), when it
+ * drops modes this build solved and corrects them statically or by a
+ * head: measured besides the spread.  Return: how many.
+ */
+static size_t screened_columns(const struct build *b, uint32_t *cols)
+{
+	struct irdm_modes all = b->m.modes;
+	struct irdm_mode *zoh;
+	bool *dropped;
+	size_t n = 0;
+
+	all.n_modes = b->n_solved;
+	if (!all_modes(b) || b->sc->representation != IRDM_REPR_MODAL || !b->sc->static_correction ||
+	    b->n_modes >= all.n_modes)
+		return 0;
+	zoh = malloc(all.n_modes * sizeof(*zoh));
+	dropped = malloc(all.n_modes * sizeof(*dropped));
+	for (size_t d = 0; dropped && d < all.n_modes; d++)
+		dropped[d] = d >= b->n_modes; /* the kept ones come first */
+	if (zoh && dropped && !irdm_modes_discretise(&all, &b->m.damping, b->sc->dt_s, zoh))
+		n = irdm_screen_columns(&all, zoh, dropped, b->sc->exact_head, b->m.col_dofs,
+					b->m.n_cols, irdm_measure_ticks(b->sc->dt_s),
+					IRDM_MEASURE_SCREENED, cols, NULL);
+	free(zoh);
+	free(dropped);
+	return n;
+}
+
+/* error_every_column: the image's error at every column (accuracy/scan.h). */
+static int scan(struct build *b, const struct irdm_image *img, struct irdm_precompute_report *rep,
+		char *err, size_t errlen)
+{
+	struct irdm_modes all = b->m.modes;
+	struct irdm_mode *zoh = NULL;
+	uint32_t *nodes = NULL;
+	struct irdm_scan res;
+	int ret = IRDM_EINVAL;
+
+	all.n_modes = b->n_solved;
+	if (!all_modes(b) || b->sc->floating) {
+		snprintf(err, errlen, "precompute: error_every_column needs a grounded object whose every mode is solved (representation = auto or exact_head); %s",
+			 b->sc->floating ? "this one floats" : "this build solved some of them");
+		return ret;
+	}
+	ret = IRDM_ENOMEM;
+	zoh = malloc(all.n_modes * sizeof(*zoh));
+	nodes = malloc(b->m.n_cols * sizeof(*nodes));
+	if (!zoh || !nodes) {
+		snprintf(err, errlen, "precompute: out of memory");
+		goto out_free;
+	}
+	irdm_modes_discretise(&all, &b->m.damping, b->sc->dt_s, zoh);
+	for (size_t c = 0; c < b->m.n_cols; c++)
+		nodes[c] = b->m.rows[b->m.cols[c]];
+	ret = irdm_scan_every_column(img, &all, zoh, b->m.col_dofs, nodes, b->m.n_cols,
+				     b->sc->max_error, b->o->progress, b->o->ctx, &res, err, errlen);
+	if (ret)
+		goto out_free;
+	b->meta.measured_error = (float)res.worst;
+	b->meta.flags |= IRDM_META_ERROR_MEASURED;
+	rep->error_measured = true;
+	rep->error_every_column = true;
+	rep->measured_error = res.worst;
+	rep->error_worst_node = res.worst_node;
+	rep->error_worst_run = res.worst_run;
+	rep->error_cols = res.n_cols;
+	rep->error_ticks = res.ticks;
+	rep->error_median = res.median;
+	rep->error_p90 = res.p90;
+	rep->seconds_error = res.seconds;
+out_free:
+	free(zoh);
+	free(nodes);
+	return ret;
+}
+
 static int measure(struct build *b, struct irdm_precompute_report *rep, char *err, size_t errlen)
 {
+	uint32_t screened[IRDM_MEASURE_SCREENED];
+	size_t n_screened;
 	const char *out = b->o->out_path;
 	size_t n = strlen(out) + 16, bytes;
 	char *tmp = malloc(n), *ref = malloc(n);
@@ -1272,8 +1353,15 @@ static int measure(struct build *b, struct irdm_precompute_report *rep, char *er
 		ret = irdm_image_map(tmp, 0, &img, err, errlen);
 	if (ret)
 		goto out_unlink;
-	ret = irdm_measure_error(b->sc, &img, ref, all_modes(b) ? reference_from_model : reference_by_precompute, b,
-				 b->o->progress, b->o->ctx, &res, err, errlen);
+	if (b->sc->error_every_column) {
+		ret = scan(b, &img, rep, err, errlen);
+		irdm_image_unmap(&img);
+		goto out_unlink;
+	}
+	n_screened = screened_columns(b, screened);
+	ret = irdm_measure_error_at(b->sc, &img, screened, n_screened, ref,
+				    all_modes(b) ? reference_from_model : reference_by_precompute, b,
+				    b->o->progress, b->o->ctx, &res, err, errlen);
 	irdm_image_unmap(&img);
 	if (ret)
 		goto out_unlink;
@@ -1612,6 +1700,131 @@ static bool over_cap_estimated(const struct build *b, const struct capped *cp,
 	return true;
 }
 
+#define AUTO_SCREENED 6  /* the columns a candidate is checked at before its build */
+#define AUTO_SUSPECTS 32 /* a resized candidate is screened again among these */
+
+/*
+ * The columns the screen ranks worst for candidate c (rank: its modes'
+ * order, the first c->modes kept), among every column on the first round
+ * (which keeps the AUTO_SUSPECTS worst in sus) and among sus after: the
+ * first AUTO_SCREENED into cols and probe.  Return: IRDM_OK; IRDM_ENOMEM;
+ * IRDM_EINVAL (nothing to check).
+ */
+static int screen_probe(const struct build *b, const struct irdm_auto_candidate *c,
+			const struct irdm_mode *zoh, const size_t *rank, bool first, uint32_t *sus,
+			size_t *n_sus, struct irdm_split_probe *probe, uint32_t *cols,
+			size_t *n_cols)
+{
+	const struct irdm_modes *md = &b->m.modes;
+	bool *dropped = malloc(md->n_modes * sizeof(*dropped));
+	int64_t dofs[3 * AUTO_SUSPECTS];
+	uint32_t pick[AUTO_SUSPECTS];
+	size_t N = irdm_measure_ticks(b->sc->dt_s);
+	int ret = IRDM_ENOMEM;
+
+	if (!dropped)
+		return ret;
+	for (size_t i = 0; i < md->n_modes; i++)
+		dropped[rank[i]] = i >= c->modes;
+	if (first) {
+		*n_sus = irdm_screen_columns(md, zoh, dropped, c->head, b->m.col_dofs, b->m.n_cols,
+					     N, AUTO_SUSPECTS, sus, NULL);
+		memcpy(pick, sus, *n_sus * sizeof(*pick));
+		*n_cols = *n_sus < AUTO_SCREENED ? *n_sus : AUTO_SCREENED;
+	} else {
+		for (size_t i = 0; i < *n_sus; i++)
+			memcpy(&dofs[3 * i], &b->m.col_dofs[3 * (size_t)sus[i]], 3 * sizeof(int64_t));
+		*n_cols = irdm_screen_columns(md, zoh, dropped, c->head, dofs, *n_sus, N,
+					      AUTO_SCREENED, pick, NULL);
+		for (size_t i = 0; i < *n_cols; i++)
+			pick[i] = sus[pick[i]];
+	}
+	free(dropped);
+	if (!*n_cols)
+		return IRDM_EINVAL;
+	for (size_t i = 0; i < *n_cols; i++) {
+		cols[i] = pick[i];
+		memcpy(&dofs[3 * i], &b->m.col_dofs[3 * (size_t)cols[i]], 3 * sizeof(int64_t));
+	}
+	return irdm_split_probe_init(probe, md, zoh, dofs, *n_cols, N);
+}
+
+static void say_screened(const struct build *b, const struct irdm_auto_candidate *c,
+			 const uint32_t *cols, size_t n, double e, double budget, size_t k)
+{
+	char line[512], at[128] = "", then[64] = "";
+	int len = 0;
+
+	if (!b->o->progress)
+		return;
+	for (size_t i = 0; i < n && len >= 0 && (size_t)len < sizeof(at); i++)
+		len += snprintf(at + len, sizeof(at) - (size_t)len, "%s%u", i ? ", " : "",
+				b->m.rows[b->m.cols[cols[i]]]);
+	if (!(e <= budget))
+		snprintf(then, sizeof(then), k ? ": over %.3g; %zu modes meet it there" : ": over %.3g; none meets it there",
+			 budget, k);
+	snprintf(line, sizeof(line), "auto: %zu modes%s%.0u: predicted error %.3g at the mesh nodes screened as worst for it (%s)%s",
+		 c->modes, c->head ? " + head " : " + static correction", c->head, e, at, then);
+	b->o->progress(b->o->ctx, line, -1.0);
+}
+
+#define AUTO_SCREEN_ROUNDS 3 /* a resized candidate is screened again, up to this many times */
+
+/*
+ * Candidate c checked before its build at the columns the screen ranks
+ * worst for it (accuracy/screen.h), which the sizing's spread may miss:
+ * when its error predicted there is over its budget, it keeps the
+ * fewest modes of its rank that meet the budget there too, and is
+ * screened again with what it then drops; resized, it goes back in the
+ * queue at its new cost (*changed), or is dropped when none meets the
+ * budget (*none).  Return: IRDM_OK; IRDM_ENOMEM.
+ */
+static int screen_candidate(struct build *b, struct irdm_auto_candidate *c,
+			    const struct irdm_mode *zoh, bool *changed, bool *none)
+{
+	const struct irdm_modes *md = &b->m.modes;
+	size_t n = md->n_modes, *rank = malloc(n * sizeof(*rank)), n_cols, k;
+	double budget = b->sc->max_error * (c->head ? IRDM_AUTO_PREDICTED_SHARE : 1.0), e, pred;
+	struct irdm_split_probe probe;
+	uint32_t cols[AUTO_SCREENED], sus[AUTO_SUSPECTS];
+	size_t n_sus = 0;
+	int ret = IRDM_ENOMEM;
+
+	*changed = *none = false;
+	if (!rank)
+		return ret;
+	for (size_t i = 0; i < n; i++)
+		rank[i] = i;
+	ret = c->head ? irdm_head_split_rank(md, &b->m.damping, c->head * b->sc->dt_s, rank) : 0;
+	for (int round = 0; !ret && round < AUTO_SCREEN_ROUNDS && !*none; round++) {
+		ret = screen_probe(b, c, zoh, rank, round == 0, sus, &n_sus, &probe, cols, &n_cols);
+		if (ret)
+			break;
+		irdm_split_begin(&probe);
+		e = irdm_split_try(&probe, &rank[c->modes], n - c->modes, c->head);
+		k = 0;
+		if (!(e <= budget))
+			k = irdm_auto_fewest(&probe, rank, n, c->modes + 1, c->head, budget, &pred);
+		say_screened(b, c, cols, n_cols, e, budget, k);
+		irdm_split_probe_free(&probe);
+		if (e <= budget)
+			break;
+		*changed = true;
+		*none = !k;
+		if (k) {
+			double w2 = 0;
+			for (size_t i = 0; i < k; i++)
+				w2 = fmax(w2, md->omega2[rank[i]]);
+			c->modes = k;
+			c->predicted = pred;
+			c->tick_us = irdm_auto_tick_us(k, c->head);
+			c->kept_max_hz = sqrt(w2) / (2 * M_PI);
+		}
+	}
+	free(rank);
+	return ret == IRDM_ENOMEM ? ret : IRDM_OK; /* EINVAL: nothing dropped, a fixed column */
+}
+
 /* The candidate not yet settled that is cheapest to tick (n: none). */
 static size_t cheapest(const struct irdm_auto_candidate *c, const bool *settled, size_t n)
 {
@@ -1634,10 +1847,11 @@ static size_t cheapest(const struct irdm_auto_candidate *c, const bool *settled,
 static int choose(struct build *b, struct irdm_precompute_report *rep, char *err, size_t errlen)
 {
 	struct irdm_auto_candidate cand[IRDM_AUTO_MAX_CANDIDATES];
-	bool settled[IRDM_AUTO_MAX_CANDIDATES] = { false };
+	bool settled[IRDM_AUTO_MAX_CANDIDATES] = { false }, checked[IRDM_AUTO_MAX_CANDIDATES] = { false };
 	struct capped cp = { .n = 0 };
 	size_t n_all = b->m.modes.n_modes, n_cand, k;
 	size_t *order = malloc(2 * n_all * sizeof(*order));
+	struct irdm_mode *zoh = NULL;
 	char last[768] = "";
 	int ret = IRDM_ENUMERIC;
 
@@ -1658,16 +1872,36 @@ static int choose(struct build *b, struct irdm_precompute_report *rep, char *err
 		n_cand = 1;
 	} else {
 		ret = candidates(b, cand, &n_cand, err, errlen);
+		zoh = ret ? NULL : malloc(n_all * sizeof(*zoh));
+		if (!ret && !zoh) {
+			snprintf(err, errlen, "precompute: out of memory");
+			ret = IRDM_ENOMEM;
+		}
 		if (ret) {
 			free(order);
 			return ret;
 		}
+		irdm_modes_discretise(&b->m.modes, &b->m.damping, b->sc->dt_s, zoh);
 	}
 	say_candidates(b, cand, n_cand);
 	while ((k = cheapest(cand, settled, n_cand)) < n_cand) {
+		bool changed, none;
+
 		if (over_cap_estimated(b, &cp, &cand[k], n_all)) {
 			settled[k] = !grow(&cand[k], n_all);
 			continue;
+		}
+		if (zoh && !checked[k] && cand[k].modes < n_all) {
+			checked[k] = true;
+			ret = screen_candidate(b, &cand[k], zoh, &changed, &none);
+			if (ret) {
+				snprintf(err, errlen, "precompute: out of memory");
+				break;
+			}
+			ret = IRDM_ENUMERIC;
+			settled[k] = none;
+			if (changed)
+				continue;
 		}
 		ret = try_candidate(b, &cand[k], n_all, rep, order, err, errlen);
 		if (ret != IRDM_ENUMERIC)
@@ -1677,6 +1911,7 @@ static int choose(struct build *b, struct irdm_precompute_report *rep, char *err
 			capped_add(&cp, cand[k].modes, b->head_capped);
 		settled[k] = !b->head_capped || !grow(&cand[k], n_all);
 	}
+	free(zoh);
 	free(order);
 	if (ret == IRDM_ENUMERIC)
 		snprintf(err, errlen, "precompute: representation = auto: no candidate met max_error = %g (set max_error higher or none); the last: %s",

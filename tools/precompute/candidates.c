@@ -40,22 +40,10 @@ static int by_cost(const void *a, const void *b)
 	return (x->tick_us > y->tick_us) - (x->tick_us < y->tick_us);
 }
 
-/*
- * The share of max_error a hybrid is sized to by the prediction: the
- * rest is room for what the prediction leaves out (accuracy/split.h).
- */
-#define PREDICTED_SHARE 0.5
-
-/*
- * The fewest modes of rank a head of H may keep with the predicted error
- * within budget: halving the step from every mode but one, each drop
- * tried on top of the ones that held (the prediction's error grows as
- * modes are dropped).  Return: 0 if even every mode but one misses it.
- */
-static size_t fewest(struct irdm_split_probe *p, const size_t *rank, size_t n, size_t n_free,
-		     unsigned H, double budget, double *predicted)
+size_t irdm_auto_fewest(struct irdm_split_probe *p, const size_t *rank, size_t n, size_t lo,
+			unsigned H, double budget, double *predicted)
 {
-	size_t hi = n - 1, lo = n_free > 1 ? n_free : 1;
+	size_t hi = n - 1;
 	double e;
 
 	irdm_split_begin(p);
@@ -93,8 +81,8 @@ static size_t hybrids(const struct irdm_modes *m, const struct irdm_rayleigh *da
 
 		if (irdm_head_split_rank(m, damp, heads[i] * dt_s, rank))
 			break;
-		k = fewest(probe, rank, m->n_modes, n_free, heads[i], tol * PREDICTED_SHARE,
-			   &predicted);
+		k = irdm_auto_fewest(probe, rank, m->n_modes, n_free > 1 ? n_free : 1, heads[i],
+				     tol * IRDM_AUTO_PREDICTED_SHARE, &predicted);
 		if (!k)
 			continue; /* not even every mode but one */
 		out[n].modes = k;

@@ -32,6 +32,23 @@ struct irdm_auto_candidate {
 };
 
 /*
+ * The share of max_error a hybrid is sized to by the prediction: the
+ * rest is room for what the prediction leaves out (accuracy/split.h).
+ */
+#define IRDM_AUTO_PREDICTED_SHARE 0.5
+
+/*
+ * The fewest modes of rank (every mode of p's model, n) a head of H (0:
+ * the static correction) may keep, at least lo >= 1, with the error
+ * predicted on p within budget: halving the step from every mode but
+ * one, each drop tried on top of the ones that held (the prediction's
+ * error grows as modes are dropped); *predicted: its prediction.
+ * Return: 0 if even every mode but one misses it.
+ */
+size_t irdm_auto_fewest(struct irdm_split_probe *p, const size_t *rank, size_t n, size_t lo,
+			unsigned H, double budget, double *predicted);
+
+/*
  * Estimated tick cost (us) of one touching node on an image of `modes`
  * modes and a head of `head` samples (plus as many tapered): the modal
  * recursion costs per mode, the head's sum per sample of age.

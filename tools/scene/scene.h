@@ -94,9 +94,10 @@ struct irdm_scene {
 	unsigned substeps;
 	enum irdm_eig_method eigensolver;
 	unsigned threads;
-	bool uncertified;    /* write an image whose stability certificate fails */
-	double max_error;    /* largest measured force error written (0: none, not measured) */
-	double max_head_mib; /* auto: the largest exact head it builds, MiB */
+	bool uncertified;        /* write an image whose stability certificate fails */
+	double max_error;        /* largest measured force error written (0: none, not measured) */
+	bool error_every_column; /* measure it at every touchable column, not a sample */
+	double max_head_mib;     /* auto: the largest exact head it builds, MiB */
 };
 
 /* The defaults: the paper's cuboid at its resolution, modal 300 + static
