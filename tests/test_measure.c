@@ -13,7 +13,7 @@
  *  - f16 storage shows in the figure (the values as stored are measured);
  *  - an image over max_error is refused, not written, with what would meet
  *    it; max_error = none neither measures nor flags;
- *  - error_every_column: the figure is the worst of every touchable
+ *  - error_columns = every: the figure is the worst of every touchable
  *    column, each recomputed here, with their median and p90;
  *  - representation = auto takes every mode of a small model, and on the
  *    4 x 4 x 8 cuboid (600 modes, 2 ms, top face) a hybrid within 1e-3
@@ -164,8 +164,10 @@ static void test_exact_measures_exact(void **state)
 	print_message("modal:all f64: measured %.3g over %zu columns x %zu ticks in %.2f s\n",
 		      rep.measured_error, rep.error_cols, rep.error_ticks, rep.seconds_error);
 	assert_true(rep.error_measured);
-	/* every mode: nothing dropped, nothing screened */
-	assert_int_equal(rep.error_cols, IRDM_MEASURE_SPREAD + IRDM_MEASURE_WORST);
+	/* every mode solved and 9 columns: error_columns = auto measures
+	 * every one */
+	assert_true(rep.error_every_column);
+	assert_int_equal(rep.error_cols, 9);
 	assert_int_equal(rep.error_ticks, 500); /* 1 s at 2 ms */
 	assert_true(rep.measured_error < 1e-9);
 	map("all.img", &img);
@@ -304,7 +306,7 @@ static int by_value(const void *a, const void *b)
 }
 
 /*
- * error_every_column: the figure is the worst of every touchable column,
+ * error_columns = every: the figure is the worst of every touchable column,
  * recomputed here at each against the test's own exact image (fresh
  * engines, the reference's convolution), with the median and p90 of the
  * columns; it needs every mode solved.
@@ -313,7 +315,7 @@ static void test_every_column(void **state)
 {
 	static const char *const keys[] = { "representation", "modal:80", "exact_head", "16",
 					    "precision", "f64", "max_error", "1",
-					    "error_every_column", "yes", NULL };
+					    "error_columns", "every", NULL };
 	struct irdm_precompute_report rep;
 	struct irdm_image img, exact;
 	double e[64], worst = 0;
@@ -352,9 +354,9 @@ static void test_every_column(void **state)
 	irdm_image_unmap(&img);
 	irdm_image_unmap(&exact);
 	/* without every mode there is no exact model to scan against */
-	assert_int_equal(build("every40.img", &rep, err, sizeof(err), (const char *const[]){ "representation", "modal:40", "error_every_column", "yes", NULL }), IRDM_EINVAL);
+	assert_int_equal(build("every40.img", &rep, err, sizeof(err), (const char *const[]){ "representation", "modal:40", "error_columns", "every", NULL }), IRDM_EINVAL);
 	print_message("%s\n", err);
-	assert_non_null(strstr(err, "error_every_column needs a grounded object whose every mode is solved"));
+	assert_non_null(strstr(err, "error_columns = every needs a grounded object whose every mode is solved"));
 	assert_false(written("every40.img"));
 }
 

@@ -11,7 +11,7 @@
  *    screened;
  *  - the measurement of a built hybrid (8-sample head, f64) at its 18
  *    sampled columns finds the figure and the node that measuring every
- *    column (error_every_column) finds, where the spread and the
+ *    column (error_columns = every) finds, where the spread and the
  *    worst-conditioned alone measure 0.9 of it or less.
  */
 #include <math.h>
@@ -137,7 +137,7 @@ static void measured(const char *every, struct irdm_precompute_report *rep)
 
 	fixture_soft_scene(&sc, (const char *const[]){ "touch", "surface", "representation", "modal:300",
 						       "exact_head", "8", "precision", "f64",
-						       "max_error", "1", "error_every_column", every,
+						       "max_error", "1", "error_columns", every,
 						       NULL });
 	snprintf(path, sizeof(path), "%s/h.img", dir);
 	o.out_path = path;
@@ -153,15 +153,18 @@ static void measured(const char *every, struct irdm_precompute_report *rep)
  */
 static void test_measured_where_worst(void **state)
 {
-	struct irdm_precompute_report sampled, every;
+	struct irdm_precompute_report sampled, every, by_default;
 	struct irdm_measure res;
 	struct irdm_scene sc;
 	struct irdm_image img;
 	char err[512], path[128], ref[128];
 
 	(void)state;
-	measured("no", &sampled);
-	measured("yes", &every);
+	measured("sample", &sampled);
+	measured("every", &every);
+	measured("auto", &by_default); /* 137 columns: every one */
+	assert_true(by_default.error_every_column);
+	assert_int_equal(by_default.error_cols, every.error_cols);
 	print_message("sampled: %.6g at mesh node %u over %zu columns; every column: %.6g at %u over %zu (median %.3g)\n",
 		      sampled.measured_error, sampled.error_worst_node, sampled.error_cols,
 		      every.measured_error, every.error_worst_node, every.error_cols,

@@ -41,6 +41,10 @@
 #define IRDM_MEASURE_SCREENED 12 /* the caller's likely worst, at most */
 #define IRDM_MEASURE_WORST 2     /* and the largest spectral radii */
 #define IRDM_MEASURE_MAX_COLS (IRDM_MEASURE_SPREAD + IRDM_MEASURE_SCREENED + IRDM_MEASURE_WORST)
+/* error_columns = auto measures every touchable column up to this many
+ * (accuracy/scan.h): the sample's exact model holds as many blocks, so
+ * the scan costs no more */
+#define IRDM_MEASURE_EVERY_AUTO (IRDM_MEASURE_MAX_COLS * IRDM_MEASURE_MAX_COLS)
 
 struct irdm_measure {
 	double error;                          /* the worst relative RMS force error */

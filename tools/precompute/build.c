@@ -1277,7 +1277,21 @@ static size_t screened_columns(const struct build *b, uint32_t *cols)
 	return n;
 }
 
-/* error_every_column: the image's error at every column (accuracy/scan.h). */
+/* error_columns: every column, when asked, or by default when it can
+ * and it costs no more than the sample. */
+static bool every_column(const struct build *b)
+{
+	switch (b->sc->error_columns) {
+	case IRDM_ERROR_COLUMNS_EVERY:
+		return true;
+	case IRDM_ERROR_COLUMNS_SAMPLE:
+		return false;
+	default:
+		return all_modes(b) && !b->sc->floating && b->m.n_cols <= IRDM_MEASURE_EVERY_AUTO;
+	}
+}
+
+/* The image's error at every column (accuracy/scan.h). */
 static int scan(struct build *b, const struct irdm_image *img, struct irdm_precompute_report *rep,
 		char *err, size_t errlen)
 {
@@ -1289,7 +1303,7 @@ static int scan(struct build *b, const struct irdm_image *img, struct irdm_preco
 
 	all.n_modes = b->n_solved;
 	if (!all_modes(b) || b->sc->floating) {
-		snprintf(err, errlen, "precompute: error_every_column needs a grounded object whose every mode is solved (representation = auto or exact_head); %s",
+		snprintf(err, errlen, "precompute: error_columns = every needs a grounded object whose every mode is solved (representation = auto or exact_head); %s",
 			 b->sc->floating ? "this one floats" : "this build solved some of them");
 		return ret;
 	}
@@ -1353,7 +1367,7 @@ static int measure(struct build *b, struct irdm_precompute_report *rep, char *er
 		ret = irdm_image_map(tmp, 0, &img, err, errlen);
 	if (ret)
 		goto out_unlink;
-	if (b->sc->error_every_column) {
+	if (every_column(b)) {
 		ret = scan(b, &img, rep, err, errlen);
 		irdm_image_unmap(&img);
 		goto out_unlink;

@@ -51,7 +51,7 @@ struct irdm_precompute_report {
 	uint32_t error_worst_node;
 	const char *error_worst_run;
 	size_t error_cols, error_ticks;
-	/* error_every_column: every column measured, their median and p90 */
+	/* every column measured (error_columns), their median and p90 */
 	bool error_every_column;
 	double error_median, error_p90;
 	/* the representation written (representation = auto: the chosen one)

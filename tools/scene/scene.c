@@ -382,6 +382,12 @@ static const struct irdm_opt_name precision_names[] = {
 	{ "f64", IRDM_ELEM_F64 },
 	{ NULL, 0 },
 };
+static const struct irdm_opt_name error_columns_names[] = {
+	{ "auto", IRDM_ERROR_COLUMNS_AUTO },
+	{ "sample", IRDM_ERROR_COLUMNS_SAMPLE },
+	{ "every", IRDM_ERROR_COLUMNS_EVERY },
+	{ NULL, 0 },
+};
 static const struct irdm_opt_name method_names[] = {
 	{ "modal", IRDM_METHOD_MODAL },
 	{ "time-domain", IRDM_METHOD_TIME_DOMAIN },
@@ -446,11 +452,11 @@ static const struct irdm_opt scene_opts[] = {
 													       "image and printed; above E the image is refused.  none neither measures "
 													       "nor checks (the measurement needs every mode: a dense eigensolve) "
 													       "(default 1e-3)" },
-	{ .name = "error_every_column", .type = IRDM_OPT_BOOL, SC(error_every_column), .help = "measure the force error at every touchable node rather than at the sampled "
-											       "ones (spread over the surface, screened as worst for the modes dropped, "
-											       "the worst-conditioned): a grounded object whose every mode is solved "
-											       "(representation = auto, exact_head); about a minute on 2,000 touchable "
-											       "nodes (default no)" },
+	{ .name = "error_columns", .type = IRDM_OPT_ENUM, SC(error_columns), .names = error_columns_names, .help = "where max_error is measured: every touchable node (a grounded object whose "
+														   "every mode is solved: representation = auto or exact_head; about a minute "
+														   "on 2,000 of them), a sample (spread over the surface, the ones screened as "
+														   "worst for the modes dropped, the worst-conditioned), or auto: every one when "
+														   "that costs no more than the sample, up to 324 (default auto)" },
 	{ .name = "max_head_mib", .type = IRDM_OPT_DOUBLE, SC(max_head_mib), .metavar = "MIB", .range = IRDM_OPT_GT | IRDM_OPT_LE, .min = 0, .max = 65536, .help = "representation = auto: the largest exact head it builds, in MiB as stored; a hybrid "
 																				   "whose head would be larger is tried again with twice the modes (fewer "
 																				   "dropped, fewer kept blocks) while that still ticks cheaper than every "

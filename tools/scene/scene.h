@@ -54,6 +54,11 @@ enum irdm_damping_kind { IRDM_DAMP_RATIOS = 0,
 enum irdm_method { IRDM_METHOD_MODAL = 0,
 		   IRDM_METHOD_TIME_DOMAIN = 1 };
 
+/* Where the force error is measured (scene key error_columns). */
+enum irdm_error_columns { IRDM_ERROR_COLUMNS_AUTO = 0,   /* every one when it costs no more */
+			  IRDM_ERROR_COLUMNS_SAMPLE = 1, /* spread, screened, worst-conditioned */
+			  IRDM_ERROR_COLUMNS_EVERY = 2 };
+
 struct irdm_scene {
 	char name[64];
 	char mesh[512];           /* "cuboid", "cube", "box:LX,LY,LZ" or a file path */
@@ -94,10 +99,10 @@ struct irdm_scene {
 	unsigned substeps;
 	enum irdm_eig_method eigensolver;
 	unsigned threads;
-	bool uncertified;        /* write an image whose stability certificate fails */
-	double max_error;        /* largest measured force error written (0: none, not measured) */
-	bool error_every_column; /* measure it at every touchable column, not a sample */
-	double max_head_mib;     /* auto: the largest exact head it builds, MiB */
+	bool uncertified;                      /* write an image whose stability certificate fails */
+	double max_error;                      /* largest measured force error written (0: none, not measured) */
+	enum irdm_error_columns error_columns; /* where max_error is measured */
+	double max_head_mib;                   /* auto: the largest exact head it builds, MiB */
 };
 
 /* The defaults: the paper's cuboid at its resolution, modal 300 + static
