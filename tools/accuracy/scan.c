@@ -14,7 +14,8 @@
 #include "util/clock.h"
 
 struct work {
-	double *h, *o, *rt, *R, *Fref, *F;
+	struct irdm_col_resp cr;
+	double *rt, *R, *Fref, *F;
 	double *errs; /* per column */
 	struct irdm_report_cmd *cmds;
 	struct irdm_report_runner *run;
@@ -22,8 +23,7 @@ struct work {
 
 static void work_free(struct work *w)
 {
-	free(w->h);
-	free(w->o);
+	irdm_col_resp_free(&w->cr);
 	free(w->rt);
 	free(w->R);
 	free(w->Fref);
@@ -100,7 +100,6 @@ int irdm_scan_every_column(const struct irdm_image *img, const struct irdm_modes
 			   size_t errlen)
 {
 	size_t N = irdm_measure_ticks(img->meta->dt_s), nm = m->n_modes;
-	size_t batch = irdm_col_resp_batch(m);
 	struct work w = { 0 };
 	double t0 = irdm_now_s();
 	int ret = IRDM_EINVAL;
@@ -117,16 +116,19 @@ int irdm_scan_every_column(const struct irdm_image *img, const struct irdm_modes
 				 c, img->nodes[img->columns[c]].mesh_node, mesh_nodes[c]);
 			return ret;
 		}
+	ret = irdm_col_resp_init(&w.cr, m, N, 1);
+	if (ret) {
+		snprintf(err, errlen, "scan: out of memory");
+		return ret;
+	}
 	ret = IRDM_ENOMEM;
-	w.h = malloc(nm * N * sizeof(double));
-	w.o = malloc(batch * 9 * nm * sizeof(double));
-	w.rt = malloc(batch * 9 * N * sizeof(double));
+	w.rt = malloc(w.cr.batch * 9 * N * sizeof(double));
 	w.R = malloc(N * 9 * sizeof(double));
 	w.Fref = malloc(N * 3 * sizeof(double));
 	w.F = malloc(N * 3 * sizeof(double));
 	w.errs = malloc(n_cols * sizeof(double));
 	w.cmds = malloc(N * sizeof(*w.cmds));
-	if (!w.h || !w.o || !w.rt || !w.R || !w.Fref || !w.F || !w.errs || !w.cmds) {
+	if (!w.rt || !w.R || !w.Fref || !w.F || !w.errs || !w.cmds) {
 		snprintf(err, errlen, "scan: out of memory");
 		goto out;
 	}
@@ -134,12 +136,14 @@ int irdm_scan_every_column(const struct irdm_image *img, const struct irdm_modes
 	if (ret)
 		goto out;
 	for (size_t d = 0; d < nm; d++)
-		irdm_zoh_response(&zoh[d], N, &w.h[d * N]);
-	for (size_t c0 = 0; c0 < n_cols && !ret; c0 += batch) {
-		size_t nb = n_cols - c0 < batch ? n_cols - c0 : batch;
+		irdm_zoh_response(&zoh[d], N, &w.cr.x[0][d * N]);
+	ret = irdm_col_resp_ready(&w.cr);
+	if (ret)
+		snprintf(err, errlen, "scan: out of memory");
+	for (size_t c0 = 0; c0 < n_cols && !ret; c0 += w.cr.batch) {
+		size_t nb = n_cols - c0 < w.cr.batch ? n_cols - c0 : w.cr.batch;
 
-		irdm_col_resp_outer(m, col_dofs, c0, nb, w.o);
-		irdm_col_resp_apply(m, w.o, nb, w.h, N, w.rt);
+		irdm_col_resp_run(&w.cr, col_dofs, c0, nb, (double *const[]){ w.rt });
 		for (size_t c = 0; c < nb && !ret; c++) {
 			irdm_col_resp_column(w.rt, c, N, w.R);
 			ret = scan_column(img, &w, c0 + c, N, res, mesh_nodes[c0 + c], err, errlen);

@@ -90,34 +90,32 @@ size_t irdm_screen_columns(const struct irdm_modes *m, const struct irdm_mode *z
 			   const bool *dropped, unsigned H, const int64_t *col_dofs, size_t n_cols,
 			   size_t N, size_t k, uint32_t *cols, double *est)
 {
-	size_t n = irdm_screen_ticks(H, N), nm = m->n_modes, found = 0, n_dropped = 0;
-	size_t batch = irdm_col_resp_batch(m);
-	double *h, *g, *o, *rt, *gt, *R, *Rh, *F, *Fh, *x, *e, *vals;
+	size_t n = irdm_screen_ticks(H, N), found = 0, n_dropped = 0;
+	struct irdm_col_resp cr;
+	double *rt = NULL, *gt = NULL, *R, *Rh, *F, *Fh, *x, *e, *vals;
 
-	for (size_t d = 0; d < nm; d++)
+	for (size_t d = 0; d < m->n_modes; d++)
 		n_dropped += dropped[d] && m->omega2[d] > 0;
-	h = malloc(nm * n * sizeof(double));
-	g = malloc(nm * n * sizeof(double));
-	o = malloc(batch * 9 * nm * sizeof(double));
-	rt = malloc(batch * 9 * n * sizeof(double));
-	gt = malloc(batch * 9 * n * sizeof(double));
+	if (!n_dropped || !k || !n || irdm_col_resp_init(&cr, m, n, 2))
+		return 0;
+	rt = malloc(cr.batch * 9 * n * sizeof(double));
+	gt = malloc(cr.batch * 9 * n * sizeof(double));
 	R = malloc(n * 9 * sizeof(double));
 	Rh = malloc(n * 9 * sizeof(double));
 	F = malloc(n * 3 * sizeof(double));
 	Fh = malloc(n * 3 * sizeof(double));
 	x = malloc(n * sizeof(double));
 	e = malloc(n * sizeof(double));
-	vals = malloc((k ? k : 1) * sizeof(double));
-	if (!n_dropped || !k || !n || !h || !g || !o || !rt || !gt || !R || !Rh || !F || !Fh ||
-	    !x || !e || !vals)
+	vals = malloc(k * sizeof(double));
+	if (!rt || !gt || !R || !Rh || !F || !Fh || !x || !e || !vals)
 		goto out_free;
-	responses(m, zoh, dropped, H, n, h, g, x, e);
-	for (size_t c0 = 0; c0 < n_cols; c0 += batch) {
-		size_t nb = n_cols - c0 < batch ? n_cols - c0 : batch;
+	responses(m, zoh, dropped, H, n, cr.x[0], cr.x[1], x, e);
+	if (irdm_col_resp_ready(&cr))
+		goto out_free;
+	for (size_t c0 = 0; c0 < n_cols; c0 += cr.batch) {
+		size_t nb = n_cols - c0 < cr.batch ? n_cols - c0 : cr.batch;
 
-		irdm_col_resp_outer(m, col_dofs, c0, nb, o);
-		irdm_col_resp_apply(m, o, nb, h, n, rt);
-		irdm_col_resp_apply(m, o, nb, g, n, gt);
+		irdm_col_resp_run(&cr, col_dofs, c0, nb, (double *const[]){ rt, gt });
 		for (size_t c = 0; c < nb; c++)
 			found = keep_largest(cols, vals, found, k, (uint32_t)(c0 + c),
 					     column_error(rt, gt, c, n, R, Rh, F, Fh));
@@ -125,9 +123,7 @@ size_t irdm_screen_columns(const struct irdm_modes *m, const struct irdm_mode *z
 	for (size_t i = 0; est && i < found; i++)
 		est[i] = vals[i];
 out_free:
-	free(h);
-	free(g);
-	free(o);
+	irdm_col_resp_free(&cr);
 	free(rt);
 	free(gt);
 	free(R);
