@@ -126,7 +126,7 @@ void irdm_measure_cmds(bool release, uint32_t row, size_t N, struct irdm_report_
 	}
 }
 
-static double rel_rms(const double *F, const double *Fref, size_t n)
+double irdm_measure_rel_rms(const double *F, const double *Fref, size_t n)
 {
 	double num = 0, den = 0;
 
@@ -205,7 +205,7 @@ static int measure_column(const struct irdm_image *img, const struct irdm_image 
 			free(Fref);
 			return ret;
 		}
-		e = faulted ? INFINITY : rel_rms(rn->F, Fref, 3 * N);
+		e = faulted ? INFINITY : irdm_measure_rel_rms(rn->F, Fref, 3 * N);
 		if (!(e <= res->error)) {
 			res->error = e;
 			res->worst_node = mesh_node;

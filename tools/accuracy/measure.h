@@ -99,6 +99,10 @@ size_t irdm_measure_ticks(double dt_s);
  * `row`: cmds, N of them. */
 void irdm_measure_cmds(bool release, uint32_t row, size_t N, struct irdm_report_cmd *cmds);
 
+/* |F - Fref|_2 / |Fref|_2 over n values (0 when both are zero, infinite
+ * when only Fref is). */
+double irdm_measure_rel_rms(const double *F, const double *Fref, size_t n);
+
 /* The push, oblique so that every axis of the contact's 3x3 response is
  * excited; the model is linear: its size only sets the units. */
 extern const double irdm_measure_push_m[3];

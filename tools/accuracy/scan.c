@@ -33,17 +33,6 @@ static void work_free(struct work *w)
 	irdm_report_runner_close(w->run);
 }
 
-static double rel_rms(const double *F, const double *Fref, size_t n)
-{
-	double num = 0, den = 0;
-
-	for (size_t i = 0; i < n; i++) {
-		num += (F[i] - Fref[i]) * (F[i] - Fref[i]);
-		den += Fref[i] * Fref[i];
-	}
-	return den > 0 ? sqrt(num / den) : (num > 0 ? INFINITY : 0);
-}
-
 /* Column c's two runs (R: its exact response): the larger error. */
 static int scan_column(const struct irdm_image *img, struct work *w, size_t c, size_t N,
 		       struct irdm_scan *res, uint32_t mesh_node, char *err, size_t errlen)
@@ -63,7 +52,7 @@ static int scan_column(const struct irdm_image *img, struct work *w, size_t c, s
 		ret = irdm_report_runner_run(w->run, w->cmds, N, w->F, &faulted, err, errlen);
 		if (ret)
 			return ret;
-		e = faulted ? INFINITY : rel_rms(w->F, w->Fref, 3 * N);
+		e = faulted ? INFINITY : irdm_measure_rel_rms(w->F, w->Fref, 3 * N);
 		if (!(e <= worst))
 			worst = e;
 		if (!(e <= res->worst)) {

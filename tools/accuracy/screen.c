@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "accuracy/col_resp.h"
+#include "accuracy/measure.h"
 #include "accuracy/screen.h"
 #include "accuracy/split.h"
 
@@ -30,17 +31,6 @@ static void responses(const struct irdm_modes *m, const struct irdm_mode *zoh, c
 	}
 }
 
-static double rel_rms(const double *F, const double *Fref, size_t n)
-{
-	double num = 0, den = 0;
-
-	for (size_t i = 0; i < n; i++) {
-		num += (F[i] - Fref[i]) * (F[i] - Fref[i]);
-		den += Fref[i] * Fref[i];
-	}
-	return den > 0 ? sqrt(num / den) : 0;
-}
-
 /* The prediction at column c of a batch from its responses rt and gt
  * (col_resp.h): both runs, the larger; 0 at a column the grab cannot
  * hold (R[0] singular: a fixed DoF).  R, F: n x 9 and n x 3 of scratch,
@@ -57,7 +47,7 @@ static double column_error(const double *rt, const double *gt, size_t c, size_t 
 			return 0;
 		if (!irdm_split_forces(Rh, n, run, Fh))
 			return INFINITY;
-		worst = fmax(worst, rel_rms(Fh, F, 3 * n));
+		worst = fmax(worst, irdm_measure_rel_rms(Fh, F, 3 * n));
 	}
 	return worst;
 }

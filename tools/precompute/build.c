@@ -1277,6 +1277,22 @@ static size_t screened_columns(const struct build *b, uint32_t *cols)
 	return n;
 }
 
+/* The measured figure into META and the report. */
+static void record(struct build *b, struct irdm_precompute_report *rep, double error,
+		   uint32_t worst_node, const char *worst_run, size_t cols, size_t ticks,
+		   double seconds)
+{
+	b->meta.measured_error = (float)error;
+	b->meta.flags |= IRDM_META_ERROR_MEASURED;
+	rep->error_measured = true;
+	rep->measured_error = error;
+	rep->error_worst_node = worst_node;
+	rep->error_worst_run = worst_run;
+	rep->error_cols = cols;
+	rep->error_ticks = ticks;
+	rep->seconds_error = seconds;
+}
+
 /* error_columns: every column, when asked, or by default when it can
  * and it costs no more than the sample. */
 static bool every_column(const struct build *b)
@@ -1321,18 +1337,10 @@ static int scan(struct build *b, const struct irdm_image *img, struct irdm_preco
 				     b->sc->max_error, b->o->progress, b->o->ctx, &res, err, errlen);
 	if (ret)
 		goto out_free;
-	b->meta.measured_error = (float)res.worst;
-	b->meta.flags |= IRDM_META_ERROR_MEASURED;
-	rep->error_measured = true;
+	record(b, rep, res.worst, res.worst_node, res.worst_run, res.n_cols, res.ticks, res.seconds);
 	rep->error_every_column = true;
-	rep->measured_error = res.worst;
-	rep->error_worst_node = res.worst_node;
-	rep->error_worst_run = res.worst_run;
-	rep->error_cols = res.n_cols;
-	rep->error_ticks = res.ticks;
 	rep->error_median = res.median;
 	rep->error_p90 = res.p90;
-	rep->seconds_error = res.seconds;
 out_free:
 	free(zoh);
 	free(nodes);
@@ -1379,15 +1387,7 @@ static int measure(struct build *b, struct irdm_precompute_report *rep, char *er
 	irdm_image_unmap(&img);
 	if (ret)
 		goto out_unlink;
-	b->meta.measured_error = (float)res.error;
-	b->meta.flags |= IRDM_META_ERROR_MEASURED;
-	rep->error_measured = true;
-	rep->measured_error = res.error;
-	rep->error_worst_node = res.worst_node;
-	rep->error_worst_run = res.worst_run;
-	rep->error_cols = res.n_cols;
-	rep->error_ticks = res.ticks;
-	rep->seconds_error = res.seconds;
+	record(b, rep, res.error, res.worst_node, res.worst_run, res.n_cols, res.ticks, res.seconds);
 out_unlink:
 	unlink(tmp);
 out_free:
