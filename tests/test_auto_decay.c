@@ -21,9 +21,9 @@
  *  - with every surface node shown, the modes it keeps have whole shapes
  *    (the eigensolve gives every mode at the touchable rows only): each
  *    the all-modes image's at every row;
- *  - max_head_mib bounds the head auto builds: a capped hybrid grows to
- *    twice the modes and waits its turn at its new cost, one estimated
- *    over the cap is not built; under a cap no head meets, every mode;
+ *  - max_head_mib bounds the head auto builds: one built over the cap is
+ *    not measured, one estimated over it is not built; under a cap no
+ *    head meets, every mode;
  *  - a tighter max_error that no candidate meets is refused with a
  *    message, and no image is written.
  */
