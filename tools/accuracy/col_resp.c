@@ -58,46 +58,51 @@ static size_t alive_len(const double *x, size_t n)
 	return len;
 }
 
-static const size_t *sort_len; /* qsort has no context: ready() alone sets it */
+/* A mode and how many of its samples count. */
+struct mode_len {
+	size_t len, d;
+};
 
+/* Longest first, ties in mode order: the sums' order is the same on any
+ * qsort. */
 static int longest_first(const void *a, const void *b)
 {
-	size_t x = sort_len[*(const size_t *)a], y = sort_len[*(const size_t *)b];
+	const struct mode_len *x = a, *y = b;
 
-	return (x < y) - (x > y);
+	if (x->len != y->len)
+		return (x->len < y->len) - (x->len > y->len);
+	return (x->d > y->d) - (x->d < y->d);
 }
 
 int irdm_col_resp_ready(struct irdm_col_resp *r)
 {
 	size_t nm = r->m->n_modes, n = r->n;
-	size_t *len = malloc((nm ? nm : 1) * sizeof(size_t));
+	struct mode_len *ml = malloc((nm ? nm : 1) * sizeof(*ml));
 
-	if (!len)
+	if (!ml)
 		return IRDM_ENOMEM;
 	for (size_t d = 0; d < nm; d++) {
-		len[d] = 0;
+		ml[d] = (struct mode_len){ .len = 0, .d = d };
 		for (size_t k = 0; k < r->n_x; k++) {
 			size_t l = alive_len(&r->x[k][d * n], n);
-			len[d] = l > len[d] ? l : len[d];
+			ml[d].len = l > ml[d].len ? l : ml[d].len;
 		}
-		r->perm[d] = d;
 	}
-	sort_len = len;
-	qsort(r->perm, nm, sizeof(size_t), longest_first);
+	qsort(ml, nm, sizeof(*ml), longest_first);
+	for (size_t i = 0; i < nm; i++) {
+		r->perm[i] = ml[i].d;
+		r->alive[i] = ml[i].len;
+	}
+	free(ml);
 	for (size_t k = 0; k < r->n_x; k++) {
 		double *y = malloc((nm ? nm : 1) * n * sizeof(double));
-		if (!y) {
-			free(len);
+		if (!y)
 			return IRDM_ENOMEM;
-		}
 		for (size_t i = 0; i < nm; i++)
 			memcpy(&y[i * n], &r->x[k][r->perm[i] * n], n * sizeof(double));
 		free(r->x[k]);
 		r->x[k] = y;
 	}
-	for (size_t i = 0; i < nm; i++)
-		r->alive[i] = len[r->perm[i]];
-	free(len);
 	return IRDM_OK;
 }
 

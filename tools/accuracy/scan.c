@@ -72,11 +72,9 @@ static int by_value(const void *a, const void *b)
 	return (x > y) - (x < y);
 }
 
-/* The median, p90 and count over target of the columns' errors. */
-static void summarise(double *errs, size_t n, double target, struct irdm_scan *res)
+/* The median and p90 of the columns' errors. */
+static void summarise(double *errs, size_t n, struct irdm_scan *res)
 {
-	for (size_t c = 0; c < n; c++)
-		res->over += !(errs[c] <= target);
 	qsort(errs, n, sizeof(*errs), by_value);
 	res->median = errs[n / 2];
 	res->p90 = errs[(9 * n) / 10 < n ? (9 * n) / 10 : n - 1];
@@ -84,7 +82,7 @@ static void summarise(double *errs, size_t n, double target, struct irdm_scan *r
 
 int irdm_scan_every_column(const struct irdm_image *img, const struct irdm_modes *m,
 			   const struct irdm_mode *zoh, const int64_t *col_dofs,
-			   const uint32_t *mesh_nodes, size_t n_cols, double target,
+			   const uint32_t *mesh_nodes, size_t n_cols,
 			   irdm_progress_fn fn, void *ctx, struct irdm_scan *res, char *err,
 			   size_t errlen)
 {
@@ -142,7 +140,7 @@ int irdm_scan_every_column(const struct irdm_image *img, const struct irdm_modes
 	}
 	if (!ret) {
 		res->n_cols = n_cols;
-		summarise(w.errs, n_cols, target, res);
+		summarise(w.errs, n_cols, res);
 	}
 out:
 	work_free(&w);

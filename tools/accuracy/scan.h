@@ -24,7 +24,6 @@ struct irdm_scan {
 	uint32_t worst_node;   /* ... at this mesh node */
 	const char *worst_run; /* "step" or "release" */
 	double median, p90;    /* of the columns' errors (each the larger run's) */
-	size_t over;           /* columns over the target */
 	size_t ticks;          /* of each run */
 	double seconds;
 };
@@ -32,14 +31,14 @@ struct irdm_scan {
 /*
  * Scan img against m (every elastic mode, zoh: them discretised), whose
  * columns are img's: col_dofs (3 free DoFs or -1 each) and mesh_nodes of
- * n_cols columns, in img's order; over target counts in res->over.
+ * n_cols columns, in img's order.
  * Return: IRDM_OK; IRDM_ENOMEM; IRDM_EINVAL if the columns are not img's
  * or img is of a floating object; the engine's errors.  A one-line reason
  * goes to err.
  */
 int irdm_scan_every_column(const struct irdm_image *img, const struct irdm_modes *m,
 			   const struct irdm_mode *zoh, const int64_t *col_dofs,
-			   const uint32_t *mesh_nodes, size_t n_cols, double target,
+			   const uint32_t *mesh_nodes, size_t n_cols,
 			   irdm_progress_fn fn, void *ctx, struct irdm_scan *res, char *err,
 			   size_t errlen);
 

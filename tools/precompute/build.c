@@ -1334,7 +1334,7 @@ static int scan(struct build *b, const struct irdm_image *img, struct irdm_preco
 	for (size_t c = 0; c < b->m.n_cols; c++)
 		nodes[c] = b->m.rows[b->m.cols[c]];
 	ret = irdm_scan_every_column(img, &all, zoh, b->m.col_dofs, nodes, b->m.n_cols,
-				     b->sc->max_error, b->o->progress, b->o->ctx, &res, err, errlen);
+				     b->o->progress, b->o->ctx, &res, err, errlen);
 	if (ret)
 		goto out_free;
 	record(b, rep, res.worst, res.worst_node, res.worst_run, res.n_cols, res.ticks, res.seconds);
@@ -1595,28 +1595,26 @@ static int try_candidate(struct build *b, const struct irdm_auto_candidate *c, s
 
 /*
  * The probe auto sizes its hybrids on (accuracy/split.h): the columns of
- * the measurement's spread, every mode discretised.
+ * the measurement's spread; zoh: every mode discretised.
  */
-static int candidates(struct build *b, struct irdm_auto_candidate *cand, size_t *n_cand,
-		      char *err, size_t errlen)
+static int candidates(struct build *b, const struct irdm_mode *zoh,
+		      struct irdm_auto_candidate *cand, size_t *n_cand, char *err, size_t errlen)
 {
 	struct irdm_model *m = &b->m;
 	struct irdm_split_probe probe;
 	uint32_t cols[IRDM_MEASURE_SPREAD];
 	int64_t dofs[3 * IRDM_MEASURE_SPREAD];
 	double *pos = malloc(3 * (m->n_cols ? m->n_cols : 1) * sizeof(double));
-	struct irdm_mode *zoh = malloc(m->modes.n_modes * sizeof(*zoh));
 	size_t n;
 	int ret = IRDM_ENOMEM;
 
-	if (!pos || !zoh)
+	if (!pos)
 		goto out_free;
 	for (size_t c = 0; c < m->n_cols; c++)
 		memcpy(&pos[3 * c], &m->mesh.pos_m[3 * (size_t)m->rows[m->cols[c]]], 3 * sizeof(double));
 	n = irdm_measure_spread(pos, m->n_cols, IRDM_MEASURE_SPREAD, cols);
 	for (size_t i = 0; i < n; i++)
 		memcpy(&dofs[3 * i], &m->col_dofs[3 * (size_t)cols[i]], 3 * sizeof(int64_t));
-	irdm_modes_discretise(&m->modes, &m->damping, b->sc->dt_s, zoh);
 	if (b->o->progress)
 		b->o->progress(b->o->ctx, "auto: sizing the hybrids", 0.0);
 	ret = irdm_split_probe_init(&probe, &m->modes, zoh, dofs, n, irdm_measure_ticks(b->sc->dt_s));
@@ -1631,7 +1629,6 @@ out_free:
 	if (ret)
 		snprintf(err, errlen, ret == IRDM_ENOMEM ? "precompute: out of memory for auto's candidates" : "precompute: auto: a probed column's first response sample is singular");
 	free(pos);
-	free(zoh);
 	return ret;
 }
 
@@ -1885,17 +1882,20 @@ static int choose(struct build *b, struct irdm_precompute_report *rep, char *err
 		};
 		n_cand = 1;
 	} else {
-		ret = candidates(b, cand, &n_cand, err, errlen);
-		zoh = ret ? NULL : malloc(n_all * sizeof(*zoh));
-		if (!ret && !zoh) {
+		/* every mode discretised once: sizing and screening share it */
+		zoh = malloc(n_all * sizeof(*zoh));
+		if (!zoh) {
 			snprintf(err, errlen, "precompute: out of memory");
-			ret = IRDM_ENOMEM;
+			free(order);
+			return IRDM_ENOMEM;
 		}
+		irdm_modes_discretise(&b->m.modes, &b->m.damping, b->sc->dt_s, zoh);
+		ret = candidates(b, zoh, cand, &n_cand, err, errlen);
 		if (ret) {
+			free(zoh);
 			free(order);
 			return ret;
 		}
-		irdm_modes_discretise(&b->m.modes, &b->m.damping, b->sc->dt_s, zoh);
 	}
 	say_candidates(b, cand, n_cand);
 	while ((k = cheapest(cand, settled, n_cand)) < n_cand) {
