@@ -54,6 +54,12 @@ struct irdm_precompute_report {
 	/* every column measured (error_columns), their median and p90 */
 	bool error_every_column;
 	double error_median, error_p90;
+	/* two contacts at once (accuracy/pairs.h): the worst of n pairs */
+	bool pairs_measured;
+	double pairs_error;
+	uint32_t pairs_nodes[2];
+	const char *pairs_run;
+	size_t pairs_n;
 	/* the representation written (representation = auto: the chosen one)
 	 * and how many candidates auto built */
 	char representation[64];
