@@ -25,6 +25,9 @@
 #include "modal/modal.h"
 
 #define IRDM_PAIRS_COLS 8 /* columns spread over the surface: 28 pairs */
+/* A pair's relative RMS force error above this is no approximation: its
+ * force recursion diverges (the precompute refuses the image). */
+#define IRDM_PAIRS_DIVERGED 1.0
 
 struct irdm_pairs {
 	double worst;      /* relative RMS force error over both contacts */

@@ -254,7 +254,12 @@ static int modal_data(struct build *b, char *err, size_t errlen)
 						    m->col_dofs, m->n_cols, b->sc->static_corr_tol,
 						    b->o->progress, b->o->ctx, &b->sparse,
 						    err, errlen);
-		if (!ret && b->sc->static_corr_rank && b->sparse.n_blocks < m->n_cols * m->n_cols)
+		/* not with a head: a dropped block's far field is a constant at
+		 * R[0] between two columns whose own blocks move with their
+		 * heads, and two contacts grabbed at once through it can
+		 * diverge (accuracy/pairs.h) */
+		if (!ret && b->sc->static_corr_rank && !zoh_all &&
+		    b->sparse.n_blocks < m->n_cols * m->n_cols)
 			ret = irdm_static_correction_lowrank(&m->fem, &m->modes, b->sc->floating,
 							     m->col_dofs, &b->sparse,
 							     b->sc->static_corr_rank < 3 * m->n_cols ?
@@ -1220,6 +1225,13 @@ static int within_target(const struct build *b, const struct irdm_precompute_rep
 {
 	char repr[64], hint[224];
 
+	if (rep->pairs_measured && !(rep->pairs_error <= IRDM_PAIRS_DIVERGED)) {
+		repr_text(b->sc, repr, sizeof(repr));
+		snprintf(err, errlen, "precompute: scene %s: %s is certified node by node, but two contacts grabbed at once at mesh nodes %u and %u are %.3g off the exact model (relative RMS force error, %s): the pair diverges; try static_correction_tol = 0 (every block between touchable nodes kept) (max_error = none skips the check)",
+			 b->sc->name, repr, rep->pairs_nodes[0], rep->pairs_nodes[1], rep->pairs_error,
+			 rep->pairs_run);
+		return IRDM_ENUMERIC;
+	}
 	if (!rep->error_measured || rep->measured_error <= b->sc->max_error)
 		return IRDM_OK;
 	repr_text(b->sc, repr, sizeof(repr));
@@ -1352,7 +1364,8 @@ out_free:
  * Two contacts at once (accuracy/pairs.h), at columns spread over the
  * surface: far apart, where a static correction drops the blocks between
  * them.  Measured on an image within max_error, printed, not held
- * against it: the target is of one contact.
+ * against it (the target is of one contact); a pair that diverges
+ * refuses the image (within_target()).
  */
 static int pairs(struct build *b, const struct irdm_image *img, struct irdm_precompute_report *rep,
 		 char *err, size_t errlen)
