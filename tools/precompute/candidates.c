@@ -11,13 +11,15 @@ static const unsigned heads[] = { 1, 2, 4, 8, 16, 32, 64, 128, 256 };
 _Static_assert(sizeof(heads) / sizeof(heads[0]) == IRDM_AUTO_N_HEADS, "IRDM_AUTO_N_HEADS");
 
 /*
- * Per-unit costs estimated from docs/measurements/bench_tick.md, one
- * touching node: every mode of the 6x6x12 cuboid (1764 modes) ticks in
- * 10.2 us, 5.8 ns a mode; the hybrid 300 + 128 head ticks 2.2 us above
- * modal 300 + static correction over 256 samples of age, 8.6 ns each.
+ * Per-unit costs estimated from docs/measurements/bench_tick.md, a point
+ * on a triangle in contact (the proxy's usual contact, three nodes):
+ * every mode of the 6x6x12 cuboid (1764 modes) ticks in 4.92 us, 2.79 ns
+ * a mode; the hybrid 300 + 128 head ticks 1.85 us above modal 300 +
+ * static correction over 256 samples of age, 7.23 ns each.  Only their
+ * ratio orders the candidates.
  */
-#define NS_PER_MODE 5.8
-#define NS_PER_HEAD_SAMPLE 8.6
+#define NS_PER_MODE 2.79
+#define NS_PER_HEAD_SAMPLE 7.23
 
 double irdm_auto_tick_us(size_t modes, unsigned head)
 {
