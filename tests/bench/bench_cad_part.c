@@ -133,7 +133,7 @@ int main(void)
 	       at_stats >= 0 && (at_eigen < 0 || at_stats < at_eigen) ? "before" : "NOT before");
 	long dummy;
 	const char *keys[] = { "modes ", "representation ", "image nodes", "image  ",
-			       "static corr", "time ", "memory ", "force error" };
+			       "static corr", "time ", "memory ", "two contacts", "force error" };
 	for (size_t k = 0; k < sizeof(keys) / sizeof(keys[0]); k++)
 		if ((l = log_line(keys[k], true, &dummy)))
 			printf("cad   %s\n", l);

@@ -12,8 +12,8 @@ shift || true
 res=("$@")
 [ ${#res[@]} -gt 0 ] || res=(11,11,22 17,17,34)
 mkdir -p out/scale
-echo "| resolution | mesh | free DoFs | eigensolve | representation | measured error | precompute | CPU | peak memory | image |"
-echo "|---|---|---|---|---|---|---|---|---|---|"
+echo "| resolution | mesh | free DoFs | eigensolve | representation | measured error | two contacts | precompute | CPU | peak memory | image |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|"
 for r in "${res[@]}"; do
 	log=out/scale/cuboid-$r.log img=out/scale/cuboid-$r.img
 	echo "scale: $r ..." >&2
@@ -29,9 +29,10 @@ for r in "${res[@]}"; do
 		/^time / { total = $2; for (i = 3; i <= NF; i++) if ($i == "eigen") eig = $(i + 1) }
 		/^memory / { peak = $3 }
 		/^force error / { err = $3 }
+		/^two contacts / { pairs = $3 }
 		END {
 			sub(/,$/, "", eig)
-			printf "| %s | %s | %s | %s s, %s | %s | %s | %s s | %.0f s | %s MiB | %.1f MB |\n",
-			       r, mesh, dofs, eig, blocks ? blocks " blocks" : "whole", repr, err, total,
-			       cpu, peak, bytes / 1e6 }'
+			printf "| %s | %s | %s | %s s, %s | %s | %s | %s | %s s | %.0f s | %s MiB | %.1f MB |\n",
+			       r, mesh, dofs, eig, blocks ? blocks " blocks" : "whole", repr, err,
+			       pairs == "" ? "-" : pairs, total, cpu, peak, bytes / 1e6 }'
 done
