@@ -1421,6 +1421,7 @@ static int measure(struct build *b, struct irdm_precompute_report *rep, char *er
 	struct irdm_image img;
 	int ret = IRDM_ENOMEM;
 
+	rep->pairs_measured = false; /* an earlier try's pairs are not this one's */
 	if (!(b->sc->max_error > 0) || irdm_dist_size() > 1) {
 		free(tmp);
 		free(ref);
