@@ -44,8 +44,7 @@ int irdm_col_resp_init(struct irdm_col_resp *r, const struct irdm_modes *m, size
 	return IRDM_OK;
 }
 
-/* Samples of x[0..n) up to its last over CUT of its peak. */
-static size_t alive_len(const double *x, size_t n)
+size_t irdm_col_resp_alive_len(const double *x, size_t n)
 {
 	double peak = 0;
 	size_t len = 0;
@@ -84,7 +83,7 @@ int irdm_col_resp_ready(struct irdm_col_resp *r)
 	for (size_t d = 0; d < nm; d++) {
 		ml[d] = (struct mode_len){ .len = 0, .d = d };
 		for (size_t k = 0; k < r->n_x; k++) {
-			size_t l = alive_len(&r->x[k][d * n], n);
+			size_t l = irdm_col_resp_alive_len(&r->x[k][d * n], n);
 			ml[d].len = l > ml[d].len ? l : ml[d].len;
 		}
 	}

@@ -46,6 +46,10 @@ void irdm_col_resp_free(struct irdm_col_resp *r);
 void irdm_col_resp_run(struct irdm_col_resp *r, const int64_t *col_dofs, size_t c0, size_t nb,
 		       double *const *out);
 
+/* Samples of x[0..n) up to its last over 1e-12 of its peak: past them
+ * a mode adds nothing the forces can show. */
+size_t irdm_col_resp_alive_len(const double *x, size_t n);
+
 /* One column's R (n x 9, [s][q]) out of a run's out[k]. */
 void irdm_col_resp_column(const double *out, size_t c, size_t n, double *R);
 

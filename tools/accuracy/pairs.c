@@ -6,26 +6,12 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "accuracy/col_resp.h"
 #include "accuracy/measure.h"
 #include "accuracy/pairs.h"
 #include "accuracy/run.h"
 #include "modal/lapack.h"
 #include "util/clock.h"
-
-/* The samples of h over 1e-12 of its peak: past them a mode adds nothing
- * the forces can show. */
-static size_t alive(const double *h, size_t N)
-{
-	double peak = 0;
-	size_t L = 0;
-
-	for (size_t s = 0; s < N; s++)
-		peak = fmax(peak, fabs(h[s]));
-	for (size_t s = 0; s < N; s++)
-		if (fabs(h[s]) > 1e-12 * peak)
-			L = s + 1;
-	return L;
-}
 
 /* R[(s D + r) D + q], D = 3n: the exact response at the n columns,
  * every pair of them, summed mode by mode. */
@@ -46,7 +32,7 @@ static int exact_blocks(const struct irdm_modes *m, const struct irdm_mode *zoh,
 			p[r] = dof < 0 ? 0.0 : m->phi[d * m->n + (size_t)dof];
 		}
 		irdm_zoh_response(&zoh[d], N, h);
-		L = alive(h, N);
+		L = irdm_col_resp_alive_len(h, N);
 		for (size_t s = 0; s < L; s++)
 			for (size_t r = 0; r < D; r++) {
 				double ph = p[r] * h[s];
