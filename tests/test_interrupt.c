@@ -247,6 +247,15 @@ static void test_image_debris(void **state)
 
 int main(void)
 {
+	/* The tests set each signal's starting disposition themselves: run
+	 * from a background job, this process starts with SIGINT ignored
+	 * (POSIX), its children would inherit that, and the tools rightly
+	 * keep a signal ignored at start ignored, so a SIGINT would never
+	 * end them. */
+	static const int sigs[] = { SIGINT, SIGTERM, SIGHUP };
+	for (size_t i = 0; i < sizeof(sigs) / sizeof(sigs[0]); i++)
+		signal(sigs[i], SIG_DFL);
+
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_signals_clean_up),
 		cmocka_unit_test(test_precompute_interrupted_in_tetgen),
