@@ -116,68 +116,57 @@ static uint32_t row_of(const struct irdm_image *img, uint32_t mesh_node)
 	return 0;
 }
 
-/* The error of one run at mesh_node: img by the engine, exact by convolution. */
-static double run_error(const struct irdm_image *img, const struct irdm_image *exact,
-			uint32_t mesh_node, bool release, size_t N)
+/*
+ * The error of one run with m contacts, at mesh nodes nodes[0..m) at
+ * once: img by the engine, exact by convolution.
+ */
+static double contacts_error(const struct irdm_image *img, const struct irdm_image *exact,
+			     const uint32_t *nodes, unsigned m, bool release, size_t N)
 {
-	struct irdm_report_cmd *cmds = malloc(N * sizeof(*cmds));
-	struct irdm_report_conv c = { .img = exact, .m = 1, .N = N, .n_resp = N, .cmds = cmds };
-	struct irdm_report_conv_out ref;
-	struct irdm_report_engine_out eo;
-	double num = 0, den = 0;
-	char err[256];
-
-	assert_non_null(cmds);
-	cmds_of(release, row_of(exact, mesh_node), N, cmds);
-	assert_int_equal(irdm_report_convolve(&c, &ref, err, sizeof(err)), 0);
-	cmds_of(release, row_of(img, mesh_node), N, cmds);
-	assert_int_equal(irdm_report_engine_run(img, cmds, 1, N, 0, &eo, err, sizeof(err)), 0);
-	assert_false(eo.faulted);
-	for (size_t i = 0; i < 3 * N; i++) {
-		num += (eo.F[i] - ref.F[i]) * (eo.F[i] - ref.F[i]);
-		den += ref.F[i] * ref.F[i];
-	}
-	irdm_report_engine_free(&eo);
-	irdm_report_conv_free(&ref);
-	free(cmds);
-	return sqrt(num / den);
-}
-
-/* The same with two contacts, mesh nodes a and b grabbed at once. */
-static double pair_error(const struct irdm_image *img, const struct irdm_image *exact,
-			 uint32_t a, uint32_t b, bool release, size_t N)
-{
-	struct irdm_report_cmd *one = malloc(N * sizeof(*one)), *two = malloc(2 * N * sizeof(*two));
-	struct irdm_report_conv c = { .img = exact, .m = 2, .N = N, .n_resp = N, .cmds = two };
+	struct irdm_report_cmd *one = malloc(N * sizeof(*one)), *all = malloc(m * N * sizeof(*all));
+	struct irdm_report_conv c = { .img = exact, .m = m, .N = N, .n_resp = N, .cmds = all };
 	struct irdm_report_conv_out ref;
 	struct irdm_report_engine_out eo;
 	const struct irdm_image *on[2] = { exact, img };
-	uint32_t node[2] = { a, b };
 	double num = 0, den = 0;
 	char err[256];
 
 	assert_non_null(one);
-	assert_non_null(two);
+	assert_non_null(all);
 	for (int k = 0; k < 2; k++) { /* the exact model's rows, then the image's */
-		for (int i = 0; i < 2; i++) {
-			cmds_of(release, row_of(on[k], node[i]), N, one);
+		for (unsigned i = 0; i < m; i++) {
+			cmds_of(release, row_of(on[k], nodes[i]), N, one);
 			for (size_t t = 0; t < N; t++)
-				two[2 * t + (size_t)i] = one[t];
+				all[m * t + i] = one[t];
 		}
 		if (k == 0)
 			assert_int_equal(irdm_report_convolve(&c, &ref, err, sizeof(err)), 0);
 	}
-	assert_int_equal(irdm_report_engine_run(img, two, 2, N, 0, &eo, err, sizeof(err)), 0);
+	assert_int_equal(irdm_report_engine_run(img, all, m, N, 0, &eo, err, sizeof(err)), 0);
 	assert_false(eo.faulted);
-	for (size_t i = 0; i < 6 * N; i++) {
+	for (size_t i = 0; i < 3 * m * N; i++) {
 		num += (eo.F[i] - ref.F[i]) * (eo.F[i] - ref.F[i]);
 		den += ref.F[i] * ref.F[i];
 	}
 	irdm_report_engine_free(&eo);
 	irdm_report_conv_free(&ref);
 	free(one);
-	free(two);
+	free(all);
 	return sqrt(num / den);
+}
+
+static double run_error(const struct irdm_image *img, const struct irdm_image *exact,
+			uint32_t mesh_node, bool release, size_t N)
+{
+	return contacts_error(img, exact, &mesh_node, 1, release, N);
+}
+
+static double pair_error(const struct irdm_image *img, const struct irdm_image *exact,
+			 uint32_t a, uint32_t b, bool release, size_t N)
+{
+	const uint32_t nodes[2] = { a, b };
+
+	return contacts_error(img, exact, nodes, 2, release, N);
 }
 
 static int setup(void **state)

@@ -15,8 +15,8 @@ _Static_assert(sizeof(heads) / sizeof(heads[0]) == IRDM_AUTO_N_HEADS, "IRDM_AUTO
  * on a triangle in contact (the proxy's usual contact, three nodes):
  * every mode of the 6x6x12 cuboid (1764 modes) ticks in 4.92 us, 2.79 ns
  * a mode; the hybrid 300 + 128 head ticks 1.85 us above modal 300 +
- * static correction over 256 samples of age, 7.23 ns each.  Only their
- * ratio orders the candidates.
+ * static correction over 256 samples of age, 7.23 ns each.  Their ratio
+ * orders the candidates; the sums are printed as estimates, not timings.
  */
 #define NS_PER_MODE 2.79
 #define NS_PER_HEAD_SAMPLE 7.23
