@@ -18,6 +18,8 @@
  *  - the image file truncated or written over under a running loop: the
  *    run goes on to its end on its own copy;
  *  - a run whose limits never let the torque on exits 7 naming the limit;
+ *  - two arms: the image's two-contact figure printed under the one-contact
+ *    one, as the image holds it, or "not measured"; one arm: no such line;
  *  - --frame-at: the deformed surface in VTK, checked physically (a dent
  *    at the pressed top centre, a still bottom) and byte-identical in
  *    virtual time;
@@ -394,6 +396,45 @@ static void test_summary_rendered_force(void **state)
 		      rend);
 	assert_true(obj > 0.25);
 	assert_true(fabs(rend - 0.2) <= 5e-5);
+}
+
+/*
+ * Two arms: the image's force error is one contact's, so irdm-fw says
+ * what two at once are worth too, as the image says it (the precompute's
+ * two-contact figure), or that it was not measured; one arm, no such line.
+ */
+static void test_two_arms_see_the_two_contact_figure(void **state)
+{
+	static const char pinch[] = "boards/sim-phantom-pinch.board";
+	char path[320], err[256], want[128];
+	struct irdm_image img;
+	const char *fw_args[] = { "--board", pinch, "--image", image, "--user", "scenes/users/pinch.user",
+				  "--clock", "virtual", "--duration", "0.01", NULL };
+
+	(void)state;
+	assert_int_equal(run_fw(fw_args), 0);
+	assert_non_null(strstr(out_text, "\nimage: two contacts at once: force error not measured\n"));
+	assert_int_equal(run_fw((const char *const[]){ "--board", BOARD, "--image", image, "--user",
+						       PRESS, "--clock", "virtual", "--duration", "0.01",
+						       NULL }),
+			 0);
+	assert_null(strstr(out_text, "two contacts"));
+
+	snprintf(path, sizeof(path), "%s/measured.img", dir);
+	assert_int_equal(finish(spawn(env_or("IRDM", "build/irdm"), (const char *const[]){
+									    "precompute", "-q", "--mesh", "cuboid", "--resolution", "4,4,8", "--fixed", "z<=0",
+									    "--touch", "z>=0.2", "--display", "touch", "-o", path, NULL })),
+			 0);
+	assert_int_equal(irdm_image_map(path, 0, &img, err, sizeof(err)), 0);
+	assert_true(img.two_contacts_error > 0 && img.two_contacts_error < 0.1);
+	snprintf(want, sizeof(want), "\nimage: two contacts at once: force error %.3g against the exact model\n",
+		 img.two_contacts_error);
+	irdm_image_unmap(&img);
+	fw_args[3] = path;
+	assert_int_equal(run_fw(fw_args), 0);
+	if (!strstr(out_text, want))
+		fail_msg("expected '%s' in: %s", want + 1, out_text);
+	unlink(path);
 }
 
 static bool kernel_is_rt(void)
@@ -1177,6 +1218,7 @@ int main(void)
 		cmocka_unit_test(test_virtual_runs_are_identical),
 		cmocka_unit_test(test_release_ringing_is_the_dominant_mode),
 		cmocka_unit_test(test_summary_rendered_force),
+		cmocka_unit_test(test_two_arms_see_the_two_contact_figure),
 		cmocka_unit_test(test_require_rt),
 		cmocka_unit_test(test_sigterm_mid_contact_turns_torque_off),
 		cmocka_unit_test(test_sighup_mid_contact_turns_torque_off),

@@ -1574,6 +1574,18 @@ static void m_prov_rayleigh(struct img_fixture *fx)
 					       "rayleigh_a_per_s=3\n");
 }
 
+/* The two-contact figure: a number >= 0, or the image is wrong. */
+static void prov_two_contacts(struct img_fixture *fx, const char *v)
+{
+	fx->provenance_len += (size_t)snprintf(fx->provenance + fx->provenance_len,
+					       sizeof(fx->provenance) - fx->provenance_len,
+					       "two_contacts_error=%s\n", v);
+}
+
+FX(m_pairs_text, prov_two_contacts(fx, "0.01x"))
+FX(m_pairs_neg, prov_two_contacts(fx, "-0.002"))
+FX(m_pairs_inf, prov_two_contacts(fx, "inf"))
+FX(m_pairs_empty, prov_two_contacts(fx, ""))
 FX(m_prov_tool, snprintf(fx->meta.tool_version, sizeof(fx->meta.tool_version), "irdm-test 0.2"))
 FX(m_floating, fx->meta.flags |= IRDM_META_FLOATING)
 FX(m_mass, fx->rigid.mass_kg = 0)
@@ -1827,6 +1839,11 @@ static const struct sem_case sem_cases[] = {
 	{ "provenance tool", FIR, m_prov_tool, NULL, IRDM_EFORMAT,
 	  "PROVENANCE tool=irdm-test 0.1 disagrees with meta's tool_version 'irdm-test 0.2'" },
 	{ "provenance NUL", FIR, m_prov_nul, NULL, IRDM_EFORMAT, "NUL byte at offset 10" },
+	{ "two contacts text", FIR, m_pairs_text, NULL, IRDM_EFORMAT,
+	  "PROVENANCE two_contacts_error=0.01x is not a finite number >= 0" },
+	{ "two contacts negative", FIR, m_pairs_neg, NULL, IRDM_EFORMAT, "two_contacts_error=-0.002 is not" },
+	{ "two contacts inf", FIR, m_pairs_inf, NULL, IRDM_EFORMAT, "two_contacts_error=inf is not" },
+	{ "two contacts empty", FIR, m_pairs_empty, NULL, IRDM_EFORMAT, "two_contacts_error= is not" },
 	{ "no META", FIR, NULL, w_no_meta, IRDM_EMISSING, "META is missing" },
 	{ "no PROVENANCE", FIR, NULL, w_no_prov, IRDM_EMISSING, "PROVENANCE is missing" },
 	{ "no NODES", FIR, NULL, w_no_nodes, IRDM_EMISSING, "NODES is missing" },
@@ -1974,6 +1991,31 @@ static void test_column_scale_values(void **state)
 					    irdm_elem_get(img.fir, img.meta->precision, i) * sc);
 		}
 		assert_true(irdm_elem_get(img.fir, img.meta->precision, per + 1) != 0);
+		free(buf);
+		img_fixture_free(&fx);
+	}
+}
+
+/* The two-contact figure of PROVENANCE, read as written; -1 without it. */
+static void test_two_contacts_read(void **state)
+{
+	struct irdm_image_writer w;
+	struct img_fixture fx;
+	struct irdm_image img;
+	char err[256];
+	size_t size;
+	void *buf;
+
+	(void)state;
+	for (int with = 0; with < 2; with++) {
+		small_fir(&fx);
+		if (with)
+			prov_two_contacts(&fx, "0.000394");
+		irdm_iw_init(&w);
+		img_fixture_add(&fx, &w);
+		assert_int_equal(irdm_iw_to_buffer(&w, &buf, &size), 0);
+		assert_int_equal(irdm_image_parse(buf, size, &img, err, sizeof(err)), IRDM_OK);
+		assert_true(img.two_contacts_error == (with ? 0.000394 : -1.0));
 		free(buf);
 		img_fixture_free(&fx);
 	}
@@ -2258,6 +2300,7 @@ int main(void)
 		cmocka_unit_test(test_crc32c_all_lengths_and_alignments),
 		cmocka_unit_test(test_f16_known_patterns),
 		cmocka_unit_test(test_column_scale_values),
+		cmocka_unit_test(test_two_contacts_read),
 		cmocka_unit_test(test_f16_roundtrip_all),
 		cmocka_unit_test(test_f16_rounding_all_midpoints),
 		cmocka_unit_test(test_elem_size_and_get),

@@ -72,6 +72,14 @@ static void print_image(const struct fw *fw)
 		printf("; force error %.3g against the exact model\n", (double)m->measured_error);
 	else
 		printf("; force error not measured\n");
+	if (fw->board.devices < 2)
+		return;
+	/* two hands: the figure above is one contact's */
+	if (fw->s->img->two_contacts_error >= 0)
+		printf("image: two contacts at once: force error %.3g against the exact model\n",
+		       fw->s->img->two_contacts_error);
+	else
+		printf("image: two contacts at once: force error not measured\n");
 }
 
 static int open_inputs(struct fw *fw)

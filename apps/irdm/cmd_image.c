@@ -140,6 +140,9 @@ static int cmd_info(const char *path)
 		       (double)m->measured_error);
 	else
 		printf("force error   not measured\n");
+	if (img.two_contacts_error >= 0)
+		printf("two contacts  %.3g against the exact model (relative RMS, two grabbed at once, measured by the precompute)\n",
+		       img.two_contacts_error);
 	printf("sections\n");
 	const struct irdm_image_section *s = (const void *)(img.base + h->section_table_offset);
 	for (uint32_t i = 0; i < h->section_count; i++)

@@ -229,8 +229,29 @@ static int check_provenance_copies(struct parse *p, const char *text, size_t len
 	return IRDM_OK;
 }
 
+/* The one figure PROVENANCE holds that meta does not: people and
+ * irdm-fw read it, so it is a number or the image is wrong. */
+static int read_two_contacts(struct parse *p, const char *text, size_t len)
+{
+	char val[64], *end;
+	double x;
+
+	p->img.two_contacts_error = -1;
+	if (!prov_value(text, len, IRDM_PROV_TWO_CONTACTS_ERROR, val, sizeof(val)))
+		return IRDM_OK;
+	x = strtod(val, &end);
+	if (end == val || *end || !f64_finite(x) || x < 0)
+		return img_fail(p, IRDM_EFORMAT,
+				"PROVENANCE " IRDM_PROV_TWO_CONTACTS_ERROR "=%s is not a finite number >= 0",
+				val);
+	p->img.two_contacts_error = x;
+	return IRDM_OK;
+}
+
 int img_check_provenance(struct parse *p)
 {
+	int ret;
+
 	const struct irdm_image_section *s = p->by_kind[IRDM_SEC_PROVENANCE];
 	const char *text = img_payload(p, IRDM_SEC_PROVENANCE);
 
@@ -245,5 +266,6 @@ int img_check_provenance(struct parse *p)
 				(const char *)memchr(text, 0, (size_t)s->size) - text);
 	p->img.provenance = text;
 	p->img.provenance_len = (size_t)s->size;
-	return check_provenance_copies(p, text, (size_t)s->size);
+	ret = check_provenance_copies(p, text, (size_t)s->size);
+	return ret ? ret : read_two_contacts(p, text, (size_t)s->size);
 }

@@ -239,6 +239,7 @@ static int build_reference(const struct irdm_scene *sc, const struct irdm_measur
 	ref->static_corr_cluster = 0;
 	ref->uncertified = true;
 	ref->max_error = 0; /* not measured itself */
+	ref->contacts = 1;
 	ref->eigensolver = IRDM_EIG_DENSE;
 	ret = irdm_scene_set(ref, "representation", "modal:all", "error measurement", err, errlen);
 	if (!ret)

@@ -68,7 +68,12 @@ struct build {
 	size_t head_capped;   /* and its head was over max_head_mib: its blocks (0: not) */
 	size_t try_bytes;     /* the measured image's size (0: none written) */
 	unsigned cluster;     /* the scene's static_correction_cluster, for auto's tries */
+	bool pairs_missed;    /* contacts = 2: the try met max_error alone, not in pairs */
 };
+
+/* The provenance text's room: the scene (at most 4096 bytes) and what the
+ * build adds to it. */
+#define PROV_BYTES 8192
 
 /* Modes the scene needs solved (0: all). */
 static size_t modes_needed(const struct irdm_scene *sc)
@@ -824,7 +829,7 @@ static int fill_nodes_rigid(struct build *b)
 static int provenance(struct build *b)
 {
 	char scene[4096];
-	size_t len = 8192;
+	size_t len = PROV_BYTES;
 
 	b->prov = malloc(len);
 	if (!b->prov)
@@ -1219,6 +1224,41 @@ static void error_hint(const struct irdm_scene *sc, char *buf, size_t len)
 	snprintf(buf, len, "precision = f32, and if that is not enough %s", rest);
 }
 
+/* contacts = 2: halving static_correction_tol keeps more of the blocks
+ * between touchable nodes, which two contacts at once need; below this it
+ * keeps them all. */
+#define CONTACTS_TOL_FLOOR 1e-3
+
+static double tighter_tol(double tol)
+{
+	return tol / 2 < CONTACTS_TOL_FLOOR ? 0 : tol / 2;
+}
+
+/* contacts = 2: the two-contact figure held against max_error too. */
+static int within_target_pairs(const struct build *b, const struct irdm_precompute_report *rep,
+			       char *err, size_t errlen)
+{
+	char repr[64], hint[96];
+
+	if (b->sc->contacts < 2 || (rep->pairs_measured && rep->pairs_error <= b->sc->max_error))
+		return IRDM_OK;
+	repr_text(b->sc, repr, sizeof(repr));
+	if (!rep->pairs_measured) {
+		snprintf(err, errlen, "precompute: scene %s: contacts = %u, but two contacts at once are measured only when every mode of a grounded object is solved (representation = auto, or modal:K with exact_head); %s is not",
+			 b->sc->name, b->sc->contacts, repr);
+		return IRDM_ENUMERIC;
+	}
+	if (b->sc->static_corr_tol > 0)
+		snprintf(hint, sizeof(hint), "static_correction_tol = %g (it is %g) or 0",
+			 tighter_tol(b->sc->static_corr_tol), b->sc->static_corr_tol);
+	else
+		snprintf(hint, sizeof(hint), "a longer head or more modes");
+	snprintf(err, errlen, "precompute: scene %s: %s is %.3g off the exact model for one contact, but two contacts grabbed at once at mesh nodes %u and %u are %.3g off (relative RMS force error, %s), above max_error = %g with contacts = %u; try %s",
+		 b->sc->name, repr, rep->measured_error, rep->pairs_nodes[0], rep->pairs_nodes[1],
+		 rep->pairs_error, rep->pairs_run, b->sc->max_error, b->sc->contacts, hint);
+	return IRDM_ENUMERIC;
+}
+
 /* Refuse an image whose measured error is above the scene's max_error. */
 static int within_target(const struct build *b, const struct irdm_precompute_report *rep,
 			 char *err, size_t errlen)
@@ -1232,8 +1272,10 @@ static int within_target(const struct build *b, const struct irdm_precompute_rep
 			 rep->pairs_run);
 		return IRDM_ENUMERIC;
 	}
-	if (!rep->error_measured || rep->measured_error <= b->sc->max_error)
+	if (!rep->error_measured)
 		return IRDM_OK;
+	if (rep->measured_error <= b->sc->max_error)
+		return within_target_pairs(b, rep, err, errlen);
 	repr_text(b->sc, repr, sizeof(repr));
 	error_hint(b->sc, hint, sizeof(hint));
 	snprintf(err, errlen, "precompute: scene %s: %s is %.3g off the exact model (relative RMS force error, worst: %s at mesh node %u), above max_error = %g; try %s (max_error = none skips the check)",
@@ -1360,6 +1402,16 @@ out_free:
 	return ret;
 }
 
+/* The two-contact figure goes with the image, for irdm-fw and image info
+ * (image-format.md, PROVENANCE); provenance() sized the text for it. */
+static void prov_pairs(struct build *b, const struct irdm_pairs *res)
+{
+	size_t n = strlen(b->prov);
+
+	snprintf(b->prov + n, PROV_BYTES - n, IRDM_PROV_TWO_CONTACTS_ERROR "=%.6g\ntwo_contacts_pairs=%zu\n",
+		 res->worst, res->n_pairs);
+}
+
 /*
  * Two contacts at once (accuracy/pairs.h), at columns spread over the
  * surface: far apart, where a static correction drops the blocks between
@@ -1404,6 +1456,7 @@ static int pairs(struct build *b, const struct irdm_image *img, struct irdm_prec
 	rep->pairs_run = res.run;
 	rep->pairs_n = res.n_pairs;
 	rep->seconds_error += res.seconds;
+	prov_pairs(b, &res);
 out_free:
 	free(zoh);
 	free(pos);
@@ -1497,7 +1550,12 @@ static int one_try(struct build *b, struct irdm_precompute_report *rep, char *er
 		return ret;
 	}
 	ret = measure(b, rep, err, errlen);
-	return ret ? ret : within_target(b, rep, err, errlen);
+	if (!ret)
+		ret = within_target(b, rep, err, errlen);
+	b->pairs_missed = ret == IRDM_ENUMERIC && b->sc->contacts > 1 && rep->pairs_measured &&
+			  rep->measured_error <= b->sc->max_error &&
+			  rep->pairs_error <= IRDM_PAIRS_DIVERGED && rep->pairs_error > b->sc->max_error;
+	return ret;
 }
 
 /* Back to the model alone, every mode in it, for another try. */
@@ -1585,6 +1643,7 @@ static void say_candidate(const struct build *b, const struct irdm_auto_candidat
 			  const struct irdm_precompute_report *rep, int ret, const char *err)
 {
 	char line[768], repr[64], size[48] = "not written", meas[64] = "not measured", pred[48] = "";
+	bool over;
 
 	if (!b->o->progress)
 		return;
@@ -1595,13 +1654,15 @@ static void say_candidate(const struct build *b, const struct irdm_auto_candidat
 		snprintf(meas, sizeof(meas), "measured error %.3g", rep->measured_error);
 	if (c->predicted >= 0)
 		snprintf(pred, sizeof(pred), ", predicted error %.3g", c->predicted);
+	over = rep->error_measured && rep->measured_error > b->sc->max_error;
 	snprintf(line, sizeof(line), "auto: %s%s: estimated tick %.2f us%s, %s, %s: %s%.400s", repr,
 		 c->head ? " (kept: the modes ringing longest past the head)" : "", c->tick_us, pred,
 		 size, meas,
-		 !ret                ? "kept, the cheapest estimated to tick that is certified and meets max_error" :
-		 rep->error_measured ? "over max_error" :
-				       "refused: ",
-		 ret && !rep->error_measured ? err : "");
+		 !ret            ? "kept, the cheapest estimated to tick that is certified and meets max_error" :
+		 b->pairs_missed ? "two contacts at once over max_error" :
+		 over            ? "over max_error" :
+				   "refused: ",
+		 ret && !over && !b->pairs_missed ? err : "");
 	b->o->progress(b->o->ctx, line, -1.0);
 }
 
@@ -1923,6 +1984,27 @@ static size_t cheapest(const struct irdm_auto_candidate *c, const bool *settled,
  * one estimated over it is grown without a build.  A model of at most
  * AUTO_ALL_MODES modes takes them all.
  */
+/*
+ * contacts = 2: a try that met max_error for one contact but not for two
+ * at once is tried again with static_correction_tol halved (the blocks
+ * between far touchable nodes are what two contacts miss), down to 0.
+ * The tighter tol stays for the candidates after it.
+ */
+static bool tighten_for_pairs(struct build *b, const struct irdm_precompute_report *rep)
+{
+	struct irdm_scene *eff = (struct irdm_scene *)b->sc;
+	char line[224];
+
+	if (!b->pairs_missed || !(eff->static_corr_tol > 0))
+		return false;
+	snprintf(line, sizeof(line), "auto: contacts = %u: two contacts at once %.3g off, above max_error: static_correction_tol %g -> %g",
+		 eff->contacts, rep->pairs_error, eff->static_corr_tol, tighter_tol(eff->static_corr_tol));
+	eff->static_corr_tol = tighter_tol(eff->static_corr_tol);
+	if (b->o->progress)
+		b->o->progress(b->o->ctx, line, -1.0);
+	return true;
+}
+
 static int choose(struct build *b, struct irdm_precompute_report *rep, char *err, size_t errlen)
 {
 	struct irdm_auto_candidate cand[IRDM_AUTO_MAX_CANDIDATES];
@@ -1989,6 +2071,8 @@ static int choose(struct build *b, struct irdm_precompute_report *rep, char *err
 		if (ret != IRDM_ENUMERIC)
 			break;
 		snprintf(last, sizeof(last), "%s", err);
+		if (tighten_for_pairs(b, rep))
+			continue; /* the same candidate, more blocks kept */
 		if (b->head_capped)
 			capped_add(&cp, cand[k].modes, b->head_capped);
 		settled[k] = !b->head_capped || !grow(&cand[k], n_all);

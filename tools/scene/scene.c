@@ -54,6 +54,7 @@ void irdm_scene_defaults(struct irdm_scene *sc)
 	sc->symmetry = true;
 	sc->max_error = IRDM_MAX_ERROR_DEFAULT;
 	sc->max_head_mib = IRDM_MAX_HEAD_MIB_DEFAULT;
+	sc->contacts = 1;
 }
 
 /* Strict number parsing: the whole token, finite. */
@@ -461,6 +462,11 @@ static const struct irdm_opt scene_opts[] = {
 																				   "whose head would be larger is tried again with twice the modes (fewer "
 																				   "dropped, fewer kept blocks) while that still ticks cheaper than every "
 																				   "mode, else left for the next candidate (default 128)" },
+	{ .name = "contacts", .type = IRDM_OPT_UNSIGNED, SC(contacts), .metavar = "N", .range = IRDM_OPT_GE | IRDM_OPT_LE, .min = 1, .max = IRDM_SCENE_CONTACTS_MAX, .help = "contacts at once that max_error holds: 1, a contact alone; 2, also two grabbed at "
+																					     "once at 28 pairs of touchable nodes spread over the surface (a grounded "
+																					     "object whose every mode is solved: representation = auto or exact_head), "
+																					     "auto halving static_correction_tol until they meet it (more blocks "
+																					     "between touchable nodes: a larger image) (default 1)" },
 	{ .name = "uncertified", .type = IRDM_OPT_BOOL, SC(uncertified), .help = "write an image although some touchable node's force recursion is not "
 										 "certified stable (spectral radius >= 1; the engine then damps an FIR's tail "
 										 "by r^s); default no: such an image is refused, as `irdm image verify "
@@ -565,6 +571,16 @@ int irdm_scene_check(const struct irdm_scene *sc, char *err, size_t errlen)
 			 sc->exact_head, sc->static_corr_cluster);
 		return IRDM_EINVAL;
 	}
+	if (sc->contacts > 1 && !(sc->max_error > 0)) {
+		snprintf(err, errlen, "scene: contacts = %u holds two contacts at once against max_error: set max_error (not none)",
+			 sc->contacts);
+		return IRDM_EINVAL;
+	}
+	if (sc->contacts > 1 && sc->floating) {
+		snprintf(err, errlen, "scene: contacts = %u: two contacts at once are measured on a grounded object only (floating = yes)",
+			 sc->contacts);
+		return IRDM_EINVAL;
+	}
 	if (sc->damping == IRDM_DAMP_RATIOS && sc->damp_hz[0] > 0 &&
 	    fabs(sc->damp_hz[0] - sc->damp_hz[1]) < 1e-9) {
 		snprintf(err, errlen, "scene: damping needs two different frequencies");
@@ -650,6 +666,12 @@ int irdm_scene_format(const struct irdm_scene *sc, char *buf, size_t len)
 	}
 	if (sc->max_head_mib != IRDM_MAX_HEAD_MIB_DEFAULT) { /* only when set */
 		int t = snprintf(buf + n, len - (size_t)n, "max_head_mib=%.17g\n", sc->max_head_mib);
+		if (t < 0 || (size_t)t >= len - (size_t)n)
+			return -1;
+		n += t;
+	}
+	if (sc->contacts != 1) { /* only when set */
+		int t = snprintf(buf + n, len - (size_t)n, "contacts=%u\n", sc->contacts);
 		if (t < 0 || (size_t)t >= len - (size_t)n)
 			return -1;
 		n += t;

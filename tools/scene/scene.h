@@ -49,6 +49,9 @@ struct irdm_region {
  * microseconds of a millisecond. */
 #define IRDM_MAX_HEAD_MIB_DEFAULT 128.0
 
+/* contacts: up to two at once are measured (accuracy/pairs.h) */
+#define IRDM_SCENE_CONTACTS_MAX 2
+
 enum irdm_damping_kind { IRDM_DAMP_RATIOS = 0,
 			 IRDM_DAMP_RAYLEIGH = 1 };
 enum irdm_method { IRDM_METHOD_MODAL = 0,
@@ -103,6 +106,7 @@ struct irdm_scene {
 	double max_error;                      /* largest measured force error written (0: none, not measured) */
 	enum irdm_error_columns error_columns; /* where max_error is measured */
 	double max_head_mib;                   /* auto: the largest exact head it builds, MiB */
+	unsigned contacts;                     /* contacts at once max_error holds: 1, or 2 (the two-contact figure too) */
 };
 
 /* The defaults: the paper's cuboid at its resolution, modal 300 + static

@@ -28,6 +28,10 @@ struct irdm_image {
 	const struct irdm_meta *meta;
 	const char *provenance; /* not NUL-terminated: provenance_len bytes */
 	size_t provenance_len;
+	/* PROVENANCE two_contacts_error: the precompute's force error with two
+	 * contacts at once (meta's measured_error is one contact's); -1 if the
+	 * image does not say */
+	double two_contacts_error;
 	const struct irdm_node *nodes; /* meta->n_nodes */
 	const uint32_t *columns;       /* meta->n_cols */
 	const uint32_t *tris;          /* 3 * meta->n_tris */

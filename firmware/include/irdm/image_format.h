@@ -109,6 +109,10 @@ enum irdm_meta_flags {
 #define IRDM_HEAD_TRANSPOSED 0x80000000u
 #define IRDM_HEAD_RUN_MASK 0x7fffffffu
 
+/* PROVENANCE key of the precompute's force error with two contacts at
+ * once (a number >= 0; meta's measured_error is one contact's). */
+#define IRDM_PROV_TWO_CONTACTS_ERROR "two_contacts_error"
+
 /* Longest head (samples): the engine keeps a ring of that many ticks. */
 #define IRDM_HEAD_SAMPLES_MAX 8192u
 
