@@ -1586,6 +1586,7 @@ static void reset_try(struct build *b, size_t n_all)
 	free(b->head_index);
 	b->head_index = NULL;
 	b->n_modes = 0;
+	b->pairs_missed = false;
 	memset(&b->meta, 0, sizeof(b->meta));
 	b->m.modes.n_modes = n_all;
 }
