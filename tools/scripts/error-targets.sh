@@ -137,7 +137,7 @@ done > "$work/cases"
 for m in "${materials[@]}"; do
 	for dt in "${dts[@]}"; do
 		# shellcheck disable=SC2086
-		printf 'small2 %03d %s %s 1e-3\n' "$n" $m "$dt"
+		printf 'small2 %03d %s %s %s %s 1e-3\n' "$n" $m "$dt"
 		n=$((n + 1))
 	done
 done >> "$work/cases"
