@@ -1978,14 +1978,6 @@ static size_t cheapest(const struct irdm_auto_candidate *c, const bool *settled,
 }
 
 /*
- * representation = auto: every mode is solved; the candidates
- * (candidates.h), cheapest to tick first, are built until one is
- * certified and measures within max_error.  A hybrid whose head is over
- * max_head_mib grows (grow()) and waits its turn at its new cost, and
- * one estimated over it is grown without a build.  A model of at most
- * AUTO_ALL_MODES modes takes them all.
- */
-/*
  * contacts = 2: a try that met max_error for one contact but not for two
  * at once is tried again with static_correction_tol halved (the blocks
  * between far touchable nodes are what two contacts miss), down to 0.
@@ -2006,6 +1998,14 @@ static bool tighten_for_pairs(struct build *b, const struct irdm_precompute_repo
 	return true;
 }
 
+/*
+ * representation = auto: every mode is solved; the candidates
+ * (candidates.h), cheapest to tick first, are built until one is
+ * certified and measures within max_error.  A hybrid whose head is over
+ * max_head_mib grows (grow()) and waits its turn at its new cost, and
+ * one estimated over it is grown without a build.  A model of at most
+ * AUTO_ALL_MODES modes takes them all.
+ */
 static int choose(struct build *b, struct irdm_precompute_report *rep, char *err, size_t errlen)
 {
 	struct irdm_auto_candidate cand[IRDM_AUTO_MAX_CANDIDATES];
