@@ -1,0 +1,418 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * Can a hybrid's head come without every mode?  The head is the dropped
+ * modes' response over 2H samples (modal/exact_head.h):
+ *   D_s = M^-1/2 P h_s(A) P M^-1/2,  A = M^-1/2 K M^-1/2 (lumped M),
+ * P the projector off the kept modes, h_s the zero-order-hold response of
+ * a mode at sample s as a function of its eigenvalue.  A Lanczos run on A
+ * from P M^-1/2 e_j gives h_s(A) for every s at once from m products with
+ * K and the kept modes alone (no dense eigensolve), as the paper's scale
+ * needs.  This measures, on the default scene (scenes/cuboid-top.scene,
+ * 9504 DoFs, the 275 modes auto keeps there, H = 128 at 1 ms), how far
+ * each column's own block of that head is from the exact one (summed here
+ * from every mode of a dense eigensolve) after m steps, at six columns
+ * spread over the touchable face: the largest |D_s - D_s,exact|_F over
+ * the 2H samples, relative to the largest |D_s,exact|_F, and the seconds
+ * a column's three runs took (full reorthogonalisation: a prototype's
+ * cost, not a production one's).  Then what that does to a grab held at
+ * each of those columns for 1000 ticks (direct convolution, the kept
+ * modes exact at every sample): the relative RMS difference of the
+ * forces with the head from m steps against those with the exact head.
+ * The head is not tapered here (the image's is, past H): the difference
+ * is the Lanczos run's alone.
+ *
+ * IRDM_BENCH_KEPT (default 275) and IRDM_BENCH_H (default 128) change the
+ * split.  Prints figures; fails only if the model cannot be built.
+ * Run from the repository root.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "modal/lapack.h"
+#include "modal/modal.h"
+#include "modal/response.h"
+#include "precompute/model.h"
+#include "scene/scene.h"
+#include "../support/bench_util.h"
+
+void dstev_(const char *jobz, const int *n, double *d, double *e, double *z, const int *ldz,
+	    double *work, int *info);
+
+#ifndef N_COLS
+#define N_COLS 6
+#endif
+#define M_MAX 600
+static const size_t checkpoints[] = { 50, 100, 200, 400, 600 };
+#define N_CHECK (sizeof(checkpoints) / sizeof(checkpoints[0]))
+
+struct kh {
+	struct irdm_model m;
+	struct irdm_scene sc;
+	size_t n, kept, S;
+	double *dinv; /* M^-1/2 diagonal */
+	double *psi;  /* kept modes, M^1/2 phi: n x kept */
+	struct irdm_mode *zoh_all;
+	double *h_all; /* every mode's response: n_modes x S */
+};
+
+static void *xcalloc(size_t n, size_t size)
+{
+	void *p = calloc(n, size);
+
+	if (!p) {
+		fprintf(stderr, "krylov-head: out of memory\n");
+		exit(1);
+	}
+	return p;
+}
+
+static size_t env_size(const char *name, size_t dflt)
+{
+	const char *v = getenv(name);
+
+	return v ? (size_t)strtoul(v, NULL, 10) : dflt;
+}
+
+/* y = A x = M^-1/2 K M^-1/2 x */
+static void apply_a(const struct kh *k, const double *x, double *tmp, double *y)
+{
+	for (size_t i = 0; i < k->n; i++)
+		tmp[i] = k->dinv[i] * x[i];
+	irdm_csc_matvec(&k->m.fem.K, tmp, y);
+	for (size_t i = 0; i < k->n; i++)
+		y[i] *= k->dinv[i];
+}
+
+/* x -= B (B^T x) for B n x nb column-major */
+static void orth_against(const double *B, size_t n, size_t nb, double *x)
+{
+	for (size_t j = 0; j < nb; j++) {
+		const double *b = &B[j * n];
+		double d = 0;
+
+		for (size_t i = 0; i < n; i++)
+			d += b[i] * x[i];
+		for (size_t i = 0; i < n; i++)
+			x[i] -= d * b[i];
+	}
+}
+
+/* out[s][i] (3 x S): rows dof[0..2] of M^-1/2 beta0 V f_s(T_m) e1. */
+static int ritz_head(const struct kh *k, const double *V, const double *alpha, const double *beta,
+		     size_t m, double beta0, const int64_t *dof, double *out)
+{
+	int mi = (int)m, info;
+	double *d = xcalloc(m, sizeof(double)), *e = xcalloc(m, sizeof(double));
+	double *z = xcalloc(m * m, sizeof(double)), *work = xcalloc(2 * m + 2, sizeof(double));
+	double *h = xcalloc(m * k->S, sizeof(double));
+	struct irdm_modes ritz = { .n = 0, .n_modes = m };
+	struct irdm_mode *zoh = xcalloc(m, sizeof(*zoh));
+
+	memcpy(d, alpha, m * sizeof(double));
+	memcpy(e, beta, (m - 1) * sizeof(double));
+	dstev_("V", &mi, d, e, z, &mi, work, &info);
+	if (info) {
+		fprintf(stderr, "krylov-head: dstev info %d\n", info);
+		goto out;
+	}
+
+	for (size_t l = 0; l < m; l++)
+		d[l] = d[l] > 0 ? d[l] : 0; /* rounding below the dropped spectrum */
+	ritz.omega2 = d;
+	irdm_modes_discretise(&ritz, &k->m.damping, k->sc.dt_s, zoh);
+	for (size_t l = 0; l < m; l++)
+		irdm_zoh_response(&zoh[l], k->S, &h[l * k->S]);
+	for (int i = 0; i < 3; i++) {
+		/* (V Q)_{dof,l} Q_{0,l} */
+		for (size_t l = 0; l < m; l++) {
+			double vq = 0;
+
+			for (size_t t = 0; t < m; t++)
+				vq += V[t * k->n + (size_t)dof[i]] * z[l * m + t];
+			vq *= z[l * m] * beta0 * k->dinv[dof[i]];
+			for (size_t s = 0; s < k->S; s++)
+				out[s * 3 + (size_t)i] += vq * h[l * k->S + s];
+		}
+	}
+out:
+	free(d);
+	free(e);
+	free(z);
+	free(work);
+	free(h);
+	free(zoh);
+	return info;
+}
+
+#define T_RUN 1000 /* ticks of the step run */
+
+/* x = A^-1 b for a 3x3 A (row-major), by Cramer's rule. */
+static void solve3(const double *A, const double *b, double *x)
+{
+	double det = A[0] * (A[4] * A[8] - A[5] * A[7]) - A[1] * (A[3] * A[8] - A[5] * A[6]) +
+		     A[2] * (A[3] * A[7] - A[4] * A[6]);
+
+	for (int c = 0; c < 3; c++) {
+		double M[9];
+
+		memcpy(M, A, sizeof(M));
+		for (int r = 0; r < 3; r++)
+			M[3 * r + c] = b[r];
+		x[c] = (M[0] * (M[4] * M[8] - M[5] * M[7]) - M[1] * (M[3] * M[8] - M[5] * M[6]) +
+			M[2] * (M[3] * M[7] - M[4] * M[6])) /
+		       det;
+	}
+}
+
+/*
+ * The grab's forces f[t] (3 each) for a displacement held at x from tick
+ * 0: sum_{s <= t} R[s] f[t - s] = x, R[s] = kept[s] + head[s] (head zero
+ * from S on), solved by direct convolution.
+ */
+static void grab(const double *kept, const double *head, size_t S, double *f)
+{
+	static const double x[3] = { 0.3e-3, 0.2e-3, -0.93e-3 };
+
+	for (size_t t = 0; t < T_RUN; t++) {
+		double r[3] = { x[0], x[1], x[2] }, R0[9];
+
+		for (size_t s = 1; s <= t; s++)
+			for (int i = 0; i < 3; i++)
+				for (int j = 0; j < 3; j++)
+					r[i] -= (kept[s * 9 + 3 * i + j] + (s < S ? head[s * 9 + 3 * i + j] : 0)) *
+						f[(t - s) * 3 + (size_t)j];
+		for (int q = 0; q < 9; q++)
+			R0[q] = kept[q] + head[q];
+		solve3(R0, r, &f[t * 3]);
+	}
+}
+
+/* Relative RMS difference of two runs' forces. */
+static double rel_rms(const double *f, const double *ref)
+{
+	double num = 0, den = 0;
+
+	for (size_t i = 0; i < 3 * T_RUN; i++) {
+		num += (f[i] - ref[i]) * (f[i] - ref[i]);
+		den += ref[i] * ref[i];
+	}
+	return sqrt(num / den);
+}
+
+/* Column c: the relative error at each checkpoint and the seconds. */
+static void column(const struct kh *k, size_t c, double err[N_CHECK], double ferr[N_CHECK],
+		   double *secs)
+{
+	const int64_t *dof = &k->m.col_dofs[3 * c];
+	size_t n = k->n, S = k->S;
+	double *V = xcalloc(n * (M_MAX + 1), sizeof(double)), *w = xcalloc(n, sizeof(double));
+	double *tmp = xcalloc(n, sizeof(double));
+	double *ex = xcalloc(S * 9, sizeof(double)), *ap = xcalloc(N_CHECK * S * 9, sizeof(double));
+	double alpha[M_MAX], beta[M_MAX], peak = 0, t0 = bench_now_us();
+
+	/* exact: every dropped mode */
+	for (size_t d = k->kept; d < k->m.modes.n_modes; d++) {
+		const double *phi = &k->m.modes.phi[d * n];
+
+		for (size_t s = 0; s < S; s++)
+			for (int i = 0; i < 3; i++)
+				for (int j = 0; j < 3; j++)
+					ex[s * 9 + 3 * i + j] += phi[dof[i]] * phi[dof[j]] *
+								 k->h_all[d * S + s];
+	}
+	for (size_t s = 0; s < S; s++) {
+		double f = 0;
+
+		for (int q = 0; q < 9; q++)
+			f += ex[s * 9 + q] * ex[s * 9 + q];
+		peak = fmax(peak, sqrt(f));
+	}
+	t0 = bench_now_us();
+	for (int j = 0; j < 3; j++) {
+		double beta0 = 0;
+		size_t ci = 0;
+
+		memset(V, 0, n * sizeof(double));
+		V[dof[j]] = k->dinv[dof[j]];
+		orth_against(k->psi, n, k->kept, V);
+		for (size_t i = 0; i < n; i++)
+			beta0 += V[i] * V[i];
+		beta0 = sqrt(beta0);
+		for (size_t i = 0; i < n; i++)
+			V[i] /= beta0;
+		for (size_t t = 0; t < M_MAX; t++) {
+			double *v = &V[t * n], *vn = &V[(t + 1) * n], a = 0, b = 0;
+
+			apply_a(k, v, tmp, w);
+			for (size_t i = 0; i < n; i++)
+				a += w[i] * v[i];
+			alpha[t] = a;
+			memcpy(vn, w, n * sizeof(double));
+			/* full: against the kept modes and every earlier vector, twice */
+			for (int pass = 0; pass < 2; pass++) {
+				orth_against(k->psi, n, k->kept, vn);
+				orth_against(V, n, t + 1, vn);
+			}
+			for (size_t i = 0; i < n; i++)
+				b += vn[i] * vn[i];
+			beta[t] = sqrt(b);
+			for (size_t i = 0; i < n; i++)
+				vn[i] /= beta[t];
+			if (ci < N_CHECK && t + 1 == checkpoints[ci]) {
+				double *o = xcalloc(S * 3, sizeof(double));
+
+				if (!ritz_head(k, V, alpha, beta, t + 1, beta0, dof, o))
+					for (size_t s = 0; s < S; s++)
+						for (int i = 0; i < 3; i++)
+							ap[(ci * S + s) * 9 + 3 * i + j] = o[s * 3 + i];
+				free(o);
+				ci++;
+			}
+		}
+	}
+	*secs = (bench_now_us() - t0) * 1e-6;
+	{
+		double *kept = xcalloc(T_RUN * 9, sizeof(double));
+		double *f_ex = xcalloc(T_RUN * 3, sizeof(double)), *f_ap = xcalloc(T_RUN * 3, sizeof(double));
+		double *hk = xcalloc(T_RUN, sizeof(double));
+
+		for (size_t d = 0; d < k->kept; d++) {
+			const double *phi = &k->m.modes.phi[d * n];
+
+			irdm_zoh_response(&k->zoh_all[d], T_RUN, hk);
+			for (size_t s = 0; s < T_RUN; s++)
+				for (int i = 0; i < 3; i++)
+					for (int j = 0; j < 3; j++)
+						kept[s * 9 + 3 * i + j] += phi[dof[i]] * phi[dof[j]] * hk[s];
+		}
+		grab(kept, ex, S, f_ex);
+		for (size_t ci = 0; ci < N_CHECK; ci++) {
+			grab(kept, &ap[ci * S * 9], S, f_ap);
+			ferr[ci] = rel_rms(f_ap, f_ex);
+		}
+		free(kept);
+		free(f_ex);
+		free(f_ap);
+		free(hk);
+	}
+	for (size_t ci = 0; ci < N_CHECK; ci++) {
+		double worst = 0;
+
+		for (size_t s = 0; s < S; s++) {
+			double f = 0;
+
+			for (int q = 0; q < 9; q++) {
+				double dd = ap[(ci * S + s) * 9 + q] - ex[s * 9 + q];
+				f += dd * dd;
+			}
+			worst = fmax(worst, sqrt(f));
+		}
+		err[ci] = worst / peak;
+	}
+	free(V);
+	free(w);
+	free(tmp);
+	free(ex);
+	free(ap);
+}
+
+static int build(struct kh *k)
+{
+	char err[512];
+	size_t n;
+
+	irdm_scene_defaults(&k->sc);
+	if (irdm_scene_load(&k->sc, "scenes/cuboid-top.scene", err, sizeof(err)) ||
+	    irdm_model_build(&k->sc, 0, NULL, NULL, &k->m, err, sizeof(err))) {
+		fprintf(stderr, "krylov-head: %s\n", err);
+		return -1;
+	}
+	n = k->n = k->m.modes.n;
+	{
+		int64_t *all = xcalloc(n, sizeof(int64_t));
+
+		for (size_t i = 0; i < n; i++)
+			all[i] = (int64_t)i;
+		/* every mode whole: the exact head and the kept projector read them */
+		if (irdm_modes_complete(&k->m.modes, 0, k->m.modes.n_modes, all, n, err,
+					sizeof(err))) {
+			fprintf(stderr, "krylov-head: %s\n", err);
+			free(all);
+			return -1;
+		}
+		free(all);
+	}
+	if (k->m.fem.M.nnz != n) {
+		fprintf(stderr, "krylov-head: the scene's mass is not lumped\n");
+		return -1;
+	}
+	k->dinv = xcalloc(n, sizeof(double));
+	for (size_t i = 0; i < n; i++)
+		k->dinv[i] = 1 / sqrt(k->m.fem.M.val[k->m.fem.M.colptr[i]]);
+	k->psi = xcalloc(n * k->kept, sizeof(double));
+	for (size_t d = 0; d < k->kept; d++)
+		for (size_t i = 0; i < n; i++)
+			k->psi[d * n + i] = k->m.modes.phi[d * n + i] / k->dinv[i];
+	k->zoh_all = xcalloc(k->m.modes.n_modes, sizeof(*k->zoh_all));
+	k->h_all = xcalloc(k->m.modes.n_modes * k->S, sizeof(double));
+	irdm_modes_discretise(&k->m.modes, &k->m.damping, k->sc.dt_s, k->zoh_all);
+	for (size_t d = 0; d < k->m.modes.n_modes; d++)
+		irdm_zoh_response(&k->zoh_all[d], k->S, &k->h_all[d * k->S]);
+	return 0;
+}
+
+int main(void)
+{
+	struct kh k = { .kept = env_size("IRDM_BENCH_KEPT", 275) };
+	size_t H = env_size("IRDM_BENCH_H", 128);
+	double worst[N_CHECK] = { 0 }, fworst[N_CHECK] = { 0 }, ferrs[N_COLS][N_CHECK];
+	double secs_sum = 0, t0 = bench_now_us();
+
+	k.S = 2 * H;
+	if (build(&k))
+		return 1;
+	printf("krylov-head  scenes/cuboid-top.scene: %zu free DoFs, %zu modes, %zu kept (the lowest: under Rayleigh damping the longest ringing), head H = %zu (2H = %zu samples compared), dt %g s; model and dense eigensolve %.1f s\n",
+	       k.n, k.m.modes.n_modes, k.kept, H, k.S, k.sc.dt_s, (bench_now_us() - t0) * 1e-6);
+	printf("krylov-head  per column: max_s |D_s - D_s,exact|_F / max_s |D_s,exact|_F of its own block after m Lanczos steps per axis\n");
+	printf("krylov-head  %-8s %-10s", "column", "mesh node");
+	for (size_t ci = 0; ci < N_CHECK; ci++)
+		printf("  m = %-6zu", checkpoints[ci]);
+	printf("  seconds (3 x %d steps)\n", M_MAX);
+	for (int q = 0; q < N_COLS; q++) {
+		size_t c = (size_t)q * (k.m.n_cols - 1) / (N_COLS - 1);
+		double e[N_CHECK], secs;
+
+		column(&k, c, e, ferrs[q], &secs);
+		secs_sum += secs;
+		printf("krylov-head  %-8zu %-10u", c, k.m.rows[k.m.cols[c]]);
+		for (size_t ci = 0; ci < N_CHECK; ci++) {
+			printf("  %-10.3g", e[ci]);
+			worst[ci] = fmax(worst[ci], e[ci]);
+		}
+		printf("  %.2f\n", secs);
+		fflush(stdout);
+	}
+	printf("krylov-head  %-19s", "worst");
+	for (size_t ci = 0; ci < N_CHECK; ci++)
+		printf("  %-10.3g", worst[ci]);
+	printf("  %.2f per column\n", secs_sum / N_COLS);
+	printf("krylov-head  the same columns' grab (held 1 mm along (0.3, 0.2, -0.93), %d ticks, the kept modes exact at every sample): relative RMS force difference, the head from m steps against the exact head\n",
+	       T_RUN);
+	for (int q = 0; q < N_COLS; q++) {
+		size_t c = (size_t)q * (k.m.n_cols - 1) / (N_COLS - 1);
+
+		printf("krylov-head  %-8zu %-10u", c, k.m.rows[k.m.cols[c]]);
+		for (size_t ci = 0; ci < N_CHECK; ci++) {
+			printf("  %-10.3g", ferrs[q][ci]);
+			fworst[ci] = fmax(fworst[ci], ferrs[q][ci]);
+		}
+		printf("\n");
+	}
+	printf("krylov-head  %-19s", "worst");
+	for (size_t ci = 0; ci < N_CHECK; ci++)
+		printf("  %-10.3g", fworst[ci]);
+	printf("\n");
+	return 0;
+}
