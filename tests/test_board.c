@@ -36,6 +36,7 @@
 #include "irdm/posix/board_file.h"
 #include "irdm/sim/hal_sim.h"
 #include "irdm/posix/options_doc.h"
+#include "support/solve3.h"
 
 #define SHIPPED "boards/sim-phantom.board"
 #define DOC "docs/boards.md"
@@ -164,7 +165,7 @@ static void assert_close3(const double *got, const double *want, double tol, con
  * pose, the Jacobian inverted by Cramer's rule.  Returns the residual (m). */
 static double solve_ik(const struct irdm_device_config *c, const double p[3], double q[3])
 {
-	double tip[3], r[3], j[9], det, dq[3];
+	double tip[3], r[3], j[9], dq[3];
 
 	q[0] = q[1] = q[2] = 0;
 	for (int it = 0; it < 50; it++) {
@@ -172,17 +173,7 @@ static double solve_ik(const struct irdm_device_config *c, const double p[3], do
 		for (int i = 0; i < 3; i++)
 			r[i] = p[i] - tip[i];
 		irdm_device_jacobian(c, q, j);
-		det = j[0] * (j[4] * j[8] - j[5] * j[7]) - j[1] * (j[3] * j[8] - j[5] * j[6]) +
-		      j[2] * (j[3] * j[7] - j[4] * j[6]);
-		for (int k = 0; k < 3; k++) {
-			double m[9];
-			memcpy(m, j, sizeof(m));
-			for (int row = 0; row < 3; row++)
-				m[3 * row + k] = r[row];
-			dq[k] = (m[0] * (m[4] * m[8] - m[5] * m[7]) - m[1] * (m[3] * m[8] - m[5] * m[6]) +
-				 m[2] * (m[3] * m[7] - m[4] * m[6])) /
-				det;
-		}
+		ts_solve3(j, r, dq);
 		for (int k = 0; k < 3; k++)
 			q[k] += dq[k];
 	}

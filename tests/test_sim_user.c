@@ -26,6 +26,7 @@
 #include "irdm/error.h"
 #include "irdm/sim/sim_device.h"
 #include "irdm/sim/sim_user.h"
+#include "support/solve3.h"
 
 static struct irdm_sim_user user; /* big: keep it off the stack */
 static struct irdm_sim_device sim;
@@ -609,24 +610,6 @@ static const char *reach =
 	"at 0.2 move 1 by 0.02,0.01,-0.03 over 0.6\n" /* device: 2 cm right, 3 down, 1 in */
 	"hold 1 for 2.5\n";
 
-/* Solve a x = y for a 3x3 row-major a (Cramer: small, independent of the library). */
-static void solve3(const double a[9], const double y[3], double x[3])
-{
-	double det = a[0] * (a[4] * a[8] - a[5] * a[7]) - a[1] * (a[3] * a[8] - a[5] * a[6]) +
-		     a[2] * (a[3] * a[7] - a[4] * a[6]);
-
-	for (int c = 0; c < 3; c++) {
-		double m[9];
-
-		memcpy(m, a, sizeof(m));
-		for (int r = 0; r < 3; r++)
-			m[3 * r + c] = y[r];
-		x[c] = (m[0] * (m[4] * m[8] - m[5] * m[7]) - m[1] * (m[3] * m[8] - m[5] * m[6]) +
-			m[2] * (m[3] * m[7] - m[4] * m[6])) /
-		       det;
-	}
-}
-
 /*
  * The largest tip error Coulomb friction can hold against the hand's
  * spring k at pose q: a stuck arm has |(J^T f)_i| <= coulomb_i, so f =
@@ -645,7 +628,7 @@ static double friction_band_m(const struct irdm_sim_params *p, const double q[3]
 
 		for (int i = 0; i < 3; i++)
 			tau[i] = (corner >> i & 1 ? 1 : -1) * p->coulomb_nm[i];
-		solve3(jt, tau, f);
+		ts_solve3(jt, tau, f);
 		worst = fmax(worst, sqrt(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]) / k);
 	}
 	return worst;
