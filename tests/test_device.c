@@ -21,6 +21,7 @@
 #include "irdm/device.h"
 #include "irdm/engine.h"
 #include "irdm/error.h"
+#include "support/solve3.h"
 
 #define PI 3.14159265358979323846
 
@@ -184,31 +185,17 @@ static double bisect_scale(const double lim[3], const double tau[3])
 	return lo;
 }
 
-static double det3(const double m[9])
-{
-	return m[0] * (m[4] * m[8] - m[5] * m[7]) - m[1] * (m[3] * m[8] - m[5] * m[6]) +
-	       m[2] * (m[3] * m[7] - m[4] * m[6]);
-}
-
 /* Solve J^T f = tau by Cramer's rule (the test's own solve). */
 static void tip_force_of(const struct irdm_device_config *c, const double q[3],
 			 const double tau[3], double f[3])
 {
-	double j[9], jt[9], d;
+	double j[9], jt[9];
 
 	irdm_device_jacobian(c, q, j);
 	for (int r = 0; r < 3; r++)
 		for (int k = 0; k < 3; k++)
 			jt[3 * r + k] = j[3 * k + r];
-	d = det3(jt);
-	for (int k = 0; k < 3; k++) {
-		double m[9];
-
-		memcpy(m, jt, sizeof(m));
-		for (int r = 0; r < 3; r++)
-			m[3 * r + k] = tau[r];
-		f[k] = det3(m) / d;
-	}
+	ts_solve3(jt, tau, f);
 }
 
 static double angle_between(const double a[3], const double b[3])
