@@ -1586,6 +1586,7 @@ FX(m_pairs_text, prov_two_contacts(fx, "0.01x"))
 FX(m_pairs_neg, prov_two_contacts(fx, "-0.002"))
 FX(m_pairs_inf, prov_two_contacts(fx, "inf"))
 FX(m_pairs_empty, prov_two_contacts(fx, ""))
+FX(m_pairs_twice, (prov_two_contacts(fx, "0.5"), prov_two_contacts(fx, "0.001")))
 FX(m_prov_tool, snprintf(fx->meta.tool_version, sizeof(fx->meta.tool_version), "irdm-test 0.2"))
 FX(m_floating, fx->meta.flags |= IRDM_META_FLOATING)
 FX(m_mass, fx->rigid.mass_kg = 0)
@@ -1844,6 +1845,8 @@ static const struct sem_case sem_cases[] = {
 	{ "two contacts negative", FIR, m_pairs_neg, NULL, IRDM_EFORMAT, "two_contacts_error=-0.002 is not" },
 	{ "two contacts inf", FIR, m_pairs_inf, NULL, IRDM_EFORMAT, "two_contacts_error=inf is not" },
 	{ "two contacts empty", FIR, m_pairs_empty, NULL, IRDM_EFORMAT, "two_contacts_error= is not" },
+	{ "two contacts twice", FIR, m_pairs_twice, NULL, IRDM_EFORMAT,
+	  "PROVENANCE has two_contacts_error 2 times" },
 	{ "no META", FIR, NULL, w_no_meta, IRDM_EMISSING, "META is missing" },
 	{ "no PROVENANCE", FIR, NULL, w_no_prov, IRDM_EMISSING, "PROVENANCE is missing" },
 	{ "no NODES", FIR, NULL, w_no_nodes, IRDM_EMISSING, "NODES is missing" },

@@ -203,6 +203,11 @@ static void test_bool_enum_string(void **state)
 	expect_ok("label", "1234567");
 	assert_string_equal(c.label, "1234567");
 	expect_bad("label", "12345678", "b.cfg:4: label = 12345678: longer than 7 characters");
+	/* one line: a newline would forge lines of the texts a value goes into */
+	expect_bad("label", "a\nb=1",
+		   "b.cfg:4: label = a\\nb=1: contains the control character 0x0a at character 2");
+	expect_bad("label", "a\tb", "b.cfg:4: label = a\\tb: contains the control character 0x09 at character 2");
+	assert_string_equal(c.label, "1234567");
 	expect_ok("path", "/tmp/x");
 	assert_string_equal(c.path, "/tmp/x");
 }
@@ -295,6 +300,9 @@ static void test_args(void **state)
 	assert_string_equal(c.path, "out");
 	assert_int_equal(parse("--gain", "0", NULL), IRDM_EFORMAT);
 	assert_string_equal(err, "--gain 0: must be > 0 N/m");
+	/* the message stays one line whatever the value holds */
+	assert_int_equal(parse("--label", "a\nb\x01", NULL), IRDM_EFORMAT);
+	assert_string_equal(err, "--label a\\nb\\x01: contains the control character 0x0a at character 2");
 	assert_int_equal(parse("--count", NULL), IRDM_EINVAL);
 	assert_string_equal(err, "--count needs a value");
 	assert_int_equal(parse("--colour", "red", NULL), IRDM_EINVAL);

@@ -223,6 +223,14 @@ static int parse_string(const struct irdm_opt *o, void *field, const char *s, ch
 		snprintf(why, len, "longer than %zu characters", o->size - 1);
 		return IRDM_EFORMAT;
 	}
+	/* a value is one line of text: a newline in it would forge lines of
+	 * the texts it is copied into (an image's PROVENANCE) */
+	for (size_t i = 0; i < n; i++)
+		if ((unsigned char)s[i] < 0x20 || s[i] == 0x7f) {
+			snprintf(why, len, "contains the control character 0x%02x at character %zu",
+				 (unsigned)(unsigned char)s[i], i + 1);
+			return IRDM_EFORMAT;
+		}
 	memcpy(field, s, n + 1);
 	return IRDM_OK;
 }
@@ -263,15 +271,36 @@ static int unknown_key(const struct irdm_opt_table *t, const char *where, const 
 	return IRDM_EINVAL;
 }
 
+/* value as the message shows it: control characters escaped, so the
+ * message stays one line (cut to buf's size). */
+static const char *shown(const char *value, char *buf, size_t size)
+{
+	size_t n = 0;
+
+	for (const char *c = value; *c && n + 5 < size; c++) {
+		unsigned char u = (unsigned char)*c;
+
+		if (u >= 0x20 && u != 0x7f)
+			buf[n++] = *c;
+		else if (u == '\n' || u == '\t')
+			n += (size_t)snprintf(buf + n, size - n, "\\%c", u == '\n' ? 'n' : 't');
+		else
+			n += (size_t)snprintf(buf + n, size - n, "\\x%02x", u);
+	}
+	buf[n] = 0;
+	return buf;
+}
+
 /* The entry's value, or the reason why not: "WHERE: key = value: why". */
 static int set_entry(const struct irdm_opt *o, void *obj, const char *where, const char *value,
 		     char *err, size_t errlen)
 {
-	char why[256];
+	char why[256], val[256];
 	int ret = irdm_opt_parse_value(o, obj, value, why, sizeof(why));
 
 	if (ret)
-		snprintf(err, errlen, "%s: %s = %s: %s", where, o->name, value, why);
+		snprintf(err, errlen, "%s: %s = %s: %s", where, o->name, shown(value, val, sizeof(val)),
+			 why);
 	return ret;
 }
 
@@ -441,10 +470,10 @@ static int parse_arg(const struct irdm_opt_set *sets, size_t n_sets, int argc,
 		return IRDM_EINVAL;
 	}
 	const char *v = argv[++*i];
-	char why[256];
+	char why[256], val[256];
 	int ret = irdm_opt_parse_value(o, obj, v, why, sizeof(why));
 	if (ret)
-		snprintf(err, errlen, "%s %s: %s", a, v, why);
+		snprintf(err, errlen, "%s %s: %s", a, shown(v, val, sizeof(val)), why);
 	return ret;
 }
 

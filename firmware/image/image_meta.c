@@ -233,11 +233,18 @@ static int check_provenance_copies(struct parse *p, const char *text, size_t len
  * irdm-fw read it, so it is a number or the image is wrong. */
 static int read_two_contacts(struct parse *p, const char *text, size_t len)
 {
+	const char *key = IRDM_PROV_TWO_CONTACTS_ERROR;
+	size_t klen = strlen(key), n = 0;
 	char val[64], *end;
 	double x;
 
 	p->img.two_contacts_error = -1;
-	if (!prov_value(text, len, IRDM_PROV_TWO_CONTACTS_ERROR, val, sizeof(val)))
+	for (size_t i = 0; i + klen < len; i++)
+		n += (!i || text[i - 1] == '\n') && !memcmp(text + i, key, klen) &&
+		     text[i + klen] == '=';
+	if (n > 1)
+		return img_fail(p, IRDM_EFORMAT, "PROVENANCE has %s %zu times", key, n);
+	if (!prov_value(text, len, key, val, sizeof(val)))
 		return IRDM_OK;
 	x = strtod(val, &end);
 	if (end == val || *end || !f64_finite(x) || x < 0)

@@ -322,6 +322,11 @@ static int build(struct kh *k)
 		return -1;
 	}
 	n = k->n = k->m.modes.n;
+	if (!k->kept || k->kept >= k->m.modes.n_modes) {
+		fprintf(stderr, "krylov-head: IRDM_BENCH_KEPT=%zu: expected 1 to %zu\n", k->kept,
+			k->m.modes.n_modes - 1);
+		return -1;
+	}
 	{
 		int64_t *all = xcalloc(n, sizeof(int64_t));
 
@@ -412,6 +417,10 @@ int main(void)
 	double t0 = bench_now_us();
 
 	k.S = 2 * H;
+	if (!H || H > 4096) {
+		fprintf(stderr, "krylov-head: IRDM_BENCH_H=%zu: expected 1 to 4096\n", H);
+		return 1;
+	}
 	if (build(&k))
 		return 1;
 	printf("krylov-head  scenes/cuboid-top.scene: %zu free DoFs, %zu modes, %zu kept (the lowest: under Rayleigh damping the longest ringing), head H = %zu (2H = %zu samples compared), dt %g s; model and dense eigensolve %.1f s\n",

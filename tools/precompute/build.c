@@ -1244,13 +1244,16 @@ static int within_target_pairs(const struct build *b, const struct irdm_precompu
 		return IRDM_OK;
 	repr_text(b->sc, repr, sizeof(repr));
 	if (!rep->pairs_measured) {
-		snprintf(err, errlen, "precompute: scene %s: contacts = %u, but two contacts at once are measured only when every mode of a grounded object is solved (representation = auto, or modal:K with exact_head); %s is not",
+		snprintf(err, errlen, "precompute: scene %s: contacts = %u, but two contacts at once were not measured on %s: they need every mode of a grounded object solved (representation = auto, or modal:K with exact_head), two touchable nodes, and one process (not MPI ranks)",
 			 b->sc->name, b->sc->contacts, repr);
 		return IRDM_ENUMERIC;
 	}
-	if (b->sc->static_corr_tol > 0)
+	if (tighter_tol(b->sc->static_corr_tol) > 0)
 		snprintf(hint, sizeof(hint), "static_correction_tol = %g (it is %g) or 0",
 			 tighter_tol(b->sc->static_corr_tol), b->sc->static_corr_tol);
+	else if (b->sc->static_corr_tol > 0)
+		snprintf(hint, sizeof(hint), "static_correction_tol = 0 (it is %g)",
+			 b->sc->static_corr_tol);
 	else
 		snprintf(hint, sizeof(hint), "a longer head or more modes");
 	snprintf(err, errlen, "precompute: scene %s: %s is %.3g off the exact model for one contact, but two contacts grabbed at once at mesh nodes %u and %u are %.3g off (relative RMS force error, %s), above max_error = %g with contacts = %u; try %s",
@@ -1272,8 +1275,8 @@ static int within_target(const struct build *b, const struct irdm_precompute_rep
 			 rep->pairs_run);
 		return IRDM_ENUMERIC;
 	}
-	if (!rep->error_measured)
-		return IRDM_OK;
+	if (!rep->error_measured) /* over MPI ranks: nothing measured */
+		return b->sc->contacts > 1 ? within_target_pairs(b, rep, err, errlen) : IRDM_OK;
 	if (rep->measured_error <= b->sc->max_error)
 		return within_target_pairs(b, rep, err, errlen);
 	repr_text(b->sc, repr, sizeof(repr));
@@ -1415,9 +1418,9 @@ static void prov_pairs(struct build *b, const struct irdm_pairs *res)
 /*
  * Two contacts at once (accuracy/pairs.h), at columns spread over the
  * surface: far apart, where a static correction drops the blocks between
- * them.  Measured on an image within max_error, printed, not held
- * against it (the target is of one contact); a pair that diverges
- * refuses the image (within_target()).
+ * them.  Measured on an image within max_error, printed and stored, held
+ * against it only with contacts = 2 (the target is of one contact); a
+ * pair that diverges refuses the image (within_target()).
  */
 static int pairs(struct build *b, const struct irdm_image *img, struct irdm_precompute_report *rep,
 		 char *err, size_t errlen)
@@ -2081,8 +2084,8 @@ static int choose(struct build *b, struct irdm_precompute_report *rep, char *err
 	free(zoh);
 	free(order);
 	if (ret == IRDM_ENUMERIC)
-		snprintf(err, errlen, "precompute: representation = auto: no candidate met max_error = %g (set max_error higher or none); the last: %s",
-			 b->sc->max_error, last);
+		snprintf(err, errlen, "precompute: representation = auto: no candidate met max_error = %g (set max_error higher%s); the last: %s",
+			 b->sc->max_error, b->sc->contacts > 1 ? ", or contacts = 1" : " or none", last);
 	return ret;
 }
 

@@ -463,7 +463,7 @@ static const struct irdm_opt scene_opts[] = {
 																				   "dropped, fewer kept blocks) while that still ticks cheaper than every "
 																				   "mode, else left for the next candidate (default 128)" },
 	{ .name = "contacts", .type = IRDM_OPT_UNSIGNED, SC(contacts), .metavar = "N", .range = IRDM_OPT_GE | IRDM_OPT_LE, .min = 1, .max = IRDM_SCENE_CONTACTS_MAX, .help = "contacts at once that max_error holds: 1, a contact alone; 2, also two grabbed at "
-																					     "once at 28 pairs of touchable nodes spread over the surface (a grounded "
+																					     "once at up to 28 pairs of touchable nodes spread over the surface (a grounded "
 																					     "object whose every mode is solved: representation = auto or exact_head), "
 																					     "auto halving static_correction_tol until they meet it (more blocks "
 																					     "between touchable nodes: a larger image) (default 1)" },

@@ -86,7 +86,7 @@ run_case() {
 		repr=$(sed -n 's/^representation auto: \(.*\), the cheapest.*(\([0-9]*\) candidates\{0,1\} built)$/\1 (\2 built)/p' "$log")
 		est=$(sed -n 's/^auto: .*: estimated tick \([0-9.]*\) us,.*: kept.*/\1/p' "$log")
 		bytes=$(stat -c %s "$img")
-		pairs=$(sed -n 's/^two contacts *\([^ ]*\) against.*/\1/p' "$log")
+		pairs=$("$irdm" image info "$img" | sed -n 's/^two contacts *\([^ ]*\) against.*/\1/p')
 		verdict=written
 		if ! "$irdm" image verify --require-stable "$img" > /dev/null 2>&1; then
 			verdict="FAIL: written, not certified"
@@ -248,7 +248,8 @@ echo "and a release against the exact model), what \`representation = auto\`"
 echo "chooses.  *written*: certified by \`irdm image verify --require-stable\`"
 echo "and its stored measured error within the target; *two contacts*: the"
 echo "worst of the 28 pairs of spread nodes grabbed at once that the"
-echo "precompute measures and prints (not held against the target); *refused*: the"
+echo "precompute measures and prints (not held against the target unless"
+echo "\`contacts = 2\`, below); *refused*: the"
 echo "precompute's one-line message.  *estimated*: the tick auto ranked its"
 echo "candidates by (us); *tick*: measured, median / p99 us of \`bench_ctrl\`'s"
 echo "slide/1 case on the image (the whole controller tick, irdm_ctrl_tick(),"
