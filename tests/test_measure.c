@@ -299,8 +299,9 @@ static void test_auto_small_takes_all(void **state)
 	assert_true(rep.measured_error < 1e-6); /* f32 storage */
 }
 
-static int cuboid(const char *name, struct irdm_precompute_report *rep, char *err, size_t errlen,
-		  const char *repr, const char *max_error)
+/* The 4x4x8 cuboid at 2 ms, touched on top, with keys kv on top. */
+static int cuboid_with(const char *name, const char *const *kv, struct irdm_precompute_report *rep,
+		       char *err, size_t errlen)
 {
 	struct irdm_scene sc;
 	struct irdm_precompute_opts o = { 0 };
@@ -311,13 +312,29 @@ static int cuboid(const char *name, struct irdm_precompute_report *rep, char *er
 	assert_int_equal(irdm_scene_set(&sc, "touch", "z>=0.2", "test", err, errlen), 0);
 	assert_int_equal(irdm_scene_set(&sc, "display", "touch", "test", err, errlen), 0);
 	assert_int_equal(irdm_scene_set(&sc, "dt", "0.002", "test", err, errlen), 0);
-	if (repr)
-		assert_int_equal(irdm_scene_set(&sc, "representation", repr, "test", err, errlen), 0);
-	if (max_error)
-		assert_int_equal(irdm_scene_set(&sc, "max_error", max_error, "test", err, errlen), 0);
+	for (; *kv; kv += 2)
+		assert_int_equal(irdm_scene_set(&sc, kv[0], kv[1], "test", err, errlen), 0);
 	snprintf(path, sizeof(path), "%s/%s", dir, name);
 	o.out_path = path;
 	return irdm_precompute(&sc, &o, rep, err, errlen);
+}
+
+static int cuboid(const char *name, struct irdm_precompute_report *rep, char *err, size_t errlen,
+		  const char *repr, const char *max_error)
+{
+	const char *kv[5];
+	size_t n = 0;
+
+	if (repr) {
+		kv[n++] = "representation";
+		kv[n++] = repr;
+	}
+	if (max_error) {
+		kv[n++] = "max_error";
+		kv[n++] = max_error;
+	}
+	kv[n] = NULL;
+	return cuboid_with(name, kv, rep, err, errlen);
 }
 
 static void test_auto_cuboid_chooses_hybrid(void **state)
@@ -375,26 +392,6 @@ static void test_two_contacts(void **state)
 	assert_true(rep.pairs_measured);
 	assert_true(dropped > 2e-3);
 	assert_true(rep.pairs_error < 5e-4);
-}
-
-/* The 4x4x8 cuboid at 2 ms, touched on top, with keys kv on top. */
-static int cuboid_with(const char *name, const char *const *kv, struct irdm_precompute_report *rep,
-		       char *err, size_t errlen)
-{
-	struct irdm_scene sc;
-	struct irdm_precompute_opts o = { 0 };
-	char path[128];
-
-	irdm_scene_defaults(&sc);
-	assert_int_equal(irdm_scene_set(&sc, "resolution", "4,4,8", "test", err, errlen), 0);
-	assert_int_equal(irdm_scene_set(&sc, "touch", "z>=0.2", "test", err, errlen), 0);
-	assert_int_equal(irdm_scene_set(&sc, "display", "touch", "test", err, errlen), 0);
-	assert_int_equal(irdm_scene_set(&sc, "dt", "0.002", "test", err, errlen), 0);
-	for (; *kv; kv += 2)
-		assert_int_equal(irdm_scene_set(&sc, kv[0], kv[1], "test", err, errlen), 0);
-	snprintf(path, sizeof(path), "%s/%s", dir, name);
-	o.out_path = path;
-	return irdm_precompute(&sc, &o, rep, err, errlen);
 }
 
 /*
