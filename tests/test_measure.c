@@ -31,8 +31,8 @@
  *  - contacts = 2 holds the pair figure against max_error: auto halves
  *    static_correction_tol until it meets it (the cuboid: 0.0025, under
  *    1e-3), the image carries the figure; a hybrid by name is refused
- *    with the tighter tol named, modal:K alone (no pair measured) and
- *    max_error = none are refused.
+ *    with the tighter tol named; modal:K alone (no pair measured),
+ *    max_error = none and a floating object are refused.
  */
 #include <math.h>
 #include <setjmp.h>
@@ -368,9 +368,7 @@ static void test_auto_cuboid_chooses_hybrid(void **state)
 static void test_two_contacts(void **state)
 {
 	struct irdm_precompute_report rep;
-	struct irdm_scene sc;
-	struct irdm_precompute_opts o = { 0 };
-	char err[768], path[128];
+	char err[768];
 	double dropped;
 
 	(void)state;
@@ -378,15 +376,9 @@ static void test_two_contacts(void **state)
 	assert_true(rep.pairs_measured);
 	assert_int_equal(rep.pairs_n, 28);
 	dropped = rep.pairs_error;
-	irdm_scene_defaults(&sc);
-	assert_int_equal(irdm_scene_set(&sc, "resolution", "4,4,8", "test", err, sizeof(err)), 0);
-	assert_int_equal(irdm_scene_set(&sc, "touch", "z>=0.2", "test", err, sizeof(err)), 0);
-	assert_int_equal(irdm_scene_set(&sc, "display", "touch", "test", err, sizeof(err)), 0);
-	assert_int_equal(irdm_scene_set(&sc, "dt", "0.002", "test", err, sizeof(err)), 0);
-	assert_int_equal(irdm_scene_set(&sc, "static_correction_tol", "0", "test", err, sizeof(err)), 0);
-	snprintf(path, sizeof(path), "%s/tol0.img", dir);
-	o.out_path = path;
-	assert_int_equal(irdm_precompute(&sc, &o, &rep, err, sizeof(err)), 0);
+	assert_int_equal(cuboid_with("tol0.img", (const char *const[]){ "static_correction_tol", "0", NULL },
+				     &rep, err, sizeof(err)),
+			 0);
 	print_message("two contacts on %s: %.3g with blocks dropped, %.3g with every block (one contact %.3g)\n",
 		      rep.representation, dropped, rep.pairs_error, rep.measured_error);
 	assert_true(rep.pairs_measured);

@@ -147,6 +147,13 @@ int img_check_meta(struct parse *p)
 	return check_meta_counts(p);
 }
 
+/* Does a line "key=..." start at text[i]? */
+static bool key_at(const char *text, size_t len, size_t i, const char *key, size_t klen)
+{
+	return i + klen < len && (!i || text[i - 1] == '\n') && !memcmp(text + i, key, klen) &&
+	       text[i + klen] == '=';
+}
+
 /* The value of "key=" at a line start in text (len bytes), copied into
  * val (NUL-terminated); false when the key is not there. */
 static bool prov_value(const char *text, size_t len, const char *key, char *val, size_t vlen)
@@ -156,7 +163,7 @@ static bool prov_value(const char *text, size_t len, const char *key, char *val,
 	for (size_t i = 0; i + klen < len; i++) {
 		size_t n = 0;
 
-		if ((i && text[i - 1] != '\n') || memcmp(text + i, key, klen) || text[i + klen] != '=')
+		if (!key_at(text, len, i, key, klen))
 			continue;
 		i += klen + 1;
 		while (i + n < len && text[i + n] != '\n' && n + 1 < vlen)
@@ -240,8 +247,7 @@ static int read_two_contacts(struct parse *p, const char *text, size_t len)
 
 	p->img.two_contacts_error = -1;
 	for (size_t i = 0; i + klen < len; i++)
-		n += (!i || text[i - 1] == '\n') && !memcmp(text + i, key, klen) &&
-		     text[i + klen] == '=';
+		n += key_at(text, len, i, key, klen);
 	if (n > 1)
 		return img_fail(p, IRDM_EFORMAT, "PROVENANCE has %s %zu times", key, n);
 	if (!prov_value(text, len, key, val, sizeof(val)))
@@ -257,10 +263,9 @@ static int read_two_contacts(struct parse *p, const char *text, size_t len)
 
 int img_check_provenance(struct parse *p)
 {
-	int ret;
-
 	const struct irdm_image_section *s = p->by_kind[IRDM_SEC_PROVENANCE];
 	const char *text = img_payload(p, IRDM_SEC_PROVENANCE);
+	int ret;
 
 	if (s->elem != IRDM_ELEM_BYTES)
 		return img_fail(p, IRDM_EFORMAT,

@@ -42,9 +42,7 @@
 void dstev_(const char *jobz, const int *n, double *d, double *e, double *z, const int *ldz,
 	    double *work, int *info);
 
-#ifndef N_COLS
 #define N_COLS 6
-#endif
 #define M_MAX 600
 static const size_t checkpoints[] = { 50, 100, 200, 400, 600 };
 #define N_CHECK (sizeof(checkpoints) / sizeof(checkpoints[0]))
@@ -53,11 +51,10 @@ struct kh {
 	struct irdm_model m;
 	struct irdm_scene sc;
 	size_t n, kept, S;
-	int plain;    /* IRDM_BENCH_PLAIN=1: no reorthogonalisation between Lanczos vectors */
-	double *dinv; /* M^-1/2 diagonal */
-	double *psi;  /* kept modes, M^1/2 phi: n x kept */
-	struct irdm_mode *zoh_all;
-	double *h_all; /* every mode's response: n_modes x S */
+	int plain;                 /* the three-term recurrence alone, no reorthogonalisation */
+	double *dinv;              /* M^-1/2 diagonal */
+	double *psi;               /* kept modes, M^1/2 phi: n x kept */
+	struct irdm_mode *zoh_all; /* every mode discretised */
 };
 
 static void *xcalloc(size_t n, size_t size)
@@ -151,6 +148,32 @@ out:
 
 #define T_RUN 1000 /* ticks of the step run */
 
+/* out[s][i][j], s < T: modes first .. first + count - 1's response at
+ * column dof (irdm_fir_from_modes() on a view of those modes). */
+static void blocks_of(const struct kh *k, size_t first, size_t count, const int64_t *dof, size_t T,
+		      double *out)
+{
+	struct irdm_modes v = k->m.modes;
+
+	v.n_modes = count;
+	v.omega2 += first;
+	v.phi += first * k->n;
+	if (irdm_fir_from_modes(&v, &k->zoh_all[first], dof, 1, dof, 1, T, NULL, out, NULL, NULL)) {
+		fprintf(stderr, "krylov-head: out of memory\n");
+		exit(1);
+	}
+}
+
+/* |B|_F of a 3x3 block, or of a - b. */
+static double frob(const double *a, const double *b)
+{
+	double f = 0;
+
+	for (int q = 0; q < 9; q++)
+		f += (a[q] - (b ? b[q] : 0)) * (a[q] - (b ? b[q] : 0));
+	return sqrt(f);
+}
+
 /*
  * The grab's forces f[t] (3 each) for a displacement held at x from tick
  * 0: sum_{s <= t} R[s] f[t - s] = x, R[s] = kept[s] + head[s] (head zero
@@ -186,6 +209,82 @@ static double rel_rms(const double *f, const double *ref)
 	return sqrt(num / den);
 }
 
+/* ferr[ci]: the grab at dof through the head of checkpoint ci (ap) against
+ * the one through the exact head (ex), the kept modes exact. */
+static void force_errors(const struct kh *k, const int64_t *dof, const double *ex,
+			 const double *ap, double ferr[N_CHECK])
+{
+	double *kept = xcalloc(T_RUN * 9, sizeof(double));
+	double *f_ex = xcalloc(T_RUN * 3, sizeof(double)), *f_ap = xcalloc(T_RUN * 3, sizeof(double));
+
+	blocks_of(k, 0, k->kept, dof, T_RUN, kept);
+	grab(kept, ex, k->S, f_ex);
+	for (size_t ci = 0; ci < N_CHECK; ci++) {
+		grab(kept, &ap[ci * k->S * 9], k->S, f_ap);
+		ferr[ci] = rel_rms(f_ap, f_ex);
+	}
+	free(kept);
+	free(f_ex);
+	free(f_ap);
+}
+
+/*
+ * Axis j of column dof: m Lanczos steps on A from P M^-1/2 e_j, and at
+ * each checkpoint ci the head's column j into ap[ci][s][i][j].  V holds
+ * M_MAX + 1 vectors of n, w and tmp n each.
+ */
+static void lanczos_axis(const struct kh *k, const int64_t *dof, int j, double *V, double *w,
+			 double *tmp, double *ap)
+{
+	size_t n = k->n, S = k->S, ci = 0;
+	double alpha[M_MAX], beta[M_MAX], beta0 = 0;
+
+	memset(V, 0, n * sizeof(double));
+	V[dof[j]] = k->dinv[dof[j]];
+	orth_against(k->psi, n, k->kept, V);
+	for (size_t i = 0; i < n; i++)
+		beta0 += V[i] * V[i];
+	beta0 = sqrt(beta0);
+	for (size_t i = 0; i < n; i++)
+		V[i] /= beta0;
+	for (size_t t = 0; t < M_MAX; t++) {
+		double *v = &V[t * n], *vn = &V[(t + 1) * n], a = 0, b = 0;
+
+		apply_a(k, v, tmp, w);
+		for (size_t i = 0; i < n; i++)
+			a += w[i] * v[i];
+		alpha[t] = a;
+		memcpy(vn, w, n * sizeof(double));
+		if (k->plain) {
+			/* the three-term recurrence, kept off the kept modes */
+			for (size_t i = 0; i < n; i++)
+				vn[i] -= a * v[i] + (t ? beta[t - 1] * V[(t - 1) * n + i] : 0);
+			orth_against(k->psi, n, k->kept, vn);
+		} else {
+			/* full: against the kept modes and every earlier vector, twice */
+			for (int pass = 0; pass < 2; pass++) {
+				orth_against(k->psi, n, k->kept, vn);
+				orth_against(V, n, t + 1, vn);
+			}
+		}
+		for (size_t i = 0; i < n; i++)
+			b += vn[i] * vn[i];
+		beta[t] = sqrt(b);
+		for (size_t i = 0; i < n; i++)
+			vn[i] /= beta[t];
+		if (ci < N_CHECK && t + 1 == checkpoints[ci]) {
+			double *o = xcalloc(S * 3, sizeof(double));
+
+			if (!ritz_head(k, V, alpha, beta, t + 1, beta0, dof, o))
+				for (size_t s = 0; s < S; s++)
+					for (int i = 0; i < 3; i++)
+						ap[(ci * S + s) * 9 + 3 * i + j] = o[s * 3 + i];
+			free(o);
+			ci++;
+		}
+	}
+}
+
 /* Column c: the relative error at each checkpoint and the seconds. */
 static void column(const struct kh *k, size_t c, double err[N_CHECK], double ferr[N_CHECK],
 		   double *secs)
@@ -195,112 +294,21 @@ static void column(const struct kh *k, size_t c, double err[N_CHECK], double fer
 	double *V = xcalloc(n * (M_MAX + 1), sizeof(double)), *w = xcalloc(n, sizeof(double));
 	double *tmp = xcalloc(n, sizeof(double));
 	double *ex = xcalloc(S * 9, sizeof(double)), *ap = xcalloc(N_CHECK * S * 9, sizeof(double));
-	double alpha[M_MAX], beta[M_MAX], peak = 0, t0 = bench_now_us();
+	double peak = 0, t0;
 
-	/* exact: every dropped mode */
-	for (size_t d = k->kept; d < k->m.modes.n_modes; d++) {
-		const double *phi = &k->m.modes.phi[d * n];
-
-		for (size_t s = 0; s < S; s++)
-			for (int i = 0; i < 3; i++)
-				for (int j = 0; j < 3; j++)
-					ex[s * 9 + 3 * i + j] += phi[dof[i]] * phi[dof[j]] *
-								 k->h_all[d * S + s];
-	}
-	for (size_t s = 0; s < S; s++) {
-		double f = 0;
-
-		for (int q = 0; q < 9; q++)
-			f += ex[s * 9 + q] * ex[s * 9 + q];
-		peak = fmax(peak, sqrt(f));
-	}
+	blocks_of(k, k->kept, k->m.modes.n_modes - k->kept, dof, S, ex); /* exact: every dropped mode */
+	for (size_t s = 0; s < S; s++)
+		peak = fmax(peak, frob(&ex[s * 9], NULL));
 	t0 = bench_now_us();
-	for (int j = 0; j < 3; j++) {
-		double beta0 = 0;
-		size_t ci = 0;
-
-		memset(V, 0, n * sizeof(double));
-		V[dof[j]] = k->dinv[dof[j]];
-		orth_against(k->psi, n, k->kept, V);
-		for (size_t i = 0; i < n; i++)
-			beta0 += V[i] * V[i];
-		beta0 = sqrt(beta0);
-		for (size_t i = 0; i < n; i++)
-			V[i] /= beta0;
-		for (size_t t = 0; t < M_MAX; t++) {
-			double *v = &V[t * n], *vn = &V[(t + 1) * n], a = 0, b = 0;
-
-			apply_a(k, v, tmp, w);
-			for (size_t i = 0; i < n; i++)
-				a += w[i] * v[i];
-			alpha[t] = a;
-			memcpy(vn, w, n * sizeof(double));
-			if (k->plain) {
-				/* the three-term recurrence, kept off the kept modes */
-				for (size_t i = 0; i < n; i++)
-					vn[i] -= a * v[i] + (t ? beta[t - 1] * V[(t - 1) * n + i] : 0);
-				orth_against(k->psi, n, k->kept, vn);
-			} else {
-				/* full: against the kept modes and every earlier vector, twice */
-				for (int pass = 0; pass < 2; pass++) {
-					orth_against(k->psi, n, k->kept, vn);
-					orth_against(V, n, t + 1, vn);
-				}
-			}
-			for (size_t i = 0; i < n; i++)
-				b += vn[i] * vn[i];
-			beta[t] = sqrt(b);
-			for (size_t i = 0; i < n; i++)
-				vn[i] /= beta[t];
-			if (ci < N_CHECK && t + 1 == checkpoints[ci]) {
-				double *o = xcalloc(S * 3, sizeof(double));
-
-				if (!ritz_head(k, V, alpha, beta, t + 1, beta0, dof, o))
-					for (size_t s = 0; s < S; s++)
-						for (int i = 0; i < 3; i++)
-							ap[(ci * S + s) * 9 + 3 * i + j] = o[s * 3 + i];
-				free(o);
-				ci++;
-			}
-		}
-	}
+	for (int j = 0; j < 3; j++)
+		lanczos_axis(k, dof, j, V, w, tmp, ap);
 	*secs = (bench_now_us() - t0) * 1e-6;
-	{
-		double *kept = xcalloc(T_RUN * 9, sizeof(double));
-		double *f_ex = xcalloc(T_RUN * 3, sizeof(double)), *f_ap = xcalloc(T_RUN * 3, sizeof(double));
-		double *hk = xcalloc(T_RUN, sizeof(double));
-
-		for (size_t d = 0; d < k->kept; d++) {
-			const double *phi = &k->m.modes.phi[d * n];
-
-			irdm_zoh_response(&k->zoh_all[d], T_RUN, hk);
-			for (size_t s = 0; s < T_RUN; s++)
-				for (int i = 0; i < 3; i++)
-					for (int j = 0; j < 3; j++)
-						kept[s * 9 + 3 * i + j] += phi[dof[i]] * phi[dof[j]] * hk[s];
-		}
-		grab(kept, ex, S, f_ex);
-		for (size_t ci = 0; ci < N_CHECK; ci++) {
-			grab(kept, &ap[ci * S * 9], S, f_ap);
-			ferr[ci] = rel_rms(f_ap, f_ex);
-		}
-		free(kept);
-		free(f_ex);
-		free(f_ap);
-		free(hk);
-	}
+	force_errors(k, dof, ex, ap, ferr);
 	for (size_t ci = 0; ci < N_CHECK; ci++) {
 		double worst = 0;
 
-		for (size_t s = 0; s < S; s++) {
-			double f = 0;
-
-			for (int q = 0; q < 9; q++) {
-				double dd = ap[(ci * S + s) * 9 + q] - ex[s * 9 + q];
-				f += dd * dd;
-			}
-			worst = fmax(worst, sqrt(f));
-		}
+		for (size_t s = 0; s < S; s++)
+			worst = fmax(worst, frob(&ap[(ci * S + s) * 9], &ex[s * 9]));
 		err[ci] = worst / peak;
 	}
 	free(V);
@@ -353,10 +361,7 @@ static int build(struct kh *k)
 		for (size_t i = 0; i < n; i++)
 			k->psi[d * n + i] = k->m.modes.phi[d * n + i] / k->dinv[i];
 	k->zoh_all = xcalloc(k->m.modes.n_modes, sizeof(*k->zoh_all));
-	k->h_all = xcalloc(k->m.modes.n_modes * k->S, sizeof(double));
 	irdm_modes_discretise(&k->m.modes, &k->m.damping, k->sc.dt_s, k->zoh_all);
-	for (size_t d = 0; d < k->m.modes.n_modes; d++)
-		irdm_zoh_response(&k->zoh_all[d], k->S, &k->h_all[d * k->S]);
 	return 0;
 }
 

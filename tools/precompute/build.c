@@ -68,7 +68,6 @@ struct build {
 	size_t head_capped;   /* and its head was over max_head_mib: its blocks (0: not) */
 	size_t try_bytes;     /* the measured image's size (0: none written) */
 	unsigned cluster;     /* the scene's static_correction_cluster, for auto's tries */
-	bool pairs_missed;    /* contacts = 2: the try met max_error alone, not in pairs */
 };
 
 /* The provenance text's room: the scene (at most 4096 bytes) and what the
@@ -1234,6 +1233,15 @@ static double tighter_tol(double tol)
 	return tol / 2 < CONTACTS_TOL_FLOOR ? 0 : tol / 2;
 }
 
+/* contacts = 2, and this try met max_error for one contact but not for
+ * two at once (a pair that diverged is refused for that instead). */
+static bool pairs_missed(const struct build *b, const struct irdm_precompute_report *rep)
+{
+	return b->sc->contacts > 1 && rep->error_measured && rep->pairs_measured &&
+	       rep->measured_error <= b->sc->max_error && rep->pairs_error <= IRDM_PAIRS_DIVERGED &&
+	       rep->pairs_error > b->sc->max_error;
+}
+
 /* contacts = 2: the two-contact figure held against max_error too. */
 static int within_target_pairs(const struct build *b, const struct irdm_precompute_report *rep,
 			       char *err, size_t errlen)
@@ -1275,9 +1283,8 @@ static int within_target(const struct build *b, const struct irdm_precompute_rep
 			 rep->pairs_run);
 		return IRDM_ENUMERIC;
 	}
-	if (!rep->error_measured) /* over MPI ranks: nothing measured */
-		return b->sc->contacts > 1 ? within_target_pairs(b, rep, err, errlen) : IRDM_OK;
-	if (rep->measured_error <= b->sc->max_error)
+	/* not measured (max_error = none, MPI ranks): contacts = 2 cannot pass */
+	if (!rep->error_measured || rep->measured_error <= b->sc->max_error)
 		return within_target_pairs(b, rep, err, errlen);
 	repr_text(b->sc, repr, sizeof(repr));
 	error_hint(b->sc, hint, sizeof(hint));
@@ -1553,12 +1560,7 @@ static int one_try(struct build *b, struct irdm_precompute_report *rep, char *er
 		return ret;
 	}
 	ret = measure(b, rep, err, errlen);
-	if (!ret)
-		ret = within_target(b, rep, err, errlen);
-	b->pairs_missed = ret == IRDM_ENUMERIC && b->sc->contacts > 1 && rep->pairs_measured &&
-			  rep->measured_error <= b->sc->max_error &&
-			  rep->pairs_error <= IRDM_PAIRS_DIVERGED && rep->pairs_error > b->sc->max_error;
-	return ret;
+	return ret ? ret : within_target(b, rep, err, errlen);
 }
 
 /* Back to the model alone, every mode in it, for another try. */
@@ -1589,7 +1591,6 @@ static void reset_try(struct build *b, size_t n_all)
 	free(b->head_index);
 	b->head_index = NULL;
 	b->n_modes = 0;
-	b->pairs_missed = false;
 	memset(&b->meta, 0, sizeof(b->meta));
 	b->m.modes.n_modes = n_all;
 }
@@ -1647,7 +1648,7 @@ static void say_candidate(const struct build *b, const struct irdm_auto_candidat
 			  const struct irdm_precompute_report *rep, int ret, const char *err)
 {
 	char line[768], repr[64], size[48] = "not written", meas[64] = "not measured", pred[48] = "";
-	bool over;
+	bool over, missed = ret && pairs_missed(b, rep);
 
 	if (!b->o->progress)
 		return;
@@ -1662,11 +1663,11 @@ static void say_candidate(const struct build *b, const struct irdm_auto_candidat
 	snprintf(line, sizeof(line), "auto: %s%s: estimated tick %.2f us%s, %s, %s: %s%.400s", repr,
 		 c->head ? " (kept: the modes ringing longest past the head)" : "", c->tick_us, pred,
 		 size, meas,
-		 !ret            ? "kept, the cheapest estimated to tick that is certified and meets max_error" :
-		 b->pairs_missed ? "two contacts at once over max_error" :
-		 over            ? "over max_error" :
-				   "refused: ",
-		 ret && !over && !b->pairs_missed ? err : "");
+		 !ret   ? "kept, the cheapest estimated to tick that is certified and meets max_error" :
+		 missed ? "two contacts at once over max_error" :
+		 over   ? "over max_error" :
+			  "refused: ",
+		 ret && !over && !missed ? err : "");
 	b->o->progress(b->o->ctx, line, -1.0);
 }
 
@@ -1991,7 +1992,7 @@ static bool tighten_for_pairs(struct build *b, const struct irdm_precompute_repo
 	struct irdm_scene *eff = (struct irdm_scene *)b->sc;
 	char line[224];
 
-	if (!b->pairs_missed || !(eff->static_corr_tol > 0))
+	if (!pairs_missed(b, rep) || !(eff->static_corr_tol > 0))
 		return false;
 	snprintf(line, sizeof(line), "auto: contacts = %u: two contacts at once %.3g off, above max_error: static_correction_tol %g -> %g",
 		 eff->contacts, rep->pairs_error, eff->static_corr_tol, tighter_tol(eff->static_corr_tol));
