@@ -13,8 +13,8 @@
 #include <string.h>
 
 #include "modal/exact_head.h"
+#include "modal/head_layout.h"
 #include "modal/lapack.h"
-#include "modal/window.h"
 
 /* P[(3 c + i) Kd + d] = phi of dropped mode k_kept + d at column c, axis i. */
 static double *dropped_shapes(const struct irdm_modes *m, size_t k_kept, const int64_t *col_dofs,
@@ -67,35 +67,6 @@ static void column_head(const struct irdm_corr_sparse *corr, uint32_t k_begin, s
 	}
 }
 
-/*
- * The first of column c's blocks to compute: R[s] is symmetric, so block
- * (c, r) with r < c is block (r, c) transposed, once column r has it
- * (mirror()); the static correction keeps both of a pair or neither.
- */
-static uint32_t upper_begin(const struct irdm_corr_sparse *corr, size_t c)
-{
-	uint32_t k = corr->start[c];
-
-	while (k < corr->start[c + 1] && corr->rows[k] < c && irdm_corr_sparse_find(corr, corr->rows[k], (uint32_t)c) >= 0)
-		k++;
-	return k;
-}
-
-/* Column c's blocks before k_end, from their mirror images. */
-static void mirror(const struct irdm_corr_sparse *corr, size_t c, uint32_t k_end, size_t S,
-		   double *head)
-{
-	for (uint32_t k = corr->start[c]; k < k_end; k++) {
-		const double *src = &head[(size_t)irdm_corr_sparse_find(corr, corr->rows[k], (uint32_t)c) * S * 9];
-		double *out = &head[(size_t)k * S * 9];
-
-		for (size_t s = 0; s < S; s++)
-			for (int i = 0; i < 3; i++)
-				for (int j = 0; j < 3; j++)
-					out[9 * s + 3 * (size_t)i + (size_t)j] = src[9 * s + 3 * (size_t)j + (size_t)i];
-	}
-}
-
 /* W[d, (j, s)] = Pc[j][d] h[s][d], for column c's force axes j. */
 static void column_weights(const double *Pc, const double *h, size_t Kd, size_t S, double *W)
 {
@@ -103,33 +74,6 @@ static void column_weights(const double *Pc, const double *h, size_t Kd, size_t 
 		for (size_t s = 0; s < S; s++)
 			for (size_t d = 0; d < Kd; d++)
 				W[((size_t)j * S + s) * Kd + d] = Pc[(size_t)j * Kd + d] * h[s * Kd + d];
-}
-
-/*
- * Samples [H, 2H): the dropped response tapered to zero by the Hann
- * window of window.h, and what the taps' sum then misses of the static
- * correction S (the response past 2H and the taper's cut) added along
- * its sine bump: the static compliance is kept exactly, and neither the
- * response nor the correction jumps (a lump at one sample moved a zero of
- * the force recursion out of the unit circle on the 4x4x8 cuboid).
- */
-static void taper(double *out, size_t H, const double *S)
-{
-	double bump_sum = 0;
-
-	for (size_t i = 0; i < H; i++) {
-		double w = irdm_window_taper(i, H);
-		bump_sum += irdm_window_bump(i, H);
-		for (int e = 0; e < 9; e++)
-			out[9 * (H + i) + (size_t)e] *= w;
-	}
-	for (int e = 0; e < 9; e++) {
-		double sum = 0;
-		for (size_t s = 0; s < 2 * H; s++)
-			sum += out[9 * s + (size_t)e];
-		for (size_t i = 0; i < H; i++)
-			out[9 * (H + i) + (size_t)e] += (S[e] - sum) * irdm_window_bump(i, H) / bump_sum;
-	}
 }
 
 int irdm_exact_head(const struct irdm_modes *modes, const struct irdm_mode *zoh_all, size_t k_kept,
@@ -160,14 +104,14 @@ int irdm_exact_head(const struct irdm_modes *modes, const struct irdm_mode *zoh_
 	 * rest mirrored, then every block tapered: its own target */
 	for (size_t c = 0; c < n_cols; c++) {
 		column_weights(&P[3 * c * Kd], h, Kd, S, W);
-		column_head(corr, upper_begin(corr, c), c, P, W, Kd, S, G, C, head);
+		column_head(corr, irdm_head_upper_begin(corr, c), c, P, W, Kd, S, G, C, head);
 		if (progress && (c % 16 == 0 || c + 1 == n_cols))
 			progress(ctx, "exact head", (double)(c + 1) / (double)n_cols);
 	}
 	for (size_t c = 0; c < n_cols; c++)
-		mirror(corr, c, upper_begin(corr, c), S, head);
+		irdm_head_mirror(corr, c, irdm_head_upper_begin(corr, c), S, head);
 	for (size_t k = 0; k < corr->n_blocks; k++)
-		taper(&head[k * S * 9], H, &target[9 * k]);
+		irdm_head_taper(&head[k * S * 9], H, &target[9 * k]);
 	ret = IRDM_OK;
 out_free:
 	free(P);

@@ -18,6 +18,7 @@
 #include "modal/decay.h"
 #include "modal/exact_head.h"
 #include "modal/head_split.h"
+#include "modal/krylov_head.h"
 #include "accuracy/pairs.h"
 #include "accuracy/scan.h"
 #include "accuracy/screen.h"
@@ -80,7 +81,8 @@ static size_t modes_needed(const struct irdm_scene *sc)
 	if (sc->repr_auto && sc->max_error > 0)
 		return 0; /* every candidate is measured: the reference needs all */
 	if (sc->representation == IRDM_REPR_MODAL)
-		return sc->exact_head ? 0 : sc->modes; /* the head needs every mode */
+		/* the head from every mode, or from Lanczos runs (krylov_head.h) */
+		return sc->exact_head && sc->eigensolver != IRDM_EIG_LANCZOS ? 0 : sc->modes;
 	if (sc->method == IRDM_METHOD_TIME_DOMAIN)
 		return 1; /* only the first mode, for the default damping */
 	return sc->modes; /* FIR synthesised from modes */
@@ -113,8 +115,30 @@ static size_t head_bytes(const struct build *b, size_t n_blocks, size_t H)
 	return runs * 2 * H * 9 * irdm_elem_size(b->sc->precision);
 }
 
+/* The head without every mode: Lanczos runs from each touchable DoF. */
+static int krylov_head(struct build *b, const double *target, char *err, size_t errlen)
+{
+	struct irdm_model *m = &b->m;
+	struct irdm_krylov_head_stats st;
+	char line[200];
+	int ret;
+
+	ret = irdm_krylov_head(&m->fem, &m->modes, &m->damping, b->sc->dt_s, m->col_dofs,
+			       &b->sparse, target, b->sc->exact_head, b->sc->threads,
+			       b->o->progress, b->o->ctx,
+			       b->head, &st, err, errlen);
+	if (ret || !b->o->progress)
+		return ret;
+	snprintf(line, sizeof(line), "krylov head: %zu Lanczos runs of %zu steps on average, at most %zu; each stopped when its own block moved by %.2g at most over its last %d",
+		 st.runs, st.runs ? st.steps_sum / st.runs : 0, st.steps_max, st.last_change,
+		 IRDM_KRYLOV_HEAD_CHECK);
+	b->o->progress(b->o->ctx, line, -1.0);
+	return IRDM_OK;
+}
+
 /*
- * The hybrid representation (scene key exact_head): every mode was solved;
+ * The hybrid representation (scene key exact_head): every mode was solved
+ * (zoh_all: each discretised; NULL: the head from Lanczos runs instead);
  * the image keeps the scene's K, and the dropped ones' exact response over
  * the head's samples at the static correction's kept blocks.  Called once
  * the static correction of the K kept modes is known.
@@ -157,10 +181,14 @@ static int exact_head(struct build *b, const struct irdm_mode *zoh_all, size_t n
 			for (int e = 0; e < 9; e++)
 				target[9 * (size_t)k + (size_t)e] = sp->blocks[9 * (size_t)k + (size_t)e] + far[e];
 		}
-	ret = irdm_exact_head(&all, zoh_all, m->modes.n_modes, m->col_dofs, sp, target, H,
-			      b->o->progress, b->o->ctx, b->head);
-	if (ret)
-		snprintf(err, errlen, "precompute: out of memory for the exact head");
+	if (zoh_all) {
+		ret = irdm_exact_head(&all, zoh_all, m->modes.n_modes, m->col_dofs, sp, target, H,
+				      b->o->progress, b->o->ctx, b->head);
+		if (ret)
+			snprintf(err, errlen, "precompute: out of memory for the exact head");
+	} else {
+		ret = krylov_head(b, target, err, errlen);
+	}
 out_free:
 	free(target);
 	return ret;
@@ -215,9 +243,10 @@ static int modal_data(struct build *b, char *err, size_t errlen)
 	struct irdm_model *m = &b->m;
 	struct irdm_mode *zoh_all = NULL;
 	size_t n_all = 0, K, n = m->modes.n;
+	bool hybrid = b->sc->exact_head && b->sc->representation == IRDM_REPR_MODAL;
 	int ret;
 
-	if (b->sc->exact_head && b->sc->representation == IRDM_REPR_MODAL) {
+	if (hybrid && b->m.modes.n_modes > b->sc->modes) {
 		ret = split_modes(b, &zoh_all, &n_all, err, errlen);
 		if (ret)
 			return ret;
@@ -262,7 +291,7 @@ static int modal_data(struct build *b, char *err, size_t errlen)
 		 * R[0] between two columns whose own blocks move with their
 		 * heads, and two contacts grabbed at once through it can
 		 * diverge (accuracy/pairs.h) */
-		if (!ret && b->sc->static_corr_rank && !zoh_all &&
+		if (!ret && b->sc->static_corr_rank && !hybrid &&
 		    b->sparse.n_blocks < m->n_cols * m->n_cols)
 			ret = irdm_static_correction_lowrank(&m->fem, &m->modes, b->sc->floating,
 							     m->col_dofs, &b->sparse,
@@ -273,7 +302,7 @@ static int modal_data(struct build *b, char *err, size_t errlen)
 							     errlen);
 		/* the hybrid's head, after the far field: it sums to the whole
 		 * correction of each kept block */
-		if (!ret && zoh_all)
+		if (!ret && hybrid)
 			ret = exact_head(b, zoh_all, n_all, err, errlen);
 		free(zoh_all);
 		return ret;
@@ -1139,19 +1168,18 @@ static bool all_modes(const struct build *b)
 	       b->m.modes.phi && irdm_dist_size() == 1;
 }
 
-/* The exact model's image from this build's own modes: the same mesh,
- * FEM and eigensolve, its own selection (the sampled nodes), every mode,
- * no static correction, in double; nothing else shared. */
-static int reference_from_model(void *ctx, const struct irdm_scene *rsc, const char *path,
-				char *err, size_t errlen)
+/* The reference image of scene rsc from this build's model and its first
+ * n_modes modes: its own selection (the sampled nodes); nothing else
+ * shared. */
+static int reference_build(struct build *b, const struct irdm_scene *rsc, const char *path,
+			   size_t n_modes, char *err, size_t errlen)
 {
-	struct build *b = ctx;
 	struct irdm_precompute_opts ro = { .out_path = path };
 	struct build r = { .sc = rsc, .o = &ro, .m = b->m };
 	size_t bytes;
 	int ret;
 
-	r.m.modes.n_modes = r.m.modes.n_elastic_total;
+	r.m.modes.n_modes = n_modes;
 	r.m.rows = r.m.cols = r.m.tris = NULL;
 	r.m.row_dofs = r.m.col_dofs = NULL;
 	r.m.n_rows = r.m.n_cols = r.m.n_tris = 0;
@@ -1182,6 +1210,66 @@ static int reference_from_model(void *ctx, const struct irdm_scene *rsc, const c
 	free(r.stab);
 	free(r.nodes);
 	free(r.prov);
+	free(r.head);
+	free(r.head_index);
+	irdm_corr_sparse_free(&r.sparse);
+	irdm_corr_lowrank_free(&r.far);
+	return ret;
+}
+
+/* The exact model's image from this build's own modes: the same mesh,
+ * FEM and eigensolve, every mode, no static correction, in double. */
+static int reference_from_model(void *ctx, const struct irdm_scene *rsc, const char *path,
+				char *err, size_t errlen)
+{
+	struct build *b = ctx;
+
+	return reference_build(b, rsc, path, b->m.modes.n_elastic_total, err, errlen);
+}
+
+/* Was the head built from Lanczos runs (not every mode solved)? */
+static bool krylov_hybrid(const struct build *b)
+{
+	return b->sc->exact_head && b->sc->representation == IRDM_REPR_MODAL &&
+	       b->n_solved < b->m.modes.n_elastic_total && irdm_dist_size() == 1;
+}
+
+/*
+ * The exact model without every mode: the kept modes, exact, and the
+ * dropped ones' whole response over the measurement's run, from Lanczos
+ * runs at the sampled nodes -- a hybrid whose head outlasts the run
+ * (exact_head = its ticks, so the convolution never reads the taper) and
+ * keeps every block between them, in double.  What it shares with the
+ * image is the kept modes and the Lanczos method (test_krylov_head holds
+ * that to every mode); what the image loses past its own head, in its
+ * dropped blocks and its storage is what it measures.
+ */
+static int reference_by_krylov(void *ctx, const struct irdm_scene *rsc, const char *path,
+			       char *err, size_t errlen)
+{
+	struct build *b = ctx;
+	struct irdm_scene *k = malloc(sizeof(*k));
+	char v[32];
+	int ret;
+
+	if (!k) {
+		snprintf(err, errlen, "error measurement: out of memory");
+		return IRDM_ENOMEM;
+	}
+	*k = *rsc;
+	k->eigensolver = IRDM_EIG_LANCZOS;
+	snprintf(v, sizeof(v), "modal:%zu", b->n_modes);
+	ret = irdm_scene_set(k, "representation", v, "error measurement", err, errlen);
+	if (!ret)
+		ret = irdm_scene_set(k, "static_correction", "yes", "error measurement", err, errlen);
+	if (!ret)
+		ret = irdm_scene_set(k, "static_correction_tol", "0", "error measurement", err, errlen);
+	snprintf(v, sizeof(v), "%zu", irdm_measure_ticks(b->sc->dt_s));
+	if (!ret)
+		ret = irdm_scene_set(k, "exact_head", v, "error measurement", err, errlen);
+	if (!ret)
+		ret = reference_build(b, k, path, b->n_modes, err, errlen);
+	free(k);
 	return ret;
 }
 
@@ -1511,7 +1599,10 @@ static int measure(struct build *b, struct irdm_precompute_report *rep, char *er
 	}
 	n_screened = screened_columns(b, screened);
 	ret = irdm_measure_error_at(b->sc, &img, screened, n_screened, ref,
-				    all_modes(b) ? reference_from_model : reference_by_precompute, b,
+				    all_modes(b)       ? reference_from_model :
+				    krylov_hybrid(b) ? reference_by_krylov :
+							 reference_by_precompute,
+				    b,
 				    b->o->progress, b->o->ctx, &res, err, errlen);
 	if (!ret)
 		record(b, rep, res.error, res.worst_node, res.worst_run, res.n_cols, res.ticks,

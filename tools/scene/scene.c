@@ -445,8 +445,10 @@ static const struct irdm_opt scene_opts[] = {
 	{ .name = "static_correction_cluster", .type = IRDM_OPT_UNSIGNED, SC(static_corr_cluster), .metavar = "N", .range = IRDM_OPT_LE, .max = IRDM_STATIC_CORR_CLUSTER_MAX, .help = "modal: keep the static correction between every pair of touchable nodes, block low-rank over clusters of at most N nearby nodes (image section STATIC_CORR_CLUSTERS): static_correction_tol then bounds every block's error, not the dropped ones', and static_correction_rank is not used; 0 drops blocks instead (default 0)" },
 	{ .name = "exact_head", .type = IRDM_OPT_UNSIGNED, SC(exact_head), .metavar = "H", .range = IRDM_OPT_LE, .max = IRDM_HEAD_SAMPLES_MAX / 2, .help = "modal: the hybrid representation: the dropped modes' exact response over the "
 																			   "first H samples between touchable nodes, on top of the kept modes, tapered off "
-																			   "over H more with the static compliance kept exactly; needs every mode, a dense "
-																			   "eigensolve (default 0: the static correction alone)" },
+																			   "over H more with the static compliance kept exactly; from every mode of a dense "
+																			   "eigensolve, or with eigensolver = lanczos from the K kept modes and Lanczos runs on "
+																			   "the stiffness, one per touchable DoF (a grounded object with lumped mass) "
+																			   "(default 0: the static correction alone)" },
 	{ .name = "max_error", .type = IRDM_OPT_CUSTOM, .parse = set_max_error, .metavar = "E | none", .help = "largest force error an image may have: after the build, its relative RMS "
 													       "force error against the exact linear model (every mode, in double) is "
 													       "measured for a step and a release at a few touchable nodes, stored in the "
@@ -564,6 +566,17 @@ int irdm_scene_check(const struct irdm_scene *sc, char *err, size_t errlen)
 	if (sc->static_corr_cluster && sc->static_corr_cluster < IRDM_STATIC_CORR_CLUSTER_MIN) {
 		snprintf(err, errlen, "scene: static_correction_cluster = %u is below %d nodes per cluster (0 turns it off)",
 			 sc->static_corr_cluster, IRDM_STATIC_CORR_CLUSTER_MIN);
+		return IRDM_EINVAL;
+	}
+	if (sc->exact_head && sc->eigensolver == IRDM_EIG_SLEPC) {
+		snprintf(err, errlen, "scene: exact_head = %u with eigensolver = slepc: the head is built on one process (eigensolver = lanczos or dense)",
+			 sc->exact_head);
+		return IRDM_EINVAL;
+	}
+	if (sc->exact_head && sc->eigensolver == IRDM_EIG_LANCZOS &&
+	    (sc->floating || sc->mass != IRDM_MASS_LUMPED)) {
+		snprintf(err, errlen, "scene: exact_head = %u with eigensolver = lanczos builds the head from Lanczos runs, on a grounded object with lumped mass only: %s",
+			 sc->exact_head, sc->floating ? "floating = yes" : "mass = consistent");
 		return IRDM_EINVAL;
 	}
 	if (sc->static_corr_cluster && sc->exact_head) {

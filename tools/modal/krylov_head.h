@@ -1,0 +1,56 @@
+/* SPDX-License-Identifier: MIT */
+/*
+ * The hybrid representation's head without every mode: the same blocks
+ * as irdm_exact_head() writes, from Lanczos runs on the stiffness and the
+ * kept modes alone, for a model whose every mode a dense eigensolve
+ * cannot afford (its cost grows as n^3, its memory as n^2).
+ */
+#ifndef IRDM_TOOLS_KRYLOV_HEAD_H
+#define IRDM_TOOLS_KRYLOV_HEAD_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "fem/fem.h"
+#include "modal/modal.h"
+#include "modal/static_sparse.h"
+
+/* A run stops when its column's own block moved by less than this,
+ * relative to the block, over the last KRYLOV_HEAD_CHECK steps. */
+#define IRDM_KRYLOV_HEAD_TOL 1e-8
+#define IRDM_KRYLOV_HEAD_CHECK 100
+/* and is refused past this many steps */
+#define IRDM_KRYLOV_HEAD_MAX_STEPS 2000
+
+struct irdm_krylov_head_stats {
+	size_t runs;       /* one per column axis (none at a fixed DoF) */
+	size_t steps_max;  /* the longest run's steps */
+	size_t steps_sum;  /* all runs' */
+	double last_change; /* the largest last relative change of a run */
+};
+
+/*
+ * head[(k 2H + s) 9 + 3 i + j] as irdm_exact_head() defines it, for every
+ * kept block k of corr and s < 2H, the dropped modes' response computed as
+ *   D_s e_j = M^-1/2 h_s(A) P M^-1/2 e_j,  A = M^-1/2 K M^-1/2,
+ * P the projector off the kept modes, h_s the zero-order-hold response of
+ * a mode (damping: Rayleigh, dt_s) at sample s as a function of its
+ * eigenvalue, by Lanczos runs on A (the plain three-term recurrence; the
+ * start vector projected) until IRDM_KRYLOV_HEAD_TOL.  fem: K and a lumped
+ * M over the free DoFs; kept: the lowest modes, whole vectors,
+ * M-orthonormal (grounded: no rigid modes); col_dofs as for
+ * irdm_static_correction_sparse(); target as for irdm_exact_head().
+ * The columns are shared by threads (0: one per online CPU).  st (may be
+ * NULL) gets the runs' counts.
+ * Return: IRDM_OK; IRDM_EINVAL (M not lumped, no kept mode, H < 1);
+ * IRDM_ENOMEM; IRDM_ENUMERIC (a run not converged in
+ * IRDM_KRYLOV_HEAD_MAX_STEPS, or the tridiagonal eigensolve failed);
+ * err says which.
+ */
+int irdm_krylov_head(const struct irdm_fem *fem, const struct irdm_modes *kept,
+		     const struct irdm_rayleigh *damping, double dt_s, const int64_t *col_dofs,
+		     const struct irdm_corr_sparse *corr, const double *target, size_t H,
+		     unsigned threads, irdm_progress_fn progress, void *ctx, double *head,
+		     struct irdm_krylov_head_stats *st, char *err, size_t errlen);
+
+#endif
