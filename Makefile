@@ -40,7 +40,9 @@
 #                   cuboid's materials (PAPER=1: and the paper's cuboid;
 #                   docs/measurements/error-targets.md)
 #   make scale      the default scene at the paper's mesh and at 11,340
-#                   nodes, its every-mode eigensolve split by symmetry
+#                   nodes, its every-mode eigensolve split by symmetry,
+#                   then with the head from Lanczos runs at the paper's
+#                   mesh and at about 20,000 nodes
 #                   (docs/measurements/scale.md)
 #   make format-check  every C source and header against .clang-format
 #                   (clang-format 14); make format rewrites them
@@ -485,8 +487,9 @@ report: $(IRDM)
 	done
 
 # The default scene at finer meshes (tools/scripts/scale.sh): how far the
-# symmetric split of the every-mode eigensolve carries the default target;
-# figures to docs/measurements/scale.md.
+# symmetric split of the every-mode eigensolve carries the default target,
+# and the head from Lanczos runs past it; figures to
+# docs/measurements/scale.md.
 scale: $(IRDM)
 	$(MEASURE) -m scale 'make scale' -- tools/scripts/scale.sh $(IRDM)
 

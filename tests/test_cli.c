@@ -344,6 +344,7 @@ static void test_alloc_failure_is_enomem(void **state)
 #else
 	assert_non_null(strstr(err_text, "the dense eigensolve of 9504 modes of 9504 free DoFs (split by symmetry) needs 1.0 GiB, more than the 0.3 GiB of ulimit -v"));
 	assert_non_null(strstr(err_text, "representation = auto with max_error = 0.001 needs every mode"));
+	assert_non_null(strstr(err_text, "exact_head = H and eigensolver = lanczos"));
 #endif
 	assert_false(exists(img));
 }

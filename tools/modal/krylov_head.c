@@ -12,8 +12,15 @@
  * so h_s(T) e1 still converges, a few hundred steps later than with full
  * reorthogonalisation but at a cost linear in m instead of quadratic.
  * Only the start vector is projected off the kept modes: what rounding
- * brings back of them has a weight of the order of the projection's
- * residual.  A run is stopped by watching its own block converge.
+ * brings back of them shows as Ritz values below the dropped spectrum,
+ * whose weight is dropped.  A run is stopped by watching its own block
+ * converge; a column's three runs share each pass over K.
+ *
+ * Runs on A^-1 instead (a solve with K's factor per step, the kept modes
+ * projected out at each) needed about 400 steps on the paper's cuboid
+ * where these need 1,100, but each step cost about ten times as much
+ * there (measured 2026-11-28: 348 s against 90 s for the default scene's
+ * head); their steps would not grow with the mesh as these do.
  */
 #include <math.h>
 #include <pthread.h>
@@ -32,6 +39,23 @@
 
 #define FIRST_CHECK 200 /* no run converges sooner on a model worth this */
 #define KH_THREADS_MAX 64
+/* A Ritz value this far below the highest kept mode is not a dropped
+ * mode's (they lie above the kept ones) but one of the kept modes that
+ * rounding brought back: its weight is dropped.  A dropped mode equal to
+ * the highest kept one stays (a double eigenvalue split by K). */
+#define SPURIOUS 1e-6
+
+/* One axis's run; a column's three go side by side. */
+struct run {
+	double beta0, b_prev, change;
+	size_t m;
+	size_t next_check;      /* the step of its next check */
+	size_t open_check;      /* its last check not within tol (0: none yet) */
+	int done;               /* 1 converged, -1 failed, 0 running */
+	double *alpha, *beta;   /* m_max each */
+	double *Vr;             /* its vectors at the rows asked: R x m_max */
+	double *own, *own_prev; /* its own block's column at the last two checks: 3 x S */
+};
 
 struct kh {
 	const struct irdm_fem *fem;
@@ -39,32 +63,54 @@ struct kh {
 	const struct irdm_rayleigh *damp;
 	double dt;
 	size_t n, S, m_max;
-	double *dinv;          /* M^-1/2, n */
-	double *msq;           /* M^1/2, n */
-	double *v, *vp, *w, *t; /* n each */
-	double *coef;          /* kept->n_modes */
-	double *alpha, *beta;  /* m_max each */
-	double *Vr;            /* the run's vectors at the rows asked: R x m_max */
-	double *d, *e, *z;     /* the tridiagonal eigensolve: m, m, m x m */
+	double tol;
+	double *dinv;           /* M^-1/2, n */
+	double *msq;            /* M^1/2, n */
+	double *v, *vp, *w, *t; /* the three runs' vectors interleaved, [i][axis]: 3n each */
+	double *x, *coef;       /* a start vector (n) and its kept-mode part */
+	struct run run[3];
+	double *d, *e, *z; /* the tridiagonal eigensolve: m, m, m x m */
 	double *work;
 	int *iwork;
 	int lwork, liwork;
-	double *hs;            /* [s][l]: m_max x S, then the weights folded in */
+	double *hs;            /* [s][l]: each Ritz value's weighted response, m x S */
 	double *W;             /* R x m_max */
+	double *G;             /* m_max x S */
 	struct irdm_mode *zoh; /* m_max */
 	double *hd;            /* one Ritz value's response: S */
-	double *own, *own_prev; /* 3 x S */
+	/* a run's first check: the last run's check before the one it stopped
+	 * at (the runs of one model converge alike; each check is an
+	 * eigensolve of T, m^2 to m^3) */
+	size_t first_check;
 	struct irdm_krylov_head_stats st;
 };
 
-/* y = A x */
-static void apply_a(const struct kh *k, const double *x, double *y)
+/*
+ * y = A x for the three interleaved vectors at once: K is read once for
+ * the three, which is most of a step's memory traffic.
+ */
+static void apply_a3(const struct kh *k, const double *x, double *y)
 {
+	const struct irdm_csc *K = &k->fem->K;
+
 	for (size_t i = 0; i < k->n; i++)
-		k->t[i] = k->dinv[i] * x[i];
-	irdm_csc_matvec(&k->fem->K, k->t, y);
+		for (int a = 0; a < 3; a++)
+			k->t[3 * i + (size_t)a] = k->dinv[i] * x[3 * i + (size_t)a];
+	memset(y, 0, 3 * k->n * sizeof(double));
+	for (size_t j = 0; j < k->n; j++) {
+		const double *tj = &k->t[3 * j];
+
+		for (int64_t q = K->colptr[j]; q < K->colptr[j + 1]; q++) {
+			double *yi = &y[3 * (size_t)K->rowind[q]], kv = K->val[q];
+
+			yi[0] += kv * tj[0];
+			yi[1] += kv * tj[1];
+			yi[2] += kv * tj[2];
+		}
+	}
 	for (size_t i = 0; i < k->n; i++)
-		y[i] *= k->dinv[i];
+		for (int a = 0; a < 3; a++)
+			y[3 * i + (size_t)a] *= k->dinv[i];
 }
 
 /* x -= Psi Psi^T x, Psi = M^1/2 Phi (orthonormal): off the kept modes. */
@@ -82,47 +128,55 @@ static void project(const struct kh *k, double *x)
 		x[i] += k->msq[i] * k->t[i];
 }
 
-static double dot(const double *a, const double *b, size_t n)
+/* sum over i of a[3 i + ax] b[3 i + ax] */
+static double dot3(const double *a, const double *b, size_t n, int ax)
 {
 	double s = 0;
 
 	for (size_t i = 0; i < n; i++)
-		s += a[i] * b[i];
+		s += a[3 * i + (size_t)ax] * b[3 * i + (size_t)ax];
 	return s;
 }
 
 /*
- * After m steps: Y[r + R s] = rows r0 .. r0 + nr - 1 of beta0 V h_s(T) e1
- * (R: Vr's leading dimension).  The eigenpairs of T by divide and
- * conquer; a Ritz value below the lowest kept mode is rounding (the
- * dropped spectrum lies above it) and is lifted to it.
+ * After m steps of run u: Y[r + nr s] = rows r0 .. r0 + nr - 1 of
+ * beta0 V h_s(T) e1 (R: u's Vr's leading dimension).  The eigenpairs of
+ * T by divide and conquer; a Ritz value below the lowest kept mode is
+ * rounding (the dropped spectrum lies above it) and is lifted to it.
  */
-static int ritz_rows(struct kh *k, size_t m, double beta0, size_t R, size_t r0, size_t nr,
+static int ritz_rows(struct kh *k, const struct run *u, size_t R, size_t r0, size_t nr,
 		     double *Y)
 {
-	int mi = (int)m, info, nri = (int)nr, Si = (int)k->S, Ri = (int)R;
+	int mi = (int)u->m, info, nri = (int)nr, Si = (int)k->S, Ri = (int)R;
+	size_t m = u->m;
 	double one = 1.0, zero = 0.0;
 	struct irdm_modes ritz = { .n = 0, .n_modes = m, .omega2 = k->d };
+	double lowest = (1 - SPURIOUS) * k->kept->omega2[k->kept->n_modes - 1];
 
-	memcpy(k->d, k->alpha, m * sizeof(double));
-	memcpy(k->e, k->beta, (m - 1) * sizeof(double));
+	memcpy(k->d, u->alpha, m * sizeof(double));
+	memcpy(k->e, u->beta, (m - 1) * sizeof(double));
 	dstedc_("I", &mi, k->d, k->e, k->z, &mi, k->work, &k->lwork, k->iwork, &k->liwork, &info);
 	if (info)
 		return info;
 	for (size_t l = 0; l < m; l++)
-		k->d[l] = fmax(k->d[l], k->kept->omega2[0]);
+		k->d[l] = fmax(k->d[l], lowest);
 	if (irdm_modes_discretise(&ritz, k->damp, k->dt, k->zoh))
 		return -1;
-	/* hs[s m + l] = beta0 Q_0l h_s(theta_l): an m x S matrix */
 	for (size_t l = 0; l < m; l++) {
-		double g = beta0 * k->z[l * m];
+		double g = k->d[l] > lowest ? u->beta0 * k->z[l * m] : 0.0;
 
 		irdm_zoh_response(&k->zoh[l], k->S, k->hd);
 		for (size_t s = 0; s < k->S; s++)
 			k->hs[s * m + l] = g * k->hd[s];
 	}
-	/* W = V_rows Q (nr x m), Y = W hs (nr x S) */
-	dgemm_("N", "N", &nri, &mi, &mi, &one, &k->Vr[r0], &Ri, k->z, &mi, &zero, k->W, &nri);
+	/* Y = V_rows Q hs, the cheaper way round: many rows (a column's
+	 * blocks) make Q hs first (m x S), a few (its own block) V_rows Q */
+	if (nr > k->S) {
+		dgemm_("N", "N", &mi, &Si, &mi, &one, k->z, &mi, k->hs, &mi, &zero, k->G, &mi);
+		dgemm_("N", "N", &nri, &Si, &mi, &one, &u->Vr[r0], &Ri, k->G, &mi, &zero, Y, &nri);
+		return 0;
+	}
+	dgemm_("N", "N", &nri, &mi, &mi, &one, &u->Vr[r0], &Ri, k->z, &mi, &zero, k->W, &nri);
 	dgemm_("N", "N", &nri, &Si, &mi, &one, k->W, &nri, k->hs, &mi, &zero, Y, &nri);
 	return 0;
 }
@@ -145,120 +199,169 @@ static double rel_change(const double *a, const double *b, size_t S)
 	return den > 0 ? sqrt(num / den) : 0;
 }
 
-/* Is the run done after m steps (b: the next beta)?  Checked every
- * IRDM_KRYLOV_HEAD_CHECK steps from FIRST_CHECK, or when the run has
- * found an invariant subspace (b negligible: exact). */
-static int converged(struct kh *k, size_t m, double beta0, double b, size_t R, size_t own,
-		     double *change)
+/* Is run u done after its m steps (b: the next beta)?  Checked at
+ * u->next_check, the next one a quarter further (at least
+ * IRDM_KRYLOV_HEAD_CHECK steps), and at the last step allowed; or when
+ * the run has found an invariant subspace (b negligible: exact). */
+static int converged(struct kh *k, struct run *u, double b, size_t R, size_t own)
 {
 	double *swap;
-	bool exact = !(b > 1e-13 * fabs(k->alpha[m - 1]));
+	bool exact = !(b > 1e-13 * fabs(u->alpha[u->m - 1]));
+	size_t gap = u->m / 4 > IRDM_KRYLOV_HEAD_CHECK ? u->m / 4 : IRDM_KRYLOV_HEAD_CHECK;
 
-	if (!exact && (m < FIRST_CHECK || (m - FIRST_CHECK) % IRDM_KRYLOV_HEAD_CHECK))
-		return 0;
 	if (exact) {
-		*change = 0;
+		u->change = 0;
 		return 1;
 	}
-	if (ritz_rows(k, m, beta0, R, own, 3, k->own))
+	if (u->m < u->next_check && u->m < k->m_max)
+		return 0;
+	if (ritz_rows(k, u, R, own, 3, u->own))
 		return -1;
-	*change = m > FIRST_CHECK ? rel_change(k->own, k->own_prev, k->S) : INFINITY;
-	swap = k->own;
-	k->own = k->own_prev;
-	k->own_prev = swap;
-	return *change < IRDM_KRYLOV_HEAD_TOL;
+	u->change = u->open_check ? rel_change(u->own, u->own_prev, k->S) : INFINITY;
+	u->next_check = u->m + gap;
+	if (u->change >= k->tol)
+		u->open_check = u->m;
+	swap = u->own;
+	u->own = u->own_prev;
+	u->own_prev = swap;
+	return u->change < k->tol;
+}
+
+/* Run ax's start: P M^-1/2 e_d0 normalised into its lane of v (none at a
+ * fixed DoF, or if the kept modes span it: done with a zero response). */
+static void start(struct kh *k, int ax, int64_t d0)
+{
+	struct run *u = &k->run[ax];
+	size_t n = k->n;
+
+	u->m = 0;
+	u->next_check = k->first_check;
+	u->open_check = 0;
+	u->b_prev = 0;
+	u->change = INFINITY;
+	u->beta0 = 0;
+	u->done = 1;
+	memset(k->x, 0, n * sizeof(double));
+	if (d0 >= 0) {
+		k->x[d0] = k->dinv[d0];
+		project(k, k->x);
+		project(k, k->x); /* twice: the first leaves rounding of the kept modes */
+		for (size_t i = 0; i < n; i++)
+			u->beta0 += k->x[i] * k->x[i];
+		u->beta0 = sqrt(u->beta0);
+		u->done = !(u->beta0 > 0);
+	}
+	for (size_t i = 0; i < n; i++) {
+		k->v[3 * i + (size_t)ax] = u->done ? 0.0 : k->x[i] / u->beta0;
+		k->vp[3 * i + (size_t)ax] = 0.0;
+	}
+}
+
+/* One step of run ax after w = A v: its coefficients, its check, its next
+ * vector in w's lane. */
+static void step(struct kh *k, int ax, size_t R, size_t own)
+{
+	struct run *u = &k->run[ax];
+	double *v = k->v, *vp = k->vp, *w = k->w, a, b;
+	size_t n = k->n, x = (size_t)ax;
+
+	a = dot3(w, v, n, ax);
+	for (size_t i = 0; i < n; i++)
+		w[3 * i + x] -= a * v[3 * i + x] + u->b_prev * vp[3 * i + x];
+	b = sqrt(dot3(w, w, n, ax));
+	u->alpha[u->m++] = a;
+	u->done = converged(k, u, b, R, own);
+	if (u->done) {
+		for (size_t i = 0; i < n; i++)
+			w[3 * i + x] = 0.0; /* its lane rests */
+		return;
+	}
+	u->beta[u->m - 1] = b;
+	for (size_t i = 0; i < n; i++)
+		w[3 * i + x] /= b;
+	u->b_prev = b;
 }
 
 /*
- * One run from the free DoF d0, its vectors kept at rdofs[0..R-1] (the
- * column's own three rows at own): Y (R x S) the rows' response.
- * Return: 0; IRDM_ENUMERIC not converged or LAPACK failed.
+ * The three runs of a column from its free DoFs d0[0..2] side by side,
+ * their vectors kept at rdofs[0..R-1] (the column's own three rows at
+ * own), until each is done or k->m_max steps.
+ * Return: 0; IRDM_ENUMERIC one not converged or LAPACK failed.
  */
-static int run_axis(struct kh *k, int64_t d0, const int64_t *rdofs, size_t R, size_t own,
-		    double *Y)
+static int run_column(struct kh *k, const int64_t *d0, const int64_t *rdofs, size_t R, size_t own)
 {
-	double beta0, b_prev = 0, change = INFINITY, *v = k->v, *vp = k->vp, *w = k->w;
-	size_t m = 0, n = k->n;
-	int done = 0;
+	size_t steps = 0, hint = 0;
+	int ret = 0;
 
-	memset(v, 0, n * sizeof(double));
-	v[d0] = k->dinv[d0];
-	project(k, v);
-	project(k, v); /* twice: the first leaves rounding of the kept modes */
-	beta0 = sqrt(dot(v, v, n));
-	if (!(beta0 > 0)) {
-		memset(Y, 0, R * k->S * sizeof(double));
-		return 0;
-	}
-	for (size_t i = 0; i < n; i++)
-		v[i] /= beta0;
-	memset(vp, 0, n * sizeof(double));
-	while (!done && m < k->m_max) {
-		double a, b, *tmp;
+	for (int ax = 0; ax < 3; ax++)
+		start(k, ax, d0[ax]);
+	while (steps++ < k->m_max && !(k->run[0].done && k->run[1].done && k->run[2].done)) {
+		double *tmp;
 
-		for (size_t r = 0; r < R; r++)
-			k->Vr[m * R + r] = rdofs[r] < 0 ? 0.0 : v[rdofs[r]];
-		apply_a(k, v, w);
-		a = dot(w, v, n);
-		for (size_t i = 0; i < n; i++)
-			w[i] -= a * v[i] + b_prev * vp[i];
-		b = sqrt(dot(w, w, n));
-		k->alpha[m++] = a;
-		done = converged(k, m, beta0, b, R, own, &change);
-		if (done)
-			break;
-		k->beta[m - 1] = b;
-		for (size_t i = 0; i < n; i++)
-			w[i] /= b;
-		tmp = vp;
-		vp = v;
-		v = w;
-		w = tmp;
-		b_prev = b;
+		for (int ax = 0; ax < 3; ax++)
+			for (size_t r = 0; !k->run[ax].done && r < R; r++)
+				k->run[ax].Vr[k->run[ax].m * R + r] =
+					rdofs[r] < 0 ? 0.0 : k->v[3 * (size_t)rdofs[r] + (size_t)ax];
+		apply_a3(k, k->v, k->w);
+		for (int ax = 0; ax < 3; ax++)
+			if (!k->run[ax].done)
+				step(k, ax, R, own);
+		tmp = k->vp;
+		k->vp = k->v;
+		k->v = k->w;
+		k->w = tmp;
 	}
-	k->v = v;
-	k->vp = vp;
-	k->w = w;
-	if (done < 0)
-		return IRDM_ENUMERIC;
-	k->st.runs++;
-	k->st.steps_sum += m;
-	k->st.steps_max = m > k->st.steps_max ? m : k->st.steps_max;
-	if (!done)
-		return IRDM_ENUMERIC;
-	k->st.last_change = fmax(k->st.last_change, change);
-	return ritz_rows(k, m, beta0, R, 0, R, Y) ? IRDM_ENUMERIC : 0;
+	for (int ax = 0; ax < 3; ax++) {
+		struct run *u = &k->run[ax];
+
+		if (!u->m)
+			continue; /* a fixed DoF: no run */
+		if (u->done != 1)
+			ret = IRDM_ENUMERIC;
+		k->st.runs++;
+		k->st.steps_sum += u->m;
+		k->st.steps_max = u->m > k->st.steps_max ? u->m : k->st.steps_max;
+		k->st.last_change = fmax(k->st.last_change, u->change);
+		if (u->done == 1 && u->open_check && (!hint || u->open_check < hint))
+			hint = u->open_check;
+	}
+	/* the column's earliest: a run that met a transient jump in its
+	 * checks (a Ritz value appearing) does not delay the next ones */
+	if (hint)
+		k->first_check = hint;
+	return ret;
 }
 
-/* Column c's blocks from its first computed one: each axis a run. */
+/* Column c's blocks from its first computed one: its three runs. */
 static int column(struct kh *k, const struct irdm_corr_sparse *corr, const int64_t *col_dofs,
 		  size_t c, int64_t *rdofs, double *Y, double *head)
 {
 	uint32_t k0 = irdm_head_upper_begin(corr, c), nb = corr->start[c + 1] - k0;
 	long kd = irdm_corr_sparse_find(corr, c, (uint32_t)c);
 	size_t R = 3 * (size_t)nb, S = k->S;
+	int ret;
 
 	if (kd < (long)k0)
 		return IRDM_EINVAL; /* the diagonal block is always kept */
 	for (uint32_t b = 0; b < nb; b++)
 		for (int i = 0; i < 3; i++)
 			rdofs[3 * b + (uint32_t)i] = col_dofs[3 * (size_t)corr->rows[k0 + b] + (size_t)i];
-	for (int j = 0; j < 3; j++) {
-		int64_t d0 = col_dofs[3 * c + (size_t)j];
-		int ret = d0 < 0 ? 0 : run_axis(k, d0, rdofs, R, 3 * (size_t)(kd - k0), Y);
+	ret = run_column(k, &col_dofs[3 * c], rdofs, R, 3 * (size_t)(kd - k0));
+	for (int j = 0; !ret && j < 3; j++) {
+		const struct run *u = &k->run[j];
 
-		if (ret)
-			return ret;
+		if (u->m && ritz_rows(k, u, R, 0, R, Y))
+			return IRDM_ENUMERIC;
 		for (uint32_t b = 0; b < nb; b++)
 			for (size_t s = 0; s < S; s++)
 				for (int i = 0; i < 3; i++) {
 					int64_t r = rdofs[3 * b + (uint32_t)i];
 
 					head[((size_t)(k0 + b) * S + s) * 9 + 3 * (size_t)i + (size_t)j] =
-						d0 < 0 || r < 0 ? 0.0 : k->dinv[r] * Y[3 * b + (size_t)i + R * s];
+						!u->m || r < 0 ? 0.0 : k->dinv[r] * Y[3 * b + (size_t)i + R * s];
 				}
 	}
-	return 0;
+	return ret;
 }
 
 static void kh_free(struct kh *k)
@@ -269,10 +372,15 @@ static void kh_free(struct kh *k)
 	free(k->vp);
 	free(k->w);
 	free(k->t);
+	free(k->x);
 	free(k->coef);
-	free(k->alpha);
-	free(k->beta);
-	free(k->Vr);
+	for (int ax = 0; ax < 3; ax++) {
+		free(k->run[ax].alpha);
+		free(k->run[ax].beta);
+		free(k->run[ax].Vr);
+		free(k->run[ax].own);
+		free(k->run[ax].own_prev);
+	}
 	free(k->d);
 	free(k->e);
 	free(k->z);
@@ -280,28 +388,36 @@ static void kh_free(struct kh *k)
 	free(k->iwork);
 	free(k->hs);
 	free(k->W);
+	free(k->G);
 	free(k->zoh);
 	free(k->hd);
-	free(k->own);
-	free(k->own_prev);
 }
 
 static int kh_alloc(struct kh *k, size_t R_max)
 {
 	size_t n = k->n, m = k->m_max, S = k->S;
+	bool ok = true;
 
 	k->lwork = (int)(1 + 4 * m + m * m);
 	k->liwork = (int)(3 + 5 * m);
 	k->dinv = malloc(n * sizeof(double));
 	k->msq = malloc(n * sizeof(double));
-	k->v = malloc(n * sizeof(double));
-	k->vp = malloc(n * sizeof(double));
-	k->w = malloc(n * sizeof(double));
-	k->t = malloc(n * sizeof(double));
+	k->v = malloc(3 * n * sizeof(double));
+	k->vp = malloc(3 * n * sizeof(double));
+	k->w = malloc(3 * n * sizeof(double));
+	k->t = malloc(3 * n * sizeof(double));
+	k->x = malloc(n * sizeof(double));
 	k->coef = malloc(k->kept->n_modes * sizeof(double));
-	k->alpha = malloc(m * sizeof(double));
-	k->beta = malloc(m * sizeof(double));
-	k->Vr = malloc(R_max * m * sizeof(double));
+	for (int ax = 0; ax < 3; ax++) {
+		struct run *u = &k->run[ax];
+
+		u->alpha = malloc(m * sizeof(double));
+		u->beta = malloc(m * sizeof(double));
+		u->Vr = malloc(R_max * m * sizeof(double));
+		u->own = malloc(3 * S * sizeof(double));
+		u->own_prev = malloc(3 * S * sizeof(double));
+		ok = ok && u->alpha && u->beta && u->Vr && u->own && u->own_prev;
+	}
 	k->d = malloc(m * sizeof(double));
 	k->e = malloc(m * sizeof(double));
 	k->z = malloc(m * m * sizeof(double));
@@ -309,20 +425,27 @@ static int kh_alloc(struct kh *k, size_t R_max)
 	k->iwork = malloc((size_t)k->liwork * sizeof(int));
 	k->hs = malloc(m * S * sizeof(double));
 	k->W = malloc(R_max * m * sizeof(double));
+	k->G = malloc(m * S * sizeof(double));
 	k->zoh = malloc(m * sizeof(*k->zoh));
 	k->hd = malloc(S * sizeof(double));
-	k->own = malloc(3 * S * sizeof(double));
-	k->own_prev = malloc(3 * S * sizeof(double));
 	for (size_t i = 0; k->dinv && k->msq && i < n; i++) {
 		k->msq[i] = sqrt(k->fem->M.val[k->fem->M.colptr[i]]);
 		k->dinv[i] = 1 / k->msq[i];
 	}
-	return k->dinv && k->msq && k->v && k->vp && k->w && k->t && k->coef && k->alpha &&
-			       k->beta && k->Vr && k->d && k->e && k->z && k->work && k->iwork &&
-			       k->hs && k->W && k->zoh && k->hd && k->own && k->own_prev ?
-		       0 :
-		       IRDM_ENOMEM;
+	ok = ok && k->dinv && k->msq && k->v && k->vp && k->w && k->t && k->x && k->coef && k->d &&
+	     k->e && k->z && k->work && k->iwork && k->hs && k->W && k->G && k->zoh && k->hd;
+	return ok ? 0 : IRDM_ENOMEM;
 }
+
+/* What every worker reads. */
+struct kh_in {
+	const struct irdm_fem *fem;
+	const struct irdm_modes *kept;
+	const struct irdm_rayleigh *damp;
+	double dt;
+	size_t S;
+	const struct irdm_krylov_head_opts *o;
+};
 
 /* The runs over threads: each takes the next column (their blocks are
  * its own); the first failure stops the others. */
@@ -409,21 +532,69 @@ static void progress_wait(struct pool *p, pthread_t *th, unsigned nt, irdm_progr
 		progress(ctx, "krylov head", 1.0);
 }
 
+/* Worker w's scratch for rows of up to R_max. */
+static int worker_init(struct worker *w, struct pool *p, const struct kh_in *in,
+		       size_t R_max)
+{
+	w->k = (struct kh){ .fem = in->fem, .kept = in->kept, .damp = in->damp, .dt = in->dt, .n = in->fem->K.n, .S = in->S, .m_max = in->o->max_steps, .tol = in->o->tol, .first_check = FIRST_CHECK };
+	w->p = p;
+	w->rdofs = malloc(R_max * sizeof(int64_t));
+	w->Y = malloc(R_max * in->S * sizeof(double));
+	return kh_alloc(&w->k, R_max) || !w->rdofs || !w->Y ? IRDM_ENOMEM : 0;
+}
+
+static void worker_free(struct worker *w, struct irdm_krylov_head_stats *st)
+{
+	if (st)
+		merge_stats(st, &w->k.st);
+	kh_free(&w->k);
+	free(w->rdofs);
+	free(w->Y);
+}
+
+/* The columns' runs over nt threads. */
+static int run_pool(struct pool *p, struct worker *w, unsigned nt, irdm_progress_fn progress,
+		    void *ctx, char *err, size_t errlen)
+{
+	pthread_t th[KH_THREADS_MAX];
+	unsigned started = 0;
+	int ret = 0, blas;
+
+	/* one thread per run: OpenBLAS's own threads would oversubscribe */
+	blas = irdm_blas_serial_begin();
+	for (unsigned t = 0; t < nt && !ret; t++, started++)
+		if (pthread_create(&th[t], NULL, work, &w[t])) {
+			atomic_store(&p->failed, 1);
+			snprintf(err, errlen, "krylov head: cannot start a thread");
+			ret = IRDM_ENOMEM;
+			break;
+		}
+	progress_wait(p, th, started, progress, ctx);
+	irdm_blas_serial_end(blas);
+	if (!ret && atomic_load(&p->failed)) {
+		ret = p->fail_ret == IRDM_EINVAL ? IRDM_EINVAL : IRDM_ENUMERIC;
+		snprintf(err, errlen, ret == IRDM_EINVAL ? "krylov head: column %zu has no diagonal block" : "krylov head: column %zu: the Lanczos run did not converge to %g in %zu steps",
+			 p->fail_col, w[0].k.tol, w[0].k.m_max);
+	}
+	return ret;
+}
+
 int irdm_krylov_head(const struct irdm_fem *fem, const struct irdm_modes *kept,
 		     const struct irdm_rayleigh *damping, double dt_s, const int64_t *col_dofs,
 		     const struct irdm_corr_sparse *corr, const double *target, size_t H,
-		     unsigned threads, irdm_progress_fn progress, void *ctx, double *head,
+		     const struct irdm_krylov_head_opts *o, irdm_progress_fn progress, void *ctx, double *head,
 		     struct irdm_krylov_head_stats *st, char *err, size_t errlen)
 {
-	struct pool p = { .corr = corr, .col_dofs = col_dofs, .head = head,
-			  .lock = PTHREAD_MUTEX_INITIALIZER };
+	struct pool p = { .corr = corr, .col_dofs = col_dofs, .head = head, .lock = PTHREAD_MUTEX_INITIALIZER };
+	struct kh_in in = { fem, kept, damping, dt_s, 2 * H, o };
 	struct worker w[KH_THREADS_MAX];
-	pthread_t th[KH_THREADS_MAX];
-	unsigned nt = n_workers(threads, corr->n_cols), started = 0;
+	unsigned nt = n_workers(o->threads, corr->n_cols), ready = 0;
 	size_t R_max = 3, S = 2 * H;
-	int ret = IRDM_OK, blas;
+	int ret = 0;
 
-	if (fem->M.nnz != fem->M.n || !kept->n_modes || !kept->phi || H < 1) {
+	if (st)
+		memset(st, 0, sizeof(*st));
+	if (fem->M.nnz != fem->M.n || !kept->n_modes || !kept->phi || H < 1 || o->max_steps < 2) {
 		snprintf(err, errlen, "krylov head: needs a lumped mass, kept modes and a head (H = %zu)", H);
 		return IRDM_EINVAL;
 	}
@@ -431,52 +602,26 @@ int irdm_krylov_head(const struct irdm_fem *fem, const struct irdm_modes *kept,
 		size_t R = 3 * (size_t)(corr->start[c + 1] - irdm_head_upper_begin(corr, c));
 		R_max = R > R_max ? R : R_max;
 	}
-	memset(w, 0, sizeof(w));
 	atomic_init(&p.next, 0);
 	atomic_init(&p.done, 0);
 	atomic_init(&p.failed, 0);
-	for (unsigned t = 0; t < nt && !ret; t++) {
-		w[t].k = (struct kh){ .fem = fem, .kept = kept, .damp = damping, .dt = dt_s,
-				      .n = fem->K.n, .S = S, .m_max = IRDM_KRYLOV_HEAD_MAX_STEPS };
-		w[t].p = &p;
-		w[t].rdofs = malloc(R_max * sizeof(int64_t));
-		w[t].Y = malloc(R_max * S * sizeof(double));
-		if (kh_alloc(&w[t].k, R_max) || !w[t].rdofs || !w[t].Y) {
+	for (; ready < nt; ready++)
+		if (worker_init(&w[ready], &p, &in, R_max)) {
 			snprintf(err, errlen, "krylov head: out of memory (%zu rows of %zu steps, %u threads)",
-				 R_max, w[t].k.m_max, nt);
+				 R_max, o->max_steps, nt);
 			ret = IRDM_ENOMEM;
+			ready++; /* what it did allocate is freed below */
+			break;
 		}
-	}
-	/* one thread per run: OpenBLAS's own threads would oversubscribe */
-	blas = irdm_blas_serial_begin();
-	for (unsigned t = 0; t < nt && !ret; t++, started++)
-		if (pthread_create(&th[t], NULL, work, &w[t])) {
-			atomic_store(&p.failed, 1);
-			snprintf(err, errlen, "krylov head: cannot start a thread");
-			ret = IRDM_ENOMEM;
-		}
-	progress_wait(&p, th, started, progress, ctx);
-	irdm_blas_serial_end(blas);
-	if (!ret && atomic_load(&p.failed)) {
-		ret = p.fail_ret == IRDM_EINVAL ? IRDM_EINVAL : IRDM_ENUMERIC;
-		snprintf(err, errlen, ret == IRDM_EINVAL ? "krylov head: column %zu has no diagonal block" :
-			 "krylov head: column %zu: the Lanczos run did not converge to %g in %d steps",
-			 p.fail_col, IRDM_KRYLOV_HEAD_TOL, IRDM_KRYLOV_HEAD_MAX_STEPS);
-	}
+	if (!ret)
+		ret = run_pool(&p, w, nt, progress, ctx, err, errlen);
 	if (!ret) {
 		for (size_t c = 0; c < corr->n_cols; c++)
 			irdm_head_mirror(corr, c, irdm_head_upper_begin(corr, c), S, head);
 		for (size_t b = 0; b < corr->n_blocks; b++)
 			irdm_head_taper(&head[b * S * 9], H, &target[9 * b]);
 	}
-	if (st)
-		memset(st, 0, sizeof(*st));
-	for (unsigned t = 0; t < nt; t++) {
-		if (st)
-			merge_stats(st, &w[t].k.st);
-		kh_free(&w[t].k);
-		free(w[t].rdofs);
-		free(w[t].Y);
-	}
+	for (unsigned t = 0; t < ready; t++)
+		worker_free(&w[t], st);
 	return ret;
 }

@@ -15,17 +15,23 @@
 #include "modal/modal.h"
 #include "modal/static_sparse.h"
 
-/* A run stops when its column's own block moved by less than this,
- * relative to the block, over the last KRYLOV_HEAD_CHECK steps. */
+/* A run stops when its column's own block moved by less than tol,
+ * relative to the block, between two checks (a quarter of the steps
+ * apart, at least IRDM_KRYLOV_HEAD_CHECK); these are an image head's. */
 #define IRDM_KRYLOV_HEAD_TOL 1e-8
 #define IRDM_KRYLOV_HEAD_CHECK 100
-/* and is refused past this many steps */
-#define IRDM_KRYLOV_HEAD_MAX_STEPS 2000
+#define IRDM_KRYLOV_HEAD_MAX_STEPS 4000
+
+struct irdm_krylov_head_opts {
+	double tol;       /* IRDM_KRYLOV_HEAD_TOL */
+	size_t max_steps; /* a run is refused past it: IRDM_KRYLOV_HEAD_MAX_STEPS */
+	unsigned threads; /* the columns are shared by threads (0: one per online CPU) */
+};
 
 struct irdm_krylov_head_stats {
-	size_t runs;       /* one per column axis (none at a fixed DoF) */
-	size_t steps_max;  /* the longest run's steps */
-	size_t steps_sum;  /* all runs' */
+	size_t runs;        /* one per column axis (none at a fixed DoF) */
+	size_t steps_max;   /* the longest run's steps */
+	size_t steps_sum;   /* all runs' */
 	double last_change; /* the largest last relative change of a run */
 };
 
@@ -36,21 +42,20 @@ struct irdm_krylov_head_stats {
  * P the projector off the kept modes, h_s the zero-order-hold response of
  * a mode (damping: Rayleigh, dt_s) at sample s as a function of its
  * eigenvalue, by Lanczos runs on A (the plain three-term recurrence; the
- * start vector projected) until IRDM_KRYLOV_HEAD_TOL.  fem: K and a lumped
+ * start vector projected) until o->tol.  fem: K and a lumped
  * M over the free DoFs; kept: the lowest modes, whole vectors,
  * M-orthonormal (grounded: no rigid modes); col_dofs as for
  * irdm_static_correction_sparse(); target as for irdm_exact_head().
- * The columns are shared by threads (0: one per online CPU).  st (may be
- * NULL) gets the runs' counts.
+ * st (may be NULL) gets the runs' counts.
  * Return: IRDM_OK; IRDM_EINVAL (M not lumped, no kept mode, H < 1);
- * IRDM_ENOMEM; IRDM_ENUMERIC (a run not converged in
- * IRDM_KRYLOV_HEAD_MAX_STEPS, or the tridiagonal eigensolve failed);
+ * IRDM_ENOMEM; IRDM_ENUMERIC (a run not converged in o->max_steps, or
+ * the tridiagonal eigensolve failed);
  * err says which.
  */
 int irdm_krylov_head(const struct irdm_fem *fem, const struct irdm_modes *kept,
 		     const struct irdm_rayleigh *damping, double dt_s, const int64_t *col_dofs,
 		     const struct irdm_corr_sparse *corr, const double *target, size_t H,
-		     unsigned threads, irdm_progress_fn progress, void *ctx, double *head,
+		     const struct irdm_krylov_head_opts *o, irdm_progress_fn progress, void *ctx, double *head,
 		     struct irdm_krylov_head_stats *st, char *err, size_t errlen);
 
 #endif

@@ -453,7 +453,8 @@ static const struct irdm_opt scene_opts[] = {
 													       "force error against the exact linear model (every mode, in double) is "
 													       "measured for a step and a release at a few touchable nodes, stored in the "
 													       "image and printed; above E the image is refused.  none neither measures "
-													       "nor checks (the measurement needs every mode: a dense eigensolve) "
+													       "nor checks (the measurement needs every mode, a dense eigensolve, or the "
+													       "Lanczos runs of exact_head with eigensolver = lanczos) "
 													       "(default 1e-3)" },
 	{ .name = "error_columns", .type = IRDM_OPT_ENUM, SC(error_columns), .names = error_columns_names, .help = "where max_error is measured: every touchable node (a grounded object whose "
 														   "every mode is solved: representation = auto or exact_head; about a minute "
