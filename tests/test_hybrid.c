@@ -245,17 +245,8 @@ static void compare(const char *what, const double *u)
 
 static void test_step_release(void **state)
 {
-	double *u = calloc(N_TICKS * 3, sizeof(double));
-
 	(void)state;
-	assert_non_null(u);
-	for (size_t t = 0; t < N_TICKS; t++)
-		u[3 * t + 2] = -0.01;
-	compare("step", u);
-	for (size_t t = RELEASE_TICK; t < N_TICKS; t++)
-		u[3 * t] = u[3 * t + 1] = u[3 * t + 2] = NAN;
-	compare("release", u);
-	free(u);
+	efx_step_release(N_TICKS, RELEASE_TICK, -0.01, compare);
 }
 
 static void test_certified(void **state)

@@ -290,6 +290,21 @@ void efx_reference_w(const double *W, int m, size_t N, const double *target,
 	}
 }
 
+void efx_step_release(size_t N, size_t release, double dz,
+		      void (*check)(const char *what, const double *target))
+{
+	double *u = calloc(N * 3, sizeof(double));
+
+	assert_non_null(u);
+	for (size_t t = 0; t < N; t++)
+		u[3 * t + 2] = dz;
+	check("step", u);
+	for (size_t t = release; t < N; t++)
+		u[3 * t] = u[3 * t + 1] = u[3 * t + 2] = NAN;
+	check("release", u);
+	free(u);
+}
+
 double efx_rel_rms(const double *a, const double *b, size_t n)
 {
 	double d = 0, r = 0;

@@ -81,6 +81,13 @@ const double *efx_column_modal(const struct irdm_image *img, size_t c, double *p
 void efx_corr_block(const struct irdm_image *img, uint32_t col_force, uint32_t col_disp,
 		    double blk[9]);
 
+/* The paper's step and release at a node, N ticks: pressed dz along z
+ * from tick 0, to the end ("step") and released at tick release
+ * ("release"); each target (N x 3, NAN: released) handed to check(what,
+ * target). */
+void efx_step_release(size_t N, size_t release, double dz,
+		      void (*check)(const char *what, const double *target));
+
 /* Image node (row) index nearest to p among the columns. */
 uint32_t efx_column_row_near(const struct irdm_image *img, const double p[3]);
 
