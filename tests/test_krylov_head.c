@@ -238,6 +238,7 @@ static void test_measured(void **state)
 		      rep.error_cols, rep.measured_error, rep.error_worst_run, rep.error_worst_node,
 		      res.error, res.worst_run, res.worst_node,
 		      fabs(rep.measured_error - res.error) / res.error, TOL_FIGURE);
+	assert_string_equal(rep.error_reference, "the kept modes and Lanczos runs");
 	assert_int_equal(rep.error_cols, res.n_cols);
 	assert_int_equal(rep.error_worst_node, res.worst_node);
 	assert_true(res.error > 1e-4); /* a figure, not rounding */
@@ -268,6 +269,8 @@ static void test_scene_refusals(void **state)
 		print_message("%s = %s, %s = %s: %s\n", bad[i][0], bad[i][1], bad[i][2], bad[i][3], err);
 		assert_non_null(strstr(err, "exact_head"));
 		assert_non_null(strstr(err, bad[i][1]));
+		if (i) /* the reason: the key that is not grounded and lumped */
+			assert_non_null(strstr(err, bad[i][3]));
 	}
 }
 

@@ -219,9 +219,12 @@ static void print_report(const struct irdm_scene *sc, const struct irdm_precompu
 		       r->measured_error, r->error_cols, r->error_ticks, r->error_worst_run,
 		       r->error_worst_node, r->error_median, r->error_p90, sc->max_error);
 	else if (r->error_measured)
-		printf("force error   %.3g against the exact model (relative RMS, worst of a step and a release at %zu touchable nodes over %zu ticks, first ticks included; worst: %s at mesh node %u); max_error %g\n",
-		       r->measured_error, r->error_cols, r->error_ticks, r->error_worst_run,
-		       r->error_worst_node, sc->max_error);
+		printf("force error   %.3g against the exact model (%s%srelative RMS, worst of a step and a release at %zu touchable nodes over %zu ticks, first ticks included; worst: %s at mesh node %u); max_error %g\n",
+		       r->measured_error,
+		       r->error_reference && strcmp(r->error_reference, "every mode") ? r->error_reference : "",
+		       r->error_reference && strcmp(r->error_reference, "every mode") ? "; " : "",
+		       r->error_cols, r->error_ticks, r->error_worst_run, r->error_worst_node,
+		       sc->max_error);
 	else
 		printf("force error   not measured (%s)\n",
 		       sc->max_error > 0 ? "over MPI ranks" : "max_error = none");

@@ -30,6 +30,7 @@
  * Run from the repository root.
  */
 #include <math.h>
+#include <stdbool.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -113,6 +114,7 @@ static int ritz_head(const struct kh *k, const double *V, const double *alpha, c
 	double *h = xcalloc(m * k->S, sizeof(double));
 	struct irdm_modes ritz = { .n = 0, .n_modes = m };
 	struct irdm_mode *zoh = xcalloc(m, sizeof(*zoh));
+	bool *spurious = xcalloc(m, sizeof(bool));
 
 	memcpy(d, alpha, m * sizeof(double));
 	memcpy(e, beta, (m - 1) * sizeof(double));
@@ -122,8 +124,12 @@ static int ritz_head(const struct kh *k, const double *V, const double *alpha, c
 		goto out;
 	}
 
-	for (size_t l = 0; l < m; l++)
-		d[l] = d[l] > 0 ? d[l] : 0; /* rounding below the dropped spectrum */
+	/* a Ritz value below the highest kept mode is one of the kept modes
+	 * that rounding brought back: no weight (as modal/krylov_head.c) */
+	for (size_t l = 0; l < m; l++) {
+		spurious[l] = d[l] <= (1 - 1e-6) * k->m.modes.omega2[k->kept - 1];
+		d[l] = spurious[l] ? k->m.modes.omega2[k->kept - 1] : d[l];
+	}
 	ritz.omega2 = d;
 	irdm_modes_discretise(&ritz, &k->m.damping, k->sc.dt_s, zoh);
 	for (size_t l = 0; l < m; l++)
@@ -135,12 +141,13 @@ static int ritz_head(const struct kh *k, const double *V, const double *alpha, c
 
 			for (size_t t = 0; t < m; t++)
 				vq += V[t * k->n + (size_t)dof[i]] * z[l * m + t];
-			vq *= z[l * m] * beta0 * k->dinv[dof[i]];
+			vq *= spurious[l] ? 0.0 : z[l * m] * beta0 * k->dinv[dof[i]];
 			for (size_t s = 0; s < k->S; s++)
 				out[s * 3 + (size_t)i] += vq * h[l * k->S + s];
 		}
 	}
 out:
+	free(spurious);
 	free(d);
 	free(e);
 	free(z);
@@ -246,6 +253,7 @@ static void lanczos_axis(const struct kh *k, const int64_t *dof, int j, double *
 	memset(V, 0, n * sizeof(double));
 	V[dof[j]] = k->dinv[dof[j]];
 	orth_against(k->psi, n, k->kept, V);
+	orth_against(k->psi, n, k->kept, V); /* twice, as the precompute */
 	for (size_t i = 0; i < n; i++)
 		beta0 += V[i] * V[i];
 	beta0 = sqrt(beta0);

@@ -16,11 +16,11 @@
  * whose weight is dropped.  A run is stopped by watching its own block
  * converge; a column's three runs share each pass over K.
  *
- * Runs on A^-1 instead (a solve with K's factor per step, the kept modes
- * projected out at each) needed about 400 steps on the paper's cuboid
- * where these need 1,100, but each step cost about ten times as much
- * there (measured 2026-11-28: 348 s against 90 s for the default scene's
- * head); their steps would not grow with the mesh as these do.
+ * Runs on A^-1 instead (a solve with K's factor per step, the kept
+ * modes, then the top of the spectrum, projected out at each) take fewer
+ * steps, and their number does not grow with the mesh as these do, but
+ * on the paper's cuboid each step cost an order of magnitude more and
+ * the head took longer.
  */
 #include <math.h>
 #include <pthread.h>
@@ -78,10 +78,13 @@ struct kh {
 	double *G;             /* m_max x S */
 	struct irdm_mode *zoh; /* m_max */
 	double *hd;            /* one Ritz value's response: S */
-	/* a run's first check: the last run's check before the one it stopped
-	 * at (the runs of one model converge alike; each check is an
-	 * eigensolve of T, m^2 to m^3) */
+	/* a run's first check: where the first column's runs had their last
+	 * check not within tol (the runs of one model converge alike; each
+	 * check is an eigensolve of T, m^2 to m^3).  Taken from the first
+	 * column alone, before the others start, so that every column's
+	 * result is the same whichever thread runs it. */
 	size_t first_check;
+	size_t hint; /* the last column's: its runs' earliest open check */
 	struct irdm_krylov_head_stats st;
 };
 
@@ -141,8 +144,8 @@ static double dot3(const double *a, const double *b, size_t n, int ax)
 /*
  * After m steps of run u: Y[r + nr s] = rows r0 .. r0 + nr - 1 of
  * beta0 V h_s(T) e1 (R: u's Vr's leading dimension).  The eigenpairs of
- * T by divide and conquer; a Ritz value below the lowest kept mode is
- * rounding (the dropped spectrum lies above it) and is lifted to it.
+ * T by divide and conquer; a Ritz value below the highest kept mode
+ * (SPURIOUS) gets no weight.
  */
 static int ritz_rows(struct kh *k, const struct run *u, size_t R, size_t r0, size_t nr,
 		     double *Y)
@@ -201,8 +204,8 @@ static double rel_change(const double *a, const double *b, size_t S)
 
 /* Is run u done after its m steps (b: the next beta)?  Checked at
  * u->next_check, the next one a quarter further (at least
- * IRDM_KRYLOV_HEAD_CHECK steps), and at the last step allowed; or when
- * the run has found an invariant subspace (b negligible: exact). */
+ * IRDM_KRYLOV_HEAD_CHECK steps); or when the run has found an invariant
+ * subspace (b negligible: exact). */
 static int converged(struct kh *k, struct run *u, double b, size_t R, size_t own)
 {
 	double *swap;
@@ -213,7 +216,7 @@ static int converged(struct kh *k, struct run *u, double b, size_t R, size_t own
 		u->change = 0;
 		return 1;
 	}
-	if (u->m < u->next_check && u->m < k->m_max)
+	if (u->m < u->next_check)
 		return 0;
 	if (ritz_rows(k, u, R, own, 3, u->own))
 		return -1;
@@ -325,10 +328,9 @@ static int run_column(struct kh *k, const int64_t *d0, const int64_t *rdofs, siz
 		if (u->done == 1 && u->open_check && (!hint || u->open_check < hint))
 			hint = u->open_check;
 	}
-	/* the column's earliest: a run that met a transient jump in its
-	 * checks (a Ritz value appearing) does not delay the next ones */
-	if (hint)
-		k->first_check = hint;
+	/* the earliest: a run that met a transient jump in its checks (a
+	 * Ritz value appearing) does not delay the next columns */
+	k->hint = hint;
 	return ret;
 }
 
@@ -552,6 +554,27 @@ static void worker_free(struct worker *w, struct irdm_krylov_head_stats *st)
 	free(w->Y);
 }
 
+/* The first column on this thread, its checks setting every worker's
+ * first check; the pool goes on from the second. */
+static void first_column(struct pool *p, struct worker *w, unsigned nt)
+{
+	size_t c = atomic_fetch_add(&p->next, 1);
+	int ret;
+
+	if (c >= p->corr->n_cols)
+		return;
+	ret = column(&w[0].k, p->corr, p->col_dofs, c, w[0].rdofs, w[0].Y, p->head);
+	if (ret) {
+		p->fail_col = c;
+		p->fail_ret = ret;
+		atomic_store(&p->failed, 1);
+		return;
+	}
+	atomic_fetch_add(&p->done, 1);
+	for (unsigned t = 0; t < nt; t++)
+		w[t].k.first_check = w[0].k.hint > FIRST_CHECK ? w[0].k.hint : FIRST_CHECK;
+}
+
 /* The columns' runs over nt threads. */
 static int run_pool(struct pool *p, struct worker *w, unsigned nt, irdm_progress_fn progress,
 		    void *ctx, char *err, size_t errlen)
@@ -562,7 +585,8 @@ static int run_pool(struct pool *p, struct worker *w, unsigned nt, irdm_progress
 
 	/* one thread per run: OpenBLAS's own threads would oversubscribe */
 	blas = irdm_blas_serial_begin();
-	for (unsigned t = 0; t < nt && !ret; t++, started++)
+	first_column(p, w, nt);
+	for (unsigned t = 0; t < nt && !ret && !atomic_load(&p->failed); t++, started++)
 		if (pthread_create(&th[t], NULL, work, &w[t])) {
 			atomic_store(&p->failed, 1);
 			snprintf(err, errlen, "krylov head: cannot start a thread");

@@ -260,6 +260,11 @@ static int modal_data(struct build *b, char *err, size_t errlen)
 	bool hybrid = b->sc->exact_head && b->sc->representation == IRDM_REPR_MODAL;
 	int ret;
 
+	if (hybrid && b->sc->modes >= b->m.modes.n_elastic_total) {
+		snprintf(err, errlen, "scene: exact_head needs dropped modes, but modal:%u keeps all %zu",
+			 b->sc->modes, b->m.modes.n_elastic_total);
+		return IRDM_EINVAL;
+	}
 	if (hybrid && b->m.modes.n_modes > b->sc->modes) {
 		ret = split_modes(b, &zoh_all, &n_all, err, errlen);
 		if (ret)
@@ -1354,7 +1359,7 @@ static int within_target_pairs(const struct build *b, const struct irdm_precompu
 		return IRDM_OK;
 	repr_text(b->sc, repr, sizeof(repr));
 	if (!rep->pairs_measured) {
-		snprintf(err, errlen, "precompute: scene %s: contacts = %u, but two contacts at once were not measured on %s: they need every mode of a grounded object solved (representation = auto, or modal:K with exact_head), two touchable nodes, and one process (not MPI ranks)",
+		snprintf(err, errlen, "precompute: scene %s: contacts = %u, but two contacts at once were not measured on %s: they need every mode of a grounded object solved (representation = auto, or modal:K with exact_head from every mode: not eigensolver = lanczos), two touchable nodes, and one process (not MPI ranks)",
 			 b->sc->name, b->sc->contacts, repr);
 		return IRDM_ENUMERIC;
 	}
@@ -1486,7 +1491,7 @@ static int scan(struct build *b, const struct irdm_image *img, struct irdm_preco
 
 	all.n_modes = b->n_solved;
 	if (!all_modes(b) || b->sc->floating) {
-		snprintf(err, errlen, "precompute: error_columns = every needs a grounded object whose every mode is solved (representation = auto or exact_head); %s",
+		snprintf(err, errlen, "precompute: error_columns = every needs a grounded object whose every mode is solved (representation = auto, or exact_head without eigensolver = lanczos); %s",
 			 b->sc->floating ? "this one floats" : "this build solved some of them");
 		return ret;
 	}
@@ -1596,6 +1601,8 @@ static int measure(struct build *b, struct irdm_precompute_report *rep, char *er
 		snprintf(err, errlen, "precompute: out of memory");
 		goto out_free;
 	}
+	rep->error_reference = krylov_hybrid(b) && !all_modes(b) ? "the kept modes and Lanczos runs" :
+								   "every mode";
 	snprintf(tmp, n, "%s.unmeasured", out);
 	snprintf(ref, n, "%s.exact", out);
 	ret = write_image(b, tmp, &bytes, err, errlen);
