@@ -3,10 +3,13 @@
  * The hybrid's head without every mode (eigensolver = lanczos with
  * exact_head: modal/krylov_head.h) against the head summed from every
  * mode of a dense eigensolve, on the paper's cuboid at 4 x 4 x 8 hexes
- * (600 elastic modes), 2 ms, the top face touchable, the lowest 200 modes
+ * (600 elastic modes), 2 ms, the top face touchable, the lowest 101 modes
  * kept and a 64-sample head, f64:
  *  - the precompute took the Krylov path: one Lanczos run per touchable
  *    DoF, and only the kept modes solved (ARPACK, not a dense solve);
+ *  - the head is the same bit for bit built by one thread or two (here
+ *    the runs stop alike either way: that a column's checks do not depend
+ *    on the thread's earlier columns is by construction, not shown);
  *  - every kept block's response over the head's 2H samples (kept modes,
  *    static correction and head, as the image holds them) is the
  *    every-mode hybrid's to the runs' convergence;
@@ -44,17 +47,20 @@
 
 /*
  * Limits, measured 2026-11-28 (gcc -O2): the kept blocks' responses over
- * 2H samples 6.5e-13 of max |R| apart (limit 1e-11: the runs converge to
- * rounding on this model, whose 400 dropped modes the Lanczos runs
- * exhaust; the kept modes come from two eigensolvers); forces 1.6e-13
- * (step) and 9.7e-14 (release) relative RMS apart (limit 1e-11).  The
- * hybrid itself is 6.3e-3 off the exact model here (test_hybrid holds
- * the hybrid to the exact model).
+ * 2H samples 9.1e-11 of max |R| apart (limit 1e-9: each run stops when
+ * its rows move by less than 1e-8 between two checks, and the kept modes
+ * come from two eigensolvers); forces at the top centre 1.6e-13 (step)
+ * and 9.7e-14 (release) relative RMS apart (limit 1e-11).  101 modes,
+ * not 100: modes 100 and 101 are a pair of one frequency (the cuboid's
+ * x <-> y mirror), and two eigensolvers may split such a pair
+ * differently, which moves blocks by 5.9e-4 while leaving the forces
+ * alike.  The hybrid itself is 2.4e-2 off the exact model here
+ * (test_hybrid holds a hybrid to the exact model).
  */
-#define TOL_R 1e-11
+#define TOL_R 1e-9
 #define TOL_FORCE 1e-11
 /* The figure against Lanczos runs (converged to 1e-6 of the response, a
- * reference's tolerance) and against every mode: 0.00244 both, 1.6e-9
+ * reference's tolerance) and against every mode: 0.0245 both, 2.5e-12
  * relative apart (limit 1e-8). */
 #define TOL_FIGURE 1e-8
 
@@ -63,7 +69,7 @@ static struct irdm_image dense, krylov;
 static size_t krylov_runs, krylov_lines;
 
 static const char *const keys[] = { "resolution", "4,4,8", "touch", "z>=0.2", "display", "z>=0.2",
-				    "dt", "0.002", "precision", "f64", "representation", "modal:200",
+				    "dt", "0.002", "precision", "f64", "representation", "modal:101",
 				    "exact_head", "64", "max_error", "none" };
 #define N_KEYS (sizeof(keys) / sizeof(keys[0]))
 
@@ -77,20 +83,27 @@ static void progress(void *ctx, const char *stage, double fraction)
 	}
 }
 
-static void build(struct irdm_image *img, const char *method, struct irdm_precompute_report *rep)
+static void build_threads(struct irdm_image *img, const char *method, const char *threads,
+			  struct irdm_precompute_report *rep)
 {
 	struct irdm_scene sc;
 	char path[128], err[512] = "";
 	struct irdm_precompute_opts o = { .out_path = path, .progress = progress };
 
-	snprintf(path, sizeof(path), "%s/%s.img", dir, method);
+	snprintf(path, sizeof(path), "%s/%s-%s.img", dir, method, threads);
 	irdm_scene_defaults(&sc);
 	for (size_t i = 0; i < N_KEYS; i += 2)
 		assert_int_equal(irdm_scene_set(&sc, keys[i], keys[i + 1], "test", err, sizeof(err)), 0);
 	assert_int_equal(irdm_scene_set(&sc, "eigensolver", method, "test", err, sizeof(err)), 0);
+	assert_int_equal(irdm_scene_set(&sc, "threads", threads, "test", err, sizeof(err)), 0);
 	if (irdm_precompute(&sc, &o, rep, err, sizeof(err)))
 		fail_msg("%s: %s", method, err);
 	assert_int_equal(irdm_image_map(path, 0, img, err, sizeof(err)), 0);
+}
+
+static void build(struct irdm_image *img, const char *method, struct irdm_precompute_report *rep)
+{
+	build_threads(img, method, "2", rep);
 }
 
 static int setup(void **state)
@@ -127,7 +140,7 @@ static void test_krylov_path(void **state)
 	print_message("Krylov head: %zu runs for %u columns\n", krylov_runs, krylov.meta->n_cols);
 	assert_int_equal(krylov_lines, 1);
 	assert_int_equal(krylov_runs, 3 * (size_t)krylov.meta->n_cols);
-	assert_int_equal(krylov.meta->n_modes, 200);
+	assert_int_equal(krylov.meta->n_modes, 101);
 	assert_int_equal(krylov.meta->head_samples, 128);
 	assert_int_equal(krylov.meta->n_cols, dense.meta->n_cols);
 }
@@ -163,6 +176,28 @@ static void test_blocks_match(void **state)
 	assert_true(worst <= TOL_R * scale);
 	free(a);
 	free(b);
+}
+
+/* The head is the same bit for bit whichever thread builds a column: each
+ * run's checks start where the first column's needed them, and that
+ * column runs alone first. */
+static void test_threads_alike(void **state)
+{
+	struct irdm_precompute_report rep;
+	struct irdm_image one;
+	size_t n;
+
+	(void)state;
+	build_threads(&one, "lanczos", "1", &rep);
+	n = (size_t)krylov.meta->head_samples * 9 *
+	    (krylov.meta->flags & IRDM_META_HEAD_PAIRS ? (krylov.corr_start[krylov.meta->n_cols] + krylov.meta->n_cols) / 2 :
+							 krylov.corr_start[krylov.meta->n_cols]);
+	print_message("one thread against two: %zu head values compared\n", n);
+	assert_int_equal(one.meta->head_samples, krylov.meta->head_samples);
+	assert_int_equal(one.corr_start[one.meta->n_cols], krylov.corr_start[krylov.meta->n_cols]);
+	assert_memory_equal(one.exact_head, krylov.exact_head,
+			    n * irdm_elem_size(krylov.meta->precision));
+	irdm_image_unmap(&one);
 }
 
 static void forces(const struct irdm_image *img, const double *u, double *F)
@@ -226,7 +261,7 @@ static void test_measured(void **state)
 	for (size_t i = 0; i < N_KEYS; i += 2)
 		assert_int_equal(irdm_scene_set(&sc, keys[i], keys[i + 1], "test", err, sizeof(err)), 0);
 	assert_int_equal(irdm_scene_set(&sc, "eigensolver", "lanczos", "test", err, sizeof(err)), 0);
-	assert_int_equal(irdm_scene_set(&sc, "max_error", "0.01", "test", err, sizeof(err)), 0);
+	assert_int_equal(irdm_scene_set(&sc, "max_error", "0.1", "test", err, sizeof(err)), 0);
 	if (irdm_precompute(&sc, &o, &rep, err, sizeof(err)))
 		fail_msg("%s", err);
 	assert_true(rep.error_measured);
@@ -260,7 +295,7 @@ static void test_scene_refusals(void **state)
 		struct irdm_scene sc;
 
 		irdm_scene_defaults(&sc);
-		assert_int_equal(irdm_scene_set(&sc, "representation", "modal:200", "test", err, sizeof(err)), 0);
+		assert_int_equal(irdm_scene_set(&sc, "representation", "modal:101", "test", err, sizeof(err)), 0);
 		assert_int_equal(irdm_scene_set(&sc, "exact_head", "16", "test", err, sizeof(err)), 0);
 		assert_int_equal(irdm_scene_set(&sc, bad[i][0], bad[i][1], "test", err, sizeof(err)), 0);
 		assert_int_equal(irdm_scene_set(&sc, bad[i][2], bad[i][3], "test", err, sizeof(err)), 0);
@@ -279,6 +314,7 @@ int main(void)
 	const struct CMUnitTest tests[] = {
 		cmocka_unit_test(test_krylov_path),
 		cmocka_unit_test(test_blocks_match),
+		cmocka_unit_test(test_threads_alike),
 		cmocka_unit_test(test_forces_certified),
 		cmocka_unit_test(test_measured),
 		cmocka_unit_test(test_scene_refusals),

@@ -13,8 +13,9 @@
  * reorthogonalisation but at a cost linear in m instead of quadratic.
  * Only the start vector is projected off the kept modes: what rounding
  * brings back of them shows as Ritz values below the dropped spectrum,
- * whose weight is dropped.  A run is stopped by watching its own block
- * converge; a column's three runs share each pass over K.
+ * whose weight is dropped.  A run is stopped by watching its rows (its
+ * column's blocks) converge; a column's three runs share each pass over
+ * K.
  *
  * Runs on A^-1 instead (a solve with K's factor per step, the kept
  * modes, then the top of the spectrum, projected out at each) take fewer
@@ -49,12 +50,12 @@
 struct run {
 	double beta0, b_prev, change;
 	size_t m;
-	size_t next_check;      /* the step of its next check */
-	size_t open_check;      /* its last check not within tol (0: none yet) */
-	int done;               /* 1 converged, -1 failed, 0 running */
-	double *alpha, *beta;   /* m_max each */
-	double *Vr;             /* its vectors at the rows asked: R x m_max */
-	double *own, *own_prev; /* its own block's column at the last two checks: 3 x S */
+	size_t next_check;    /* the step of its next check */
+	size_t open_check;    /* its last check not within tol (0: none yet) */
+	int done;             /* 1 converged, -1 failed, 0 running */
+	double *alpha, *beta; /* m_max each */
+	double *Vr;           /* its vectors at the rows asked: R x m_max */
+	double *cur, *prev;   /* its rows' responses at the last two checks: R x S */
 };
 
 struct kh {
@@ -173,7 +174,7 @@ static int ritz_rows(struct kh *k, const struct run *u, size_t R, size_t r0, siz
 			k->hs[s * m + l] = g * k->hd[s];
 	}
 	/* Y = V_rows Q hs, the cheaper way round: many rows (a column's
-	 * blocks) make Q hs first (m x S), a few (its own block) V_rows Q */
+	 * blocks) make Q hs first (m x S), a few V_rows Q first */
 	if (nr > k->S) {
 		dgemm_("N", "N", &mi, &Si, &mi, &one, k->z, &mi, k->hs, &mi, &zero, k->G, &mi);
 		dgemm_("N", "N", &nri, &Si, &mi, &one, &u->Vr[r0], &Ri, k->G, &mi, &zero, Y, &nri);
@@ -184,17 +185,19 @@ static int ritz_rows(struct kh *k, const struct run *u, size_t R, size_t r0, siz
 	return 0;
 }
 
-/* max_s |a_s - b_s| / max_s |a_s| over 3 x S values */
-static double rel_change(const double *a, const double *b, size_t S)
+/* max_s |a_s - b_s| / max_s |a_s|, a_s the nr rows of sample s */
+static double rel_change(const double *a, const double *b, size_t nr, size_t S)
 {
 	double num = 0, den = 0;
 
 	for (size_t s = 0; s < S; s++) {
 		double dn = 0, dd = 0;
 
-		for (int i = 0; i < 3; i++) {
-			dn += (a[3 * s + (size_t)i] - b[3 * s + (size_t)i]) * (a[3 * s + (size_t)i] - b[3 * s + (size_t)i]);
-			dd += a[3 * s + (size_t)i] * a[3 * s + (size_t)i];
+		for (size_t r = 0; r < nr; r++) {
+			double x = a[r + nr * s], y = b[r + nr * s];
+
+			dn += (x - y) * (x - y);
+			dd += x * x;
 		}
 		num = fmax(num, dn);
 		den = fmax(den, dd);
@@ -202,31 +205,32 @@ static double rel_change(const double *a, const double *b, size_t S)
 	return den > 0 ? sqrt(num / den) : 0;
 }
 
-/* Is run u done after its m steps (b: the next beta)?  Checked at
+/*
+ * Is run u done after its m steps (b: the next beta)?  Checked at
  * u->next_check, the next one a quarter further (at least
- * IRDM_KRYLOV_HEAD_CHECK steps); or when the run has found an invariant
- * subspace (b negligible: exact). */
-static int converged(struct kh *k, struct run *u, double b, size_t R, size_t own)
+ * IRDM_KRYLOV_HEAD_CHECK steps), on every row of the column's blocks (an
+ * off-diagonal block can converge later than the column's own); or when
+ * the run has found an invariant subspace (b negligible: exact).  Its
+ * rows' responses at the last check are in u->prev.
+ */
+static int converged(struct kh *k, struct run *u, double b, size_t R)
 {
 	double *swap;
 	bool exact = !(b > 1e-13 * fabs(u->alpha[u->m - 1]));
 	size_t gap = u->m / 4 > IRDM_KRYLOV_HEAD_CHECK ? u->m / 4 : IRDM_KRYLOV_HEAD_CHECK;
 
-	if (exact) {
-		u->change = 0;
-		return 1;
-	}
-	if (u->m < u->next_check)
+	if (!exact && u->m < u->next_check)
 		return 0;
-	if (ritz_rows(k, u, R, own, 3, u->own))
+	if (ritz_rows(k, u, R, 0, R, u->cur))
 		return -1;
-	u->change = u->open_check ? rel_change(u->own, u->own_prev, k->S) : INFINITY;
+	u->change = exact ? 0 : u->open_check ? rel_change(u->cur, u->prev, R, k->S) :
+						INFINITY;
 	u->next_check = u->m + gap;
 	if (u->change >= k->tol)
 		u->open_check = u->m;
-	swap = u->own;
-	u->own = u->own_prev;
-	u->own_prev = swap;
+	swap = u->cur;
+	u->cur = u->prev;
+	u->prev = swap;
 	return u->change < k->tol;
 }
 
@@ -262,7 +266,7 @@ static void start(struct kh *k, int ax, int64_t d0)
 
 /* One step of run ax after w = A v: its coefficients, its check, its next
  * vector in w's lane. */
-static void step(struct kh *k, int ax, size_t R, size_t own)
+static void step(struct kh *k, int ax, size_t R)
 {
 	struct run *u = &k->run[ax];
 	double *v = k->v, *vp = k->vp, *w = k->w, a, b;
@@ -273,7 +277,7 @@ static void step(struct kh *k, int ax, size_t R, size_t own)
 		w[3 * i + x] -= a * v[3 * i + x] + u->b_prev * vp[3 * i + x];
 	b = sqrt(dot3(w, w, n, ax));
 	u->alpha[u->m++] = a;
-	u->done = converged(k, u, b, R, own);
+	u->done = converged(k, u, b, R);
 	if (u->done) {
 		for (size_t i = 0; i < n; i++)
 			w[3 * i + x] = 0.0; /* its lane rests */
@@ -287,11 +291,11 @@ static void step(struct kh *k, int ax, size_t R, size_t own)
 
 /*
  * The three runs of a column from its free DoFs d0[0..2] side by side,
- * their vectors kept at rdofs[0..R-1] (the column's own three rows at
- * own), until each is done or k->m_max steps.
+ * their vectors kept at rdofs[0..R-1], until each is done or k->m_max
+ * steps.
  * Return: 0; IRDM_ENUMERIC one not converged or LAPACK failed.
  */
-static int run_column(struct kh *k, const int64_t *d0, const int64_t *rdofs, size_t R, size_t own)
+static int run_column(struct kh *k, const int64_t *d0, const int64_t *rdofs, size_t R)
 {
 	size_t steps = 0, hint = 0;
 	int ret = 0;
@@ -308,7 +312,7 @@ static int run_column(struct kh *k, const int64_t *d0, const int64_t *rdofs, siz
 		apply_a3(k, k->v, k->w);
 		for (int ax = 0; ax < 3; ax++)
 			if (!k->run[ax].done)
-				step(k, ax, R, own);
+				step(k, ax, R);
 		tmp = k->vp;
 		k->vp = k->v;
 		k->v = k->w;
@@ -334,9 +338,10 @@ static int run_column(struct kh *k, const int64_t *d0, const int64_t *rdofs, siz
 	return ret;
 }
 
-/* Column c's blocks from its first computed one: its three runs. */
+/* Column c's blocks from its first computed one: its three runs, each
+ * read from its last check. */
 static int column(struct kh *k, const struct irdm_corr_sparse *corr, const int64_t *col_dofs,
-		  size_t c, int64_t *rdofs, double *Y, double *head)
+		  size_t c, int64_t *rdofs, double *head)
 {
 	uint32_t k0 = irdm_head_upper_begin(corr, c), nb = corr->start[c + 1] - k0;
 	long kd = irdm_corr_sparse_find(corr, c, (uint32_t)c);
@@ -348,19 +353,17 @@ static int column(struct kh *k, const struct irdm_corr_sparse *corr, const int64
 	for (uint32_t b = 0; b < nb; b++)
 		for (int i = 0; i < 3; i++)
 			rdofs[3 * b + (uint32_t)i] = col_dofs[3 * (size_t)corr->rows[k0 + b] + (size_t)i];
-	ret = run_column(k, &col_dofs[3 * c], rdofs, R, 3 * (size_t)(kd - k0));
+	ret = run_column(k, &col_dofs[3 * c], rdofs, R);
 	for (int j = 0; !ret && j < 3; j++) {
 		const struct run *u = &k->run[j];
 
-		if (u->m && ritz_rows(k, u, R, 0, R, Y))
-			return IRDM_ENUMERIC;
 		for (uint32_t b = 0; b < nb; b++)
 			for (size_t s = 0; s < S; s++)
 				for (int i = 0; i < 3; i++) {
 					int64_t r = rdofs[3 * b + (uint32_t)i];
 
 					head[((size_t)(k0 + b) * S + s) * 9 + 3 * (size_t)i + (size_t)j] =
-						!u->m || r < 0 ? 0.0 : k->dinv[r] * Y[3 * b + (size_t)i + R * s];
+						!u->m || r < 0 ? 0.0 : k->dinv[r] * u->prev[3 * b + (size_t)i + R * s];
 				}
 	}
 	return ret;
@@ -380,8 +383,8 @@ static void kh_free(struct kh *k)
 		free(k->run[ax].alpha);
 		free(k->run[ax].beta);
 		free(k->run[ax].Vr);
-		free(k->run[ax].own);
-		free(k->run[ax].own_prev);
+		free(k->run[ax].cur);
+		free(k->run[ax].prev);
 	}
 	free(k->d);
 	free(k->e);
@@ -416,9 +419,9 @@ static int kh_alloc(struct kh *k, size_t R_max)
 		u->alpha = malloc(m * sizeof(double));
 		u->beta = malloc(m * sizeof(double));
 		u->Vr = malloc(R_max * m * sizeof(double));
-		u->own = malloc(3 * S * sizeof(double));
-		u->own_prev = malloc(3 * S * sizeof(double));
-		ok = ok && u->alpha && u->beta && u->Vr && u->own && u->own_prev;
+		u->cur = malloc(R_max * S * sizeof(double));
+		u->prev = malloc(R_max * S * sizeof(double));
+		ok = ok && u->alpha && u->beta && u->Vr && u->cur && u->prev;
 	}
 	k->d = malloc(m * sizeof(double));
 	k->e = malloc(m * sizeof(double));
@@ -466,7 +469,6 @@ struct worker {
 	struct kh k;
 	struct pool *p;
 	int64_t *rdofs;
-	double *Y;
 };
 
 static void *work(void *arg)
@@ -480,7 +482,7 @@ static void *work(void *arg)
 
 		if (c >= p->corr->n_cols)
 			break;
-		ret = column(&w->k, p->corr, p->col_dofs, c, w->rdofs, w->Y, p->head);
+		ret = column(&w->k, p->corr, p->col_dofs, c, w->rdofs, p->head);
 		if (ret) {
 			pthread_mutex_lock(&p->lock);
 			if (!atomic_load(&p->failed)) {
@@ -541,8 +543,7 @@ static int worker_init(struct worker *w, struct pool *p, const struct kh_in *in,
 	w->k = (struct kh){ .fem = in->fem, .kept = in->kept, .damp = in->damp, .dt = in->dt, .n = in->fem->K.n, .S = in->S, .m_max = in->o->max_steps, .tol = in->o->tol, .first_check = FIRST_CHECK };
 	w->p = p;
 	w->rdofs = malloc(R_max * sizeof(int64_t));
-	w->Y = malloc(R_max * in->S * sizeof(double));
-	return kh_alloc(&w->k, R_max) || !w->rdofs || !w->Y ? IRDM_ENOMEM : 0;
+	return kh_alloc(&w->k, R_max) || !w->rdofs ? IRDM_ENOMEM : 0;
 }
 
 static void worker_free(struct worker *w, struct irdm_krylov_head_stats *st)
@@ -551,7 +552,6 @@ static void worker_free(struct worker *w, struct irdm_krylov_head_stats *st)
 		merge_stats(st, &w->k.st);
 	kh_free(&w->k);
 	free(w->rdofs);
-	free(w->Y);
 }
 
 /* The first column on this thread, its checks setting every worker's
@@ -563,7 +563,7 @@ static void first_column(struct pool *p, struct worker *w, unsigned nt)
 
 	if (c >= p->corr->n_cols)
 		return;
-	ret = column(&w[0].k, p->corr, p->col_dofs, c, w[0].rdofs, w[0].Y, p->head);
+	ret = column(&w[0].k, p->corr, p->col_dofs, c, w[0].rdofs, p->head);
 	if (ret) {
 		p->fail_col = c;
 		p->fail_ret = ret;

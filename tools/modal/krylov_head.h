@@ -15,9 +15,10 @@
 #include "modal/modal.h"
 #include "modal/static_sparse.h"
 
-/* A run stops when its column's own block moved by less than tol,
- * relative to the block, between two checks (a quarter of the steps
- * apart, at least IRDM_KRYLOV_HEAD_CHECK); these are an image head's. */
+/* A run stops when its rows (every row of its column's blocks) moved by
+ * less than tol, relative to them, between two checks (a quarter of the
+ * steps apart, at least IRDM_KRYLOV_HEAD_CHECK); these are an image
+ * head's. */
 #define IRDM_KRYLOV_HEAD_TOL 1e-8
 #define IRDM_KRYLOV_HEAD_CHECK 100
 #define IRDM_KRYLOV_HEAD_MAX_STEPS 4000
@@ -32,7 +33,7 @@ struct irdm_krylov_head_stats {
 	size_t runs;        /* one per column axis (none at a fixed DoF) */
 	size_t steps_max;   /* the longest run's steps */
 	size_t steps_sum;   /* all runs' */
-	double last_change; /* the largest last relative change of a run */
+	double last_change; /* the largest last relative change of a run's rows */
 };
 
 /*

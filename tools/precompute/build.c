@@ -144,7 +144,7 @@ static int krylov_head(struct build *b, const double *target, char *err, size_t 
 			       b->head, &st, err, errlen);
 	if (ret || !b->o->progress)
 		return ret;
-	snprintf(line, sizeof(line), "krylov head: %zu Lanczos runs of %zu steps on average, at most %zu; each stopped when its own block moved by %.2g at most between its last two checks",
+	snprintf(line, sizeof(line), "krylov head: %zu Lanczos runs of %zu steps on average, at most %zu; each stopped when its rows moved by %.2g at most between its last two checks",
 		 st.runs, st.runs ? st.steps_sum / st.runs : 0, st.steps_max, st.last_change);
 	b->o->progress(b->o->ctx, line, -1.0);
 	return IRDM_OK;
