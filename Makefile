@@ -42,8 +42,7 @@
 #   make scale      the default scene at the paper's mesh and at 11,340
 #                   nodes, its every-mode eigensolve split by symmetry,
 #                   then with the head from Lanczos runs at the paper's
-#                   mesh and at about 20,000 nodes
-#                   (docs/measurements/scale.md)
+#                   mesh (docs/measurements/scale.md)
 #   make format-check  every C source and header against .clang-format
 #                   (clang-format 14); make format rewrites them
 #

@@ -2,14 +2,14 @@
 # The default scene (the paper's cuboid, top face touchable, every key at
 # its default: representation = auto, max_error = 1e-3) at finer meshes:
 # how far the every-mode dense eigensolve, split by the mesh's symmetries
-# (docs/precompute.md), carries the default target; then, past it, a
-# hybrid whose head comes from Lanczos runs (eigensolver = lanczos, its
-# kept modes and head named, measured against max_error as the default
-# asks).  Prints a Markdown table; the logs and images stay in out/scale/.
+# (docs/precompute.md), carries the default target; then a hybrid whose
+# head comes from Lanczos runs (eigensolver = lanczos, its kept modes and
+# head named, measured against max_error as the default asks).  Prints a Markdown table; the logs and images stay in out/scale/.
 #   tools/scripts/scale.sh [IRDM] [RES ...]   (RES: NX,NY,NZ; default the
 #   paper's 11,11,22 and 17,17,34)
-#   SCALE_KRYLOV='RES:K:H ...' (default 11,11,22:275:128 and
-#   21,21,42:350:128; empty: none) the Lanczos rows
+#   SCALE_KRYLOV='RES:K:H ...' (default 11,11,22:275:128; empty: none)
+#   the Lanczos rows (21,21,42:350:128, 20,812 nodes, is refused: a run
+#   does not settle within the steps allowed)
 set -euo pipefail
 irdm=${1:-build/irdm}
 shift || true
@@ -52,7 +52,7 @@ row() {
 for r in "${res[@]}"; do
 	row "$r" "cuboid-$r" ""
 done
-krylov=${SCALE_KRYLOV-11,11,22:275:128 21,21,42:350:128}
+krylov=${SCALE_KRYLOV-11,11,22:275:128}
 [ -n "$krylov" ] || exit 0
 for spec in $krylov; do
 	IFS=: read -r r k h <<<"$spec"
