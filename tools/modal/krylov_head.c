@@ -143,15 +143,13 @@ static double dot3(const double *a, const double *b, size_t n, int ax)
 }
 
 /*
- * After m steps of run u: Y[r + nr s] = rows r0 .. r0 + nr - 1 of
- * beta0 V h_s(T) e1 (R: u's Vr's leading dimension).  The eigenpairs of
- * T by divide and conquer; a Ritz value below the highest kept mode
- * (SPURIOUS) gets no weight.
+ * After m steps of run u: Y[r + R s] = row r of beta0 V h_s(T) e1, its R
+ * rows.  The eigenpairs of T by divide and conquer; a Ritz value below
+ * the highest kept mode (SPURIOUS) gets no weight.
  */
-static int ritz_rows(struct kh *k, const struct run *u, size_t R, size_t r0, size_t nr,
-		     double *Y)
+static int ritz_rows(struct kh *k, const struct run *u, size_t R, double *Y)
 {
-	int mi = (int)u->m, info, nri = (int)nr, Si = (int)k->S, Ri = (int)R;
+	int mi = (int)u->m, info, Si = (int)k->S, Ri = (int)R;
 	size_t m = u->m;
 	double one = 1.0, zero = 0.0;
 	struct irdm_modes ritz = { .n = 0, .n_modes = m, .omega2 = k->d };
@@ -175,13 +173,13 @@ static int ritz_rows(struct kh *k, const struct run *u, size_t R, size_t r0, siz
 	}
 	/* Y = V_rows Q hs, the cheaper way round: many rows (a column's
 	 * blocks) make Q hs first (m x S), a few V_rows Q first */
-	if (nr > k->S) {
+	if (R > k->S) {
 		dgemm_("N", "N", &mi, &Si, &mi, &one, k->z, &mi, k->hs, &mi, &zero, k->G, &mi);
-		dgemm_("N", "N", &nri, &Si, &mi, &one, &u->Vr[r0], &Ri, k->G, &mi, &zero, Y, &nri);
+		dgemm_("N", "N", &Ri, &Si, &mi, &one, u->Vr, &Ri, k->G, &mi, &zero, Y, &Ri);
 		return 0;
 	}
-	dgemm_("N", "N", &nri, &mi, &mi, &one, &u->Vr[r0], &Ri, k->z, &mi, &zero, k->W, &nri);
-	dgemm_("N", "N", &nri, &Si, &mi, &one, k->W, &nri, k->hs, &mi, &zero, Y, &nri);
+	dgemm_("N", "N", &Ri, &mi, &mi, &one, u->Vr, &Ri, k->z, &mi, &zero, k->W, &Ri);
+	dgemm_("N", "N", &Ri, &Si, &mi, &one, k->W, &Ri, k->hs, &mi, &zero, Y, &Ri);
 	return 0;
 }
 
@@ -221,7 +219,7 @@ static int converged(struct kh *k, struct run *u, double b, size_t R)
 
 	if (!exact && u->m < u->next_check)
 		return 0;
-	if (ritz_rows(k, u, R, 0, R, u->cur))
+	if (ritz_rows(k, u, R, u->cur))
 		return -1;
 	u->change = exact ? 0 : u->open_check ? rel_change(u->cur, u->prev, R, k->S) :
 						INFINITY;
