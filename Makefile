@@ -41,8 +41,9 @@
 #                   docs/measurements/error-targets.md)
 #   make scale      the default scene at the paper's mesh and at 11,340
 #                   nodes, its every-mode eigensolve split by symmetry,
-#                   then with the head from Lanczos runs at the paper's
-#                   mesh (docs/measurements/scale.md)
+#                   then with the head from Chebyshev series at the
+#                   paper's mesh and at 20,812 nodes
+#                   (docs/measurements/scale.md)
 #   make format-check  every C source and header against .clang-format
 #                   (clang-format 14); make format rewrites them
 #
@@ -487,7 +488,7 @@ report: $(IRDM)
 
 # The default scene at finer meshes (tools/scripts/scale.sh): how far the
 # symmetric split of the every-mode eigensolve carries the default target,
-# and the head from Lanczos runs past it; figures to
+# and the head from Chebyshev series past it; figures to
 # docs/measurements/scale.md.
 scale: $(IRDM)
 	$(MEASURE) -m scale 'make scale' -- tools/scripts/scale.sh $(IRDM)

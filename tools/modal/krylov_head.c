@@ -1,28 +1,32 @@
 /* SPDX-License-Identifier: MIT */
 /*
- * The dropped modes' head from Lanczos runs.  The head is a function of
- * the stiffness: each dropped mode's response h_s(w^2) weighted by its
- * shape at two columns.  A Lanczos run of m steps on A = M^-1/2 K M^-1/2
- * from P M^-1/2 e_j (P: off the kept modes) gives h_s(A) of that vector
- * for every sample s at once, as beta0 V h_s(T) e1 with T the run's
- * tridiagonal matrix: m products with K, no dense eigensolve.
+ * The dropped modes' head from Chebyshev expansions.  The head is a
+ * function of the stiffness: each dropped mode's response h_s(w^2)
+ * weighted by its shape at two columns, i.e. h_s(A) with
+ * A = M^-1/2 K M^-1/2 applied to P M^-1/2 e_j (P: off the kept modes).
+ * On [0, lam_up], lam_up above the spectrum, h_s is entire in the
+ * eigenvalue, and its Chebyshev series
+ *   h_s(A) b = sum_k c_k(s) T_k(2 A / lam_up - 1) b
+ * converges once k passes about w_max t / 2 (t = s dt: the series of
+ * cos(w t) in T_k(x) are Bessel functions J_2k(w_max t)).  So one
+ * three-term recurrence per start vector gives every sample at once, and:
+ *  - the degree is known before any product with K, from the
+ *    coefficients alone, with a bound on what the truncation leaves
+ *    (sum of |c_k| past it, since |T_k| <= 1 on the spectrum); no
+ *    run-time check, no tridiagonal eigensolve;
+ *  - every run has the same length, so many columns share each pass over
+ *    K (a batch), and a column's result does not depend on its batch
+ *    mates or its thread (no inner products between lanes);
+ *  - rounding cannot grow: |T_k| <= 1, and the kept modes that rounding
+ *    brings back get h_s at their eigenvalue, times that rounding.
+ * lam_up is Gershgorin's bound, which holds for any matrix; an eigenvalue
+ * above it would make the recurrence grow, which is checked.
  *
- * The plain recurrence is used, without reorthogonalisation: the Ritz
- * values it repeats ("ghosts") carry the weights of the values they copy,
- * so h_s(T) e1 still converges, a few hundred steps later than with full
- * reorthogonalisation but at a cost linear in m instead of quadratic.
- * Only the start vector is projected off the kept modes: what rounding
- * brings back of them shows as Ritz values below the dropped spectrum,
- * whose weight is dropped.  A run is stopped by watching its rows (its
- * column's blocks) converge; a column's three runs share each pass over
- * K.
- *
- * Runs on A^-1 instead (a solve with K's factor per step, the kept
- * modes, then the top of the spectrum, projected out at each) take fewer
- * steps, and their number does not grow with the mesh as these do, but
- * on the paper's cuboid each step cost an order of magnitude more and
- * the head took longer.
+ * A Lanczos run adapts to the start vector's spectrum and needs a little
+ * fewer steps, but its stopping is a heuristic, its ghosts must be
+ * filtered and each check is an eigensolve of its tridiagonal matrix.
  */
+#include <complex.h>
 #include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
@@ -33,441 +37,399 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "fem/fem.h"
+#include "modal/fft.h"
 #include "modal/head_layout.h"
 #include "modal/krylov_head.h"
 #include "modal/lapack.h"
-#include "modal/response.h"
 
-#define FIRST_CHECK 200 /* no run converges sooner on a model worth this */
 #define KH_THREADS_MAX 64
-/* A Ritz value this far below the highest kept mode is not a dropped
- * mode's (they lie above the kept ones) but one of the kept modes that
- * rounding brought back: its weight is dropped.  A dropped mode equal to
- * the highest kept one stays (a double eigenvalue split by K). */
-#define SPURIOUS 1e-6
+#define KH_BATCH 8  /* columns per pass over K: 24 lanes */
+#define KH_CHUNK 64 /* steps whose rows go to one GEMM with the coefficients */
+/* A lane whose vector grew past this factor of its start met an
+ * eigenvalue above lam_up (|T_k| <= 1 on the spectrum, exact arithmetic). */
+#define KH_GROWTH 2.0
 
-/* One axis's run; a column's three go side by side. */
-struct run {
-	double beta0, b_prev, change;
-	size_t m;
-	size_t next_check;    /* the step of its next check */
-	size_t open_check;    /* its last check not within tol (0: none yet) */
-	int done;             /* 1 converged, -1 failed, 0 running */
-	double *alpha, *beta; /* m_max each */
-	double *Vr;           /* its vectors at the rows asked: R x m_max */
-	double *cur, *prev;   /* its rows' responses at the last two checks: R x S */
+/* The expansion every run shares. */
+struct cheb {
+	double lam_up; /* Gershgorin's bound on A's spectrum */
+	double scale;  /* 2 / lam_up */
+	size_t N;      /* terms kept: T_0 .. T_{N-1} */
+	size_t S;      /* samples computed exactly */
+	size_t S_out;  /* samples of a head (2H): the rest are 0 before the taper */
+	double *C;     /* c_k(s): N x S, column-major */
+	double tail;   /* sum of max_s |c_k(s)| past N, over the largest dropped response */
 };
-
-struct kh {
-	const struct irdm_fem *fem;
-	const struct irdm_modes *kept;
-	const struct irdm_rayleigh *damp;
-	double dt;
-	size_t n, S, m_max;
-	double tol;
-	double *dinv;           /* M^-1/2, n */
-	double *msq;            /* M^1/2, n */
-	double *v, *vp, *w, *t; /* the three runs' vectors interleaved, [i][axis]: 3n each */
-	double *x, *coef;       /* a start vector (n) and its kept-mode part */
-	struct run run[3];
-	double *d, *e, *z; /* the tridiagonal eigensolve: m, m, m x m */
-	double *work;
-	int *iwork;
-	int lwork, liwork;
-	double *hs;            /* [s][l]: each Ritz value's weighted response, m x S */
-	double *W;             /* R x m_max */
-	double *G;             /* m_max x S */
-	struct irdm_mode *zoh; /* m_max */
-	double *hd;            /* one Ritz value's response: S */
-	/* a run's first check: where the first column's runs had their last
-	 * check not within tol (the runs of one model converge alike; each
-	 * check is an eigensolve of T, m^2 to m^3).  Taken from the first
-	 * column alone, before the others start, so that every column's
-	 * result is the same whichever thread runs it. */
-	size_t first_check;
-	size_t hint; /* the last column's: its runs' earliest open check */
-	struct irdm_krylov_head_stats st;
-};
-
-/*
- * y = A x for the three interleaved vectors at once: K is read once for
- * the three, which is most of a step's memory traffic.
- */
-static void apply_a3(const struct kh *k, const double *x, double *y)
-{
-	const struct irdm_csc *K = &k->fem->K;
-
-	for (size_t i = 0; i < k->n; i++)
-		for (int a = 0; a < 3; a++)
-			k->t[3 * i + (size_t)a] = k->dinv[i] * x[3 * i + (size_t)a];
-	memset(y, 0, 3 * k->n * sizeof(double));
-	for (size_t j = 0; j < k->n; j++) {
-		const double *tj = &k->t[3 * j];
-
-		for (int64_t q = K->colptr[j]; q < K->colptr[j + 1]; q++) {
-			double *yi = &y[3 * (size_t)K->rowind[q]], kv = K->val[q];
-
-			yi[0] += kv * tj[0];
-			yi[1] += kv * tj[1];
-			yi[2] += kv * tj[2];
-		}
-	}
-	for (size_t i = 0; i < k->n; i++)
-		for (int a = 0; a < 3; a++)
-			y[3 * i + (size_t)a] *= k->dinv[i];
-}
-
-/* x -= Psi Psi^T x, Psi = M^1/2 Phi (orthonormal): off the kept modes. */
-static void project(const struct kh *k, double *x)
-{
-	const struct irdm_modes *p = k->kept;
-	int n = (int)k->n, K = (int)p->n_modes, one = 1;
-	double d_one = 1.0, d_zero = 0.0, d_minus = -1.0;
-
-	for (size_t i = 0; i < k->n; i++)
-		k->t[i] = k->msq[i] * x[i];
-	dgemm_("T", "N", &K, &one, &n, &d_one, p->phi, &n, k->t, &n, &d_zero, k->coef, &K);
-	dgemm_("N", "N", &n, &one, &K, &d_minus, p->phi, &n, k->coef, &K, &d_zero, k->t, &n);
-	for (size_t i = 0; i < k->n; i++)
-		x[i] += k->msq[i] * k->t[i];
-}
-
-/* sum over i of a[3 i + ax] b[3 i + ax] */
-static double dot3(const double *a, const double *b, size_t n, int ax)
-{
-	double s = 0;
-
-	for (size_t i = 0; i < n; i++)
-		s += a[3 * i + (size_t)ax] * b[3 * i + (size_t)ax];
-	return s;
-}
-
-/*
- * After m steps of run u: Y[r + R s] = row r of beta0 V h_s(T) e1, its R
- * rows.  The eigenpairs of T by divide and conquer; a Ritz value below
- * the highest kept mode (SPURIOUS) gets no weight.
- */
-static int ritz_rows(struct kh *k, const struct run *u, size_t R, double *Y)
-{
-	int mi = (int)u->m, info, Si = (int)k->S, Ri = (int)R;
-	size_t m = u->m;
-	double one = 1.0, zero = 0.0;
-	struct irdm_modes ritz = { .n = 0, .n_modes = m, .omega2 = k->d };
-	double lowest = (1 - SPURIOUS) * k->kept->omega2[k->kept->n_modes - 1];
-
-	memcpy(k->d, u->alpha, m * sizeof(double));
-	memcpy(k->e, u->beta, (m - 1) * sizeof(double));
-	dstedc_("I", &mi, k->d, k->e, k->z, &mi, k->work, &k->lwork, k->iwork, &k->liwork, &info);
-	if (info)
-		return info;
-	for (size_t l = 0; l < m; l++)
-		k->d[l] = fmax(k->d[l], lowest);
-	if (irdm_modes_discretise(&ritz, k->damp, k->dt, k->zoh))
-		return -1;
-	for (size_t l = 0; l < m; l++) {
-		double g = k->d[l] > lowest ? u->beta0 * k->z[l * m] : 0.0;
-
-		irdm_zoh_response(&k->zoh[l], k->S, k->hd);
-		for (size_t s = 0; s < k->S; s++)
-			k->hs[s * m + l] = g * k->hd[s];
-	}
-	/* Y = V_rows Q hs, the cheaper way round: many rows (a column's
-	 * blocks) make Q hs first (m x S), a few V_rows Q first */
-	if (R > k->S) {
-		dgemm_("N", "N", &mi, &Si, &mi, &one, k->z, &mi, k->hs, &mi, &zero, k->G, &mi);
-		dgemm_("N", "N", &Ri, &Si, &mi, &one, u->Vr, &Ri, k->G, &mi, &zero, Y, &Ri);
-		return 0;
-	}
-	dgemm_("N", "N", &Ri, &mi, &mi, &one, u->Vr, &Ri, k->z, &mi, &zero, k->W, &Ri);
-	dgemm_("N", "N", &Ri, &Si, &mi, &one, k->W, &Ri, k->hs, &mi, &zero, Y, &Ri);
-	return 0;
-}
-
-/* max_s |a_s - b_s| / max_s |a_s|, a_s the nr rows of sample s */
-static double rel_change(const double *a, const double *b, size_t nr, size_t S)
-{
-	double num = 0, den = 0;
-
-	for (size_t s = 0; s < S; s++) {
-		double dn = 0, dd = 0;
-
-		for (size_t r = 0; r < nr; r++) {
-			double x = a[r + nr * s], y = b[r + nr * s];
-
-			dn += (x - y) * (x - y);
-			dd += x * x;
-		}
-		num = fmax(num, dn);
-		den = fmax(den, dd);
-	}
-	return den > 0 ? sqrt(num / den) : 0;
-}
-
-/*
- * Is run u done after its m steps (b: the next beta)?  Checked at
- * u->next_check, the next one a quarter further (at least
- * IRDM_KRYLOV_HEAD_CHECK steps), on every row of the column's blocks (an
- * off-diagonal block can converge later than the column's own); or when
- * the run has found an invariant subspace (b negligible: exact).  Its
- * rows' responses at the last check are in u->prev.
- */
-static int converged(struct kh *k, struct run *u, double b, size_t R)
-{
-	double *swap;
-	bool exact = !(b > 1e-13 * fabs(u->alpha[u->m - 1]));
-	size_t gap = u->m / 4 > IRDM_KRYLOV_HEAD_CHECK ? u->m / 4 : IRDM_KRYLOV_HEAD_CHECK;
-
-	if (!exact && u->m < u->next_check)
-		return 0;
-	if (ritz_rows(k, u, R, u->cur))
-		return -1;
-	u->change = exact ? 0 : u->open_check ? rel_change(u->cur, u->prev, R, k->S) :
-						INFINITY;
-	u->next_check = u->m + gap;
-	if (u->change >= k->tol)
-		u->open_check = u->m;
-	swap = u->cur;
-	u->cur = u->prev;
-	u->prev = swap;
-	return u->change < k->tol;
-}
-
-/* Run ax's start: P M^-1/2 e_d0 normalised into its lane of v (none at a
- * fixed DoF, or if the kept modes span it: done with a zero response). */
-static void start(struct kh *k, int ax, int64_t d0)
-{
-	struct run *u = &k->run[ax];
-	size_t n = k->n;
-
-	u->m = 0;
-	u->next_check = k->first_check;
-	u->open_check = 0;
-	u->b_prev = 0;
-	u->change = INFINITY;
-	u->beta0 = 0;
-	u->done = 1;
-	memset(k->x, 0, n * sizeof(double));
-	if (d0 >= 0) {
-		k->x[d0] = k->dinv[d0];
-		project(k, k->x);
-		project(k, k->x); /* twice: the first leaves rounding of the kept modes */
-		for (size_t i = 0; i < n; i++)
-			u->beta0 += k->x[i] * k->x[i];
-		u->beta0 = sqrt(u->beta0);
-		u->done = !(u->beta0 > 0);
-	}
-	for (size_t i = 0; i < n; i++) {
-		k->v[3 * i + (size_t)ax] = u->done ? 0.0 : k->x[i] / u->beta0;
-		k->vp[3 * i + (size_t)ax] = 0.0;
-	}
-}
-
-/* One step of run ax after w = A v: its coefficients, its check, its next
- * vector in w's lane. */
-static void step(struct kh *k, int ax, size_t R)
-{
-	struct run *u = &k->run[ax];
-	double *v = k->v, *vp = k->vp, *w = k->w, a, b;
-	size_t n = k->n, x = (size_t)ax;
-
-	a = dot3(w, v, n, ax);
-	for (size_t i = 0; i < n; i++)
-		w[3 * i + x] -= a * v[3 * i + x] + u->b_prev * vp[3 * i + x];
-	b = sqrt(dot3(w, w, n, ax));
-	u->alpha[u->m++] = a;
-	u->done = converged(k, u, b, R);
-	if (u->done) {
-		for (size_t i = 0; i < n; i++)
-			w[3 * i + x] = 0.0; /* its lane rests */
-		return;
-	}
-	u->beta[u->m - 1] = b;
-	for (size_t i = 0; i < n; i++)
-		w[3 * i + x] /= b;
-	u->b_prev = b;
-}
-
-/*
- * The three runs of a column from its free DoFs d0[0..2] side by side,
- * their vectors kept at rdofs[0..R-1], until each is done or k->m_max
- * steps.
- * Return: 0; IRDM_ENUMERIC one not converged or LAPACK failed.
- */
-static int run_column(struct kh *k, const int64_t *d0, const int64_t *rdofs, size_t R)
-{
-	size_t steps = 0, hint = 0;
-	int ret = 0;
-
-	for (int ax = 0; ax < 3; ax++)
-		start(k, ax, d0[ax]);
-	while (steps++ < k->m_max && !(k->run[0].done && k->run[1].done && k->run[2].done)) {
-		double *tmp;
-
-		for (int ax = 0; ax < 3; ax++)
-			for (size_t r = 0; !k->run[ax].done && r < R; r++)
-				k->run[ax].Vr[k->run[ax].m * R + r] =
-					rdofs[r] < 0 ? 0.0 : k->v[3 * (size_t)rdofs[r] + (size_t)ax];
-		apply_a3(k, k->v, k->w);
-		for (int ax = 0; ax < 3; ax++)
-			if (!k->run[ax].done)
-				step(k, ax, R);
-		tmp = k->vp;
-		k->vp = k->v;
-		k->v = k->w;
-		k->w = tmp;
-	}
-	for (int ax = 0; ax < 3; ax++) {
-		struct run *u = &k->run[ax];
-
-		if (!u->m)
-			continue; /* a fixed DoF: no run */
-		if (u->done != 1)
-			ret = IRDM_ENUMERIC;
-		k->st.runs++;
-		k->st.steps_sum += u->m;
-		k->st.steps_max = u->m > k->st.steps_max ? u->m : k->st.steps_max;
-		k->st.last_change = fmax(k->st.last_change, u->change);
-		if (u->done == 1 && u->open_check && (!hint || u->open_check < hint))
-			hint = u->open_check;
-	}
-	/* the earliest: a run that met a transient jump in its checks (a
-	 * Ritz value appearing) does not delay the next columns */
-	k->hint = hint;
-	return ret;
-}
-
-/* Column c's blocks from its first computed one: its three runs, each
- * read from its last check. */
-static int column(struct kh *k, const struct irdm_corr_sparse *corr, const int64_t *col_dofs,
-		  size_t c, int64_t *rdofs, double *head)
-{
-	uint32_t k0 = irdm_head_upper_begin(corr, c), nb = corr->start[c + 1] - k0;
-	long kd = irdm_corr_sparse_find(corr, c, (uint32_t)c);
-	size_t R = 3 * (size_t)nb, S = k->S;
-	int ret;
-
-	if (kd < (long)k0)
-		return IRDM_EINVAL; /* the diagonal block is always kept */
-	for (uint32_t b = 0; b < nb; b++)
-		for (int i = 0; i < 3; i++)
-			rdofs[3 * b + (uint32_t)i] = col_dofs[3 * (size_t)corr->rows[k0 + b] + (size_t)i];
-	ret = run_column(k, &col_dofs[3 * c], rdofs, R);
-	for (int j = 0; !ret && j < 3; j++) {
-		const struct run *u = &k->run[j];
-
-		for (uint32_t b = 0; b < nb; b++)
-			for (size_t s = 0; s < S; s++)
-				for (int i = 0; i < 3; i++) {
-					int64_t r = rdofs[3 * b + (uint32_t)i];
-
-					head[((size_t)(k0 + b) * S + s) * 9 + 3 * (size_t)i + (size_t)j] =
-						!u->m || r < 0 ? 0.0 : k->dinv[r] * u->prev[3 * b + (size_t)i + R * s];
-				}
-	}
-	return ret;
-}
-
-static void kh_free(struct kh *k)
-{
-	free(k->dinv);
-	free(k->msq);
-	free(k->v);
-	free(k->vp);
-	free(k->w);
-	free(k->t);
-	free(k->x);
-	free(k->coef);
-	for (int ax = 0; ax < 3; ax++) {
-		free(k->run[ax].alpha);
-		free(k->run[ax].beta);
-		free(k->run[ax].Vr);
-		free(k->run[ax].cur);
-		free(k->run[ax].prev);
-	}
-	free(k->d);
-	free(k->e);
-	free(k->z);
-	free(k->work);
-	free(k->iwork);
-	free(k->hs);
-	free(k->W);
-	free(k->G);
-	free(k->zoh);
-	free(k->hd);
-}
-
-static int kh_alloc(struct kh *k, size_t R_max)
-{
-	size_t n = k->n, m = k->m_max, S = k->S;
-	bool ok = true;
-
-	k->lwork = (int)(1 + 4 * m + m * m);
-	k->liwork = (int)(3 + 5 * m);
-	k->dinv = malloc(n * sizeof(double));
-	k->msq = malloc(n * sizeof(double));
-	k->v = malloc(3 * n * sizeof(double));
-	k->vp = malloc(3 * n * sizeof(double));
-	k->w = malloc(3 * n * sizeof(double));
-	k->t = malloc(3 * n * sizeof(double));
-	k->x = malloc(n * sizeof(double));
-	k->coef = malloc(k->kept->n_modes * sizeof(double));
-	for (int ax = 0; ax < 3; ax++) {
-		struct run *u = &k->run[ax];
-
-		u->alpha = malloc(m * sizeof(double));
-		u->beta = malloc(m * sizeof(double));
-		u->Vr = malloc(R_max * m * sizeof(double));
-		u->cur = malloc(R_max * S * sizeof(double));
-		u->prev = malloc(R_max * S * sizeof(double));
-		ok = ok && u->alpha && u->beta && u->Vr && u->cur && u->prev;
-	}
-	k->d = malloc(m * sizeof(double));
-	k->e = malloc(m * sizeof(double));
-	k->z = malloc(m * m * sizeof(double));
-	k->work = malloc((size_t)k->lwork * sizeof(double));
-	k->iwork = malloc((size_t)k->liwork * sizeof(int));
-	k->hs = malloc(m * S * sizeof(double));
-	k->W = malloc(R_max * m * sizeof(double));
-	k->G = malloc(m * S * sizeof(double));
-	k->zoh = malloc(m * sizeof(*k->zoh));
-	k->hd = malloc(S * sizeof(double));
-	for (size_t i = 0; k->dinv && k->msq && i < n; i++) {
-		k->msq[i] = sqrt(k->fem->M.val[k->fem->M.colptr[i]]);
-		k->dinv[i] = 1 / k->msq[i];
-	}
-	ok = ok && k->dinv && k->msq && k->v && k->vp && k->w && k->t && k->x && k->coef && k->d &&
-	     k->e && k->z && k->work && k->iwork && k->hs && k->W && k->G && k->zoh && k->hd;
-	return ok ? 0 : IRDM_ENOMEM;
-}
 
 /* What every worker reads. */
 struct kh_in {
 	const struct irdm_fem *fem;
 	const struct irdm_modes *kept;
-	const struct irdm_rayleigh *damp;
-	double dt;
-	size_t S;
-	const struct irdm_krylov_head_opts *o;
-};
-
-/* The runs over threads: each takes the next column (their blocks are
- * its own); the first failure stops the others. */
-struct pool {
 	const struct irdm_corr_sparse *corr;
 	const int64_t *col_dofs;
+	const struct cheb *ch;
+	double *dinv, *msq; /* M^-1/2, M^1/2: n */
+	size_t n;
+};
+
+/* One lane: a column's axis. */
+struct lane {
+	size_t col;
+	int axis;
+	bool live;     /* a start vector (not a fixed DoF, not spanned by the kept modes) */
+	double norm0;  /* its start's norm */
+	uint32_t k0;   /* its column's first block to compute */
+	size_t R;      /* rows: 3 per block from k0 */
+	int64_t *rdof; /* R_max */
+	double *Vb;    /* its rows over a chunk of steps: R x KH_CHUNK */
+	double *Y;     /* h_s(A) b at its rows: R x S */
+};
+
+struct kh {
+	const struct kh_in *in;
+	size_t L;               /* lanes of this batch */
+	double *x, *xp, *w, *t; /* the lanes' vectors interleaved [i][lane]: n L each */
+	double *coef, *corrv;   /* the projection's: L x K, L x n */
+	struct lane lane[3 * KH_BATCH];
+};
+
+/* y = A x for the L interleaved vectors at once: K is read once for all. */
+static void apply_a(const struct kh *k, const double *x, double *y)
+{
+	const struct irdm_csc *K = &k->in->fem->K;
+	const double *dinv = k->in->dinv;
+	size_t n = k->in->n, L = k->L;
+
+	for (size_t i = 0; i < n; i++)
+		for (size_t l = 0; l < L; l++)
+			k->t[i * L + l] = dinv[i] * x[i * L + l];
+	memset(y, 0, n * L * sizeof(double));
+	for (size_t j = 0; j < n; j++) {
+		const double *tj = &k->t[j * L];
+
+		for (int64_t q = K->colptr[j]; q < K->colptr[j + 1]; q++) {
+			double *yi = &y[(size_t)K->rowind[q] * L], kv = K->val[q];
+
+			for (size_t l = 0; l < L; l++)
+				yi[l] += kv * tj[l];
+		}
+	}
+	for (size_t i = 0; i < n; i++)
+		for (size_t l = 0; l < L; l++)
+			y[i * L + l] *= dinv[i];
+}
+
+/* x -= Psi Psi^T x for the L lanes, Psi = M^1/2 Phi (orthonormal): off the
+ * kept modes, as two GEMMs over the lanes. */
+static void project(const struct kh *k, double *x)
+{
+	const struct irdm_modes *p = k->in->kept;
+	int n = (int)k->in->n, K = (int)p->n_modes, L = (int)k->L;
+	double one = 1.0, zero = 0.0;
+
+	for (size_t i = 0; i < k->in->n; i++)
+		for (size_t l = 0; l < k->L; l++)
+			k->t[i * k->L + l] = k->in->msq[i] * x[i * k->L + l];
+	dgemm_("N", "N", &L, &K, &n, &one, k->t, &L, p->phi, &n, &zero, k->coef, &L);
+	dgemm_("N", "T", &L, &n, &K, &one, k->coef, &L, p->phi, &n, &zero, k->corrv, &L);
+	for (size_t i = 0; i < k->in->n; i++)
+		for (size_t l = 0; l < k->L; l++)
+			x[i * k->L + l] -= k->in->msq[i] * k->corrv[i * k->L + l];
+}
+
+static double lane_norm(const struct kh *k, const double *x, size_t l)
+{
+	double s = 0;
+
+	for (size_t i = 0; i < k->in->n; i++)
+		s += x[i * k->L + l] * x[i * k->L + l];
+	return sqrt(s);
+}
+
+/* The batch's lanes for columns c0 .. c0 + nc - 1 and their starts
+ * P M^-1/2 e_d in x. */
+static void start(struct kh *k, size_t c0, size_t nc)
+{
+	const struct kh_in *in = k->in;
+	size_t n = in->n;
+
+	k->L = 3 * nc;
+	memset(k->x, 0, n * k->L * sizeof(double));
+	for (size_t l = 0; l < k->L; l++) {
+		struct lane *u = &k->lane[l];
+		size_t c = c0 + l / 3;
+		int64_t d = in->col_dofs[3 * c + l % 3];
+
+		u->col = c;
+		u->axis = (int)(l % 3);
+		u->k0 = irdm_head_upper_begin(in->corr, c);
+		u->R = 3 * (size_t)(in->corr->start[c + 1] - u->k0);
+		for (uint32_t b = 0; b < u->R / 3; b++)
+			for (int i = 0; i < 3; i++)
+				u->rdof[3 * b + (uint32_t)i] =
+					in->col_dofs[3 * (size_t)in->corr->rows[u->k0 + b] + (size_t)i];
+		memset(u->Y, 0, u->R * in->ch->S * sizeof(double));
+		if (d >= 0)
+			k->x[(size_t)d * k->L + l] = in->dinv[d];
+	}
+	project(k, k->x);
+	project(k, k->x); /* twice: the first leaves rounding of the kept modes */
+	for (size_t l = 0; l < k->L; l++) {
+		struct lane *u = &k->lane[l];
+
+		u->norm0 = lane_norm(k, k->x, l);
+		u->live = u->norm0 > 0;
+	}
+}
+
+/* Step k's vector's rows into each lane's chunk buffer; a full chunk (or
+ * the last step) is summed into Y with the chunk's coefficients. */
+static void gather(struct kh *k, const double *x, size_t step)
+{
+	const struct cheb *ch = k->in->ch;
+	size_t j = step % KH_CHUNK;
+	bool flush = j == KH_CHUNK - 1 || step == ch->N - 1;
+
+	for (size_t l = 0; l < k->L; l++) {
+		struct lane *u = &k->lane[l];
+
+		if (!u->live)
+			continue;
+		for (size_t r = 0; r < u->R; r++)
+			u->Vb[r + u->R * j] = u->rdof[r] < 0 ? 0.0 : x[(size_t)u->rdof[r] * k->L + l];
+		if (flush) {
+			int R = (int)u->R, S = (int)ch->S, m = (int)j + 1, ldc = (int)ch->N;
+			double one = 1.0;
+
+			dgemm_("N", "N", &R, &S, &m, &one, u->Vb, &R, &ch->C[step - j], &ldc, &one,
+			       u->Y, &R);
+		}
+	}
+}
+
+/* Has a lane grown (an eigenvalue above lam_up)?  Checked once a chunk. */
+static bool grew(const struct kh *k, const double *x)
+{
+	for (size_t l = 0; l < k->L; l++)
+		if (k->lane[l].live && lane_norm(k, x, l) > KH_GROWTH * k->lane[l].norm0)
+			return true;
+	return false;
+}
+
+/*
+ * The batch's recurrence: x_0 = b, x_1 = B b, x_{k+1} = 2 B x_k - x_{k-1},
+ * B = scale A - I, each step's rows summed with c_k.
+ * Return: 0; IRDM_ENUMERIC a lane grew.
+ */
+static int recur(struct kh *k)
+{
+	const struct cheb *ch = k->in->ch;
+	size_t nL = k->in->n * k->L;
+	double *tmp;
+
+	gather(k, k->x, 0);
+	if (ch->N < 2)
+		return 0;
+	apply_a(k, k->x, k->w);
+	for (size_t i = 0; i < nL; i++)
+		k->w[i] = ch->scale * k->w[i] - k->x[i];
+	tmp = k->xp, k->xp = k->x, k->x = k->w, k->w = tmp;
+	gather(k, k->x, 1);
+	for (size_t step = 2; step < ch->N; step++) {
+		apply_a(k, k->x, k->w);
+		for (size_t i = 0; i < nL; i++)
+			k->w[i] = 2 * (ch->scale * k->w[i] - k->x[i]) - k->xp[i];
+		tmp = k->xp, k->xp = k->x, k->x = k->w, k->w = tmp;
+		gather(k, k->x, step);
+		if (step % KH_CHUNK == 0 && grew(k, k->x))
+			return IRDM_ENUMERIC;
+	}
+	return grew(k, k->x) ? IRDM_ENUMERIC : 0;
+}
+
+/* The lanes' rows into the head: block (k0 + b), sample s, [i][axis]. */
+static void store(const struct kh *k, double *head)
+{
+	const struct kh_in *in = k->in;
+	size_t S = in->ch->S, So = in->ch->S_out;
+
+	for (size_t l = 0; l < k->L; l++) {
+		const struct lane *u = &k->lane[l];
+
+		for (uint32_t b = 0; b < u->R / 3; b++)
+			for (size_t s = 0; s < So; s++)
+				for (int i = 0; i < 3; i++) {
+					int64_t r = u->rdof[3 * b + (uint32_t)i];
+					double v = !u->live || r < 0 || s >= S ?
+							   0.0 :
+							   in->dinv[r] * u->Y[3 * b + (size_t)i + u->R * s];
+
+					head[((size_t)(u->k0 + b) * So + s) * 9 + 3 * (size_t)i +
+					     (size_t)u->axis] = v;
+				}
+	}
+}
+
+/*
+ * Gershgorin's bound on the spectrum of A = M^-1/2 K M^-1/2: every
+ * eigenvalue is at most the largest absolute row sum.
+ */
+static double gershgorin(const struct irdm_csc *K, const double *dinv)
+{
+	double up = 0;
+
+	for (size_t j = 0; j < K->n; j++) {
+		double s = 0;
+
+		for (int64_t q = K->colptr[j]; q < K->colptr[j + 1]; q++)
+			s += fabs(K->val[q]) * dinv[K->rowind[q]];
+		up = fmax(up, s * dinv[j]);
+	}
+	return up;
+}
+
+/* Each mode's response h_s(lam) at the Chebyshev points
+ * lam_j = lam_up (1 + cos(pi (j + 1/2) / Nc)) / 2: F[s Nc + j]. */
+static int responses_at_points(const struct irdm_rayleigh *damp, double dt, double lam_up,
+			       size_t Nc, size_t S, double *F, double *dropped_max, double lam_kept)
+{
+	double *h = malloc(S * sizeof(double));
+
+	if (!h)
+		return IRDM_ENOMEM;
+	*dropped_max = 0;
+	for (size_t j = 0; j < Nc; j++) {
+		double lam = lam_up * (1 + cos(M_PI * ((double)j + 0.5) / (double)Nc)) / 2;
+		double w = sqrt(lam);
+		struct irdm_mode md;
+
+		irdm_zoh_mode(w, irdm_rayleigh_ratio(damp, w), dt, &md);
+		irdm_zoh_response(&md, S, h);
+		for (size_t s = 0; s < S; s++) {
+			F[s * Nc + j] = h[s];
+			if (lam >= lam_kept)
+				*dropped_max = fmax(*dropped_max, fabs(h[s]));
+		}
+	}
+	free(h);
+	return 0;
+}
+
+/* c_k(s) = (2 - [k = 0]) / Nc sum_j F[s][j] cos(pi k (j + 1/2) / Nc), k < Nc,
+ * by an FFT of the even extension (2 Nc points). */
+static int dct(const double *F, size_t Nc, size_t S, double *Cfull)
+{
+	double complex *y = malloc(2 * Nc * sizeof(*y));
+
+	if (!y)
+		return IRDM_ENOMEM;
+	for (size_t s = 0; s < S; s++) {
+		const double *f = &F[s * Nc];
+
+		for (size_t j = 0; j < Nc; j++)
+			y[j] = y[2 * Nc - 1 - j] = f[j];
+		irdm_fft_inverse_sign(y, 2 * Nc);
+		for (size_t k = 0; k < Nc; k++) {
+			double v = creal(cexp(I * M_PI * (double)k / (2.0 * (double)Nc)) * y[k]) / 2;
+			Cfull[k * S + s] = (k ? 2.0 : 1.0) * v / (double)Nc;
+		}
+	}
+	free(y);
+	return 0;
+}
+
+/*
+ * The expansion for samples [0, S) to tol of the largest dropped response
+ * (at an eigenvalue at or above the highest kept mode's): the points
+ * double until the coefficients have died out well before the last one
+ * (no aliasing), up to max_terms.
+ */
+static int expansion(struct cheb *ch, const struct irdm_rayleigh *damp, double dt, double lam_kept,
+		     double tol, size_t max_terms, char *err, size_t errlen)
+{
+	double w_up = sqrt(ch->lam_up), t = (double)(ch->S ? ch->S - 1 : 0) * dt, fmax_d;
+	size_t need = (size_t)(0.5 * w_up * t) + 64, Nc = 256;
+	int ret = 0;
+
+	while (Nc < 2 * need)
+		Nc *= 2;
+	for (;; Nc *= 2) {
+		double *F = malloc(Nc * ch->S * sizeof(double));
+		double *Cf = malloc(Nc * ch->S * sizeof(double));
+		double tail = 0;
+		size_t N = Nc;
+
+		ret = !F || !Cf ? IRDM_ENOMEM : 0;
+		if (!ret)
+			ret = responses_at_points(damp, dt, ch->lam_up, Nc, ch->S, F, &fmax_d, lam_kept);
+		if (!ret)
+			ret = dct(F, Nc, ch->S, Cf);
+		free(F);
+		if (ret) {
+			free(Cf);
+			snprintf(err, errlen, "krylov head: out of memory for %zu Chebyshev points", Nc);
+			return IRDM_ENOMEM;
+		}
+		/* N: the fewest terms whose tail is within tol */
+		for (; N > 1; N--) {
+			double cmax = 0;
+
+			for (size_t s = 0; s < ch->S; s++)
+				cmax = fmax(cmax, fabs(Cf[(N - 1) * ch->S + s]));
+			if (tail + cmax > tol * fmax_d)
+				break;
+			tail += cmax;
+		}
+		if (4 * N <= 3 * Nc) {
+			ch->N = N;
+			ch->tail = fmax_d > 0 ? tail / fmax_d : 0;
+			ch->C = malloc(N * ch->S * sizeof(double));
+			for (size_t k = 0; ch->C && k < N; k++)
+				for (size_t s = 0; s < ch->S; s++)
+					ch->C[k + N * s] = Cf[k * ch->S + s];
+			free(Cf);
+			if (!ch->C) {
+				snprintf(err, errlen, "krylov head: out of memory for %zu coefficients", N);
+				return IRDM_ENOMEM;
+			}
+			return N <= max_terms ? 0 : IRDM_ENUMERIC;
+		}
+		free(Cf);
+		if (Nc >= 4 * max_terms) {
+			ch->N = N;
+			return IRDM_ENUMERIC;
+		}
+	}
+}
+
+/* Columns in batches over threads; the first failure stops the others. */
+struct pool {
+	const struct kh_in *in;
 	double *head;
+	size_t n_batches;
 	atomic_size_t next, done;
 	atomic_int failed;
-	size_t fail_col;
-	int fail_ret;
+	size_t fail_batch;
 	pthread_mutex_t lock;
 };
 
 struct worker {
 	struct kh k;
 	struct pool *p;
-	int64_t *rdofs;
 };
+
+static int batch(struct worker *w, size_t bi)
+{
+	size_t nc_all = w->p->in->corr->n_cols, c0 = bi * KH_BATCH;
+	size_t nc = nc_all - c0 < KH_BATCH ? nc_all - c0 : KH_BATCH;
+	int ret;
+
+	start(&w->k, c0, nc);
+	ret = recur(&w->k);
+	if (!ret)
+		store(&w->k, w->p->head);
+	return ret;
+}
 
 static void *work(void *arg)
 {
@@ -475,17 +437,14 @@ static void *work(void *arg)
 	struct pool *p = w->p;
 
 	while (!atomic_load(&p->failed)) {
-		size_t c = atomic_fetch_add(&p->next, 1);
-		int ret;
+		size_t bi = atomic_fetch_add(&p->next, 1);
 
-		if (c >= p->corr->n_cols)
+		if (bi >= p->n_batches)
 			break;
-		ret = column(&w->k, p->corr, p->col_dofs, c, w->rdofs, p->head);
-		if (ret) {
+		if (batch(w, bi)) {
 			pthread_mutex_lock(&p->lock);
 			if (!atomic_load(&p->failed)) {
-				p->fail_col = c;
-				p->fail_ret = ret;
+				p->fail_batch = bi;
 				atomic_store(&p->failed, 1);
 			}
 			pthread_mutex_unlock(&p->lock);
@@ -496,35 +455,69 @@ static void *work(void *arg)
 	return NULL;
 }
 
-static void merge_stats(struct irdm_krylov_head_stats *a, const struct irdm_krylov_head_stats *b)
+static void worker_free(struct worker *w)
 {
-	a->runs += b->runs;
-	a->steps_sum += b->steps_sum;
-	a->steps_max = b->steps_max > a->steps_max ? b->steps_max : a->steps_max;
-	a->last_change = fmax(a->last_change, b->last_change);
+	free(w->k.x);
+	free(w->k.xp);
+	free(w->k.w);
+	free(w->k.t);
+	free(w->k.coef);
+	free(w->k.corrv);
+	for (int l = 0; l < 3 * KH_BATCH; l++) {
+		free(w->k.lane[l].rdof);
+		free(w->k.lane[l].Vb);
+		free(w->k.lane[l].Y);
+	}
 }
 
-static unsigned n_workers(unsigned threads, size_t n_cols)
+static int worker_init(struct worker *w, struct pool *p, size_t R_max)
+{
+	const struct kh_in *in = p->in;
+	size_t nL = in->n * 3 * KH_BATCH;
+	bool ok;
+
+	memset(w, 0, sizeof(*w));
+	w->p = p;
+	w->k.in = in;
+	w->k.x = malloc(nL * sizeof(double));
+	w->k.xp = malloc(nL * sizeof(double));
+	w->k.w = malloc(nL * sizeof(double));
+	w->k.t = malloc(nL * sizeof(double));
+	w->k.coef = malloc(3 * KH_BATCH * in->kept->n_modes * sizeof(double));
+	w->k.corrv = malloc(nL * sizeof(double));
+	ok = w->k.x && w->k.xp && w->k.w && w->k.t && w->k.coef && w->k.corrv;
+	for (int l = 0; ok && l < 3 * KH_BATCH; l++) {
+		struct lane *u = &w->k.lane[l];
+
+		u->rdof = malloc(R_max * sizeof(int64_t));
+		u->Vb = malloc(R_max * KH_CHUNK * sizeof(double));
+		u->Y = malloc(R_max * in->ch->S * sizeof(double));
+		ok = u->rdof && u->Vb && u->Y;
+	}
+	return ok ? 0 : IRDM_ENOMEM;
+}
+
+static unsigned n_workers(unsigned threads, size_t n_batches)
 {
 	long cpus = sysconf(_SC_NPROCESSORS_ONLN);
 	size_t nt = threads ? threads : (size_t)(cpus > 0 ? cpus : 1);
 
 	nt = nt > KH_THREADS_MAX ? KH_THREADS_MAX : nt;
-	return (unsigned)(nt > n_cols ? (n_cols ? n_cols : 1) : nt);
+	return (unsigned)(nt > n_batches ? (n_batches ? n_batches : 1) : nt);
 }
 
 static void progress_wait(struct pool *p, pthread_t *th, unsigned nt, irdm_progress_fn progress,
 			  void *ctx)
 {
-	size_t n_cols = p->corr->n_cols, last = 0;
+	size_t last = 0;
 
 	/* the caller's progress is not thread-safe: reported from here */
-	while (progress && !atomic_load(&p->failed) && atomic_load(&p->done) < n_cols) {
+	while (progress && !atomic_load(&p->failed) && atomic_load(&p->done) < p->n_batches) {
 		size_t d = atomic_load(&p->done);
 		struct timespec ts = { 0, 100000000 };
 
 		if (d != last)
-			progress(ctx, "krylov head", (double)d / (double)n_cols);
+			progress(ctx, "krylov head", (double)d / (double)p->n_batches);
 		last = d;
 		nanosleep(&ts, NULL);
 	}
@@ -534,46 +527,6 @@ static void progress_wait(struct pool *p, pthread_t *th, unsigned nt, irdm_progr
 		progress(ctx, "krylov head", 1.0);
 }
 
-/* Worker w's scratch for rows of up to R_max. */
-static int worker_init(struct worker *w, struct pool *p, const struct kh_in *in,
-		       size_t R_max)
-{
-	w->k = (struct kh){ .fem = in->fem, .kept = in->kept, .damp = in->damp, .dt = in->dt, .n = in->fem->K.n, .S = in->S, .m_max = in->o->max_steps, .tol = in->o->tol, .first_check = FIRST_CHECK };
-	w->p = p;
-	w->rdofs = malloc(R_max * sizeof(int64_t));
-	return kh_alloc(&w->k, R_max) || !w->rdofs ? IRDM_ENOMEM : 0;
-}
-
-static void worker_free(struct worker *w, struct irdm_krylov_head_stats *st)
-{
-	if (st)
-		merge_stats(st, &w->k.st);
-	kh_free(&w->k);
-	free(w->rdofs);
-}
-
-/* The first column on this thread, its checks setting every worker's
- * first check; the pool goes on from the second. */
-static void first_column(struct pool *p, struct worker *w, unsigned nt)
-{
-	size_t c = atomic_fetch_add(&p->next, 1);
-	int ret;
-
-	if (c >= p->corr->n_cols)
-		return;
-	ret = column(&w[0].k, p->corr, p->col_dofs, c, w[0].rdofs, p->head);
-	if (ret) {
-		p->fail_col = c;
-		p->fail_ret = ret;
-		atomic_store(&p->failed, 1);
-		return;
-	}
-	atomic_fetch_add(&p->done, 1);
-	for (unsigned t = 0; t < nt; t++)
-		w[t].k.first_check = w[0].k.hint > FIRST_CHECK ? w[0].k.hint : FIRST_CHECK;
-}
-
-/* The columns' runs over nt threads. */
 static int run_pool(struct pool *p, struct worker *w, unsigned nt, irdm_progress_fn progress,
 		    void *ctx, char *err, size_t errlen)
 {
@@ -581,10 +534,9 @@ static int run_pool(struct pool *p, struct worker *w, unsigned nt, irdm_progress
 	unsigned started = 0;
 	int ret = 0, blas;
 
-	/* one thread per run: OpenBLAS's own threads would oversubscribe */
+	/* one thread per batch: OpenBLAS's own threads would oversubscribe */
 	blas = irdm_blas_serial_begin();
-	first_column(p, w, nt);
-	for (unsigned t = 0; t < nt && !ret && !atomic_load(&p->failed); t++, started++)
+	for (unsigned t = 0; t < nt; t++, started++)
 		if (pthread_create(&th[t], NULL, work, &w[t])) {
 			atomic_store(&p->failed, 1);
 			snprintf(err, errlen, "krylov head: cannot start a thread");
@@ -594,10 +546,53 @@ static int run_pool(struct pool *p, struct worker *w, unsigned nt, irdm_progress
 	progress_wait(p, th, started, progress, ctx);
 	irdm_blas_serial_end(blas);
 	if (!ret && atomic_load(&p->failed)) {
-		ret = p->fail_ret == IRDM_EINVAL ? IRDM_EINVAL : IRDM_ENUMERIC;
-		snprintf(err, errlen, ret == IRDM_EINVAL ? "krylov head: column %zu has no diagonal block" : "krylov head: column %zu: the Lanczos run did not converge to %g in %zu steps",
-			 p->fail_col, w[0].k.tol, w[0].k.m_max);
+		snprintf(err, errlen, "krylov head: columns %zu..: a Chebyshev run grew past %g times its start (an eigenvalue above Gershgorin's bound %g: rounding)",
+			 p->fail_batch * KH_BATCH, KH_GROWTH, p->in->ch->lam_up);
+		ret = IRDM_ENUMERIC;
 	}
+	return ret;
+}
+
+static int check_args(const struct irdm_fem *fem, const struct irdm_modes *kept,
+		      const struct irdm_corr_sparse *corr, size_t H,
+		      const struct irdm_krylov_head_opts *o, char *err, size_t errlen)
+{
+	if (fem->M.nnz != fem->M.n || !kept->n_modes || !kept->phi || H < 1 || o->max_steps < 2) {
+		snprintf(err, errlen, "krylov head: needs a lumped mass, kept modes and a head (H = %zu)", H);
+		return IRDM_EINVAL;
+	}
+	for (size_t c = 0; c < corr->n_cols; c++)
+		if (irdm_corr_sparse_find(corr, c, (uint32_t)c) < (long)irdm_head_upper_begin(corr, c)) {
+			snprintf(err, errlen, "krylov head: column %zu has no diagonal block", c);
+			return IRDM_EINVAL;
+		}
+	return 0;
+}
+
+/* M^-1/2, M^1/2 and the expansion. */
+static int setup(struct kh_in *in, struct cheb *ch, const struct irdm_rayleigh *damping,
+		 double dt_s, const struct irdm_krylov_head_opts *o, char *err, size_t errlen)
+{
+	const struct irdm_fem *fem = in->fem;
+	double lam_kept = in->kept->omega2[in->kept->n_modes - 1];
+	int ret;
+
+	in->dinv = malloc(in->n * sizeof(double));
+	in->msq = malloc(in->n * sizeof(double));
+	if (!in->dinv || !in->msq) {
+		snprintf(err, errlen, "krylov head: out of memory");
+		return IRDM_ENOMEM;
+	}
+	for (size_t i = 0; i < in->n; i++) {
+		in->msq[i] = sqrt(fem->M.val[fem->M.colptr[i]]);
+		in->dinv[i] = 1 / in->msq[i];
+	}
+	ch->lam_up = gershgorin(&fem->K, in->dinv);
+	ch->scale = 2 / ch->lam_up;
+	ret = expansion(ch, damping, dt_s, lam_kept, o->tol, o->max_steps, err, errlen);
+	if (ret == IRDM_ENUMERIC)
+		snprintf(err, errlen, "krylov head: %zu samples at dt %g s up to w = %.4g rad/s need a Chebyshev expansion of %zu terms, more than %zu",
+			 ch->S, dt_s, sqrt(ch->lam_up), ch->N, o->max_steps);
 	return ret;
 }
 
@@ -607,43 +602,57 @@ int irdm_krylov_head(const struct irdm_fem *fem, const struct irdm_modes *kept,
 		     const struct irdm_krylov_head_opts *o, irdm_progress_fn progress, void *ctx, double *head,
 		     struct irdm_krylov_head_stats *st, char *err, size_t errlen)
 {
-	struct pool p = { .corr = corr, .col_dofs = col_dofs, .head = head, .lock = PTHREAD_MUTEX_INITIALIZER };
-	struct kh_in in = { fem, kept, damping, dt_s, 2 * H, o };
+	struct cheb ch = { .S = 2 * H, .S_out = 2 * H };
+	struct kh_in in = { .fem = fem, .kept = kept, .corr = corr, .col_dofs = col_dofs, .ch = &ch, .n = fem->K.n };
+	struct pool p = { .in = &in, .head = head, .lock = PTHREAD_MUTEX_INITIALIZER };
 	struct worker w[KH_THREADS_MAX];
-	unsigned nt = n_workers(o->threads, corr->n_cols), ready = 0;
-	size_t R_max = 3, S = 2 * H;
-	int ret = 0;
+	unsigned nt, ready = 0;
+	size_t R_max = 3;
+	int ret;
 
 	if (st)
 		memset(st, 0, sizeof(*st));
-	if (fem->M.nnz != fem->M.n || !kept->n_modes || !kept->phi || H < 1 || o->max_steps < 2) {
-		snprintf(err, errlen, "krylov head: needs a lumped mass, kept modes and a head (H = %zu)", H);
-		return IRDM_EINVAL;
-	}
-	for (size_t c = 0; c < corr->n_cols; c++) {
+	ret = check_args(fem, kept, corr, H, o, err, errlen);
+	if (ret)
+		return ret;
+	if (o->samples && o->samples < ch.S)
+		ch.S = o->samples;
+	ret = setup(&in, &ch, damping, dt_s, o, err, errlen);
+	p.n_batches = (corr->n_cols + KH_BATCH - 1) / KH_BATCH;
+	nt = n_workers(o->threads, p.n_batches);
+	for (size_t c = 0; !ret && c < corr->n_cols; c++) {
 		size_t R = 3 * (size_t)(corr->start[c + 1] - irdm_head_upper_begin(corr, c));
 		R_max = R > R_max ? R : R_max;
 	}
 	atomic_init(&p.next, 0);
 	atomic_init(&p.done, 0);
 	atomic_init(&p.failed, 0);
-	for (; ready < nt; ready++)
-		if (worker_init(&w[ready], &p, &in, R_max)) {
-			snprintf(err, errlen, "krylov head: out of memory (%zu rows of %zu steps, %u threads)",
-				 R_max, o->max_steps, nt);
+	for (; !ret && ready < nt; ready++)
+		if (worker_init(&w[ready], &p, R_max)) {
+			snprintf(err, errlen, "krylov head: out of memory (%zu rows of %zu samples, %u threads)",
+				 R_max, ch.S, nt);
 			ret = IRDM_ENOMEM;
 			ready++; /* what it did allocate is freed below */
-			break;
 		}
 	if (!ret)
 		ret = run_pool(&p, w, nt, progress, ctx, err, errlen);
 	if (!ret) {
 		for (size_t c = 0; c < corr->n_cols; c++)
-			irdm_head_mirror(corr, c, irdm_head_upper_begin(corr, c), S, head);
+			irdm_head_mirror(corr, c, irdm_head_upper_begin(corr, c), ch.S_out, head);
 		for (size_t b = 0; b < corr->n_blocks; b++)
-			irdm_head_taper(&head[b * S * 9], H, &target[9 * b]);
+			irdm_head_taper(&head[b * ch.S_out * 9], H, &target[9 * b]);
+	}
+	if (st) {
+		st->runs = 3 * corr->n_cols;
+		st->terms = ch.N;
+		st->tail = ch.tail;
+		st->lam_up = ch.lam_up;
+		st->samples = ch.S;
 	}
 	for (unsigned t = 0; t < ready; t++)
-		worker_free(&w[t], st);
+		worker_free(&w[t]);
+	free(in.dinv);
+	free(in.msq);
+	free(ch.C);
 	return ret;
 }

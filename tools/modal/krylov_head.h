@@ -1,8 +1,9 @@
 /* SPDX-License-Identifier: MIT */
 /*
  * The hybrid representation's head without every mode: the same blocks
- * as irdm_exact_head() writes, from Lanczos runs on the stiffness and the
- * kept modes alone, for a model whose every mode a dense eigensolve
+ * as irdm_exact_head() writes, from polynomials in the stiffness (a
+ * Chebyshev series per touchable DoF) and the kept modes alone, for a
+ * model whose every mode a dense eigensolve
  * cannot afford (its cost grows as n^3, its memory as n^2).
  */
 #ifndef IRDM_TOOLS_KRYLOV_HEAD_H
@@ -15,25 +16,25 @@
 #include "modal/modal.h"
 #include "modal/static_sparse.h"
 
-/* A run stops when its rows (every row of its column's blocks) moved by
- * less than tol, relative to them, between two checks (a quarter of the
- * steps apart, at least IRDM_KRYLOV_HEAD_CHECK); these are an image
- * head's. */
+/* The expansion is cut where what it leaves (the sum of its dropped
+ * coefficients' sizes) is below tol of the largest dropped mode's
+ * response; these are an image head's. */
 #define IRDM_KRYLOV_HEAD_TOL 1e-8
-#define IRDM_KRYLOV_HEAD_CHECK 100
-#define IRDM_KRYLOV_HEAD_MAX_STEPS 4000
+#define IRDM_KRYLOV_HEAD_MAX_TERMS 20000
 
 struct irdm_krylov_head_opts {
 	double tol;       /* IRDM_KRYLOV_HEAD_TOL */
-	size_t max_steps; /* a run is refused past it: IRDM_KRYLOV_HEAD_MAX_STEPS */
-	unsigned threads; /* the columns are shared by threads (0: one per online CPU) */
+	size_t max_steps; /* terms (products with K per run): refused past it */
+	unsigned threads; /* the column batches are shared by threads (0: one per online CPU) */
+	size_t samples;   /* samples computed, the rest 0 before the taper (0: all 2H) */
 };
 
 struct irdm_krylov_head_stats {
-	size_t runs;        /* one per column axis (none at a fixed DoF) */
-	size_t steps_max;   /* the longest run's steps */
-	size_t steps_sum;   /* all runs' */
-	double last_change; /* the largest last relative change of a run's rows */
+	size_t runs;    /* one per column axis */
+	size_t terms;   /* the expansion's, the same for every run */
+	size_t samples; /* computed */
+	double tail;    /* the bound on what the cut leaves, relative */
+	double lam_up;  /* the bound on the spectrum of M^-1/2 K M^-1/2 */
 };
 
 /*
@@ -42,15 +43,17 @@ struct irdm_krylov_head_stats {
  *   D_s e_j = M^-1/2 h_s(A) P M^-1/2 e_j,  A = M^-1/2 K M^-1/2,
  * P the projector off the kept modes, h_s the zero-order-hold response of
  * a mode (damping: Rayleigh, dt_s) at sample s as a function of its
- * eigenvalue, by Lanczos runs on A (the plain three-term recurrence; the
- * start vector projected) until o->tol.  fem: K and a lumped
+ * eigenvalue, by its Chebyshev series in A on [0, Gershgorin's bound]
+ * (one three-term recurrence per start vector, the start projected),
+ * cut at o->tol.  fem: K and a lumped
  * M over the free DoFs; kept: the lowest modes, whole vectors,
  * M-orthonormal (grounded: no rigid modes); col_dofs as for
  * irdm_static_correction_sparse(); target as for irdm_exact_head().
  * st (may be NULL) gets the runs' counts.
- * Return: IRDM_OK; IRDM_EINVAL (M not lumped, no kept mode, H < 1);
- * IRDM_ENOMEM; IRDM_ENUMERIC (a run not converged in o->max_steps, or
- * the tridiagonal eigensolve failed);
+ * Return: IRDM_OK; IRDM_EINVAL (M not lumped, no kept mode, H < 1, a
+ * column without its diagonal block); IRDM_ENOMEM; IRDM_ENUMERIC (the
+ * expansion needs more than o->max_steps terms, or a run grew: an
+ * eigenvalue above the bound);
  * err says which.
  */
 int irdm_krylov_head(const struct irdm_fem *fem, const struct irdm_modes *kept,

@@ -82,7 +82,7 @@ static size_t modes_needed(const struct irdm_scene *sc)
 	if (sc->repr_auto && sc->max_error > 0)
 		return 0; /* every candidate is measured: the reference needs all */
 	if (sc->representation == IRDM_REPR_MODAL)
-		/* the head from every mode, or from Lanczos runs (krylov_head.h) */
+		/* the head from every mode, or from Chebyshev series (krylov_head.h) */
 		return sc->exact_head && sc->eigensolver != IRDM_EIG_LANCZOS ? 0 : sc->modes;
 	if (sc->method == IRDM_METHOD_TIME_DOMAIN)
 		return 1; /* only the first mode, for the default damping */
@@ -116,43 +116,35 @@ static size_t head_bytes(const struct build *b, size_t n_blocks, size_t H)
 	return runs * 2 * H * 9 * irdm_elem_size(b->sc->precision);
 }
 
-/*
- * A measurement's reference from Lanczos runs reads its head over the
- * whole run (irdm_measure_ticks() samples, not 2H): the dropped modes
- * that ring longest then need many more steps to resolve, and 1e-6 of the
- * response is far below any figure max_error holds.
- */
-#define REF_KRYLOV_TOL 1e-6
-#define REF_KRYLOV_MAX_STEPS 6000
-
-/* The head without every mode: Lanczos runs from each touchable DoF. */
+/* The head without every mode: a Chebyshev series from each touchable
+ * DoF.  A measurement's reference reads its head over the whole run
+ * (irdm_measure_ticks() samples): only those are computed, the run never
+ * reads the rest. */
 static int krylov_head(struct build *b, const double *target, char *err, size_t errlen)
 {
 	struct irdm_model *m = &b->m;
 	struct irdm_krylov_head_stats st;
-	char line[200];
-	struct irdm_krylov_head_opts ko = { IRDM_KRYLOV_HEAD_TOL, IRDM_KRYLOV_HEAD_MAX_STEPS,
-					    b->sc->threads };
+	char line[240];
+	struct irdm_krylov_head_opts ko = { IRDM_KRYLOV_HEAD_TOL, IRDM_KRYLOV_HEAD_MAX_TERMS,
+					    b->sc->threads, 0 };
 	int ret;
 
-	if (b->reference) {
-		ko.tol = REF_KRYLOV_TOL;
-		ko.max_steps = REF_KRYLOV_MAX_STEPS;
-	}
+	if (b->reference)
+		ko.samples = irdm_measure_ticks(b->sc->dt_s);
 	ret = irdm_krylov_head(&m->fem, &m->modes, &m->damping, b->sc->dt_s, m->col_dofs,
 			       &b->sparse, target, b->sc->exact_head, &ko, b->o->progress, b->o->ctx,
 			       b->head, &st, err, errlen);
 	if (ret || !b->o->progress)
 		return ret;
-	snprintf(line, sizeof(line), "krylov head: %zu Lanczos runs of %zu steps on average, at most %zu; each stopped when its rows moved by %.2g at most between its last two checks",
-		 st.runs, st.runs ? st.steps_sum / st.runs : 0, st.steps_max, st.last_change);
+	snprintf(line, sizeof(line), "krylov head: %zu Chebyshev runs of %zu terms over %zu samples, the spectrum bounded by w = %.4g rad/s; the terms cut leave %.2g of the largest dropped response at most",
+		 st.runs, st.terms, st.samples, sqrt(st.lam_up), st.tail);
 	b->o->progress(b->o->ctx, line, -1.0);
 	return IRDM_OK;
 }
 
 /*
  * The hybrid representation (scene key exact_head): every mode was solved
- * (zoh_all: each discretised; NULL: the head from Lanczos runs instead);
+ * (zoh_all: each discretised; NULL: the head from Chebyshev series instead);
  * the image keeps the scene's K, and the dropped ones' exact response over
  * the head's samples at the static correction's kept blocks.  Called once
  * the static correction of the K kept modes is known.
@@ -1246,7 +1238,7 @@ static int reference_from_model(void *ctx, const struct irdm_scene *rsc, const c
 	return reference_build(b, rsc, path, b->m.modes.n_elastic_total, err, errlen);
 }
 
-/* Was the head built from Lanczos runs (not every mode solved)? */
+/* Was the head built from Chebyshev series (not every mode solved)? */
 static bool krylov_hybrid(const struct build *b)
 {
 	return b->sc->exact_head && b->sc->representation == IRDM_REPR_MODAL &&
@@ -1255,13 +1247,14 @@ static bool krylov_hybrid(const struct build *b)
 
 /*
  * The exact model without every mode: the kept modes, exact, and the
- * dropped ones' whole response over the measurement's run, from Lanczos
- * runs at the sampled nodes -- a hybrid whose head outlasts the run
- * (exact_head = its ticks, so the convolution never reads the taper) and
- * keeps every block between them, in double.  What it shares with the
- * image is the kept modes and the Lanczos method (test_krylov_head holds
- * that to every mode); what the image loses past its own head, in its
- * dropped blocks and its storage is what it measures.
+ * dropped ones' whole response over the measurement's run, from Chebyshev
+ * series at the sampled nodes -- a hybrid whose head outlasts the run
+ * (exact_head = its ticks, so the convolution never reads the taper, and
+ * only the run's samples are computed) and keeps every block between
+ * them, in double.  What it shares with the image is the kept modes and
+ * the method (test_krylov_head holds that to every mode); what the image
+ * loses past its own head, in its dropped blocks and its storage is what
+ * it measures.
  */
 static int reference_by_krylov(void *ctx, const struct irdm_scene *rsc, const char *path,
 			       char *err, size_t errlen)
@@ -1601,7 +1594,7 @@ static int measure(struct build *b, struct irdm_precompute_report *rep, char *er
 		snprintf(err, errlen, "precompute: out of memory");
 		goto out_free;
 	}
-	rep->error_reference = krylov_hybrid(b) && !all_modes(b) ? "the kept modes and Lanczos runs" :
+	rep->error_reference = krylov_hybrid(b) && !all_modes(b) ? "the kept modes and Chebyshev series" :
 								   "every mode";
 	snprintf(tmp, n, "%s.unmeasured", out);
 	snprintf(ref, n, "%s.exact", out);

@@ -228,10 +228,10 @@ static void say_all_modes(const struct irdm_scene *sc, char *err, size_t errlen)
 	size_t len = strlen(err);
 
 	if (sc->repr_auto && sc->max_error > 0)
-		snprintf(err + len, errlen - len, "; representation = auto with max_error = %g needs every mode (to choose and to measure): representation = modal:K with exact_head = H and eigensolver = lanczos needs K (a Lanczos solve) and builds the head from Lanczos runs, measured; or a coarser mesh",
+		snprintf(err + len, errlen - len, "; representation = auto with max_error = %g needs every mode (to choose and to measure): representation = modal:K with exact_head = H and eigensolver = lanczos needs K (a Lanczos solve) and builds the head from Chebyshev series in the stiffness, measured; or a coarser mesh",
 			 sc->max_error);
 	else if (sc->exact_head)
-		snprintf(err + len, errlen - len, "; exact_head from every mode needs them all: eigensolver = lanczos needs K (a Lanczos solve) and builds the head from Lanczos runs");
+		snprintf(err + len, errlen - len, "; exact_head from every mode needs them all: eigensolver = lanczos needs K (a Lanczos solve) and builds the head from Chebyshev series in the stiffness");
 	else
 		snprintf(err + len, errlen - len, "; every mode was asked for: modal:K needs K (a Lanczos solve)");
 }

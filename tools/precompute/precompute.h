@@ -52,7 +52,7 @@ struct irdm_precompute_report {
 	const char *error_worst_run;
 	/* the exact model it was measured against: "every mode" (this
 	 * build's, or a precompute of its own), or "the kept modes and
-	 * Lanczos runs" (a head from Lanczos runs: krylov_head.h) */
+	 * Chebyshev series" (a head without every mode: krylov_head.h) */
 	const char *error_reference;
 	size_t error_cols, error_ticks;
 	/* every column measured (error_columns), their median and p90 */

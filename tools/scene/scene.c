@@ -446,7 +446,7 @@ static const struct irdm_opt scene_opts[] = {
 	{ .name = "exact_head", .type = IRDM_OPT_UNSIGNED, SC(exact_head), .metavar = "H", .range = IRDM_OPT_LE, .max = IRDM_HEAD_SAMPLES_MAX / 2, .help = "modal: the hybrid representation: the dropped modes' exact response over the "
 																			   "first H samples between touchable nodes, on top of the kept modes, tapered off "
 																			   "over H more with the static compliance kept exactly; from every mode of a dense "
-																			   "eigensolve, or with eigensolver = lanczos from the K kept modes and Lanczos runs on "
+																			   "eigensolve, or with eigensolver = lanczos from the K kept modes and Chebyshev series in "
 																			   "the stiffness, one per touchable DoF (a grounded object with lumped mass) "
 																			   "(default 0: the static correction alone)" },
 	{ .name = "max_error", .type = IRDM_OPT_CUSTOM, .parse = set_max_error, .metavar = "E | none", .help = "largest force error an image may have: after the build, its relative RMS "
@@ -454,7 +454,7 @@ static const struct irdm_opt scene_opts[] = {
 													       "measured for a step and a release at a few touchable nodes, stored in the "
 													       "image and printed; above E the image is refused.  none neither measures "
 													       "nor checks (the measurement needs every mode, a dense eigensolve, or the "
-													       "Lanczos runs of exact_head with eigensolver = lanczos) "
+													       "Chebyshev series of exact_head with eigensolver = lanczos) "
 													       "(default 1e-3)" },
 	{ .name = "error_columns", .type = IRDM_OPT_ENUM, SC(error_columns), .names = error_columns_names, .help = "where max_error is measured: every touchable node (a grounded object whose "
 														   "every mode is solved: representation = auto or exact_head; about a minute "
@@ -576,7 +576,7 @@ int irdm_scene_check(const struct irdm_scene *sc, char *err, size_t errlen)
 	}
 	if (sc->exact_head && sc->eigensolver == IRDM_EIG_LANCZOS &&
 	    (sc->floating || sc->mass != IRDM_MASS_LUMPED)) {
-		snprintf(err, errlen, "scene: exact_head = %u with eigensolver = lanczos builds the head from Lanczos runs, on a grounded object with lumped mass only: %s",
+		snprintf(err, errlen, "scene: exact_head = %u with eigensolver = lanczos builds the head from Chebyshev series in the stiffness, on a grounded object with lumped mass only: %s",
 			 sc->exact_head, sc->floating ? "floating = yes" : "mass = consistent");
 		return IRDM_EINVAL;
 	}
