@@ -522,17 +522,13 @@ static void assert_off_with_zero_torque(const struct irdm_tick_record *last)
 		assert_true(last->dev[0].joint_torque_nm[j] == 0.0);
 }
 
-/*
- * A signal asking irdm-fw to end, mid-contact on a real-clock run: the
- * next tick shuts down (state off, torque zero, the signal logged as the
- * reason) and irdm-fw exits 6, as --help says.
- */
-static void signal_mid_contact(int sig, const char *name)
+/* One real-clock run of PRESS sent sig after wait_s: its exit checked,
+ * its log read. */
+static uint64_t signal_run(int sig, const char *name, double wait_s, uint64_t *contact_ticks,
+			   struct irdm_tick_record *last)
 {
 	char log[320], board[320], line[96];
-	struct timespec t = { 1, 700000000 }; /* 1.7 s: pressed and holding */
-	struct irdm_tick_record last;
-	uint64_t n, contact_ticks;
+	struct timespec t = { (time_t)wait_s, (long)((wait_s - floor(wait_s)) * 1e9) };
 	pid_t pid;
 	int rc;
 
@@ -549,10 +545,32 @@ static void signal_mid_contact(int sig, const char *name)
 	snprintf(line, sizeof(line), "stopped by %s (signal %d)", name, sig);
 	assert_non_null(strstr(err_text, line));
 	assert_non_null(strstr(err_text, "torque off, state off"));
-	n = read_log(log, 0, &contact_ticks, &last);
-	print_message("%s: %llu ticks logged, %llu in contact; last: state %u, faults 0x%x\n", name,
-		      (unsigned long long)n, (unsigned long long)contact_ticks, last.state,
-		      last.fault_flags);
+	return read_log(log, 0, contact_ticks, last);
+}
+
+/*
+ * A signal asking irdm-fw to end, mid-contact on a real-clock run: the
+ * next tick shuts down (state off, torque zero, the signal logged as the
+ * reason) and irdm-fw exits 6, as --help says.  The signal goes 1.7 s in
+ * (1700 ticks: pressed and holding); on a host so busy that the run's
+ * ticks fell behind the clock and the press had not begun, once or twice
+ * more after as long as 1700 ticks took at the rate seen.
+ */
+static void signal_mid_contact(int sig, const char *name)
+{
+	struct irdm_tick_record last;
+	double wait_s = 1.7;
+	uint64_t n = 0, contact_ticks = 0;
+
+	for (int attempt = 0; attempt < 3; attempt++) {
+		n = signal_run(sig, name, wait_s, &contact_ticks, &last);
+		print_message("%s after %.2f s: %llu ticks logged, %llu in contact; last: state %u, faults 0x%x\n",
+			      name, wait_s, (unsigned long long)n, (unsigned long long)contact_ticks,
+			      last.state, last.fault_flags);
+		if (contact_ticks > 100)
+			break;
+		wait_s = fmin(1700.0 * wait_s / (double)(n ? n : 1), 10.0);
+	}
 	assert_true(contact_ticks > 100); /* the signal came mid-contact */
 	assert_off_with_zero_torque(&last);
 	assert_true(last.fault_flags & IRDM_FAULT_SIGNAL);

@@ -27,6 +27,7 @@
  * filtered and each check is an eigensolve of its tridiagonal matrix.
  */
 #include <complex.h>
+#include <float.h>
 #include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
@@ -49,6 +50,9 @@
 /* A lane whose vector grew past this factor of its start met an
  * eigenvalue above lam_up (|T_k| <= 1 on the spectrum, exact arithmetic). */
 #define KH_GROWTH 2.0
+/* A Chebyshev coefficient below this fraction of the largest value
+ * transformed is the transform's rounding (some 2e-13). */
+#define KH_NOISE (1024 * DBL_EPSILON)
 
 /* The expansion every run shares. */
 struct cheb {
@@ -289,15 +293,17 @@ static double gershgorin(const struct irdm_csc *K, const double *dinv)
 }
 
 /* Each mode's response h_s(lam) at the Chebyshev points
- * lam_j = lam_up (1 + cos(pi (j + 1/2) / Nc)) / 2: F[s Nc + j]. */
+ * lam_j = lam_up (1 + cos(pi (j + 1/2) / Nc)) / 2: F[s Nc + j]; the
+ * largest |h| at all of them and at those of the dropped modes. */
 static int responses_at_points(const struct irdm_rayleigh *damp, double dt, double lam_up,
-			       size_t Nc, size_t S, double *F, double *dropped_max, double lam_kept)
+			       size_t Nc, size_t S, double *F, double *all_max, double *dropped_max,
+			       double lam_kept)
 {
 	double *h = malloc(S * sizeof(double));
 
 	if (!h)
 		return IRDM_ENOMEM;
-	*dropped_max = 0;
+	*all_max = *dropped_max = 0;
 	for (size_t j = 0; j < Nc; j++) {
 		double lam = lam_up * (1 + cos(M_PI * ((double)j + 0.5) / (double)Nc)) / 2;
 		double w = sqrt(lam);
@@ -307,6 +313,7 @@ static int responses_at_points(const struct irdm_rayleigh *damp, double dt, doub
 		irdm_zoh_response(&md, S, h);
 		for (size_t s = 0; s < S; s++) {
 			F[s * Nc + j] = h[s];
+			*all_max = fmax(*all_max, fabs(h[s]));
 			if (lam >= lam_kept)
 				*dropped_max = fmax(*dropped_max, fabs(h[s]));
 		}
@@ -339,6 +346,46 @@ static int dct(const double *F, size_t Nc, size_t S, double *Cfull)
 }
 
 /*
+ * The fewest terms N whose tail (sum over k >= N of max_s |c_k(s)|) is
+ * within tol of the largest dropped response; coefficients at the
+ * rounding level of the largest value, noise of the transform (a slow
+ * mode's response can be a hundred times a dropped one's), count as 0.
+ */
+static size_t cut(const double *Cf, size_t Nc, size_t S, double tol, double fmax_d, double fmax_all,
+		  double *tail)
+{
+	double floor = KH_NOISE * fmax_all;
+	size_t N = Nc;
+
+	*tail = 0;
+	for (; N > 1; N--) {
+		double cmax = 0;
+
+		for (size_t s = 0; s < S; s++)
+			cmax = fmax(cmax, fabs(Cf[(N - 1) * S + s]));
+		cmax = fmax(cmax - floor, 0);
+		if (*tail + cmax > tol * fmax_d)
+			break;
+		*tail += cmax;
+	}
+	*tail = fmax_d > 0 ? *tail / fmax_d : 0;
+	return N;
+}
+
+/* Cf (k-major, Nc x S) cut to N terms into ch->C (column-major N x S). */
+static int keep_terms(struct cheb *ch, const double *Cf, size_t N)
+{
+	ch->N = N;
+	ch->C = malloc(N * ch->S * sizeof(double));
+	if (!ch->C)
+		return IRDM_ENOMEM;
+	for (size_t k = 0; k < N; k++)
+		for (size_t s = 0; s < ch->S; s++)
+			ch->C[k + N * s] = Cf[k * ch->S + s];
+	return 0;
+}
+
+/*
  * The expansion for samples [0, S) to tol of the largest dropped response
  * (at an eigenvalue at or above the highest kept mode's): the points
  * double until the coefficients have died out well before the last one
@@ -347,21 +394,21 @@ static int dct(const double *F, size_t Nc, size_t S, double *Cfull)
 static int expansion(struct cheb *ch, const struct irdm_rayleigh *damp, double dt, double lam_kept,
 		     double tol, size_t max_terms, char *err, size_t errlen)
 {
-	double w_up = sqrt(ch->lam_up), t = (double)(ch->S ? ch->S - 1 : 0) * dt, fmax_d;
+	double w_up = sqrt(ch->lam_up), t = (double)(ch->S ? ch->S - 1 : 0) * dt;
 	size_t need = (size_t)(0.5 * w_up * t) + 64, Nc = 256;
-	int ret = 0;
 
 	while (Nc < 2 * need)
 		Nc *= 2;
 	for (;; Nc *= 2) {
 		double *F = malloc(Nc * ch->S * sizeof(double));
 		double *Cf = malloc(Nc * ch->S * sizeof(double));
-		double tail = 0;
-		size_t N = Nc;
+		double fmax_all, fmax_d;
+		size_t N;
+		int ret = !F || !Cf ? IRDM_ENOMEM : 0;
 
-		ret = !F || !Cf ? IRDM_ENOMEM : 0;
 		if (!ret)
-			ret = responses_at_points(damp, dt, ch->lam_up, Nc, ch->S, F, &fmax_d, lam_kept);
+			ret = responses_at_points(damp, dt, ch->lam_up, Nc, ch->S, F, &fmax_all,
+						  &fmax_d, lam_kept);
 		if (!ret)
 			ret = dct(F, Nc, ch->S, Cf);
 		free(F);
@@ -370,32 +417,16 @@ static int expansion(struct cheb *ch, const struct irdm_rayleigh *damp, double d
 			snprintf(err, errlen, "krylov head: out of memory for %zu Chebyshev points", Nc);
 			return IRDM_ENOMEM;
 		}
-		/* N: the fewest terms whose tail is within tol */
-		for (; N > 1; N--) {
-			double cmax = 0;
-
-			for (size_t s = 0; s < ch->S; s++)
-				cmax = fmax(cmax, fabs(Cf[(N - 1) * ch->S + s]));
-			if (tail + cmax > tol * fmax_d)
-				break;
-			tail += cmax;
-		}
-		if (4 * N <= 3 * Nc) {
-			ch->N = N;
-			ch->tail = fmax_d > 0 ? tail / fmax_d : 0;
-			ch->C = malloc(N * ch->S * sizeof(double));
-			for (size_t k = 0; ch->C && k < N; k++)
-				for (size_t s = 0; s < ch->S; s++)
-					ch->C[k + N * s] = Cf[k * ch->S + s];
+		N = cut(Cf, Nc, ch->S, tol, fmax_d, fmax_all, &ch->tail);
+		if (4 * N <= 3 * Nc && N <= max_terms) {
+			ret = keep_terms(ch, Cf, N);
 			free(Cf);
-			if (!ch->C) {
+			if (ret)
 				snprintf(err, errlen, "krylov head: out of memory for %zu coefficients", N);
-				return IRDM_ENOMEM;
-			}
-			return N <= max_terms ? 0 : IRDM_ENUMERIC;
+			return ret;
 		}
 		free(Cf);
-		if (Nc >= 4 * max_terms) {
+		if (4 * N <= 3 * Nc || Nc >= 4 * max_terms) {
 			ch->N = N;
 			return IRDM_ENUMERIC;
 		}
