@@ -17,8 +17,9 @@
  *  - every run has the same length, so many columns share each pass over
  *    K (a batch), and a column's result does not depend on its batch
  *    mates or its thread (no inner products between lanes);
- *  - rounding cannot grow: |T_k| <= 1, and the kept modes that rounding
- *    brings back get h_s at their eigenvalue, times that rounding.
+ *  - rounding stays small: on the spectrum |T_k| <= 1, so an error made
+ *    at one step is carried on at most linearly in the steps left, about
+ *    terms x eps of the response in all.
  * lam_up is Gershgorin's bound, which holds for any matrix; an eigenvalue
  * above it would make the recurrence grow, which is checked.
  *
@@ -45,7 +46,8 @@
 #include "modal/lapack.h"
 
 #define KH_THREADS_MAX 64
-#define KH_BATCH 8  /* columns per pass over K: 24 lanes */
+#define KH_BATCH 8 /* columns per pass over K */
+#define KH_LANES (3 * KH_BATCH)
 #define KH_CHUNK 64 /* steps whose rows go to one GEMM with the coefficients */
 /* A lane whose vector grew past this factor of its start met an
  * eigenvalue above lam_up (|T_k| <= 1 on the spectrum, exact arithmetic). */
@@ -94,8 +96,24 @@ struct kh {
 	size_t L;               /* lanes of this batch */
 	double *x, *xp, *w, *t; /* the lanes' vectors interleaved [i][lane]: n L each */
 	double *coef, *corrv;   /* the projection's: L x K, L x n */
-	struct lane lane[3 * KH_BATCH];
+	struct lane lane[KH_LANES];
 };
+
+/* y += K t for a full batch: a constant lane count, which the compiler
+ * vectorises (the same sums in the same order as the general loop). */
+static void spmm_full(const struct irdm_csc *K, const double *restrict t, double *restrict y)
+{
+	for (size_t j = 0; j < K->n; j++) {
+		const double *tj = &t[j * KH_LANES];
+
+		for (int64_t q = K->colptr[j]; q < K->colptr[j + 1]; q++) {
+			double *yi = &y[(size_t)K->rowind[q] * KH_LANES], kv = K->val[q];
+
+			for (size_t l = 0; l < KH_LANES; l++)
+				yi[l] += kv * tj[l];
+		}
+	}
+}
 
 /* y = A x for the L interleaved vectors at once: K is read once for all. */
 static void apply_a(const struct kh *k, const double *x, double *y)
@@ -108,16 +126,19 @@ static void apply_a(const struct kh *k, const double *x, double *y)
 		for (size_t l = 0; l < L; l++)
 			k->t[i * L + l] = dinv[i] * x[i * L + l];
 	memset(y, 0, n * L * sizeof(double));
-	for (size_t j = 0; j < n; j++) {
-		const double *tj = &k->t[j * L];
+	if (L == KH_LANES)
+		spmm_full(K, k->t, y);
+	else
+		for (size_t j = 0; j < n; j++) {
+			const double *tj = &k->t[j * L];
 
-		for (int64_t q = K->colptr[j]; q < K->colptr[j + 1]; q++) {
-			double *yi = &y[(size_t)K->rowind[q] * L], kv = K->val[q];
+			for (int64_t q = K->colptr[j]; q < K->colptr[j + 1]; q++) {
+				double *yi = &y[(size_t)K->rowind[q] * L], kv = K->val[q];
 
-			for (size_t l = 0; l < L; l++)
-				yi[l] += kv * tj[l];
+				for (size_t l = 0; l < L; l++)
+					yi[l] += kv * tj[l];
+			}
 		}
-	}
 	for (size_t i = 0; i < n; i++)
 		for (size_t l = 0; l < L; l++)
 			y[i * L + l] *= dinv[i];
@@ -397,6 +418,10 @@ static int expansion(struct cheb *ch, const struct irdm_rayleigh *damp, double d
 	double w_up = sqrt(ch->lam_up), t = (double)(ch->S ? ch->S - 1 : 0) * dt;
 	size_t need = (size_t)(0.5 * w_up * t) + 64, Nc = 256;
 
+	if (need > max_terms) {
+		ch->N = need;
+		return IRDM_ENUMERIC;
+	}
 	while (Nc < 2 * need)
 		Nc *= 2;
 	for (;; Nc *= 2) {
@@ -494,7 +519,7 @@ static void worker_free(struct worker *w)
 	free(w->k.t);
 	free(w->k.coef);
 	free(w->k.corrv);
-	for (int l = 0; l < 3 * KH_BATCH; l++) {
+	for (int l = 0; l < KH_LANES; l++) {
 		free(w->k.lane[l].rdof);
 		free(w->k.lane[l].Vb);
 		free(w->k.lane[l].Y);
@@ -504,7 +529,7 @@ static void worker_free(struct worker *w)
 static int worker_init(struct worker *w, struct pool *p, size_t R_max)
 {
 	const struct kh_in *in = p->in;
-	size_t nL = in->n * 3 * KH_BATCH;
+	size_t nL = in->n * KH_LANES;
 	bool ok;
 
 	memset(w, 0, sizeof(*w));
@@ -514,10 +539,10 @@ static int worker_init(struct worker *w, struct pool *p, size_t R_max)
 	w->k.xp = malloc(nL * sizeof(double));
 	w->k.w = malloc(nL * sizeof(double));
 	w->k.t = malloc(nL * sizeof(double));
-	w->k.coef = malloc(3 * KH_BATCH * in->kept->n_modes * sizeof(double));
+	w->k.coef = malloc(KH_LANES * in->kept->n_modes * sizeof(double));
 	w->k.corrv = malloc(nL * sizeof(double));
 	ok = w->k.x && w->k.xp && w->k.w && w->k.t && w->k.coef && w->k.corrv;
-	for (int l = 0; ok && l < 3 * KH_BATCH; l++) {
+	for (int l = 0; ok && l < KH_LANES; l++) {
 		struct lane *u = &w->k.lane[l];
 
 		u->rdof = malloc(R_max * sizeof(int64_t));
@@ -662,8 +687,7 @@ int irdm_krylov_head(const struct irdm_fem *fem, const struct irdm_modes *kept,
 		if (worker_init(&w[ready], &p, R_max)) {
 			snprintf(err, errlen, "krylov head: out of memory (%zu rows of %zu samples, %u threads)",
 				 R_max, ch.S, nt);
-			ret = IRDM_ENOMEM;
-			ready++; /* what it did allocate is freed below */
+			ret = IRDM_ENOMEM; /* the loop's step counts it: its part is freed below */
 		}
 	if (!ret)
 		ret = run_pool(&p, w, nt, progress, ctx, err, errlen);

@@ -24,7 +24,7 @@
 
 struct irdm_krylov_head_opts {
 	double tol;       /* IRDM_KRYLOV_HEAD_TOL */
-	size_t max_steps; /* terms (products with K per run): refused past it */
+	size_t max_steps; /* terms (a run's products with K: one fewer): refused past it */
 	unsigned threads; /* the column batches are shared by threads (0: one per online CPU) */
 	size_t samples;   /* samples computed, the rest 0 before the taper (0: all 2H) */
 };
@@ -50,8 +50,8 @@ struct irdm_krylov_head_stats {
  * M-orthonormal (grounded: no rigid modes); col_dofs as for
  * irdm_static_correction_sparse(); target as for irdm_exact_head().
  * st (may be NULL) gets the runs' counts.
- * Return: IRDM_OK; IRDM_EINVAL (M not lumped, no kept mode, H < 1, a
- * column without its diagonal block); IRDM_ENOMEM; IRDM_ENUMERIC (the
+ * Return: IRDM_OK; IRDM_EINVAL (M not lumped, no kept mode, H < 1,
+ * o->max_steps < 2, a column without its diagonal block); IRDM_ENOMEM; IRDM_ENUMERIC (the
  * expansion needs more than o->max_steps terms, or a run grew: an
  * eigenvalue above the bound);
  * err says which.
