@@ -23,6 +23,14 @@
  *    whole run, every block): measured again here at the same nodes
  *    against the exact model of every mode (a dense eigensolve of its
  *    own), the figure is the same;
+ *  - at a reference's length (1000 samples at 1 ms, as a measurement
+ *    computes), straight through modal/krylov_head.h on the same cuboid
+ *    at the default material: the top centre's own block against the
+ *    dropped modes' response summed from every mode, for cuts at 1e-6,
+ *    1e-8 and 1e-10, each within its tolerance, and each with about
+ *    w_up t / 2 terms (a tighter cut adds a few: the coefficients die out
+ *    faster than geometrically; rounding noise must not be summed as if
+ *    it were coefficients);
  *  - the scene refuses the Krylov head where it cannot be built: over
  *    MPI ranks (slepc), on a floating object, with a consistent mass.
  */
@@ -38,11 +46,14 @@
 #include <cmocka.h>
 
 #include "accuracy/measure.h"
+#include "modal/krylov_head.h"
+#include "modal/response.h"
 #include "image/image_response.h"
 #include "irdm/posix/image_map.h"
 #include "precompute/precompute.h"
 #include "scene/scene.h"
 #include "support/engine_fixture.h"
+#include "support/model_fixture.h"
 
 #define N_TICKS 1500 /* 3 s at 2 ms */
 #define RELEASE_TICK 500
@@ -299,6 +310,97 @@ static void test_measured(void **state)
 	irdm_image_unmap(&img);
 }
 
+/*
+ * The series at a reference's length.  Limits, measured 2026-11-29: the
+ * block's largest error over the samples, relative to its largest value,
+ * 4.2e-7 / 1.1e-10 / 4.1e-11 for cuts at 1e-6 / 1e-8 / 1e-10 (a cut
+ * bounds the error relative to the largest dropped response: limit 1.2
+ * tol), terms 1.07 to 1.10 times w_up t / 2.
+ */
+#define REF_SAMPLES 1000
+#define REF_KEPT 101
+#define REF_TERMS_MAX 1.15
+
+static void series_block(const struct irdm_model *m, const int64_t *dof, double tol, double *head,
+			 struct irdm_krylov_head_stats *st)
+{
+	uint32_t index[3] = { 0, 1, 0 };
+	struct irdm_corr_sparse corr = { .n_cols = 1, .n_blocks = 1, .start = index, .rows = &index[2] };
+	struct irdm_modes kept = m->modes;
+	struct irdm_krylov_head_opts o = { tol, IRDM_KRYLOV_HEAD_MAX_TERMS, 1, REF_SAMPLES };
+	double target[9] = { 0 };
+	char err[256];
+
+	kept.n_modes = REF_KEPT;
+	if (irdm_krylov_head(&m->fem, &kept, &m->damping, 0.001, dof, &corr, target, REF_SAMPLES, &o,
+			     NULL, NULL, head, st, err, sizeof(err)))
+		fail_msg("%s", err);
+}
+
+static void test_reference_length(void **state)
+{
+	static const double tols[] = { 1e-6, 1e-8, 1e-10 };
+	struct irdm_model m;
+	struct irdm_mode *zoh;
+	struct irdm_modes dropped;
+	const double top[3] = { 0.05, 0.05, 0.2 };
+	size_t n, terms_before = 0;
+	int64_t dof[3], *all;
+	double *ex = malloc(REF_SAMPLES * 9 * sizeof(double));
+	double *head = malloc(2 * REF_SAMPLES * 9 * sizeof(double)), peak = 0;
+	char err[256];
+
+	(void)state;
+	assert_non_null(ex);
+	assert_non_null(head);
+	fixture_model(&m, 0.1, 0.1, 0.2, 4, 4, 8, 5, 0.45, false, 0, IRDM_EIG_DENSE, 0.001);
+	n = m.modes.n;
+	assert_int_equal(m.modes.n_modes, m.modes.n_elastic_total);
+	all = malloc(n * sizeof(*all));
+	zoh = malloc(m.modes.n_modes * sizeof(*zoh));
+	assert_non_null(all);
+	assert_non_null(zoh);
+	for (size_t i = 0; i < n; i++)
+		all[i] = (int64_t)i;
+	assert_int_equal(irdm_modes_complete(&m.modes, 0, m.modes.n_modes, all, n, err, sizeof(err)), 0);
+	irdm_modes_discretise(&m.modes, &m.damping, 0.001, zoh);
+	for (int a = 0; a < 3; a++)
+		dof[a] = fixture_free_dof(&m, fixture_nearest_node(&m.mesh, top), a);
+	/* the exact head: the dropped modes' response, summed */
+	dropped = m.modes;
+	dropped.n_modes -= REF_KEPT;
+	dropped.omega2 += REF_KEPT;
+	dropped.phi += REF_KEPT * n;
+	assert_int_equal(irdm_fir_from_modes(&dropped, &zoh[REF_KEPT], dof, 1, dof, 1, REF_SAMPLES,
+					     NULL, ex, NULL, NULL),
+			 0);
+	for (size_t q = 0; q < REF_SAMPLES * 9; q++)
+		peak = fmax(peak, fabs(ex[q]));
+	for (size_t ti = 0; ti < sizeof(tols) / sizeof(tols[0]); ti++) {
+		struct irdm_krylov_head_stats st;
+		double worst = 0, theory;
+
+		series_block(&m, dof, tols[ti], head, &st);
+		theory = sqrt(st.lam_up) * (REF_SAMPLES - 1) * 0.001 / 2;
+		for (size_t q = 0; q < REF_SAMPLES * 9; q++)
+			worst = fmax(worst, fabs(head[q] - ex[q]));
+		print_message("cut at %.0e: %zu terms, %.3f times w_up t / 2 = %.0f (at most %.2f); the top centre's block %.2e of its largest value off every mode's (at most %.1e)\n",
+			      tols[ti], st.terms, (double)st.terms / theory, theory, REF_TERMS_MAX,
+			      worst / peak, 1.2 * tols[ti]);
+		assert_int_equal(st.samples, REF_SAMPLES);
+		assert_true((double)st.terms >= theory);
+		assert_true((double)st.terms <= REF_TERMS_MAX * theory);
+		assert_true(st.terms > terms_before);
+		assert_true(worst <= 1.2 * tols[ti] * peak);
+		terms_before = st.terms;
+	}
+	free(all);
+	free(zoh);
+	free(ex);
+	free(head);
+	irdm_model_free(&m);
+}
+
 static void test_scene_refusals(void **state)
 {
 	static const char *const bad[][4] = {
@@ -335,6 +437,7 @@ int main(void)
 		cmocka_unit_test(test_threads_alike),
 		cmocka_unit_test(test_forces_certified),
 		cmocka_unit_test(test_measured),
+		cmocka_unit_test(test_reference_length),
 		cmocka_unit_test(test_scene_refusals),
 	};
 
