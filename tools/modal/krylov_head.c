@@ -80,7 +80,6 @@ struct kh_in {
 
 /* One lane: a column's axis. */
 struct lane {
-	size_t col;
 	int axis;
 	bool live;     /* a start vector (not a fixed DoF, not spanned by the kept modes) */
 	double norm0;  /* its start's norm */
@@ -99,17 +98,19 @@ struct kh {
 	struct lane lane[KH_LANES];
 };
 
-/* y += K t for a full batch: a constant lane count, which the compiler
- * vectorises (the same sums in the same order as the general loop). */
-static void spmm_full(const struct irdm_csc *K, const double *restrict t, double *restrict y)
+/* y += K t for L interleaved vectors.  Inlined with L a constant (a full
+ * batch), the lane loop is vectorised; the sums and their order are the
+ * same either way. */
+static inline void spmm(const struct irdm_csc *K, const double *restrict t, double *restrict y,
+			size_t L)
 {
 	for (size_t j = 0; j < K->n; j++) {
-		const double *tj = &t[j * KH_LANES];
+		const double *tj = &t[j * L];
 
 		for (int64_t q = K->colptr[j]; q < K->colptr[j + 1]; q++) {
-			double *yi = &y[(size_t)K->rowind[q] * KH_LANES], kv = K->val[q];
+			double *yi = &y[(size_t)K->rowind[q] * L], kv = K->val[q];
 
-			for (size_t l = 0; l < KH_LANES; l++)
+			for (size_t l = 0; l < L; l++)
 				yi[l] += kv * tj[l];
 		}
 	}
@@ -127,18 +128,9 @@ static void apply_a(const struct kh *k, const double *x, double *y)
 			k->t[i * L + l] = dinv[i] * x[i * L + l];
 	memset(y, 0, n * L * sizeof(double));
 	if (L == KH_LANES)
-		spmm_full(K, k->t, y);
+		spmm(K, k->t, y, KH_LANES);
 	else
-		for (size_t j = 0; j < n; j++) {
-			const double *tj = &k->t[j * L];
-
-			for (int64_t q = K->colptr[j]; q < K->colptr[j + 1]; q++) {
-				double *yi = &y[(size_t)K->rowind[q] * L], kv = K->val[q];
-
-				for (size_t l = 0; l < L; l++)
-					yi[l] += kv * tj[l];
-			}
-		}
+		spmm(K, k->t, y, L);
 	for (size_t i = 0; i < n; i++)
 		for (size_t l = 0; l < L; l++)
 			y[i * L + l] *= dinv[i];
@@ -185,7 +177,6 @@ static void start(struct kh *k, size_t c0, size_t nc)
 		size_t c = c0 + l / 3;
 		int64_t d = in->col_dofs[3 * c + l % 3];
 
-		u->col = c;
 		u->axis = (int)(l % 3);
 		u->k0 = irdm_head_upper_begin(in->corr, c);
 		u->R = 3 * (size_t)(in->corr->start[c + 1] - u->k0);
