@@ -167,6 +167,7 @@ static void print_report(const struct irdm_scene *sc, const struct irdm_precompu
 	       r->first_elastic_hz);
 	if (sc->repr_auto)
 		printf("representation auto: %s%s (%zu candidate%s built)\n", r->representation,
+		       r->auto_lowest    ? ", from the lowest modes of a Lanczos solve (every mode does not fit), within max_error" :
 		       sc->max_error > 0 ? ", the cheapest to tick that meets max_error" :
 					   " (max_error = none: not chosen by accuracy)",
 		       r->auto_tries, r->auto_tries == 1 ? "" : "s");

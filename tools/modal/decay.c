@@ -22,6 +22,40 @@ double irdm_decay_left(double rate, double t)
 	return exp(-rate * t);
 }
 
+static double left_at(const struct irdm_rayleigh *damp, double horizon_s, double w)
+{
+	return irdm_decay_left(irdm_decay_rate(w, irdm_rayleigh_ratio(damp, w)), horizon_s);
+}
+
+#define CUTOFF_GRID 4096
+#define CUTOFF_SPAN 1e6 /* the grid's lowest point: w_max over this */
+
+double irdm_decay_cutoff(const struct irdm_rayleigh *damp, double horizon_s, double left,
+			 double w_max)
+{
+	double ratio = pow(CUTOFF_SPAN, 1.0 / (CUTOFF_GRID - 1)), hi = w_max, lo;
+
+	if (!(w_max > 0))
+		return 0;
+	if (left_at(damp, horizon_s, w_max) > left)
+		return w_max;
+	for (int i = 1; i < CUTOFF_GRID; i++, hi = lo) {
+		lo = hi / ratio;
+		if (!(left_at(damp, horizon_s, lo) > left))
+			continue;
+		for (int k = 0; k < 60; k++) { /* lo rings over `left`, hi not */
+			double mid = sqrt(lo * hi);
+
+			if (left_at(damp, horizon_s, mid) > left)
+				lo = mid;
+			else
+				hi = mid;
+		}
+		return lo;
+	}
+	return 0;
+}
+
 /* Follow each cycle of the permutation with one column in hand. */
 int irdm_modes_permute(struct irdm_modes *m, const size_t *order)
 {

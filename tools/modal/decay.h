@@ -29,6 +29,18 @@ double irdm_decay_rate(double w_rad_s, double zeta);
 double irdm_decay_left(double rate_per_s, double t_s);
 
 /*
+ * The highest angular frequency (rad/s) up to w_max whose free response
+ * under damp still has more than `left` of its envelope after horizon_s:
+ * every mode ringing that long lies at or below it (the rate need not
+ * grow with w: Rayleigh's overdamped modes ring longer again).  0 if none
+ * does; w_max if the envelope is still over `left` there.  Scanned on a
+ * geometric grid of 4096 points from w_max / 1e6, the crossing then
+ * bisected.
+ */
+double irdm_decay_cutoff(const struct irdm_rayleigh *damp, double horizon_s, double left,
+			 double w_max);
+
+/*
  * Put m's modes (omega2 and the columns of phi) in order: mode k becomes
  * the one at order[k].  order must be a permutation of 0 .. m->n_modes - 1.
  * Return: IRDM_OK; IRDM_ENOMEM (m untouched).

@@ -286,20 +286,19 @@ static void store(const struct kh *k, double *head)
 	}
 }
 
-/*
- * Gershgorin's bound on the spectrum of A = M^-1/2 K M^-1/2: every
- * eigenvalue is at most the largest absolute row sum.
- */
-static double gershgorin(const struct irdm_csc *K, const double *dinv)
+/* Gershgorin's bound: every eigenvalue is at most the largest absolute
+ * row sum (the same arithmetic as the runs' 1 / sqrt(M_ii)). */
+double irdm_krylov_spectrum_bound(const struct irdm_fem *fem)
 {
+	const struct irdm_csc *K = &fem->K, *M = &fem->M;
 	double up = 0;
 
 	for (size_t j = 0; j < K->n; j++) {
 		double s = 0;
 
 		for (int64_t q = K->colptr[j]; q < K->colptr[j + 1]; q++)
-			s += fabs(K->val[q]) * dinv[K->rowind[q]];
-		up = fmax(up, s * dinv[j]);
+			s += fabs(K->val[q]) * (1 / sqrt(M->val[M->colptr[K->rowind[q]]]));
+		up = fmax(up, s * (1 / sqrt(M->val[M->colptr[j]])));
 	}
 	return up;
 }
@@ -634,7 +633,7 @@ static int setup(struct kh_in *in, struct cheb *ch, const struct irdm_rayleigh *
 		in->msq[i] = sqrt(fem->M.val[fem->M.colptr[i]]);
 		in->dinv[i] = 1 / in->msq[i];
 	}
-	ch->lam_up = gershgorin(&fem->K, in->dinv);
+	ch->lam_up = irdm_krylov_spectrum_bound(fem);
 	ch->scale = 2 / ch->lam_up;
 	ret = expansion(ch, damping, dt_s, lam_kept, o->tol, o->max_steps, err, errlen);
 	if (ret == IRDM_ENUMERIC)

@@ -56,6 +56,13 @@ struct irdm_krylov_head_stats {
  * eigenvalue above the bound);
  * err says which.
  */
+/*
+ * Gershgorin's bound on the spectrum of M^-1/2 K M^-1/2 (fem: a lumped
+ * M), as the head's expansion takes it: no mode is above its square
+ * root in rad/s.
+ */
+double irdm_krylov_spectrum_bound(const struct irdm_fem *fem);
+
 int irdm_krylov_head(const struct irdm_fem *fem, const struct irdm_modes *kept,
 		     const struct irdm_rayleigh *damping, double dt_s, const int64_t *col_dofs,
 		     const struct irdm_corr_sparse *corr, const double *target, size_t H,

@@ -56,7 +56,7 @@ static bool dense_fits(size_t n, size_t n_req, double sum_sq, char *err, size_t 
 
 	if (!(budget > 0) || need <= budget)
 		return true;
-	snprintf(err, errlen, "modes: the dense eigensolve of %zu modes of %zu free DoFs%s needs %.1f GiB, more than the %.1f GiB of %s",
+	snprintf(err, errlen, "modes: the dense eigensolve of %zu modes of %zu free DoFs%s needs %.3g GiB, more than the %.3g GiB of %s",
 		 n_req, n, sum_sq < (double)n * (double)n ? " (split by symmetry)" : "",
 		 need / (1 << 30), budget / (1 << 30), what);
 	return false;

@@ -33,6 +33,7 @@
 #include "precompute/col_scale.h"
 #include "precompute/fir_tail.h"
 #include "precompute/head_pairs.h"
+#include "precompute/lowest.h"
 #include "precompute/precompute.h"
 #include "precompute/td_part.h"
 #include "accuracy/measure.h"
@@ -2195,6 +2196,140 @@ static int choose(struct build *b, struct irdm_precompute_report *rep, char *err
 	return ret;
 }
 
+/*
+ * Make sure the modes solved pass the cutoff of share `left` (lowest.h),
+ * solving more of the lowest ones when they do not (at most
+ * IRDM_LOWEST_SOLVES times); *K: how many are at or below it.  Refused
+ * (IRDM_ENUMERIC) when every mode to the top of the spectrum rings that
+ * long, or when the cutoff needs nearly every mode.
+ */
+static int lowest_solved(struct build *b, double left, double horizon_s, double w_up, size_t *K,
+			 char *err, size_t errlen)
+{
+	struct irdm_model *m = &b->m;
+	size_t n_free = m->modes.n_elastic_total, want;
+	double w_c, w_top;
+	char line[320];
+	int ret;
+
+	for (unsigned i = 0;; i++) {
+		w_c = irdm_decay_cutoff(&m->damping, horizon_s, left, w_up);
+		w_top = sqrt(m->modes.omega2[b->n_solved - 1]);
+		if (!(w_c < w_up)) {
+			snprintf(err, errlen, "precompute: representation = auto: every mode up to the top of the spectrum (%.4g Hz) rings past a head of %u samples to %.3g of its envelope at this damping, and every mode does not fit: more damping at high frequency, or a coarser mesh",
+				 w_up / (2 * M_PI), IRDM_LOWEST_HEAD, left);
+			return IRDM_ENUMERIC;
+		}
+		if (w_top > w_c || b->n_solved == n_free)
+			break;
+		/* a Krylov solve holds twice its modes and more: at most
+		 * about half of them (modal/modes.c) */
+		want = irdm_lowest_to_solve(&m->modes, b->n_solved, w_c);
+		if (want * 2 + 20 > n_free)
+			want = n_free > 20 ? (n_free - 20) / 2 : 0;
+		if (i == IRDM_LOWEST_SOLVES || want <= b->n_solved) {
+			snprintf(err, errlen, "precompute: representation = auto: the modes to %.4g Hz ring past a head of %u samples to %.3g of their envelope, more than the lowest %zu (to %.4g Hz) of the %zu modes a Lanczos solve takes here, and every mode does not fit: a coarser mesh, more damping, or max_memory_mib higher",
+				 w_c / (2 * M_PI), IRDM_LOWEST_HEAD, left, b->n_solved, w_top / (2 * M_PI), n_free);
+			return IRDM_ENUMERIC;
+		}
+		snprintf(line, sizeof(line), "auto: the modes to %.4g Hz ring past the head to %.3g of their envelope; the lowest %zu reach %.4g Hz: solving the lowest %zu",
+			 w_c / (2 * M_PI), left, b->n_solved, w_top / (2 * M_PI), want);
+		if (b->o->progress)
+			b->o->progress(b->o->ctx, line, -1.0);
+		ret = irdm_model_solve_lowest(b->sc, want, b->o->progress, b->o->ctx, m, err, errlen);
+		if (ret)
+			return ret;
+		b->n_solved = m->modes.n_modes;
+	}
+	*K = irdm_lowest_below(&m->modes, b->n_solved, w_c);
+	if (*K == 0)
+		*K = 1; /* a hybrid keeps one mode at least */
+	return IRDM_OK;
+}
+
+/* The head over max_head_mib: refused, saying what would build it. */
+static int head_over_cap(const struct build *b, char *err, size_t errlen)
+{
+	double mib = (double)head_bytes(b, b->head_capped, IRDM_LOWEST_HEAD) / (1 << 20);
+
+	snprintf(err, errlen, "precompute: representation = auto: from the lowest modes (every mode does not fit), the head would take %.4g MiB (%zu blocks x %u samples), more than max_head_mib = %g: max_head_mib = %.0f or more builds it, or static_correction_tol higher keeps fewer blocks",
+		 mib, b->head_capped, 2 * IRDM_LOWEST_HEAD, b->sc->max_head_mib, ceil(mib));
+	return IRDM_ENUMERIC;
+}
+
+/* One build's line: what it kept, what it measured. */
+static void say_lowest(const struct build *b, size_t K, double left,
+		       const struct irdm_precompute_report *rep, int ret, const char *err)
+{
+	char line[768], meas[64] = "not measured";
+
+	if (!b->o->progress)
+		return;
+	if (rep->error_measured)
+		snprintf(meas, sizeof(meas), "measured error %.3g", rep->measured_error);
+	snprintf(line, sizeof(line), "auto: modal:%zu (the modes to %.4g Hz, over %.3g of their envelope after the head) + static correction + exact_head %u from Chebyshev series: estimated tick %.2f us, image %.1f MiB, %s: %s%.400s",
+		 K, sqrt(b->m.modes.omega2[K - 1]) / (2 * M_PI), left, IRDM_LOWEST_HEAD,
+		 irdm_auto_tick_us(K, IRDM_LOWEST_HEAD), (double)b->try_bytes / (1 << 20), meas,
+		 !ret                                                          ? "kept, certified and within max_error" :
+		 rep->error_measured && rep->measured_error > b->sc->max_error ? "over max_error" :
+										 "refused: ",
+		 ret && !(rep->error_measured && rep->measured_error > b->sc->max_error) ? err : "");
+	b->o->progress(b->o->ctx, line, -1.0);
+}
+
+/*
+ * representation = auto when every mode did not fit (lowest.h): the
+ * lowest modes ringing past the head to `left`, the head from Chebyshev
+ * series, built and measured; a miss lowers `left` and builds again.
+ */
+static int choose_lowest(struct build *b, struct irdm_precompute_report *rep, char *err,
+			 size_t errlen)
+{
+	struct irdm_scene *eff = (struct irdm_scene *)b->sc;
+	double left = irdm_lowest_left_first(eff->max_error);
+	double w_up = sqrt(irdm_krylov_spectrum_bound(&b->m.fem));
+	char last[768] = "";
+	int ret = IRDM_ENUMERIC;
+
+	rep->auto_lowest = true;
+	/* the provenance's scene builds the same image again */
+	eff->eigensolver = IRDM_EIG_LANCZOS;
+	eff->representation = IRDM_REPR_MODAL;
+	eff->static_correction = true;
+	eff->exact_head = IRDM_LOWEST_HEAD;
+	for (unsigned round = 0; round < IRDM_LOWEST_ROUNDS; round++) {
+		size_t K;
+
+		ret = lowest_solved(b, left, IRDM_LOWEST_HEAD * eff->dt_s, w_up, &K, err, errlen);
+		if (ret && rep->error_measured) {
+			size_t len = strlen(err);
+
+			snprintf(err + len, errlen - len, "; the last build measured %.3g", rep->measured_error);
+		}
+		if (ret)
+			return ret;
+		reset_try(b, K); /* the image keeps the lowest K */
+		eff->modes = (unsigned)K;
+		b->auto_try = true;
+		b->head_capped = 0;
+		b->try_bytes = 0;
+		rep->error_measured = false;
+		ret = one_try(b, rep, err, errlen);
+		rep->auto_tries++;
+		say_lowest(b, K, left, rep, ret, err);
+		if (b->head_capped) /* more modes keep as many blocks: measured */
+			return head_over_cap(b, err, errlen);
+		if (ret != IRDM_ENUMERIC || !rep->error_measured ||
+		    !(rep->measured_error > eff->max_error))
+			return ret;
+		snprintf(last, sizeof(last), "%s", err);
+		left = irdm_lowest_left_next(left, eff->max_error, rep->measured_error);
+	}
+	snprintf(err, errlen, "precompute: representation = auto: from the lowest modes (every mode does not fit), no build met max_error = %g in %u (set max_error higher); the last: %s",
+		 eff->max_error, IRDM_LOWEST_ROUNDS, last);
+	return ret;
+}
+
 /* Columns whose force recursion is not certified stable. */
 static size_t unstable_cols(const struct build *b)
 {
@@ -2301,7 +2436,9 @@ int irdm_precompute(const struct irdm_scene *sc, const struct irdm_precompute_op
 			ret = td_distributed(&b, list_inputs(&b.m, NULL, NULL), err, errlen);
 		goto out_worker;
 	}
-	if (auto_choice)
+	if (auto_choice && b.m.lowest_only)
+		ret = choose_lowest(&b, rep, err, errlen);
+	else if (auto_choice)
 		ret = choose(&b, rep, err, errlen);
 	else
 		ret = fir_tail_auto(sc) ? fir_tail_search(&b, rep, err, errlen) : one_try(&b, rep, err, errlen);

@@ -9,6 +9,7 @@
 #include "modal/symmetry.h"
 #include "precompute/model.h"
 #include "util/clock.h"
+#include "util/memory.h"
 
 /*
  * A mesh file; a surface is sized (target_nodes, max_tet_volume) unless the
@@ -228,12 +229,64 @@ static void say_all_modes(const struct irdm_scene *sc, char *err, size_t errlen)
 	size_t len = strlen(err);
 
 	if (sc->repr_auto && sc->max_error > 0)
-		snprintf(err + len, errlen - len, "; representation = auto with max_error = %g needs every mode (to choose and to measure): representation = modal:K with exact_head = H and eigensolver = lanczos needs K (a Lanczos solve) and builds the head from Chebyshev series in the stiffness, measured; or a coarser mesh",
-			 sc->max_error);
+		snprintf(err + len, errlen - len, "; representation = auto chooses from the lowest modes of a Lanczos solve instead on a grounded object with lumped mass, contacts = 1 and eigensolver = auto, in one process; or representation = modal:K with exact_head = H and eigensolver = lanczos");
 	else if (sc->exact_head)
 		snprintf(err + len, errlen - len, "; exact_head from every mode needs them all: eigensolver = lanczos needs K (a Lanczos solve) and builds the head from Chebyshev series in the stiffness");
 	else
 		snprintf(err + len, errlen - len, "; every mode was asked for: modal:K needs K (a Lanczos solve)");
+}
+
+/*
+ * Solve the model's modes (n: how many, the lowest; 0: every one) with
+ * method, and pick the damping from them.  Every mode's solve may split
+ * by the mesh's symmetries (only the lumped-mass dense one does).
+ */
+static int solve_modes(const struct irdm_scene *sc, struct irdm_model *m, size_t n,
+		       enum irdm_eig_method method, irdm_progress_fn progress, void *ctx,
+		       char *err, size_t errlen)
+{
+	double t0 = irdm_now_s();
+	struct irdm_modes_want want;
+	/* only a slepc run has ranks (irdm_dist_begin started them) */
+	struct irdm_eig_dist dist = { .rank = 0, .solve = irdm_eig_slepc };
+	struct irdm_sym sym = { 0 };
+	int ret;
+
+	ret = wanted_of_modes(sc, m, &want);
+	if (ret) {
+		snprintf(err, errlen, "model: out of memory");
+		return ret;
+	}
+	if (method == IRDM_EIG_SLEPC)
+		dist.rank = irdm_dist_rank();
+	if (n == 0 && method != IRDM_EIG_SLEPC && sc->mass == IRDM_MASS_LUMPED && sc->symmetry)
+		find_symmetry(m, &sym, progress, ctx);
+	want.sym = &sym;
+	ret = irdm_modes_solve_kept(&m->fem, n, sc->floating, method, &dist, &want, progress, ctx,
+				    &m->modes, err, errlen);
+	irdm_sym_free(&sym);
+	free((void *)want.keep);
+	free((void *)want.every);
+	free((void *)want.load_dofs);
+	if (ret)
+		return ret;
+	m->seconds_eig += irdm_now_s() - t0;
+	return pick_damping(sc, m, err, errlen);
+}
+
+/*
+ * representation = auto with max_error wants every mode, to choose and to
+ * measure; when they do not fit in memory it chooses from the lowest
+ * modes of a Lanczos solve instead (precompute/lowest.h), beginning with
+ * IRDM_LOWEST_FIRST of them, where the head from Chebyshev series can be
+ * built (modal/krylov_head.h: grounded, lumped mass) and measured (one
+ * contact: two at once are measured on every mode only).
+ */
+static bool lowest_instead(const struct irdm_scene *sc, size_t n_modes_needed, int ret)
+{
+	return ret == IRDM_ENOMEM && n_modes_needed == 0 && sc->repr_auto && sc->max_error > 0 &&
+	       sc->eigensolver == IRDM_EIG_AUTO && irdm_dist_size() == 1 &&
+	       sc->mass == IRDM_MASS_LUMPED && !sc->floating && sc->contacts == 1;
 }
 
 int irdm_model_build(const struct irdm_scene *sc, size_t n_modes_needed,
@@ -241,9 +294,6 @@ int irdm_model_build(const struct irdm_scene *sc, size_t n_modes_needed,
 		     char *err, size_t errlen)
 {
 	double t0 = irdm_now_s();
-	struct irdm_modes_want want;
-	/* only a slepc run has ranks (irdm_dist_begin started them) */
-	struct irdm_eig_dist dist = { .rank = 0, .solve = irdm_eig_slepc };
 	int ret;
 
 	memset(m, 0, sizeof(*m));
@@ -277,43 +327,39 @@ int irdm_model_build(const struct irdm_scene *sc, size_t n_modes_needed,
 	if (progress)
 		progress(ctx, "FEM assembly", 1.0);
 	m->seconds_fem = irdm_now_s() - t0;
-	t0 = irdm_now_s();
 	/* the scene's rows and columns before the eigensolve: over MPI only
 	 * their eigenvector entries cross the network */
 	ret = irdm_model_select(sc, m, err, errlen);
 	if (ret)
 		goto out_fail;
-	ret = wanted_of_modes(sc, m, &want);
-	if (ret) {
-		snprintf(err, errlen, "model: out of memory");
-		goto out_fail;
-	}
-	if (sc->eigensolver == IRDM_EIG_SLEPC)
-		dist.rank = irdm_dist_rank();
-	struct irdm_sym sym = { 0 };
-	/* only the lumped-mass all-modes solve splits (eig_dense_at.c) */
-	if (n_modes_needed == 0 && sc->eigensolver != IRDM_EIG_SLEPC && sc->mass == IRDM_MASS_LUMPED &&
-	    sc->symmetry)
-		find_symmetry(m, &sym, progress, ctx);
-	want.sym = &sym;
-	ret = irdm_modes_solve_kept(&m->fem, n_modes_needed, sc->floating, sc->eigensolver, &dist,
-				    &want, progress, ctx, &m->modes, err, errlen);
-	irdm_sym_free(&sym);
-	free((void *)want.keep);
-	free((void *)want.every);
-	free((void *)want.load_dofs);
-	if (ret == IRDM_ENOMEM && n_modes_needed == 0)
+	irdm_memory_cap(sc->max_memory_mib * (1 << 20));
+	ret = solve_modes(sc, m, n_modes_needed, sc->eigensolver, progress, ctx, err, errlen);
+	if (lowest_instead(sc, n_modes_needed, ret)) {
+		char line[512];
+
+		snprintf(line, sizeof(line), "auto: every mode does not fit (%.300s): the lowest modes from a Lanczos solve instead, the head from Chebyshev series",
+			 err);
+		if (progress)
+			progress(ctx, line, -1.0);
+		m->lowest_only = true;
+		ret = solve_modes(sc, m, IRDM_LOWEST_FIRST, IRDM_EIG_LANCZOS, progress, ctx, err,
+				  errlen);
+	} else if (ret == IRDM_ENOMEM && n_modes_needed == 0) {
 		say_all_modes(sc, err, errlen);
-	if (ret)
-		goto out_fail;
-	m->seconds_eig = irdm_now_s() - t0;
-	ret = pick_damping(sc, m, err, errlen);
+	}
 	if (ret)
 		goto out_fail;
 	return IRDM_OK;
 out_fail:
 	irdm_model_free(m);
 	return ret;
+}
+
+int irdm_model_solve_lowest(const struct irdm_scene *sc, size_t n, irdm_progress_fn progress,
+			    void *ctx, struct irdm_model *m, char *err, size_t errlen)
+{
+	irdm_modes_free(&m->modes);
+	return solve_modes(sc, m, n, IRDM_EIG_LANCZOS, progress, ctx, err, errlen);
 }
 
 void irdm_model_free(struct irdm_model *m)

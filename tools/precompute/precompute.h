@@ -68,6 +68,9 @@ struct irdm_precompute_report {
 	 * and how many candidates auto built */
 	char representation[64];
 	size_t auto_tries;
+	/* auto chose from the lowest modes of a Lanczos solve: every mode
+	 * did not fit (lowest.h) */
+	bool auto_lowest;
 };
 
 /*

@@ -430,7 +430,11 @@ static const struct irdm_opt scene_opts[] = {
 																		   "modal:all (up to 300 modes), modal:300 + static correction, hybrids with "
 																		   "heads of 1 to 256 samples, each keeping the fewest modes ringing longest "
 																		   "past it whose predicted error is within half of max_error, and "
-																		   "modal:all, whose measured error meets max_error; with max_error = none, "
+																		   "modal:all, whose measured error meets max_error; when every mode does not "
+																		   "fit in memory (max_memory_mib), the lowest modes of a Lanczos solve whose "
+																		   "envelope after a 128-sample head is over 200 max_error, the head from "
+																		   "Chebyshev series, measured, and kept up to three times with more modes "
+																		   "until it meets max_error; with max_error = none, "
 																		   "modal:300 + static correction (default auto)" },
 	{ .name = "modes", .type = IRDM_OPT_CUSTOM, .parse = set_modes, .metavar = "K | all", .help = "modes that synthesise a modal-method FIR, 1 to 1000000 (default 300)" },
 	{ .name = "fir_tail", .type = IRDM_OPT_CUSTOM, .parse = set_fir_tail, .metavar = "window | window:L | none", .help = "FIR stabilisation: window:L appends L samples past T tapered to zero (Hann), "
@@ -465,6 +469,10 @@ static const struct irdm_opt scene_opts[] = {
 																				   "whose head would be larger is tried again with twice the modes (fewer "
 																				   "dropped, fewer kept blocks) while that still ticks cheaper than every "
 																				   "mode, else left for the next candidate (default 128)" },
+	{ .name = "max_memory_mib", .type = IRDM_OPT_DOUBLE, SC(max_memory_mib), .metavar = "MIB", .range = IRDM_OPT_GE | IRDM_OPT_LE, .min = 0, .max = 1 << 30, .help = "the memory the precompute plans for, in MiB: a step that needs more (the dense "
+																					 "eigensolve of every mode) is refused before it starts, and representation = auto "
+																					 "then chooses from the lowest modes of a Lanczos solve (0: the machine's physical "
+																					 "memory, or ulimit -v or -d when lower; default 0)" },
 	{ .name = "contacts", .type = IRDM_OPT_UNSIGNED, SC(contacts), .metavar = "N", .range = IRDM_OPT_GE | IRDM_OPT_LE, .min = 1, .max = IRDM_SCENE_CONTACTS_MAX, .help = "contacts at once that max_error holds: 1, a contact alone; 2, also two grabbed at "
 																					     "once at up to 28 pairs of touchable nodes spread over the surface (a grounded "
 																					     "object whose every mode is solved: representation = auto or exact_head), "
@@ -674,6 +682,12 @@ int irdm_scene_format(const struct irdm_scene *sc, char *buf, size_t len)
 	}
 	if (!sc->symmetry) { /* only when set: the same eigenpairs either way */
 		int t = snprintf(buf + n, len - (size_t)n, "symmetry=no\n");
+		if (t < 0 || (size_t)t >= len - (size_t)n)
+			return -1;
+		n += t;
+	}
+	if (sc->max_memory_mib > 0) { /* only when set */
+		int t = snprintf(buf + n, len - (size_t)n, "max_memory_mib=%.17g\n", sc->max_memory_mib);
 		if (t < 0 || (size_t)t >= len - (size_t)n)
 			return -1;
 		n += t;

@@ -106,6 +106,7 @@ struct irdm_scene {
 	double max_error;                      /* largest measured force error written (0: none, not measured) */
 	enum irdm_error_columns error_columns; /* where max_error is measured */
 	double max_head_mib;                   /* auto: the largest exact head it builds, MiB */
+	double max_memory_mib;                 /* the precompute's memory budget, MiB (0: the machine's) */
 	unsigned contacts;                     /* contacts at once max_error holds: 1, or 2 (the two-contact figure too) */
 };
 

@@ -18,6 +18,13 @@ static void limit(int r, const char *name, double *budget, const char **what)
 	}
 }
 
+static double cap; /* irdm_memory_cap()'s, bytes (0: none) */
+
+void irdm_memory_cap(double bytes)
+{
+	cap = bytes > 0 ? bytes : 0;
+}
+
 double irdm_memory_budget(const char **what)
 {
 	long pages = sysconf(_SC_PHYS_PAGES), size = sysconf(_SC_PAGESIZE);
@@ -26,5 +33,9 @@ double irdm_memory_budget(const char **what)
 	*what = "physical memory";
 	limit(RLIMIT_AS, "ulimit -v", &budget, what);
 	limit(RLIMIT_DATA, "ulimit -d", &budget, what);
+	if (cap > 0 && (budget == 0 || cap < budget)) {
+		budget = cap;
+		*what = "max_memory_mib";
+	}
 	return budget;
 }
