@@ -263,17 +263,6 @@ static void test_forces_certified(void **state)
 		assert_true(krylov.stability[c].flags & IRDM_STAB_STABLE);
 }
 
-/* The exact model of every mode, precomputed on its own. */
-static int every_mode(void *ctx, const struct irdm_scene *rsc, const char *path, char *err,
-		      size_t errlen)
-{
-	struct irdm_precompute_opts o = { .out_path = path };
-	struct irdm_precompute_report rep;
-
-	(void)ctx;
-	return irdm_precompute(rsc, &o, &rep, err, errlen);
-}
-
 static void test_measured(void **state)
 {
 	struct irdm_scene sc;
@@ -295,7 +284,7 @@ static void test_measured(void **state)
 		fail_msg("%s", err);
 	assert_true(rep.error_measured);
 	assert_int_equal(irdm_image_map(path, 0, &img, err, sizeof(err)), 0);
-	assert_int_equal(irdm_measure_error(&sc, &img, ref, every_mode, NULL, NULL, NULL, &res, err,
+	assert_int_equal(irdm_measure_error(&sc, &img, ref, fixture_exact_by_precompute, NULL, NULL, NULL, &res, err,
 					    sizeof(err)),
 			 0);
 	print_message("measured at %zu nodes: %.6g against Chebyshev series (worst: %s at mesh node %u), %.6g against every mode (%s at %u): %.2e apart (limit %.0e)\n",

@@ -39,27 +39,52 @@ struct irdm_modes_rest {
 	bool *whole;   /* each column whole */
 };
 
-/*
- * Does the dense eigensolve of n DoFs for n_req modes fit the memory
- * budget (util/memory.h)?  It holds the n_req vectors, and the matrix and
- * the eigenvectors of its tridiagonal (or the Cholesky factor): about
- * 8 n (2 n + n_req) bytes, 2.1 GiB for every mode of the paper's cuboid
- * (its measured peak: 2.5 GiB).  Split by symmetry (eig_dense_at.c), a
- * block's matrix and vectors are of its own size: 8 (n n_req + 2 sum_sq),
- * sum_sq the blocks' sizes squared, summed.  If not, say so in err.
- */
-static bool dense_fits(size_t n, size_t n_req, double sum_sq, char *err, size_t errlen)
+/* Does need (bytes) fit the memory budget (util/memory.h)?  If not, say
+ * so in err: "modes: <solve> needs ...". */
+static bool fits(double need, const char *solve, char *err, size_t errlen)
 {
 	const char *what;
-	double need = 8.0 * ((double)n * (double)n_req + 2.0 * sum_sq);
 	double budget = irdm_memory_budget(&what);
 
 	if (!(budget > 0) || need <= budget)
 		return true;
-	snprintf(err, errlen, "modes: the dense eigensolve of %zu modes of %zu free DoFs%s needs %.3g GiB, more than the %.3g GiB of %s",
-		 n_req, n, sum_sq < (double)n * (double)n ? " (split by symmetry)" : "",
+	snprintf(err, errlen, "modes: %s needs %.3g GiB, more than the %.3g GiB of %s", solve,
 		 need / (1 << 30), budget / (1 << 30), what);
 	return false;
+}
+
+/*
+ * Does the dense eigensolve of n DoFs for n_req modes fit?  It holds the
+ * n_req vectors, and the matrix and the eigenvectors of its tridiagonal
+ * (or the Cholesky factor): about 8 n (2 n + n_req) bytes, 2.1 GiB for
+ * every mode of the paper's cuboid (its measured peak: 2.5 GiB).  Split
+ * by symmetry (eig_dense_at.c), a block's matrix and vectors are of its
+ * own size: 8 (n n_req + 2 sum_sq), sum_sq the blocks' sizes squared,
+ * summed.
+ */
+static bool dense_fits(size_t n, size_t n_req, double sum_sq, char *err, size_t errlen)
+{
+	char solve[160];
+
+	snprintf(solve, sizeof(solve), "the dense eigensolve of %zu modes of %zu free DoFs%s", n_req,
+		 n, sum_sq < (double)n * (double)n ? " (split by symmetry)" : "");
+	return fits(8.0 * ((double)n * (double)n_req + 2.0 * sum_sq), solve, err, errlen);
+}
+
+/*
+ * Does the Lanczos solve of n_req modes of n DoFs fit?  ARPACK holds a
+ * basis of ncv = 2 n_req + 20 vectors (eig_lanczos.c), three more, ncv^2
+ * of work, and the n_req vectors returned: about 8 (n (3 n_req + 24) +
+ * ncv^2) bytes, beside the sparse factor of K (known only once
+ * factorised, not counted).
+ */
+static bool lanczos_fits(size_t n, size_t n_req, char *err, size_t errlen)
+{
+	double ncv = 2.0 * (double)n_req + 20;
+	char solve[128];
+
+	snprintf(solve, sizeof(solve), "the Lanczos solve of %zu modes of %zu free DoFs", n_req, n);
+	return fits(8.0 * ((double)n * (3.0 * (double)n_req + 24) + ncv * ncv), solve, err, errlen);
 }
 
 /* The dense solve's blocks' sizes squared, summed: n^2 unless it is the
@@ -403,6 +428,8 @@ int irdm_modes_solve_kept(const struct irdm_fem *fem, size_t n_wanted, bool floa
 		return IRDM_EINVAL;
 	}
 	if (method == IRDM_EIG_DENSE && !dense_fits(n, n_req, blocks_sum_sq(fem, want, n_req), err, errlen))
+		return IRDM_ENOMEM;
+	if (method == IRDM_EIG_LANCZOS && !lanczos_fits(n, n_req, err, errlen))
 		return IRDM_ENOMEM;
 	has_phi = method != IRDM_EIG_SLEPC || dist->rank == 0;
 	w2 = malloc(n_req * sizeof(double));

@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include "dist/dist.h"
+#include "fem/inertia.h"
 #include "image/bvh_build.h"
 #include "image/elem_store.h"
 #include "image/image_writer.h"
@@ -2197,51 +2198,61 @@ static int choose(struct build *b, struct irdm_precompute_report *rep, char *err
 }
 
 /*
- * Make sure the modes solved pass the cutoff of share `left` (lowest.h),
- * solving more of the lowest ones when they do not (at most
- * IRDM_LOWEST_SOLVES times); *K: how many are at or below it.  Refused
+ * Make sure the modes solved pass the cutoff of share `left` (lowest.h):
+ * how many lie below it is counted first (fem/inertia.h), then that many
+ * and IRDM_LOWEST_MARGIN more are solved when the solved ones do not
+ * pass it; *K: how many of those solved are at or below it, 1 at least
+ * (*ringing: whether any is).  Refused
  * (IRDM_ENUMERIC) when every mode to the top of the spectrum rings that
- * long, or when the cutoff needs nearly every mode.
+ * long, or when the cutoff needs more modes than a Lanczos solve takes.
  */
 static int lowest_solved(struct build *b, double left, double horizon_s, double w_up, size_t *K,
-			 char *err, size_t errlen)
+			 bool *ringing, char *err, size_t errlen)
 {
 	struct irdm_model *m = &b->m;
-	size_t n_free = m->modes.n_elastic_total, want;
-	double w_c, w_top;
+	size_t n_free = m->modes.n_elastic_total, below, most = n_free > 20 ? (n_free - 20) / 2 : 0;
+	double w_c = irdm_decay_cutoff(&m->damping, horizon_s, left, w_up), w_top;
 	char line[320];
 	int ret;
 
-	for (unsigned i = 0;; i++) {
-		w_c = irdm_decay_cutoff(&m->damping, horizon_s, left, w_up);
-		w_top = sqrt(m->modes.omega2[b->n_solved - 1]);
-		if (!(w_c < w_up)) {
-			snprintf(err, errlen, "precompute: representation = auto: every mode up to the top of the spectrum (%.4g Hz) rings past a head of %u samples to %.3g of its envelope at this damping, and every mode does not fit: more damping at high frequency, or a coarser mesh",
-				 w_up / (2 * M_PI), IRDM_LOWEST_HEAD, left);
-			return IRDM_ENUMERIC;
-		}
-		if (w_top > w_c || b->n_solved == n_free)
-			break;
-		/* a Krylov solve holds twice its modes and more: at most
-		 * about half of them (modal/modes.c) */
-		want = irdm_lowest_to_solve(&m->modes, b->n_solved, w_c);
-		if (want * 2 + 20 > n_free)
-			want = n_free > 20 ? (n_free - 20) / 2 : 0;
-		if (i == IRDM_LOWEST_SOLVES || want <= b->n_solved) {
-			snprintf(err, errlen, "precompute: representation = auto: the modes to %.4g Hz ring past a head of %u samples to %.3g of their envelope, more than the lowest %zu (to %.4g Hz) of the %zu modes a Lanczos solve takes here, and every mode does not fit: a coarser mesh, more damping, or max_memory_mib higher",
-				 w_c / (2 * M_PI), IRDM_LOWEST_HEAD, left, b->n_solved, w_top / (2 * M_PI), n_free);
-			return IRDM_ENUMERIC;
-		}
-		snprintf(line, sizeof(line), "auto: the modes to %.4g Hz ring past the head to %.3g of their envelope; the lowest %zu reach %.4g Hz: solving the lowest %zu",
-			 w_c / (2 * M_PI), left, b->n_solved, w_top / (2 * M_PI), want);
+	if (!(w_c < w_up)) {
+		snprintf(err, errlen, "precompute: representation = auto: every mode up to the top of the spectrum (%.4g Hz) rings past a head of %u samples to %.3g of its envelope at this damping, and every mode does not fit: more damping at high frequency, or a coarser mesh",
+			 w_up / (2 * M_PI), IRDM_LOWEST_HEAD, left);
+		return IRDM_ENUMERIC;
+	}
+	ret = irdm_fem_count_below(&m->fem, w_c * w_c, &below, err, errlen);
+	if (ret)
+		return ret;
+	/* a Krylov solve holds twice its modes and more: at most about half
+	 * of them (modal/modes.c) */
+	if (below + IRDM_LOWEST_MARGIN > most) {
+		snprintf(err, errlen, "precompute: representation = auto: %zu modes lie below %.4g Hz and ring past a head of %u samples to %.3g of their envelope, more than the %zu of %zu modes a Lanczos solve takes, and every mode does not fit: a coarser mesh, more damping, or max_memory_mib higher",
+			 below, w_c / (2 * M_PI), IRDM_LOWEST_HEAD, left, most, n_free);
+		return IRDM_ENUMERIC;
+	}
+	w_top = sqrt(m->modes.omega2[b->n_solved - 1]);
+	if (!(w_top > w_c) && b->n_solved < n_free) {
+		snprintf(line, sizeof(line), "auto: %zu modes lie below %.4g Hz (inertia), ringing past the head to %.3g of their envelope: solving the lowest %zu",
+			 below, w_c / (2 * M_PI), left, below + IRDM_LOWEST_MARGIN);
 		if (b->o->progress)
 			b->o->progress(b->o->ctx, line, -1.0);
-		ret = irdm_model_solve_lowest(b->sc, want, b->o->progress, b->o->ctx, m, err, errlen);
+		ret = irdm_model_solve_lowest(b->sc, below + IRDM_LOWEST_MARGIN, b->o->progress,
+					      b->o->ctx, m, err, errlen);
 		if (ret)
 			return ret;
 		b->n_solved = m->modes.n_modes;
+		/* the damping was picked again from the first mode: the same,
+		 * to rounding, so the cutoff stays */
 	}
 	*K = irdm_lowest_below(&m->modes, b->n_solved, w_c);
+	if (*K != below && b->o->progress) {
+		/* a mode the solve missed is not projected off: it stays in
+		 * the head with the dropped ones, and the measurement sees it */
+		snprintf(line, sizeof(line), "auto: the Lanczos solve has %zu modes below %.4g Hz, the inertia %zu",
+			 *K, w_c / (2 * M_PI), below);
+		b->o->progress(b->o->ctx, line, -1.0);
+	}
+	*ringing = *K > 0;
 	if (*K == 0)
 		*K = 1; /* a hybrid keeps one mode at least */
 	return IRDM_OK;
@@ -2258,7 +2269,7 @@ static int head_over_cap(const struct build *b, char *err, size_t errlen)
 }
 
 /* One build's line: what it kept, what it measured. */
-static void say_lowest(const struct build *b, size_t K, double left,
+static void say_lowest(const struct build *b, size_t K, bool ringing, double left,
 		       const struct irdm_precompute_report *rep, int ret, const char *err)
 {
 	char line[768], meas[64] = "not measured";
@@ -2267,14 +2278,34 @@ static void say_lowest(const struct build *b, size_t K, double left,
 		return;
 	if (rep->error_measured)
 		snprintf(meas, sizeof(meas), "measured error %.3g", rep->measured_error);
-	snprintf(line, sizeof(line), "auto: modal:%zu (the modes to %.4g Hz, over %.3g of their envelope after the head) + static correction + exact_head %u from Chebyshev series: estimated tick %.2f us, image %.1f MiB, %s: %s%.400s",
-		 K, sqrt(b->m.modes.omega2[K - 1]) / (2 * M_PI), left, IRDM_LOWEST_HEAD,
+	snprintf(line, sizeof(line), "auto: modal:%zu (%s %.4g Hz, over %.3g of their envelope after the head) + static correction + exact_head %u from Chebyshev series: estimated tick %.2f us, image %.1f MiB, %s: %s%.400s",
+		 K, ringing ? "the modes to" : "none rings past the head; the first mode,",
+		 sqrt(b->m.modes.omega2[K - 1]) / (2 * M_PI), left, IRDM_LOWEST_HEAD,
 		 irdm_auto_tick_us(K, IRDM_LOWEST_HEAD), (double)b->try_bytes / (1 << 20), meas,
 		 !ret                                                          ? "kept, certified and within max_error" :
 		 rep->error_measured && rep->measured_error > b->sc->max_error ? "over max_error" :
 										 "refused: ",
 		 ret && !(rep->error_measured && rep->measured_error > b->sc->max_error) ? err : "");
 	b->o->progress(b->o->ctx, line, -1.0);
+}
+
+/*
+ * The measurement's reference runs Chebyshev series over the whole run
+ * (irdm_measure_ticks()), about w_up t / 2 terms (1.07 to 1.16 times
+ * that measured, test_krylov_head): a stiff object's spectrum reaches so
+ * high that they would be more than the series may have.  Refused before
+ * any mode is solved for it.
+ */
+static int lowest_measurable(const struct build *b, double w_up, char *err, size_t errlen)
+{
+	double t = (double)(irdm_measure_ticks(b->sc->dt_s) - 1) * b->sc->dt_s;
+	double terms = 1.2 * w_up * t / 2;
+
+	if (terms <= IRDM_KRYLOV_HEAD_MAX_TERMS)
+		return IRDM_OK;
+	snprintf(err, errlen, "precompute: representation = auto: every mode does not fit, and without them the error measurement over %.3g s needs Chebyshev series of about %.0f terms (the spectrum reaches %.4g Hz), more than %d: a stiff object needs every mode: max_memory_mib higher, a coarser mesh, or max_error = none",
+		 t, terms, w_up / (2 * M_PI), IRDM_KRYLOV_HEAD_MAX_TERMS);
+	return IRDM_ENUMERIC;
 }
 
 /*
@@ -2292,15 +2323,21 @@ static int choose_lowest(struct build *b, struct irdm_precompute_report *rep, ch
 	int ret = IRDM_ENUMERIC;
 
 	rep->auto_lowest = true;
-	/* the provenance's scene builds the same image again */
+	ret = lowest_measurable(b, w_up, err, errlen);
+	if (ret)
+		return ret;
+	/* the provenance's scene builds the image again (to rounding: its
+	 * Lanczos solve is of the kept modes alone) */
 	eff->eigensolver = IRDM_EIG_LANCZOS;
 	eff->representation = IRDM_REPR_MODAL;
 	eff->static_correction = true;
 	eff->exact_head = IRDM_LOWEST_HEAD;
 	for (unsigned round = 0; round < IRDM_LOWEST_ROUNDS; round++) {
 		size_t K;
+		bool ringing;
 
-		ret = lowest_solved(b, left, IRDM_LOWEST_HEAD * eff->dt_s, w_up, &K, err, errlen);
+		ret = lowest_solved(b, left, IRDM_LOWEST_HEAD * eff->dt_s, w_up, &K, &ringing, err,
+				    errlen);
 		if (ret && rep->error_measured) {
 			size_t len = strlen(err);
 
@@ -2316,7 +2353,7 @@ static int choose_lowest(struct build *b, struct irdm_precompute_report *rep, ch
 		rep->error_measured = false;
 		ret = one_try(b, rep, err, errlen);
 		rep->auto_tries++;
-		say_lowest(b, K, left, rep, ret, err);
+		say_lowest(b, K, ringing, left, rep, ret, err);
 		if (b->head_capped) /* more modes keep as many blocks: measured */
 			return head_over_cap(b, err, errlen);
 		if (ret != IRDM_ENUMERIC || !rep->error_measured ||

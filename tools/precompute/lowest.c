@@ -24,12 +24,3 @@ size_t irdm_lowest_below(const struct irdm_modes *m, size_t n, double w)
 		k++;
 	return k;
 }
-
-size_t irdm_lowest_to_solve(const struct irdm_modes *m, size_t n, double w_c)
-{
-	double w_top = sqrt(m->omega2[n - 1]), w_mid = sqrt(m->omega2[n / 2 - 1]);
-	double p = w_top > w_mid ? log((double)n / (double)(n / 2)) / log(w_top / w_mid) : 3;
-
-	p = fmin(fmax(p, 1), 3);
-	return (size_t)ceil(1.3 * (double)n * pow(w_c / w_top, p)) + 16;
-}

@@ -6,8 +6,10 @@
  * Without every mode there is no prediction to size it by
  * (accuracy/split.h reads them all), so the kept modes are every one
  * whose envelope after the head is over a share `left` of its start
- * (modal/decay.h: all of them lie below one frequency, the cutoff), the
- * image is built and measured against max_error, and a miss lowers
+ * (modal/decay.h: all of them lie below one frequency, the cutoff),
+ * counted by the inertia of K - sigma M (fem/inertia.h) and solved with
+ * IRDM_LOWEST_MARGIN more, the image is built and measured against
+ * max_error, and a miss lowers
  * `left` by as much as it missed and builds again, IRDM_LOWEST_ROUNDS
  * times at most.
  *
@@ -27,7 +29,7 @@
 
 #define IRDM_LOWEST_HEAD 128  /* the head's samples */
 #define IRDM_LOWEST_ROUNDS 3  /* builds at most */
-#define IRDM_LOWEST_SOLVES 4  /* Lanczos solves a round may take to reach its cutoff */
+#define IRDM_LOWEST_MARGIN 8  /* modes solved past the cutoff's count */
 #define IRDM_LOWEST_SHARE 200 /* the first share, per unit of max_error */
 #define IRDM_LOWEST_SHARE_MAX 0.5
 
@@ -43,14 +45,5 @@ double irdm_lowest_left_next(double left, double max_error, double measured);
 
 /* How many of m's first n modes (ascending) are at or below w rad/s. */
 size_t irdm_lowest_below(const struct irdm_modes *m, size_t n, double w);
-
-/*
- * How many of the lowest modes to solve to pass w_c rad/s, when m's
- * lowest n (ascending, n >= 2) reach w_top < w_c: the count below w grown
- * as w^p, p fitted on the upper half of the n (between 1 and 3: Weyl's
- * law in a solid is w^3, reached only at high frequency; a slender
- * part's bending modes come sparser), 30 % and 16 more for its error.
- */
-size_t irdm_lowest_to_solve(const struct irdm_modes *m, size_t n, double w_c);
 
 #endif

@@ -229,7 +229,7 @@ static void say_all_modes(const struct irdm_scene *sc, char *err, size_t errlen)
 	size_t len = strlen(err);
 
 	if (sc->repr_auto && sc->max_error > 0)
-		snprintf(err + len, errlen - len, "; representation = auto chooses from the lowest modes of a Lanczos solve instead on a grounded object with lumped mass, contacts = 1 and eigensolver = auto, in one process; or representation = modal:K with exact_head = H and eigensolver = lanczos");
+		snprintf(err + len, errlen - len, "; representation = auto chooses from the lowest modes of a Lanczos solve instead on a grounded object with lumped mass, contacts = 1, eigensolver = auto, error_columns not every and no static_correction_cluster, in one process; or a coarser mesh");
 	else if (sc->exact_head)
 		snprintf(err + len, errlen - len, "; exact_head from every mode needs them all: eigensolver = lanczos needs K (a Lanczos solve) and builds the head from Chebyshev series in the stiffness");
 	else
@@ -262,8 +262,10 @@ static int solve_modes(const struct irdm_scene *sc, struct irdm_model *m, size_t
 	if (n == 0 && method != IRDM_EIG_SLEPC && sc->mass == IRDM_MASS_LUMPED && sc->symmetry)
 		find_symmetry(m, &sym, progress, ctx);
 	want.sym = &sym;
+	irdm_memory_cap(sc->max_memory_mib * (1 << 20)); /* the scene's, for this solve only */
 	ret = irdm_modes_solve_kept(&m->fem, n, sc->floating, method, &dist, &want, progress, ctx,
 				    &m->modes, err, errlen);
+	irdm_memory_cap(0);
 	irdm_sym_free(&sym);
 	free((void *)want.keep);
 	free((void *)want.every);
@@ -279,14 +281,16 @@ static int solve_modes(const struct irdm_scene *sc, struct irdm_model *m, size_t
  * measure; when they do not fit in memory it chooses from the lowest
  * modes of a Lanczos solve instead (precompute/lowest.h), beginning with
  * IRDM_LOWEST_FIRST of them, where the head from Chebyshev series can be
- * built (modal/krylov_head.h: grounded, lumped mass) and measured (one
- * contact: two at once are measured on every mode only).
+ * built (modal/krylov_head.h: grounded, lumped mass, its blocks not
+ * clustered) and measured (one contact at a sample of nodes: two at once
+ * and every node are measured on every mode only).
  */
 static bool lowest_instead(const struct irdm_scene *sc, size_t n_modes_needed, int ret)
 {
 	return ret == IRDM_ENOMEM && n_modes_needed == 0 && sc->repr_auto && sc->max_error > 0 &&
 	       sc->eigensolver == IRDM_EIG_AUTO && irdm_dist_size() == 1 &&
-	       sc->mass == IRDM_MASS_LUMPED && !sc->floating && sc->contacts == 1;
+	       sc->mass == IRDM_MASS_LUMPED && !sc->floating && sc->contacts == 1 &&
+	       !sc->static_corr_cluster && sc->error_columns != IRDM_ERROR_COLUMNS_EVERY;
 }
 
 int irdm_model_build(const struct irdm_scene *sc, size_t n_modes_needed,
@@ -332,7 +336,6 @@ int irdm_model_build(const struct irdm_scene *sc, size_t n_modes_needed,
 	ret = irdm_model_select(sc, m, err, errlen);
 	if (ret)
 		goto out_fail;
-	irdm_memory_cap(sc->max_memory_mib * (1 << 20));
 	ret = solve_modes(sc, m, n_modes_needed, sc->eigensolver, progress, ctx, err, errlen);
 	if (lowest_instead(sc, n_modes_needed, ret)) {
 		char line[512];

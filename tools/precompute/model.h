@@ -34,7 +34,7 @@ struct irdm_model {
 };
 
 /* The lowest modes auto solves first when every mode does not fit. */
-#define IRDM_LOWEST_FIRST 64
+#define IRDM_LOWEST_FIRST 16
 
 /* Builtin or file mesh of the scene (validated, boundary computed); note:
  * what the sizing of a surface did, "" if nothing. */

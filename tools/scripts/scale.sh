@@ -46,7 +46,7 @@ row() {
 		/^two contacts / { pairs = $3 }
 		END {
 			sub(/,$/, "", eig)
-			how = lanczos ? "Lanczos, the lowest " (solved != "" ? solved : "") : blocks ? blocks " blocks (every mode)" : "whole"
+			how = lanczos ? "Lanczos, the lowest " (solved != "" ? solved : 16) : blocks ? blocks " blocks (every mode)" : "whole"
 			printf "| %s | %s | %s | %s | %s s, %s | %s | %s | %s | %s s | %.0f s | %s MiB | %.1f MB |\n",
 			       r, set != "" ? set : "none", mesh, dofs, eig, how, repr, err,
 			       pairs == "" ? "-" : pairs, total, cpu, peak, bytes / 1e6 }'

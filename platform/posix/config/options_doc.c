@@ -1,5 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /* --help lines and Markdown from an option table. */
+#include <stdlib.h>
 #include <string.h>
 
 #include "irdm/posix/options_doc.h"
@@ -35,12 +36,20 @@ static void metavar(const struct irdm_opt *o, char *buf, size_t len)
 }
 
 /* The help and, when the entry has one, its default: "help (default X)". */
-static void help_text(const struct irdm_opt *o, char *buf, size_t len)
+/* The help and its default, in a buffer of their size (init time: the
+ * caller frees it); NULL if out of memory. */
+static char *help_text(const struct irdm_opt *o)
 {
+	size_t len = strlen(o->help) + (o->def ? strlen(o->def) : 0) + sizeof(" (default none)");
+	char *buf = malloc(len);
+
+	if (!buf)
+		return NULL;
 	if (!o->def)
 		snprintf(buf, len, "%s", o->help);
 	else
 		snprintf(buf, len, "%s (default %s)", o->help, o->def[0] ? o->def : "none");
+	return buf;
 }
 
 /* Go to a new indented line before n more characters would pass LINE_WIDTH. */
@@ -80,12 +89,12 @@ static void print_wrapped(FILE *f, const char *text, const char *range)
 
 void irdm_opt_print_help(FILE *f, const struct irdm_opt_table *t, enum irdm_opt_style style)
 {
-	char syntax[256], mv[192], range[128], help[640];
+	char syntax[256], mv[192], range[128], *help;
 
 	for (size_t i = 0; i < t->n_opts; i++) {
 		const struct irdm_opt *o = &t->opts[i];
 		metavar(o, mv, sizeof(mv));
-		help_text(o, help, sizeof(help));
+		help = help_text(o);
 		if (style == IRDM_OPT_STYLE_KEY)
 			snprintf(syntax, sizeof(syntax), "  %s = %s", o->name, mv);
 		else if (o->short_name)
@@ -98,7 +107,8 @@ void irdm_opt_print_help(FILE *f, const struct irdm_opt_table *t, enum irdm_opt_
 			fprintf(f, "%s\n%*s", syntax, HELP_COLUMN, "");
 		else
 			fprintf(f, "%-*s", HELP_COLUMN, syntax);
-		print_wrapped(f, help, range);
+		print_wrapped(f, help ? help : o->help, range);
+		free(help);
 	}
 }
 
@@ -114,7 +124,7 @@ static void print_cell(FILE *f, const char *s)
 
 void irdm_opt_print_markdown(FILE *f, const struct irdm_opt_table *t)
 {
-	char mv[192], range[128], help[640];
+	char mv[192], range[128], *help;
 
 	fprintf(f, "| Key | Value | Range | Description |\n|---|---|---|---|\n");
 	for (size_t i = 0; i < t->n_opts; i++) {
@@ -126,8 +136,9 @@ void irdm_opt_print_markdown(FILE *f, const struct irdm_opt_table *t)
 		fputs("` | ", f);
 		print_cell(f, range);
 		fputs(" | ", f);
-		help_text(o, help, sizeof(help));
-		print_cell(f, help);
+		help = help_text(o);
+		print_cell(f, help ? help : o->help);
+		free(help);
 		fputs(" |\n", f);
 	}
 }
