@@ -27,8 +27,9 @@
  *    (every mode rings as long), a head over max_head_mib (with the cap
  *    that builds it, and that cap then builds it: more modes kept do not
  *    shrink it), a material so stiff that measuring without every mode
- *    needs too long a series, two contacts at once (measured on every mode
- *    only: before any solve).
+ *    needs too long a series; before any solve, two contacts at once and
+ *    error_columns = every (measured on every mode only) and a clustered
+ *    static correction (the head needs the blocks).
  */
 #include <math.h>
 #include <setjmp.h>
@@ -333,17 +334,23 @@ static void test_stiff_refused(void **state)
 	assert_int_equal(rep.modes, 0);
 }
 
-static void test_two_contacts_refused(void **state)
+/* What only every mode measures, or a head cannot be built on. */
+static void test_every_mode_only_refused(void **state)
 {
+	static const char *const kv[][2] = { { "contacts", "2" },
+					     { "error_columns", "every" },
+					     { "static_correction_cluster", "16" } };
 	struct irdm_precompute_report rep;
-	char err[512] = "";
+	char err[1024] = "";
 
 	(void)state;
-	assert_int_equal(build_with("contacts", "2", &rep, err, sizeof(err)), IRDM_ENOMEM);
-	print_message("%s\n", err);
-	assert_non_null(strstr(err, "more than the 0.00293 GiB of max_memory_mib"));
-	assert_non_null(strstr(err, "from the lowest modes of a Lanczos solve instead on a grounded object with lumped mass, contacts = 1"));
-	assert_int_equal(rep.modes, 0); /* not a mode solved */
+	for (size_t i = 0; i < sizeof(kv) / sizeof(kv[0]); i++) {
+		assert_int_equal(build_with(kv[i][0], kv[i][1], &rep, err, sizeof(err)), IRDM_ENOMEM);
+		print_message("%s = %s: %s\n", kv[i][0], kv[i][1], err);
+		assert_non_null(strstr(err, "more than the 0.00293 GiB of max_memory_mib"));
+		assert_non_null(strstr(err, "from the lowest modes of a Lanczos solve instead on a grounded object with lumped mass, contacts = 1, eigensolver = auto, error_columns not every and no static_correction_cluster"));
+		assert_int_equal(rep.modes, 0); /* not a mode solved */
+	}
 }
 
 int main(void)
@@ -356,7 +363,7 @@ int main(void)
 		cmocka_unit_test(test_stiff_refused),
 		cmocka_unit_test(test_mass_damping_refused),
 		cmocka_unit_test(test_head_cap),
-		cmocka_unit_test(test_two_contacts_refused),
+		cmocka_unit_test(test_every_mode_only_refused),
 	};
 
 	return cmocka_run_group_tests(tests, setup, teardown);
