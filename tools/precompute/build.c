@@ -1702,6 +1702,23 @@ static void reset_try(struct build *b, size_t n_all)
 	b->m.modes.n_modes = n_all;
 }
 
+/* One of auto's builds, from the model alone with its first n modes:
+ * nothing of an earlier try's is left, its head under the cap. */
+static void begin_auto_try(struct build *b, struct irdm_precompute_report *rep, size_t n)
+{
+	reset_try(b, n);
+	b->auto_try = true;
+	b->head_capped = 0;
+	b->try_bytes = 0;
+	rep->error_measured = false;
+}
+
+/* Did the try measure over max_error? */
+static bool over_target(const struct build *b, const struct irdm_precompute_report *rep)
+{
+	return rep->error_measured && rep->measured_error > b->sc->max_error;
+}
+
 #define AUTO_ALL_MODES 300 /* at most this many modes: modal:all, exact and as cheap */
 
 /*
@@ -1766,7 +1783,7 @@ static void say_candidate(const struct build *b, const struct irdm_auto_candidat
 		snprintf(meas, sizeof(meas), "measured error %.3g", rep->measured_error);
 	if (c->predicted >= 0)
 		snprintf(pred, sizeof(pred), ", predicted error %.3g", c->predicted);
-	over = rep->error_measured && rep->measured_error > b->sc->max_error;
+	over = over_target(b, rep);
 	snprintf(line, sizeof(line), "auto: %s%s: estimated tick %.2f us%s, %s, %s: %s%.400s", repr,
 		 c->head ? " (kept: the modes ringing longest past the head)" : "", c->tick_us, pred,
 		 size, meas,
@@ -1806,16 +1823,12 @@ static int try_candidate(struct build *b, const struct irdm_auto_candidate *c, s
 	bool hybrid = c->modes < n_all && c->head;
 	int ret;
 
-	reset_try(b, n_all);
-	b->auto_try = true;
-	b->head_capped = 0;
+	begin_auto_try(b, rep, n_all);
 	eff->modes = c->modes < n_all ? (unsigned)c->modes : 0;
 	eff->static_correction = c->modes < n_all;
 	eff->exact_head = hybrid ? c->head : 0;
 	/* a hybrid's head needs the dropped-block correction */
 	eff->static_corr_cluster = !hybrid && c->modes < n_all ? b->cluster : 0;
-	rep->error_measured = false;
-	b->try_bytes = 0;
 	if (hybrid) {
 		ret = kept_first(b, c, order, err, errlen);
 		if (ret)
@@ -2273,6 +2286,7 @@ static void say_lowest(const struct build *b, size_t K, bool ringing, double lef
 		       const struct irdm_precompute_report *rep, int ret, const char *err)
 {
 	char line[768], meas[64] = "not measured";
+	bool over = over_target(b, rep);
 
 	if (!b->o->progress)
 		return;
@@ -2282,10 +2296,9 @@ static void say_lowest(const struct build *b, size_t K, bool ringing, double lef
 		 K, ringing ? "the modes to" : "none rings past the head; the first mode,",
 		 sqrt(b->m.modes.omega2[K - 1]) / (2 * M_PI), left, IRDM_LOWEST_HEAD,
 		 irdm_auto_tick_us(K, IRDM_LOWEST_HEAD), (double)b->try_bytes / (1 << 20), meas,
-		 !ret                                                          ? "kept, certified and within max_error" :
-		 rep->error_measured && rep->measured_error > b->sc->max_error ? "over max_error" :
-										 "refused: ",
-		 ret && !(rep->error_measured && rep->measured_error > b->sc->max_error) ? err : "");
+		 !ret ? "kept, certified and within max_error" : over ? "over max_error" :
+									"refused: ",
+		 ret && !over ? err : "");
 	b->o->progress(b->o->ctx, line, -1.0);
 }
 
@@ -2294,7 +2307,7 @@ static void say_lowest(const struct build *b, size_t K, bool ringing, double lef
  * (irdm_measure_ticks()), about w_up t / 2 terms (1.07 to 1.16 times
  * that measured, test_krylov_head): a stiff object's spectrum reaches so
  * high that they would be more than the series may have.  Refused before
- * any mode is solved for it.
+ * the modes it would keep are solved (the first few, for the damping, are).
  */
 static int lowest_measurable(const struct build *b, double w_up, char *err, size_t errlen)
 {
@@ -2345,19 +2358,14 @@ static int choose_lowest(struct build *b, struct irdm_precompute_report *rep, ch
 		}
 		if (ret)
 			return ret;
-		reset_try(b, K); /* the image keeps the lowest K */
+		begin_auto_try(b, rep, K); /* the image keeps the lowest K */
 		eff->modes = (unsigned)K;
-		b->auto_try = true;
-		b->head_capped = 0;
-		b->try_bytes = 0;
-		rep->error_measured = false;
 		ret = one_try(b, rep, err, errlen);
 		rep->auto_tries++;
 		say_lowest(b, K, ringing, left, rep, ret, err);
 		if (b->head_capped) /* more modes keep as many blocks: measured */
 			return head_over_cap(b, err, errlen);
-		if (ret != IRDM_ENUMERIC || !rep->error_measured ||
-		    !(rep->measured_error > eff->max_error))
+		if (ret != IRDM_ENUMERIC || !over_target(b, rep))
 			return ret;
 		snprintf(last, sizeof(last), "%s", err);
 		left = irdm_lowest_left_next(left, eff->max_error, rep->measured_error);
